@@ -1,0 +1,40 @@
+# Finds GSL, FFTW3, parallel HDF5 with Fortran, and MPI with mpi_f08.  A
+# missing dependency stops configuration with the Debian package to install
+# (scripts/install-deps installs them all).
+
+macro(friction_require found what package)
+  if(NOT ${found})
+    message(FATAL_ERROR
+      "friction needs ${what}, which was not found.\n"
+      "On Debian/Ubuntu: sudo apt-get install ${package}\n"
+      "(or run scripts/install-deps, which installs every dependency)")
+  endif()
+endmacro()
+
+find_package(MPI COMPONENTS Fortran C QUIET)
+friction_require(MPI_Fortran_FOUND "MPI for Fortran" "libopenmpi-dev openmpi-bin")
+if(NOT MPI_Fortran_HAVE_F08_MODULE)
+  message(FATAL_ERROR "friction needs the MPI Fortran 2008 bindings (mpi_f08).\n"
+    "On Debian/Ubuntu: sudo apt-get install libopenmpi-dev")
+endif()
+
+find_package(GSL QUIET)
+friction_require(GSL_FOUND "the GNU Scientific Library" "libgsl-dev")
+
+find_package(PkgConfig QUIET)
+friction_require(PKG_CONFIG_FOUND "pkg-config" "pkg-config")
+pkg_check_modules(FFTW3 QUIET IMPORTED_TARGET fftw3)
+friction_require(FFTW3_FOUND "FFTW3" "libfftw3-dev")
+
+# Parallel HDF5 with its Fortran interface.  FindHDF5 asks the h5pfc wrapper.
+set(HDF5_PREFER_PARALLEL TRUE)
+find_package(HDF5 QUIET COMPONENTS Fortran)
+friction_require(HDF5_FOUND "HDF5 with Fortran support" "libhdf5-openmpi-dev")
+if(NOT HDF5_IS_PARALLEL)
+  message(FATAL_ERROR "friction needs the parallel (MPI) build of HDF5, found a serial one.\n"
+    "On Debian/Ubuntu: sudo apt-get install libhdf5-openmpi-dev")
+endif()
+add_library(friction::hdf5 INTERFACE IMPORTED)
+target_include_directories(friction::hdf5 INTERFACE ${HDF5_Fortran_INCLUDE_DIRS} ${HDF5_INCLUDE_DIRS})
+target_link_libraries(friction::hdf5 INTERFACE ${HDF5_Fortran_LIBRARIES} ${HDF5_LIBRARIES})
+target_compile_definitions(friction::hdf5 INTERFACE ${HDF5_Fortran_DEFINITIONS})

@@ -1,0 +1,102 @@
+!> The friction-force-map file (README: output reference).  Collective: all
+!> ranks call it; each passes the block of lines it computed.
+module friction_afm_output
+   use mpi_f08, only: MPI_Comm
+   use friction_kinds, only: wp, i8
+   use friction_error, only: error_type
+   use friction_ode_solver, only: integrator_statistics
+   use friction_afm_config, only: afm_config
+   use friction_afm_scan, only: quantity_names, quantity_units, n_quantities, q_f_along, &
+      & support_along, support_across
+   use friction_io_h5_file, only: h5_file
+   implicit none
+   private
+
+   public :: afm_run_summary, write_afm_file, line_friction
+
+   !> What the file records about the run besides the maps.
+   type :: afm_run_summary
+      character(len=:), allocatable :: input_text
+      character(len=:), allocatable :: version
+      integer :: nranks = 1
+      real(wp) :: wall_time = 0.0_wp
+      type(integrator_statistics) :: stats
+   end type afm_run_summary
+
+contains
+
+   !> Friction of each line: half the difference of the mean force along
+   !> the scan on trace and retrace (PHYSICS §1), nN.
+   pure function line_friction(trace, retrace) result(friction)
+      real(wp), intent(in) :: trace(:, :, :), retrace(:, :, :)
+      real(wp) :: friction(size(trace, 2))
+      integer :: j, nx
+
+      nx = size(trace, 1)
+      do j = 1, size(trace, 2)
+         friction(j) = 0.5_wp * (sum(trace(:, j, q_f_along)) - sum(retrace(:, j, q_f_along))) / nx
+      end do
+   end function line_friction
+
+   !> Write the scan.  trace(:, j, q) holds local line j (global first + j - 1,
+   !> 1-based) and quantity q; retrace likewise when config%retrace.
+   subroutine write_afm_file(path, comm, config, first, trace, retrace, summary, error)
+      character(len=*), intent(in) :: path
+      type(MPI_Comm), intent(in) :: comm
+      type(afm_config), intent(in) :: config
+      integer, intent(in) :: first
+      real(wp), intent(in) :: trace(:, :, :), retrace(:, :, :)
+      type(afm_run_summary), intent(in) :: summary
+      type(error_type), allocatable, intent(out) :: error
+      type(h5_file) :: file
+      type(error_type), allocatable :: close_error
+      integer :: q
+
+      call file%create(path, comm, error)
+      if (allocated(error)) then
+         call file%close(close_error)
+         return
+      end if
+      call file%write_attribute_text('/', 'program', 'friction')
+      call file%write_attribute_text('/', 'version', summary%version)
+      call file%write_attribute_text('/', 'scene', 'afm')
+      call file%write_attribute_text('/', 'input', summary%input_text)
+      call file%write_attribute_integer('/', 'nranks', int(summary%nranks, i8))
+      call file%write_attribute_real('/', 'wall_time', summary%wall_time)
+      call file%write_attribute_text('/', 'method', trim(config%solver%method))
+      call file%write_attribute_integer('/', 'integrator_steps', summary%stats%steps)
+      call file%write_attribute_integer('/', 'integrator_rejected_steps', summary%stats%failed_steps)
+      call file%write_attribute_integer('/', 'rhs_evaluations', summary%stats%rhs_evaluations)
+      call file%write_attribute_integer('/', 'jacobian_evaluations', summary%stats%jacobian_evaluations)
+
+      call file%create_group('/afm')
+      call file%write_attribute_text('/afm', 'potential', trim(config%potential))
+      call file%write_attribute_real('/afm', 'angle', config%angle)
+      call file%write_attribute_real('/afm', 'origin_x', config%origin_x)
+      call file%write_attribute_real('/afm', 'origin_y', config%origin_y)
+      call file%write_vector('/afm/support_x', support_along(config), 'angstrom')
+      call file%write_vector('/afm/support_y', support_across(config), 'angstrom')
+      call write_trips('/afm/trace', trace)
+      if (config%retrace) then
+         call write_trips('/afm/retrace', retrace)
+         call file%write_vector_block('/afm/friction', line_friction(trace, retrace), &
+            & config%ny, first, 'nN')
+      end if
+      call file%close(error)
+
+   contains
+
+      subroutine write_trips(group, values)
+         character(len=*), intent(in) :: group
+         real(wp), intent(in) :: values(:, :, :)
+
+         call file%create_group(group)
+         do q = 1, n_quantities
+            call file%write_line_block(group//'/'//trim(quantity_names(q)), values(:, :, q), &
+               & config%ny, first, trim(quantity_units(q)))
+         end do
+      end subroutine write_trips
+
+   end subroutine write_afm_file
+
+end module friction_afm_output

@@ -1,0 +1,166 @@
+!> Scan geometry and the integration of one trip of the support.
+!>
+!> Line j (0-based) runs along the scan direction u at the offset
+!> t_j = j * width / (ny - 1) along the across direction n from the origin.
+!> Sample i sits at s_i = i * length / (nx - 1) along the line.  A trace trip
+!> moves the support from s = -lead_in to s = length; a retrace trip from
+!> s = length + lead_in back to 0; samples are stored by i either way, so
+!> trace and retrace share the support_x axis.  Each trip starts with the tip
+!> at the support and at rest (paper §3.1, §5.1).
+module friction_afm_scan
+   use friction_kinds, only: wp, i8, pi, ev_per_angstrom_to_nn
+   use friction_error, only: error_type, fatal_error
+   use friction_ode_solver, only: ode_solver, integrator_statistics
+   use friction_afm_config, only: afm_config, new_tip
+   use friction_afm_tip, only: afm_tip
+   implicit none
+   private
+
+   public :: afm_scanner, trip_record, quantity_names, quantity_units, n_quantities
+   public :: q_fx, q_fy, q_f_along, q_f_across, q_tip_x, q_tip_y
+   public :: support_along, support_across, block_range
+
+   integer, parameter :: n_quantities = 6
+   integer, parameter :: q_fx = 1, q_fy = 2, q_f_along = 3, q_f_across = 4, q_tip_x = 5, q_tip_y = 6
+   !> HDF5 dataset names and units of the recorded quantities.
+   character(len=*), parameter :: quantity_names(n_quantities) = [character(len=8) :: &
+      & 'fx', 'fy', 'f_along', 'f_across', 'tip_x', 'tip_y']
+   character(len=*), parameter :: quantity_units(n_quantities) = [character(len=8) :: &
+      & 'nN', 'nN', 'nN', 'nN', 'angstrom', 'angstrom']
+
+   !> One trip's samples: values(i, q) for sample i and quantity q (output units).
+   type :: trip_record
+      real(wp), allocatable :: values(:, :)
+   end type trip_record
+
+   !> Integrates trips of one scene; owns one tip model and its solver.
+   type :: afm_scanner
+      type(afm_config) :: config
+      type(afm_tip), allocatable :: tip
+      type(ode_solver) :: solver
+      real(wp) :: h_start = 0.0_wp
+   contains
+      procedure :: init
+      procedure :: run_trip
+      procedure :: statistics
+   end type afm_scanner
+
+contains
+
+   !> Support positions along the line, Å.
+   pure function support_along(config) result(s)
+      type(afm_config), intent(in) :: config
+      real(wp) :: s(config%nx)
+      integer :: i
+
+      s = [(config%length * real(i, wp) / real(config%nx - 1, wp), i = 0, config%nx - 1)]
+   end function support_along
+
+   !> Offsets of the lines across the scan, Å.
+   pure function support_across(config) result(t)
+      type(afm_config), intent(in) :: config
+      real(wp) :: t(config%ny)
+      integer :: j
+
+      if (config%ny == 1) then
+         t = 0.0_wp
+      else
+         t = [(config%width * real(j, wp) / real(config%ny - 1, wp), j = 0, config%ny - 1)]
+      end if
+   end function support_across
+
+   !> Contiguous share of n items for a rank: items first .. first+count-1
+   !> (0-based).  Every scan line costs about the same, so equal blocks
+   !> balance the work and let each rank write one hyperslab.
+   pure subroutine block_range(n, nranks, rank, first, count)
+      integer, intent(in) :: n, nranks, rank
+      integer, intent(out) :: first, count
+
+      first = int(int(n, i8) * rank / nranks)
+      count = int(int(n, i8) * (rank + 1) / nranks) - first
+   end subroutine block_range
+
+   subroutine init(self, config, error)
+      class(afm_scanner), intent(inout) :: self
+      type(afm_config), intent(in) :: config
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: sample_time, period
+
+      self%config = config
+      if (allocated(self%tip)) deallocate (self%tip)
+      allocate (self%tip)
+      call new_tip(config, self%tip, error)
+      if (allocated(error)) return
+      ! First step: a small fraction of the fastest time scale in sight.
+      sample_time = config%length / real(config%nx - 1, wp) / config%velocity
+      period = sample_time
+      if (maxval(self%tip%spring) > 0.0_wp) &
+         & period = min(period, 2.0_wp * pi * sqrt(self%tip%mass / maxval(self%tip%spring)))
+      self%h_start = config%solver%h_start
+      if (self%h_start <= 0.0_wp) self%h_start = 1.0e-3_wp * period
+      call self%solver%init(self%tip, config%solver, self%h_start, error)
+   end subroutine init
+
+   !> One trip along line j (0-based): trace when forward, else retrace.
+   subroutine run_trip(self, j, forward, record, error)
+      class(afm_scanner), intent(inout) :: self
+      integer, intent(in) :: j
+      logical, intent(in) :: forward
+      type(trip_record), intent(inout) :: record
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: u(3), n(3), line_start(3), s(self%config%nx), offset(self%config%ny)
+      real(wp) :: y(6), t, t_sample, s_start, force(3)
+      integer :: i, k, nx, nd
+      character(len=96) :: where
+
+      associate (c => self%config, tip => self%tip)
+         nx = c%nx
+         nd = tip%ndim
+         u = c%scan_direction()
+         n = c%across_direction()
+         s = support_along(c)
+         offset = support_across(c)
+         line_start = [c%origin_x, c%origin_y, 0.0_wp] + offset(j + 1) * n
+         if (forward) then
+            s_start = -c%lead_in
+            tip%support_velocity = c%velocity * u
+         else
+            s_start = c%length + c%lead_in
+            tip%support_velocity = -c%velocity * u
+         end if
+         tip%support_start = line_start + s_start * u
+         y = 0.0_wp
+         y(1:nd) = tip%support_start(1:nd)
+         t = 0.0_wp
+         call self%solver%restart(self%h_start)
+         if (.not. allocated(record%values)) allocate (record%values(nx, n_quantities))
+         do k = 1, nx
+            i = merge(k, nx + 1 - k, forward)
+            t_sample = abs(s(i) - s_start) / c%velocity
+            if (t_sample > t) call self%solver%advance(t, t_sample, y(1:2 * nd), error)
+            if (allocated(error)) then
+               write (where, '(a, i0, a, f0.4, a)') ' (line ', j, trim(merge(' trace  ', ' retrace', forward)) &
+                  & //', support at ', c%velocity * t, ' Å into the trip)'
+               error%message = error%message//trim(where)
+               return
+            end if
+            force = tip%lateral_force(t, y) * ev_per_angstrom_to_nn
+            record%values(i, q_fx) = force(1)
+            record%values(i, q_fy) = force(2)
+            record%values(i, q_f_along) = dot_product(force, u)
+            record%values(i, q_f_across) = dot_product(force, n)
+            record%values(i, q_tip_x) = y(1)
+            record%values(i, q_tip_y) = y(2)
+         end do
+      end associate
+   end subroutine run_trip
+
+   !> Integrator counters of all trips so far.
+   function statistics(self) result(stats)
+      class(afm_scanner), intent(in) :: self
+      type(integrator_statistics) :: stats
+
+      stats = self%solver%statistics()
+   end function statistics
+
+end module friction_afm_scan

@@ -1,0 +1,109 @@
+!> The microscope tip on its springs, Eq. 4: for each direction i
+!>   m r_i'' = k_i (r_M,i - r_i) - dV/dr_i - c_i r_i',
+!> with the support r_M(t) = r_M(0) + v_M t.  State y = (r, r') with r of
+!> `ndim` components (2 for the analytic potentials, 3 for a lattice sum).
+!> Internal units (friction_kinds): Å, eV, s.
+module friction_afm_tip
+   use friction_kinds, only: wp
+   use friction_ode_system, only: ode_system
+   use friction_surface_potential, only: surface_potential
+   implicit none
+   private
+
+   public :: afm_tip
+
+   type, extends(ode_system) :: afm_tip
+      class(surface_potential), allocatable :: potential
+      integer :: ndim = 2                  !! moving coordinates
+      real(wp) :: mass = 0.0_wp            !! eV s²/Å²
+      real(wp) :: spring(3) = 0.0_wp       !! k_x, k_y, k_z in eV/Å²
+      real(wp) :: damping(3) = 0.0_wp      !! c_x, c_y, c_z in eV s/Å²
+      real(wp) :: support_start(3) = 0.0_wp     !! r_M(0), Å
+      real(wp) :: support_velocity(3) = 0.0_wp  !! v_M, Å/s
+   contains
+      procedure :: dimension
+      procedure :: rhs
+      procedure :: jacobian
+      procedure :: support
+      procedure :: lateral_force
+   end type afm_tip
+
+contains
+
+   pure function dimension(self) result(n)
+      class(afm_tip), intent(in) :: self
+      integer :: n
+
+      n = 2 * self%ndim
+   end function dimension
+
+   !> Support position r_M(t) in Å.
+   pure function support(self, t) result(r)
+      class(afm_tip), intent(in) :: self
+      real(wp), intent(in) :: t
+      real(wp) :: r(3)
+
+      r = self%support_start + self%support_velocity * t
+   end function support
+
+   !> The spring force k (r_M - r_t) on the tip in eV/Å: what the microscope
+   !> measures as lateral force.
+   pure function lateral_force(self, t, y) result(f)
+      class(afm_tip), intent(in) :: self
+      real(wp), intent(in) :: t
+      real(wp), intent(in) :: y(:)
+      real(wp) :: f(3)
+      integer :: nd
+
+      nd = self%ndim
+      f = 0.0_wp
+      f(1:nd) = self%spring(1:nd) * (self%support_start(1:nd) &
+         & + self%support_velocity(1:nd) * t - y(1:nd))
+   end function lateral_force
+
+   !> Eq. 4.
+   pure subroutine rhs(self, t, y, dydt)
+      class(afm_tip), intent(in) :: self
+      real(wp), intent(in) :: t
+      real(wp), intent(in) :: y(:)
+      real(wp), intent(out) :: dydt(:)
+      real(wp) :: r(3), g(3)
+      integer :: nd
+
+      nd = self%ndim
+      r = 0.0_wp
+      r(1:nd) = y(1:nd)
+      call self%potential%gradient(r, g)
+      dydt(1:nd) = y(nd + 1:2 * nd)
+      dydt(nd + 1:2 * nd) = (self%spring(1:nd) * (self%support_start(1:nd) &
+         & + self%support_velocity(1:nd) * t - r(1:nd)) - g(1:nd) &
+         & - self%damping(1:nd) * y(nd + 1:2 * nd)) / self%mass
+   end subroutine rhs
+
+   !> Analytic Jacobian of Eq. 4: the potential's Hessian enters the
+   !> velocity rows; the moving support makes f depend on t explicitly.
+   pure subroutine jacobian(self, t, y, dfdy, dfdt)
+      class(afm_tip), intent(in) :: self
+      real(wp), intent(in) :: t
+      real(wp), intent(in) :: y(:)
+      real(wp), intent(out) :: dfdy(:, :)
+      real(wp), intent(out) :: dfdt(:)
+      real(wp) :: r(3), h(3, 3)
+      integer :: nd, i
+
+      nd = self%ndim
+      r = 0.0_wp
+      r(1:nd) = y(1:nd)
+      call self%potential%hessian(r, h)
+      dfdy = 0.0_wp
+      dfdt = 0.0_wp
+      do i = 1, nd
+         dfdy(i, nd + i) = 1.0_wp
+         dfdy(nd + i, 1:nd) = -h(i, 1:nd) / self%mass
+         dfdy(nd + i, i) = dfdy(nd + i, i) - self%spring(i) / self%mass
+         dfdy(nd + i, nd + i) = -self%damping(i) / self%mass
+         dfdt(nd + i) = self%spring(i) * self%support_velocity(i) / self%mass
+      end do
+   end subroutine jacobian
+
+end module friction_afm_tip

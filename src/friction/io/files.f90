@@ -1,0 +1,50 @@
+!> File-system operations Fortran lacks: atomic rename and removal through
+!> the C library, so output appears under its final name only when complete.
+module friction_io_files
+   use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char
+   use friction_error, only: error_type, fatal_error, error_io
+   implicit none
+   private
+
+   public :: rename_file, remove_file, file_exists
+
+   interface
+      function c_rename(from, to) result(stat) bind(c, name='rename')
+         import :: c_int, c_char
+         character(kind=c_char), intent(in) :: from(*), to(*)
+         integer(c_int) :: stat
+      end function c_rename
+
+      function c_remove(path) result(stat) bind(c, name='remove')
+         import :: c_int, c_char
+         character(kind=c_char), intent(in) :: path(*)
+         integer(c_int) :: stat
+      end function c_remove
+   end interface
+
+contains
+
+   logical function file_exists(path)
+      character(len=*), intent(in) :: path
+
+      inquire (file=path, exist=file_exists)
+   end function file_exists
+
+   !> Rename atomically (within one file system), replacing `to` if present.
+   subroutine rename_file(from, to, error)
+      character(len=*), intent(in) :: from, to
+      type(error_type), allocatable, intent(out) :: error
+
+      if (c_rename(from//c_null_char, to//c_null_char) /= 0) &
+         & call fatal_error(error, 'cannot rename '//from//' to '//to, error_io)
+   end subroutine rename_file
+
+   !> Remove a file if it exists; failures are ignored (best effort cleanup).
+   subroutine remove_file(path)
+      character(len=*), intent(in) :: path
+      integer(c_int) :: stat
+
+      if (file_exists(path)) stat = c_remove(path//c_null_char)
+   end subroutine remove_file
+
+end module friction_io_files

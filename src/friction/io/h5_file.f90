@@ -1,0 +1,272 @@
+!> HDF5 output behind one file type (create / group / write / attribute /
+!> close), opened with the MPI-IO driver so every rank writes its own block
+!> of scan lines collectively.  Every call is collective: all ranks call it
+!> with the same names and the same small data.  A `units` attribute goes on
+!> every dataset.
+module friction_io_h5_file
+   use, intrinsic :: iso_fortran_env, only: int64
+   use mpi_f08, only: MPI_Comm, MPI_INFO_NULL, MPI_Comm_rank
+   use hdf5
+   use friction_kinds, only: wp, i8
+   use friction_error, only: error_type, fatal_error, error_io
+   implicit none
+   private
+
+   public :: h5_file
+
+   type :: h5_file
+      private
+      integer(hid_t) :: id = -1
+      character(len=:), allocatable :: path
+      integer :: rank = 0         !! this process in the communicator
+      integer :: status = 0       !! first HDF5 failure, kept until checked
+      character(len=:), allocatable :: failed_at
+   contains
+      procedure :: create
+      procedure :: create_group
+      procedure :: write_vector
+      procedure :: write_vector_block
+      procedure :: write_line_block
+      procedure :: write_attribute_text
+      procedure :: write_attribute_real
+      procedure :: write_attribute_integer
+      procedure :: close
+      procedure, private :: check
+   end type h5_file
+
+contains
+
+   !> Create (truncate) a file for parallel writing on communicator comm.
+   subroutine create(self, path, comm, error)
+      class(h5_file), intent(inout) :: self
+      character(len=*), intent(in) :: path
+      type(MPI_Comm), intent(in) :: comm
+      type(error_type), allocatable, intent(out) :: error
+      integer(hid_t) :: fapl
+      integer :: stat
+
+      self%path = path
+      self%status = 0
+      call MPI_Comm_rank(comm, self%rank)
+      call h5open_f(stat)
+      call self%check(stat, 'initialising HDF5')
+      ! The library never prints: failures come back through stat.
+      call h5eset_auto_f(0, stat)
+      call h5pcreate_f(H5P_FILE_ACCESS_F, fapl, stat)
+      call self%check(stat, 'creating the file access list')
+      call h5pset_fapl_mpio_f(fapl, comm%MPI_VAL, MPI_INFO_NULL%MPI_VAL, stat)
+      call self%check(stat, 'selecting the MPI-IO driver')
+      call h5fcreate_f(path, H5F_ACC_TRUNC_F, self%id, stat, access_prp=fapl)
+      call self%check(stat, 'creating the file')
+      call h5pclose_f(fapl, stat)
+      if (self%status /= 0) call fatal_error(error, path//': HDF5 failed '//self%failed_at, error_io)
+   end subroutine create
+
+   subroutine create_group(self, name)
+      class(h5_file), intent(inout) :: self
+      character(len=*), intent(in) :: name
+      integer(hid_t) :: group
+      integer :: stat
+
+      if (self%status /= 0) return
+      call h5gcreate_f(self%id, name, group, stat)
+      call self%check(stat, 'creating group '//name)
+      if (stat == 0) call h5gclose_f(group, stat)
+   end subroutine create_group
+
+   !> A 1-D dataset that every rank holds whole; rank 0 writes it.
+   subroutine write_vector(self, name, values, units)
+      class(h5_file), intent(inout) :: self
+      character(len=*), intent(in) :: name, units
+      real(wp), intent(in) :: values(:)
+
+      if (self%rank == 0) then
+         call write_block(self, name, reshape(values, [1, size(values)]), size(values), 0, units, .true.)
+      else
+         call write_block(self, name, reshape(values, [1, 0]), size(values), 0, units, .true.)
+      end if
+   end subroutine write_vector
+
+   !> A 1-D dataset of n_total values to which this rank contributes
+   !> values first+1 .. first+size(values).
+   subroutine write_vector_block(self, name, values, n_total, first, units)
+      class(h5_file), intent(inout) :: self
+      character(len=*), intent(in) :: name, units
+      real(wp), intent(in) :: values(:)
+      integer, intent(in) :: n_total, first
+
+      call write_block(self, name, reshape(values, [1, size(values)]), n_total, first, units, .true.)
+   end subroutine write_vector_block
+
+   !> A dataset of shape (nx, n_total) in Fortran, (n_total, nx) in h5py, to
+   !> which this rank contributes columns first+1 .. first+size(block, 2).
+   subroutine write_line_block(self, name, block, n_total, first, units)
+      class(h5_file), intent(inout) :: self
+      character(len=*), intent(in) :: name, units
+      real(wp), intent(in) :: block(:, :)
+      integer, intent(in) :: n_total, first
+
+      call write_block(self, name, block, n_total, first, units, .false.)
+   end subroutine write_line_block
+
+   !> Collective write of this rank's columns of a (size(block, 1), n_total)
+   !> dataset, or of a 1-D dataset of n_total values when one_d.
+   subroutine write_block(self, name, block, n_total, first, units, one_d)
+      class(h5_file), intent(inout) :: self
+      character(len=*), intent(in) :: name, units
+      real(wp), intent(in) :: block(:, :)
+      integer, intent(in) :: n_total, first
+      logical, intent(in) :: one_d
+      integer(hid_t) :: filespace, memspace, dset, xfer
+      integer(hsize_t) :: dims(2), count(2), offset(2)
+      integer :: stat, rank
+
+      if (self%status /= 0) return
+      if (one_d) then
+         rank = 1
+         dims = [int(n_total, hsize_t), 0_hsize_t]
+         count = [int(size(block, 2), hsize_t), 0_hsize_t]
+         offset = [int(first, hsize_t), 0_hsize_t]
+      else
+         rank = 2
+         dims = [int(size(block, 1), hsize_t), int(n_total, hsize_t)]
+         count = [int(size(block, 1), hsize_t), int(size(block, 2), hsize_t)]
+         offset = [0_hsize_t, int(first, hsize_t)]
+      end if
+      call h5screate_simple_f(rank, dims(1:rank), filespace, stat)
+      call h5dcreate_f(self%id, name, H5T_NATIVE_DOUBLE, filespace, dset, stat)
+      call self%check(stat, 'creating dataset '//name)
+      if (stat /= 0) return
+      call h5screate_simple_f(rank, count(1:rank), memspace, stat)
+      if (size(block) > 0) then
+         call h5sselect_hyperslab_f(filespace, H5S_SELECT_SET_F, offset(1:rank), count(1:rank), stat)
+      else
+         ! A rank with no lines still takes part in the collective write.
+         call h5sselect_none_f(filespace, stat)
+         call h5sselect_none_f(memspace, stat)
+      end if
+      call h5pcreate_f(H5P_DATASET_XFER_F, xfer, stat)
+      call h5pset_dxpl_mpio_f(xfer, H5FD_MPIO_COLLECTIVE_F, stat)
+      call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, block, count(1:rank), stat, &
+         & mem_space_id=memspace, file_space_id=filespace, xfer_prp=xfer)
+      call self%check(stat, 'writing dataset '//name)
+      call h5pclose_f(xfer, stat)
+      call h5sclose_f(memspace, stat)
+      call h5sclose_f(filespace, stat)
+      call attribute_text(self, dset, 'units', units)
+      call h5dclose_f(dset, stat)
+   end subroutine write_block
+
+   !> A text attribute on the object at path object ('/' for the root).
+   subroutine write_attribute_text(self, object, name, text)
+      class(h5_file), intent(inout) :: self
+      character(len=*), intent(in) :: object, name, text
+      integer(hid_t) :: obj
+      integer :: stat
+
+      if (self%status /= 0) return
+      call h5oopen_f(self%id, object, obj, stat)
+      call self%check(stat, 'opening '//object)
+      if (stat /= 0) return
+      call attribute_text(self, obj, name, text)
+      call h5oclose_f(obj, stat)
+   end subroutine write_attribute_text
+
+   subroutine attribute_text(self, obj, name, text)
+      class(h5_file), intent(inout) :: self
+      integer(hid_t), intent(in) :: obj
+      character(len=*), intent(in) :: name, text
+      integer(hid_t) :: space, type, attr
+      integer(hsize_t) :: dims(1) = [1]
+      integer :: stat
+
+      if (self%status /= 0) return
+      call h5screate_f(H5S_SCALAR_F, space, stat)
+      call h5tcopy_f(H5T_FORTRAN_S1, type, stat)
+      call h5tset_size_f(type, int(max(1, len(text)), size_t), stat)
+      call h5tset_cset_f(type, H5T_CSET_UTF8_F, stat)
+      call h5acreate_f(obj, name, type, space, attr, stat)
+      call self%check(stat, 'creating attribute '//name)
+      if (stat == 0) then
+         call h5awrite_f(attr, type, text, dims, stat)
+         call self%check(stat, 'writing attribute '//name)
+         call h5aclose_f(attr, stat)
+      end if
+      call h5tclose_f(type, stat)
+      call h5sclose_f(space, stat)
+   end subroutine attribute_text
+
+   subroutine write_attribute_real(self, object, name, value)
+      class(h5_file), intent(inout) :: self
+      character(len=*), intent(in) :: object, name
+      real(wp), intent(in) :: value
+      integer(hid_t) :: obj, space, attr
+      integer(hsize_t) :: dims(1) = [1]
+      integer :: stat
+
+      if (self%status /= 0) return
+      call h5oopen_f(self%id, object, obj, stat)
+      call self%check(stat, 'opening '//object)
+      if (stat /= 0) return
+      call h5screate_f(H5S_SCALAR_F, space, stat)
+      call h5acreate_f(obj, name, H5T_NATIVE_DOUBLE, space, attr, stat)
+      call self%check(stat, 'creating attribute '//name)
+      if (stat == 0) then
+         call h5awrite_f(attr, H5T_NATIVE_DOUBLE, value, dims, stat)
+         call h5aclose_f(attr, stat)
+      end if
+      call h5sclose_f(space, stat)
+      call h5oclose_f(obj, stat)
+   end subroutine write_attribute_real
+
+   subroutine write_attribute_integer(self, object, name, value)
+      class(h5_file), intent(inout) :: self
+      character(len=*), intent(in) :: object, name
+      integer(i8), intent(in) :: value
+      integer(hid_t) :: obj, space, attr, type
+      integer(hsize_t) :: dims(1) = [1]
+      integer :: stat
+
+      if (self%status /= 0) return
+      call h5oopen_f(self%id, object, obj, stat)
+      call self%check(stat, 'opening '//object)
+      if (stat /= 0) return
+      type = h5kind_to_type(int64, H5_INTEGER_KIND)
+      call h5screate_f(H5S_SCALAR_F, space, stat)
+      call h5acreate_f(obj, name, type, space, attr, stat)
+      call self%check(stat, 'creating attribute '//name)
+      if (stat == 0) then
+         call h5awrite_f(attr, type, value, dims, stat)
+         call h5aclose_f(attr, stat)
+      end if
+      call h5sclose_f(space, stat)
+      call h5oclose_f(obj, stat)
+   end subroutine write_attribute_integer
+
+   !> Close the file; report the first failure since create, if any.
+   subroutine close(self, error)
+      class(h5_file), intent(inout) :: self
+      type(error_type), allocatable, intent(out) :: error
+      integer :: stat
+
+      if (self%id >= 0) then
+         call h5fclose_f(self%id, stat)
+         call self%check(stat, 'closing the file')
+         self%id = -1
+      end if
+      call h5close_f(stat)
+      if (self%status /= 0) call fatal_error(error, self%path//': HDF5 failed '//self%failed_at, error_io)
+   end subroutine close
+
+   subroutine check(self, stat, what)
+      class(h5_file), intent(inout) :: self
+      integer, intent(in) :: stat
+      character(len=*), intent(in) :: what
+
+      if (stat /= 0 .and. self%status == 0) then
+         self%status = stat
+         self%failed_at = what
+      end if
+   end subroutine check
+
+end module friction_io_h5_file

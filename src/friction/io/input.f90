@@ -1,0 +1,319 @@
+!> Reading a job from namelist files.
+!>
+!> Files are read in order; a later file overrides earlier values variable by
+!> variable (Fortran namelist input leaves unnamed variables alone), so a
+!> two-line override file tweaks or sweeps a job.  Unknown groups and
+!> variables, unreadable values and non-physical settings are errors naming
+!> the file, the group and the variable.  The resolved input comes back as
+!> namelist text for the output file.
+module friction_io_input
+   use friction_kinds, only: wp, i8
+   use friction_error, only: error_type, fatal_error, error_input
+   use friction_ode_solver, only: step_type_names, step_type_index
+   use friction_afm_config, only: afm_config, potential_names
+   use friction_io_namelist_scan, only: mention, scan_namelist_file, lower, namelist_names
+   implicit none
+   private
+
+   public :: job_config, read_input, group_names
+
+   character(len=*), parameter :: group_names(5) = [character(len=10) :: &
+      & 'job', 'surface', 'tip', 'scan', 'integrator']
+
+   !> Everything a run needs from its input files.
+   type :: job_config
+      character(len=16) :: scene = 'afm'
+      type(afm_config) :: afm
+   end type job_config
+
+contains
+
+   !> Read and validate the files in order into config; input_text is the
+   !> resolved input as namelist text.
+   subroutine read_input(paths, config, input_text, error)
+      character(len=*), intent(in) :: paths(:)
+      type(job_config), intent(out) :: config
+      character(len=:), allocatable, intent(out) :: input_text
+      type(error_type), allocatable, intent(out) :: error
+
+      ! &job
+      character(len=16) :: scene
+      ! &surface
+      character(len=16) :: potential
+      real(wp) :: v0, ax, ay, a
+      ! &tip
+      real(wp) :: mass, kx, ky, cx, cy
+      ! &scan
+      real(wp) :: velocity, length, width, angle, origin_x, origin_y, lead_in
+      integer :: nx, ny
+      logical :: retrace
+      ! &integrator
+      character(len=16) :: method
+      real(wp) :: rtol, atol, h_start, h_min
+      integer(i8) :: max_steps
+
+      namelist /job/ scene
+      namelist /surface/ potential, v0, ax, ay, a
+      namelist /tip/ mass, kx, ky, cx, cy
+      namelist /scan/ velocity, length, width, angle, origin_x, origin_y, lead_in, nx, ny, retrace
+      namelist /integrator/ method, rtol, atol, h_start, h_min, max_steps
+
+      type(mention), allocatable :: mentions(:), all_mentions(:)
+      character(len=4096), allocatable :: source(:)
+      integer :: ifile, unit, stat, k, g
+      character(len=32), allocatable :: known(:)
+
+      call from_config()
+      allocate (all_mentions(0))
+      allocate (source(0))
+      do ifile = 1, size(paths)
+         call scan_namelist_file(trim(paths(ifile)), group_names, mentions, error)
+         if (allocated(error)) return
+         ! Unknown variables, with their line: clearer than the runtime's message.
+         do k = 1, size(mentions)
+            do g = 1, size(group_names)
+               if (mentions(k)%group /= group_names(g)) cycle
+               call namelist_names(group_as_text(g), known)
+               if (.not. any(known == mentions(k)%name)) then
+                  call fatal_error(error, trim(paths(ifile))//':'//itoa(mentions(k)%line)//': &' &
+                     & //trim(mentions(k)%group)//": unknown variable '"//trim(mentions(k)%name) &
+                     & //"' (known: "//join(known)//')', error_input)
+                  return
+               end if
+            end do
+         end do
+         open (newunit=unit, file=trim(paths(ifile)), status='old', action='read', iostat=stat)
+         do g = 1, size(group_names)
+            rewind (unit)
+            call read_group(unit, trim(paths(ifile)), g)
+            if (allocated(error)) then
+               close (unit)
+               return
+            end if
+         end do
+         close (unit)
+         all_mentions = [all_mentions, mentions]
+         source = [character(len=len(source)) :: source, (paths(ifile), k=1, size(mentions))]
+      end do
+      call to_config()
+      call validate()
+      if (allocated(error)) return
+      input_text = ''
+      do g = 1, size(group_names)
+         input_text = input_text//group_as_text(g)
+      end do
+
+   contains
+
+      subroutine read_group(unit, path, g)
+         integer, intent(in) :: unit, g
+         character(len=*), intent(in) :: path
+         character(len=512) :: msg, offending
+         integer :: s, s2
+
+         msg = ''
+         select case (g)
+         case (1); read (unit, nml=job, iostat=s, iomsg=msg)
+         case (2); read (unit, nml=surface, iostat=s, iomsg=msg)
+         case (3); read (unit, nml=tip, iostat=s, iomsg=msg)
+         case (4); read (unit, nml=scan, iostat=s, iomsg=msg)
+         case (5); read (unit, nml=integrator, iostat=s, iomsg=msg)
+         end select
+         if (is_iostat_end(s)) return  ! absent: keep what we have
+         if (s /= 0) then
+            ! Show the line the runtime stopped on.
+            offending = ''
+            backspace (unit, iostat=s2)
+            if (s2 == 0) read (unit, '(a)', iostat=s2) offending
+            call fatal_error(error, path//': &'//trim(group_names(g))//': '//trim(msg), error_input)
+            if (len_trim(offending) > 0) &
+               & error%message = error%message//', in the line "'//trim(adjustl(offending))//'"'
+         end if
+      end subroutine read_group
+
+      !> The group's current values as namelist text.
+      function group_as_text(g) result(text)
+         integer, intent(in) :: g
+         character(len=:), allocatable :: text
+         character(len=1024) :: buffer
+         integer :: scratch, s
+
+         open (newunit=scratch, status='scratch', action='readwrite', form='formatted')
+         select case (g)
+         case (1); write (scratch, nml=job)
+         case (2); write (scratch, nml=surface)
+         case (3); write (scratch, nml=tip)
+         case (4); write (scratch, nml=scan)
+         case (5); write (scratch, nml=integrator)
+         end select
+         rewind (scratch)
+         text = ''
+         do
+            read (scratch, '(a)', iostat=s) buffer
+            if (s /= 0) exit
+            text = text//trim(buffer)//new_line('a')
+         end do
+         close (scratch)
+      end function group_as_text
+
+      subroutine from_config()
+         type(job_config) :: defaults
+
+         scene = defaults%scene
+         associate (c => defaults%afm)
+            potential = c%potential; v0 = c%v0; ax = c%ax; ay = c%ay; a = c%a
+            mass = c%mass; kx = c%kx; ky = c%ky; cx = c%cx; cy = c%cy
+            velocity = c%velocity; length = c%length; width = c%width; angle = c%angle
+            origin_x = c%origin_x; origin_y = c%origin_y; lead_in = c%lead_in
+            nx = c%nx; ny = c%ny; retrace = c%retrace
+            method = c%solver%method; rtol = c%solver%rtol; atol = c%solver%atol
+            h_start = c%solver%h_start; h_min = c%solver%h_min; max_steps = c%solver%max_steps
+         end associate
+      end subroutine from_config
+
+      subroutine to_config()
+         method = lower(method)
+         potential = lower(potential)
+         scene = lower(scene)
+         config%scene = scene
+         associate (c => config%afm)
+            c%potential = potential; c%v0 = v0; c%ax = ax; c%ay = ay; c%a = a
+            c%mass = mass; c%kx = kx; c%ky = ky; c%cx = cx; c%cy = cy
+            c%velocity = velocity; c%length = length; c%width = width; c%angle = angle
+            c%origin_x = origin_x; c%origin_y = origin_y; c%lead_in = lead_in
+            c%nx = nx; c%ny = ny; c%retrace = retrace
+            c%solver%method = method; c%solver%rtol = rtol; c%solver%atol = atol
+            c%solver%h_start = h_start; c%solver%h_min = h_min; c%solver%max_steps = max_steps
+         end associate
+      end subroutine to_config
+
+      !> The file that last set a variable, for messages.
+      function origin(group, name) result(text)
+         character(len=*), intent(in) :: group, name
+         character(len=:), allocatable :: text
+         integer :: k
+
+         text = '(default)'
+         do k = size(all_mentions), 1, -1
+            if (all_mentions(k)%group == group .and. all_mentions(k)%name == name) then
+               text = trim(source(k))//':'//itoa(all_mentions(k)%line)
+               return
+            end if
+         end do
+      end function origin
+
+      subroutine reject(group, name, value, reason)
+         character(len=*), intent(in) :: group, name, value, reason
+
+         if (allocated(error)) return
+         call fatal_error(error, origin(group, name)//': &'//group//': '//name//' = ' &
+            & //value//': '//reason, error_input)
+      end subroutine reject
+
+      subroutine require_positive(group, name, value, unit_text)
+         character(len=*), intent(in) :: group, name, unit_text
+         real(wp), intent(in) :: value
+
+         if (.not. (value > 0.0_wp)) call reject(group, name, rtoa(value), 'must be > 0 ('//unit_text//')')
+      end subroutine require_positive
+
+      subroutine require_nonnegative(group, name, value, unit_text)
+         character(len=*), intent(in) :: group, name, unit_text
+         real(wp), intent(in) :: value
+
+         if (.not. (value >= 0.0_wp)) call reject(group, name, rtoa(value), 'must be >= 0 ('//unit_text//')')
+      end subroutine require_nonnegative
+
+      subroutine require_finite(group, name, value)
+         character(len=*), intent(in) :: group, name
+         real(wp), intent(in) :: value
+
+         if (.not. (abs(value) <= huge(value))) call reject(group, name, rtoa(value), 'must be a finite number')
+      end subroutine require_finite
+
+      subroutine validate()
+         if (scene /= 'afm') call reject('job', 'scene', "'"//trim(scene)//"'", &
+            & "unknown scene (known: 'afm')")
+         if (.not. any(potential_names == potential)) call reject('surface', 'potential', &
+            & "'"//trim(potential)//"'", 'unknown potential (known: '//quoted(potential_names)//')')
+         call require_nonnegative('surface', 'v0', v0, 'eV')
+         call require_positive('surface', 'ax', ax, 'Å')
+         call require_positive('surface', 'ay', ay, 'Å')
+         call require_positive('surface', 'a', a, 'Å')
+         call require_positive('tip', 'mass', mass, 'kg')
+         call require_nonnegative('tip', 'kx', kx, 'N/m')
+         call require_nonnegative('tip', 'ky', ky, 'N/m')
+         call require_nonnegative('tip', 'cx', cx, 'N s/m')
+         call require_nonnegative('tip', 'cy', cy, 'N s/m')
+         call require_positive('scan', 'velocity', velocity, 'Å/s; the direction is set by angle')
+         call require_positive('scan', 'length', length, 'Å')
+         call require_nonnegative('scan', 'width', width, 'Å')
+         call require_finite('scan', 'angle', angle)
+         call require_finite('scan', 'origin_x', origin_x)
+         call require_finite('scan', 'origin_y', origin_y)
+         call require_nonnegative('scan', 'lead_in', lead_in, 'Å')
+         if (nx < 2) call reject('scan', 'nx', itoa(nx), 'must be >= 2 (sample points per line)')
+         if (ny < 1) call reject('scan', 'ny', itoa(ny), 'must be >= 1 (lines)')
+         if (step_type_index(method) == 0) call reject('integrator', 'method', "'"//trim(method)//"'", &
+            & 'unknown GSL step type (known: '//quoted(step_type_names)//')')
+         call require_positive('integrator', 'rtol', rtol, 'relative tolerance')
+         call require_positive('integrator', 'atol', atol, 'absolute tolerance, Å and Å/s')
+         call require_nonnegative('integrator', 'h_start', h_start, 's; 0 chooses automatically')
+         call require_nonnegative('integrator', 'h_min', h_min, 's; 0 for no limit')
+         if (max_steps < 1) call reject('integrator', 'max_steps', itoa8(max_steps), 'must be >= 1')
+      end subroutine validate
+
+   end subroutine read_input
+
+   pure function itoa(i) result(text)
+      integer, intent(in) :: i
+      character(len=:), allocatable :: text
+      character(len=16) :: buffer
+
+      write (buffer, '(i0)') i
+      text = trim(buffer)
+   end function itoa
+
+   pure function itoa8(i) result(text)
+      integer(i8), intent(in) :: i
+      character(len=:), allocatable :: text
+      character(len=24) :: buffer
+
+      write (buffer, '(i0)') i
+      text = trim(buffer)
+   end function itoa8
+
+   pure function rtoa(x) result(text)
+      real(wp), intent(in) :: x
+      character(len=:), allocatable :: text
+      character(len=32) :: buffer
+
+      write (buffer, '(g0)') x
+      text = trim(buffer)
+   end function rtoa
+
+   pure function join(words) result(text)
+      character(len=*), intent(in) :: words(:)
+      character(len=:), allocatable :: text
+      integer :: i
+
+      text = ''
+      do i = 1, size(words)
+         text = text//trim(words(i))
+         if (i < size(words)) text = text//', '
+      end do
+   end function join
+
+   pure function quoted(words) result(text)
+      character(len=*), intent(in) :: words(:)
+      character(len=:), allocatable :: text
+      integer :: i
+
+      text = ''
+      do i = 1, size(words)
+         text = text//"'"//trim(words(i))//"'"
+         if (i < size(words)) text = text//', '
+      end do
+   end function quoted
+
+end module friction_io_input

@@ -1,0 +1,381 @@
+!> Bridge to GSL's odeiv2 driver through ISO_C_BINDING.
+!>
+!> Every GSL step type is selectable by name; the implicit ones receive the
+!> system's analytic Jacobian.  GSL's abort-on-error handler is switched off
+!> (in the C shim), and every failure (GSL status, too many steps, step size
+!> below the minimum, NaN or Inf in the state) comes back as an error that
+!> carries the time reached.
+module friction_ode_solver
+   use, intrinsic :: iso_c_binding, only: c_int, c_double, c_long, c_size_t, c_ptr, c_funptr, &
+      & c_null_ptr, c_associated, c_loc, c_funloc, c_f_pointer, c_char, c_null_char
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+   use friction_kinds, only: wp, i8
+   use friction_error, only: error_type, fatal_error, error_numerical, error_input, error_internal
+   use friction_ode_system, only: ode_system
+   implicit none
+   private
+
+   public :: ode_solver, solver_settings, integrator_statistics
+   public :: step_type_names, step_type_index, is_implicit_step_type
+
+   !> GSL step types, in the order of the C shim's friction_gsl_step_type.
+   character(len=*), parameter :: step_type_names(11) = [character(len=7) :: &
+      & 'rk2', 'rk4', 'rkf45', 'rkck', 'rk8pd', 'rk1imp', 'rk2imp', 'rk4imp', 'bsimp', &
+      & 'msadams', 'msbdf']
+
+   integer, parameter :: max_dimension = 8
+
+   !> GSL status codes used here (gsl_errno.h).
+   integer(c_int), parameter :: gsl_success = 0, gsl_ebadfunc = 9
+
+   !> What the user chooses about the integration.
+   type :: solver_settings
+      character(len=16) :: method = 'rkf45'  !! GSL step type name
+      real(wp) :: rtol = 1.0e-6_wp     !! relative tolerance
+      real(wp) :: atol = 1.0e-6_wp     !! absolute tolerance, in the state's units
+      real(wp) :: h_start = 0.0_wp     !! first step; 0 lets the caller choose
+      real(wp) :: h_min = 0.0_wp       !! smallest step allowed; 0 for no limit
+      integer(i8) :: max_steps = 10000000_i8  !! per restart (per scan trip)
+   end type solver_settings
+
+   !> Cost counters, summed over restarts.
+   type :: integrator_statistics
+      integer(i8) :: steps = 0             !! accepted steps
+      integer(i8) :: failed_steps = 0      !! rejected steps
+      integer(i8) :: rhs_evaluations = 0   !! right-hand-side calls
+      integer(i8) :: jacobian_evaluations = 0
+   contains
+      procedure :: add => statistics_add
+   end type integrator_statistics
+
+   !> Mirror of gsl_odeiv2_system.
+   type, bind(c) :: gsl_odeiv2_system
+      type(c_funptr) :: function
+      type(c_funptr) :: jacobian
+      integer(c_size_t) :: dimension
+      type(c_ptr) :: params
+   end type gsl_odeiv2_system
+
+   !> What the C callbacks receive as params: the model and the counters.
+   type :: system_box
+      class(ode_system), pointer :: model => null()
+      integer :: n = 0
+      integer(i8) :: rhs_evaluations = 0
+      integer(i8) :: jacobian_evaluations = 0
+   end type system_box
+
+   !> A GSL driver bound to one system.  The system must outlive the solver.
+   type :: ode_solver
+      private
+      type(c_ptr) :: driver = c_null_ptr
+      type(gsl_odeiv2_system), pointer :: sys => null()
+      type(system_box), pointer :: box => null()
+      integer(i8) :: max_steps = 0
+      real(wp) :: h_min = 0.0_wp
+      character(len=16) :: method = ''
+      !> counters of the finished restarts
+      type(integrator_statistics) :: done
+   contains
+      procedure :: init
+      procedure :: restart
+      procedure :: advance
+      procedure :: statistics
+      procedure :: destroy
+      final :: finalize
+   end type ode_solver
+
+   interface
+      function friction_gsl_driver_new(sys, index, hstart, epsabs, epsrel) &
+         & result(driver) bind(c, name='friction_gsl_driver_new')
+         import :: c_ptr, c_int, c_double
+         type(c_ptr), value :: sys
+         integer(c_int), value :: index
+         real(c_double), value :: hstart, epsabs, epsrel
+         type(c_ptr) :: driver
+      end function friction_gsl_driver_new
+
+      subroutine friction_gsl_driver_counts(driver, steps, failed) &
+         & bind(c, name='friction_gsl_driver_counts')
+         import :: c_ptr, c_long
+         type(c_ptr), value :: driver
+         integer(c_long), intent(out) :: steps, failed
+      end subroutine friction_gsl_driver_counts
+
+      function gsl_odeiv2_driver_apply(driver, t, t1, y) result(status) &
+         & bind(c, name='gsl_odeiv2_driver_apply')
+         import :: c_ptr, c_double, c_int
+         type(c_ptr), value :: driver
+         real(c_double), intent(inout) :: t
+         real(c_double), value :: t1
+         real(c_double), intent(inout) :: y(*)
+         integer(c_int) :: status
+      end function gsl_odeiv2_driver_apply
+
+      function gsl_odeiv2_driver_reset_hstart(driver, hstart) result(status) &
+         & bind(c, name='gsl_odeiv2_driver_reset_hstart')
+         import :: c_ptr, c_double, c_int
+         type(c_ptr), value :: driver
+         real(c_double), value :: hstart
+         integer(c_int) :: status
+      end function gsl_odeiv2_driver_reset_hstart
+
+      function gsl_odeiv2_driver_set_nmax(driver, nmax) result(status) &
+         & bind(c, name='gsl_odeiv2_driver_set_nmax')
+         import :: c_ptr, c_long, c_int
+         type(c_ptr), value :: driver
+         integer(c_long), value :: nmax
+         integer(c_int) :: status
+      end function gsl_odeiv2_driver_set_nmax
+
+      function gsl_odeiv2_driver_set_hmin(driver, hmin) result(status) &
+         & bind(c, name='gsl_odeiv2_driver_set_hmin')
+         import :: c_ptr, c_double, c_int
+         type(c_ptr), value :: driver
+         real(c_double), value :: hmin
+         integer(c_int) :: status
+      end function gsl_odeiv2_driver_set_hmin
+
+      subroutine gsl_odeiv2_driver_free(driver) bind(c, name='gsl_odeiv2_driver_free')
+         import :: c_ptr
+         type(c_ptr), value :: driver
+      end subroutine gsl_odeiv2_driver_free
+
+      function gsl_strerror(status) result(message) bind(c, name='gsl_strerror')
+         import :: c_int, c_ptr
+         integer(c_int), value :: status
+         type(c_ptr) :: message
+      end function gsl_strerror
+   end interface
+
+contains
+
+   !> Index of a GSL step type name (case-sensitive, lower case), 0 if unknown.
+   pure function step_type_index(name) result(index)
+      character(len=*), intent(in) :: name
+      integer :: index
+
+      do index = 1, size(step_type_names)
+         if (trim(step_type_names(index)) == trim(name)) return
+      end do
+      index = 0
+   end function step_type_index
+
+   !> Whether a step type uses the Jacobian (implicit and BDF methods).
+   pure logical function is_implicit_step_type(name)
+      character(len=*), intent(in) :: name
+
+      select case (trim(name))
+      case ('rk1imp', 'rk2imp', 'rk4imp', 'bsimp', 'msbdf')
+         is_implicit_step_type = .true.
+      case default
+         is_implicit_step_type = .false.
+      end select
+   end function is_implicit_step_type
+
+   !> Bind a driver to a system.  h_start must be > 0 here.
+   subroutine init(self, model, settings, h_start, error)
+      class(ode_solver), intent(inout) :: self
+      class(ode_system), target, intent(in) :: model
+      type(solver_settings), intent(in) :: settings
+      real(wp), intent(in) :: h_start
+      type(error_type), allocatable, intent(out) :: error
+      integer :: index
+      integer(c_int) :: status
+
+      call self%destroy()
+      index = step_type_index(settings%method)
+      if (index == 0) then
+         call fatal_error(error, "unknown step type '"//trim(settings%method)//"'", error_input)
+         return
+      end if
+      if (model%dimension() > max_dimension) then
+         call fatal_error(error, 'ODE system too large for the GSL bridge', error_internal)
+         return
+      end if
+      allocate (self%box, self%sys)
+      self%box%model => model
+      self%box%n = model%dimension()
+      self%sys%function = c_funloc(gsl_rhs)
+      self%sys%jacobian = c_funloc(gsl_jacobian)
+      self%sys%dimension = int(self%box%n, c_size_t)
+      self%sys%params = c_loc(self%box)
+      self%driver = friction_gsl_driver_new(c_loc(self%sys), int(index, c_int), &
+         & real(h_start, c_double), real(settings%atol, c_double), real(settings%rtol, c_double))
+      if (.not. c_associated(self%driver)) then
+         call fatal_error(error, 'GSL could not allocate a driver for '//trim(settings%method), &
+            & error_internal)
+         return
+      end if
+      self%max_steps = settings%max_steps
+      self%h_min = settings%h_min
+      self%method = settings%method
+      status = gsl_odeiv2_driver_set_nmax(self%driver, int(settings%max_steps, c_long))
+      if (settings%h_min > 0.0_wp) &
+         & status = gsl_odeiv2_driver_set_hmin(self%driver, real(settings%h_min, c_double))
+      self%done = integrator_statistics()
+   end subroutine init
+
+   !> Start afresh (new initial condition or changed model parameters):
+   !> multistep methods forget their history; counters are kept.
+   subroutine restart(self, h_start)
+      class(ode_solver), intent(inout) :: self
+      real(wp), intent(in) :: h_start
+      integer(c_int) :: status
+
+      self%done = self%statistics()
+      self%box%rhs_evaluations = 0
+      self%box%jacobian_evaluations = 0
+      status = gsl_odeiv2_driver_reset_hstart(self%driver, real(h_start, c_double))
+   end subroutine restart
+
+   !> Advance y from t to t1.  On failure t holds the time reached.
+   subroutine advance(self, t, t1, y, error)
+      class(ode_solver), intent(inout) :: self
+      real(wp), intent(inout) :: t
+      real(wp), intent(in) :: t1
+      real(wp), intent(inout) :: y(:)
+      type(error_type), allocatable, intent(out) :: error
+      integer(c_int) :: status
+      integer(c_long) :: steps, failed
+      character(len=32) :: when
+
+      status = gsl_odeiv2_driver_apply(self%driver, t, t1, y)
+      call friction_gsl_driver_counts(self%driver, steps, failed)
+      write (when, '(es14.7)') t
+      if (status /= gsl_success) then
+         if (status == gsl_ebadfunc) then
+            call fatal_error(error, trim(self%method)//': the right-hand side became NaN or Inf at t = ' &
+               & //trim(adjustl(when))//' s', error_numerical)
+         else
+            call fatal_error(error, trim(self%method)//' failed at t = '//trim(adjustl(when)) &
+               & //' s: '//gsl_message(status)//step_hint(status), error_numerical)
+         end if
+         return
+      end if
+      if (.not. all(ieee_is_finite(y))) then
+         call fatal_error(error, trim(self%method)//': the state became NaN or Inf at t = ' &
+            & //trim(adjustl(when))//' s', error_numerical)
+         return
+      end if
+      if (steps > self%max_steps) then
+         call fatal_error(error, trim(self%method)//': more than max_steps steps in one trip at t = ' &
+            & //trim(adjustl(when))//' s', error_numerical)
+      end if
+   end subroutine advance
+
+   !> Counters summed over all restarts so far.
+   function statistics(self) result(stats)
+      class(ode_solver), intent(in) :: self
+      type(integrator_statistics) :: stats
+      integer(c_long) :: steps, failed
+
+      stats = self%done
+      if (.not. c_associated(self%driver)) return
+      call friction_gsl_driver_counts(self%driver, steps, failed)
+      stats%steps = stats%steps + steps
+      stats%failed_steps = stats%failed_steps + failed
+      stats%rhs_evaluations = stats%rhs_evaluations + self%box%rhs_evaluations
+      stats%jacobian_evaluations = stats%jacobian_evaluations + self%box%jacobian_evaluations
+   end function statistics
+
+   subroutine destroy(self)
+      class(ode_solver), intent(inout) :: self
+
+      if (c_associated(self%driver)) call gsl_odeiv2_driver_free(self%driver)
+      self%driver = c_null_ptr
+      if (associated(self%sys)) deallocate (self%sys)
+      if (associated(self%box)) deallocate (self%box)
+   end subroutine destroy
+
+   subroutine finalize(self)
+      type(ode_solver), intent(inout) :: self
+
+      call self%destroy()
+   end subroutine finalize
+
+   pure subroutine statistics_add(self, other)
+      class(integrator_statistics), intent(inout) :: self
+      type(integrator_statistics), intent(in) :: other
+
+      self%steps = self%steps + other%steps
+      self%failed_steps = self%failed_steps + other%failed_steps
+      self%rhs_evaluations = self%rhs_evaluations + other%rhs_evaluations
+      self%jacobian_evaluations = self%jacobian_evaluations + other%jacobian_evaluations
+   end subroutine statistics_add
+
+   !> GSL's text for a status code.
+   function gsl_message(status) result(message)
+      integer(c_int), intent(in) :: status
+      character(len=:), allocatable :: message
+      character(kind=c_char), pointer :: text(:)
+      integer :: n
+
+      call c_f_pointer(gsl_strerror(status), text, [256])
+      n = 0
+      do while (n < 256)
+         if (text(n + 1) == c_null_char) exit
+         n = n + 1
+      end do
+      allocate (character(len=n) :: message)
+      message = transfer(text(1:n), message)
+   end function gsl_message
+
+   !> What a user can do about a failure status.
+   pure function step_hint(status) result(hint)
+      integer(c_int), intent(in) :: status
+      character(len=:), allocatable :: hint
+
+      select case (status)
+      case (11) ! GSL_EMAXITER
+         hint = ' (max_steps reached; raise max_steps, loosen the tolerance or try an implicit method)'
+      case (27) ! GSL_ENOPROG
+         hint = ' (step size fell below h_min; the problem may be stiff: try an implicit method)'
+      case default
+         hint = ''
+      end select
+   end function step_hint
+
+   !> Right-hand side as GSL calls it.
+   function gsl_rhs(t, y, dydt, params) result(status) bind(c)
+      real(c_double), value :: t
+      real(c_double), intent(in) :: y(*)
+      real(c_double), intent(out) :: dydt(*)
+      type(c_ptr), value :: params
+      integer(c_int) :: status
+      type(system_box), pointer :: box
+      real(wp) :: f(max_dimension)
+      integer :: n
+
+      call c_f_pointer(params, box)
+      n = box%n
+      call box%model%rhs(t, y(1:n), f(1:n))
+      box%rhs_evaluations = box%rhs_evaluations + 1
+      dydt(1:n) = f(1:n)
+      status = gsl_success
+      if (.not. all(ieee_is_finite(f(1:n)))) status = gsl_ebadfunc
+   end function gsl_rhs
+
+   !> Jacobian as GSL wants it: dfdy row-major, dfdy[i*n + j] = ∂f_i/∂y_j.
+   function gsl_jacobian(t, y, dfdy, dfdt, params) result(status) bind(c)
+      real(c_double), value :: t
+      real(c_double), intent(in) :: y(*)
+      real(c_double), intent(out) :: dfdy(*)
+      real(c_double), intent(out) :: dfdt(*)
+      type(c_ptr), value :: params
+      integer(c_int) :: status
+      type(system_box), pointer :: box
+      real(wp) :: jac(max_dimension, max_dimension), ft(max_dimension)
+      integer :: n, i
+
+      call c_f_pointer(params, box)
+      n = box%n
+      call box%model%jacobian(t, y(1:n), jac(1:n, 1:n), ft(1:n))
+      box%jacobian_evaluations = box%jacobian_evaluations + 1
+      do i = 1, n
+         dfdy((i - 1) * n + 1:i * n) = jac(i, 1:n)
+      end do
+      dfdt(1:n) = ft(1:n)
+      status = gsl_success
+   end function gsl_jacobian
+
+end module friction_ode_solver

@@ -1,0 +1,47 @@
+!> An ordinary differential equation system dy/dt = f(t, y) as an abstract
+!> type: the right-hand side and its analytic Jacobian (for the implicit
+!> steppers).  Model parameters live in the extending type, never in module
+!> variables, so two systems can be integrated at once.
+module friction_ode_system
+   use friction_kinds, only: wp
+   implicit none
+   private
+
+   public :: ode_system
+
+   type, abstract :: ode_system
+   contains
+      procedure(dimension_interface), deferred :: dimension
+      procedure(rhs_interface), deferred :: rhs
+      procedure(jacobian_interface), deferred :: jacobian
+   end type ode_system
+
+   abstract interface
+      !> Number of state variables.
+      pure function dimension_interface(self) result(n)
+         import :: ode_system
+         class(ode_system), intent(in) :: self
+         integer :: n
+      end function dimension_interface
+
+      !> dydt = f(t, y).
+      pure subroutine rhs_interface(self, t, y, dydt)
+         import :: ode_system, wp
+         class(ode_system), intent(in) :: self
+         real(wp), intent(in) :: t
+         real(wp), intent(in) :: y(:)
+         real(wp), intent(out) :: dydt(:)
+      end subroutine rhs_interface
+
+      !> dfdy(i, j) = ∂f_i/∂y_j and dfdt(i) = ∂f_i/∂t.
+      pure subroutine jacobian_interface(self, t, y, dfdy, dfdt)
+         import :: ode_system, wp
+         class(ode_system), intent(in) :: self
+         real(wp), intent(in) :: t
+         real(wp), intent(in) :: y(:)
+         real(wp), intent(out) :: dfdy(:, :)
+         real(wp), intent(out) :: dfdt(:)
+      end subroutine jacobian_interface
+   end interface
+
+end module friction_ode_system

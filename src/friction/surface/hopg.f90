@@ -1,0 +1,82 @@
+!> Highly oriented pyrolytic graphite under a scanning force microscope tip
+!> (Hölscher et al.), Eq. 2:
+!> V = -V0 [2 cos(2πx/a) cos(2πy/(a√3)) + cos(4πy/(a√3))].
+!> Periodic under (a, 0) and (a/2, a√3/2): a hexagonal lattice.
+module friction_surface_hopg
+   use friction_kinds, only: wp, pi
+   use friction_surface_potential, only: surface_potential
+   implicit none
+   private
+
+   public :: hopg_potential, new_hopg_potential
+
+   type, extends(surface_potential) :: hopg_potential
+      real(wp) :: v0 = 0.0_wp  !! amplitude, eV
+      real(wp) :: qx = 0.0_wp  !! 2π/a, 1/Å
+      real(wp) :: qy = 0.0_wp  !! 2π/(a√3), 1/Å
+   contains
+      procedure :: energy
+      procedure :: gradient
+      procedure :: hessian
+      procedure :: dimensions
+   end type hopg_potential
+
+contains
+
+   !> The potential for amplitude v0 (eV) and lattice constant a (Å).
+   pure function new_hopg_potential(v0, a) result(self)
+      real(wp), intent(in) :: v0, a
+      type(hopg_potential) :: self
+
+      self%v0 = v0
+      self%qx = 2.0_wp * pi / a
+      self%qy = 2.0_wp * pi / (a * sqrt(3.0_wp))
+   end function new_hopg_potential
+
+   pure function energy(self, r) result(v)
+      class(hopg_potential), intent(in) :: self
+      real(wp), intent(in) :: r(3)
+      real(wp) :: v
+
+      v = -self%v0 * (2.0_wp * cos(self%qx * r(1)) * cos(self%qy * r(2)) &
+         & + cos(2.0_wp * self%qy * r(2)))
+   end function energy
+
+   pure subroutine gradient(self, r, g)
+      class(hopg_potential), intent(in) :: self
+      real(wp), intent(in) :: r(3)
+      real(wp), intent(out) :: g(3)
+      real(wp) :: sx, cx, sy, cy
+
+      sx = sin(self%qx * r(1)); cx = cos(self%qx * r(1))
+      sy = sin(self%qy * r(2)); cy = cos(self%qy * r(2))
+      g(1) = 2.0_wp * self%v0 * self%qx * sx * cy
+      ! sin(2 qy y) = 2 sy cy
+      g(2) = 2.0_wp * self%v0 * self%qy * (cx * sy + 2.0_wp * sy * cy)
+      g(3) = 0.0_wp
+   end subroutine gradient
+
+   pure subroutine hessian(self, r, h)
+      class(hopg_potential), intent(in) :: self
+      real(wp), intent(in) :: r(3)
+      real(wp), intent(out) :: h(3, 3)
+      real(wp) :: sx, cx, sy, cy
+
+      sx = sin(self%qx * r(1)); cx = cos(self%qx * r(1))
+      sy = sin(self%qy * r(2)); cy = cos(self%qy * r(2))
+      h = 0.0_wp
+      h(1, 1) = 2.0_wp * self%v0 * self%qx**2 * cx * cy
+      ! cos(2 qy y) = cy² - sy²
+      h(2, 2) = 2.0_wp * self%v0 * self%qy**2 * (cx * cy + 2.0_wp * (cy**2 - sy**2))
+      h(1, 2) = -2.0_wp * self%v0 * self%qx * self%qy * sx * sy
+      h(2, 1) = h(1, 2)
+   end subroutine hessian
+
+   pure function dimensions(self) result(n)
+      class(hopg_potential), intent(in) :: self
+      integer :: n
+
+      n = 2
+   end function dimensions
+
+end module friction_surface_hopg
