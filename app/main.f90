@@ -28,6 +28,11 @@ program friction_main
          import :: c_int
          integer(c_int) :: pid
       end function friction_process_id
+      !> The C library's exit: a status code without the runtime's backtrace.
+      subroutine c_exit(status) bind(c, name='exit')
+         import :: c_int
+         integer(c_int), value :: status
+      end subroutine c_exit
    end interface
 
    integer, parameter :: exit_usage = 2, exit_input = 3, exit_numerical = 4, exit_io = 5
@@ -289,8 +294,9 @@ contains
       integer, intent(in) :: code
 
       call MPI_Finalize()
-      if (code == 0) stop
-      error stop code, quiet=.true.
+      flush (error_unit)
+      flush (output_unit)
+      call c_exit(int(code, c_int))
    end subroutine finish
 
    pure function itoa(i) result(text)

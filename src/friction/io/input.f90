@@ -288,8 +288,8 @@ contains
       character(len=:), allocatable :: text
       character(len=32) :: buffer
 
-      write (buffer, '(g0)') x
-      text = trim(buffer)
+      write (buffer, '(1pg0.6)') x
+      text = trim(adjustl(buffer))
    end function rtoa
 
    pure function join(words) result(text)

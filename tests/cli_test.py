@@ -1,0 +1,250 @@
+#!/usr/bin/env python3
+"""End-to-end tests of the `friction` program, one case per CTest test.
+
+    cli_test.py --binary BIN --mpiexec MPIEXEC --inputs DIR --workdir DIR CASE
+
+Cases: datasets-naf, datasets-hopg, ranks, override, force, numerical-failure,
+and bad-<name> for each bad input in BAD_INPUTS.  Each asserts on exit codes,
+messages and file contents (read with h5py); none asserts on timings.
+"""
+import argparse
+import os
+import shutil
+import subprocess
+import sys
+
+import h5py
+import numpy as np
+
+SMALL = "&scan nx = 24, ny = 7 /\n"
+
+# name: (override text, expected exit code, words the message must contain)
+# The message names the file, the group and the variable (PHYSICS units).
+BAD_INPUTS = {
+    "unknown-variable": ("&tip mas = 1e-8 /\n", 3, ["bad.nml:1", "&tip", "mas"]),
+    "wrong-type": ("&scan nx = 'many' /\n", 3, ["bad.nml", "&scan", "nx"]),
+    "negative-mass": ("&tip mass = -1e-8 /\n", 3, ["bad.nml:1", "&tip", "mass", "> 0"]),
+    "zero-mass": ("&tip mass = 0 /\n", 3, ["bad.nml:1", "&tip", "mass"]),
+    "negative-spring": ("&tip ky = -2 /\n", 3, ["bad.nml:1", "&tip", "ky", ">= 0"]),
+    "negative-damping": ("&tip cx = -1e-3 /\n", 3, ["bad.nml:1", "&tip", "cx", ">= 0"]),
+    "zero-velocity": ("&scan velocity = 0 /\n", 3, ["bad.nml:1", "&scan", "velocity"]),
+    "nx-below-two": ("&scan nx = 1 /\n", 3, ["bad.nml:1", "&scan", "nx", ">= 2"]),
+    "zero-rtol": ("&integrator rtol = 0 /\n", 3, ["bad.nml:1", "&integrator", "rtol"]),
+    "negative-atol": ("&integrator atol = -1e-6 /\n", 3, ["bad.nml:1", "&integrator", "atol"]),
+    "unknown-potential": ("&surface potential = 'gold' /\n", 3,
+                          ["bad.nml:1", "&surface", "potential", "gold", "naf"]),
+    "unknown-method": ("&integrator method = 'rk45' /\n", 3,
+                       ["bad.nml:1", "&integrator", "method", "rk45", "rkf45"]),
+    "unknown-group": ("&tips mass = 1e-8 /\n", 3, ["bad.nml:1", "&tips"]),
+    "unclosed-group": ("&tip mass = 1e-8\n", 3, ["bad.nml", "&tip", "not closed"]),
+    "missing-file": (None, 3, ["no-such-file.nml", "no such file"]),
+    "no-arguments": (None, 2, ["usage"]),
+    "unknown-option": (None, 2, ["--frobnicate"]),
+}
+
+DOCUMENTED = ["fx", "fy", "f_along", "f_across", "tip_x", "tip_y"]
+
+
+def fail(message):
+    print("FAILED: " + message)
+    sys.exit(1)
+
+
+def run(args, cmd, expect=0):
+    env = dict(os.environ)
+    result = subprocess.run(cmd, cwd=args.workdir, capture_output=True, text=True, env=env,
+                            timeout=600)
+    if expect is not None and result.returncode != expect:
+        fail(f"{' '.join(cmd)} exited {result.returncode}, expected {expect}\n"
+             f"stdout: {result.stdout}\nstderr: {result.stderr}")
+    return result
+
+
+def friction(args, *rest, ranks=None, expect=0):
+    cmd = [args.binary, "--quiet", *rest]
+    if ranks is not None:
+        cmd = [args.mpiexec, "-n", str(ranks), *cmd]
+    return run(args, cmd, expect)
+
+
+def write(args, name, text):
+    path = os.path.join(args.workdir, name)
+    with open(path, "w") as handle:
+        handle.write(text)
+    return path
+
+
+def leftovers(args):
+    """Files a run left in the work directory (besides inputs)."""
+    return sorted(f for f in os.listdir(args.workdir) if not f.endswith(".nml"))
+
+
+def case_datasets(args, scene):
+    small = write(args, "small.nml", SMALL)
+    friction(args, os.path.join(args.inputs, scene + ".nml"), small)
+    path = os.path.join(args.workdir, scene + ".h5")
+    with h5py.File(path, "r") as f:
+        for attr in ["program", "version", "input", "nranks", "wall_time", "integrator_steps",
+                     "integrator_rejected_steps", "rhs_evaluations", "jacobian_evaluations"]:
+            if attr not in f.attrs:
+                fail(f"root attribute {attr} missing")
+        text = f.attrs["input"].decode()
+        if "NX=24" not in text.replace(" ", "") or "&SCAN" not in text:
+            fail("resolved input does not show the override nx = 24:\n" + text)
+        if f.attrs["integrator_steps"] <= 0 or f.attrs["rhs_evaluations"] < f.attrs["integrator_steps"]:
+            fail("integrator statistics implausible")
+        expect = {"afm/support_x": (24,), "afm/support_y": (7,), "afm/friction": (7,)}
+        for trip in ["trace", "retrace"]:
+            for name in DOCUMENTED:
+                expect[f"afm/{trip}/{name}"] = (7, 24)
+        for name, shape in expect.items():
+            if name not in f:
+                fail(f"dataset /{name} missing")
+            if f[name].shape != shape:
+                fail(f"/{name} has shape {f[name].shape}, expected {shape}")
+            if "units" not in f[name].attrs:
+                fail(f"/{name} has no units attribute")
+            if not np.all(np.isfinite(f[name][()])):
+                fail(f"/{name} has non-finite values")
+        x = f["afm/support_x"][()]
+        if abs(x[0]) > 0 or abs(x[-1] - 20.0) > 1e-12:
+            fail(f"support_x runs {x[0]} .. {x[-1]}, expected 0 .. 20 Å")
+        # The spring force is k (r_M - r_t): at the first trace sample the tip
+        # sits at the support, so the force is zero there.
+        if np.max(np.abs(f["afm/trace/fx"][:, 0])) > 1e-12:
+            fail("trace force at the first sample is not zero")
+        # f_along / f_across are fx, fy turned by the scan angle.
+        angle = np.radians(f["afm"].attrs["angle"])
+        fx, fy = f["afm/trace/fx"][()], f["afm/trace/fy"][()]
+        along = fx * np.cos(angle) + fy * np.sin(angle)
+        if np.max(np.abs(along - f["afm/trace/f_along"][()])) > 1e-12:
+            fail("f_along is not fx cos θ + fy sin θ")
+        friction_expected = 0.5 * (f["afm/trace/f_along"][()].mean(axis=1)
+                                   - f["afm/retrace/f_along"][()].mean(axis=1))
+        if np.max(np.abs(friction_expected - f["afm/friction"][()])) > 1e-12:
+            fail("/afm/friction is not half the trace-retrace difference of the mean force")
+        if not np.all(f["afm/friction"][()] > 0):
+            fail("friction is not positive on every line")
+
+
+def comparable(path):
+    """Every dataset and attribute of a file, except those that depend on the
+    run rather than the physics (wall time, number of ranks)."""
+    items = {}
+    with h5py.File(path, "r") as f:
+        def visit(name, obj):
+            for key, value in obj.attrs.items():
+                items[f"{name}@{key}"] = value
+            if isinstance(obj, h5py.Dataset):
+                items[name] = obj[()]
+        f.visititems(visit)
+        for key, value in f.attrs.items():
+            if key not in ("wall_time", "nranks"):
+                items["@" + key] = value
+    return items
+
+
+def case_ranks(args):
+    small = write(args, "small.nml", SMALL)
+    files = {}
+    for n in (1, 2, 3):
+        out = f"naf_{n}.h5"
+        friction(args, "-o", out, os.path.join(args.inputs, "naf.nml"), small, ranks=n)
+        with h5py.File(os.path.join(args.workdir, out), "r") as f:
+            if f.attrs["nranks"] != n:
+                fail(f"{out}: nranks = {f.attrs['nranks']}, expected {n}")
+        files[n] = comparable(os.path.join(args.workdir, out))
+    for n in (2, 3):
+        if files[n].keys() != files[1].keys():
+            fail(f"{n} ranks wrote different objects: {set(files[n]) ^ set(files[1])}")
+        for key, value in files[1].items():
+            if not np.array_equal(np.asarray(value), np.asarray(files[n][key])):
+                fail(f"{key} differs between 1 and {n} ranks")
+
+
+def case_override(args):
+    first = write(args, "first.nml", "&tip kx = 12.5 /\n&scan nx = 9, ny = 2 /\n")
+    second = write(args, "second.nml", "&scan ny = 3 /\n")
+    friction(args, "-o", "o.h5", first, second)
+    with h5py.File(os.path.join(args.workdir, "o.h5"), "r") as f:
+        text = f.attrs["input"].decode().replace(" ", "")
+        for wanted in ["KX=12.5", "NX=9", "NY=3"]:
+            if wanted not in text:
+                fail(f"{wanted} not in the resolved input:\n{text}")
+        if f["afm/trace/fx"].shape != (3, 9):
+            fail("override did not shape the map")
+
+
+def case_force(args):
+    small = write(args, "small.nml", SMALL)
+    naf = os.path.join(args.inputs, "naf.nml")
+    friction(args, "-o", "f.h5", naf, small)
+    before = os.stat(os.path.join(args.workdir, "f.h5")).st_mtime_ns
+    result = friction(args, "-o", "f.h5", naf, small, expect=3)
+    if "--force" not in result.stderr or "f.h5" not in result.stderr:
+        fail("refusal to overwrite does not name the file and --force: " + result.stderr)
+    if os.stat(os.path.join(args.workdir, "f.h5")).st_mtime_ns != before:
+        fail("existing output was touched without --force")
+    friction(args, "-o", "f.h5", "--force", naf, small)
+    if leftovers(args) != ["f.h5"]:
+        fail(f"unexpected files: {leftovers(args)}")
+
+
+def case_numerical_failure(args):
+    small = write(args, "small.nml", SMALL)
+    limit = write(args, "limit.nml", "&integrator max_steps = 20 /\n")
+    result = friction(args, os.path.join(args.inputs, "naf.nml"), small, limit, ranks=2, expect=4)
+    for word in ["max_steps", "t = ", "line", "rkf45"]:
+        if word not in result.stderr:
+            fail(f"failure message lacks {word!r}: {result.stderr}")
+    if result.stderr.count("friction: error:") != 1:
+        fail("expected exactly one error message: " + result.stderr)
+    if leftovers(args):
+        fail(f"a failed run left files: {leftovers(args)}")
+
+
+def case_bad(args, name):
+    text, code, words = BAD_INPUTS[name]
+    naf = os.path.join(args.inputs, "naf.nml")
+    if name == "missing-file":
+        cmd = [naf, "no-such-file.nml"]
+    elif name == "no-arguments":
+        cmd = []
+    elif name == "unknown-option":
+        cmd = ["--frobnicate", naf]
+    else:
+        cmd = [naf, write(args, "bad.nml", text)]
+    result = friction(args, *cmd, ranks=2, expect=code)
+    for word in words:
+        if word not in result.stderr:
+            fail(f"message lacks {word!r}: {result.stderr!r}")
+    # One message from the program (mpiexec may add its own banner about the exit code).
+    ours = [line for line in result.stderr.splitlines() if line.startswith("friction:")]
+    if len(ours) != 1:
+        fail(f"expected one message from friction, got: {result.stderr}")
+    if leftovers(args):
+        fail(f"bad input left files: {leftovers(args)}")
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--binary", required=True)
+    parser.add_argument("--mpiexec", required=True)
+    parser.add_argument("--inputs", required=True)
+    parser.add_argument("--workdir", required=True)
+    parser.add_argument("case")
+    args = parser.parse_args()
+    shutil.rmtree(args.workdir, ignore_errors=True)
+    os.makedirs(args.workdir)
+    if args.case.startswith("datasets-"):
+        case_datasets(args, args.case.split("-", 1)[1])
+    elif args.case.startswith("bad-"):
+        case_bad(args, args.case[4:])
+    else:
+        {"ranks": case_ranks, "override": case_override, "force": case_force,
+         "numerical-failure": case_numerical_failure}[args.case](args)
+    print("1 passed, 0 failed")
+
+
+if __name__ == "__main__":
+    main()
