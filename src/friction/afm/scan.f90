@@ -109,7 +109,7 @@ contains
       type(trip_record), intent(inout) :: record
       type(error_type), allocatable, intent(out) :: error
       real(wp) :: u(3), n(3), line_start(3), s(self%config%nx), offset(self%config%ny)
-      real(wp) :: y(6), t, t_sample, s_start, force(3)
+      real(wp) :: y(6), t, t_sample, s_start, force(3), tip_r(3)
       integer :: i, k, nx, nd
       character(len=96) :: where
 
@@ -129,8 +129,8 @@ contains
             tip%support_velocity = -c%velocity * u
          end if
          tip%support_start = line_start + s_start * u
+         ! At the support and at rest: u = 0, r' = 0.
          y = 0.0_wp
-         y(1:nd) = tip%support_start(1:nd)
          t = 0.0_wp
          call self%solver%restart(self%h_start)
          if (.not. allocated(record%values)) allocate (record%values(nx, n_quantities))
@@ -144,13 +144,14 @@ contains
                error%message = error%message//trim(where)
                return
             end if
-            force = tip%lateral_force(t, y) * ev_per_angstrom_to_nn
+            force = tip%lateral_force(y) * ev_per_angstrom_to_nn
+            tip_r = tip%tip_position(t, y)
             record%values(i, q_fx) = force(1)
             record%values(i, q_fy) = force(2)
             record%values(i, q_f_along) = dot_product(force, u)
             record%values(i, q_f_across) = dot_product(force, n)
-            record%values(i, q_tip_x) = y(1)
-            record%values(i, q_tip_y) = y(2)
+            record%values(i, q_tip_x) = tip_r(1)
+            record%values(i, q_tip_y) = tip_r(2)
          end do
       end associate
    end subroutine run_trip

@@ -1,8 +1,11 @@
 !> The microscope tip on its springs, Eq. 4: for each direction i
 !>   m r_i'' = k_i (r_M,i - r_i) - dV/dr_i - c_i r_i',
-!> with the support r_M(t) = r_M(0) + v_M t.  State y = (r, r') with r of
-!> `ndim` components (2 for the analytic potentials, 3 for a lattice sum).
-!> Internal units (friction_kinds): Å, eV, s.
+!> with the support r_M(t) = r_M(0) + v_M t.  The state is y = (u, r') with
+!> u = r - r_M the tip's displacement from the support, of `ndim` components
+!> (2 for the analytic potentials, 3 for a lattice sum).  Integrating u
+!> rather than r makes the error control independent of where the scan lies
+!> on the surface, and the absolute tolerance (Å) bounds the lateral force
+!> error directly: |δF| <= k |δu|.  Internal units (friction_kinds): Å, eV, s.
 module friction_afm_tip
    use friction_kinds, only: wp
    use friction_ode_system, only: ode_system
@@ -26,6 +29,7 @@ module friction_afm_tip
       procedure :: jacobian
       procedure :: support
       procedure :: lateral_force
+      procedure :: tip_position
    end type afm_tip
 
 contains
@@ -46,22 +50,33 @@ contains
       r = self%support_start + self%support_velocity * t
    end function support
 
-   !> The spring force k (r_M - r_t) on the tip in eV/Å: what the microscope
-   !> measures as lateral force.
-   pure function lateral_force(self, t, y) result(f)
+   !> The spring force k (r_M - r_t) = -k u on the tip in eV/Å: what the
+   !> microscope measures as lateral force.
+   pure function lateral_force(self, y) result(f)
       class(afm_tip), intent(in) :: self
-      real(wp), intent(in) :: t
       real(wp), intent(in) :: y(:)
       real(wp) :: f(3)
       integer :: nd
 
       nd = self%ndim
       f = 0.0_wp
-      f(1:nd) = self%spring(1:nd) * (self%support_start(1:nd) &
-         & + self%support_velocity(1:nd) * t - y(1:nd))
+      f(1:nd) = -self%spring(1:nd) * y(1:nd)
    end function lateral_force
 
-   !> Eq. 4.
+   !> Tip position r = r_M(t) + u in Å.
+   pure function tip_position(self, t, y) result(r)
+      class(afm_tip), intent(in) :: self
+      real(wp), intent(in) :: t
+      real(wp), intent(in) :: y(:)
+      real(wp) :: r(3)
+      integer :: nd
+
+      nd = self%ndim
+      r = self%support(t)
+      r(1:nd) = r(1:nd) + y(1:nd)
+   end function tip_position
+
+   !> Eq. 4 in (u, r'): u' = r' - v_M, m r'' = -k u - dV/dr - c r'.
    pure subroutine rhs(self, t, y, dydt)
       class(afm_tip), intent(in) :: self
       real(wp), intent(in) :: t
@@ -71,30 +86,26 @@ contains
       integer :: nd
 
       nd = self%ndim
-      r = 0.0_wp
-      r(1:nd) = y(1:nd)
+      r = self%tip_position(t, y)
       call self%potential%gradient(r, g)
-      dydt(1:nd) = y(nd + 1:2 * nd)
-      dydt(nd + 1:2 * nd) = (self%spring(1:nd) * (self%support_start(1:nd) &
-         & + self%support_velocity(1:nd) * t - r(1:nd)) - g(1:nd) &
+      dydt(1:nd) = y(nd + 1:2 * nd) - self%support_velocity(1:nd)
+      dydt(nd + 1:2 * nd) = (-self%spring(1:nd) * y(1:nd) - g(1:nd) &
          & - self%damping(1:nd) * y(nd + 1:2 * nd)) / self%mass
    end subroutine rhs
 
-   !> Analytic Jacobian of Eq. 4: the potential's Hessian enters the
-   !> velocity rows; the moving support makes f depend on t explicitly.
+   !> Analytic Jacobian: the potential's Hessian H enters the velocity rows,
+   !> and through r = r_M(t) + u also the explicit time dependence.
    pure subroutine jacobian(self, t, y, dfdy, dfdt)
       class(afm_tip), intent(in) :: self
       real(wp), intent(in) :: t
       real(wp), intent(in) :: y(:)
       real(wp), intent(out) :: dfdy(:, :)
       real(wp), intent(out) :: dfdt(:)
-      real(wp) :: r(3), h(3, 3)
+      real(wp) :: h(3, 3)
       integer :: nd, i
 
       nd = self%ndim
-      r = 0.0_wp
-      r(1:nd) = y(1:nd)
-      call self%potential%hessian(r, h)
+      call self%potential%hessian(self%tip_position(t, y), h)
       dfdy = 0.0_wp
       dfdt = 0.0_wp
       do i = 1, nd
@@ -102,7 +113,7 @@ contains
          dfdy(nd + i, 1:nd) = -h(i, 1:nd) / self%mass
          dfdy(nd + i, i) = dfdy(nd + i, i) - self%spring(i) / self%mass
          dfdy(nd + i, nd + i) = -self%damping(i) / self%mass
-         dfdt(nd + i) = self%spring(i) * self%support_velocity(i) / self%mass
+         dfdt(nd + i) = -dot_product(h(i, 1:nd), self%support_velocity(1:nd)) / self%mass
       end do
    end subroutine jacobian
 
