@@ -10,7 +10,8 @@
 # Included from tests/CMakeLists.txt, which must have run
 #   find_package(Python3 COMPONENTS Interpreter REQUIRED)
 # The plot_afm.py tests need h5py and matplotlib in that Python, the gnuplot
-# ones h5dump and gnuplot; without them those tests are registered DISABLED.
+# ones h5dump and gnuplot; without them configuration stops (a test that is
+# skipped could hide a broken install).
 #   ctest -L scripts            # run them all
 
 set(_fs_scripts "${CMAKE_CURRENT_LIST_DIR}/../scripts")
@@ -29,15 +30,16 @@ execute_process(COMMAND ${Python3_EXECUTABLE} -c "import h5py, matplotlib, numpy
                 RESULT_VARIABLE _fs_py_modules OUTPUT_QUIET ERROR_QUIET)
 set(_fs_no_python_modules OFF)
 if(NOT _fs_py_modules EQUAL 0)
-  message(STATUS "scripts tests: no h5py/matplotlib/numpy in ${Python3_EXECUTABLE}; "
-                 "plot_afm.py tests disabled")
+  message(FATAL_ERROR "The tests need h5py, matplotlib and numpy in ${Python3_EXECUTABLE}: "
+                      "run scripts/install-deps (python3 -m pip install h5py matplotlib numpy)")
   set(_fs_no_python_modules ON)
 endif()
 find_program(FRICTION_GNUPLOT_EXECUTABLE gnuplot DOC "gnuplot, for the scripts tests")
 find_program(FRICTION_H5DUMP_EXECUTABLE h5dump DOC "h5dump (hdf5-tools), for the scripts tests")
 set(_fs_no_gnuplot OFF)
 if(NOT FRICTION_GNUPLOT_EXECUTABLE OR NOT FRICTION_H5DUMP_EXECUTABLE)
-  message(STATUS "scripts tests: gnuplot or h5dump not found; gnuplot route tests disabled")
+  message(FATAL_ERROR "The tests need gnuplot and h5dump: "
+                      "sudo apt-get install gnuplot-nox hdf5-tools (or run scripts/install-deps)")
   set(_fs_no_gnuplot ON)
 endif()
 set(_fs_gnuplot_env "GNUPLOT=${FRICTION_GNUPLOT_EXECUTABLE}" "H5DUMP=${FRICTION_H5DUMP_EXECUTABLE}")
