@@ -22,7 +22,10 @@ SMALL = "&scan nx = 24, ny = 7 /\n"
 # The message names the file, the group and the variable (PHYSICS units).
 BAD_INPUTS = {
     "unknown-variable": ("&tip mas = 1e-8 /\n", 3, ["bad.nml:1", "&tip", "mas"]),
-    "wrong-type": ("&scan nx = 'many' /\n", 3, ["bad.nml", "&scan", "nx"]),
+    "wrong-type": ("&scan nx = 'many' /\n", 3, ["bad.nml:1", "&scan", "nx", "integer"]),
+    "wrong-logical": ("&scan\n  nx = 12\n  retrace = maybe\n/\n", 3,
+                      ["bad.nml:3", "&scan", "retrace", ".true."]),
+    "unquoted-text": ("&integrator method = rkf45 /\n", 3, ["bad.nml:1", "&integrator", "method", "quoted"]),
     "negative-mass": ("&tip mass = -1e-8 /\n", 3, ["bad.nml:1", "&tip", "mass", "> 0"]),
     "zero-mass": ("&tip mass = 0 /\n", 3, ["bad.nml:1", "&tip", "mass"]),
     "negative-spring": ("&tip ky = -2 /\n", 3, ["bad.nml:1", "&tip", "ky", ">= 0"]),

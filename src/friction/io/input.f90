@@ -11,7 +11,8 @@ module friction_io_input
    use friction_error, only: error_type, fatal_error, error_input
    use friction_ode_solver, only: step_type_names, step_type_index
    use friction_afm_config, only: afm_config, potential_names
-   use friction_io_namelist_scan, only: mention, scan_namelist_file, lower, namelist_names
+   use friction_io_namelist_scan, only: mention, scan_namelist_file, lower, namelist_names, &
+      & assigned_names, value_has_kind, kind_text
    implicit none
    private
 
@@ -62,6 +63,8 @@ contains
       character(len=4096), allocatable :: source(:)
       integer :: ifile, unit, stat, k, g
       character(len=32), allocatable :: known(:)
+      character, allocatable :: kinds(:)
+      character :: kind
 
       call from_config()
       allocate (all_mentions(0))
@@ -73,11 +76,19 @@ contains
          do k = 1, size(mentions)
             do g = 1, size(group_names)
                if (mentions(k)%group /= group_names(g)) cycle
-               call namelist_names(group_as_text(g), known)
+               call namelist_names(group_as_text(g), known, kinds)
                if (.not. any(known == mentions(k)%name)) then
                   call fatal_error(error, trim(paths(ifile))//':'//itoa(mentions(k)%line)//': &' &
                      & //trim(mentions(k)%group)//": unknown variable '"//trim(mentions(k)%name) &
                      & //"' (known: "//join(known)//')', error_input)
+                  return
+               end if
+               ! The runtime's own check is lenient (it skips some bad values).
+               kind = kinds(findloc(known, mentions(k)%name, dim=1))
+               if (.not. value_has_kind(mentions(k)%value, kind)) then
+                  call fatal_error(error, trim(paths(ifile))//':'//itoa(mentions(k)%line)//': &' &
+                     & //trim(mentions(k)%group)//': '//trim(mentions(k)%name)//' = ' &
+                     & //trim(mentions(k)%value)//': expected '//kind_text(kind), error_input)
                   return
                end if
             end do
@@ -125,9 +136,14 @@ contains
             offending = ''
             backspace (unit, iostat=s2)
             if (s2 == 0) read (unit, '(a)', iostat=s2) offending
-            call fatal_error(error, path//': &'//trim(group_names(g))//': '//trim(msg), error_input)
-            if (len_trim(offending) > 0) &
-               & error%message = error%message//', in the line "'//trim(adjustl(offending))//'"'
+            if (len(assigned_names(offending)) > 0) then
+               call fatal_error(error, path//': &'//trim(group_names(g))//': cannot read the value of ' &
+                  & //assigned_names(offending)//' in "'//trim(adjustl(offending))//'" (' &
+                  & //trim(msg)//'; check the type: number, integer, .true./.false. or ''text'')', &
+                  & error_input)
+            else
+               call fatal_error(error, path//': &'//trim(group_names(g))//': '//trim(msg), error_input)
+            end if
          end if
       end subroutine read_group
 

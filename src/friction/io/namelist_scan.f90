@@ -3,17 +3,22 @@
 !> with line numbers.  It lets the input reader reject unknown groups and
 !> variables with a precise message, and name the file a value came from.
 module friction_io_namelist_scan
+   use, intrinsic :: iso_fortran_env, only: int64
+   use friction_kinds, only: wp
    use friction_error, only: error_type, fatal_error, error_input
    implicit none
    private
 
-   public :: mention, scan_namelist_file, lower, namelist_names
+   public :: mention, scan_namelist_file, lower, namelist_names, assigned_names, value_has_kind, &
+      & kind_text
 
-   !> One assignment `name = ...` inside group `&group` of a file.
+   !> One assignment `name = value` inside group `&group` of a file; value
+   !> is the text after '=' on the same line, up to the next assignment.
    type :: mention
       character(len=32) :: group = ''
       character(len=32) :: name = ''
       integer :: line = 0
+      character(len=256) :: value = ''
    end type mention
 
 contains
@@ -36,14 +41,17 @@ contains
    end function is_name_char
 
    !> The variable names of a group as written by `write(unit, nml=...)`,
-   !> given that text (one `NAME=value` per line, as gfortran writes it).
-   subroutine namelist_names(text, names)
+   !> given that text (one `NAME=value` per line, as gfortran writes it),
+   !> and the kind of each value: 'c' text, 'l' logical, 'r' real, 'i' integer.
+   subroutine namelist_names(text, names, kinds)
       character(len=*), intent(in) :: text
       character(len=32), allocatable, intent(out) :: names(:)
+      character, allocatable, intent(out) :: kinds(:)
       integer :: start, eol, eq
-      character(len=:), allocatable :: line
+      character(len=:), allocatable :: line, value
+      character :: kind
 
-      allocate (names(0))
+      allocate (names(0), kinds(0))
       start = 1
       do while (start <= len(text))
          eol = index(text(start:), new_line('a'))
@@ -55,12 +63,90 @@ contains
          line = adjustl(text(start:eol - 1))
          eq = index(line, '=')
          if (eq > 1 .and. line(1:1) /= '&') then
-            if (verify(lower(trim(line(1:eq - 1))), 'abcdefghijklmnopqrstuvwxyz0123456789_') == 0) &
-               & names = [character(len=32) :: names, lower(trim(line(1:eq - 1)))]
+            if (verify(lower(trim(line(1:eq - 1))), 'abcdefghijklmnopqrstuvwxyz0123456789_') == 0) then
+               value = trim(adjustl(line(eq + 1:)))
+               if (value(1:1) == '"' .or. value(1:1) == "'") then
+                  kind = 'c'
+               else if (value == 'T,' .or. value == 'F,') then
+                  kind = 'l'
+               else if (scan(value, '.Ee') > 0) then
+                  kind = 'r'
+               else
+                  kind = 'i'
+               end if
+               names = [character(len=32) :: names, lower(trim(line(1:eq - 1)))]
+               kinds = [kinds, kind]
+            end if
          end if
          start = eol + 1
       end do
    end subroutine namelist_names
+
+   !> What a kind code means, for messages.
+   pure function kind_text(kind) result(text)
+      character, intent(in) :: kind
+      character(len=:), allocatable :: text
+
+      select case (kind)
+      case ('c'); text = "quoted text, like 'rkf45'"
+      case ('l'); text = '.true. or .false.'
+      case ('r'); text = 'a number'
+      case default; text = 'an integer'
+      end select
+   end function kind_text
+
+   !> Whether every item of a value (separated by commas or blanks outside
+   !> quotes) reads as the kind; an empty value is left to the runtime.
+   logical function value_has_kind(value, kind) result(ok)
+      character(len=*), intent(in) :: value
+      character, intent(in) :: kind
+      character(len=len(value)) :: item
+      integer :: i, n, stat
+      real(wp) :: x
+      integer(int64) :: m
+      character :: quote
+
+      ok = .true.
+      n = 0
+      item = ''
+      quote = ' '
+      do i = 1, len_trim(value) + 1
+         if (i <= len_trim(value)) then
+            if (quote /= ' ') then
+               if (value(i:i) == quote) quote = ' '
+               n = n + 1
+               item(n:n) = value(i:i)
+               cycle
+            end if
+            if (value(i:i) == '"' .or. value(i:i) == "'") quote = value(i:i)
+            if (value(i:i) /= ',' .and. value(i:i) /= ' ') then
+               n = n + 1
+               item(n:n) = value(i:i)
+               cycle
+            end if
+         end if
+         if (n == 0) cycle
+         select case (kind)
+         case ('c')
+            ok = (item(1:1) == '"' .or. item(1:1) == "'") .and. item(n:n) == item(1:1) .and. n >= 2
+         case ('l')
+            select case (lower(item(1:n)))
+            case ('t', 'f', '.t.', '.f.', '.true.', '.false.', 'true', 'false')
+            case default
+               ok = .false.
+            end select
+         case ('r')
+            read (item(1:n), *, iostat=stat) x
+            ok = stat == 0 .and. verify(lower(item(1:n)), '0123456789+-.ed') == 0
+         case default
+            read (item(1:n), *, iostat=stat) m
+            ok = stat == 0 .and. verify(item(1:n), '0123456789+-') == 0
+         end select
+         if (.not. ok) return
+         n = 0
+         item = ''
+      end do
+   end function value_has_kind
 
    !> The groups and assignments of a namelist file.  Groups outside
    !> `known_groups`, and a group given twice, are errors naming the line.
@@ -73,7 +159,7 @@ contains
       character(len=32) :: group, seen(64)
       character(len=8) :: lineno
       character :: quote
-      integer :: unit, stat, line, i, j, k, nseen, n
+      integer :: unit, stat, line, i, j, k, nseen, n, value_from
       logical :: in_group
 
       logical :: exists
@@ -159,7 +245,16 @@ contains
                      if (.not. is_name_char(lower(buffer(j:j)))) exit
                      j = j - 1
                   end do
-                  if (k > j) mentions = [mentions, mention(group, lower(buffer(j + 1:k)), line)]
+                  if (k > j) then
+                     ! The previous assignment's value ends where this name starts.
+                     if (size(mentions) > 0) then
+                        if (mentions(size(mentions))%line == line) &
+                           & mentions(size(mentions))%value = value_text(buffer(value_from:j))
+                     end if
+                     mentions = [mentions, mention(group, lower(buffer(j + 1:k)), line, &
+                        & value_text(buffer(i + 1:)))]
+                     value_from = i + 1
+                  end if
                end if
             end associate
             i = i + 1
@@ -170,6 +265,58 @@ contains
          call fatal_error(error, path//': group &'//trim(group)//" is not closed with '/'", error_input)
       end if
    end subroutine scan_namelist_file
+
+   !> A value's text: up to a closing '/' or a comment outside quotes.
+   pure function value_text(text) result(value)
+      character(len=*), intent(in) :: text
+      character(len=256) :: value
+      character :: quote
+      integer :: i
+
+      quote = ' '
+      do i = 1, len(text)
+         if (quote /= ' ') then
+            if (text(i:i) == quote) quote = ' '
+         else if (text(i:i) == '"' .or. text(i:i) == "'") then
+            quote = text(i:i)
+         else if (text(i:i) == '/' .or. text(i:i) == '!') then
+            value = adjustl(text(1:i - 1))
+            return
+         end if
+      end do
+      value = adjustl(text)
+   end function value_text
+
+   !> The variable names assigned on one line (`name = value`, outside quotes).
+   pure function assigned_names(line) result(text)
+      character(len=*), intent(in) :: line
+      character(len=:), allocatable :: text
+      character :: quote
+      integer :: i, j, k
+
+      text = ''
+      quote = ' '
+      do i = 1, len_trim(line)
+         if (quote /= ' ') then
+            if (line(i:i) == quote) quote = ' '
+         else if (line(i:i) == '"' .or. line(i:i) == "'") then
+            quote = line(i:i)
+         else if (line(i:i) == '!') then
+            exit
+         else if (line(i:i) == '=') then
+            k = len_trim(line(1:i - 1))
+            j = k
+            do while (j >= 1)
+               if (.not. is_name_char(lower(line(j:j)))) exit
+               j = j - 1
+            end do
+            if (k > j) then
+               if (len(text) > 0) text = text//', '
+               text = text//lower(line(j + 1:k))
+            end if
+         end if
+      end do
+   end function assigned_names
 
    pure function join(words) result(text)
       character(len=*), intent(in) :: words(:)
