@@ -12,6 +12,7 @@ program friction_main
    use friction_kinds, only: wp, i8
    use friction_error, only: error_type, fatal_error, error_input, error_io
    use friction_version, only: version_string
+   use friction_strings, only: itoa
    use friction_io_input, only: job_config, read_input
    use friction_io_files, only: file_exists, rename_file, remove_file
    use friction_ode_solver, only: integrator_statistics
@@ -84,6 +85,7 @@ contains
       integer :: first, count, j, failed_rank
       real(wp) :: wall
       character(len=:), allocatable :: temporary
+      character(len=12) :: seconds
       integer :: pid
 
       associate (c => config%afm)
@@ -138,8 +140,10 @@ contains
             call remove_file(temporary)
             call report(error)
          else if (.not. opts%quiet) then
-            write (error_unit, '(a, i0, a, i0, a, f0.2, a, i0, a)') 'friction: wrote '//opts%output// &
-               & ' (', config%afm%ny, ' lines x ', config%afm%nx, ' points, ', wall, ' s on ', nranks, ' ranks)'
+            write (seconds, '(f12.2)') wall
+            write (error_unit, '(a)') 'friction: wrote '//opts%output//' ('//itoa(config%afm%ny) &
+               & //' lines x '//itoa(config%afm%nx)//' points, '//trim(adjustl(seconds))//' s on ' &
+               & //itoa(nranks)//trim(merge(' rank) ', ' ranks)', nranks == 1))
          end if
       end if
       code = merge(1, 0, allocated(error))
@@ -298,14 +302,5 @@ contains
       flush (output_unit)
       call c_exit(int(code, c_int))
    end subroutine finish
-
-   pure function itoa(i) result(text)
-      integer, intent(in) :: i
-      character(len=:), allocatable :: text
-      character(len=16) :: buffer
-
-      write (buffer, '(i0)') i
-      text = trim(buffer)
-   end function itoa
 
 end program friction_main

@@ -8,6 +8,7 @@
 !> namelist text for the output file.
 module friction_io_input
    use friction_kinds, only: wp, i8
+   use friction_strings, only: itoa, rtoa, join, quoted
    use friction_error, only: error_type, fatal_error, error_input
    use friction_ode_solver, only: step_type_names, step_type_index
    use friction_afm_config, only: afm_config, potential_names
@@ -276,60 +277,9 @@ contains
          call require_positive('integrator', 'atol', atol, 'absolute tolerance, Å and Å/s')
          call require_nonnegative('integrator', 'h_start', h_start, 's; 0 chooses automatically')
          call require_nonnegative('integrator', 'h_min', h_min, 's; 0 for no limit')
-         if (max_steps < 1) call reject('integrator', 'max_steps', itoa8(max_steps), 'must be >= 1')
+         if (max_steps < 1) call reject('integrator', 'max_steps', itoa(max_steps), 'must be >= 1')
       end subroutine validate
 
    end subroutine read_input
-
-   pure function itoa(i) result(text)
-      integer, intent(in) :: i
-      character(len=:), allocatable :: text
-      character(len=16) :: buffer
-
-      write (buffer, '(i0)') i
-      text = trim(buffer)
-   end function itoa
-
-   pure function itoa8(i) result(text)
-      integer(i8), intent(in) :: i
-      character(len=:), allocatable :: text
-      character(len=24) :: buffer
-
-      write (buffer, '(i0)') i
-      text = trim(buffer)
-   end function itoa8
-
-   pure function rtoa(x) result(text)
-      real(wp), intent(in) :: x
-      character(len=:), allocatable :: text
-      character(len=32) :: buffer
-
-      write (buffer, '(1pg0.6)') x
-      text = trim(adjustl(buffer))
-   end function rtoa
-
-   pure function join(words) result(text)
-      character(len=*), intent(in) :: words(:)
-      character(len=:), allocatable :: text
-      integer :: i
-
-      text = ''
-      do i = 1, size(words)
-         text = text//trim(words(i))
-         if (i < size(words)) text = text//', '
-      end do
-   end function join
-
-   pure function quoted(words) result(text)
-      character(len=*), intent(in) :: words(:)
-      character(len=:), allocatable :: text
-      integer :: i
-
-      text = ''
-      do i = 1, size(words)
-         text = text//"'"//trim(words(i))//"'"
-         if (i < size(words)) text = text//', '
-      end do
-   end function quoted
 
 end module friction_io_input

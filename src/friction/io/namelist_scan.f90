@@ -5,6 +5,7 @@
 module friction_io_namelist_scan
    use, intrinsic :: iso_fortran_env, only: int64
    use friction_kinds, only: wp
+   use friction_strings, only: join
    use friction_error, only: error_type, fatal_error, error_input
    implicit none
    private
@@ -211,7 +212,7 @@ contains
                   end if
                   if (.not. any(known_groups == group)) then
                      call fatal_error(error, path//':'//trim(lineno)//': unknown namelist group &' &
-                        & //trim(group)//' (known: '//join(known_groups)//')', error_input)
+                        & //trim(group)//' (known: '//join(known_groups, ' ', '&')//')', error_input)
                      close (unit)
                      return
                   end if
@@ -317,17 +318,5 @@ contains
          end if
       end do
    end function assigned_names
-
-   pure function join(words) result(text)
-      character(len=*), intent(in) :: words(:)
-      character(len=:), allocatable :: text
-      integer :: i
-
-      text = ''
-      do i = 1, size(words)
-         text = text//'&'//trim(words(i))
-         if (i < size(words)) text = text//' '
-      end do
-   end function join
 
 end module friction_io_namelist_scan
