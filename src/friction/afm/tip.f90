@@ -77,20 +77,26 @@ contains
    end function tip_position
 
    !> Eq. 4 in (u, r'): u' = r' - v_M, m r'' = -k u - dV/dr - c r'.
+   !> The hot path: scalar loops, no array-valued calls.
    pure subroutine rhs(self, t, y, dydt)
       class(afm_tip), intent(in) :: self
       real(wp), intent(in) :: t
       real(wp), intent(in) :: y(:)
       real(wp), intent(out) :: dydt(:)
-      real(wp) :: r(3), g(3)
-      integer :: nd
+      real(wp) :: r(3), g(3), inverse_mass
+      integer :: nd, i
 
       nd = self%ndim
-      r = self%tip_position(t, y)
+      r(3) = 0.0_wp
+      do i = 1, nd
+         r(i) = self%support_start(i) + self%support_velocity(i) * t + y(i)
+      end do
       call self%potential%gradient(r, g)
-      dydt(1:nd) = y(nd + 1:2 * nd) - self%support_velocity(1:nd)
-      dydt(nd + 1:2 * nd) = (-self%spring(1:nd) * y(1:nd) - g(1:nd) &
-         & - self%damping(1:nd) * y(nd + 1:2 * nd)) / self%mass
+      inverse_mass = 1.0_wp / self%mass
+      do i = 1, nd
+         dydt(i) = y(nd + i) - self%support_velocity(i)
+         dydt(nd + i) = (-self%spring(i) * y(i) - g(i) - self%damping(i) * y(nd + i)) * inverse_mass
+      end do
    end subroutine rhs
 
    !> Analytic Jacobian: the potential's Hessian H enters the velocity rows,

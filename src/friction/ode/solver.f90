@@ -346,17 +346,17 @@ contains
       type(c_ptr), value :: params
       integer(c_int) :: status
       type(system_box), pointer :: box
-      real(wp) :: f(max_dimension)
-      integer :: n
+      integer :: n, i
 
       call c_f_pointer(params, box)
       n = box%n
-      call box%model%rhs(t, y(1:n), f(1:n))
+      call box%model%rhs(t, y(1:n), dydt(1:n))
       box%rhs_evaluations = box%rhs_evaluations + 1
-      dydt(1:n) = f(1:n)
       status = gsl_success
       ! NaN fails every comparison, Inf exceeds huge: both stop the driver at once.
-      if (.not. all(abs(f(1:n)) <= huge(f))) status = gsl_ebadfunc
+      do i = 1, n
+         if (.not. (abs(dydt(i)) <= huge(1.0_c_double))) status = gsl_ebadfunc
+      end do
    end function gsl_rhs
 
    !> Jacobian as GSL wants it: dfdy row-major, dfdy[i*n + j] = ∂f_i/∂y_j.
