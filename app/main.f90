@@ -68,6 +68,14 @@ program friction_main
          & error_input)
       call fail(error)
    end if
+   ! Find out now, not after the computation, whether the output can be written.
+   if (rank == 0) call check_writable(opts%output, error)
+   code = merge(1, 0, allocated(error))
+   call MPI_Bcast(code, 1, MPI_INTEGER, 0, MPI_COMM_WORLD)
+   if (code /= 0) then
+      if (rank == 0) call report(error)
+      call finish(exit_io)
+   end if
 
    call run_afm()
    call finish(0)
@@ -258,6 +266,23 @@ contains
          & '', &
          & 'exit codes: 0 done, 2 usage, 3 bad input, 4 integration failed, 5 output failed'
    end subroutine print_help
+
+   !> Create and remove a probe file beside the output.
+   subroutine check_writable(path, error)
+      character(len=*), intent(in) :: path
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: probe
+      character(len=256) :: message
+      integer :: unit, stat
+
+      probe = path//'.tmp-'//itoa(friction_process_id())
+      open (newunit=unit, file=probe, status='new', action='write', iostat=stat, iomsg=message)
+      if (stat /= 0) then
+         call fatal_error(error, path//': cannot write the output here ('//trim(message)//')', error_io)
+         return
+      end if
+      close (unit, status='delete')
+   end subroutine check_writable
 
    !> inputs/hopg.nml -> hopg.h5
    function default_output(path) result(name)

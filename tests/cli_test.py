@@ -42,6 +42,7 @@ BAD_INPUTS = {
     "unclosed-group": ("&tip mass = 1e-8\n", 3, ["bad.nml", "&tip", "not closed"]),
     "missing-file": (None, 3, ["no-such-file.nml", "no such file"]),
     "no-arguments": (None, 2, ["usage"]),
+    "unwritable-output": (None, 5, ["no-such-dir/out.h5", "cannot write"]),
     "unknown-option": (None, 2, ["--frobnicate"]),
 }
 
@@ -215,6 +216,8 @@ def case_bad(args, name):
         cmd = []
     elif name == "unknown-option":
         cmd = ["--frobnicate", naf]
+    elif name == "unwritable-output":
+        cmd = ["-o", "no-such-dir/out.h5", naf]
     else:
         cmd = [naf, write(args, "bad.nml", text)]
     result = friction(args, *cmd, ranks=2, expect=code)
