@@ -2,9 +2,9 @@
 !>
 !>   mpirun -n N friction [options] FILE.nml [MORE.nml ...]
 !>
-!> The only place that prints and sets the exit code.  Scan lines are shared
-!> among MPI ranks in contiguous blocks; the file is written collectively
-!> under a temporary name and renamed when complete.
+!> The only place that prints and sets the exit code.  Scan lines are dealt
+!> round-robin to the MPI ranks; the file is written collectively under a
+!> temporary name and renamed when complete.
 program friction_main
    use, intrinsic :: iso_c_binding, only: c_int
    use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
@@ -16,7 +16,7 @@ program friction_main
    use friction_io_input, only: job_config, read_input
    use friction_io_files, only: file_exists, rename_file, remove_file
    use friction_ode_solver, only: integrator_statistics
-   use friction_afm_scan, only: afm_scanner, trip_record, block_range, n_quantities
+   use friction_afm_scan, only: afm_scanner, trip_record, share_of, n_quantities
    use friction_afm_output, only: afm_run_summary, write_afm_file
    implicit none
 
@@ -97,17 +97,17 @@ contains
       integer :: pid
 
       associate (c => config%afm)
-         call block_range(c%ny, nranks, rank, first, count)
+         call share_of(c%ny, nranks, rank, first, count)
          allocate (trace(c%nx, count, n_quantities))
          allocate (retrace(c%nx, merge(count, 0, c%retrace), n_quantities))
          call scanner%init(c, error)
          do j = 1, count
             if (allocated(error)) exit
-            call scanner%run_trip(first + j - 1, .true., trip, error)
+            call scanner%run_trip(first + (j - 1) * nranks, .true., trip, error)
             if (allocated(error)) exit
             trace(:, j, :) = trip%values
             if (c%retrace) then
-               call scanner%run_trip(first + j - 1, .false., trip, error)
+               call scanner%run_trip(first + (j - 1) * nranks, .false., trip, error)
                if (allocated(error)) exit
                retrace(:, j, :) = trip%values
             end if
@@ -135,7 +135,8 @@ contains
       pid = friction_process_id()
       call MPI_Bcast(pid, 1, MPI_INTEGER, 0, MPI_COMM_WORLD)
       temporary = opts%output//'.tmp-'//itoa(pid)
-      call write_afm_file(temporary, MPI_COMM_WORLD, config%afm, first, trace, retrace, summary, error)
+      call write_afm_file(temporary, MPI_COMM_WORLD, config%afm, first, nranks, trace, retrace, summary, &
+         & error)
       code = merge(1, 0, allocated(error))
       call MPI_Allreduce(MPI_IN_PLACE, code, 1, MPI_INTEGER, MPI_MAX, MPI_COMM_WORLD)
       if (rank == 0) then
@@ -159,20 +160,24 @@ contains
       if (code /= 0) call finish(exit_io)
    end subroutine run_afm
 
-   !> Rank 0's progress: it scans the first block, as large as any other, so
-   !> its share done is the map's share done.
+   !> Rank 0's progress: its share is as large as any other and spread over
+   !> the whole map, so its fraction done is the map's fraction done.
    subroutine show_progress(done, share, total, last)
       integer, intent(in) :: done, share, total
       logical, intent(in) :: last
       real(wp), save :: shown = -1.0_wp
-      real(wp) :: now, elapsed, remaining
+      real(wp) :: now, elapsed, remaining, interval
       integer :: lines
       logical :: tty
 
       if (opts%quiet) return
       tty = friction_stderr_is_terminal() /= 0
       now = MPI_Wtime()
-      if (.not. last .and. now - shown < merge(0.5_wp, 10.0_wp, tty)) return
+      ! Under mpirun stderr is a pipe even at a terminal: plain lines there,
+      ! spaced further apart as the run goes on so a long batch log stays short.
+      interval = 0.5_wp
+      if (.not. tty) interval = max(2.0_wp, 0.1_wp * (now - t_start))
+      if (.not. last .and. now - max(shown, t_start) < interval) return
       if (last .and. shown < 0.0_wp) return   ! finished before the first report: say nothing
       shown = now
       elapsed = now - t_start

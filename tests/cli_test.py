@@ -158,12 +158,17 @@ def case_ranks(args):
             if f.attrs["nranks"] != n:
                 fail(f"{out}: nranks = {f.attrs['nranks']}, expected {n}")
         files[n] = comparable(os.path.join(args.workdir, out))
-    for n in (2, 3):
-        if files[n].keys() != files[1].keys():
-            fail(f"{n} ranks wrote different objects: {set(files[n]) ^ set(files[1])}")
-        for key, value in files[1].items():
-            if not np.array_equal(np.asarray(value), np.asarray(files[n][key])):
-                fail(f"{key} differs between 1 and {n} ranks")
+    # Fewer lines than ranks: a rank with no line still takes part in the writes.
+    two = write(args, "two.nml", "&scan nx = 24, ny = 2 /\n")
+    for n in (1, 3):
+        friction(args, "-o", f"two_{n}.h5", os.path.join(args.inputs, "naf.nml"), two, ranks=n)
+        files[f"two lines on {n}"] = comparable(os.path.join(args.workdir, f"two_{n}.h5"))
+    for a, b in [(1, 2), (1, 3), ("two lines on 1", "two lines on 3")]:
+        if files[a].keys() != files[b].keys():
+            fail(f"{a} and {b} ranks wrote different objects: {set(files[a]) ^ set(files[b])}")
+        for key, value in files[a].items():
+            if not np.array_equal(np.asarray(value), np.asarray(files[b][key])):
+                fail(f"{key} differs between {a} and {b} ranks")
 
 
 def case_override(args):

@@ -38,13 +38,14 @@ contains
       end do
    end function line_friction
 
-   !> Write the scan.  trace(:, j, q) holds local line j (global first + j - 1,
-   !> 1-based) and quantity q; retrace likewise when config%retrace.
-   subroutine write_afm_file(path, comm, config, first, trace, retrace, summary, error)
+   !> Write the scan.  trace(:, j, q) holds quantity q of local line j, which
+   !> is line first + (j - 1) * stride of the map (0-based); retrace likewise
+   !> when config%retrace.
+   subroutine write_afm_file(path, comm, config, first, stride, trace, retrace, summary, error)
       character(len=*), intent(in) :: path
       type(MPI_Comm), intent(in) :: comm
       type(afm_config), intent(in) :: config
-      integer, intent(in) :: first
+      integer, intent(in) :: first, stride
       real(wp), intent(in) :: trace(:, :, :), retrace(:, :, :)
       type(afm_run_summary), intent(in) :: summary
       type(error_type), allocatable, intent(out) :: error
@@ -80,7 +81,7 @@ contains
       if (config%retrace) then
          call write_trips('/afm/retrace', retrace)
          call file%write_vector_block('/afm/friction', line_friction(trace, retrace), &
-            & config%ny, first, 'nN')
+            & config%ny, first, stride, 'nN')
       end if
       call file%close(error)
 
@@ -93,7 +94,7 @@ contains
          call file%create_group(group)
          do q = 1, n_quantities
             call file%write_line_block(group//'/'//trim(quantity_names(q)), values(:, :, q), &
-               & config%ny, first, trim(quantity_units(q)))
+               & config%ny, first, stride, trim(quantity_units(q)))
          end do
       end subroutine write_trips
 

@@ -81,44 +81,45 @@ contains
       real(wp), intent(in) :: values(:)
 
       if (self%rank == 0) then
-         call write_block(self, name, reshape(values, [1, size(values)]), size(values), 0, units, .true.)
+         call write_block(self, name, reshape(values, [1, size(values)]), size(values), 0, 1, units, .true.)
       else
-         call write_block(self, name, reshape(values, [1, 0]), size(values), 0, units, .true.)
+         call write_block(self, name, reshape(values, [1, 0]), size(values), 0, 1, units, .true.)
       end if
    end subroutine write_vector
 
    !> A 1-D dataset of n_total values to which this rank contributes
-   !> values first+1 .. first+size(values).
-   subroutine write_vector_block(self, name, values, n_total, first, units)
+   !> values(k) at index first + (k - 1) * stride (0-based).
+   subroutine write_vector_block(self, name, values, n_total, first, stride, units)
       class(h5_file), intent(inout) :: self
       character(len=*), intent(in) :: name, units
       real(wp), intent(in) :: values(:)
-      integer, intent(in) :: n_total, first
+      integer, intent(in) :: n_total, first, stride
 
-      call write_block(self, name, reshape(values, [1, size(values)]), n_total, first, units, .true.)
+      call write_block(self, name, reshape(values, [1, size(values)]), n_total, first, stride, units, .true.)
    end subroutine write_vector_block
 
    !> A dataset of shape (nx, n_total) in Fortran, (n_total, nx) in h5py, to
-   !> which this rank contributes columns first+1 .. first+size(block, 2).
-   subroutine write_line_block(self, name, block, n_total, first, units)
+   !> which this rank contributes column k of block at first + (k - 1) * stride.
+   subroutine write_line_block(self, name, block, n_total, first, stride, units)
       class(h5_file), intent(inout) :: self
       character(len=*), intent(in) :: name, units
       real(wp), intent(in) :: block(:, :)
-      integer, intent(in) :: n_total, first
+      integer, intent(in) :: n_total, first, stride
 
-      call write_block(self, name, block, n_total, first, units, .false.)
+      call write_block(self, name, block, n_total, first, stride, units, .false.)
    end subroutine write_line_block
 
    !> Collective write of this rank's columns of a (size(block, 1), n_total)
-   !> dataset, or of a 1-D dataset of n_total values when one_d.
-   subroutine write_block(self, name, block, n_total, first, units, one_d)
+   !> dataset, or of a 1-D dataset of n_total values when one_d: one regular
+   !> (strided) hyperslab per rank.
+   subroutine write_block(self, name, block, n_total, first, stride, units, one_d)
       class(h5_file), intent(inout) :: self
       character(len=*), intent(in) :: name, units
       real(wp), intent(in) :: block(:, :)
-      integer, intent(in) :: n_total, first
+      integer, intent(in) :: n_total, first, stride
       logical, intent(in) :: one_d
       integer(hid_t) :: filespace, memspace, dset, xfer
-      integer(hsize_t) :: dims(2), count(2), offset(2)
+      integer(hsize_t) :: dims(2), count(2), offset(2), step(2)
       integer :: stat, rank
 
       if (self%status /= 0) return
@@ -127,11 +128,13 @@ contains
          dims = [int(n_total, hsize_t), 0_hsize_t]
          count = [int(size(block, 2), hsize_t), 0_hsize_t]
          offset = [int(first, hsize_t), 0_hsize_t]
+         step = [int(stride, hsize_t), 1_hsize_t]
       else
          rank = 2
          dims = [int(size(block, 1), hsize_t), int(n_total, hsize_t)]
          count = [int(size(block, 1), hsize_t), int(size(block, 2), hsize_t)]
          offset = [0_hsize_t, int(first, hsize_t)]
+         step = [1_hsize_t, int(stride, hsize_t)]
       end if
       call h5screate_simple_f(rank, dims(1:rank), filespace, stat)
       call h5dcreate_f(self%id, name, H5T_NATIVE_DOUBLE, filespace, dset, stat)
@@ -139,7 +142,8 @@ contains
       if (stat /= 0) return
       call h5screate_simple_f(rank, count(1:rank), memspace, stat)
       if (size(block) > 0) then
-         call h5sselect_hyperslab_f(filespace, H5S_SELECT_SET_F, offset(1:rank), count(1:rank), stat)
+         call h5sselect_hyperslab_f(filespace, H5S_SELECT_SET_F, offset(1:rank), count(1:rank), stat, &
+            & stride=step(1:rank))
       else
          ! A rank with no lines still takes part in the collective write.
          call h5sselect_none_f(filespace, stat)
