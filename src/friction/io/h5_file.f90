@@ -5,6 +5,7 @@
 !> every dataset.
 module friction_io_h5_file
    use, intrinsic :: iso_fortran_env, only: int64
+   use, intrinsic :: iso_c_binding, only: c_ptr, c_loc
    use mpi_f08, only: MPI_Comm, MPI_INFO_NULL, MPI_Comm_rank
    use hdf5
    use friction_kinds, only: wp, i8
@@ -203,49 +204,43 @@ contains
    subroutine write_attribute_real(self, object, name, value)
       class(h5_file), intent(inout) :: self
       character(len=*), intent(in) :: object, name
-      real(wp), intent(in) :: value
-      integer(hid_t) :: obj, space, attr
-      integer(hsize_t) :: dims(1) = [1]
-      integer :: stat
+      real(wp), intent(in), target :: value
 
-      if (self%status /= 0) return
-      call h5oopen_f(self%id, object, obj, stat)
-      call self%check(stat, 'opening '//object)
-      if (stat /= 0) return
-      call h5screate_f(H5S_SCALAR_F, space, stat)
-      call h5acreate_f(obj, name, H5T_NATIVE_DOUBLE, space, attr, stat)
-      call self%check(stat, 'creating attribute '//name)
-      if (stat == 0) then
-         call h5awrite_f(attr, H5T_NATIVE_DOUBLE, value, dims, stat)
-         call h5aclose_f(attr, stat)
-      end if
-      call h5sclose_f(space, stat)
-      call h5oclose_f(obj, stat)
+      call scalar_attribute(self, object, name, H5T_NATIVE_DOUBLE, c_loc(value))
    end subroutine write_attribute_real
 
    subroutine write_attribute_integer(self, object, name, value)
       class(h5_file), intent(inout) :: self
       character(len=*), intent(in) :: object, name
-      integer(i8), intent(in) :: value
-      integer(hid_t) :: obj, space, attr, type
-      integer(hsize_t) :: dims(1) = [1]
+      integer(i8), intent(in), target :: value
+
+      call scalar_attribute(self, object, name, h5kind_to_type(int64, H5_INTEGER_KIND), c_loc(value))
+   end subroutine write_attribute_integer
+
+   !> A scalar numeric attribute of HDF5 type `type` read from `value`.
+   subroutine scalar_attribute(self, object, name, type, value)
+      class(h5_file), intent(inout) :: self
+      character(len=*), intent(in) :: object, name
+      integer(hid_t), intent(in) :: type
+      type(c_ptr), intent(in) :: value
+      integer(hid_t) :: obj, space, attr
       integer :: stat
 
       if (self%status /= 0) return
       call h5oopen_f(self%id, object, obj, stat)
       call self%check(stat, 'opening '//object)
       if (stat /= 0) return
-      type = h5kind_to_type(int64, H5_INTEGER_KIND)
       call h5screate_f(H5S_SCALAR_F, space, stat)
       call h5acreate_f(obj, name, type, space, attr, stat)
       call self%check(stat, 'creating attribute '//name)
       if (stat == 0) then
-         call h5awrite_f(attr, type, value, dims, stat)
+         call h5awrite_f(attr, type, value, stat)
+         call self%check(stat, 'writing attribute '//name)
          call h5aclose_f(attr, stat)
       end if
       call h5sclose_f(space, stat)
       call h5oclose_f(obj, stat)
-   end subroutine write_attribute_integer
+   end subroutine scalar_attribute
 
    !> Close the file; report the first failure since create, if any.
    subroutine close(self, error)
