@@ -1,7 +1,7 @@
 !> Scan geometry and the integration of one trip of the support.
 !>
-!> Line j (0-based) runs along the scan direction u at the offset
-!> t_j = j * width / (ny - 1) along the across direction n from the origin.
+!> Line j (0-based) runs along the scan direction at the offset
+!> t_j = j * width / (ny - 1) across it (the direction turned by +90°) from the origin.
 !> Sample i sits at s_i = i * length / (nx - 1) along the line.  A trace trip
 !> moves the support from s = -lead_in to s = length; a retrace trip from
 !> s = length + lead_in back to 0; samples are stored by i either way, so
@@ -111,7 +111,7 @@ contains
       logical, intent(in) :: forward
       type(trip_record), intent(inout) :: record
       type(error_type), allocatable, intent(out) :: error
-      real(wp) :: u(3), n(3), line_start(3), s(self%config%nx), offset(self%config%ny)
+      real(wp) :: along(3), across(3), line_start(3), s(self%config%nx), offset(self%config%ny)
       real(wp) :: y(6), t, t_sample, s_start, force(3), tip_r(3)
       integer :: i, k, nx, nd
       character(len=96) :: where
@@ -119,20 +119,20 @@ contains
       associate (c => self%config, tip => self%tip)
          nx = c%nx
          nd = tip%ndim
-         u = c%scan_direction()
-         n = c%across_direction()
+         along = c%scan_direction()
+         across = c%across_direction()
          s = support_along(c)
          offset = support_across(c)
-         line_start = [c%origin_x, c%origin_y, 0.0_wp] + offset(j + 1) * n
+         line_start = [c%origin_x, c%origin_y, 0.0_wp] + offset(j + 1) * across
          if (forward) then
             s_start = -c%lead_in
-            tip%support_velocity = c%velocity * u
+            tip%support_velocity = c%velocity * along
          else
             s_start = c%length + c%lead_in
-            tip%support_velocity = -c%velocity * u
+            tip%support_velocity = -c%velocity * along
          end if
-         tip%support_start = line_start + s_start * u
-         ! At the support and at rest: u = 0, r' = 0.
+         tip%support_start = line_start + s_start * along
+         ! At the support and at rest: r - r_M = 0, r' = 0.
          y = 0.0_wp
          t = 0.0_wp
          call self%solver%restart(self%h_start)
@@ -151,8 +151,8 @@ contains
             tip_r = tip%tip_position(t, y)
             record%values(i, q_fx) = force(1)
             record%values(i, q_fy) = force(2)
-            record%values(i, q_f_along) = dot_product(force, u)
-            record%values(i, q_f_across) = dot_product(force, n)
+            record%values(i, q_f_along) = dot_product(force, along)
+            record%values(i, q_f_across) = dot_product(force, across)
             record%values(i, q_tip_x) = tip_r(1)
             record%values(i, q_tip_y) = tip_r(2)
          end do
