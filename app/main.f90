@@ -17,7 +17,9 @@ program friction_main
    use friction_io_files, only: file_exists, rename_file, remove_file
    use friction_ode_solver, only: integrator_statistics
    use friction_afm_scan, only: afm_scanner, trip_record, share_of, n_quantities
-   use friction_afm_output, only: afm_run_summary, write_afm_file
+   use friction_afm_output, only: afm_run_summary, write_afm_file, afm_surface_record
+   use friction_afm_config, only: new_potential, species_count
+   use friction_surface_potential, only: surface_potential
    implicit none
 
    interface
@@ -85,6 +87,8 @@ contains
    !> Scan this rank's lines, then write the file together.
    subroutine run_afm()
       type(afm_scanner), target :: scanner
+      class(surface_potential), allocatable :: potential
+      type(afm_surface_record) :: surface
       type(trip_record) :: trip
       real(wp), allocatable :: trace(:, :, :), retrace(:, :, :)
       type(afm_run_summary) :: summary
@@ -97,10 +101,17 @@ contains
       integer :: pid
 
       associate (c => config%afm)
+         ! The surface first, identically on every rank: a bad net or defect is
+         ! bad input, reported before any work.
+         call new_potential(c, potential, error, surface%net, surface%cutoff)
+         if (allocated(error)) call fail(error)
+         surface%species_names = c%species(1:species_count(c))
          call share_of(c%ny, nranks, rank, first, count)
          allocate (trace(c%nx, count, n_quantities))
          allocate (retrace(c%nx, merge(count, 0, c%retrace), n_quantities))
-         call scanner%init(c, error)
+         call scanner%init(c, potential, error)
+         surface%contact_height = scanner%contact_height
+         surface%support_height = scanner%support_height
          do j = 1, count
             if (allocated(error)) exit
             call scanner%run_trip(first + (j - 1) * nranks, .true., trip, error)
@@ -120,8 +131,13 @@ contains
       failed_rank = merge(rank, nranks, allocated(error))
       call MPI_Allreduce(MPI_IN_PLACE, failed_rank, 1, MPI_INTEGER, MPI_MIN, MPI_COMM_WORLD)
       if (failed_rank < nranks) then
-         if (rank == failed_rank) call report(error)
-         call finish(exit_numerical)
+         code = exit_numerical
+         if (rank == failed_rank) then
+            call report(error)
+            code = exit_code(error)
+         end if
+         call MPI_Bcast(code, 1, MPI_INTEGER, failed_rank, MPI_COMM_WORLD)
+         call finish(code)
       end if
 
       stats = scanner%statistics()
@@ -135,8 +151,13 @@ contains
       pid = friction_process_id()
       call MPI_Bcast(pid, 1, MPI_INTEGER, 0, MPI_COMM_WORLD)
       temporary = opts%output//'.tmp-'//itoa(pid)
-      call write_afm_file(temporary, MPI_COMM_WORLD, config%afm, first, nranks, trace, retrace, summary, &
-         & error)
+      if (scanner%tip%ndim == 3) then
+         call write_afm_file(temporary, MPI_COMM_WORLD, config%afm, first, nranks, trace, retrace, summary, &
+            & error, surface)
+      else
+         call write_afm_file(temporary, MPI_COMM_WORLD, config%afm, first, nranks, trace, retrace, summary, &
+            & error)
+      end if
       code = merge(1, 0, allocated(error))
       call MPI_Allreduce(MPI_IN_PLACE, code, 1, MPI_INTEGER, MPI_MAX, MPI_COMM_WORLD)
       if (rank == 0) then
@@ -166,6 +187,7 @@ contains
       integer, intent(in) :: done, share, total
       logical, intent(in) :: last
       real(wp), save :: shown = -1.0_wp
+      integer, save :: shown_done = -1
       real(wp) :: now, elapsed, remaining, interval
       integer :: lines
       logical :: tty
@@ -178,8 +200,9 @@ contains
       interval = 0.5_wp
       if (.not. tty) interval = max(2.0_wp, 0.1_wp * (now - t_start))
       if (.not. last .and. now - max(shown, t_start) < interval) return
-      if (last .and. shown < 0.0_wp) return   ! finished before the first report: say nothing
+      if (last .and. (shown < 0.0_wp .or. done == shown_done)) return   ! nothing new to say
       shown = now
+      shown_done = done
       elapsed = now - t_start
       lines = min(total, int(real(done, wp) / max(1, share) * total))
       remaining = 0.0_wp
@@ -314,15 +337,21 @@ contains
       type(error_type), intent(in) :: error
 
       if (rank == 0) call report(error)
+      call finish(exit_code(error))
+   end subroutine fail
+
+   integer function exit_code(error)
+      type(error_type), intent(in) :: error
+
       select case (error%stat)
       case (error_input)
-         call finish(exit_input)
+         exit_code = exit_input
       case (error_io)
-         call finish(exit_io)
+         exit_code = exit_io
       case default
-         call finish(exit_numerical)
+         exit_code = exit_numerical
       end select
-   end subroutine fail
+   end function exit_code
 
    subroutine finish(code)
       integer, intent(in) :: code

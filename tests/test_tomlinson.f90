@@ -13,7 +13,8 @@
 program test_tomlinson
    use friction_kinds, only: wp, pi, ev_per_angstrom_to_nn, n_per_m_to_internal
    use friction_error, only: error_type
-   use friction_afm_config, only: afm_config
+   use friction_afm_config, only: afm_config, new_potential
+   use friction_surface_potential, only: surface_potential
    use friction_afm_scan, only: afm_scanner, trip_record, q_f_along, q_fy
    use testing, only: test_suite, check, check_close
    implicit none
@@ -55,8 +56,10 @@ contains
       type(afm_scanner), target :: scanner
       type(trip_record) :: trip
       type(error_type), allocatable :: error
+      class(surface_potential), allocatable :: potential
 
-      call scanner%init(c, error)
+      call new_potential(c, potential, error)
+      if (.not. allocated(error)) call scanner%init(c, potential, error)
       if (.not. allocated(error)) call scanner%run_trip(0, .true., trip, error)
       if (.not. allocated(error)) trace = trip%values
       if (.not. allocated(error)) call scanner%run_trip(0, .false., trip, error)

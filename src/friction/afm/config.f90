@@ -1,20 +1,26 @@
 !> Settings of a friction-force-map scene, in the units of the namelist
 !> (see README: input reference), and the conversion to the internal model.
 module friction_afm_config
-   use friction_kinds, only: wp, kg_to_internal, n_per_m_to_internal, ns_per_m_to_internal, &
+   use friction_kinds, only: wp, pi, kg_to_internal, n_per_m_to_internal, ns_per_m_to_internal, &
       & deg_to_rad
    use friction_error, only: error_type, fatal_error, error_input
    use friction_ode_solver, only: solver_settings
    use friction_surface_potential, only: surface_potential
    use friction_surface_naf, only: new_naf_potential
    use friction_surface_hopg, only: new_hopg_potential
+   use friction_surface_net, only: crystal_net, graphite_net, square_net, read_xyz
+   use friction_surface_lennard_jones, only: new_lj_potential, cutoff_for_tolerance
+   use friction_kinds, only: ev_per_angstrom_to_nn
    use friction_afm_tip, only: afm_tip
    implicit none
    private
 
-   public :: afm_config, potential_names, new_potential, new_tip
+   public :: afm_config, potential_names, net_names, new_potential, new_tip, net_sites, max_species, &
+      & max_defects, species_count
 
-   character(len=*), parameter :: potential_names(2) = [character(len=4) :: 'naf', 'hopg']
+   character(len=*), parameter :: potential_names(3) = [character(len=4) :: 'naf', 'hopg', 'lj']
+   character(len=*), parameter :: net_names(3) = [character(len=8) :: 'graphite', 'square', 'file']
+   integer, parameter :: max_species = 8, max_defects = 64
 
    type :: afm_config
       ! &surface
@@ -22,13 +28,31 @@ module friction_afm_config
       real(wp) :: v0 = 1.0_wp          !! potential amplitude, eV
       real(wp) :: ax = 4.62_wp         !! NaF period along x, Å
       real(wp) :: ay = 4.62_wp         !! NaF period along y, Å
-      real(wp) :: a = 2.46_wp          !! HOPG lattice constant, Å
+      real(wp) :: a = 2.46_wp          !! HOPG, graphite or square-net lattice constant, Å
+      ! &surface, Lennard-Jones sum over a crystal net (Eq. 3)
+      character(len=16) :: net = 'graphite'   !! 'graphite', 'square' or 'file'
+      character(len=1024) :: net_file = ''    !! XYZ file when net = 'file'
+      integer :: shells = 9            !! graphite: hexagon shells around the central ring
+      integer :: side = 20             !! square: atoms per edge
+      !> Tip–atom pair parameters by species (Sasaki et al. for carbon); a
+      !> blank name ends the table.
+      character(len=8) :: species(max_species) = [character(len=8) :: 'C', '', '', '', '', '', '', '']
+      real(wp) :: epsilon(max_species) = [0.87381e-2_wp, 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp]
+      real(wp) :: sigma(max_species) = [2.4945_wp, 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp]
+      integer :: vacancies(max_defects) = 0       !! site numbers (1-based); 0 unused
+      integer :: substitutions(max_defects) = 0   !! site numbers (1-based); 0 unused
+      character(len=8) :: substitution_species = ''
+      real(wp) :: cutoff = 0.0_wp            !! Å; 0: from cutoff_tolerance
+      real(wp) :: cutoff_tolerance = 1.0e-4_wp   !! largest force of the atoms beyond the cutoff, nN
       ! &tip
       real(wp) :: mass = 1.0e-8_wp     !! kg
       real(wp) :: kx = 10.0_wp         !! N/m
       real(wp) :: ky = 10.0_wp         !! N/m
       real(wp) :: cx = 1.0e-3_wp       !! N s/m
       real(wp) :: cy = 1.0e-3_wp       !! N s/m
+      real(wp) :: kz = 0.25_wp         !! N/m (three-dimensional potentials)
+      real(wp) :: cz = 0.0_wp          !! N s/m
+      real(wp) :: support_z = 0.0_wp   !! support height from the contact height, Å
       ! &scan
       real(wp) :: velocity = 400.0_wp  !! support speed, Å/s
       real(wp) :: length = 20.0_wp     !! along the scan direction, Å
@@ -65,34 +89,134 @@ contains
       n = [-sin(self%angle * deg_to_rad), cos(self%angle * deg_to_rad), 0.0_wp]
    end function across_direction
 
-   !> The surface potential the settings name.
-   subroutine new_potential(config, potential, error)
+   !> Species in use: the names before the first blank one.
+   pure integer function species_count(config)
+      type(afm_config), intent(in) :: config
+
+      do species_count = 0, max_species - 1
+         if (len_trim(config%species(species_count + 1)) == 0) return
+      end do
+      species_count = max_species
+   end function species_count
+
+   !> Number of sites of the net the settings describe (before vacancies),
+   !> without building it; -1 if an XYZ file cannot tell.
+   function net_sites(config) result(n)
+      type(afm_config), intent(in) :: config
+      integer :: n, unit, stat
+
+      select case (trim(config%net))
+      case ('graphite')
+         n = 6 * (config%shells + 1)**2
+      case ('square')
+         n = config%side**2
+      case default
+         n = -1
+         open (newunit=unit, file=config%net_file, status='old', action='read', iostat=stat)
+         if (stat /= 0) return
+         read (unit, *, iostat=stat) n
+         if (stat /= 0) n = -1
+         close (unit)
+      end select
+   end function net_sites
+
+   !> The crystal net with its defects.
+   subroutine new_net(config, net, error)
+      type(afm_config), intent(in) :: config
+      type(crystal_net), intent(out) :: net
+      type(error_type), allocatable, intent(out) :: error
+      logical, allocatable :: vacant(:)
+      integer :: substitute
+
+      select case (trim(config%net))
+      case ('graphite')
+         net = graphite_net(config%a, config%shells)
+      case ('square')
+         net = square_net(config%a, config%side)
+      case default
+         call read_xyz(trim(config%net_file), config%species(1:species_count(config)), net, error)
+         if (allocated(error)) return
+      end select
+      ! Substitutions first: site numbers refer to the net before vacancies.
+      if (any(config%substitutions > 0)) then
+         substitute = findloc(config%species, config%substitution_species, dim=1)
+         call net%substitute(pack(config%substitutions, config%substitutions > 0), substitute)
+      end if
+      allocate (vacant(net%size()))
+      vacant = .false.
+      vacant(pack(config%vacancies, config%vacancies > 0)) = .true.
+      call net%remove_sites(vacant)
+   end subroutine new_net
+
+   !> Atoms per Å² in the middle of a net: those within 8 Å of its centroid
+   !> (the whole bounding box for a small net).
+   pure real(wp) function net_density(net) result(density)
+      type(crystal_net), intent(in) :: net
+      real(wp), parameter :: radius = 8.0_wp
+      real(wp) :: centre(2), extent(2)
+      integer :: inside, i
+
+      centre = sum(net%position(1:2, :), dim=2) / net%size()
+      inside = 0
+      do i = 1, net%size()
+         if (sum((net%position(1:2, i) - centre)**2) < radius**2) inside = inside + 1
+      end do
+      extent = maxval(net%position(1:2, :), dim=2) - minval(net%position(1:2, :), dim=2)
+      if (inside >= 10) then
+         density = inside / (pi * radius**2)
+      else
+         density = net%size() / max(1.0_wp, product(extent + 1.0_wp))
+      end if
+   end function net_density
+
+   !> The surface potential the settings name; for a lattice sum also the
+   !> net (for the output) and the cutoff used.
+   subroutine new_potential(config, potential, error, net, cutoff)
       type(afm_config), intent(in) :: config
       class(surface_potential), allocatable, intent(out) :: potential
       type(error_type), allocatable, intent(out) :: error
+      type(crystal_net), intent(out), optional :: net
+      real(wp), intent(out), optional :: cutoff
+      type(crystal_net) :: atoms
+      real(wp) :: rc
+      integer :: ns
 
       select case (trim(config%potential))
       case ('naf')
          allocate (potential, source=new_naf_potential(config%v0, config%ax, config%ay))
       case ('hopg')
          allocate (potential, source=new_hopg_potential(config%v0, config%a))
+      case ('lj')
+         call new_net(config, atoms, error)
+         if (allocated(error)) return
+         if (atoms%size() == 0) then
+            call fatal_error(error, 'the crystal net has no atoms left', error_input)
+            return
+         end if
+         ns = species_count(config)
+         rc = config%cutoff
+         if (rc <= 0.0_wp) rc = cutoff_for_tolerance(maxval(config%epsilon(1:ns) * config%sigma(1:ns)**6), &
+            & 1.0_wp, net_density(atoms), config%cutoff_tolerance / ev_per_angstrom_to_nn)
+         allocate (potential, source=new_lj_potential(atoms, config%epsilon(1:ns), config%sigma(1:ns), rc))
+         if (present(net)) net = atoms
+         if (present(cutoff)) cutoff = rc
       case default
          call fatal_error(error, "unknown potential '"//trim(config%potential)//"'", error_input)
       end select
    end subroutine new_potential
 
-   !> The tip model in internal units; the support path is set per trip.
-   subroutine new_tip(config, tip, error)
+   !> The tip model in internal units around a potential; the support path
+   !> is set per trip.
+   subroutine new_tip(config, potential, tip)
       type(afm_config), intent(in) :: config
+      class(surface_potential), intent(in) :: potential
       type(afm_tip), intent(out) :: tip
-      type(error_type), allocatable, intent(out) :: error
 
-      call new_potential(config, tip%potential, error)
-      if (allocated(error)) return
+      allocate (tip%potential, source=potential)
       tip%ndim = tip%potential%dimensions()
       tip%mass = config%mass * kg_to_internal
-      tip%spring = [config%kx, config%ky, 0.0_wp] * n_per_m_to_internal
-      tip%damping = [config%cx, config%cy, 0.0_wp] * ns_per_m_to_internal
+      tip%spring = [config%kx, config%ky, config%kz] * n_per_m_to_internal
+      tip%damping = [config%cx, config%cy, config%cz] * ns_per_m_to_internal
    end subroutine new_tip
 
 end module friction_afm_config

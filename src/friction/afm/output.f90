@@ -6,13 +6,24 @@ module friction_afm_output
    use friction_error, only: error_type
    use friction_ode_solver, only: integrator_statistics
    use friction_afm_config, only: afm_config
-   use friction_afm_scan, only: quantity_names, quantity_units, n_quantities, q_f_along, &
+   use friction_afm_scan, only: quantity_names, quantity_units, quantity_count, q_f_along, &
       & support_along, support_across
    use friction_io_h5_file, only: h5_file
+   use friction_surface_net, only: crystal_net
+   use friction_strings, only: join
    implicit none
    private
 
-   public :: afm_run_summary, write_afm_file, line_friction
+   public :: afm_run_summary, write_afm_file, line_friction, afm_surface_record
+
+   !> The sample of a lattice-sum scene, for pictures that overlay it.
+   type :: afm_surface_record
+      type(crystal_net) :: net
+      character(len=8), allocatable :: species_names(:)
+      real(wp) :: cutoff = 0.0_wp           !! Å
+      real(wp) :: contact_height = 0.0_wp   !! Å
+      real(wp) :: support_height = 0.0_wp   !! Å
+   end type afm_surface_record
 
    !> What the file records about the run besides the maps.
    type :: afm_run_summary
@@ -41,7 +52,7 @@ contains
    !> Write the scan.  trace(:, j, q) holds quantity q of local line j, which
    !> is line first + (j - 1) * stride of the map (0-based); retrace likewise
    !> when config%retrace.
-   subroutine write_afm_file(path, comm, config, first, stride, trace, retrace, summary, error)
+   subroutine write_afm_file(path, comm, config, first, stride, trace, retrace, summary, error, surface)
       character(len=*), intent(in) :: path
       type(MPI_Comm), intent(in) :: comm
       type(afm_config), intent(in) :: config
@@ -49,9 +60,11 @@ contains
       real(wp), intent(in) :: trace(:, :, :), retrace(:, :, :)
       type(afm_run_summary), intent(in) :: summary
       type(error_type), allocatable, intent(out) :: error
+      !> present for a tip moving in 3D over a crystal net
+      type(afm_surface_record), intent(in), optional :: surface
       type(h5_file) :: file
       type(error_type), allocatable :: close_error
-      integer :: q
+      integer :: q, nq
 
       call file%create(path, comm, error)
       if (allocated(error)) then
@@ -77,6 +90,16 @@ contains
       call file%write_attribute_real('/afm', 'origin_y', config%origin_y)
       call file%write_vector('/afm/support_x', support_along(config), 'angstrom')
       call file%write_vector('/afm/support_y', support_across(config), 'angstrom')
+      nq = quantity_count(merge(3, 2, present(surface)))
+      if (present(surface)) then
+         call file%write_attribute_real('/afm', 'contact_height', surface%contact_height)
+         call file%write_attribute_real('/afm', 'support_height', surface%support_height)
+         call file%create_group('/surface')
+         call file%write_matrix('/surface/atoms', surface%net%position, 'angstrom')
+         call file%write_integer_vector('/surface/species', surface%net%species)
+         call file%write_attribute_text('/surface', 'species_names', join(surface%species_names))
+         call file%write_attribute_real('/surface', 'cutoff', surface%cutoff)
+      end if
       call write_trips('/afm/trace', trace)
       if (config%retrace) then
          call write_trips('/afm/retrace', retrace)
@@ -92,7 +115,7 @@ contains
          real(wp), intent(in) :: values(:, :, :)
 
          call file%create_group(group)
-         do q = 1, n_quantities
+         do q = 1, nq
             call file%write_line_block(group//'/'//trim(quantity_names(q)), values(:, :, q), &
                & config%ny, first, stride, trim(quantity_units(q)))
          end do

@@ -9,24 +9,28 @@
 !> at the support and at rest (paper §3.1, §5.1).
 module friction_afm_scan
    use friction_kinds, only: wp, i8, pi, ev_per_angstrom_to_nn
-   use friction_error, only: error_type, fatal_error
+   use friction_error, only: error_type, fatal_error, error_input
    use friction_ode_solver, only: ode_solver, integrator_statistics
    use friction_afm_config, only: afm_config, new_tip
    use friction_afm_tip, only: afm_tip
+   use friction_surface_potential, only: surface_potential
+   use friction_strings, only: rtoa
    implicit none
    private
 
-   public :: afm_scanner, trip_record, quantity_names, quantity_units, n_quantities
-   public :: q_fx, q_fy, q_f_along, q_f_across, q_tip_x, q_tip_y
+   public :: afm_scanner, trip_record, quantity_names, quantity_units, n_quantities, quantity_count
+   public :: q_fx, q_fy, q_f_along, q_f_across, q_tip_x, q_tip_y, q_fz, q_tip_z
    public :: support_along, support_across, share_of
 
-   integer, parameter :: n_quantities = 6
-   integer, parameter :: q_fx = 1, q_fy = 2, q_f_along = 3, q_f_across = 4, q_tip_x = 5, q_tip_y = 6
-   !> HDF5 dataset names and units of the recorded quantities.
+   integer, parameter :: n_quantities = 8
+   integer, parameter :: q_fx = 1, q_fy = 2, q_f_along = 3, q_f_across = 4, q_tip_x = 5, q_tip_y = 6, &
+      & q_fz = 7, q_tip_z = 8
+   !> HDF5 dataset names and units of the recorded quantities; the last two
+   !> only for a tip that moves in z.
    character(len=*), parameter :: quantity_names(n_quantities) = [character(len=8) :: &
-      & 'fx', 'fy', 'f_along', 'f_across', 'tip_x', 'tip_y']
+      & 'fx', 'fy', 'f_along', 'f_across', 'tip_x', 'tip_y', 'fz', 'tip_z']
    character(len=*), parameter :: quantity_units(n_quantities) = [character(len=8) :: &
-      & 'nN', 'nN', 'nN', 'nN', 'angstrom', 'angstrom']
+      & 'nN', 'nN', 'nN', 'nN', 'angstrom', 'angstrom', 'nN', 'angstrom']
 
    !> One trip's samples: values(i, q) for sample i and quantity q (output units).
    type :: trip_record
@@ -39,6 +43,8 @@ module friction_afm_scan
       type(afm_tip), allocatable :: tip
       type(ode_solver) :: solver
       real(wp) :: h_start = 0.0_wp
+      real(wp) :: contact_height = 0.0_wp   !! z0: free tip's equilibrium height at the origin, Å (3D)
+      real(wp) :: support_height = 0.0_wp   !! z_M = z0 + support_z, Å (3D)
    contains
       procedure :: init
       procedure :: run_trip
@@ -46,6 +52,13 @@ module friction_afm_scan
    end type afm_scanner
 
 contains
+
+   !> Quantities recorded for a tip moving in ndim dimensions.
+   pure integer function quantity_count(ndim)
+      integer, intent(in) :: ndim
+
+      quantity_count = merge(n_quantities, q_tip_y, ndim == 3)
+   end function quantity_count
 
    !> Support positions along the line, Å.
    pure function support_along(config) result(s)
@@ -83,17 +96,25 @@ contains
       count = max(0, (n - rank + nranks - 1) / nranks)
    end subroutine share_of
 
-   subroutine init(self, config, error)
+   subroutine init(self, config, potential, error)
       class(afm_scanner), intent(inout) :: self
       type(afm_config), intent(in) :: config
+      class(surface_potential), intent(in) :: potential
       type(error_type), allocatable, intent(out) :: error
       real(wp) :: sample_time, period
 
       self%config = config
       if (allocated(self%tip)) deallocate (self%tip)
       allocate (self%tip)
-      call new_tip(config, self%tip, error)
-      if (allocated(error)) return
+      call new_tip(config, potential, self%tip)
+      if (self%tip%ndim == 3) then
+         ! The support's height is set from the contact of the free tip at the
+         ! scan origin: z_M = z0 + support_z (support_z < 0 presses the tip).
+         call find_height(self%tip, [config%origin_x, config%origin_y, 0.0_wp], 0.0_wp, &
+            & self%contact_height, error)
+         if (allocated(error)) return
+         self%support_height = self%contact_height + config%support_z
+      end if
       ! First step: a small fraction of the fastest time scale in sight.
       sample_time = config%length / real(config%nx - 1, wp) / config%velocity
       period = sample_time
@@ -112,7 +133,7 @@ contains
       type(trip_record), intent(inout) :: record
       type(error_type), allocatable, intent(out) :: error
       real(wp) :: along(3), across(3), line_start(3), s(self%config%nx), offset(self%config%ny)
-      real(wp) :: y(6), t, t_sample, s_start, force(3), tip_r(3)
+      real(wp) :: y(6), t, t_sample, s_start, force(3), tip_r(3), z_start
       integer :: i, k, nx, nd
       character(len=96) :: where
 
@@ -132,8 +153,15 @@ contains
             tip%support_velocity = -c%velocity * along
          end if
          tip%support_start = line_start + s_start * along
-         ! At the support and at rest: r - r_M = 0, r' = 0.
+         ! At the support and at rest: r - r_M = 0, r' = 0; in z at the
+         ! static equilibrium under the support (paper §3.1: z differs).
          y = 0.0_wp
+         if (nd == 3) then
+            tip%support_start(3) = self%support_height
+            call find_height(tip, tip%support_start, tip%spring(3), z_start, error)
+            if (allocated(error)) return
+            y(3) = z_start - self%support_height
+         end if
          t = 0.0_wp
          call self%solver%restart(self%h_start)
          if (.not. allocated(record%values)) allocate (record%values(nx, n_quantities))
@@ -155,9 +183,60 @@ contains
             record%values(i, q_f_across) = dot_product(force, across)
             record%values(i, q_tip_x) = tip_r(1)
             record%values(i, q_tip_y) = tip_r(2)
+            record%values(i, q_fz) = force(3)
+            record%values(i, q_tip_z) = tip_r(3)
          end do
       end associate
    end subroutine run_trip
+
+   !> The height z at which the tip above (x, y) = at(1:2) is in equilibrium
+   !> between the surface and a z spring of constant `spring` (eV/Å²) held
+   !> at z_M = at(3): the root of g(z) = spring (z - z_M) + dV/dz.  Searched
+   !> downward from 20 Å above the support or the contact, so it is the
+   !> equilibrium a tip brought in from above reaches; refined by bisection
+   !> to 1e-12 Å.  spring = 0 gives the free tip's contact height.
+   subroutine find_height(tip, at, spring, z, error)
+      type(afm_tip), intent(in) :: tip
+      real(wp), intent(in) :: at(3), spring
+      real(wp), intent(out) :: z
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: upper, lower, middle
+      integer :: k
+
+      upper = max(at(3), 0.0_wp) + 20.0_wp
+      lower = upper
+      do k = 1, 4000
+         lower = upper - 0.05_wp
+         if (force_balance(lower) < 0.0_wp) exit
+         upper = lower
+      end do
+      if (force_balance(lower) >= 0.0_wp) then
+         call fatal_error(error, 'no contact height found: the tip is not repelled anywhere above (' &
+            & //rtoa(at(1))//', '//rtoa(at(2))//') Å; is the scan over the net?', error_input)
+         return
+      end if
+      do k = 1, 200
+         middle = 0.5_wp * (lower + upper)
+         if (upper - lower < 1.0e-12_wp) exit
+         if (force_balance(middle) < 0.0_wp) then
+            lower = middle
+         else
+            upper = middle
+         end if
+      end do
+      z = 0.5_wp * (lower + upper)
+
+   contains
+
+      real(wp) function force_balance(height)
+         real(wp), intent(in) :: height
+         real(wp) :: g(3)
+
+         call tip%potential%gradient([at(1), at(2), height], g)
+         force_balance = spring * (height - at(3)) + g(3)
+      end function force_balance
+
+   end subroutine find_height
 
    !> Integrator counters of all trips so far.
    function statistics(self) result(stats)

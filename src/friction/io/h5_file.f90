@@ -26,6 +26,8 @@ module friction_io_h5_file
       procedure :: create
       procedure :: create_group
       procedure :: write_vector
+      procedure :: write_integer_vector
+      procedure :: write_matrix
       procedure :: write_vector_block
       procedure :: write_line_block
       procedure :: write_attribute_text
@@ -79,24 +81,47 @@ contains
    subroutine write_vector(self, name, values, units)
       class(h5_file), intent(inout) :: self
       character(len=*), intent(in) :: name, units
-      real(wp), intent(in) :: values(:)
+      real(wp), intent(in), target, contiguous :: values(:)
+      integer :: held
 
-      if (self%rank == 0) then
-         call write_block(self, name, reshape(values, [1, size(values)]), size(values), 0, 1, units, .true.)
-      else
-         call write_block(self, name, reshape(values, [1, 0]), size(values), 0, 1, units, .true.)
-      end if
+      held = merge(size(values), 0, self%rank == 0)
+      call write_block(self, name, H5T_NATIVE_DOUBLE, c_loc(values), [1, held], size(values), 0, 1, units, .true.)
    end subroutine write_vector
+
+   !> A 1-D integer dataset that every rank holds whole; rank 0 writes it.
+   subroutine write_integer_vector(self, name, values)
+      class(h5_file), intent(inout) :: self
+      character(len=*), intent(in) :: name
+      integer, intent(in), target, contiguous :: values(:)
+      integer :: held
+
+      held = merge(size(values), 0, self%rank == 0)
+      call write_block(self, name, H5T_NATIVE_INTEGER, c_loc(values), [1, held], size(values), 0, 1, '', .true.)
+   end subroutine write_integer_vector
+
+   !> A 2-D dataset (size(values, 2), size(values, 1)) in h5py that every
+   !> rank holds whole; rank 0 writes it.
+   subroutine write_matrix(self, name, values, units)
+      class(h5_file), intent(inout) :: self
+      character(len=*), intent(in) :: name, units
+      real(wp), intent(in), target, contiguous :: values(:, :)
+      integer :: held
+
+      held = merge(size(values, 2), 0, self%rank == 0)
+      call write_block(self, name, H5T_NATIVE_DOUBLE, c_loc(values), [size(values, 1), held], &
+         & size(values, 2), 0, 1, units, .false.)
+   end subroutine write_matrix
 
    !> A 1-D dataset of n_total values to which this rank contributes
    !> values(k) at index first + (k - 1) * stride (0-based).
    subroutine write_vector_block(self, name, values, n_total, first, stride, units)
       class(h5_file), intent(inout) :: self
       character(len=*), intent(in) :: name, units
-      real(wp), intent(in) :: values(:)
+      real(wp), intent(in), target, contiguous :: values(:)
       integer, intent(in) :: n_total, first, stride
 
-      call write_block(self, name, reshape(values, [1, size(values)]), n_total, first, stride, units, .true.)
+      call write_block(self, name, H5T_NATIVE_DOUBLE, c_loc(values), [1, size(values)], n_total, first, &
+         & stride, units, .true.)
    end subroutine write_vector_block
 
    !> A dataset of shape (nx, n_total) in Fortran, (n_total, nx) in h5py, to
@@ -104,20 +129,23 @@ contains
    subroutine write_line_block(self, name, block, n_total, first, stride, units)
       class(h5_file), intent(inout) :: self
       character(len=*), intent(in) :: name, units
-      real(wp), intent(in) :: block(:, :)
+      real(wp), intent(in), target, contiguous :: block(:, :)
       integer, intent(in) :: n_total, first, stride
 
-      call write_block(self, name, block, n_total, first, stride, units, .false.)
+      call write_block(self, name, H5T_NATIVE_DOUBLE, c_loc(block), shape(block), n_total, first, stride, &
+         & units, .false.)
    end subroutine write_line_block
 
-   !> Collective write of this rank's columns of a (size(block, 1), n_total)
-   !> dataset, or of a 1-D dataset of n_total values when one_d: one regular
-   !> (strided) hyperslab per rank.
-   subroutine write_block(self, name, block, n_total, first, stride, units, one_d)
+   !> Collective write of this rank's `held` columns (Fortran shape held(1) x
+   !> held(2), at `buffer`) of a (held(1), n_total) dataset, or of a 1-D
+   !> dataset of n_total values when one_d: one regular (strided) hyperslab
+   !> per rank.  A units attribute is added unless units is blank.
+   subroutine write_block(self, name, type, buffer, held, n_total, first, stride, units, one_d)
       class(h5_file), intent(inout) :: self
       character(len=*), intent(in) :: name, units
-      real(wp), intent(in) :: block(:, :)
-      integer, intent(in) :: n_total, first, stride
+      integer(hid_t), intent(in) :: type
+      type(c_ptr), intent(in) :: buffer
+      integer, intent(in) :: held(2), n_total, first, stride
       logical, intent(in) :: one_d
       integer(hid_t) :: filespace, memspace, dset, xfer
       integer(hsize_t) :: dims(2), count(2), offset(2), step(2)
@@ -127,38 +155,38 @@ contains
       if (one_d) then
          rank = 1
          dims = [int(n_total, hsize_t), 0_hsize_t]
-         count = [int(size(block, 2), hsize_t), 0_hsize_t]
+         count = [int(held(2), hsize_t), 0_hsize_t]
          offset = [int(first, hsize_t), 0_hsize_t]
          step = [int(stride, hsize_t), 1_hsize_t]
       else
          rank = 2
-         dims = [int(size(block, 1), hsize_t), int(n_total, hsize_t)]
-         count = [int(size(block, 1), hsize_t), int(size(block, 2), hsize_t)]
+         dims = [int(held(1), hsize_t), int(n_total, hsize_t)]
+         count = [int(held(1), hsize_t), int(held(2), hsize_t)]
          offset = [0_hsize_t, int(first, hsize_t)]
          step = [1_hsize_t, int(stride, hsize_t)]
       end if
       call h5screate_simple_f(rank, dims(1:rank), filespace, stat)
-      call h5dcreate_f(self%id, name, H5T_NATIVE_DOUBLE, filespace, dset, stat)
+      call h5dcreate_f(self%id, name, type, filespace, dset, stat)
       call self%check(stat, 'creating dataset '//name)
       if (stat /= 0) return
       call h5screate_simple_f(rank, count(1:rank), memspace, stat)
-      if (size(block) > 0) then
+      if (product(held) > 0) then
          call h5sselect_hyperslab_f(filespace, H5S_SELECT_SET_F, offset(1:rank), count(1:rank), stat, &
             & stride=step(1:rank))
       else
-         ! A rank with no lines still takes part in the collective write.
+         ! A rank with nothing to write still takes part in the collective write.
          call h5sselect_none_f(filespace, stat)
          call h5sselect_none_f(memspace, stat)
       end if
       call h5pcreate_f(H5P_DATASET_XFER_F, xfer, stat)
       call h5pset_dxpl_mpio_f(xfer, H5FD_MPIO_COLLECTIVE_F, stat)
-      call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, block, count(1:rank), stat, &
-         & mem_space_id=memspace, file_space_id=filespace, xfer_prp=xfer)
+      call h5dwrite_f(dset, type, buffer, stat, mem_space_id=memspace, file_space_id=filespace, &
+         & xfer_prp=xfer)
       call self%check(stat, 'writing dataset '//name)
       call h5pclose_f(xfer, stat)
       call h5sclose_f(memspace, stat)
       call h5sclose_f(filespace, stat)
-      call attribute_text(self, dset, 'units', units)
+      if (len_trim(units) > 0) call attribute_text(self, dset, 'units', units)
       call h5dclose_f(dset, stat)
    end subroutine write_block
 

@@ -11,7 +11,8 @@ module friction_io_input
    use friction_strings, only: itoa, rtoa, join, quoted
    use friction_error, only: error_type, fatal_error, error_input
    use friction_ode_solver, only: step_type_names, step_type_index
-   use friction_afm_config, only: afm_config, potential_names
+   use friction_afm_config, only: afm_config, potential_names, net_names, net_sites, max_species, max_defects
+   use friction_io_files, only: file_exists
    use friction_io_namelist_scan, only: mention, scan_namelist_file, lower, namelist_names, &
       & assigned_names, value_has_kind, kind_text
    implicit none
@@ -41,10 +42,15 @@ contains
       ! &job
       character(len=16) :: scene
       ! &surface
-      character(len=16) :: potential
-      real(wp) :: v0, ax, ay, a
+      character(len=16) :: potential, net
+      real(wp) :: v0, ax, ay, a, cutoff, cutoff_tolerance
+      character(len=1024) :: net_file
+      integer :: shells, side
+      character(len=8) :: species(max_species), substitution_species
+      real(wp) :: epsilon(max_species), sigma(max_species)
+      integer :: vacancies(max_defects), substitutions(max_defects)
       ! &tip
-      real(wp) :: mass, kx, ky, cx, cy
+      real(wp) :: mass, kx, ky, kz, cx, cy, cz, support_z
       ! &scan
       real(wp) :: velocity, length, width, angle, origin_x, origin_y, lead_in
       integer :: nx, ny
@@ -55,8 +61,9 @@ contains
       integer(i8) :: max_steps
 
       namelist /job/ scene
-      namelist /surface/ potential, v0, ax, ay, a
-      namelist /tip/ mass, kx, ky, cx, cy
+      namelist /surface/ potential, v0, ax, ay, a, net, net_file, shells, side, species, epsilon, sigma, &
+         & vacancies, substitutions, substitution_species, cutoff, cutoff_tolerance
+      namelist /tip/ mass, kx, ky, kz, cx, cy, cz, support_z
       namelist /scan/ velocity, length, width, angle, origin_x, origin_y, lead_in, nx, ny, retrace
       namelist /integrator/ method, rtol, atol, h_start, h_min, max_steps
 
@@ -179,7 +186,13 @@ contains
          scene = defaults%scene
          associate (c => defaults%afm)
             potential = c%potential; v0 = c%v0; ax = c%ax; ay = c%ay; a = c%a
-            mass = c%mass; kx = c%kx; ky = c%ky; cx = c%cx; cy = c%cy
+            net = c%net; net_file = c%net_file; shells = c%shells; side = c%side
+            species = c%species; epsilon = c%epsilon; sigma = c%sigma
+            vacancies = c%vacancies; substitutions = c%substitutions
+            substitution_species = c%substitution_species; cutoff = c%cutoff
+            cutoff_tolerance = c%cutoff_tolerance
+            mass = c%mass; kx = c%kx; ky = c%ky; kz = c%kz; cx = c%cx; cy = c%cy; cz = c%cz
+            support_z = c%support_z
             velocity = c%velocity; length = c%length; width = c%width; angle = c%angle
             origin_x = c%origin_x; origin_y = c%origin_y; lead_in = c%lead_in
             nx = c%nx; ny = c%ny; retrace = c%retrace
@@ -191,11 +204,18 @@ contains
       subroutine to_config()
          method = lower(method)
          potential = lower(potential)
+         net = lower(net)
          scene = lower(scene)
          config%scene = scene
          associate (c => config%afm)
             c%potential = potential; c%v0 = v0; c%ax = ax; c%ay = ay; c%a = a
-            c%mass = mass; c%kx = kx; c%ky = ky; c%cx = cx; c%cy = cy
+            c%net = net; c%net_file = net_file; c%shells = shells; c%side = side
+            c%species = species; c%epsilon = epsilon; c%sigma = sigma
+            c%vacancies = vacancies; c%substitutions = substitutions
+            c%substitution_species = substitution_species; c%cutoff = cutoff
+            c%cutoff_tolerance = cutoff_tolerance
+            c%mass = mass; c%kx = kx; c%ky = ky; c%kz = kz; c%cx = cx; c%cy = cy; c%cz = cz
+            c%support_z = support_z
             c%velocity = velocity; c%length = length; c%width = width; c%angle = angle
             c%origin_x = origin_x; c%origin_y = origin_y; c%lead_in = lead_in
             c%nx = nx; c%ny = ny; c%retrace = retrace
@@ -219,11 +239,17 @@ contains
          end do
       end function origin
 
-      subroutine reject(group, name, value, reason)
+      !> The error for a bad value: where it was set, group, variable (with
+      !> its array index when given), value and reason.
+      subroutine reject(group, name, value, reason, index)
          character(len=*), intent(in) :: group, name, value, reason
+         integer, intent(in), optional :: index
+         character(len=:), allocatable :: shown
 
          if (allocated(error)) return
-         call fatal_error(error, origin(group, name)//': &'//group//': '//name//' = ' &
+         shown = name
+         if (present(index)) shown = name//'('//itoa(index)//')'
+         call fatal_error(error, origin(group, name)//': &'//group//': '//shown//' = ' &
             & //value//': '//reason, error_input)
       end subroutine reject
 
@@ -248,6 +274,57 @@ contains
          if (.not. (abs(value) <= huge(value))) call reject(group, name, rtoa(value), 'must be a finite number')
       end subroutine require_finite
 
+      !> The Lennard-Jones sum and its crystal net (Eq. 3).
+      subroutine validate_net()
+         integer :: ns, k, sites
+
+         call require_positive('tip', 'kz', kz, 'N/m; the tip moves in z over a lattice sum')
+         if (.not. any(net_names == net)) call reject('surface', 'net', "'"//trim(net)//"'", &
+            & 'unknown net (known: '//quoted(net_names)//')')
+         ns = 0
+         do while (ns < max_species)
+            if (len_trim(species(ns + 1)) == 0) exit
+            ns = ns + 1
+         end do
+         if (ns == 0) call reject('surface', 'species', "''", 'name at least one species')
+         do k = 1, ns
+            if (.not. (sigma(k) > 0.0_wp)) call reject('surface', 'sigma', rtoa(sigma(k)), &
+               & 'must be > 0 (Å) for species '//trim(species(k)), k)
+            if (.not. (epsilon(k) >= 0.0_wp)) call reject('surface', 'epsilon', rtoa(epsilon(k)), &
+               & 'must be >= 0 (eV) for species '//trim(species(k)), k)
+         end do
+         if (cutoff < 0.0_wp) call reject('surface', 'cutoff', rtoa(cutoff), 'must be >= 0 (Å; 0 chooses it)')
+         if (ns > 0 .and. cutoff > 0.0_wp .and. cutoff < maxval(sigma(1:max(ns, 1)))) &
+            & call reject('surface', 'cutoff', rtoa(cutoff), 'must not be below sigma ('// &
+            & rtoa(maxval(sigma(1:max(ns, 1))))//' Å): the sum would miss the repulsive core')
+         call require_positive('surface', 'cutoff_tolerance', cutoff_tolerance, 'nN')
+         select case (trim(net))
+         case ('graphite')
+            if (shells < 0) call reject('surface', 'shells', itoa(shells), 'must be >= 0')
+         case ('square')
+            if (side < 1) call reject('surface', 'side', itoa(side), 'must be >= 1')
+         case ('file')
+            if (len_trim(net_file) == 0) then
+               call reject('surface', 'net_file', "''", "name an XYZ file for net = 'file'")
+            else if (.not. file_exists(trim(net_file))) then
+               call reject('surface', 'net_file', "'"//trim(net_file)//"'", 'no such file')
+            end if
+         end select
+         if (allocated(error)) return
+         sites = net_sites(config%afm)
+         do k = 1, max_defects
+            if (vacancies(k) < 0 .or. (sites >= 0 .and. vacancies(k) > sites)) &
+               & call reject('surface', 'vacancies', itoa(vacancies(k)), &
+               & 'site outside the net of '//itoa(sites)//' sites', k)
+            if (substitutions(k) < 0 .or. (sites >= 0 .and. substitutions(k) > sites)) &
+               & call reject('surface', 'substitutions', itoa(substitutions(k)), &
+               & 'site outside the net of '//itoa(sites)//' sites', k)
+         end do
+         if (any(substitutions > 0) .and. .not. any(species(1:max(ns, 1)) == substitution_species)) &
+            & call reject('surface', 'substitution_species', "'"//trim(substitution_species)//"'", &
+            & 'not in the species table (known: '//quoted(species(1:max(ns, 1)))//')')
+      end subroutine validate_net
+
       subroutine validate()
          if (scene /= 'afm') call reject('job', 'scene', "'"//trim(scene)//"'", &
             & "unknown scene (known: 'afm')")
@@ -262,6 +339,9 @@ contains
          call require_nonnegative('tip', 'ky', ky, 'N/m')
          call require_nonnegative('tip', 'cx', cx, 'N s/m')
          call require_nonnegative('tip', 'cy', cy, 'N s/m')
+         call require_nonnegative('tip', 'cz', cz, 'N s/m')
+         call require_finite('tip', 'support_z', support_z)
+         if (potential == 'lj') call validate_net()
          call require_positive('scan', 'velocity', velocity, 'Å/s; the direction is set by angle')
          call require_positive('scan', 'length', length, 'Å')
          call require_nonnegative('scan', 'width', width, 'Å')

@@ -102,7 +102,7 @@ contains
       character(len=*), intent(in) :: value
       character, intent(in) :: kind
       character(len=len(value)) :: item
-      integer :: i, n, stat
+      integer :: i, n, stat, star
       real(wp) :: x
       integer(int64) :: m
       character :: quote
@@ -127,6 +127,15 @@ contains
             end if
          end if
          if (n == 0) cycle
+         ! A repeat count r*value checks the value.
+         star = index(item(1:n), '*')
+         if (star > 1) then
+            if (verify(item(1:star - 1), '0123456789') == 0) then
+               item = item(star + 1:n)
+               n = n - star
+               if (n == 0) cycle
+            end if
+         end if
          select case (kind)
          case ('c')
             ok = (item(1:1) == '"' .or. item(1:1) == "'") .and. item(n:n) == item(1:1) .and. n >= 2

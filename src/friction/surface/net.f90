@@ -1,0 +1,236 @@
+!> Crystal nets: the atoms of a rigid sample surface, each with a species.
+!>
+!> Generated nets: one graphite (graphene) layer as a hexagonal flake of
+!> hexagons in shells around a central ring (shells = 9 gives the paper's 271
+!> hexagons and 600 atoms: 1 + 3n(n+1) hexagons, 6(n+1)² atoms), and square
+!> nets.  Any net can be read from, and written to, a plain XYZ file
+!> (count, comment, then `species x y z` per line, Å).  Defects: vacancies
+!> (sites removed) and substitutional atoms (another species at a site), by
+!> site number (1-based, in the order of the generated or read net).
+module friction_surface_net
+   use friction_kinds, only: wp
+   use friction_error, only: error_type, fatal_error, error_input, error_io
+   use friction_strings, only: itoa, join
+   implicit none
+   private
+
+   public :: crystal_net, graphite_net, square_net, read_xyz, write_xyz, vacancy_mark
+
+   !> Species label that marks a vacant site in an XYZ file.
+   character(len=*), parameter :: vacancy_mark = 'X'
+
+   type :: crystal_net
+      real(wp), allocatable :: position(:, :)   !! (3, n) atom positions, Å
+      integer, allocatable :: species(:)        !! (n) index into the species table
+   contains
+      procedure :: size => net_size
+      procedure :: remove_sites
+      procedure :: substitute
+   end type crystal_net
+
+contains
+
+   pure integer function net_size(self)
+      class(crystal_net), intent(in) :: self
+
+      net_size = 0
+      if (allocated(self%species)) net_size = size(self%species)
+   end function net_size
+
+   !> One graphene layer in the plane z = 0: the hexagons within `shells`
+   !> hexagon-steps of the central one, centred on the origin, with lattice
+   !> constant a (C–C bond a/√3).  Lattice vectors (a, 0), (a/2, a√3/2): the
+   !> zigzag rows run along x, as for Eq. 2.  All atoms get species 1.
+   pure function graphite_net(a, shells) result(net)
+      real(wp), intent(in) :: a
+      integer, intent(in) :: shells
+      type(crystal_net) :: net
+      ! A hexagon centred on cell (i, j) has its A atoms (offset (0, a/√3)) in
+      ! cells (i, j), (i, j-1), (i+1, j-1) and its B atoms (offset (0, -a/√3))
+      ! in cells (i, j), (i, j+1), (i-1, j+1): marking them on the cell grid
+      ! shares the atoms of neighbouring hexagons without any search.
+      integer, parameter :: a_cells(2, 3) = reshape([0, 0, 0, -1, 1, -1], [2, 3])
+      integer, parameter :: b_cells(2, 3) = reshape([0, 0, 0, 1, -1, 1], [2, 3])
+      logical :: occupied(-shells - 1:shells + 1, -shells - 1:shells + 1, 2)
+      real(wp) :: a1(2), a2(2), offset(2, 2)
+      integer :: i, j, k, sub, n
+
+      a1 = [a, 0.0_wp]
+      a2 = [a / 2, a * sqrt(3.0_wp) / 2]
+      offset(:, 1) = [0.0_wp, a / sqrt(3.0_wp)]
+      offset(:, 2) = [0.0_wp, -a / sqrt(3.0_wp)]
+      occupied = .false.
+      ! Hexagon centres i a1 + j a2 with hexagonal distance max(|i|, |j|, |i+j|) <= shells.
+      do j = -shells, shells
+         do i = -shells, shells
+            if (max(abs(i), abs(j), abs(i + j)) > shells) cycle
+            do k = 1, 3
+               occupied(i + a_cells(1, k), j + a_cells(2, k), 1) = .true.
+               occupied(i + b_cells(1, k), j + b_cells(2, k), 2) = .true.
+            end do
+         end do
+      end do
+      n = count(occupied)
+      allocate (net%position(3, n), net%species(n))
+      n = 0
+      do j = -shells - 1, shells + 1
+         do i = -shells - 1, shells + 1
+            do sub = 1, 2
+               if (.not. occupied(i, j, sub)) cycle
+               n = n + 1
+               net%position(1:2, n) = i * a1 + j * a2 + offset(:, sub)
+            end do
+         end do
+      end do
+      net%position(3, :) = 0.0_wp
+      net%species = 1
+   end function graphite_net
+
+   !> A square net of side atoms per edge, spacing a, centred on the origin,
+   !> in the plane z = 0; species 1.
+   pure function square_net(a, side) result(net)
+      real(wp), intent(in) :: a
+      integer, intent(in) :: side
+      type(crystal_net) :: net
+      integer :: i, j, n
+
+      allocate (net%position(3, side * side), net%species(side * side))
+      n = 0
+      do j = 1, side
+         do i = 1, side
+            n = n + 1
+            net%position(:, n) = [(i - 1 - (side - 1) / 2.0_wp) * a, (j - 1 - (side - 1) / 2.0_wp) * a, 0.0_wp]
+         end do
+      end do
+      net%species = 1
+   end function square_net
+
+   !> Remove the sites marked (vacancies).
+   pure subroutine remove_sites(self, vacant)
+      class(crystal_net), intent(inout) :: self
+      logical, intent(in) :: vacant(:)
+      real(wp), allocatable :: position(:, :)
+      integer, allocatable :: species(:)
+      integer :: i, n
+
+      allocate (position(3, count(.not. vacant)), species(count(.not. vacant)))
+      n = 0
+      do i = 1, size(vacant)
+         if (vacant(i)) cycle
+         n = n + 1
+         position(:, n) = self%position(:, i)
+         species(n) = self%species(i)
+      end do
+      call move_alloc(position, self%position)
+      call move_alloc(species, self%species)
+   end subroutine remove_sites
+
+   !> Put species `kind` at the given sites.
+   pure subroutine substitute(self, sites, kind)
+      class(crystal_net), intent(inout) :: self
+      integer, intent(in) :: sites(:), kind
+
+      self%species(sites) = kind
+   end subroutine substitute
+
+   !> Read a net from an XYZ file.  Species labels are looked up in
+   !> species_names; the label `X` marks a vacancy (the site counts for site
+   !> numbers but holds no atom).  Errors name the file and the line.
+   subroutine read_xyz(path, species_names, net, error)
+      character(len=*), intent(in) :: path
+      character(len=*), intent(in) :: species_names(:)
+      type(crystal_net), intent(out) :: net
+      type(error_type), allocatable, intent(out) :: error
+      character(len=1024) :: line
+      character(len=64) :: label
+      real(wp), allocatable :: position(:, :)
+      integer, allocatable :: species(:)
+      logical, allocatable :: vacant(:)
+      integer :: unit, stat, n, i, k
+      logical :: exists
+
+      inquire (file=path, exist=exists)
+      if (.not. exists) then
+         call fatal_error(error, path//': no such file', error_input)
+         return
+      end if
+      open (newunit=unit, file=path, status='old', action='read', iostat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, path//': cannot open the file', error_io)
+         return
+      end if
+      read (unit, '(a)', iostat=stat) line
+      if (stat == 0) read (line, *, iostat=stat) n
+      if (stat /= 0 .or. n < 1) then
+         call fatal_error(error, path//':1: the first line must hold the number of atoms (>= 1)', error_input)
+         close (unit)
+         return
+      end if
+      read (unit, '(a)', iostat=stat) line   ! comment line
+      allocate (position(3, n), species(n), vacant(n))
+      do i = 1, n
+         read (unit, '(a)', iostat=stat) line
+         if (stat /= 0) then
+            call fatal_error(error, path//':'//itoa(i + 2)//': the file ends after '//itoa(i - 1) &
+               & //' atoms, but its first line announces '//itoa(n), error_input)
+            close (unit)
+            return
+         end if
+         read (line, *, iostat=stat) label, position(:, i)
+         if (stat /= 0 .or. .not. all(abs(position(:, i)) <= huge(1.0_wp))) then
+            call fatal_error(error, path//':'//itoa(i + 2)//': expected "species x y z" with numbers, got "' &
+               & //trim(line)//'"', error_input)
+            close (unit)
+            return
+         end if
+         vacant(i) = trim(label) == vacancy_mark
+         species(i) = 0
+         do k = 1, size(species_names)
+            if (trim(label) == trim(species_names(k))) species(i) = k
+         end do
+         if (species(i) == 0 .and. .not. vacant(i)) then
+            call fatal_error(error, path//':'//itoa(i + 2)//": unknown species '"//trim(label) &
+               & //"' (known: "//join(species_names)//', and '//vacancy_mark//' for a vacancy)', error_input)
+            close (unit)
+            return
+         end if
+      end do
+      ! Anything but blank lines after the announced atoms means a wrong count.
+      do
+         read (unit, '(a)', iostat=stat) line
+         if (stat /= 0) exit
+         if (len_trim(line) > 0) then
+            call fatal_error(error, path//':'//itoa(n + 3)//': more atoms than the '//itoa(n) &
+               & //' the first line announces', error_input)
+            close (unit)
+            return
+         end if
+      end do
+      close (unit)
+      net%position = position
+      net%species = max(species, 1)
+      call net%remove_sites(vacant)
+   end subroutine read_xyz
+
+   !> Write a net as XYZ (positions to 1e-10 Å).
+   subroutine write_xyz(path, net, species_names, comment, error)
+      character(len=*), intent(in) :: path, comment
+      type(crystal_net), intent(in) :: net
+      character(len=*), intent(in) :: species_names(:)
+      type(error_type), allocatable, intent(out) :: error
+      integer :: unit, stat, i
+
+      open (newunit=unit, file=path, status='replace', action='write', iostat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, path//': cannot write the file', error_io)
+         return
+      end if
+      write (unit, '(i0)') net%size()
+      write (unit, '(a)') comment
+      do i = 1, net%size()
+         write (unit, '(a, 3(1x, f18.10))') trim(species_names(net%species(i))), net%position(:, i)
+      end do
+      close (unit)
+   end subroutine write_xyz
+
+end module friction_surface_net
