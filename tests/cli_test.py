@@ -43,6 +43,22 @@ BAD_INPUTS = {
     "missing-file": (None, 3, ["no-such-file.nml", "no such file"]),
     "no-arguments": (None, 2, ["usage"]),
     "unwritable-output": (None, 5, ["no-such-dir/out.h5", "cannot write"]),
+    # The lattice-sum scene (graphite): nets, defects, Lennard-Jones parameters.
+    "lj-sigma": ("&surface potential = 'lj', sigma = 0.0 /\n", 3, ["bad.nml:1", "&surface", "sigma(1)", "> 0"]),
+    "lj-epsilon": ("&surface potential = 'lj', epsilon = -1e-3 /\n", 3,
+                   ["bad.nml:1", "&surface", "epsilon(1)", ">= 0"]),
+    "lj-cutoff-below-sigma": ("&surface potential = 'lj', cutoff = 2.0 /\n", 3,
+                              ["bad.nml:1", "&surface", "cutoff", "below sigma"]),
+    "lj-vacancy-outside": ("&surface potential = 'lj', shells = 9, vacancies = 12, 601 /\n", 3,
+                           ["bad.nml:1", "&surface", "vacancies(2) = 601", "600 sites"]),
+    "lj-unknown-net": ("&surface potential = 'lj', net = 'kagome' /\n", 3, ["bad.nml:1", "net", "kagome"]),
+    "lj-no-kz": ("&surface potential = 'lj' /\n&tip kz = 0 /\n", 3, ["bad.nml:2", "&tip", "kz"]),
+    "xyz-count": ("&surface potential = 'lj', net = 'file', net_file = 'net.xyz' /\n", 3,
+                  ["net.xyz:4", "ends after 1 atoms"]),
+    "xyz-field": ("&surface potential = 'lj', net = 'file', net_file = 'net.xyz' /\n", 3,
+                  ["net.xyz:4", "numbers"]),
+    "xyz-species": ("&surface potential = 'lj', net = 'file', net_file = 'net.xyz' /\n", 3,
+                    ["net.xyz:3", "unknown species 'Au'"]),
     "unknown-option": (None, 2, ["--frobnicate"]),
 }
 
@@ -129,6 +145,68 @@ def case_datasets(args, scene):
             fail("/afm/friction is not half the trace-retrace difference of the mean force")
         if not np.all(f["afm/friction"][()] > 0):
             fail("friction is not positive on every line")
+
+
+GRAPHITE_SMALL = "&surface shells = 4 /\n&scan nx = 12, ny = 3, length = 2.0 /\n"
+
+
+def case_graphite(args):
+    """The lattice-sum scene: the 3D datasets and the net, consistent."""
+    small = write(args, "small.nml", GRAPHITE_SMALL)
+    friction(args, os.path.join(args.inputs, "graphite.nml"), small)
+    with h5py.File(os.path.join(args.workdir, "graphite.h5"), "r") as f:
+        for trip in ["trace", "retrace"]:
+            for name in DOCUMENTED + ["fz", "tip_z"]:
+                if f[f"afm/{trip}/{name}"].shape != (3, 12):
+                    fail(f"/afm/{trip}/{name} has shape {f[f'afm/{trip}/{name}'].shape}")
+        atoms, species = f["surface/atoms"][()], f["surface/species"][()]
+        if atoms.shape != (150, 3) or species.shape != (150,) or set(species) != {1}:
+            fail(f"/surface: {atoms.shape} atoms, species {set(species)}; expected 150 carbon atoms")
+        if f["surface"].attrs["species_names"].decode() != "C":
+            fail("species_names is not C")
+        cutoff = f["surface"].attrs["cutoff"]
+        if not 2 * 2.4945 <= cutoff < 30:
+            fail(f"implausible cutoff {cutoff}")
+        # fz is the z spring force kz (z_M - z_t); kz = 0.25 N/m = 0.025 nN/Å.
+        support = f["afm"].attrs["support_height"]
+        expected = 0.025 * (support - f["afm/trace/tip_z"][()])
+        if np.max(np.abs(expected - f["afm/trace/fz"][()])) > 1e-12:
+            fail("fz is not kz (z_M - z_t)")
+        # support_z = -6: the support sits 6 Å below the contact height.
+        if abs(support - (f["afm"].attrs["contact_height"] - 6.0)) > 1e-12:
+            fail("support height is not contact height - 6 Å")
+        # At the first sample the tip rests at its static equilibrium under
+        # the load: pressed in, so fz < 0 and about the load kz * 6 Å.
+        fz0 = f["afm/trace/fz"][:, 0]
+        if not np.all((fz0 < -0.1) & (fz0 > -0.2)):
+            fail(f"first-sample fz {fz0} is not near the load -0.15 nN")
+
+
+def case_graphite_ranks(args):
+    small = write(args, "small.nml", GRAPHITE_SMALL)
+    files = {}
+    for n in (1, 2):
+        out = f"g_{n}.h5"
+        friction(args, "-o", out, os.path.join(args.inputs, "graphite.nml"), small, ranks=n)
+        files[n] = comparable(os.path.join(args.workdir, out))
+    if files[1].keys() != files[2].keys():
+        fail(f"different objects: {set(files[1]) ^ set(files[2])}")
+    for key, value in files[1].items():
+        if not np.array_equal(np.asarray(value), np.asarray(files[2][key])):
+            fail(f"{key} differs between 1 and 2 ranks")
+
+
+def case_graphite_defects(args):
+    """The shipped XYZ net with a vacancy and a nitrogen atom."""
+    small = write(args, "small.nml", "&scan nx = 8, ny = 2, length = 1.0 /\n")
+    friction(args, "-o", "d.h5", os.path.join(args.inputs, "graphite.nml"),
+             os.path.join(args.inputs, "graphite_defects.nml"), small)
+    with h5py.File(os.path.join(args.workdir, "d.h5"), "r") as f:
+        species = f["surface/species"][()]
+        if len(species) != 149 or list(species).count(2) != 1:
+            fail(f"expected 149 atoms with one N, got {len(species)} with {list(species).count(2)}")
+        if f["surface"].attrs["species_names"].decode() != "C, N":
+            fail("species_names is not 'C, N'")
 
 
 def comparable(path):
@@ -225,6 +303,11 @@ def case_bad(args, name):
         cmd = ["-o", "no-such-dir/out.h5", naf]
     else:
         cmd = [naf, write(args, "bad.nml", text)]
+    xyz = {"xyz-count": "3\nnet\nC 0 0 0\n",
+           "xyz-field": "2\nnet\nC 0 0 0\nC 1.4 zero 0\n",
+           "xyz-species": "1\nnet\nAu 0 0 0\n"}
+    if name in xyz:
+        write(args, "net.xyz", xyz[name])
     result = friction(args, *cmd, ranks=2, expect=code)
     for word in words:
         if word not in result.stderr:
@@ -233,7 +316,7 @@ def case_bad(args, name):
     ours = [line for line in result.stderr.splitlines() if line.startswith("friction:")]
     if len(ours) != 1:
         fail(f"expected one message from friction, got: {result.stderr}")
-    if leftovers(args):
+    if [f for f in leftovers(args) if f != "net.xyz"]:
         fail(f"bad input left files: {leftovers(args)}")
 
 
@@ -253,7 +336,8 @@ def main():
         case_bad(args, args.case[4:])
     else:
         {"ranks": case_ranks, "override": case_override, "force": case_force,
-         "numerical-failure": case_numerical_failure}[args.case](args)
+         "numerical-failure": case_numerical_failure, "graphite": case_graphite,
+         "graphite-ranks": case_graphite_ranks, "graphite-defects": case_graphite_defects}[args.case](args)
     print("1 passed, 0 failed")
 
 

@@ -16,6 +16,8 @@ program test_potentials
    call suite%add('hopg_periodicity', hopg_periodicity)
    call suite%add('naf_values', naf_values)
    call suite%add('hopg_values', hopg_values)
+   ! Random test points, the same on every run.
+   call random_init(repeatable=.true., image_distinct=.false.)
    call suite%run_all()
 
 contains

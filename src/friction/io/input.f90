@@ -115,6 +115,7 @@ contains
          source = [character(len=len(source)) :: source, (paths(ifile), k=1, size(mentions))]
       end do
       call to_config()
+      call resolve_net_file()
       call validate()
       if (allocated(error)) return
       input_text = ''
@@ -223,6 +224,22 @@ contains
             c%solver%h_start = h_start; c%solver%h_min = h_min; c%solver%max_steps = max_steps
          end associate
       end subroutine to_config
+
+      !> A relative net_file is relative to the namelist file that names it,
+      !> so a job runs the same from any working directory.
+      subroutine resolve_net_file()
+         integer :: k, slash
+
+         if (len_trim(net_file) == 0 .or. net_file(1:1) == '/') return
+         do k = size(all_mentions), 1, -1
+            if (all_mentions(k)%group == 'surface' .and. all_mentions(k)%name == 'net_file') then
+               slash = index(source(k), '/', back=.true.)
+               if (slash > 0) net_file = source(k)(1:slash)//trim(net_file)
+               config%afm%net_file = net_file
+               return
+            end if
+         end do
+      end subroutine resolve_net_file
 
       !> The file that last set a variable, for messages.
       function origin(group, name) result(text)
