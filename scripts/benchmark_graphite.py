@@ -1,0 +1,393 @@
+#!/usr/bin/env python3
+"""Benchmark friction's graphite (Lennard-Jones lattice-sum) scene.
+
+Measures and prints (this is not a test; nothing fails on a missed target):
+
+1. Cost against sample size: the same short trace-only scan (40 points on
+   each of 2 lines, 4 angstrom long, inputs/graphite.nml otherwise) over
+   graphite flakes of 600, 6 144 and 60 000 atoms (shells = 9, 31, 99).
+   Printed: atoms, the lattice-sum cutoff (/surface attrs), atoms within it
+   around the scan centre, set-up time, rhs evaluations per line, time per
+   line, time per rhs evaluation and the ratio of the time per line to the
+   600-atom flake's.  With the cell list and the cutoff the work per rhs
+   evaluation depends on the atoms within the cutoff, not on the flake, so
+   the target is a ratio near 1.
+   Times are the file's wall_time (median of --repeats runs) less the set-up,
+   which is the wall_time of a 1-line, 2-point, 0.001-angstrom scan of the
+   same flake (net, cell list, contact height, start-up): per line =
+   (wall - set-up) / lines, per rhs = (wall - set-up) / (rhs - rhs of set-up).
+
+2. Cutoff error: the same short scan on the 600-atom flake with the default
+   cutoff (cutoff = 0.0, chosen from cutoff_tolerance = 1e-4 nN) and with
+   cutoff = 1000 angstrom (every atom), both at rtol = atol = 1e-10 so that
+   the integration error is negligible, and max |dF| over fx, fy, fz next to
+   the stated tolerance.  The integration error is checked, not assumed: each
+   comparison is repeated at rtol = atol = 1e-11 and the difference between
+   the two tolerances is printed as the floor of the comparison.
+   a) the paper's tip (soft, undamped springs): its stick-slip is chaotic,
+      so a perturbation of any size (cutoff or tolerance alike) moves the
+      slips and the sampled forces differ by a good part of their range; the
+      floor shows it.  Printed for completeness.
+   b) the same scan with stiff, near-critically damped lateral springs
+      (kx = ky = 10 N/m, cx = cy = 6e-3 N s/m, cz = 1e-3 N s/m; the paper's
+      kz and load): the tip follows the support smoothly, the floor is far
+      below the tolerance, and |dF| is the cutoff's own error.
+
+Usage (from anywhere; normally through scripts/benchmark_graphite, which builds first):
+
+    python3 scripts/benchmark_graphite.py [--repeats N] [--quick] [--json FILE]
+                                          [--binary PATH] [--keep]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+try:
+    import h5py
+    import numpy as np
+except ImportError as exc:  # pragma: no cover - environment problem
+    sys.exit(f"benchmark_graphite: {exc}; run scripts/install-deps")
+
+ROOT = Path(__file__).resolve().parent.parent
+INPUTS = ROOT / "inputs"
+CASE = "graphite.nml"
+
+FLAKES = ((9, 600), (31, 6144), (99, 60000))  # shells, expected atoms
+SCAN = "&scan nx = 40, ny = 2, retrace = .false., length = 4.0 /"
+QUICK_SCAN = "&scan nx = 20, ny = 1, retrace = .false., length = 2.0 /"
+SETUP_SCAN = "&scan nx = 2, ny = 1, retrace = .false., length = 0.001 /"
+CUTOFF_TOLERANCE = 1e-4  # nN, the input default
+TIGHT, TIGHTER = 1e-10, 1e-11
+DEFAULT_CUTOFF = f"&surface cutoff = 0.0, cutoff_tolerance = {CUTOFF_TOLERANCE:g} /"
+FULL_CUTOFF = "&surface cutoff = 1000.0 /"
+SMOOTH_TIP = "&tip kx = 10.0, ky = 10.0, cx = 6.0e-3, cy = 6.0e-3, cz = 1.0e-3 /"
+FORCES = ("fx", "fy", "fz")
+
+
+def log(msg: str) -> None:
+    print(f"benchmark_graphite: {msg}", file=sys.stderr, flush=True)
+
+
+# --------------------------------------------------------------------------
+# Running friction
+# --------------------------------------------------------------------------
+
+
+@dataclass
+class Run:
+    """One friction run and what its file says."""
+
+    path: Path
+    wall: float  # root attribute wall_time, s
+    rhs: int
+    steps: int
+    ny: int
+    atoms: int
+    cutoff: float  # /surface attrs cutoff, angstrom
+    near: int  # atoms within the cutoff of the scan centre
+
+
+class Friction:
+    def __init__(self, binary: Path, workdir: Path):
+        self.binary = binary
+        self.workdir = workdir
+        self.inputs = workdir / "inputs"
+        self.env = dict(os.environ)
+        if hasattr(os, "geteuid") and os.geteuid() == 0:
+            # Open MPI refuses to run as root unless both are set.
+            self.env["OMPI_ALLOW_RUN_AS_ROOT"] = "1"
+            self.env["OMPI_ALLOW_RUN_AS_ROOT_CONFIRM"] = "1"
+        self._count = 0
+
+    def override(self, name: str, text: str) -> Path:
+        path = self.workdir / f"{name}.nml"
+        path.write_text(text + "\n")
+        return path
+
+    def run(self, overrides: list[Path]) -> Run:
+        """friction on one rank (no mpirun: the single-process cost is measured)."""
+        self._count += 1
+        out = self.workdir / f"run{self._count:04d}.h5"
+        cmd = [str(self.binary), "--quiet", "--force", "-o", str(out),
+               str(self.inputs / CASE)] + [str(p) for p in overrides]
+        proc = subprocess.run(cmd, env=self.env, cwd=self.workdir,
+                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        if proc.returncode != 0:
+            raise RuntimeError(f"friction failed with exit code {proc.returncode}: "
+                               f"{' '.join(cmd)}\n{proc.stdout}{proc.stderr}")
+        with h5py.File(out, "r") as f:
+            a, afm, surf = f.attrs, f["afm"], f["surface"]
+            atoms = surf["atoms"][()]
+            cutoff = float(surf.attrs["cutoff"])
+            theta = np.radians(float(afm.attrs["angle"]))
+            u = np.array([np.cos(theta), np.sin(theta)])
+            n = np.array([-np.sin(theta), np.cos(theta)])
+            sx, sy = afm["support_x"][()], afm["support_y"][()]
+            centre = (np.array([afm.attrs["origin_x"], afm.attrs["origin_y"]], dtype=float)
+                      + 0.5 * (sx.min() + sx.max()) * u + 0.5 * (sy.min() + sy.max()) * n)
+            near = int(np.sum(np.sum((atoms[:, :2] - centre) ** 2, axis=1) < cutoff ** 2))
+            return Run(path=out, wall=float(a["wall_time"]), rhs=int(a["rhs_evaluations"]),
+                       steps=int(a["integrator_steps"]), ny=int(sy.size),
+                       atoms=int(atoms.shape[0]), cutoff=cutoff, near=near)
+
+
+def max_force_difference(a: Path, b: Path) -> float:
+    worst = 0.0
+    with h5py.File(a, "r") as fa, h5py.File(b, "r") as fb:
+        for q in FORCES:
+            x, y = fa["afm/trace"][q][()], fb["afm/trace"][q][()]
+            if x.shape != y.shape:
+                raise RuntimeError(f"trace/{q}: shapes differ {x.shape} vs {y.shape}")
+            worst = max(worst, float(np.max(np.abs(x - y))))
+    return worst
+
+
+def force_range(path: Path) -> float:
+    """Largest peak-to-peak of fx, fy, fz over the map: the scale of the forces."""
+    with h5py.File(path, "r") as f:
+        return max(float(np.ptp(f["afm/trace"][q][()])) for q in FORCES)
+
+
+# --------------------------------------------------------------------------
+# The benchmark
+# --------------------------------------------------------------------------
+
+
+class Benchmark:
+    def __init__(self, args, fr: Friction):
+        self.args = args
+        self.fr = fr
+        self.scan = fr.override("scan", QUICK_SCAN if args.quick else SCAN)
+        self.setup_scan = fr.override("setup_scan", SETUP_SCAN)
+        self.sizes: list[dict] = []
+        self.cutoff: list[dict] = []
+
+    def flake(self, shells: int) -> Path:
+        return self.fr.override(f"shells{shells}", f"&surface shells = {shells} /")
+
+    def sizes_part(self) -> None:
+        reps = self.args.repeats
+        for shells, _ in FLAKES:
+            flake = self.flake(shells)
+            setups, runs = [], []
+            for i in range(reps):
+                log(f"flake shells = {shells}: set-up run {i + 1}/{reps}")
+                setups.append(self.fr.run([flake, self.setup_scan]))
+            for i in range(reps):
+                log(f"flake shells = {shells}: scan run {i + 1}/{reps}")
+                runs.append(self.fr.run([flake, self.scan]))
+            last = runs[-1]
+            setup = statistics.median(r.wall for r in setups)
+            wall = statistics.median(r.wall for r in runs)
+            rhs_setup = setups[-1].rhs
+            line = (wall - setup) / last.ny
+            self.sizes.append({
+                "shells": shells, "atoms": last.atoms, "cutoff_A": last.cutoff,
+                "atoms_within_cutoff": last.near, "lines": last.ny,
+                "setup_s": setup, "wall_median_s": wall,
+                "wall_s": [r.wall for r in runs], "setup_wall_s": [r.wall for r in setups],
+                "rhs_evaluations": last.rhs, "rhs_per_line": (last.rhs - rhs_setup) / last.ny,
+                "time_per_line_s": line,
+                "time_per_rhs_s": (wall - setup) / max(last.rhs - rhs_setup, 1),
+            })
+        base = self.sizes[0]["time_per_line_s"]
+        for row in self.sizes:
+            row["ratio_to_smallest"] = row["time_per_line_s"] / base
+
+    def cutoff_part(self) -> None:
+        flake = self.flake(FLAKES[0][0])
+        default = self.fr.override("cutoff_default", DEFAULT_CUTOFF)
+        full = self.fr.override("cutoff_full", FULL_CUTOFF)
+        tight = self.fr.override("tol_tight", f"&integrator rtol = {TIGHT:g}, atol = {TIGHT:g} /")
+        tighter = self.fr.override("tol_tighter",
+                                   f"&integrator rtol = {TIGHTER:g}, atol = {TIGHTER:g} /")
+        smooth = self.fr.override("smooth_tip", SMOOTH_TIP)
+        for label, tip in (("paper's tip (soft, undamped)", []),
+                           ("stiff damped lateral springs", [smooth])):
+            runs = {}
+            for cut_name, cut in (("default", default), ("full", full)):
+                for tol_name, tol in (("tight", tight), ("tighter", tighter)):
+                    log(f"cutoff check, {label}: cutoff {cut_name}, tolerance {tol_name}")
+                    runs[cut_name, tol_name] = self.fr.run([flake, self.scan, *tip, cut, tol])
+            d = runs["default", "tight"]
+            self.cutoff.append({
+                "tip": label, "overrides": [p.read_text().strip() for p in tip],
+                "atoms": d.atoms, "cutoff_A": d.cutoff,
+                "max_dF_cutoff_nN": max_force_difference(d.path, runs["full", "tight"].path),
+                "max_dF_cutoff_at_tighter_nN": max_force_difference(
+                    runs["default", "tighter"].path, runs["full", "tighter"].path),
+                "floor_default_cutoff_nN": max_force_difference(
+                    d.path, runs["default", "tighter"].path),
+                "floor_full_cutoff_nN": max_force_difference(
+                    runs["full", "tight"].path, runs["full", "tighter"].path),
+                "force_range_nN": force_range(d.path),
+                "tolerance_nN": CUTOFF_TOLERANCE,
+                "rhs_default": d.rhs, "rhs_full": runs["full", "tight"].rhs,
+                "wall_default_s": d.wall, "wall_full_s": runs["full", "tight"].wall,
+            })
+
+    def run(self) -> None:
+        self.sizes_part()
+        self.cutoff_part()
+
+    # ---------------------------------------------------------------- output
+
+    def report(self, header: dict) -> str:
+        lines = []
+        w = lines.append
+        w("friction graphite benchmark")
+        w("=" * 27)
+        for k, v in header.items():
+            w(f"  {k:<9} {v}")
+        w("")
+        w(f"1. Time per scan line against the flake size, 1 rank, trace only, "
+          f"median of {self.args.repeats}")
+        w(f"   scan: inputs/{CASE} + {self.scan.read_text().strip()}")
+        hdr = (f"  {'shells':>6} {'atoms':>7} {'cutoff A':>8} {'in cutoff':>9} {'set-up ms':>9} "
+               f"{'rhs/line':>9} {'ms/line':>8} {'us/rhs':>7} {'ratio':>6}")
+        w(hdr)
+        w("  " + "-" * (len(hdr) - 2))
+        for r in self.sizes:
+            w(f"  {r['shells']:>6} {r['atoms']:>7} {r['cutoff_A']:>8.3f} "
+              f"{r['atoms_within_cutoff']:>9} {1e3 * r['setup_s']:>9.1f} "
+              f"{r['rhs_per_line']:>9.0f} {1e3 * r['time_per_line_s']:>8.1f} "
+              f"{1e6 * r['time_per_rhs_s']:>7.2f} {r['ratio_to_smallest']:>6.2f}")
+        w("  in cutoff: atoms within the cutoff of the scan centre; set-up: wall_time of a")
+        w("  1-line 2-point 0.001 A scan of the same flake, taken off the times per line and")
+        w("  per rhs evaluation; ratio: time per line / the 600-atom flake's (target: near 1)")
+        w("")
+        w("2. Cutoff error on the 600-atom flake: default cutoff (from cutoff_tolerance) vs")
+        w(f"   cutoff = 1000 A (every atom), same scan, both at rtol = atol = {TIGHT:g} so that")
+        w(f"   the integration error is negligible; checked by repeating at {TIGHTER:g}")
+        w("   (floor = max |dF| between the two tolerances).  |dF| = max over trace fx, fy, fz.")
+        for c in self.cutoff:
+            w(f"  {c['tip']}" + (f": {' '.join(c['overrides'])}" if c["overrides"] else ""))
+            w(f"    cutoff {c['cutoff_A']:.3f} A vs 1000 A: max |dF| = "
+              f"{c['max_dF_cutoff_nN']:.2e} nN at {TIGHT:g} ({c['max_dF_cutoff_at_tighter_nN']:.2e} "
+              f"at {TIGHTER:g});")
+            w(f"      stated tolerance {c['tolerance_nN']:.0e} nN; forces span "
+              f"{c['force_range_nN']:.3f} nN")
+            w(f"    integration floor ({TIGHT:g} vs {TIGHTER:g}): {c['floor_default_cutoff_nN']:.2e} nN "
+              f"(default cutoff), {c['floor_full_cutoff_nN']:.2e} nN (full sum)")
+            ok = c["max_dF_cutoff_nN"] < c["tolerance_nN"]
+            resolved = max(c["floor_default_cutoff_nN"], c["floor_full_cutoff_nN"]) \
+                < 0.1 * c["max_dF_cutoff_nN"]
+            if resolved:
+                verdict = "within the tolerance" if ok else "ABOVE the tolerance"
+                w(f"    -> the cutoff error is resolved (floor < 10% of it) and {verdict}")
+            else:
+                w("    -> NOT a measure of the cutoff: the floor is as large as |dF|, the runs")
+                w("       differ by where the chaotic stick-slip puts the slips, whatever perturbs it")
+            w(f"    at {TIGHT:g}: rhs evaluations {c['rhs_default']} (default cutoff) vs "
+              f"{c['rhs_full']} (full sum), wall {c['wall_default_s']:.2f} s vs "
+              f"{c['wall_full_s']:.2f} s")
+        return "\n".join(lines)
+
+
+def git_state() -> str:
+    """The source commit, with '-dirty' when the working tree has changes."""
+    try:
+        out = subprocess.run(["git", "-C", str(ROOT), "describe", "--always", "--dirty"],
+                             capture_output=True, text=True, timeout=30)
+        return out.stdout.strip() or "unknown"
+    except (OSError, subprocess.SubprocessError):
+        return "unknown"
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(
+        description="Benchmark friction's graphite lattice-sum scene: time per scan line "
+                    "against the flake size, and the cutoff error (prints a table; not a test).")
+    p.add_argument("--repeats", type=int, default=None,
+                   help="runs per timing, median reported (default 3; 1 with --quick)")
+    p.add_argument("--quick", action="store_true",
+                   help="1 repeat and a shorter scan (1 line of 20 points over 2 angstrom)")
+    p.add_argument("--json", metavar="FILE", help="also save the results as JSON to FILE")
+    p.add_argument("--binary", default=str(ROOT / "build" / "friction"),
+                   help="the friction executable (default: build/friction)")
+    p.add_argument("--keep", action="store_true",
+                   help="keep the temporary directory with all outputs")
+    args = p.parse_args(argv)
+    if args.repeats is None:
+        args.repeats = 1 if args.quick else 3
+    if args.repeats < 1:
+        p.error("--repeats must be at least 1")
+
+    binary = Path(args.binary).resolve()
+    if not os.access(binary, os.X_OK):
+        p.error(f"{args.binary} is not an executable; build first (scripts/build)")
+    if not (INPUTS / CASE).is_file():
+        p.error(f"no inputs/{CASE} next to this script")
+
+    workdir = Path(tempfile.mkdtemp(prefix="friction-graphite-bench-"))
+    # Private copies of the executable and the inputs, so a rebuild or an edit
+    # during the benchmark neither breaks it nor mixes two versions in a table.
+    snapshot = workdir / "friction"
+    shutil.copy2(binary, snapshot)
+    shutil.copytree(INPUTS, workdir / "inputs")
+    fr = Friction(snapshot, workdir)
+    try:
+        version = subprocess.run([str(snapshot), "--version"], capture_output=True, text=True,
+                                 env=fr.env, timeout=60).stdout.strip()
+    except (OSError, subprocess.SubprocessError):
+        version = "?"
+    try:
+        cpus = len(os.sched_getaffinity(0))
+    except AttributeError:
+        cpus = os.cpu_count() or 1
+
+    bench = Benchmark(args, fr)
+    t0 = time.perf_counter()
+    try:
+        bench.run()
+    except (RuntimeError, OSError, KeyError) as exc:
+        log(str(exc))
+        if args.keep:
+            log(f"outputs kept in {workdir}")
+        else:
+            shutil.rmtree(workdir, ignore_errors=True)
+        return 1
+    total = time.perf_counter() - t0
+
+    header = {
+        "binary": f"{os.path.relpath(binary)} ({version}, source {git_state()})",
+        "machine": f"{platform.machine()}, {cpus} CPUs available, "
+                   f"{platform.processor() or platform.system()}",
+        "repeats": f"{args.repeats}{'  --quick' if args.quick else ''}",
+    }
+    print(bench.report(header))
+    print(f"\n(benchmark took {total:.0f} s)")
+
+    if args.json:
+        results = {
+            "sizes": bench.sizes, "cutoff": bench.cutoff,
+            "meta": {"version": version, "source": git_state(), "cpus": cpus,
+                     "machine": platform.machine(), "repeats": args.repeats,
+                     "quick": args.quick, "scan": bench.scan.read_text().strip(),
+                     "benchmark_seconds": total,
+                     "created": time.strftime("%Y-%m-%dT%H:%M:%S%z")},
+        }
+        Path(args.json).write_text(json.dumps(results, indent=2) + "\n")
+        log(f"results saved to {args.json}")
+
+    if args.keep:
+        log(f"outputs kept in {workdir}")
+    else:
+        shutil.rmtree(workdir, ignore_errors=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
