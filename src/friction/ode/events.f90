@@ -14,12 +14,15 @@
 !> (a Poincaré section, a diagnostic threshold) the integration goes on
 !> exactly as without it, multistep history included.
 !>
-!> The located time is the end of the final bracket on the far side of the
-!> crossing: g_k there has the sign it has after the event (or is zero), so
-!> a caller that switches models at the event never starts the new one on
-!> the wrong side.  A function that is zero at a restart counts as being on
-!> the near side of its crossing (+ for falling, - for rising events); one
-!> that then moves to the far side crosses at once.
+!> A crossing is a strict change of sign: a zero is no information (a
+!> function that touches zero and turns back has not crossed).  The located
+!> time is the end of the final bracket on the far side of the crossing: g_k
+!> there has, strictly, the sign it has after the event, so a caller that
+!> switches models at the event never starts the new one on the wrong side,
+!> and a restart there does not see the same event again.  A function that
+!> is exactly zero at a restart counts as being on the near side of its
+!> crossing (+ for falling, - for rising events); one that then moves to the
+!> far side crosses at once.
 !>
 !> Guards: a step budget over all steps since init (max_steps), the
 !> driver's smallest step (h_min) and a wall-clock limit (max_wall_time),
@@ -89,10 +92,10 @@ module friction_ode_events
       integer, allocatable :: direction(:)
       logical, allocatable :: terminal(:)
       integer, allocatable :: last_sign(:) !! sign of g_k on the near side; 0 unknown
-      logical, allocatable :: assumed(:)   !! last_sign is assumed (g_k was 0 at the restart)
       real(wp), allocatable :: g(:)        !! g at the current point
       real(wp) :: tolerance = 1.0e-10_wp   !! absolute, in the system's time
       real(wp) :: h_first = 1.0e-6_wp      !! first step when nothing better is known
+      real(wp) :: h_min = 0.0_wp           !! smallest step of the main integration
       integer(i8) :: max_steps = 0
       integer(i8) :: steps = 0             !! accepted main steps since init
       integer(i8) :: located = 0           !! events located since init
@@ -136,6 +139,7 @@ contains
       real(wp), intent(in) :: time_tolerance, h_first
       type(error_type), allocatable, intent(out) :: error
       character(len=*), intent(in), optional :: time_name, time_unit
+      type(solver_settings) :: probe_settings
 
       self%system => system
       self%n = system%dimension()
@@ -153,24 +157,32 @@ contains
       self%tolerance = time_tolerance
       self%max_steps = settings%max_steps
       self%max_wall_time = settings%max_wall_time
+      self%h_min = settings%h_min
       self%method = settings%method
       if (present(time_name)) self%time_name = time_name
       if (present(time_unit)) self%time_unit = time_unit
       self%h_first = h_first
       if (settings%h_start > 0.0_wp) self%h_first = settings%h_start
+      ! GSL refuses an h_min above the current step (and would ignore it).
+      self%h_first = max(self%h_first, settings%h_min)
       if (.not. (self%h_first > 0.0_wp)) then
          call fatal_error(error, 'event locator: the first step must be > 0', error_internal)
          return
       end if
       call self%main%init(system, settings, self%h_first, error)
       if (allocated(error)) return
-      call self%probe%init(system, settings, self%h_first, error)
+      ! The probe re-integrates parts of accepted steps, which may be as short
+      ! as the root finder needs: h_min guards the main integration only.
+      probe_settings = settings
+      probe_settings%h_min = 0.0_wp
+      call self%probe%init(system, probe_settings, self%h_first, error)
       if (allocated(error)) return
       call self%main%set_time_label(trim(self%time_name), trim(self%time_unit))
       call self%probe%set_time_label(trim(self%time_name), trim(self%time_unit))
       if (allocated(self%hits)) deallocate (self%hits)
       allocate (self%hits(max(1, self%m)))
-      allocate (self%last_sign(self%m), self%assumed(self%m), self%g(self%m))
+      if (allocated(self%g)) deallocate (self%last_sign, self%g)
+      allocate (self%last_sign(self%m), self%g(self%m))
       self%steps = 0
       self%located = 0
       self%probes = 0
@@ -194,11 +206,11 @@ contains
       h = h_start
       if (.not. (h > 0.0_wp) .and. self%steps > 0) h = self%main%step_size()
       if (.not. (h > 0.0_wp)) h = self%h_first
+      h = max(h, self%h_min)
       call self%main%restart(h)
       call self%system%event_values(t, y(1:self%n), self%g)
       do k = 1, self%m
          self%last_sign(k) = near_sign(self%g(k), self%direction(k))
-         self%assumed(k) = self%g(k) == 0.0_wp
       end do
       self%n_hits = 0
       self%ready = .true.
@@ -253,7 +265,6 @@ contains
          call self%system%event_values(t, y(1:self%n), self%g)
          nfound = 0
          do k = 1, self%m
-            if (self%assumed(k) .and. self%g(k) == 0.0_wp) cycle   ! still at the restart's zero
             if (.not. crossed(self%last_sign(k), self%g(k), self%direction(k))) cycle
             nfound = nfound + 1
             found(nfound)%which = k
@@ -262,14 +273,9 @@ contains
             call self%locate(k, t0, y0(1:self%n), g0(k), t, y(1:self%n), -self%last_sign(k), &
                & found(nfound)%t, found(nfound)%y(1:self%n), error)
             if (allocated(error)) return
-            ! Now on the far side, even where g is exactly zero.
-            self%last_sign(k) = -self%last_sign(k)
          end do
          do k = 1, self%m
-            if (self%g(k) /= 0.0_wp) then
-               self%last_sign(k) = int(sign(1.0_wp, self%g(k)))
-               self%assumed(k) = .false.
-            end if
+            if (self%g(k) /= 0.0_wp) self%last_sign(k) = int(sign(1.0_wp, self%g(k)))
          end do
          if (nfound == 0) cycle
          ! Time order (few events per step: insertion sort).
@@ -424,12 +430,12 @@ contains
       t = b
    end function interpolant_zero
 
-   !> Whether g is on the far side of a crossing (sign far), zero included.
+   !> Whether g is strictly on the far side of a crossing (sign far).
    pure logical function on_far_side(g, far)
       real(wp), intent(in) :: g
       integer, intent(in) :: far
 
-      on_far_side = g == 0.0_wp .or. (g > 0.0_wp .eqv. far > 0)
+      on_far_side = g /= 0.0_wp .and. (g > 0.0_wp .eqv. far > 0)
    end function on_far_side
 
    !> The sign g counts as before an event of the direction: its own sign,
@@ -453,8 +459,8 @@ contains
       real(wp), intent(in) :: g
 
       crossed = .false.
-      if (last_sign == 1 .and. g <= 0.0_wp) crossed = direction /= event_rising
-      if (last_sign == -1 .and. g >= 0.0_wp) crossed = direction /= event_falling
+      if (last_sign == 1 .and. g < 0.0_wp) crossed = direction /= event_rising
+      if (last_sign == -1 .and. g > 0.0_wp) crossed = direction /= event_falling
    end function crossed
 
    !> Integrator counters of both drivers.
