@@ -387,6 +387,8 @@ contains
                & 's/m; the regularized law needs a steepness')
             call require_nonnegative('brake_dimensional', 'delta', delta, 's/m')
             call require_finite('brake_dimensional', 'v_dr', v_dr)
+            if (abs(k2 - k1) > 1.0e-9_wp * k1) call reject('brake_dimensional', 'k2', rtoa(k2), &
+               & 'must equal k1 = '//rtoa(k1)//': Eq. 10 assumes k2 = k1 (paper §4.1)')
             if (allocated(error)) return
             call config%brake%resolve(derive_error)
             if (allocated(derive_error)) then
