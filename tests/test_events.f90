@@ -79,6 +79,7 @@ program test_events
    call suite%add('time_error_within_tolerance', time_error_within_tolerance)
    call suite%add('zero_at_restart', zero_at_restart)
    call suite%add('non_terminal_leaves_integration_alone', non_terminal_leaves_integration_alone)
+   call suite%add('dips_within_a_step', dips_within_a_step)
    call suite%add('step_budget_reported', step_budget_reported)
    call suite%add('wall_time_reported', wall_time_reported)
    call suite%add('h_min_reported', h_min_reported)
@@ -305,6 +306,55 @@ contains
             & //': locating events changed the integration')
       end do
    end subroutine non_terminal_leaves_integration_alone
+
+   !> x - 0.99 is positive only for |3t - 2πk| < acos(0.99) = 0.14: a bump
+   !> 0.094 wide, a third of rk8pd's steps at 1e-6 (about 0.3), 0.01 high
+   !> against the Hermite interpolant's error of about 2e-3 at such steps.
+   !> Both crossings of every bump are found, at the exact times.
+   subroutine dips_within_a_step(failure)
+      character(len=:), allocatable, intent(out) :: failure
+      type(ringing), target :: system
+      type(event_locator) :: locator
+      type(solver_settings) :: settings
+      type(error_type), allocatable :: error
+      real(wp) :: t, y(2), expected(9), half_width
+      integer :: i, found, k
+      character(len=40) :: text
+
+      half_width = acos(0.99_wp) / 3.0_wp
+      expected(1) = half_width
+      do k = 1, 4
+         expected(2 * k) = 2 * pi * k / 3.0_wp - half_width
+         expected(2 * k + 1) = 2 * pi * k / 3.0_wp + half_width
+      end do
+      system%offset = 0.99_wp
+      settings%method = 'rk8pd'
+      settings%rtol = 1.0e-6_wp
+      settings%atol = 1.0e-6_wp
+      call locator%init(system, settings, [event_either, event_either], [.false., .false.], &
+         & 1.0e-10_wp, 1.0e-3_wp, error)
+      t = 0.0_wp
+      y = [1.0_wp, 0.0_wp]
+      call locator%restart(t, y, 0.0_wp)
+      found = 0
+      do while (t < 10.0_wp)
+         call locator%advance(t, 10.0_wp, y, error)
+         if (allocated(error)) then
+            failure = error%message
+            return
+         end if
+         do i = 1, locator%n_hits
+            if (locator%hits(i)%which /= 1) cycle
+            found = found + 1
+            if (found > size(expected)) exit
+            write (text, '(a, i0)') 'crossing of x = 0.99, number ', found
+            ! State error at rtol 1e-6 (a few 1e-6) over the speed |x'| = 0.42 there.
+            call check_close(failure, locator%hits(i)%t, expected(found), 1.0e-5_wp, trim(text))
+         end do
+      end do
+      call check(failure, found == size(expected), 'expected 9 crossings of x = 0.99 in (0, 10]')
+      call check(failure, locator%steps_taken() < 100, 'steps too short to test dips within a step')
+   end subroutine dips_within_a_step
 
    subroutine step_budget_reported(failure)
       character(len=:), allocatable, intent(out) :: failure

@@ -14,6 +14,15 @@
 !> (a Poincaré section, a diagnostic threshold) the integration goes on
 !> exactly as without it, multistep history included.
 !>
+!> A function can cross zero and come back within one step, so that its
+!> values at the step's ends agree in sign (a large step of an implicit or
+!> extrapolation method over a short dip).  After every step the locator
+!> therefore also samples g_k along the step's cubic Hermite interpolant
+!> (the right-hand side at both ends: one extra evaluation per step, the
+!> start's being the previous end's) and confirms a dip it sees with a
+!> probe.  A dip shallower than the interpolant's error, O(h⁴), can still
+!> go unseen; the integration tolerance bounds that.
+!>
 !> A crossing is a strict change of sign: a zero is no information (a
 !> function that touches zero and turns back has not crossed).  The located
 !> time is the end of the final bracket on the far side of the crossing: g_k
@@ -93,6 +102,8 @@ module friction_ode_events
       logical, allocatable :: terminal(:)
       integer, allocatable :: last_sign(:) !! sign of g_k on the near side; 0 unknown
       real(wp), allocatable :: g(:)        !! g at the current point
+      real(wp) :: f(max_state) = 0.0_wp    !! the right-hand side at the current point
+      logical :: f_valid = .false.         !! f is up to date (not after a restart)
       real(wp) :: tolerance = 1.0e-10_wp   !! absolute, in the system's time
       real(wp) :: h_first = 1.0e-6_wp      !! first step when nothing better is known
       real(wp) :: h_min = 0.0_wp           !! smallest step of the main integration
@@ -107,6 +118,7 @@ module friction_ode_events
       character(len=8) :: time_name = 't', time_unit = ' s'
       logical :: ready = .false.
       !> Events of the last advance, in time order; a terminal one is last.
+      !> (Up to two per function and step: out across zero and back.)
       type(event_hit), allocatable, public :: hits(:)
       integer, public :: n_hits = 0
    contains
@@ -180,7 +192,7 @@ contains
       call self%main%set_time_label(trim(self%time_name), trim(self%time_unit))
       call self%probe%set_time_label(trim(self%time_name), trim(self%time_unit))
       if (allocated(self%hits)) deallocate (self%hits)
-      allocate (self%hits(max(1, self%m)))
+      allocate (self%hits(max(1, 2 * self%m)))
       if (allocated(self%g)) deallocate (self%last_sign, self%g)
       allocate (self%last_sign(self%m), self%g(self%m))
       self%steps = 0
@@ -213,6 +225,7 @@ contains
          self%last_sign(k) = near_sign(self%g(k), self%direction(k))
       end do
       self%n_hits = 0
+      self%f_valid = .false.
       self%ready = .true.
    end subroutine restart
 
@@ -227,9 +240,11 @@ contains
       real(wp), intent(in) :: t1
       real(wp), intent(inout) :: y(:)
       type(error_type), allocatable, intent(out) :: error
-      real(wp) :: t0, y0(max_state), g0(self%m)
-      type(event_hit) :: found(self%m), swap
-      integer :: k, nfound, i, j, first_terminal
+      real(wp) :: t0, y0(max_state), g0(self%m), f0(max_state)
+      real(wp) :: tc, yc(max_state), gc(self%m), theta, h
+      type(event_hit) :: found(2 * self%m), swap
+      integer :: k, nfound, i, j, first_terminal, near
+      integer, parameter :: samples = 16
 
       self%n_hits = 0
       if (.not. self%ready) then
@@ -240,6 +255,11 @@ contains
          t0 = t
          y0(1:self%n) = y(1:self%n)
          g0 = self%g
+         if (.not. self%f_valid) then
+            call self%system%rhs(t0, y0(1:self%n), self%f(1:self%n))
+            self%extra_rhs = self%extra_rhs + 1
+         end if
+         f0(1:self%n) = self%f(1:self%n)
          call self%main%step(t, t1, y(1:self%n), error)
          if (allocated(error)) return
          self%steps = self%steps + 1
@@ -262,22 +282,65 @@ contains
                return
             end if
          end if
+         call self%system%rhs(t, y(1:self%n), self%f(1:self%n))
+         self%extra_rhs = self%extra_rhs + 1
+         self%f_valid = .true.
          call self%system%event_values(t, y(1:self%n), self%g)
          nfound = 0
+         h = t - t0
          do k = 1, self%m
-            if (.not. crossed(self%last_sign(k), self%g(k), self%direction(k))) cycle
-            nfound = nfound + 1
-            found(nfound)%which = k
-            found(nfound)%direction = -self%last_sign(k)
-            found(nfound)%terminal = self%terminal(k)
-            call self%locate(k, t0, y0(1:self%n), g0(k), t, y(1:self%n), -self%last_sign(k), &
-               & found(nfound)%t, found(nfound)%y(1:self%n), error)
+            near = self%last_sign(k)
+            if (crossed(near, self%g(k), self%direction(k))) then
+               nfound = nfound + 1
+               call self%locate(k, t0, y0(1:self%n), g0(k), t, y(1:self%n), -near, &
+                  & found(nfound)%t, found(nfound)%y(1:self%n), error)
+               call describe(found(nfound), k, -near)
+               if (allocated(error)) return
+               cycle
+            end if
+            if (near == 0) cycle
+            ! No change of sign between the ends, but g may have dipped across
+            ! zero and back inside the step: look along the step's cubic
+            ! Hermite interpolant, and confirm a dip with a probe.
+            do i = 1, samples - 1
+               theta = real(i, wp) / samples
+               yc(1:self%n) = hermite(theta, h, y0(1:self%n), f0(1:self%n), y(1:self%n), self%f(1:self%n))
+               call self%system%event_values(t0 + theta * h, yc(1:self%n), gc)
+               if (gc(k) /= 0.0_wp .and. (gc(k) > 0.0_wp .neqv. near > 0)) exit
+            end do
+            if (i == samples) cycle
+            tc = t0
+            yc(1:self%n) = y0(1:self%n)
+            call self%probe%restart(theta * h)
+            call self%probe%advance(tc, t0 + theta * h, yc(1:self%n), error)
+            self%probes = self%probes + 1
             if (allocated(error)) return
+            call self%system%event_values(tc, yc(1:self%n), gc)
+            if (gc(k) == 0.0_wp .or. (gc(k) > 0.0_wp .eqv. near > 0)) cycle   ! the interpolant erred
+            ! Out across zero ...
+            if (crossed(near, gc(k), self%direction(k))) then
+               nfound = nfound + 1
+               call self%locate(k, t0, y0(1:self%n), g0(k), tc, yc(1:self%n), -near, &
+                  & found(nfound)%t, found(nfound)%y(1:self%n), error)
+               call describe(found(nfound), k, -near)
+               if (allocated(error)) return
+            end if
+            ! ... and back, if that direction counts.
+            if (crossed(-near, self%g(k), self%direction(k))) then
+               nfound = nfound + 1
+               call self%locate(k, tc, yc(1:self%n), gc(k), t, y(1:self%n), near, &
+                  & found(nfound)%t, found(nfound)%y(1:self%n), error)
+               call describe(found(nfound), k, near)
+               if (allocated(error)) return
+            end if
          end do
          do k = 1, self%m
             if (self%g(k) /= 0.0_wp) self%last_sign(k) = int(sign(1.0_wp, self%g(k)))
          end do
          if (nfound == 0) cycle
+         do i = 1, nfound
+            found(i)%terminal = self%terminal(found(i)%which)
+         end do
          ! Time order (few events per step: insertion sort).
          do i = 2, nfound
             swap = found(i)
@@ -308,6 +371,27 @@ contains
          return
       end do
    end subroutine advance
+
+   !> Fill in which function crossed, in which direction, and whether terminal.
+   subroutine describe(hit, k, direction)
+      type(event_hit), intent(inout) :: hit
+      integer, intent(in) :: k, direction
+
+      hit%which = k
+      hit%direction = direction
+   end subroutine describe
+
+   !> The cubic Hermite interpolant at θ in [0, 1] of a step of length h
+   !> from (y0, f0) to (y1, f1): error O(h⁴).
+   pure function hermite(theta, h, y0, f0, y1, f1) result(y)
+      real(wp), intent(in) :: theta, h, y0(:), f0(:), y1(:), f1(:)
+      real(wp) :: y(size(y0))
+
+      y = (2.0_wp * theta**3 - 3.0_wp * theta**2 + 1.0_wp) * y0 &
+         & + (theta**3 - 2.0_wp * theta**2 + theta) * h * f0 &
+         & + (-2.0_wp * theta**3 + 3.0_wp * theta**2) * y1 &
+         & + (theta**3 - theta**2) * h * f1
+   end function hermite
 
    !> The crossing of g_k in [ta, tb], where g_k(ta) = ga is on the near side
    !> and g_k(tb) on the far side, whose sign is far.  Returns the far end of
@@ -409,10 +493,7 @@ contains
          end if
          if (.not. (t > a .and. t < b)) t = 0.5_wp * (a + b)
          theta = (t - ta) / h
-         ya_ = (2.0_wp * theta**3 - 3.0_wp * theta**2 + 1.0_wp) * ya &
-            & + (theta**3 - 2.0_wp * theta**2 + theta) * h * fa &
-            & + (-2.0_wp * theta**3 + 3.0_wp * theta**2) * yb &
-            & + (theta**3 - theta**2) * h * fb
+         ya_ = hermite(theta, h, ya, fa, yb, fb)
          call self%system%event_values(t, ya_, g)
          vc = g(k)
          if (on_far_side(vc, far)) then
