@@ -1,4 +1,5 @@
-!> friction: friction-force maps of a microscope tip over a crystal surface.
+!> friction: friction-force maps of a microscope tip over a crystal surface,
+!> and the stick-slip of a Girling brake (scene 'brake', run_brake).
 !>
 !>   mpirun -n N friction [options] FILE.nml [MORE.nml ...]
 !>
@@ -214,14 +215,14 @@ contains
          check%comparison = compare_runs(main_run, check_run)
          associate (d => check%comparison, c => check_config%solver)
             if (rank == 0) then
-               write (line, '(a, es9.2, a, es9.2, a, es9.2, a, i0, a, i0)') 'friction: verify: ' &
+               write (line, '(a, es8.2, a, es8.2, a, es8.2, a, i0, a, i0)') 'friction: verify: ' &
                   & //trim(c%method)//' at rtol ', c%rtol, ', atol ', c%atol, ': max |dx| = ', &
                   & d%max_difference(1), ' m over the grid; events ', d%events, ' vs ', d%check_events
                write (error_unit, '(a)') trim(line)
             end if
             if (config%brake%check%max_difference > 0.0_wp .and. &
                & .not. (d%max_difference(1) <= config%brake%check%max_difference)) then
-               write (line, '(a, es9.2, a, es9.2, a)') 'verify failed: the check run differs by ', &
+               write (line, '(a, es8.2, a, es8.2, a)') 'verify failed: the check run differs by ', &
                   & d%max_difference(1), ' m in x, more than check_limit = ', &
                   & config%brake%check%max_difference, ' m (README: Girling brake, which steppers need verify)'
                call fatal_error(error, trim(line), error_numerical)
@@ -456,6 +457,8 @@ contains
          & 'Friction-force maps of a microscope tip dragged over a crystal surface', &
          & '(NaF, HOPG): the tip''s equations of motion integrated with GSL odeiv2,', &
          & 'scan lines shared among MPI ranks, results in one HDF5 file.', &
+         & 'With &job scene = ''brake'': the stick-slip of a Girling brake (one', &
+         & 'trajectory; inputs/brake.nml; groups &brake &brake_dimensional &verify).', &
          & '', &
          & 'Input files are namelist files read in order; a later file overrides', &
          & 'earlier values variable by variable.  Groups: &job &surface &tip &scan', &

@@ -9,8 +9,8 @@ Reads one output file and writes two PNGs into the output directory
                     shows as the horizontal line x' = v'_dr, drawn in its own
                     colour from the file's stick flag, with the belt velocity
                     as a dashed line
-  <stem>_x.png      x(tau) over the whole run, stick stretches marked, with the
-                    stick/slip events of the file
+  <stem>_x.png      x(tau) over the whole run, and over the last 30 units of
+                    the window, stick stretches marked
 
 Axes: x in m, x' in m per unit tau (the nondimensional time of Eq. 10,
 tau = t sqrt(k1/m)).
@@ -102,20 +102,26 @@ def plot_phase(run, window, out, dpi):
     plt.close(fig)
 
 
-def plot_x(run, out, dpi):
-    """x(τ) over the whole run with stick marked and events as ticks."""
+def plot_x(run, window, out, dpi):
+    """x(τ): the whole run above, the last 30 τ of the window below, where
+    stick shows as straight stretches of slope v'_dr."""
     t, x, stick = run["t"], run["x"], run["stick"] == 1
-    fig, ax = plt.subplots(figsize=(11, 4.8), layout="constrained")
-    ax.plot(t, x, "-", color="tab:blue", linewidth=0.6, label="x(τ)")
-    if stick.any():
-        ax.plot(t[stick], x[stick], ".", color="tab:red", markersize=1.5, label="stick")
-    ax.set_xlabel("τ = t √(k1/m)")
-    ax.set_ylabel("x, block displacement (m)")
-    ax.set_xlim(t[0], t[-1])
+    fig, (whole, zoom) = plt.subplots(2, 1, figsize=(11, 7), layout="constrained")
+    zoom_from = max(window[0], window[1] - 30.0)
+    for ax, (t0, t1) in ((whole, (t[0], t[-1])), (zoom, (zoom_from, window[1]))):
+        inside = (t >= t0) & (t <= t1)
+        ax.plot(t[inside], x[inside], "-", color="tab:blue", linewidth=0.6, label="x(τ)")
+        part = inside & stick
+        if part.any():
+            ax.plot(t[part], x[part], ".", color="tab:red", markersize=1.5 if ax is whole else 3,
+                    label="stick")
+        ax.set_xlim(t0, t1)
+        ax.set_ylabel("x, block displacement (m)")
+    zoom.set_xlabel("τ = t √(k1/m)")
+    whole.legend(loc="upper right", fontsize="small")
     n_events = run["event_t"].size
-    ax.set_title(f"Block displacement, {_describe(run)}\n{n_events} stick/slip events, "
-                 f"{stick.mean():.1%} of the points in stick")
-    ax.legend(loc="upper right", fontsize="small")
+    whole.set_title(f"Block displacement, {_describe(run)}\n{n_events} stick/slip events, "
+                    f"{stick.mean():.1%} of the points in stick; below: τ ∈ [{zoom_from:g}, {window[1]:g}]")
     fig.savefig(out, dpi=dpi)
     plt.close(fig)
 
@@ -161,7 +167,7 @@ def main(argv=None):
         args.output_dir.mkdir(parents=True, exist_ok=True)
         plot_phase(run, args.window, phase, args.dpi)
         print(f"wrote {phase}")
-        plot_x(run, xplot, args.dpi)
+        plot_x(run, args.window, xplot, args.dpi)
         print(f"wrote {xplot}")
     except OSError as err:
         print(f"{prog}: cannot write into {args.output_dir}: {err}", file=sys.stderr)

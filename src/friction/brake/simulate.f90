@@ -39,7 +39,7 @@ module friction_brake_simulate
       real(wp) :: max_difference(4) = 0.0_wp    !! max over the grid of |Δx|, |Δv|, |Δy|, |Δw|
       real(wp) :: end_difference(4) = 0.0_wp    !! the same at the last grid point
       integer :: events = 0, check_events = 0   !! event counts of both runs
-      real(wp) :: max_event_time_difference = 0.0_wp  !! over events paired in order (when counts agree)
+      real(wp) :: max_event_time_difference = 0.0_wp  !! over events paired in order (only when counts agree)
    end type brake_comparison
 
 contains
@@ -190,12 +190,9 @@ contains
             & maxval(abs(a%y(1:n) - b%y(1:n))), maxval(abs(a%w(1:n) - b%w(1:n)))]
          cmp%end_difference = abs([a%x(n) - b%x(n), a%v(n) - b%v(n), a%y(n) - b%y(n), a%w(n) - b%w(n)])
       end associate
-      if (run%events%n == check%events%n .and. run%events%n > 0) then
-         cmp%max_event_time_difference = maxval(abs(run%events%t(1:run%events%n) &
-            & - check%events%t(1:run%events%n)))
-      else
-         cmp%max_event_time_difference = huge(1.0_wp)
-      end if
+      if (run%events%n == check%events%n .and. run%events%n > 0) &
+         & cmp%max_event_time_difference = maxval(abs(run%events%t(1:run%events%n) &
+         & - check%events%t(1:run%events%n)))
    end function compare_runs
 
 end module friction_brake_simulate
