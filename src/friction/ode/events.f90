@@ -17,11 +17,13 @@
 !> A function can cross zero and come back within one step, so that its
 !> values at the step's ends agree in sign (a large step of an implicit or
 !> extrapolation method over a short dip).  After every step the locator
-!> therefore also samples g_k along the step's cubic Hermite interpolant
+!> therefore also follows g_k along the step's cubic Hermite interpolant
 !> (the right-hand side at both ends: one extra evaluation per step, the
-!> start's being the previous end's) and confirms a dip it sees with a
-!> probe.  A dip shallower than the interpolant's error, O(h⁴), can still
-!> go unseen; the integration tolerance bounds that.
+!> start's being the previous end's): the values and slopes of g_k at the
+!> step's ends define a cubic, exact when g_k is linear in the state, whose
+!> extrema show a dip; a probe confirms it.  A dip shallower than the
+!> interpolant's error, O(h⁴), can still go unseen; the integration
+!> tolerance bounds that.
 !>
 !> A crossing is a strict change of sign: a zero is no information (a
 !> function that touches zero and turns back has not crossed).  The located
@@ -241,10 +243,10 @@ contains
       real(wp), intent(inout) :: y(:)
       type(error_type), allocatable, intent(out) :: error
       real(wp) :: t0, y0(max_state), g0(self%m), f0(max_state)
-      real(wp) :: tc, yc(max_state), gc(self%m), theta, h
+      real(wp) :: tc, yc(max_state), gc(self%m), theta, h, slope0(self%m), slope1(self%m)
       type(event_hit) :: found(2 * self%m), swap
       integer :: k, nfound, i, j, first_terminal, near
-      integer, parameter :: samples = 16
+      real(wp), parameter :: nudge = 1.0e-3_wp
 
       self%n_hits = 0
       if (.not. self%ready) then
@@ -288,6 +290,18 @@ contains
          call self%system%event_values(t, y(1:self%n), self%g)
          nfound = 0
          h = t - t0
+         ! Slopes dg/dθ at both ends, by differences along the step's Hermite
+         ! interpolant (θ = (t - t0)/h): with g at the ends they define a
+         ! cubic in θ for each g_k, exact when g_k is linear in the state.
+         if (self%m > 0) then
+            yc(1:self%n) = hermite(nudge, h, y0(1:self%n), f0(1:self%n), y(1:self%n), self%f(1:self%n))
+            call self%system%event_values(t0 + nudge * h, yc(1:self%n), gc)
+            slope0 = (gc - g0) / nudge
+            yc(1:self%n) = hermite(1.0_wp - nudge, h, y0(1:self%n), f0(1:self%n), y(1:self%n), &
+               & self%f(1:self%n))
+            call self%system%event_values(t - nudge * h, yc(1:self%n), gc)
+            slope1 = (self%g - gc) / nudge
+         end if
          do k = 1, self%m
             near = self%last_sign(k)
             if (crossed(near, self%g(k), self%direction(k))) then
@@ -300,15 +314,10 @@ contains
             end if
             if (near == 0) cycle
             ! No change of sign between the ends, but g may have dipped across
-            ! zero and back inside the step: look along the step's cubic
-            ! Hermite interpolant, and confirm a dip with a probe.
-            do i = 1, samples - 1
-               theta = real(i, wp) / samples
-               yc(1:self%n) = hermite(theta, h, y0(1:self%n), f0(1:self%n), y(1:self%n), self%f(1:self%n))
-               call self%system%event_values(t0 + theta * h, yc(1:self%n), gc)
-               if (gc(k) /= 0.0_wp .and. (gc(k) > 0.0_wp .neqv. near > 0)) exit
-            end do
-            if (i == samples) cycle
+            ! zero and back inside the step: look at the extrema of its cubic,
+            ! and confirm a dip with a probe.
+            theta = dip(g0(k), self%g(k), slope0(k), slope1(k), near)
+            if (theta < 0.0_wp) cycle
             tc = t0
             yc(1:self%n) = y0(1:self%n)
             call self%probe%restart(theta * h)
@@ -380,6 +389,44 @@ contains
       hit%which = k
       hit%direction = direction
    end subroutine describe
+
+   !> Where the cubic p on [0, 1] with p(0) = g0, p(1) = g1, p'(0) = d0,
+   !> p'(1) = d1 reaches furthest to the side opposite near, if it crosses
+   !> zero there; -1 if it stays on the near side.  (Both ends are on the
+   !> near side.)
+   pure real(wp) function dip(g0, g1, d0, d1, near) result(theta)
+      real(wp), intent(in) :: g0, g1, d0, d1
+      integer, intent(in) :: near
+      real(wp) :: a, b, c, disc, roots(2), p, best, q
+      integer :: i
+
+      ! p = g0 + d0 θ + c2 θ² + c3 θ³ with the Hermite coefficients.
+      a = 3.0_wp * (2.0_wp * (g0 - g1) + d0 + d1)           ! p' = a θ² + b θ + c
+      b = 2.0_wp * (3.0_wp * (g1 - g0) - 2.0_wp * d0 - d1)
+      c = d0
+      theta = -1.0_wp
+      roots = -1.0_wp
+      if (abs(a) > 1.0e-14_wp * (abs(b) + abs(c))) then
+         disc = b * b - 4.0_wp * a * c
+         if (disc < 0.0_wp) return
+         q = -0.5_wp * (b + sign(sqrt(disc), b))
+         roots(1) = q / a
+         if (q /= 0.0_wp) roots(2) = c / q
+      else if (b /= 0.0_wp) then
+         roots(1) = -c / b
+      end if
+      best = 0.0_wp
+      do i = 1, 2
+         if (.not. (roots(i) > 0.0_wp .and. roots(i) < 1.0_wp)) cycle
+         q = roots(i)
+         p = g0 + q * (d0 + q * (b / 2.0_wp + q * a / 3.0_wp))
+         ! Far side: sign opposite near; keep the furthest.
+         if (p * near < best) then
+            best = p * near
+            theta = q
+         end if
+      end do
+   end function dip
 
    !> The cubic Hermite interpolant at θ in [0, 1] of a step of length h
    !> from (y0, f0) to (y1, f1): error O(h⁴).
