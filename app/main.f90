@@ -338,6 +338,8 @@ contains
       real(wp), save :: shown = -1.0_wp
       real(wp) :: now, elapsed, remaining, interval, fraction
       logical :: tty
+      character(len=160) :: text
+      character(len=12) :: seconds(2)
 
       if (opts%quiet) return
       tty = friction_stderr_is_terminal() /= 0
@@ -350,13 +352,16 @@ contains
       elapsed = now - t_start
       fraction = max(1.0e-9_wp, (t - t_first) / (t_last - t_first))
       remaining = elapsed * (1.0_wp - fraction) / fraction
+      ! (f0.1 would drop the leading zero of 0.5 s.)
+      write (seconds(1), '(f12.1)') elapsed
+      write (seconds(2), '(f12.1)') remaining
+      write (text, '(a, f0.1, a, f0.1, a)') 'friction: τ = ', t, ' of ', t_last, ', ' &
+         & //trim(adjustl(seconds(1)))//' s elapsed, '//trim(adjustl(seconds(2)))//' s remaining'
       if (tty) then
-         write (error_unit, '(a, f0.1, a, f0.1, a, f0.1, a, f0.1, a)', advance='no') achar(13)// &
-            & 'friction: τ = ', t, ' of ', t_last, ', ', elapsed, ' s elapsed, ', remaining, ' s remaining   '
+         write (error_unit, '(a)', advance='no') achar(13)//trim(text)//'   '
          if (last) write (error_unit, '(a)') ''
       else
-         write (error_unit, '(a, f0.1, a, f0.1, a, f0.1, a, f0.1, a)') 'friction: τ = ', t, ' of ', t_last, &
-            & ', ', elapsed, ' s elapsed, ', remaining, ' s remaining'
+         write (error_unit, '(a)') trim(text)
       end if
       flush (error_unit)
    end subroutine show_brake_progress

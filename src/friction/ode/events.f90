@@ -4,10 +4,11 @@
 !> event is a zero crossing of one of them in a chosen direction.  The
 !> `event_locator` advances step by step with a GSL driver, watches the sign
 !> of every g_k after each accepted step and, when one has crossed, finds
-!> the crossing time to an absolute time tolerance by the Illinois variant of
-!> regula falsi.  Every trial time c of the root finder is reached by
-!> integrating again from the start of the step to c with a second driver
-!> (the probe), at the same tolerances: the event state is then an
+!> the crossing time to an absolute time tolerance: a first guess from the
+!> step's cubic Hermite interpolant, then secants, with bisection as the
+!> fallback (see locate).  Every trial time c of the root finder is reached
+!> by integrating again from the start of the step to c with a second
+!> driver (the probe), at the same tolerances: the event state is then an
 !> integrated state, exact to the integrator's accuracy, not an
 !> interpolant's (GSL's steppers offer no common dense output).  The probe
 !> leaves the main driver untouched, so after a non-terminal event
@@ -381,7 +382,7 @@ contains
       end do
    end subroutine advance
 
-   !> Fill in which function crossed, in which direction, and whether terminal.
+   !> Record which function crossed and in which direction.
    subroutine describe(hit, k, direction)
       type(event_hit), intent(inout) :: hit
       integer, intent(in) :: k, direction
