@@ -357,9 +357,10 @@ def case_brake_ranks(args):
 
 
 def case_brake_dimensional(args):
-    """The §6.2 data: derived parameters recorded, the time scale too."""
-    dim = write(args, "dim.nml", BRAKE_SHORT.replace("/", "units = 'dimensional' /"))
-    friction(args, "-o", "dim.h5", os.path.join(args.inputs, "brake.nml"), dim)
+    """The §6.2 data (inputs/brake_dimensional.nml): derived parameters recorded, the time scale too."""
+    short = write(args, "short.nml", BRAKE_SHORT)
+    friction(args, "-o", "dim.h5", os.path.join(args.inputs, "brake.nml"),
+             os.path.join(args.inputs, "brake_dimensional.nml"), short)
     a = brake_file(args, "dim.h5")["attrs"]
     checks = {"xi": (0.215 / (3 * 0.174), 1e-14), "kappa": (1.5, 1e-14),
               "g_prime": (9.81 * 0.389 / 214.62, 1e-16), "time_scale": ((0.174 / 214.62) ** 0.5, 1e-16),

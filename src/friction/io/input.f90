@@ -61,7 +61,9 @@ contains
       real(wp) :: xi, kappa, g_prime, mu, mu_s, epsilon_prime, delta_prime, v_dr_prime
       real(wp) :: x0, y0, v_rel0, w0, t_start, t_end, dt_out, event_tolerance, stick_velocity
       ! &brake_dimensional (§6.2 data, SI; used when units = 'dimensional')
-      real(wp) :: arm_length, drum_radius, crank_mass, block_mass, k1, k2, k3, gravity, epsilon, delta, v_dr
+      ! (epsilon_si, delta_si, v_dr_si: the SI values of ε, δ, v_dr; &surface has its own epsilon)
+      real(wp) :: arm_length, drum_radius, crank_mass, block_mass, k1, k2, k3, gravity
+      real(wp) :: epsilon_si, delta_si, v_dr_si
       ! &verify (brake: a second run with another stepper or tighter tolerances)
       logical :: check
       character(len=16) :: check_method
@@ -75,7 +77,7 @@ contains
       namelist /brake/ model, units, xi, kappa, g_prime, mu, mu_s, epsilon_prime, delta_prime, v_dr_prime, &
          & x0, y0, v_rel0, w0, t_start, t_end, dt_out, event_tolerance, stick_velocity
       namelist /brake_dimensional/ arm_length, drum_radius, crank_mass, block_mass, k1, k2, k3, gravity, &
-         & epsilon, delta, v_dr
+         & epsilon_si, delta_si, v_dr_si
       namelist /verify/ check, check_method, check_rtol, check_atol, check_limit
 
       type(mention), allocatable :: mentions(:), all_mentions(:)
@@ -223,7 +225,7 @@ contains
             event_tolerance = b%event_tolerance; stick_velocity = b%stick_velocity
             arm_length = d%arm_length; drum_radius = d%drum_radius; crank_mass = d%crank_mass
             block_mass = d%block_mass; k1 = d%k1; k2 = d%k2; k3 = d%k3; gravity = d%gravity
-            epsilon = d%epsilon; delta = d%delta; v_dr = d%v_dr
+            epsilon_si = d%epsilon; delta_si = d%delta; v_dr_si = d%v_dr
             check = b%check%enabled; check_method = b%check%method; check_rtol = b%check%rtol
             check_atol = b%check%atol; check_limit = b%check%max_difference
          end associate
@@ -262,7 +264,7 @@ contains
             b%event_tolerance = event_tolerance; b%stick_velocity = stick_velocity
             d%arm_length = arm_length; d%drum_radius = drum_radius; d%crank_mass = crank_mass
             d%block_mass = block_mass; d%k1 = k1; d%k2 = k2; d%k3 = k3; d%gravity = gravity
-            d%epsilon = epsilon; d%delta = delta; d%v_dr = v_dr
+            d%epsilon = epsilon_si; d%delta = delta_si; d%v_dr = v_dr_si
             b%check%enabled = check; b%check%method = check_method; b%check%rtol = check_rtol
             b%check%atol = check_atol; b%check%max_difference = check_limit
             b%solver%method = method; b%solver%rtol = rtol; b%solver%atol = atol
@@ -383,10 +385,10 @@ contains
             call require_positive('brake_dimensional', 'k2', k2, 'N/m')
             call require_nonnegative('brake_dimensional', 'k3', k3, 'N/m')
             call require_nonnegative('brake_dimensional', 'gravity', gravity, 'm/s²')
-            if (regularized) call require_positive('brake_dimensional', 'epsilon', epsilon, &
+            if (regularized) call require_positive('brake_dimensional', 'epsilon_si', epsilon_si, &
                & 's/m; the regularized law needs a steepness')
-            call require_nonnegative('brake_dimensional', 'delta', delta, 's/m')
-            call require_finite('brake_dimensional', 'v_dr', v_dr)
+            call require_nonnegative('brake_dimensional', 'delta_si', delta_si, 's/m')
+            call require_finite('brake_dimensional', 'v_dr_si', v_dr_si)
             if (abs(k2 - k1) > 1.0e-9_wp * k1) call reject('brake_dimensional', 'k2', rtoa(k2), &
                & 'must equal k1 = '//rtoa(k1)//': Eq. 10 assumes k2 = k1 (paper §4.1)')
             if (allocated(error)) return
