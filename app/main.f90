@@ -1,4 +1,5 @@
-!> friction: friction-force maps of a microscope tip over a crystal surface.
+!> friction: friction-force maps of a microscope tip over a crystal surface,
+!> and the stick-slip of a Girling brake (scene 'brake', run_brake).
 !>
 !>   mpirun -n N friction [options] FILE.nml [MORE.nml ...]
 !>
@@ -10,7 +11,7 @@ program friction_main
    use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
    use mpi_f08
    use friction_kinds, only: wp, i8
-   use friction_error, only: error_type, fatal_error, error_input, error_io
+   use friction_error, only: error_type, fatal_error, error_input, error_io, error_numerical
    use friction_version, only: version_string
    use friction_strings, only: itoa
    use friction_io_input, only: job_config, read_input
@@ -20,6 +21,9 @@ program friction_main
    use friction_afm_output, only: afm_run_summary, write_afm_file, afm_surface_record
    use friction_afm_config, only: new_potential, species_count
    use friction_surface_potential, only: surface_potential
+   use friction_brake_config, only: brake_config
+   use friction_brake_simulate, only: brake_run, brake_comparison, compare_runs
+   use friction_brake_output, only: brake_run_summary, brake_check_summary, write_brake_file
    implicit none
 
    interface
@@ -79,7 +83,11 @@ program friction_main
       call finish(exit_io)
    end if
 
-   call run_afm()
+   if (config%scene == 'brake') then
+      call run_brake()
+   else
+      call run_afm()
+   end if
    call finish(0)
 
 contains
@@ -181,6 +189,204 @@ contains
       if (code /= 0) call finish(exit_io)
    end subroutine run_afm
 
+   !> The brake is one trajectory: rank 0 integrates it; with verify on, the
+   !> check run goes to rank 1 when there is one (concurrently), else rank 0
+   !> runs it after the main run.  The results are broadcast (a few MB at
+   !> most) so that every rank takes part in the collective writes with the
+   !> same data; the file does not depend on the number of ranks.
+   subroutine run_brake()
+      type(brake_run), target :: main_run, check_run
+      type(brake_config) :: check_config
+      type(brake_run_summary) :: summary
+      type(brake_check_summary) :: check
+      type(error_type), allocatable :: check_error
+      integer :: check_rank, failed_rank, pid
+      real(wp) :: wall, stick_time
+      integer(i8) :: counts(4)
+      character(len=:), allocatable :: temporary
+      character(len=160) :: line
+      character(len=12) :: seconds
+
+      check%enabled = config%brake%check%enabled
+      check_rank = merge(1, 0, nranks > 1)
+      if (rank == 0) call integrate_brake(main_run, config%brake, .true., error)
+      if (check%enabled) then
+         check_config = config%brake%check_settings()
+         if (rank == check_rank) call integrate_brake(check_run, check_config, check_rank /= 0, check_error)
+         if (allocated(check_error) .and. .not. allocated(error)) then
+            call move_alloc(check_error, error)
+            error%message = 'verify run: '//error%message
+         end if
+      end if
+      failed_rank = merge(rank, nranks, allocated(error))
+      call MPI_Allreduce(MPI_IN_PLACE, failed_rank, 1, MPI_INTEGER, MPI_MIN, MPI_COMM_WORLD)
+      if (failed_rank < nranks) then
+         if (rank == failed_rank) call report(error)
+         call finish(exit_numerical)
+      end if
+
+      call share_brake_run(main_run, 0, config%brake%grid_size(), counts, summary%compute_time, stick_time)
+      summary%stats = integrator_statistics(counts(1), counts(2), counts(3), counts(4))
+      summary%stick_time = stick_time
+      if (check%enabled) then
+         call share_brake_run(check_run, check_rank, config%brake%grid_size(), counts, check%compute_time, &
+            & stick_time)
+         check%stats = integrator_statistics(counts(1), counts(2), counts(3), counts(4))
+         check%config = check_config
+         check%comparison = compare_runs(main_run, check_run)
+         associate (d => check%comparison, c => check_config%solver)
+            if (rank == 0) then
+               write (line, '(a, es8.2, a, es8.2, a, es8.2, a, i0, a, i0)') 'friction: verify: ' &
+                  & //trim(c%method)//' at rtol ', c%rtol, ', atol ', c%atol, ': max |dx| = ', &
+                  & d%max_difference(1), ' m over the grid; events ', d%events, ' vs ', d%check_events
+               write (error_unit, '(a)') trim(line)
+            end if
+            if (config%brake%check%max_difference > 0.0_wp .and. &
+               & .not. (d%max_difference(1) <= config%brake%check%max_difference)) then
+               write (line, '(a, es8.2, a, es8.2, a)') 'verify failed: the check run differs by ', &
+                  & d%max_difference(1), ' m in x, more than check_limit = ', &
+                  & config%brake%check%max_difference, ' m (README: Girling brake, which steppers need verify)'
+               call fatal_error(error, trim(line), error_numerical)
+               if (rank == 0) call report(error)
+               call finish(exit_numerical)
+            end if
+         end associate
+      end if
+
+      wall = MPI_Wtime() - t_start
+      call MPI_Allreduce(MPI_IN_PLACE, wall, 1, MPI_DOUBLE_PRECISION, MPI_MAX, MPI_COMM_WORLD)
+      summary%input_text = input_text
+      summary%version = version_string
+      summary%nranks = nranks
+      summary%wall_time = wall
+
+      pid = friction_process_id()
+      call MPI_Bcast(pid, 1, MPI_INTEGER, 0, MPI_COMM_WORLD)
+      temporary = opts%output//'.tmp-'//itoa(pid)
+      call write_brake_file(temporary, MPI_COMM_WORLD, config%brake, main_run%trajectory, main_run%events, &
+         & summary, check, error)
+      code = merge(1, 0, allocated(error))
+      call MPI_Allreduce(MPI_IN_PLACE, code, 1, MPI_INTEGER, MPI_MAX, MPI_COMM_WORLD)
+      if (rank == 0) then
+         if (code == 0) then
+            call rename_file(temporary, opts%output, error)
+         else if (.not. allocated(error)) then
+            call fatal_error(error, temporary//': writing failed on another rank', error_io)
+         end if
+         if (allocated(error)) then
+            call remove_file(temporary)
+            call report(error)
+         else if (.not. opts%quiet) then
+            write (seconds, '(f12.3)') wall
+            write (line, '(a, i0, a, f0.1, a, i0, a, i0, a)') ' model, ', main_run%n, &
+               & ' points to τ = ', config%brake%grid_time(main_run%n), ', ', main_run%events%n, &
+               & ' events, '//trim(adjustl(seconds))//' s on ', nranks, trim(merge(' rank) ', ' ranks)', nranks == 1))
+            write (error_unit, '(a)') 'friction: wrote '//opts%output//' ('//trim(config%brake%model)//trim(line)
+         end if
+      end if
+      code = merge(1, 0, allocated(error))
+      call MPI_Bcast(code, 1, MPI_INTEGER, 0, MPI_COMM_WORLD)
+      if (code /= 0) call finish(exit_io)
+   end subroutine run_brake
+
+   !> One brake run, in pieces so that long runs can show progress.
+   subroutine integrate_brake(run, settings, show, error)
+      type(brake_run), target, intent(inout) :: run
+      type(brake_config), intent(in) :: settings
+      logical, intent(in) :: show
+      type(error_type), allocatable, intent(out) :: error
+      integer :: piece, last
+
+      call run%init(settings, error)
+      if (allocated(error)) return
+      piece = max(1, run%n / 200)
+      do last = piece, run%n + piece - 1, piece
+         call run%run_until(min(last, run%n), error)
+         if (allocated(error)) return
+         if (show) call show_brake_progress(run%time_reached(), settings%t_start, settings%t_end, .false.)
+      end do
+      if (show) call show_brake_progress(run%time_reached(), settings%t_start, settings%t_end, .true.)
+   end subroutine integrate_brake
+
+   !> Give every rank root's trajectory, events and counters.
+   subroutine share_brake_run(run, root, n, counts, compute_time, stick_time)
+      type(brake_run), intent(inout) :: run
+      integer, intent(in) :: root, n
+      integer(i8), intent(out) :: counts(4)
+      real(wp), intent(out) :: compute_time, stick_time
+      type(integrator_statistics) :: stats
+      integer :: n_events
+      real(wp) :: times(2)
+
+      if (rank == root) then
+         stats = run%statistics()
+         counts = [stats%steps, stats%failed_steps, stats%rhs_evaluations, stats%jacobian_evaluations]
+         times = [run%compute_time, run%stick_time()]
+         n_events = run%events%n
+      else
+         call run%trajectory%allocate_points(n)
+         run%n = n
+         run%done = n
+      end if
+      call MPI_Bcast(counts, 4, MPI_INTEGER8, root, MPI_COMM_WORLD)
+      call MPI_Bcast(times, 2, MPI_DOUBLE_PRECISION, root, MPI_COMM_WORLD)
+      call MPI_Bcast(n_events, 1, MPI_INTEGER, root, MPI_COMM_WORLD)
+      compute_time = times(1)
+      stick_time = times(2)
+      call MPI_Bcast(run%trajectory%t, n, MPI_DOUBLE_PRECISION, root, MPI_COMM_WORLD)
+      call MPI_Bcast(run%trajectory%x, n, MPI_DOUBLE_PRECISION, root, MPI_COMM_WORLD)
+      call MPI_Bcast(run%trajectory%v, n, MPI_DOUBLE_PRECISION, root, MPI_COMM_WORLD)
+      call MPI_Bcast(run%trajectory%y, n, MPI_DOUBLE_PRECISION, root, MPI_COMM_WORLD)
+      call MPI_Bcast(run%trajectory%w, n, MPI_DOUBLE_PRECISION, root, MPI_COMM_WORLD)
+      call MPI_Bcast(run%trajectory%stick, n, MPI_INTEGER, root, MPI_COMM_WORLD)
+      if (rank /= root) then
+         run%events%n = n_events
+         if (allocated(run%events%t)) deallocate (run%events%t, run%events%kind, run%events%state)
+         allocate (run%events%t(max(1, n_events)), run%events%kind(max(1, n_events)), &
+            & run%events%state(4, max(1, n_events)))
+      end if
+      if (n_events > 0) then
+         call MPI_Bcast(run%events%t, n_events, MPI_DOUBLE_PRECISION, root, MPI_COMM_WORLD)
+         call MPI_Bcast(run%events%kind, n_events, MPI_INTEGER, root, MPI_COMM_WORLD)
+         call MPI_Bcast(run%events%state, 4 * n_events, MPI_DOUBLE_PRECISION, root, MPI_COMM_WORLD)
+      end if
+   end subroutine share_brake_run
+
+   !> Rank 0's progress through τ, in the style of show_progress.
+   subroutine show_brake_progress(t, t_first, t_last, last)
+      real(wp), intent(in) :: t, t_first, t_last
+      logical, intent(in) :: last
+      real(wp), save :: shown = -1.0_wp
+      real(wp) :: now, elapsed, remaining, interval, fraction
+      logical :: tty
+      character(len=160) :: text
+      character(len=12) :: seconds(2)
+
+      if (opts%quiet) return
+      tty = friction_stderr_is_terminal() /= 0
+      now = MPI_Wtime()
+      interval = 0.5_wp
+      if (.not. tty) interval = max(2.0_wp, 0.1_wp * (now - t_start))
+      if (.not. last .and. now - max(shown, t_start) < interval) return
+      if (last .and. shown < 0.0_wp) return   ! finished before the first report: say nothing
+      shown = now
+      elapsed = now - t_start
+      fraction = max(1.0e-9_wp, (t - t_first) / (t_last - t_first))
+      remaining = elapsed * (1.0_wp - fraction) / fraction
+      ! (f0.1 would drop the leading zero of 0.5 s.)
+      write (seconds(1), '(f12.1)') elapsed
+      write (seconds(2), '(f12.1)') remaining
+      write (text, '(a, f0.1, a, f0.1, a)') 'friction: τ = ', t, ' of ', t_last, ', ' &
+         & //trim(adjustl(seconds(1)))//' s elapsed, '//trim(adjustl(seconds(2)))//' s remaining'
+      if (tty) then
+         write (error_unit, '(a)', advance='no') achar(13)//trim(text)//'   '
+         if (last) write (error_unit, '(a)') ''
+      else
+         write (error_unit, '(a)') trim(text)
+      end if
+      flush (error_unit)
+   end subroutine show_brake_progress
+
    !> Rank 0's progress: its share is as large as any other and spread over
    !> the whole map, so its fraction done is the map's fraction done.
    subroutine show_progress(done, share, total, last)
@@ -279,6 +485,8 @@ contains
          & 'Friction-force maps of a microscope tip dragged over a crystal surface', &
          & '(NaF, HOPG): the tip''s equations of motion integrated with GSL odeiv2,', &
          & 'scan lines shared among MPI ranks, results in one HDF5 file.', &
+         & 'With &job scene = ''brake'': the stick-slip of a Girling brake (one', &
+         & 'trajectory; inputs/brake.nml; groups &brake &brake_dimensional &verify).', &
          & '', &
          & 'Input files are namelist files read in order; a later file overrides', &
          & 'earlier values variable by variable.  Groups: &job &surface &tip &scan', &

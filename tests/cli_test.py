@@ -4,7 +4,9 @@
     cli_test.py --binary BIN --mpiexec MPIEXEC --inputs DIR --workdir DIR CASE
 
 Cases: datasets-naf, datasets-hopg, ranks, override, force, numerical-failure,
-and bad-<name> for each bad input in BAD_INPUTS.  Each asserts on exit codes,
+and bad-<name> for each bad input in BAD_INPUTS; for the brake scene
+brake-run, brake-ranks, brake-dimensional, brake-verify, brake-failure and
+bad-brake-<name> for each bad input in BAD_BRAKE_INPUTS.  Each asserts on exit codes,
 messages and file contents (read with h5py); none asserts on timings.
 """
 import argparse
@@ -63,6 +65,35 @@ BAD_INPUTS = {
 }
 
 DOCUMENTED = ["fx", "fy", "f_along", "f_across", "tip_x", "tip_y"]
+
+# The brake scene (inputs/brake.nml) on a short span for the tests.
+BRAKE_SHORT = "&brake t_end = 100.0, dt_out = 0.1 /\n"
+
+# Bad brake input: (override text on inputs/brake.nml, exit code, words of the message).
+BAD_BRAKE_INPUTS = {
+    "negative-mu": ("&brake mu = -0.1 /\n", 3, ["bad.nml:1", "&brake", "mu", ">= 0"]),
+    "negative-mu-s": ("&brake mu_s = -0.5 /\n", 3, ["bad.nml:1", "&brake", "mu_s", ">= 0"]),
+    "mu-above-mu-s": ("&brake mu = 0.7 /\n", 3, ["bad.nml:1", "&brake", "mu", "mu_s", "regularized"]),
+    "zero-xi": ("&brake xi = 0 /\n", 3, ["bad.nml:1", "&brake", "xi", "> 0"]),
+    "zero-epsilon": ("&brake model = 'regularized'\n epsilon_prime = 0.0 /\n", 3,
+                     ["bad.nml:2", "&brake", "epsilon_prime", "> 0"]),
+    "zero-dt-out": ("&brake dt_out = 0.0 /\n", 3, ["bad.nml:1", "&brake", "dt_out", "> 0"]),
+    "end-before-start": ("&brake t_start = 10.0, t_end = 5.0 /\n", 3,
+                         ["bad.nml:1", "&brake", "t_end", "after t_start"]),
+    "unknown-model": ("&brake model = 'coulomb' /\n", 3, ["bad.nml:1", "&brake", "model", "coulomb", "switched"]),
+    "unknown-units": ("&brake units = 'imperial' /\n", 3, ["bad.nml:1", "&brake", "units", "dimensional"]),
+    "k2-not-k1": ("&brake units = 'dimensional' /\n&brake_dimensional k2 = 100.0 /\n", 3,
+                  ["bad.nml:2", "&brake_dimensional", "k2", "k2 = k1"]),
+    "negative-mass": ("&brake units = 'dimensional' /\n&brake_dimensional block_mass = -1 /\n", 3,
+                      ["bad.nml:2", "&brake_dimensional", "block_mass", "> 0"]),
+    "lift-off-start": ("&brake y0 = 0.05 /\n", 3, ["bad.nml:1", "&brake", "y0", "N'"]),
+    "unknown-check-method": ("&verify check = .true., check_method = 'rk99' /\n", 3,
+                             ["bad.nml:1", "&verify", "check_method", "rk99", "rk8pd"]),
+    "negative-wall-time": ("&integrator max_wall_time = -1.0 /\n", 3,
+                           ["bad.nml:1", "&integrator", "max_wall_time", ">= 0"]),
+    "wrong-type": ("&brake t_end = 'long' /\n", 3, ["bad.nml:1", "&brake", "t_end", "number"]),
+    "unknown-variable": ("&brake epsilon = 1e6 /\n", 3, ["bad.nml:1", "&brake", "epsilon", "known"]),
+}
 
 
 def fail(message):
@@ -320,6 +351,162 @@ def case_bad(args, name):
         fail(f"bad input left files: {leftovers(args)}")
 
 
+def brake_file(args, name):
+    """Every dataset and attribute of a brake file, for the checks."""
+    with h5py.File(os.path.join(args.workdir, name), "r") as f:
+        data = {key: f["brake"][key][()] for key in ("t", "x", "v", "y", "w", "stick")}
+        data["events"] = {key: f["brake/events"][key][()] for key in ("t", "kind", "x", "v", "y", "w")}
+        data["attrs"] = dict(f["brake"].attrs)
+        data["root"] = dict(f.attrs)
+        data["verify"] = dict(f["brake/verify"].attrs) if "brake/verify" in f else None
+        data["units"] = {key: f["brake"][key].attrs["units"] for key in ("t", "x", "v", "y", "w", "stick")}
+    return data
+
+
+def case_brake_run(args):
+    """A short paper case: datasets, units, the exact stick, the event table."""
+    short = write(args, "short.nml", BRAKE_SHORT)
+    result = run(args, [args.binary, os.path.join(args.inputs, "brake.nml"), short])
+    if "friction: wrote brake.h5 (switched model, 1001 points" not in result.stderr:
+        fail("summary line missing or wrong: " + result.stderr)
+    d = brake_file(args, "brake.h5")
+    if d["root"]["scene"] != b"brake" or d["root"]["method"] != b"rk8pd":
+        fail(f"scene/method attributes: {d['root']['scene']}, {d['root']['method']}")
+    text = d["root"]["input"].decode().replace(" ", "")
+    for wanted in ["&BRAKE", "T_END=100.", "&VERIFY", "&INTEGRATOR", "MAX_WALL_TIME="]:
+        if wanted not in text:
+            fail(f"{wanted} not in the resolved input")
+    if "&SCAN" in text:
+        fail("the brake file echoes the AFM's groups")
+    t = d["t"]
+    if t.shape != (1001,) or abs(t[0]) > 0 or abs(t[-1] - 100.0) > 1e-9:
+        fail(f"grid: {t.shape}, {t[0]} .. {t[-1]}")
+    for key, unit in [("x", b"m"), ("t", b"1")]:
+        if d["units"][key] != unit:
+            fail(f"/brake/{key} units {d['units'][key]}")
+    a = d["attrs"]
+    expected = {"xi": 0.412, "kappa": 1.5, "g_prime": 0.01778, "mu": 0.59, "mu_s": 0.59,
+                "v_dr_prime": -0.002788, "epsilon_prime": 3.5121e7, "delta_prime": 3.5121}
+    for key, value in expected.items():
+        if abs(a[key] - value) > 1e-12 * abs(value):
+            fail(f"/brake attribute {key} = {a[key]}, expected {value}")
+    stick = d["stick"] == 1
+    if stick.sum() < 20 or stick.all():
+        fail(f"{stick.sum()} stick points out of {stick.size}")
+    # Stick is exact: x' equals v'_dr bit for bit.
+    if not np.all(d["v"][stick] == a["v_dr_prime"]):
+        fail("x' differs from v'_dr at a stick point")
+    if np.any(d["v"][~stick] == a["v_dr_prime"]):
+        fail("a slip point moves exactly with the belt")
+    e = d["events"]
+    if e["t"].size < 5 or not np.all(np.diff(e["t"]) > 0) or not set(e["kind"]) <= {1, 2, 3}:
+        fail(f"event table: {e['t'].size} events, kinds {set(e['kind'])}")
+    # Between a slip-to-stick event and the next stick-to-slip the grid sticks.
+    for k in range(e["t"].size - 1):
+        if e["kind"][k] == 2:
+            inside = (t > e["t"][k]) & (t < e["t"][k + 1])
+            if not stick[inside].all():
+                fail(f"grid points in the stick from {e['t'][k]} to {e['t'][k + 1]} not flagged")
+        if e["kind"][k] == 1:
+            # The elastic force is at the static limit when stick ends.
+            force = abs(2 * e["x"][k] - e["y"][k])
+            limit = a["mu_s"] * ((1 - a["kappa"]) * e["y"][k] + a["g_prime"])
+            if abs(force - limit) > 1e-15:
+                fail(f"stick ends at |2x - y| = {force}, limit {limit}")
+    if not (d["root"]["integrator_steps"] > 0 and d["root"]["rhs_evaluations"] > d["root"]["integrator_steps"]):
+        fail("integrator statistics implausible")
+    if not 0 < a["stick_time"] < 100 or a["compute_time"] <= 0:
+        fail(f"stick_time {a['stick_time']}, compute_time {a['compute_time']}")
+
+
+def case_brake_ranks(args):
+    """1, 2 and 3 ranks give the same file; with verify on, the check run
+    goes to rank 1 and still gives the same numbers."""
+    short = write(args, "short.nml", BRAKE_SHORT)
+    check = write(args, "check.nml", "&verify check = .true., check_method = 'rkf45' /\n")
+    brake = os.path.join(args.inputs, "brake.nml")
+    files = {}
+    for n in (1, 2, 3):
+        friction(args, "-o", f"b{n}.h5", brake, short, check, ranks=n)
+        files[n] = comparable(os.path.join(args.workdir, f"b{n}.h5"))
+    for other in (2, 3):
+        if files[1].keys() != files[other].keys():
+            fail(f"1 and {other} ranks wrote different objects")
+        for key, value in files[1].items():
+            if key.endswith("compute_time"):
+                continue
+            if not np.array_equal(np.asarray(value), np.asarray(files[other][key])):
+                fail(f"{key} differs between 1 and {other} ranks")
+
+
+def case_brake_dimensional(args):
+    """The §6.2 data (inputs/brake_dimensional.nml): derived parameters recorded, the time scale too."""
+    short = write(args, "short.nml", BRAKE_SHORT)
+    friction(args, "-o", "dim.h5", os.path.join(args.inputs, "brake.nml"),
+             os.path.join(args.inputs, "brake_dimensional.nml"), short)
+    a = brake_file(args, "dim.h5")["attrs"]
+    checks = {"xi": (0.215 / (3 * 0.174), 1e-14), "kappa": (1.5, 1e-14),
+              "g_prime": (9.81 * 0.389 / 214.62, 1e-16), "time_scale": ((0.174 / 214.62) ** 0.5, 1e-16),
+              "epsilon_prime": (1e6 * (214.62 / 0.174) ** 0.5, 1e-6), "v_dr_prime": (-0.002788, 5e-7)}
+    for key, (value, tol) in checks.items():
+        if abs(a[key] - value) > tol:
+            fail(f"derived {key} = {a[key]}, expected {value}")
+    if a["units"] != b"dimensional":
+        fail("units attribute")
+
+
+def case_brake_verify(args):
+    """msbdf on the regularized law at 1e-6 succeeds with a wrong answer:
+    verify against rk4imp at 1e-10 reports it; check_limit turns it into a failure."""
+    loose = write(args, "loose.nml", "&brake model = 'regularized', t_end = 200.0, dt_out = 0.5 /\n"
+                  "&integrator method = 'msbdf', rtol = 1e-6, atol = 1e-8 /\n"
+                  "&verify check = .true., check_method = 'rk4imp', check_rtol = 1e-10, check_atol = 1e-12 /\n")
+    brake = os.path.join(args.inputs, "brake.nml")
+    result = friction(args, "-o", "v.h5", brake, loose)
+    if "friction: verify: rk4imp" not in result.stderr or "max |dx|" not in result.stderr:
+        fail("no verification report on stderr: " + result.stderr)
+    v = brake_file(args, "v.h5")["verify"]
+    if v is None or v["method"] != b"rk4imp" or not v["max_difference_x"] > 1e-5:
+        fail(f"/brake/verify: {v}")
+    limit = write(args, "limit.nml", "&verify check_limit = 1e-6 /\n")
+    result = friction(args, "-o", "w.h5", brake, loose, limit, expect=4)
+    if "verify failed" not in result.stderr or "check_limit" not in result.stderr:
+        fail("no verify failure message: " + result.stderr)
+    if os.path.exists(os.path.join(args.workdir, "w.h5")):
+        fail("a failed verification wrote its file")
+
+
+def case_brake_failure(args):
+    """An explicit stepper on the stiff law with a small budget stops with
+    a message naming the stepper, the budget, the time; nothing written."""
+    stiff = write(args, "stiff.nml", "&brake model = 'regularized' /\n"
+                  "&integrator method = 'rk4', rtol = 1e-6, atol = 1e-8, max_steps = 2000 /\n")
+    result = friction(args, os.path.join(args.inputs, "brake.nml"), stiff, ranks=2, expect=4)
+    for word in ["rk4", "max_steps = 2000", "τ = ", "implicit"]:
+        if word not in result.stderr:
+            fail(f"failure message lacks {word!r}: {result.stderr}")
+    if result.stderr.count("friction: error:") != 1:
+        fail("expected exactly one error message: " + result.stderr)
+    if leftovers(args):
+        fail(f"a failed run left files: {leftovers(args)}")
+
+
+def case_bad_brake(args, name):
+    text, code, words = BAD_BRAKE_INPUTS[name]
+    cmd = [os.path.join(args.inputs, "brake.nml"), write(args, "bad.nml", text)]
+    # One rank: the input checks are the same on every rank, and the AFM's
+    # bad-input cases already show that 2 ranks give one message.
+    result = friction(args, *cmd, expect=code)
+    for word in words:
+        if word not in result.stderr:
+            fail(f"message lacks {word!r}: {result.stderr!r}")
+    ours = [line for line in result.stderr.splitlines() if line.startswith("friction:")]
+    if len(ours) != 1:
+        fail(f"expected one message from friction, got: {result.stderr}")
+    if leftovers(args):
+        fail(f"bad input left files: {leftovers(args)}")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--binary", required=True)
@@ -332,8 +519,14 @@ def main():
     os.makedirs(args.workdir)
     if args.case.startswith("datasets-"):
         case_datasets(args, args.case.split("-", 1)[1])
+    elif args.case.startswith("bad-brake-"):
+        case_bad_brake(args, args.case[len("bad-brake-"):])
     elif args.case.startswith("bad-"):
         case_bad(args, args.case[4:])
+    elif args.case.startswith("brake-"):
+        {"brake-run": case_brake_run, "brake-ranks": case_brake_ranks,
+         "brake-dimensional": case_brake_dimensional, "brake-verify": case_brake_verify,
+         "brake-failure": case_brake_failure}[args.case](args)
     else:
         {"ranks": case_ranks, "override": case_override, "force": case_force,
          "numerical-failure": case_numerical_failure, "graphite": case_graphite,

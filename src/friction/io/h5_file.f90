@@ -30,6 +30,7 @@ module friction_io_h5_file
       procedure :: write_matrix
       procedure :: write_vector_block
       procedure :: write_line_block
+      procedure :: write_vector_integer
       procedure :: write_attribute_text
       procedure :: write_attribute_real
       procedure :: write_attribute_integer
@@ -189,6 +190,39 @@ contains
       if (len_trim(units) > 0) call attribute_text(self, dset, 'units', units)
       call h5dclose_f(dset, stat)
    end subroutine write_block
+
+   !> A 1-D integer dataset that every rank holds whole; rank 0 writes it
+   !> (flags, codes).  Collective like the others.
+   subroutine write_vector_integer(self, name, values, units)
+      class(h5_file), intent(inout) :: self
+      character(len=*), intent(in) :: name, units
+      integer, intent(in) :: values(:)
+      integer(hid_t) :: filespace, memspace, dset, xfer
+      integer(hsize_t) :: dims(1)
+      integer :: stat
+
+      if (self%status /= 0) return
+      dims = [int(size(values), hsize_t)]
+      call h5screate_simple_f(1, dims, filespace, stat)
+      call h5dcreate_f(self%id, name, H5T_NATIVE_INTEGER, filespace, dset, stat)
+      call self%check(stat, 'creating dataset '//name)
+      if (stat /= 0) return
+      call h5screate_simple_f(1, dims, memspace, stat)
+      if (self%rank /= 0 .or. size(values) == 0) then
+         call h5sselect_none_f(filespace, stat)
+         call h5sselect_none_f(memspace, stat)
+      end if
+      call h5pcreate_f(H5P_DATASET_XFER_F, xfer, stat)
+      call h5pset_dxpl_mpio_f(xfer, H5FD_MPIO_COLLECTIVE_F, stat)
+      call h5dwrite_f(dset, H5T_NATIVE_INTEGER, values, dims, stat, &
+         & mem_space_id=memspace, file_space_id=filespace, xfer_prp=xfer)
+      call self%check(stat, 'writing dataset '//name)
+      call h5pclose_f(xfer, stat)
+      call h5sclose_f(memspace, stat)
+      call h5sclose_f(filespace, stat)
+      call attribute_text(self, dset, 'units', units)
+      call h5dclose_f(dset, stat)
+   end subroutine write_vector_integer
 
    !> A text attribute on the object at path object ('/' for the root).
    subroutine write_attribute_text(self, object, name, text)

@@ -13,6 +13,7 @@ module friction_io_input
    use friction_ode_solver, only: step_type_names, step_type_index
    use friction_afm_config, only: afm_config, potential_names, net_names, net_sites, max_species, max_defects
    use friction_io_files, only: file_exists
+   use friction_brake_config, only: brake_config, model_names, units_names, brake_solver_defaults
    use friction_io_namelist_scan, only: mention, scan_namelist_file, lower, namelist_names, &
       & assigned_names, value_has_kind, kind_text
    implicit none
@@ -20,13 +21,14 @@ module friction_io_input
 
    public :: job_config, read_input, group_names
 
-   character(len=*), parameter :: group_names(5) = [character(len=10) :: &
-      & 'job', 'surface', 'tip', 'scan', 'integrator']
+   character(len=*), parameter :: group_names(8) = [character(len=17) :: &
+      & 'job', 'surface', 'tip', 'scan', 'integrator', 'brake', 'brake_dimensional', 'verify']
 
    !> Everything a run needs from its input files.
    type :: job_config
       character(len=16) :: scene = 'afm'
       type(afm_config) :: afm
+      type(brake_config) :: brake
    end type job_config
 
 contains
@@ -59,13 +61,31 @@ contains
       character(len=16) :: method
       real(wp) :: rtol, atol, h_start, h_min
       integer(i8) :: max_steps
+      real(wp) :: max_wall_time
+      ! &brake (scene 'brake': Eq. 10, nondimensional; README: Girling brake)
+      character(len=16) :: model, units
+      real(wp) :: xi, kappa, g_prime, mu, mu_s, epsilon_prime, delta_prime, v_dr_prime
+      real(wp) :: x0, y0, v_rel0, w0, t_start, t_end, dt_out, event_tolerance, stick_velocity
+      ! &brake_dimensional (§6.2 data, SI; used when units = 'dimensional')
+      ! (epsilon_si, delta_si, v_dr_si: the SI values of ε, δ, v_dr; &surface has its own epsilon)
+      real(wp) :: arm_length, drum_radius, crank_mass, block_mass, k1, k2, k3, gravity
+      real(wp) :: epsilon_si, delta_si, v_dr_si
+      ! &verify (brake: a second run with another stepper or tighter tolerances)
+      logical :: check
+      character(len=16) :: check_method
+      real(wp) :: check_rtol, check_atol, check_limit
 
       namelist /job/ scene
       namelist /surface/ potential, v0, ax, ay, a, net, net_file, shells, side, species, epsilon, sigma, &
          & vacancies, substitutions, substitution_species, cutoff, cutoff_tolerance
       namelist /tip/ mass, kx, ky, kz, cx, cy, cz, support_z
       namelist /scan/ velocity, length, width, angle, origin_x, origin_y, lead_in, nx, ny, retrace
-      namelist /integrator/ method, rtol, atol, h_start, h_min, max_steps
+      namelist /integrator/ method, rtol, atol, h_start, h_min, max_steps, max_wall_time
+      namelist /brake/ model, units, xi, kappa, g_prime, mu, mu_s, epsilon_prime, delta_prime, v_dr_prime, &
+         & x0, y0, v_rel0, w0, t_start, t_end, dt_out, event_tolerance, stick_velocity
+      namelist /brake_dimensional/ arm_length, drum_radius, crank_mass, block_mass, k1, k2, k3, gravity, &
+         & epsilon_si, delta_si, v_dr_si
+      namelist /verify/ check, check_method, check_rtol, check_atol, check_limit
 
       type(mention), allocatable :: mentions(:), all_mentions(:)
       character(len=4096), allocatable :: source(:)
@@ -118,8 +138,11 @@ contains
       call resolve_net_file()
       call validate()
       if (allocated(error)) return
+      ! Echo the groups the scene reads (the AFM's: 1-5; the brake's: job, integrator, 6-8).
       input_text = ''
       do g = 1, size(group_names)
+         if (scene == 'brake' .and. any(g == [2, 3, 4])) cycle
+         if (scene /= 'brake' .and. g > 5) cycle
          input_text = input_text//group_as_text(g)
       end do
 
@@ -138,6 +161,9 @@ contains
          case (3); read (unit, nml=tip, iostat=s, iomsg=msg)
          case (4); read (unit, nml=scan, iostat=s, iomsg=msg)
          case (5); read (unit, nml=integrator, iostat=s, iomsg=msg)
+         case (6); read (unit, nml=brake, iostat=s, iomsg=msg)
+         case (7); read (unit, nml=brake_dimensional, iostat=s, iomsg=msg)
+         case (8); read (unit, nml=verify, iostat=s, iomsg=msg)
          end select
          if (is_iostat_end(s)) return  ! absent: keep what we have
          if (s /= 0) then
@@ -170,6 +196,9 @@ contains
          case (3); write (scratch, nml=tip)
          case (4); write (scratch, nml=scan)
          case (5); write (scratch, nml=integrator)
+         case (6); write (scratch, nml=brake)
+         case (7); write (scratch, nml=brake_dimensional)
+         case (8); write (scratch, nml=verify)
          end select
          rewind (scratch)
          text = ''
@@ -199,6 +228,20 @@ contains
             nx = c%nx; ny = c%ny; retrace = c%retrace
             method = c%solver%method; rtol = c%solver%rtol; atol = c%solver%atol
             h_start = c%solver%h_start; h_min = c%solver%h_min; max_steps = c%solver%max_steps
+            max_wall_time = c%solver%max_wall_time
+         end associate
+         associate (b => defaults%brake, p => defaults%brake%params, d => defaults%brake%dimensional)
+            model = b%model; units = b%units
+            xi = p%xi; kappa = p%kappa; g_prime = p%g_prime; mu = p%mu; mu_s = p%mu_s
+            epsilon_prime = p%epsilon_prime; delta_prime = p%delta_prime; v_dr_prime = p%v_dr
+            x0 = b%x0; y0 = b%y0; v_rel0 = b%v_rel0; w0 = b%w0
+            t_start = b%t_start; t_end = b%t_end; dt_out = b%dt_out
+            event_tolerance = b%event_tolerance; stick_velocity = b%stick_velocity
+            arm_length = d%arm_length; drum_radius = d%drum_radius; crank_mass = d%crank_mass
+            block_mass = d%block_mass; k1 = d%k1; k2 = d%k2; k3 = d%k3; gravity = d%gravity
+            epsilon_si = d%epsilon; delta_si = d%delta; v_dr_si = d%v_dr
+            check = b%check%enabled; check_method = b%check%method; check_rtol = b%check%rtol
+            check_atol = b%check%atol; check_limit = b%check%max_difference
          end associate
       end subroutine from_config
 
@@ -222,6 +265,32 @@ contains
             c%nx = nx; c%ny = ny; c%retrace = retrace
             c%solver%method = method; c%solver%rtol = rtol; c%solver%atol = atol
             c%solver%h_start = h_start; c%solver%h_min = h_min; c%solver%max_steps = max_steps
+            c%solver%max_wall_time = max_wall_time
+         end associate
+         ! The brake's &integrator defaults differ from the AFM's (τ units, tight tolerances).
+         if (scene == 'brake') then
+            if (.not. is_set('integrator', 'method')) method = brake_solver_defaults%method
+            if (.not. is_set('integrator', 'rtol')) rtol = brake_solver_defaults%rtol
+            if (.not. is_set('integrator', 'atol')) atol = brake_solver_defaults%atol
+         end if
+         model = lower(model)
+         units = lower(units)
+         check_method = lower(check_method)
+         associate (b => config%brake, p => config%brake%params, d => config%brake%dimensional)
+            b%model = model; b%units = units
+            p%xi = xi; p%kappa = kappa; p%g_prime = g_prime; p%mu = mu; p%mu_s = mu_s
+            p%epsilon_prime = epsilon_prime; p%delta_prime = delta_prime; p%v_dr = v_dr_prime
+            b%x0 = x0; b%y0 = y0; b%v_rel0 = v_rel0; b%w0 = w0
+            b%t_start = t_start; b%t_end = t_end; b%dt_out = dt_out
+            b%event_tolerance = event_tolerance; b%stick_velocity = stick_velocity
+            d%arm_length = arm_length; d%drum_radius = drum_radius; d%crank_mass = crank_mass
+            d%block_mass = block_mass; d%k1 = k1; d%k2 = k2; d%k3 = k3; d%gravity = gravity
+            d%epsilon = epsilon_si; d%delta = delta_si; d%v_dr = v_dr_si
+            b%check%enabled = check; b%check%method = check_method; b%check%rtol = check_rtol
+            b%check%atol = check_atol; b%check%max_difference = check_limit
+            b%solver%method = method; b%solver%rtol = rtol; b%solver%atol = atol
+            b%solver%h_start = h_start; b%solver%h_min = h_min; b%solver%max_steps = max_steps
+            b%solver%max_wall_time = max_wall_time
          end associate
       end subroutine to_config
 
@@ -240,6 +309,13 @@ contains
             end if
          end do
       end subroutine resolve_net_file
+
+      !> Whether any file set a variable.
+      logical function is_set(group, name)
+         character(len=*), intent(in) :: group, name
+
+         is_set = origin(group, name) /= '(default)'
+      end function is_set
 
       !> The file that last set a variable, for messages.
       function origin(group, name) result(text)
@@ -343,8 +419,8 @@ contains
       end subroutine validate_net
 
       subroutine validate()
-         if (scene /= 'afm') call reject('job', 'scene', "'"//trim(scene)//"'", &
-            & "unknown scene (known: 'afm')")
+         if (scene /= 'afm' .and. scene /= 'brake') call reject('job', 'scene', "'"//trim(scene)//"'", &
+            & "unknown scene (known: 'afm', 'brake')")
          if (.not. any(potential_names == potential)) call reject('surface', 'potential', &
             & "'"//trim(potential)//"'", 'unknown potential (known: '//quoted(potential_names)//')')
          call require_nonnegative('surface', 'v0', v0, 'eV')
@@ -375,7 +451,85 @@ contains
          call require_nonnegative('integrator', 'h_start', h_start, 's; 0 chooses automatically')
          call require_nonnegative('integrator', 'h_min', h_min, 's; 0 for no limit')
          if (max_steps < 1) call reject('integrator', 'max_steps', itoa(max_steps), 'must be >= 1')
+         call require_nonnegative('integrator', 'max_wall_time', max_wall_time, 's; 0 for no limit')
+         if (scene == 'brake') call validate_brake()
       end subroutine validate
+
+      !> The brake scene's settings (README: Girling brake, input reference).
+      subroutine validate_brake()
+         type(error_type), allocatable :: derive_error
+         real(wp) :: normal
+         logical :: regularized, dimensional
+
+         if (.not. any(model_names == model)) call reject('brake', 'model', "'"//trim(model)//"'", &
+            & 'unknown friction model (known: '//quoted(model_names)//')')
+         if (.not. any(units_names == units)) call reject('brake', 'units', "'"//trim(units)//"'", &
+            & 'unknown parameter set (known: '//quoted(units_names)//')')
+         if (allocated(error)) return
+         regularized = model == 'regularized'
+         dimensional = units == 'dimensional'
+         call require_nonnegative('brake', 'mu', mu, 'kinetic friction coefficient')
+         call require_nonnegative('brake', 'mu_s', mu_s, 'static friction coefficient')
+         if (.not. regularized .and. mu > mu_s) call reject('brake', 'mu', rtoa(mu), &
+            & 'the switched model needs mu <= mu_s = '//rtoa(mu_s)//' (a kinetic coefficient above the ' &
+            & //'static one makes every slip stop at once: use the regularized model)')
+         if (dimensional) then
+            call require_positive('brake_dimensional', 'arm_length', arm_length, 'm')
+            call require_nonnegative('brake_dimensional', 'drum_radius', drum_radius, 'm')
+            call require_positive('brake_dimensional', 'crank_mass', crank_mass, 'kg')
+            call require_positive('brake_dimensional', 'block_mass', block_mass, 'kg')
+            call require_positive('brake_dimensional', 'k1', k1, 'N/m')
+            call require_positive('brake_dimensional', 'k2', k2, 'N/m')
+            call require_nonnegative('brake_dimensional', 'k3', k3, 'N/m')
+            call require_nonnegative('brake_dimensional', 'gravity', gravity, 'm/s²')
+            if (regularized) call require_positive('brake_dimensional', 'epsilon_si', epsilon_si, &
+               & 's/m; the regularized law needs a steepness')
+            call require_nonnegative('brake_dimensional', 'delta_si', delta_si, 's/m')
+            call require_finite('brake_dimensional', 'v_dr_si', v_dr_si)
+            if (abs(k2 - k1) > 1.0e-9_wp * k1) call reject('brake_dimensional', 'k2', rtoa(k2), &
+               & 'must equal k1 = '//rtoa(k1)//': Eq. 10 assumes k2 = k1 (paper §4.1)')
+            if (allocated(error)) return
+            call config%brake%resolve(derive_error)
+            if (allocated(derive_error)) then
+               call reject('brake_dimensional', 'k2', rtoa(k2), derive_error%message)
+               return
+            end if
+         else
+            call require_positive('brake', 'xi', xi, 'J/(m L²)')
+            call require_positive('brake', 'kappa', kappa, '(k1 + k3)/k1')
+            call require_finite('brake', 'g_prime', g_prime)
+            if (regularized) call require_positive('brake', 'epsilon_prime', epsilon_prime, &
+               & 'the regularized law needs a steepness')
+            call require_nonnegative('brake', 'delta_prime', delta_prime, 'velocity weakening')
+            call require_finite('brake', 'v_dr_prime', v_dr_prime)
+         end if
+         call require_finite('brake', 'x0', x0)
+         call require_finite('brake', 'y0', y0)
+         call require_finite('brake', 'v_rel0', v_rel0)
+         call require_finite('brake', 'w0', w0)
+         call require_finite('brake', 't_start', t_start)
+         call require_finite('brake', 't_end', t_end)
+         if (.not. (t_end > t_start)) call reject('brake', 't_end', rtoa(t_end), &
+            & 'must be after t_start = '//rtoa(t_start))
+         call require_positive('brake', 'dt_out', dt_out, 'output grid step in τ')
+         call require_positive('brake', 'event_tolerance', event_tolerance, 'τ')
+         call require_positive('brake', 'stick_velocity', stick_velocity, 'm per unit τ')
+         if (allocated(error)) return
+         if ((t_end - t_start) / dt_out > 1.0e7_wp) call reject('brake', 'dt_out', rtoa(dt_out), &
+            & 'gives more than 1e7 output points over [t_start, t_end]')
+         associate (p => config%brake%params)
+            normal = p%normal_force(y0)
+            if (.not. (normal > 0.0_wp)) call reject('brake', 'y0', rtoa(y0), &
+               & "the initial normal force N' = (1 - kappa) y0 + g_prime = "//rtoa(normal) &
+               & //' must be > 0 (kappa = '//rtoa(p%kappa)//', g_prime = '//rtoa(p%g_prime)//')')
+         end associate
+         if (len_trim(check_method) > 0 .and. step_type_index(check_method) == 0) &
+            & call reject('verify', 'check_method', "'"//trim(check_method)//"'", &
+            & "unknown GSL step type (known: ''"//', '//quoted(step_type_names)//')')
+         call require_nonnegative('verify', 'check_rtol', check_rtol, '0 for rtol / 1000')
+         call require_nonnegative('verify', 'check_atol', check_atol, '0 for atol / 1000')
+         call require_nonnegative('verify', 'check_limit', check_limit, 'm; 0 reports only')
+      end subroutine validate_brake
 
    end subroutine read_input
 

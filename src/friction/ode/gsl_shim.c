@@ -4,6 +4,7 @@
  * import those through bind(c) (it defines a zero copy of its own), so they
  * are handed out here by index.  The driver's counters live in structs whose
  * layout Fortran should not mirror, so they are read here too. */
+#include <math.h>
 #include <stddef.h>
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_odeiv2.h>
@@ -50,4 +51,22 @@ void friction_gsl_driver_counts(const gsl_odeiv2_driver *d, long *steps, long *f
 double friction_gsl_driver_step(const gsl_odeiv2_driver *d)
 {
     return d->h;
+}
+
+/* One accepted step from *t towards t1 (never past it), with the checks of
+ * gsl_odeiv2_driver_apply (h_max, h_min) but without its step budget, which
+ * a caller that looks at every step counts itself.  h_min applies to the
+ * step just taken as well as to the next one proposed: evolve shrinks a
+ * rejected step internally and may accept one far below h_min, then
+ * propose a larger one, which the driver's check alone would let through.
+ * A final step clamped to t1 is exempt (GSL's evolve does not shrink the
+ * suggested step after it, so stepping onto output times is harmless). */
+int friction_gsl_driver_step_once(gsl_odeiv2_driver *d, double *t, double t1, double y[])
+{
+    double t0 = *t;
+    int status = gsl_odeiv2_evolve_apply(d->e, d->c, d->s, d->sys, t, t1, &d->h, y);
+    if (status != GSL_SUCCESS) return status;
+    if (fabs(d->h) > d->hmax) d->h = copysign(d->hmax, d->h);
+    if (*t != t1 && (fabs(d->h) < d->hmin || fabs(*t - t0) < d->hmin)) return GSL_ENOPROG;
+    return GSL_SUCCESS;
 }

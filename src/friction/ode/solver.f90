@@ -35,6 +35,7 @@ module friction_ode_solver
       real(wp) :: h_start = 0.0_wp     !! first step; 0 lets the caller choose
       real(wp) :: h_min = 0.0_wp       !! smallest step allowed; 0 for no limit
       integer(i8) :: max_steps = 10000000_i8  !! per restart (per scan trip)
+      real(wp) :: max_wall_time = 0.0_wp  !! s; 0 for no limit (honoured by step-by-step callers)
    end type solver_settings
 
    !> Cost counters, summed over restarts.
@@ -72,12 +73,18 @@ module friction_ode_solver
       integer(i8) :: max_steps = 0
       real(wp) :: h_min = 0.0_wp
       character(len=16) :: method = ''
+      !> how messages name the time and its unit (the brake runs in nondimensional τ)
+      character(len=8) :: time_name = 't', time_unit = ' s'
       !> counters of the finished restarts
       type(integrator_statistics) :: done
    contains
       procedure :: init
       procedure :: restart
       procedure :: advance
+      procedure :: step
+      procedure :: step_size
+      procedure :: set_time_label
+      procedure :: time_at
       procedure :: statistics
       procedure :: destroy
       final :: finalize
@@ -133,6 +140,22 @@ module friction_ode_solver
          real(c_double), value :: hmin
          integer(c_int) :: status
       end function gsl_odeiv2_driver_set_hmin
+
+      function friction_gsl_driver_step_once(driver, t, t1, y) result(status) &
+         & bind(c, name='friction_gsl_driver_step_once')
+         import :: c_ptr, c_double, c_int
+         type(c_ptr), value :: driver
+         real(c_double), intent(inout) :: t
+         real(c_double), value :: t1
+         real(c_double), intent(inout) :: y(*)
+         integer(c_int) :: status
+      end function friction_gsl_driver_step_once
+
+      function friction_gsl_driver_step(driver) result(h) bind(c, name='friction_gsl_driver_step')
+         import :: c_ptr, c_double
+         type(c_ptr), value :: driver
+         real(c_double) :: h
+      end function friction_gsl_driver_step
 
       subroutine gsl_odeiv2_driver_free(driver) bind(c, name='gsl_odeiv2_driver_free')
          import :: c_ptr
@@ -241,20 +264,75 @@ contains
       call friction_gsl_driver_counts(self%driver, steps, failed)
       if (status /= gsl_success) then
          if (status == gsl_ebadfunc) then
-            call fatal_error(error, trim(self%method)//': the right-hand side became NaN or Inf at t = ' &
-               & //time_text(t), error_numerical)
+            call fatal_error(error, trim(self%method)//': the right-hand side became NaN or Inf at ' &
+               & //self%time_at(t), error_numerical)
          else
-            call fatal_error(error, trim(self%method)//' failed at t = '//time_text(t) &
+            call fatal_error(error, trim(self%method)//' failed at '//self%time_at(t) &
                & //': '//gsl_message(status)//step_hint(status), error_numerical)
          end if
       else if (.not. all(abs(y) <= huge(y))) then
-         call fatal_error(error, trim(self%method)//': the state became NaN or Inf at t = ' &
-            & //time_text(t), error_numerical)
+         call fatal_error(error, trim(self%method)//': the state became NaN or Inf at ' &
+            & //self%time_at(t), error_numerical)
       else if (steps > self%max_steps) then
-         call fatal_error(error, trim(self%method)//': more than max_steps steps in one trip at t = ' &
-            & //time_text(t), error_numerical)
+         call fatal_error(error, trim(self%method)//': more than max_steps steps in one trip at ' &
+            & //self%time_at(t), error_numerical)
       end if
    end subroutine advance
+
+   !> One accepted step of the driver from t towards t1 (never past it), for
+   !> callers that look at every step (event location).  The driver's
+   !> h_min check applies; max_steps is the caller's to count.  On failure t
+   !> holds the time reached.
+   subroutine step(self, t, t1, y, error)
+      class(ode_solver), intent(inout) :: self
+      real(wp), intent(inout) :: t
+      real(wp), intent(in) :: t1
+      real(wp), intent(inout) :: y(:)
+      type(error_type), allocatable, intent(out) :: error
+      integer(c_int) :: status
+
+      status = friction_gsl_driver_step_once(self%driver, t, t1, y)
+      if (status == gsl_ebadfunc) then
+         call fatal_error(error, trim(self%method)//': the right-hand side became NaN or Inf at ' &
+            & //self%time_at(t), error_numerical)
+      else if (status /= gsl_success) then
+         call fatal_error(error, trim(self%method)//' failed at '//self%time_at(t) &
+            & //': '//gsl_message(status)//step_hint(status), error_numerical)
+      else if (.not. all(abs(y) <= huge(y))) then
+         call fatal_error(error, trim(self%method)//': the state became NaN or Inf at ' &
+            & //self%time_at(t), error_numerical)
+      end if
+   end subroutine step
+
+   !> The step size the driver will try next.
+   function step_size(self) result(h)
+      class(ode_solver), intent(in) :: self
+      real(wp) :: h
+
+      h = 0.0_wp
+      if (c_associated(self%driver)) h = friction_gsl_driver_step(self%driver)
+   end function step_size
+
+   !> How messages name the time: 't', ' s' by default; a nondimensional
+   !> scene passes its own symbol and an empty unit.
+   subroutine set_time_label(self, name, unit)
+      class(ode_solver), intent(inout) :: self
+      character(len=*), intent(in) :: name, unit
+
+      self%time_name = name
+      self%time_unit = unit
+   end subroutine set_time_label
+
+   !> 't = 1.2345670E-03 s' for messages.
+   function time_at(self, t) result(text)
+      class(ode_solver), intent(in) :: self
+      real(wp), intent(in) :: t
+      character(len=:), allocatable :: text
+      character(len=32) :: buffer
+
+      write (buffer, '(es14.7)') t
+      text = trim(self%time_name)//' = '//trim(adjustl(buffer))//trim(self%time_unit)
+   end function time_at
 
    !> Counters summed over all restarts so far.
    function statistics(self) result(stats)
@@ -312,16 +390,6 @@ contains
       allocate (character(len=n) :: message)
       message = transfer(text(1:n), message)
    end function gsl_message
-
-   !> A time for messages, in seconds.
-   function time_text(t) result(text)
-      real(wp), intent(in) :: t
-      character(len=:), allocatable :: text
-      character(len=32) :: buffer
-
-      write (buffer, '(es14.7)') t
-      text = trim(adjustl(buffer))//' s'
-   end function time_text
 
    !> What a user can do about a failure status.
    pure function step_hint(status) result(hint)

@@ -1,0 +1,171 @@
+!> The brake file (README: output reference, /brake).  Collective: every
+!> rank calls it with the same data (rank 0 computed it and broadcast it;
+!> the datasets are small), and rank 0 writes the values.
+module friction_brake_output
+   use mpi_f08, only: MPI_Comm
+   use friction_kinds, only: wp, i8
+   use friction_error, only: error_type
+   use friction_strings, only: join
+   use friction_ode_solver, only: integrator_statistics
+   use friction_brake_config, only: brake_config
+   use friction_brake_params, only: time_scale
+   use friction_brake_record, only: brake_trajectory, brake_event_table, event_kind_names
+   use friction_brake_simulate, only: brake_comparison
+   use friction_io_h5_file, only: h5_file
+   implicit none
+   private
+
+   public :: brake_run_summary, brake_check_summary, write_brake_file
+
+   !> What the file records about the run besides the trajectory.
+   type :: brake_run_summary
+      character(len=:), allocatable :: input_text
+      character(len=:), allocatable :: version
+      integer :: nranks = 1
+      real(wp) :: wall_time = 0.0_wp       !! s, up to the write
+      real(wp) :: compute_time = 0.0_wp    !! s, integration of the main run alone
+      real(wp) :: stick_time = 0.0_wp      !! τ spent in stick
+      type(integrator_statistics) :: stats
+   end type brake_run_summary
+
+   !> The verification run: its settings, cost and differences.
+   type :: brake_check_summary
+      logical :: enabled = .false.
+      type(brake_config) :: config
+      type(brake_comparison) :: comparison
+      type(integrator_statistics) :: stats
+      real(wp) :: compute_time = 0.0_wp
+   end type brake_check_summary
+
+contains
+
+   subroutine write_brake_file(path, comm, config, trajectory, events, summary, check, error)
+      character(len=*), intent(in) :: path
+      type(MPI_Comm), intent(in) :: comm
+      type(brake_config), intent(in) :: config
+      type(brake_trajectory), intent(in) :: trajectory
+      type(brake_event_table), intent(in) :: events
+      type(brake_run_summary), intent(in) :: summary
+      type(brake_check_summary), intent(in) :: check
+      type(error_type), allocatable, intent(out) :: error
+      type(h5_file) :: file
+      type(error_type), allocatable :: close_error
+      real(wp) :: f(2)
+      integer :: n
+      character(len=32) :: codes(size(event_kind_names))
+
+      call file%create(path, comm, error)
+      if (allocated(error)) then
+         call file%close(close_error)
+         return
+      end if
+      call file%write_attribute_text('/', 'program', 'friction')
+      call file%write_attribute_text('/', 'version', summary%version)
+      call file%write_attribute_text('/', 'scene', 'brake')
+      call file%write_attribute_text('/', 'input', summary%input_text)
+      call file%write_attribute_integer('/', 'nranks', int(summary%nranks, i8))
+      call file%write_attribute_real('/', 'wall_time', summary%wall_time)
+      call file%write_attribute_text('/', 'method', trim(config%solver%method))
+      call file%write_attribute_integer('/', 'integrator_steps', summary%stats%steps)
+      call file%write_attribute_integer('/', 'integrator_rejected_steps', summary%stats%failed_steps)
+      call file%write_attribute_integer('/', 'rhs_evaluations', summary%stats%rhs_evaluations)
+      call file%write_attribute_integer('/', 'jacobian_evaluations', summary%stats%jacobian_evaluations)
+
+      call file%create_group('/brake')
+      call file%write_attribute_text('/brake', 'model', trim(config%model))
+      call file%write_attribute_text('/brake', 'units', trim(config%units))
+      associate (p => config%params)
+         ! The parameters of Eq. 10 the run used (derived when units = 'dimensional').
+         call file%write_attribute_real('/brake', 'xi', p%xi)
+         call file%write_attribute_real('/brake', 'kappa', p%kappa)
+         call file%write_attribute_real('/brake', 'g_prime', p%g_prime)
+         call file%write_attribute_real('/brake', 'mu', p%mu)
+         call file%write_attribute_real('/brake', 'mu_s', p%mu_s)
+         call file%write_attribute_real('/brake', 'epsilon_prime', p%epsilon_prime)
+         call file%write_attribute_real('/brake', 'delta_prime', p%delta_prime)
+         call file%write_attribute_real('/brake', 'v_dr_prime', p%v_dr)
+         f = p%natural_frequencies()
+         call file%write_attribute_real('/brake', 'natural_frequency_1', f(1))
+         call file%write_attribute_real('/brake', 'natural_frequency_2', f(2))
+      end associate
+      if (trim(config%units) == 'dimensional') &
+         & call file%write_attribute_real('/brake', 'time_scale', time_scale(config%dimensional))
+      call file%write_attribute_real('/brake', 't_start', config%t_start)
+      call file%write_attribute_real('/brake', 't_end', config%t_end)
+      call file%write_attribute_real('/brake', 'dt_out', config%dt_out)
+      call file%write_attribute_real('/brake', 'event_tolerance', config%event_tolerance)
+      call file%write_attribute_real('/brake', 'stick_velocity', config%stick_velocity)
+      call file%write_attribute_real('/brake', 'compute_time', summary%compute_time)
+      call file%write_attribute_real('/brake', 'stick_time', summary%stick_time)
+      call file%write_attribute_real('/brake', 'rtol', config%solver%rtol)
+      call file%write_attribute_real('/brake', 'atol', config%solver%atol)
+
+      call file%write_vector('/brake/t', trajectory%t, '1')
+      call file%write_vector('/brake/x', trajectory%x, 'm')
+      call file%write_vector('/brake/v', trajectory%v, 'm per unit tau')
+      call file%write_vector('/brake/y', trajectory%y, 'm')
+      call file%write_vector('/brake/w', trajectory%w, 'm per unit tau')
+      call file%write_vector_integer('/brake/stick', trajectory%stick, '1')
+
+      n = events%n
+      call file%create_group('/brake/events')
+      do n = 1, size(event_kind_names)
+         write (codes(n), '(i0, a)') n, ' = '//trim(event_kind_names(n))
+      end do
+      n = events%n
+      call file%write_attribute_text('/brake/events', 'kind_names', join(codes))
+      call file%write_vector('/brake/events/t', event_column(0), '1')
+      call file%write_vector_integer('/brake/events/kind', event_kinds(), '1')
+      call file%write_vector('/brake/events/x', event_column(1), 'm')
+      call file%write_vector('/brake/events/v', event_column(2), 'm per unit tau')
+      call file%write_vector('/brake/events/y', event_column(3), 'm')
+      call file%write_vector('/brake/events/w', event_column(4), 'm per unit tau')
+
+      if (check%enabled) then
+         call file%create_group('/brake/verify')
+         associate (c => check%config, d => check%comparison)
+            call file%write_attribute_text('/brake/verify', 'method', trim(c%solver%method))
+            call file%write_attribute_real('/brake/verify', 'rtol', c%solver%rtol)
+            call file%write_attribute_real('/brake/verify', 'atol', c%solver%atol)
+            call file%write_attribute_real('/brake/verify', 'event_tolerance', c%event_tolerance)
+            call file%write_attribute_real('/brake/verify', 'max_difference_x', d%max_difference(1))
+            call file%write_attribute_real('/brake/verify', 'max_difference_v', d%max_difference(2))
+            call file%write_attribute_real('/brake/verify', 'max_difference_y', d%max_difference(3))
+            call file%write_attribute_real('/brake/verify', 'max_difference_w', d%max_difference(4))
+            call file%write_attribute_real('/brake/verify', 'end_difference_x', d%end_difference(1))
+            call file%write_attribute_integer('/brake/verify', 'events', int(d%events, i8))
+            call file%write_attribute_integer('/brake/verify', 'check_events', int(d%check_events, i8))
+            ! Events pair up in order only when both runs have as many.
+            if (d%events == d%check_events) call file%write_attribute_real('/brake/verify', &
+               & 'max_event_time_difference', d%max_event_time_difference)
+            call file%write_attribute_integer('/brake/verify', 'rhs_evaluations', check%stats%rhs_evaluations)
+            call file%write_attribute_real('/brake/verify', 'compute_time', check%compute_time)
+         end associate
+      end if
+      call file%close(error)
+
+   contains
+
+      !> Column k of the event table: 0 the times, 1..4 the state.
+      function event_column(k) result(values)
+         integer, intent(in) :: k
+         real(wp) :: values(n)
+
+         if (n == 0) return
+         if (k == 0) then
+            values = events%t(1:n)
+         else
+            values = events%state(k, 1:n)
+         end if
+      end function event_column
+
+      function event_kinds() result(values)
+         integer :: values(n)
+
+         if (n == 0) return
+         values = events%kind(1:n)
+      end function event_kinds
+
+   end subroutine write_brake_file
+
+end module friction_brake_output

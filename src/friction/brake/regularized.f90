@@ -1,0 +1,228 @@
+!> The regularized friction law: Eq. 10 as one smooth ODE, with the arctan
+!> standing in for the sign of v_rel.  State y = (x, x', y, y') as
+!> (x, v, y, w); time τ.
+!>
+!>   x' = v,  v' = -(2x - y) + F(N', v_rel),  y' = w,  w' = (x - κ y)/ξ
+!>   F = -μ N' (2/π) arctan(ε' v_rel) / (1 + δ' |v_rel|)
+!>
+!> With ε' = 3.5e7 the system is very stiff near v_rel = 0: ∂v'/∂v is about
+!> -(2/π) μ N' ε' ≈ -2.3e5 there, against natural frequencies of order 1.
+!> The analytic Jacobian serves the implicit steppers.
+!>
+!> Event functions (for the event locator): 1. N' (falling to 0 is an
+!> error: the block lifts off); 2., 3. v_rel ∓ stick_velocity, the edges of
+!> the creep band the output counts as stick.
+module friction_brake_regularized
+   use friction_kinds, only: wp, i8, pi
+   use friction_error, only: error_type, fatal_error, error_numerical
+   use friction_strings, only: rtoa
+   use friction_ode_solver, only: solver_settings, integrator_statistics, is_implicit_step_type
+   use friction_ode_events, only: event_system, event_locator, event_falling, event_either, &
+      & event_rising
+   use friction_brake_params, only: brake_parameters
+   use friction_brake_record, only: brake_event_table, event_stick_to_slip, event_slip_to_stick
+   implicit none
+   private
+
+   public :: brake_regularized, regularized_friction, regularized_friction_slope
+   public :: regularized_integrator
+
+   type, extends(event_system) :: brake_regularized
+      type(brake_parameters) :: params
+      real(wp) :: stick_velocity = 1.0e-6_wp   !! half-width of the creep band
+   contains
+      procedure :: dimension
+      procedure :: rhs
+      procedure :: jacobian
+      procedure :: event_count
+      procedure :: event_values
+   end type brake_regularized
+
+   !> Integrates the regularized model forward from an initial state; records
+   !> when |v_rel| enters and leaves the creep band as events.
+   type :: regularized_integrator
+      type(brake_regularized), allocatable :: system
+      type(event_locator) :: locator
+      character(len=16) :: method = ''
+      real(wp) :: t = 0.0_wp
+      real(wp) :: y(4) = 0.0_wp
+   contains
+      procedure :: init => integrator_init
+      procedure :: advance_to => integrator_advance_to
+      procedure :: statistics => integrator_statistics_of
+      procedure :: steps_taken => integrator_steps_taken
+   end type regularized_integrator
+
+contains
+
+   !> F/k1 of Eq. 10 (m): the friction force on the block, regularized.
+   pure real(wp) function regularized_friction(p, normal, v_rel)
+      type(brake_parameters), intent(in) :: p
+      real(wp), intent(in) :: normal, v_rel
+
+      regularized_friction = -p%mu * normal * (2.0_wp / pi) * atan(p%epsilon_prime * v_rel) &
+         & / (1.0_wp + p%delta_prime * abs(v_rel))
+   end function regularized_friction
+
+   !> ∂F/∂v_rel at fixed N'.  The kink of |v_rel| at 0 multiplies
+   !> arctan(0) = 0, so the derivative is continuous.
+   pure real(wp) function regularized_friction_slope(p, normal, v_rel)
+      type(brake_parameters), intent(in) :: p
+      real(wp), intent(in) :: normal, v_rel
+      real(wp) :: ev, denominator
+
+      ev = p%epsilon_prime * v_rel
+      denominator = 1.0_wp + p%delta_prime * abs(v_rel)
+      regularized_friction_slope = -p%mu * normal * (2.0_wp / pi) * &
+         & (p%epsilon_prime / (1.0_wp + ev * ev) / denominator &
+         & - atan(ev) * p%delta_prime * sign(1.0_wp, v_rel) / denominator**2)
+   end function regularized_friction_slope
+
+   pure function dimension(self) result(n)
+      class(brake_regularized), intent(in) :: self
+      integer :: n
+
+      n = 4
+   end function dimension
+
+   !> Eq. 10.
+   pure subroutine rhs(self, t, y, dydt)
+      class(brake_regularized), intent(in) :: self
+      real(wp), intent(in) :: t
+      real(wp), intent(in) :: y(:)
+      real(wp), intent(out) :: dydt(:)
+      real(wp) :: normal
+
+      associate (p => self%params)
+         normal = (1.0_wp - p%kappa) * y(3) + p%g_prime
+         dydt(1) = y(2)
+         dydt(2) = -(2.0_wp * y(1) - y(3)) + regularized_friction(p, normal, y(2) - p%v_dr)
+         dydt(3) = y(4)
+         dydt(4) = (y(1) - p%kappa * y(3)) / p%xi
+      end associate
+   end subroutine rhs
+
+   !> Analytic Jacobian; autonomous, so dfdt = 0.
+   pure subroutine jacobian(self, t, y, dfdy, dfdt)
+      class(brake_regularized), intent(in) :: self
+      real(wp), intent(in) :: t
+      real(wp), intent(in) :: y(:)
+      real(wp), intent(out) :: dfdy(:, :)
+      real(wp), intent(out) :: dfdt(:)
+      real(wp) :: normal, v_rel
+
+      associate (p => self%params)
+         normal = (1.0_wp - p%kappa) * y(3) + p%g_prime
+         v_rel = y(2) - p%v_dr
+         dfdy = 0.0_wp
+         dfdy(1, 2) = 1.0_wp
+         dfdy(2, 1) = -2.0_wp
+         dfdy(2, 2) = regularized_friction_slope(p, normal, v_rel)
+         ! F is linear in N', and ∂N'/∂y = 1 - κ.
+         dfdy(2, 3) = 1.0_wp + (1.0_wp - p%kappa) * regularized_friction(p, 1.0_wp, v_rel)
+         dfdy(3, 4) = 1.0_wp
+         dfdy(4, 1) = 1.0_wp / p%xi
+         dfdy(4, 3) = -p%kappa / p%xi
+         dfdt = 0.0_wp
+      end associate
+   end subroutine jacobian
+
+   pure function event_count(self) result(n)
+      class(brake_regularized), intent(in) :: self
+      integer :: n
+
+      n = 3
+   end function event_count
+
+   pure subroutine event_values(self, t, y, g)
+      class(brake_regularized), intent(in) :: self
+      real(wp), intent(in) :: t
+      real(wp), intent(in) :: y(:)
+      real(wp), intent(out) :: g(:)
+
+      associate (p => self%params)
+         g(1) = (1.0_wp - p%kappa) * y(3) + p%g_prime
+         g(2) = y(2) - p%v_dr - self%stick_velocity
+         g(3) = y(2) - p%v_dr + self%stick_velocity
+      end associate
+   end subroutine event_values
+
+   subroutine integrator_init(self, p, stick_velocity, settings, event_tolerance, t0, y0, events, error)
+      class(regularized_integrator), target, intent(inout) :: self
+      type(brake_parameters), intent(in) :: p
+      real(wp), intent(in) :: stick_velocity, event_tolerance, t0, y0(4)
+      type(solver_settings), intent(in) :: settings
+      type(brake_event_table), intent(inout) :: events
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: h_start
+
+      if (allocated(self%system)) deallocate (self%system)
+      allocate (self%system)
+      self%system%params = p
+      self%system%stick_velocity = stick_velocity
+      self%method = settings%method
+      ! The fastest time scale near v_rel = 0 is 1/|∂v'/∂v| ~ 1/((2/π) μ N' ε').
+      h_start = settings%h_start
+      if (.not. (h_start > 0.0_wp)) h_start = min(1.0e-3_wp, &
+         & 0.1_wp / max(1.0_wp, abs(regularized_friction_slope(p, p%normal_force(y0(3)), 0.0_wp))))
+      call self%locator%init(self%system, settings, [event_falling, event_either, event_either], &
+         & [.true., .false., .false.], event_tolerance, h_start, error, time_name='τ', time_unit='')
+      if (allocated(error)) return
+      self%t = t0
+      self%y = y0
+      call self%locator%restart(t0, y0, h_start)
+      call events%clear()
+   end subroutine integrator_init
+
+   !> Advance to t_target; creep-band crossings go into the table.
+   subroutine integrator_advance_to(self, t_target, events, error)
+      class(regularized_integrator), intent(inout) :: self
+      real(wp), intent(in) :: t_target
+      type(brake_event_table), intent(inout) :: events
+      type(error_type), allocatable, intent(out) :: error
+      integer :: i
+
+      do while (self%t < t_target)
+         call self%locator%advance(self%t, t_target, self%y, error)
+         if (allocated(error)) then
+            error%message = error%message//' (regularized model'
+            if (.not. is_implicit_step_type(self%method)) error%message = error%message &
+               & //'; with a large epsilon_prime the law is stiff near v_rel = 0: try an implicit' &
+               & //' stepper (bsimp, rk4imp, msbdf) or the switched model'
+            error%message = error%message//')'
+            return
+         end if
+         do i = 1, self%locator%n_hits
+            associate (hit => self%locator%hits(i))
+               select case (hit%which)
+               case (1)
+                  call fatal_error(error, "regularized model: N' reached 0 at τ = "//rtoa(hit%t) &
+                     & //': the pad lifts off the belt, outside Eq. 10', error_numerical)
+                  return
+               case (2)   ! v_rel - v_s: falling enters the band from above
+                  call events%add(hit%t, merge(event_slip_to_stick, event_stick_to_slip, &
+                     & hit%direction == event_falling), hit%y(1:4))
+               case default   ! v_rel + v_s: rising enters the band from below
+                  call events%add(hit%t, merge(event_slip_to_stick, event_stick_to_slip, &
+                     & hit%direction == event_rising), hit%y(1:4))
+               end select
+            end associate
+         end do
+      end do
+   end subroutine integrator_advance_to
+
+   function integrator_statistics_of(self) result(stats)
+      class(regularized_integrator), intent(in) :: self
+      type(integrator_statistics) :: stats
+
+      stats = self%locator%statistics()
+   end function integrator_statistics_of
+
+   function integrator_steps_taken(self) result(n)
+      class(regularized_integrator), intent(in) :: self
+      integer(i8) :: n
+
+      n = self%locator%steps_taken()
+   end function integrator_steps_taken
+
+end module friction_brake_regularized

@@ -1,0 +1,198 @@
+!> A brake run: either friction model integrated over the output grid, the
+!> trajectory and event table it records, and the comparison of two runs
+!> (`verify`).  The run can be driven in pieces (run_until) so that the
+!> program can report progress between them.
+module friction_brake_simulate
+   use friction_kinds, only: wp, i8
+   use friction_error, only: error_type, fatal_error, error_input
+   use friction_strings, only: rtoa
+   use friction_ode_solver, only: integrator_statistics
+   use friction_brake_config, only: brake_config, model_switched
+   use friction_brake_record, only: brake_trajectory, brake_event_table
+   use friction_brake_switched, only: switched_integrator
+   use friction_brake_regularized, only: regularized_integrator
+   implicit none
+   private
+
+   public :: brake_run, brake_comparison, compare_runs, simulate_brake, initial_state
+
+   type :: brake_run
+      type(brake_config) :: config
+      type(brake_trajectory) :: trajectory
+      type(brake_event_table) :: events
+      type(switched_integrator) :: switched
+      type(regularized_integrator) :: regularized
+      integer :: n = 0             !! grid points
+      integer :: done = 0          !! grid points filled so far
+      real(wp) :: compute_time = 0.0_wp   !! wall-clock seconds spent integrating
+   contains
+      procedure :: init
+      procedure :: run_until
+      procedure :: statistics
+      procedure :: steps_taken
+      procedure :: stick_time
+      procedure :: time_reached
+   end type brake_run
+
+   !> Differences of a run from a check run on the same grid.
+   type :: brake_comparison
+      real(wp) :: max_difference(4) = 0.0_wp    !! max over the grid of |Δx|, |Δv|, |Δy|, |Δw|
+      real(wp) :: end_difference(4) = 0.0_wp    !! the same at the last grid point
+      integer :: events = 0, check_events = 0   !! event counts of both runs
+      real(wp) :: max_event_time_difference = 0.0_wp  !! over events paired in order (only when counts agree)
+   end type brake_comparison
+
+contains
+
+   !> The initial state (x, x', y, y') of the settings, x' = v'_dr + v_rel0.
+   pure function initial_state(config) result(y)
+      type(brake_config), intent(in) :: config
+      real(wp) :: y(4)
+
+      y = [config%x0, config%params%v_dr + config%v_rel0, config%y0, config%w0]
+   end function initial_state
+
+   !> Set up a run of a resolved configuration (parameters of Eq. 10 set).
+   subroutine init(self, config, error)
+      class(brake_run), target, intent(inout) :: self
+      type(brake_config), intent(in) :: config
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: y0(4)
+
+      self%config = config
+      self%n = config%grid_size()
+      self%done = 0
+      self%compute_time = 0.0_wp
+      call self%trajectory%allocate_points(self%n)
+      y0 = initial_state(config)
+      associate (p => config%params)
+         if (.not. (p%normal_force(y0(3)) > 0.0_wp)) then
+            call fatal_error(error, "&brake: the initial state has N' = (1 - kappa) y0 + g_prime = " &
+               & //rtoa(p%normal_force(y0(3)))//': must be > 0 (the pad presses on the belt)', error_input)
+            return
+         end if
+         if (trim(config%model) == model_switched) then
+            call self%switched%init(p, config%solver, config%event_tolerance, config%t_start, y0, &
+               & self%events, error)
+         else
+            call self%regularized%init(p, config%stick_velocity, config%solver, config%event_tolerance, &
+               & config%t_start, y0, self%events, error)
+         end if
+      end associate
+   end subroutine init
+
+   !> Fill the grid up to point last (or the end).  On error the points
+   !> before the failure are filled and time_reached tells how far it got.
+   subroutine run_until(self, last, error)
+      class(brake_run), intent(inout) :: self
+      integer, intent(in) :: last
+      type(error_type), allocatable, intent(out) :: error
+      integer :: i
+      integer(i8) :: start, finish, rate
+      real(wp) :: t, y(4)
+      logical :: stick
+
+      call system_clock(start, rate)
+      do i = self%done + 1, min(last, self%n)
+         t = self%config%grid_time(i)
+         if (trim(self%config%model) == model_switched) then
+            call self%switched%advance_to(t, self%events, error)
+            y = self%switched%y
+            stick = self%switched%sticking
+         else
+            call self%regularized%advance_to(t, self%events, error)
+            y = self%regularized%y
+            stick = abs(y(2) - self%config%params%v_dr) <= self%config%stick_velocity
+         end if
+         if (allocated(error)) exit
+         self%trajectory%t(i) = t
+         self%trajectory%x(i) = y(1)
+         self%trajectory%v(i) = y(2)
+         self%trajectory%y(i) = y(3)
+         self%trajectory%w(i) = y(4)
+         self%trajectory%stick(i) = merge(1, 0, stick)
+         self%done = i
+      end do
+      call system_clock(finish)
+      self%compute_time = self%compute_time + real(finish - start, wp) / real(rate, wp)
+   end subroutine run_until
+
+   function statistics(self) result(stats)
+      class(brake_run), intent(in) :: self
+      type(integrator_statistics) :: stats
+
+      if (trim(self%config%model) == model_switched) then
+         stats = self%switched%statistics()
+      else
+         stats = self%regularized%statistics()
+      end if
+   end function statistics
+
+   function steps_taken(self) result(n)
+      class(brake_run), intent(in) :: self
+      integer(i8) :: n
+
+      if (trim(self%config%model) == model_switched) then
+         n = self%switched%steps_taken()
+      else
+         n = self%regularized%steps_taken()
+      end if
+   end function steps_taken
+
+   !> Time spent in stick: exact for the switched model; for the regularized
+   !> one the grid's share of stick points times the span.
+   pure real(wp) function stick_time(self)
+      class(brake_run), intent(in) :: self
+
+      if (trim(self%config%model) == model_switched) then
+         stick_time = self%switched%stick_time
+      else if (self%done > 1) then
+         stick_time = real(count(self%trajectory%stick(1:self%done) == 1), wp) / self%done &
+            & * (self%trajectory%t(self%done) - self%trajectory%t(1))
+      else
+         stick_time = 0.0_wp
+      end if
+   end function stick_time
+
+   pure real(wp) function time_reached(self)
+      class(brake_run), intent(in) :: self
+
+      if (trim(self%config%model) == model_switched) then
+         time_reached = self%switched%t
+      else
+         time_reached = self%regularized%t
+      end if
+   end function time_reached
+
+   !> A whole run in one call.
+   subroutine simulate_brake(config, run, error)
+      type(brake_config), intent(in) :: config
+      type(brake_run), target, intent(inout) :: run
+      type(error_type), allocatable, intent(out) :: error
+
+      call run%init(config, error)
+      if (allocated(error)) return
+      call run%run_until(run%n, error)
+   end subroutine simulate_brake
+
+   !> How far a run is from a check run of the same grid.
+   pure function compare_runs(run, check) result(cmp)
+      type(brake_run), intent(in) :: run, check
+      type(brake_comparison) :: cmp
+      integer :: n
+
+      n = min(run%done, check%done)
+      cmp%events = run%events%n
+      cmp%check_events = check%events%n
+      if (n < 1) return
+      associate (a => run%trajectory, b => check%trajectory)
+         cmp%max_difference = [maxval(abs(a%x(1:n) - b%x(1:n))), maxval(abs(a%v(1:n) - b%v(1:n))), &
+            & maxval(abs(a%y(1:n) - b%y(1:n))), maxval(abs(a%w(1:n) - b%w(1:n)))]
+         cmp%end_difference = abs([a%x(n) - b%x(n), a%v(n) - b%v(n), a%y(n) - b%y(n), a%w(n) - b%w(n)])
+      end associate
+      if (run%events%n == check%events%n .and. run%events%n > 0) &
+         & cmp%max_event_time_difference = maxval(abs(run%events%t(1:run%events%n) &
+         & - check%events%t(1:run%events%n)))
+   end function compare_runs
+
+end module friction_brake_simulate
