@@ -18,7 +18,8 @@ program friction_main
    use friction_io_files, only: file_exists, rename_file, remove_file
    use friction_ode_solver, only: integrator_statistics
    use friction_afm_scan, only: afm_scanner, trip_record, share_of, n_quantities
-   use friction_afm_output, only: afm_run_summary, write_afm_file, afm_surface_record
+   use friction_afm_output, only: write_afm_file, afm_surface_record
+   use friction_io_run_summary, only: run_summary
    use friction_afm_config, only: new_potential, species_count
    use friction_surface_potential, only: surface_potential
    use friction_brake_config, only: brake_config
@@ -99,14 +100,13 @@ contains
       type(afm_surface_record) :: surface
       type(trip_record) :: trip
       real(wp), allocatable :: trace(:, :, :), retrace(:, :, :)
-      type(afm_run_summary) :: summary
+      type(run_summary) :: summary
       type(integrator_statistics) :: stats
       integer(i8) :: counts(4)
       integer :: first, count, j, failed_rank
       real(wp) :: wall
       character(len=:), allocatable :: temporary
       character(len=12) :: seconds
-      integer :: pid
 
       associate (c => config%afm)
          ! The surface first, identically on every rank: a bad net or defect is
@@ -154,11 +154,9 @@ contains
       stats = integrator_statistics(counts(1), counts(2), counts(3), counts(4))
       wall = MPI_Wtime() - t_start
       call MPI_Allreduce(MPI_IN_PLACE, wall, 1, MPI_DOUBLE_PRECISION, MPI_MAX, MPI_COMM_WORLD)
-      summary = afm_run_summary(input_text, version_string, nranks, wall, stats)
+      summary = run_summary(input_text, version_string, nranks, wall, stats)
 
-      pid = friction_process_id()
-      call MPI_Bcast(pid, 1, MPI_INTEGER, 0, MPI_COMM_WORLD)
-      temporary = opts%output//'.tmp-'//itoa(pid)
+      temporary = temporary_name()
       if (scanner%tip%ndim == 3) then
          call write_afm_file(temporary, MPI_COMM_WORLD, config%afm, first, nranks, trace, retrace, summary, &
             & error, surface)
@@ -166,27 +164,9 @@ contains
          call write_afm_file(temporary, MPI_COMM_WORLD, config%afm, first, nranks, trace, retrace, summary, &
             & error)
       end if
-      code = merge(1, 0, allocated(error))
-      call MPI_Allreduce(MPI_IN_PLACE, code, 1, MPI_INTEGER, MPI_MAX, MPI_COMM_WORLD)
-      if (rank == 0) then
-         if (code == 0) then
-            call rename_file(temporary, opts%output, error)
-         else if (.not. allocated(error)) then
-            call fatal_error(error, temporary//': writing failed on another rank', error_io)
-         end if
-         if (allocated(error)) then
-            call remove_file(temporary)
-            call report(error)
-         else if (.not. opts%quiet) then
-            write (seconds, '(f12.2)') wall
-            write (error_unit, '(a)') 'friction: wrote '//opts%output//' ('//itoa(config%afm%ny) &
-               & //' lines x '//itoa(config%afm%nx)//' points, '//trim(adjustl(seconds))//' s on ' &
-               & //itoa(nranks)//trim(merge(' rank) ', ' ranks)', nranks == 1))
-         end if
-      end if
-      code = merge(1, 0, allocated(error))
-      call MPI_Bcast(code, 1, MPI_INTEGER, 0, MPI_COMM_WORLD)
-      if (code /= 0) call finish(exit_io)
+      write (seconds, '(f12.2)') wall
+      call publish(temporary, itoa(config%afm%ny)//' lines x '//itoa(config%afm%nx)//' points, ' &
+         & //trim(adjustl(seconds))//' s on '//itoa(nranks)//trim(merge(' rank ', ' ranks', nranks == 1)))
    end subroutine run_afm
 
    !> The brake is one trajectory: rank 0 integrates it; with verify on, the
@@ -200,7 +180,7 @@ contains
       type(brake_run_summary) :: summary
       type(brake_check_summary) :: check
       type(error_type), allocatable :: check_error
-      integer :: check_rank, failed_rank, pid
+      integer :: check_rank, failed_rank
       real(wp) :: wall, stick_time
       integer(i8) :: counts(4)
       character(len=:), allocatable :: temporary
@@ -260,33 +240,14 @@ contains
       summary%nranks = nranks
       summary%wall_time = wall
 
-      pid = friction_process_id()
-      call MPI_Bcast(pid, 1, MPI_INTEGER, 0, MPI_COMM_WORLD)
-      temporary = opts%output//'.tmp-'//itoa(pid)
+      temporary = temporary_name()
       call write_brake_file(temporary, MPI_COMM_WORLD, config%brake, main_run%trajectory, main_run%events, &
          & summary, check, error)
-      code = merge(1, 0, allocated(error))
-      call MPI_Allreduce(MPI_IN_PLACE, code, 1, MPI_INTEGER, MPI_MAX, MPI_COMM_WORLD)
-      if (rank == 0) then
-         if (code == 0) then
-            call rename_file(temporary, opts%output, error)
-         else if (.not. allocated(error)) then
-            call fatal_error(error, temporary//': writing failed on another rank', error_io)
-         end if
-         if (allocated(error)) then
-            call remove_file(temporary)
-            call report(error)
-         else if (.not. opts%quiet) then
-            write (seconds, '(f12.3)') wall
-            write (line, '(a, i0, a, f0.1, a, i0, a, i0, a)') ' model, ', main_run%n, &
-               & ' points to τ = ', config%brake%grid_time(main_run%n), ', ', main_run%events%n, &
-               & ' events, '//trim(adjustl(seconds))//' s on ', nranks, trim(merge(' rank) ', ' ranks)', nranks == 1))
-            write (error_unit, '(a)') 'friction: wrote '//opts%output//' ('//trim(config%brake%model)//trim(line)
-         end if
-      end if
-      code = merge(1, 0, allocated(error))
-      call MPI_Bcast(code, 1, MPI_INTEGER, 0, MPI_COMM_WORLD)
-      if (code /= 0) call finish(exit_io)
+      write (seconds, '(f12.3)') wall
+      write (line, '(a, i0, a, f0.1, a, i0, a)') ' model, ', main_run%n, ' points to τ = ', &
+         & config%brake%grid_time(main_run%n), ', ', main_run%events%n, ' events, '
+      call publish(temporary, trim(config%brake%model)//trim(line)//' '//trim(adjustl(seconds))//' s on ' &
+         & //itoa(nranks)//trim(merge(' rank ', ' ranks', nranks == 1)))
    end subroutine run_brake
 
    !> One brake run, in pieces so that long runs can show progress.
@@ -502,6 +463,43 @@ contains
          & '', &
          & 'exit codes: 0 done, 2 usage, 3 bad input, 4 integration failed, 5 output failed'
    end subroutine print_help
+
+   !> The name the output is written under until it is complete: unique per
+   !> run (rank 0's process id), beside the output so the rename is atomic.
+   function temporary_name() result(name)
+      character(len=:), allocatable :: name
+      integer :: pid
+
+      pid = friction_process_id()
+      call MPI_Bcast(pid, 1, MPI_INTEGER, 0, MPI_COMM_WORLD)
+      name = opts%output//'.tmp-'//itoa(pid)
+   end function temporary_name
+
+   !> After the collective write to `temporary`: on success on every rank,
+   !> rename it to the output and summarise (`what`); otherwise remove it,
+   !> report and stop.
+   subroutine publish(temporary, what)
+      character(len=*), intent(in) :: temporary, what
+
+      code = merge(1, 0, allocated(error))
+      call MPI_Allreduce(MPI_IN_PLACE, code, 1, MPI_INTEGER, MPI_MAX, MPI_COMM_WORLD)
+      if (rank == 0) then
+         if (code == 0) then
+            call rename_file(temporary, opts%output, error)
+         else if (.not. allocated(error)) then
+            call fatal_error(error, temporary//': writing failed on another rank', error_io)
+         end if
+         if (allocated(error)) then
+            call remove_file(temporary)
+            call report(error)
+         else if (.not. opts%quiet) then
+            write (error_unit, '(a)') 'friction: wrote '//opts%output//' ('//what//')'
+         end if
+      end if
+      code = merge(1, 0, allocated(error))
+      call MPI_Bcast(code, 1, MPI_INTEGER, 0, MPI_COMM_WORLD)
+      if (code /= 0) call finish(exit_io)
+   end subroutine publish
 
    !> Create and remove a probe file beside the output.
    subroutine check_writable(path, error)

@@ -9,12 +9,13 @@ module friction_afm_output
    use friction_afm_scan, only: quantity_names, quantity_units, quantity_count, q_f_along, &
       & support_along, support_across
    use friction_io_h5_file, only: h5_file
+   use friction_io_run_summary, only: run_summary, write_run_attributes
    use friction_surface_net, only: crystal_net
    use friction_strings, only: join
    implicit none
    private
 
-   public :: afm_run_summary, write_afm_file, line_friction, afm_surface_record
+   public :: write_afm_file, line_friction, afm_surface_record
 
    !> The sample of a lattice-sum scene, for pictures that overlay it.
    type :: afm_surface_record
@@ -25,14 +26,6 @@ module friction_afm_output
       real(wp) :: support_height = 0.0_wp   !! Å
    end type afm_surface_record
 
-   !> What the file records about the run besides the maps.
-   type :: afm_run_summary
-      character(len=:), allocatable :: input_text
-      character(len=:), allocatable :: version
-      integer :: nranks = 1
-      real(wp) :: wall_time = 0.0_wp
-      type(integrator_statistics) :: stats
-   end type afm_run_summary
 
 contains
 
@@ -58,7 +51,7 @@ contains
       type(afm_config), intent(in) :: config
       integer, intent(in) :: first, stride
       real(wp), intent(in) :: trace(:, :, :), retrace(:, :, :)
-      type(afm_run_summary), intent(in) :: summary
+      type(run_summary), intent(in) :: summary
       type(error_type), allocatable, intent(out) :: error
       !> present for a tip moving in 3D over a crystal net
       type(afm_surface_record), intent(in), optional :: surface
@@ -71,17 +64,7 @@ contains
          call file%close(close_error)
          return
       end if
-      call file%write_attribute_text('/', 'program', 'friction')
-      call file%write_attribute_text('/', 'version', summary%version)
-      call file%write_attribute_text('/', 'scene', 'afm')
-      call file%write_attribute_text('/', 'input', summary%input_text)
-      call file%write_attribute_integer('/', 'nranks', int(summary%nranks, i8))
-      call file%write_attribute_real('/', 'wall_time', summary%wall_time)
-      call file%write_attribute_text('/', 'method', trim(config%solver%method))
-      call file%write_attribute_integer('/', 'integrator_steps', summary%stats%steps)
-      call file%write_attribute_integer('/', 'integrator_rejected_steps', summary%stats%failed_steps)
-      call file%write_attribute_integer('/', 'rhs_evaluations', summary%stats%rhs_evaluations)
-      call file%write_attribute_integer('/', 'jacobian_evaluations', summary%stats%jacobian_evaluations)
+      call write_run_attributes(file, 'afm', trim(config%solver%method), summary)
 
       call file%create_group('/afm')
       call file%write_attribute_text('/afm', 'potential', trim(config%potential))

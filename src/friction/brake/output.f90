@@ -12,20 +12,16 @@ module friction_brake_output
    use friction_brake_record, only: brake_trajectory, brake_event_table, event_kind_names
    use friction_brake_simulate, only: brake_comparison
    use friction_io_h5_file, only: h5_file
+   use friction_io_run_summary, only: run_summary, write_run_attributes
    implicit none
    private
 
    public :: brake_run_summary, brake_check_summary, write_brake_file
 
    !> What the file records about the run besides the trajectory.
-   type :: brake_run_summary
-      character(len=:), allocatable :: input_text
-      character(len=:), allocatable :: version
-      integer :: nranks = 1
-      real(wp) :: wall_time = 0.0_wp       !! s, up to the write
+   type, extends(run_summary) :: brake_run_summary
       real(wp) :: compute_time = 0.0_wp    !! s, integration of the main run alone
       real(wp) :: stick_time = 0.0_wp      !! τ spent in stick
-      type(integrator_statistics) :: stats
    end type brake_run_summary
 
    !> The verification run: its settings, cost and differences.
@@ -59,17 +55,7 @@ contains
          call file%close(close_error)
          return
       end if
-      call file%write_attribute_text('/', 'program', 'friction')
-      call file%write_attribute_text('/', 'version', summary%version)
-      call file%write_attribute_text('/', 'scene', 'brake')
-      call file%write_attribute_text('/', 'input', summary%input_text)
-      call file%write_attribute_integer('/', 'nranks', int(summary%nranks, i8))
-      call file%write_attribute_real('/', 'wall_time', summary%wall_time)
-      call file%write_attribute_text('/', 'method', trim(config%solver%method))
-      call file%write_attribute_integer('/', 'integrator_steps', summary%stats%steps)
-      call file%write_attribute_integer('/', 'integrator_rejected_steps', summary%stats%failed_steps)
-      call file%write_attribute_integer('/', 'rhs_evaluations', summary%stats%rhs_evaluations)
-      call file%write_attribute_integer('/', 'jacobian_evaluations', summary%stats%jacobian_evaluations)
+      call write_run_attributes(file, 'brake', trim(config%solver%method), summary)
 
       call file%create_group('/brake')
       call file%write_attribute_text('/brake', 'model', trim(config%model))
