@@ -32,49 +32,27 @@ import matplotlib
 
 matplotlib.use("Agg")  # headless: no display needed
 
-import h5py  # noqa: E402
+from friction_output import InputError, open_output, text  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 POTENTIAL_LABELS = {"naf": "NaF(001)", "hopg": "HOPG"}
 
 
-class InputError(Exception):
-    """A problem with the input file or the request; exit code 2."""
-
-
-def _text(value):
-    """HDF5 string attributes come back as bytes; give str."""
-    return value.decode() if isinstance(value, bytes) else str(value)
-
-
 def read_scan(path):
     """Read the map and its axes from a friction output file into a dict."""
-    if not path.exists():
-        raise InputError("no such file")
-    if not path.is_file():
-        raise InputError("not a regular file")
-    try:
-        with h5py.File(path, "r") as f:
-            if (_text(f.attrs.get("program", b"")) != "friction"
-                    or _text(f.attrs.get("scene", b"")) != "afm" or "afm" not in f):
-                raise InputError("not a friction force-map file "
-                                 "(needs program = 'friction', scene = 'afm', group /afm)")
-            afm = f["afm"]
-            scan = {
-                "potential": _text(afm.attrs["potential"]),
-                "angle": float(afm.attrs["angle"]),
-                "x": afm["support_x"][()],
-                "y": afm["support_y"][()],
-                "friction": afm["friction"][()] if "friction" in afm else None,
-            }
-            for trip in ("trace", "retrace"):
-                if trip in afm:
-                    scan[trip] = {q: afm[trip][q][()] for q in ("fx", "fy", "f_along")}
-    except KeyError as err:
-        raise InputError(f"incomplete friction force-map file ({err})") from None
-    except OSError as err:
-        raise InputError(f"cannot read as HDF5 ({err})") from None
+    with open_output(path, "afm", "force-map") as f:
+        afm = f["afm"]
+        scan = {
+            "potential": text(afm.attrs["potential"]),
+            "angle": float(afm.attrs["angle"]),
+            "x": afm["support_x"][()],
+            "y": afm["support_y"][()],
+            "friction": afm["friction"][()] if "friction" in afm else None,
+        }
+        for trip in ("trace", "retrace"):
+            if trip in afm:
+                scan[trip] = {q: afm[trip][q][()] for q in ("fx", "fy", "f_along")}
     if "trace" not in scan:
         raise InputError("no /afm/trace group")
     shape = (scan["y"].size, scan["x"].size)

@@ -31,44 +31,22 @@ import matplotlib
 
 matplotlib.use("Agg")  # headless: no display needed
 
-import h5py  # noqa: E402
+from friction_output import InputError, open_output, text  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 
-class InputError(Exception):
-    """A problem with the input file or the request; exit code 2."""
-
-
-def _text(value):
-    """HDF5 string attributes come back as bytes; give str."""
-    return value.decode() if isinstance(value, bytes) else str(value)
-
-
 def read_run(path):
     """Read the trajectory, events and parameters of a brake file into a dict."""
-    if not path.exists():
-        raise InputError("no such file")
-    if not path.is_file():
-        raise InputError("not a regular file")
-    try:
-        with h5py.File(path, "r") as f:
-            if (_text(f.attrs.get("program", b"")) != "friction"
-                    or _text(f.attrs.get("scene", b"")) != "brake" or "brake" not in f):
-                raise InputError("not a friction brake file "
-                                 "(needs program = 'friction', scene = 'brake', group /brake)")
-            brake = f["brake"]
-            run = {name: brake[name][()] for name in ("t", "x", "v", "y", "w", "stick")}
-            run["model"] = _text(brake.attrs["model"])
-            run["v_dr"] = float(brake.attrs["v_dr_prime"])
-            run["method"] = _text(f.attrs.get("method", b"?"))
-            events = brake["events"]
-            run["event_t"] = events["t"][()]
-            run["event_kind"] = events["kind"][()]
-    except KeyError as err:
-        raise InputError(f"incomplete friction brake file ({err})") from None
-    except OSError as err:
-        raise InputError(f"cannot read as HDF5 ({err})") from None
+    with open_output(path, "brake", "brake") as f:
+        brake = f["brake"]
+        run = {name: brake[name][()] for name in ("t", "x", "v", "y", "w", "stick")}
+        run["model"] = text(brake.attrs["model"])
+        run["v_dr"] = float(brake.attrs["v_dr_prime"])
+        run["method"] = text(f.attrs.get("method", b"?"))
+        events = brake["events"]
+        run["event_t"] = events["t"][()]
+        run["event_kind"] = events["kind"][()]
     n = run["t"].size
     for name in ("x", "v", "y", "w", "stick"):
         if run[name].shape != (n,):

@@ -39,7 +39,7 @@ import matplotlib
 
 matplotlib.use("Agg")  # headless: no display needed
 
-import h5py  # noqa: E402
+from friction_output import InputError, open_output, text  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.collections import LineCollection  # noqa: E402
@@ -58,17 +58,6 @@ BOND_FACTOR = 1.2  # bonds: pairs closer than this x the nearest-neighbour dista
 NN_SAMPLE = 400  # atoms whose nearest neighbour sets the nearest-neighbour distance
 
 
-class InputError(Exception):
-    """A problem with the input file or the request; exit code 2."""
-
-
-def _text(value):
-    """HDF5 string attributes come back as bytes; give str."""
-    if isinstance(value, np.ndarray) and value.shape == ():
-        value = value[()]
-    return value.decode() if isinstance(value, bytes) else str(value)
-
-
 # --------------------------------------------------------------------------
 # Reading
 # --------------------------------------------------------------------------
@@ -76,46 +65,31 @@ def _text(value):
 
 def read_file(path):
     """Read the scan, the tip path and the net into a dict; InputError if unfit."""
-    if not path.exists():
-        raise InputError("no such file")
-    if not path.is_file():
-        raise InputError("not a regular file")
-    try:
-        with h5py.File(path, "r") as f:
-            if (_text(f.attrs.get("program", b"")) != "friction"
-                    or _text(f.attrs.get("scene", b"")) != "afm" or "afm" not in f):
-                raise InputError("not a friction force-map file "
-                                 "(needs program = 'friction', scene = 'afm', group /afm)")
-            if "surface" not in f or "atoms" not in f["surface"]:
-                raise InputError("not a lattice-sum scene: no /surface/atoms "
-                                 "(for NaF/HOPG maps use plot_afm.py)")
-            afm, surf = f["afm"], f["surface"]
-            data = {
-                "potential": _text(afm.attrs.get("potential", b"?")),
-                "angle": float(afm.attrs["angle"]),
-                "origin": np.array([float(afm.attrs["origin_x"]),
-                                    float(afm.attrs["origin_y"])]),
-                "x": np.asarray(afm["support_x"][()], dtype=float),
-                "y": np.asarray(afm["support_y"][()], dtype=float),
-                "atoms": np.asarray(surf["atoms"][()], dtype=float),
-                "species": (np.asarray(surf["species"][()], dtype=int)
-                            if "species" in surf else None),
-                "species_names": [s.strip() for s in
-                                  _text(surf.attrs.get("species_names", b"")).split(",")],
-                "cutoff": (float(surf.attrs["cutoff"]) if "cutoff" in surf.attrs else None),
-                "trips": {},
-            }
-            for trip in ("trace", "retrace"):
-                if trip in afm:
-                    data["trips"][trip] = {q: np.asarray(afm[trip][q][()], dtype=float)
-                                           for q in (*COMPONENTS, "tip_x", "tip_y")
-                                           if q in afm[trip]}
-    except KeyError as err:
-        raise InputError(f"incomplete friction force-map file ({err})") from None
-    except OSError as err:
-        raise InputError(f"cannot read as HDF5 ({err})") from None
-    except (TypeError, ValueError) as err:
-        raise InputError(f"unexpected data in the file ({err})") from None
+    with open_output(path, "afm", "force-map") as f:
+        if "surface" not in f or "atoms" not in f["surface"]:
+            raise InputError("not a lattice-sum scene: no /surface/atoms "
+                             "(for NaF/HOPG maps use plot_afm.py)")
+        afm, surf = f["afm"], f["surface"]
+        data = {
+            "potential": text(afm.attrs.get("potential", b"?")),
+            "angle": float(afm.attrs["angle"]),
+            "origin": np.array([float(afm.attrs["origin_x"]),
+                                float(afm.attrs["origin_y"])]),
+            "x": np.asarray(afm["support_x"][()], dtype=float),
+            "y": np.asarray(afm["support_y"][()], dtype=float),
+            "atoms": np.asarray(surf["atoms"][()], dtype=float),
+            "species": (np.asarray(surf["species"][()], dtype=int)
+                        if "species" in surf else None),
+            "species_names": [s.strip() for s in
+                              text(surf.attrs.get("species_names", b"")).split(",")],
+            "cutoff": (float(surf.attrs["cutoff"]) if "cutoff" in surf.attrs else None),
+            "trips": {},
+        }
+        for trip in ("trace", "retrace"):
+            if trip in afm:
+                data["trips"][trip] = {q: np.asarray(afm[trip][q][()], dtype=float)
+                                       for q in (*COMPONENTS, "tip_x", "tip_y")
+                                       if q in afm[trip]}
 
     atoms = data["atoms"]
     if atoms.ndim != 2 or atoms.shape[1] not in (2, 3) or atoms.shape[0] < 1:
