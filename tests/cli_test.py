@@ -321,6 +321,17 @@ def case_numerical_failure(args):
         fail(f"a failed run left files: {leftovers(args)}")
 
 
+def case_wall_time(args):
+    """The wall-time guard stops a long map with the documented message."""
+    big = write(args, "big.nml", "&scan nx = 256, ny = 256 /\n&integrator max_wall_time = 0.02 /\n")
+    result = friction(args, os.path.join(args.inputs, "naf.nml"), big, ranks=2, expect=4)
+    for word in ["max_wall_time", "t = ", "line", "rkf45"]:
+        if word not in result.stderr:
+            fail(f"message lacks {word!r}: {result.stderr}")
+    if leftovers(args):
+        fail(f"a stopped run left files: {leftovers(args)}")
+
+
 def case_bad(args, name):
     text, code, words = BAD_INPUTS[name]
     naf = os.path.join(args.inputs, "naf.nml")
@@ -529,7 +540,8 @@ def main():
          "brake-failure": case_brake_failure}[args.case](args)
     else:
         {"ranks": case_ranks, "override": case_override, "force": case_force,
-         "numerical-failure": case_numerical_failure, "graphite": case_graphite,
+         "numerical-failure": case_numerical_failure, "wall-time": case_wall_time,
+         "graphite": case_graphite,
          "graphite-ranks": case_graphite_ranks, "graphite-defects": case_graphite_defects}[args.case](args)
     print("1 passed, 0 failed")
 

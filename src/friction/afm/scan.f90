@@ -9,7 +9,7 @@
 !> at the support and at rest (paper §3.1, §5.1).
 module friction_afm_scan
    use friction_kinds, only: wp, i8, pi, ev_per_angstrom_to_nn
-   use friction_error, only: error_type, fatal_error, error_input
+   use friction_error, only: error_type, fatal_error, error_input, error_numerical
    use friction_ode_solver, only: ode_solver, integrator_statistics
    use friction_afm_config, only: afm_config, new_tip
    use friction_afm_tip, only: afm_tip
@@ -43,6 +43,7 @@ module friction_afm_scan
       type(afm_tip), allocatable :: tip
       type(ode_solver) :: solver
       real(wp) :: h_start = 0.0_wp
+      integer(i8) :: clock_start = 0, clock_rate = 1   !! wall clock at init, for max_wall_time
       real(wp) :: contact_height = 0.0_wp   !! z0: free tip's equilibrium height at the origin, Å (3D)
       real(wp) :: support_height = 0.0_wp   !! z_M = z0 + support_z, Å (3D)
    contains
@@ -104,6 +105,7 @@ contains
       real(wp) :: sample_time, period
 
       self%config = config
+      call system_clock(self%clock_start, self%clock_rate)
       if (allocated(self%tip)) deallocate (self%tip)
       allocate (self%tip)
       call new_tip(config, potential, self%tip)
@@ -134,6 +136,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       real(wp) :: along(3), across(3), line_start(3), s(self%config%nx), offset(self%config%ny)
       real(wp) :: y(6), t, t_sample, s_start, force(3), tip_r(3), z_start
+      integer(i8) :: now
       integer :: i, k, nx, nd
       character(len=96) :: where
 
@@ -169,6 +172,12 @@ contains
             i = merge(k, nx + 1 - k, forward)
             t_sample = abs(s(i) - s_start) / c%velocity
             if (t_sample > t) call self%solver%advance(t, t_sample, y(1:2 * nd), error)
+            if (.not. allocated(error) .and. c%solver%max_wall_time > 0.0_wp) then
+               call system_clock(now)
+               if (real(now - self%clock_start, wp) / self%clock_rate > c%solver%max_wall_time) &
+                  & call fatal_error(error, trim(c%solver%method)//': max_wall_time = ' &
+                  & //rtoa(c%solver%max_wall_time)//' s reached at t = '//rtoa(t)//' s', error_numerical)
+            end if
             if (allocated(error)) then
                write (where, '(a, i0, a, f0.4, a)') ' (line ', j, trim(merge(' trace  ', ' retrace', forward)) &
                   & //', support at ', c%velocity * t, ' Å into the trip)'
