@@ -124,7 +124,8 @@ contains
                & theiler=a%rosenstein_theiler, horizon=a%rosenstein_horizon, &
                & fit_start=a%rosenstein_fit_start, fit_end=a%rosenstein_fit_end), result%series, error)
             if (allocated(error)) then
-               error%message = '&analysis: '//error%message
+               error%message = '&analysis: '//error%message//' (the window [window_start, window_end] ' &
+                  & //'strided by rosenstein_stride against the embedding and rosenstein_horizon)'
                return
             end if
          end if
