@@ -2,6 +2,7 @@
 module analysis_test_systems
    use friction_kinds, only: wp
    use friction_ode_system, only: ode_system
+   use friction_ode_events, only: event_system
    implicit none
    private
    public :: lorenz, oscillator
@@ -15,13 +16,16 @@ module analysis_test_systems
       procedure :: jacobian => lorenz_jacobian
    end type lorenz
 
-   !> x'' = -ω² x: every orbit periodic, exponent 0.
-   type, extends(ode_system) :: oscillator
+   !> x'' = -ω² x: every orbit periodic, exponent 0.  Event function: x'
+   !> (upward zero at the minimum of x), for a located section.
+   type, extends(event_system) :: oscillator
       real(wp) :: omega = 1.0_wp
    contains
       procedure :: dimension => oscillator_dimension
       procedure :: rhs => oscillator_rhs
       procedure :: jacobian => oscillator_jacobian
+      procedure :: event_count => oscillator_event_count
+      procedure :: event_values => oscillator_event_values
    end type oscillator
 
 contains
@@ -71,6 +75,18 @@ contains
       dfdt = 0.0_wp
    end subroutine oscillator_jacobian
 
+   pure integer function oscillator_event_count(self) result(n)
+      class(oscillator), intent(in) :: self
+      n = 1
+   end function oscillator_event_count
+
+   pure subroutine oscillator_event_values(self, t, y, g)
+      class(oscillator), intent(in) :: self
+      real(wp), intent(in) :: t, y(:)
+      real(wp), intent(out) :: g(:)
+      g(1) = y(2)
+   end subroutine oscillator_event_values
+
 end module analysis_test_systems
 
 !> The chaos diagnostics against known answers: Lorenz and a periodic
@@ -84,7 +100,7 @@ program test_analysis
    use friction_analysis_spectrum, only: spectrum_settings, spectrum_result, amplitude_spectrum, window_none
    use friction_analysis_lyapunov_series, only: rosenstein_settings, rosenstein_result, rosenstein_exponent
    use friction_analysis_lyapunov_flow, only: benettin_settings, benettin_accumulator, benettin_exponent
-   use friction_analysis_poincare, only: stroboscopic_map, upward_section
+   use friction_analysis_poincare, only: stroboscopic_map, upward_section, located_section
    use analysis_test_systems, only: lorenz, oscillator
    use testing, only: test_suite, check, check_close
    implicit none
@@ -103,6 +119,7 @@ program test_analysis
    call suite%add('welch_keeps_the_peak', welch_keeps_the_peak)
    call suite%add('strobe_of_periodic_orbit_is_a_point', strobe_of_periodic_orbit_is_a_point)
    call suite%add('section_of_periodic_orbit_is_a_point', section_of_periodic_orbit_is_a_point)
+   call suite%add('located_section_of_periodic_orbit_is_a_point', located_section_of_periodic_orbit_is_a_point)
    call suite%add('bad_settings_are_errors', bad_settings_are_errors)
    call suite%run_all()
 
@@ -385,6 +402,35 @@ contains
             & 'return time')
       end do
    end subroutine section_of_periodic_orbit_is_a_point
+
+   !> The same section located by the event machinery: the point (-1, 0)
+   !> to the integration tolerance, crossings at ωt = π + 2πk to the time
+   !> tolerance plus the state error over the crossing speed ω².
+   subroutine located_section_of_periodic_orbit_is_a_point(failure)
+      character(len=:), allocatable, intent(out) :: failure
+      type(oscillator), target :: system
+      type(solver_settings) :: settings
+      type(error_type), allocatable :: error
+      real(wp), allocatable :: times(:), points(:, :)
+      integer :: k
+
+      system%omega = 1.3_wp
+      settings%method = 'rk8pd'
+      settings%rtol = 1.0e-10_wp
+      settings%atol = 1.0e-10_wp
+      ! 83 crossings: past the first storage block of 64.
+      call located_section(system, settings, 0.0_wp, [1.0_wp, 0.0_wp], 400.0_wp, 1, 1.0e-10_wp, &
+         & times, points, error)
+      if (allocated(error)) then
+         failure = error%message
+         return
+      end if
+      call check(failure, size(times) == 83, 'one crossing per period')
+      do k = 1, size(times)
+         call check_close(failure, points(1, k), -1.0_wp, 1.0e-8_wp, 'located section point x')
+         call check_close(failure, times(k), (2 * k - 1) * pi / system%omega, 1.0e-8_wp, 'crossing time')
+      end do
+   end subroutine located_section_of_periodic_orbit_is_a_point
 
    subroutine bad_settings_are_errors(failure)
       character(len=:), allocatable, intent(out) :: failure
