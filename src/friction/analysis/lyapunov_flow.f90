@@ -33,7 +33,7 @@ module friction_analysis_lyapunov_flow
    contains
       procedure :: start
       procedure :: renormalise
-      procedure :: exponent
+      procedure :: current => current_exponent
    end type benettin_accumulator
 
 contains
@@ -73,12 +73,12 @@ contains
       end if
    end subroutine renormalise
 
-   pure real(wp) function exponent(self)
+   pure real(wp) function current_exponent(self) result(exponent)
       class(benettin_accumulator), intent(in) :: self
 
       exponent = 0.0_wp
       if (self%elapsed > 0.0_wp) exponent = self%log_growth / self%elapsed
-   end function exponent
+   end function current_exponent
 
    !> The exponent of a smooth system from y0 at t0; the perturbation starts
    !> along (1, 1, ..., 1)/√n after the transient.

@@ -198,7 +198,7 @@ contains
          end if
          if (a%lyapunov .or. a%rosenstein) call file%create_group('/brake/lyapunov')
          if (a%lyapunov) then
-            call file%write_attribute_real('/brake/lyapunov', 'benettin_exponent', d%flow%exponent())
+            call file%write_attribute_real('/brake/lyapunov', 'benettin_exponent', d%flow%current())
             call file%write_attribute_real('/brake/lyapunov', 'benettin_transient', d%benettin%transient)
             call file%write_attribute_real('/brake/lyapunov', 'benettin_duration', d%benettin%duration)
             call file%write_attribute_real('/brake/lyapunov', 'benettin_renormalise', d%benettin%renormalise)
@@ -223,7 +223,7 @@ contains
                & int(a%rosenstein_fit_start, i8))
             call file%write_attribute_integer('/brake/lyapunov', 'rosenstein_fit_end', int(a%rosenstein_fit_end, i8))
             call file%write_vector('/brake/lyapunov/rosenstein_time', d%series%time, '1')
-            call file%write_vector('/brake/lyapunov/rosenstein_divergence', d%series%divergence, 'ln m')
+            call file%write_vector('/brake/lyapunov/rosenstein_divergence', d%series%divergence, 'ln of the series unit')
          end if
       end associate
    end subroutine write_diagnostics
