@@ -33,7 +33,7 @@ module friction_analysis_lyapunov_series
 contains
 
    !> The exponent of series sampled every dt.
-   subroutine rosenstein_exponent(series, dt, settings, result, error)
+   pure subroutine rosenstein_exponent(series, dt, settings, result, error)
       real(wp), intent(in) :: series(:)
       real(wp), intent(in) :: dt
       type(rosenstein_settings), intent(in) :: settings

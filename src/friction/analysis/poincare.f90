@@ -19,7 +19,7 @@ contains
 
    !> states(:, i) at times t(i) (increasing, uniform or not); points(:, k)
    !> at t_start + (k - 1) period within [t_start, t_end] and the trajectory.
-   subroutine stroboscopic_map(t, states, t_start, t_end, period, times, points, error)
+   pure subroutine stroboscopic_map(t, states, t_start, t_end, period, times, points, error)
       real(wp), intent(in) :: t(:), states(:, :)
       real(wp), intent(in) :: t_start, t_end, period
       real(wp), allocatable, intent(out) :: times(:), points(:, :)

@@ -16,6 +16,9 @@ module friction_analysis_spectrum
 
    character(len=*), parameter :: window_hann = 'hann', window_none = 'none'
 
+   !> FFTW_ESTIMATE: plans without trial transforms, so planning leaves the
+   !> input alone.  FFTW's planner is not thread-safe; the program calls it
+   !> from one thread per rank.
    integer(c_int), parameter :: fftw_estimate = 64
 
    !> What the user chooses.
