@@ -25,6 +25,7 @@ program friction_main
    use friction_brake_config, only: brake_config
    use friction_brake_simulate, only: brake_run, brake_comparison, compare_runs
    use friction_brake_output, only: brake_run_summary, brake_check_summary, write_brake_file
+   use friction_brake_diagnostics, only: brake_diagnostics, diagnose_brake
    implicit none
 
    interface
@@ -179,7 +180,9 @@ contains
       type(brake_config) :: check_config
       type(brake_run_summary) :: summary
       type(brake_check_summary) :: check
+      type(brake_diagnostics) :: diagnostics
       type(error_type), allocatable :: check_error
+      logical :: analysing
       integer :: check_rank, failed_rank
       real(wp) :: wall, stick_time
       integer(i8) :: counts(4)
@@ -233,6 +236,17 @@ contains
          end associate
       end if
 
+      ! The diagnostics are deterministic functions of the shared run (and, for
+      ! Benettin, of the settings): every rank computes the same numbers, so
+      ! the file does not depend on the number of ranks.
+      associate (a => config%brake%analysis)
+         analysing = a%spectrum .or. a%poincare .or. a%lyapunov .or. a%rosenstein
+      end associate
+      if (analysing) then
+         call diagnose_brake(config%brake, main_run%trajectory, main_run%events, diagnostics, error)
+         if (allocated(error)) call fail(error)
+      end if
+
       wall = MPI_Wtime() - t_start
       call MPI_Allreduce(MPI_IN_PLACE, wall, 1, MPI_DOUBLE_PRECISION, MPI_MAX, MPI_COMM_WORLD)
       summary%input_text = input_text
@@ -241,8 +255,13 @@ contains
       summary%wall_time = wall
 
       temporary = temporary_name()
-      call write_brake_file(temporary, MPI_COMM_WORLD, config%brake, main_run%trajectory, main_run%events, &
-         & summary, check, error)
+      if (analysing) then
+         call write_brake_file(temporary, MPI_COMM_WORLD, config%brake, main_run%trajectory, main_run%events, &
+            & summary, check, error, diagnostics)
+      else
+         call write_brake_file(temporary, MPI_COMM_WORLD, config%brake, main_run%trajectory, main_run%events, &
+            & summary, check, error)
+      end if
       write (seconds, '(f12.3)') wall
       write (line, '(a, i0, a, f0.1, a, i0, a)') ' model, ', main_run%n, ' points to τ = ', &
          & config%brake%grid_time(main_run%n), ', ', main_run%events%n, ' events, '
@@ -447,7 +466,7 @@ contains
          & '(NaF, HOPG): the tip''s equations of motion integrated with GSL odeiv2,', &
          & 'scan lines shared among MPI ranks, results in one HDF5 file.', &
          & 'With &job scene = ''brake'': the stick-slip of a Girling brake (one', &
-         & 'trajectory; inputs/brake.nml; groups &brake &brake_dimensional &verify).', &
+         & 'trajectory; inputs/brake.nml; groups &brake &brake_dimensional &verify &analysis).', &
          & '', &
          & 'Input files are namelist files read in order; a later file overrides', &
          & 'earlier values variable by variable.  Groups: &job &surface &tip &scan', &

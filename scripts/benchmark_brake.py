@@ -94,7 +94,9 @@ class Friction:
             f"&brake model = '{model}', t_end = {t_end!r}, dt_out = {dt_out!r}, "
             f"event_tolerance = {event_tolerance!r} /\n"
             f"&integrator method = '{method}', rtol = {rtol!r}, atol = {atol!r}, "
-            f"max_steps = 200000000, max_wall_time = {self.max_wall!r} /\n")
+            f"max_steps = 200000000, max_wall_time = {self.max_wall!r} /\n"
+            # The integration alone is measured: no chaos diagnostics.
+            "&analysis spectrum = .false., poincare = .false., lyapunov = .false., rosenstein = .false. /\n")
         proc = subprocess.run([str(self.binary), "--quiet", "--force", "-o", str(out), str(INPUT), str(nml)],
                               capture_output=True, text=True, cwd=self.workdir)
         if proc.returncode != 0:

@@ -5,7 +5,7 @@
 
 Cases: datasets-naf, datasets-hopg, ranks, override, force, numerical-failure,
 and bad-<name> for each bad input in BAD_INPUTS; for the brake scene
-brake-run, brake-ranks, brake-dimensional, brake-verify, brake-failure and
+brake-run, brake-ranks, brake-dimensional, brake-verify, brake-failure, brake-analysis and
 bad-brake-<name> for each bad input in BAD_BRAKE_INPUTS.  Each asserts on exit codes,
 messages and file contents (read with h5py); none asserts on timings.
 """
@@ -67,7 +67,13 @@ BAD_INPUTS = {
 DOCUMENTED = ["fx", "fy", "f_along", "f_across", "tip_x", "tip_y"]
 
 # The brake scene (inputs/brake.nml) on a short span for the tests.
-BRAKE_SHORT = "&brake t_end = 100.0, dt_out = 0.1 /\n"
+# (The chaos diagnostics of inputs/brake.nml are off here: the brake-analysis case tests them.)
+BRAKE_SHORT = ("&brake t_end = 100.0, dt_out = 0.1 /\n"
+               "&analysis spectrum = .false., poincare = .false., lyapunov = .false., rosenstein = .false. /\n")
+# The chaos diagnostics on a short span (brake-analysis).
+BRAKE_ANALYSIS = ("&brake t_end = 400.0, dt_out = 0.1 /\n"
+                  "&analysis window_start = 50.0, window_end = 400.0, lyapunov_transient = 50.0,"
+                  " rosenstein_stride = 2 /\n")
 
 # Bad brake input: (override text on inputs/brake.nml, exit code, words of the message).
 BAD_BRAKE_INPUTS = {
@@ -93,6 +99,15 @@ BAD_BRAKE_INPUTS = {
                            ["bad.nml:1", "&integrator", "max_wall_time", ">= 0"]),
     "wrong-type": ("&brake t_end = 'long' /\n", 3, ["bad.nml:1", "&brake", "t_end", "number"]),
     "unknown-variable": ("&brake epsilon = 1e6 /\n", 3, ["bad.nml:1", "&brake", "epsilon", "known"]),
+    "analysis-unknown-section": ("&analysis section = 'x_zero' /\n", 3,
+                                 ["bad.nml:1", "&analysis", "section", "stick_to_slip"]),
+    "analysis-unknown-series": ("&analysis series = 'z' /\n", 3, ["bad.nml:1", "&analysis", "series", "'x'"]),
+    "analysis-fit-beyond-horizon": ("&analysis rosenstein_horizon = 20, rosenstein_fit_end = 30 /\n", 3,
+                                    ["bad.nml:1", "&analysis", "rosenstein_fit_end", "rosenstein_horizon"]),
+    "analysis-window-reversed": ("&analysis window_start = 500.0, window_end = 200.0 /\n", 3,
+                                 ["bad.nml:1", "&analysis", "window_end", "after window_start"]),
+    "analysis-zero-renormalise": ("&analysis lyapunov_renormalise = 0.0 /\n", 3,
+                                  ["bad.nml:1", "&analysis", "lyapunov_renormalise", "> 0"]),
 }
 
 
@@ -450,6 +465,47 @@ def case_brake_ranks(args):
                 fail(f"{key} differs between 1 and {other} ranks")
 
 
+def case_brake_analysis(args):
+    """The chaos diagnostics: /brake/spectrum, /brake/poincare, /brake/lyapunov
+    with their settings and units, the same on 1 and 2 ranks."""
+    short = write(args, "analysis.nml", BRAKE_ANALYSIS)
+    brake = os.path.join(args.inputs, "brake.nml")
+    files = {}
+    for n in (1, 2):
+        friction(args, "-o", f"a{n}.h5", brake, short, ranks=n)
+        files[n] = comparable(os.path.join(args.workdir, f"a{n}.h5"))
+    if files[1].keys() != files[2].keys():
+        fail("1 and 2 ranks wrote different objects")
+    for key, value in files[1].items():
+        if key.endswith("compute_time"):
+            continue
+        if not np.array_equal(np.asarray(value), np.asarray(files[2][key])):
+            fail(f"{key} differs between 1 and 2 ranks")
+    a = files[1]
+    if abs(a["brake/spectrum@resolution"] - 1 / (3501 * 0.1)) > 1e-12:
+        fail(f"resolution {a['brake/spectrum@resolution']}, expected 1/(3501 * 0.1)")
+    if a["brake/spectrum/frequency@units"] != b"cycles per unit tau" or a["brake/spectrum/amplitude@units"] != b"m":
+        fail("spectrum units")
+    if not 0.1 < a["brake/spectrum@peak_frequency"] < 0.2:
+        fail(f"peak frequency {a['brake/spectrum@peak_frequency']} outside the stick-slip band")
+    if abs(a["brake/poincare@strobe_period"] * a["brake/spectrum@peak_frequency"] - 1) > 1e-12:
+        fail("strobe period is not 1 / peak frequency")
+    with h5py.File(os.path.join(args.workdir, "a1.h5"), "r") as f:
+        kinds = f["brake/events/kind"][()]
+        if f["brake/poincare/section_t"].size != np.count_nonzero(kinds == 1):
+            fail("the stick-to-slip section does not hold every stick-to-slip event")
+        estimate = f["brake/lyapunov/benettin_estimate"][()]
+        if estimate.size != 350 or estimate[-1] != f["brake/lyapunov"].attrs["benettin_exponent"]:
+            fail(f"Benettin running estimate: {estimate.size} values")
+        lyap = f["brake/lyapunov"].attrs
+        if lyap["rosenstein_dimension"] != 4 or abs(lyap["rosenstein_sample_spacing"] - 0.2) > 1e-15:
+            fail("Rosenstein settings not recorded")
+        if abs(lyap["rosenstein_log2_per_sample"] - lyap["rosenstein_exponent"] * 0.2 / np.log(2)) > 1e-12:
+            fail("log2-per-sample conversion")
+        if f["brake/lyapunov/rosenstein_divergence"].size != 151:
+            fail("divergence curve length")
+
+
 def case_brake_dimensional(args):
     """The §6.2 data (inputs/brake_dimensional.nml): derived parameters recorded, the time scale too."""
     short = write(args, "short.nml", BRAKE_SHORT)
@@ -471,7 +527,8 @@ def case_brake_verify(args):
     verify against rk4imp at 1e-10 reports it; check_limit turns it into a failure."""
     loose = write(args, "loose.nml", "&brake model = 'regularized', t_end = 200.0, dt_out = 0.5 /\n"
                   "&integrator method = 'msbdf', rtol = 1e-6, atol = 1e-8 /\n"
-                  "&verify check = .true., check_method = 'rk4imp', check_rtol = 1e-10, check_atol = 1e-12 /\n")
+                  "&verify check = .true., check_method = 'rk4imp', check_rtol = 1e-10, check_atol = 1e-12 /\n"
+                  + BRAKE_SHORT.splitlines(keepends=True)[1])
     brake = os.path.join(args.inputs, "brake.nml")
     result = friction(args, "-o", "v.h5", brake, loose)
     if "friction: verify: rk4imp" not in result.stderr or "max |dx|" not in result.stderr:
@@ -537,7 +594,7 @@ def main():
     elif args.case.startswith("brake-"):
         {"brake-run": case_brake_run, "brake-ranks": case_brake_ranks,
          "brake-dimensional": case_brake_dimensional, "brake-verify": case_brake_verify,
-         "brake-failure": case_brake_failure}[args.case](args)
+         "brake-failure": case_brake_failure, "brake-analysis": case_brake_analysis}[args.case](args)
     else:
         {"ranks": case_ranks, "override": case_override, "force": case_force,
          "numerical-failure": case_numerical_failure, "wall-time": case_wall_time,

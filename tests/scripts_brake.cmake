@@ -52,7 +52,36 @@ add_test(NAME scripts.plot_brake.window_outside
 set_tests_properties(scripts.plot_brake.window_outside PROPERTIES
   FIXTURES_REQUIRED scripts_brake_run)
 
-set(_fb_all scripts.brake_run scripts.plot_brake.run scripts.plot_brake.png scripts.plot_brake.help
+# plot_chaos.py on the same run (tests/data/brake_short.nml keeps the
+# diagnostics of inputs/brake.nml on, over its 300 tau).
+set(_fc_plot ${Python3_EXECUTABLE} "${_fs_scripts}/plot_chaos.py")
+add_test(NAME scripts.plot_chaos.run
+  COMMAND ${_fc_plot} "${_fb_run}" -o "${_fb_work}/chaos"
+  WORKING_DIRECTORY "${_fb_work}")
+set_tests_properties(scripts.plot_chaos.run PROPERTIES
+  FIXTURES_REQUIRED scripts_brake_run FIXTURES_SETUP scripts_plot_chaos)
+add_test(NAME scripts.plot_chaos.png
+  COMMAND ${_fb_check} "${_fb_work}/chaos/brake_short_spectrum.png"
+          "${_fb_work}/chaos/brake_short_poincare.png" "${_fb_work}/chaos/brake_short_lyapunov.png")
+set_tests_properties(scripts.plot_chaos.png PROPERTIES
+  FIXTURES_REQUIRED "scripts_brake_run;scripts_plot_chaos")
+add_test(NAME scripts.plot_chaos.help COMMAND ${_fc_plot} --help)
+set_tests_properties(scripts.plot_chaos.help PROPERTIES
+  PASS_REGULAR_EXPRESSION "usage: plot_chaos.py.*--output-dir")
+add_test(NAME scripts.plot_chaos.missing_file
+  COMMAND ${_fs_expect} 2 --stderr "no_such_run\\.h5: no such file"
+          -- ${_fc_plot} no_such_run.h5
+  WORKING_DIRECTORY "${_fb_work}")
+add_test(NAME scripts.plot_chaos.not_a_brake_file
+  COMMAND ${_fs_expect} 2 --stderr "small\\.h5: not a friction brake file"
+          -- ${_fc_plot} "${_fs_map}" -o "${_fb_work}/not_chaos"
+  WORKING_DIRECTORY "${_fb_work}")
+set_tests_properties(scripts.plot_chaos.not_a_brake_file PROPERTIES
+  FIXTURES_REQUIRED scripts_small_map)
+
+set(_fb_all scripts.plot_chaos.run scripts.plot_chaos.png scripts.plot_chaos.help
+  scripts.plot_chaos.missing_file scripts.plot_chaos.not_a_brake_file
+  scripts.brake_run scripts.plot_brake.run scripts.plot_brake.png scripts.plot_brake.help
   scripts.plot_brake.missing_file scripts.plot_brake.not_a_brake_file scripts.plot_brake.window_outside)
 set_property(TEST ${_fb_all} APPEND PROPERTY LABELS scripts)
 set_tests_properties(${_fb_all} PROPERTIES TIMEOUT 120)

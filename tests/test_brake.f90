@@ -116,6 +116,8 @@ program test_brake
    use friction_brake_regularized, only: brake_regularized
    use friction_brake_switched, only: brake_slip
    use friction_brake_simulate, only: brake_run, simulate_brake
+   use friction_brake_diagnostics, only: brake_benettin
+   use friction_analysis_lyapunov_flow, only: benettin_settings, benettin_accumulator
    use brake_test_systems, only: crank_in_stick, stick_end_oracle
    use testing, only: test_suite, check, check_close
    implicit none
@@ -137,6 +139,7 @@ program test_brake
    call suite%add('wall_time_guard_stops', wall_time_guard_stops)
    call suite%add('nan_is_caught', nan_is_caught)
    call suite%add('lift_off_is_an_error', lift_off_is_an_error)
+   call suite%add('benettin_of_linear_motion_is_zero', benettin_of_linear_motion_is_zero)
    call suite%run_all()
 
 contains
@@ -350,6 +353,42 @@ contains
       call check(failure, count(run%events%kind == event_slip_reversal) == 0, &
          & 'the regularized model reports reversals')
    end subroutine linear_motion_is_modal
+
+   !> With μ = μs = 0 Eq. 10 is linear and undamped: the separation of two
+   !> runs is a quasi-periodic function of time, bounded above and below,
+   !> so the Benettin sum stays bounded and the estimate is O(1/T).  Both
+   !> runs go through the brake's own logic (the switched model here, with
+   !> its reversal events).  The bound 5e-3 is ln(100)/1000: a separation
+   !> that varies a hundredfold over the orbit; a chaotic 0.05 would exceed
+   !> it tenfold.
+   subroutine benettin_of_linear_motion_is_zero(failure)
+      character(len=:), allocatable, intent(out) :: failure
+      type(brake_config) :: c
+      type(benettin_accumulator) :: result
+      type(error_type), allocatable :: error
+      integer :: model
+
+      do model = 1, 2
+         c = paper_case(1100.0_wp, 0.1_wp)
+         c%params%mu = 0.0_wp
+         c%params%mu_s = 0.0_wp
+         c%x0 = 0.004_wp
+         c%y0 = -0.002_wp
+         c%v_rel0 = 0.001_wp
+         c%w0 = 0.0005_wp
+         c%solver%rtol = 1.0e-10_wp
+         c%solver%atol = 1.0e-12_wp
+         if (model == 2) c%model = 'regularized'
+         call brake_benettin(c, benettin_settings(transient=100.0_wp, duration=1000.0_wp, renormalise=1.0_wp, &
+            & d0=1.0e-8_wp), result, error)
+         if (allocated(error)) then
+            failure = error%message
+            return
+         end if
+         call check_close(failure, result%current(), 0.0_wp, 5.0e-3_wp, 'Benettin, linear brake, '//trim(c%model))
+         call check(failure, result%n == 1000, 'one running estimate per renormalisation')
+      end do
+   end subroutine benettin_of_linear_motion_is_zero
 
    !> x(τ) of the linear system from the modal decomposition.
    pure real(wp) function modal_x(c, t)

@@ -6,6 +6,7 @@ module friction_brake_config
    use friction_error, only: error_type
    use friction_ode_solver, only: solver_settings
    use friction_brake_params, only: brake_parameters, brake_dimensional, derive_parameters
+   use friction_analysis_settings, only: analysis_settings
    implicit none
    private
 
@@ -50,6 +51,7 @@ module friction_brake_config
       real(wp) :: stick_velocity = 1.0e-6_wp    !! regularized: |v_rel| below this counts as stick
       type(solver_settings) :: solver = brake_solver_defaults
       type(brake_check) :: check
+      type(analysis_settings) :: analysis   !! chaos diagnostics (&analysis)
    contains
       procedure :: resolve
       procedure :: grid_size

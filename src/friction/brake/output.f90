@@ -11,6 +11,7 @@ module friction_brake_output
    use friction_brake_params, only: time_scale
    use friction_brake_record, only: brake_trajectory, brake_event_table, event_kind_names
    use friction_brake_simulate, only: brake_comparison
+   use friction_brake_diagnostics, only: brake_diagnostics
    use friction_io_h5_file, only: h5_file
    use friction_io_run_summary, only: run_summary, write_run_attributes
    implicit none
@@ -35,7 +36,7 @@ module friction_brake_output
 
 contains
 
-   subroutine write_brake_file(path, comm, config, trajectory, events, summary, check, error)
+   subroutine write_brake_file(path, comm, config, trajectory, events, summary, check, error, diagnostics)
       character(len=*), intent(in) :: path
       type(MPI_Comm), intent(in) :: comm
       type(brake_config), intent(in) :: config
@@ -44,6 +45,7 @@ contains
       type(brake_run_summary), intent(in) :: summary
       type(brake_check_summary), intent(in) :: check
       type(error_type), allocatable, intent(out) :: error
+      type(brake_diagnostics), intent(in), optional :: diagnostics   !! with &analysis on
       type(h5_file) :: file
       type(error_type), allocatable :: close_error
       real(wp) :: f(2)
@@ -128,6 +130,7 @@ contains
             call file%write_attribute_real('/brake/verify', 'compute_time', check%compute_time)
          end associate
       end if
+      if (present(diagnostics)) call write_diagnostics(file, diagnostics)
       call file%close(error)
 
    contains
@@ -153,5 +156,76 @@ contains
       end function event_kinds
 
    end subroutine write_brake_file
+
+   !> /brake/spectrum, /brake/poincare, /brake/lyapunov (README: output reference).
+   subroutine write_diagnostics(file, d)
+      type(h5_file), intent(inout) :: file
+      type(brake_diagnostics), intent(in) :: d
+      character(len=*), parameter :: frequency_unit = 'cycles per unit tau'
+      integer :: k
+      character(len=*), parameter :: names(4) = ['x', 'v', 'y', 'w']
+      character(len=*), parameter :: units(4) = [character(len=14) :: 'm', 'm per unit tau', 'm', 'm per unit tau']
+
+      associate (a => d%settings)
+         if (a%spectrum) then
+            call file%create_group('/brake/spectrum')
+            call file%write_attribute_text('/brake/spectrum', 'series', trim(a%series))
+            call file%write_attribute_text('/brake/spectrum', 'window', trim(a%window))
+            call file%write_attribute_integer('/brake/spectrum', 'welch_segments', int(a%welch_segments, i8))
+            call file%write_attribute_integer('/brake/spectrum', 'segment_length', &
+               & int(d%spectrum%segment_length, i8))
+            call file%write_attribute_real('/brake/spectrum', 'window_start', a%window_start)
+            call file%write_attribute_real('/brake/spectrum', 'window_end', a%window_end)
+            call file%write_attribute_real('/brake/spectrum', 'peak_frequency', d%spectrum%peak_frequency)
+            call file%write_attribute_real('/brake/spectrum', 'peak_amplitude', d%spectrum%peak_amplitude)
+            call file%write_attribute_real('/brake/spectrum', 'resolution', d%spectrum%resolution)
+            call file%write_vector('/brake/spectrum/frequency', d%spectrum%frequency, frequency_unit)
+            k = findloc(names, trim(a%series), 1)
+            call file%write_vector('/brake/spectrum/amplitude', d%spectrum%amplitude, trim(units(max(k, 1))))
+         end if
+         if (a%poincare) then
+            call file%create_group('/brake/poincare')
+            call file%write_attribute_real('/brake/poincare', 'strobe_period', d%strobe_period)
+            call file%write_attribute_real('/brake/poincare', 'strobe_start', a%strobe_start)
+            call file%write_attribute_real('/brake/poincare', 'strobe_end', a%strobe_end)
+            call file%write_attribute_text('/brake/poincare', 'section', trim(a%section))
+            call file%write_vector('/brake/poincare/strobe_t', d%strobe_t, '1')
+            call file%write_vector('/brake/poincare/section_t', d%section_t, '1')
+            do k = 1, 4
+               call file%write_vector('/brake/poincare/strobe_'//names(k), d%strobe_points(k, :), trim(units(k)))
+               call file%write_vector('/brake/poincare/section_'//names(k), d%section_points(k, :), trim(units(k)))
+            end do
+         end if
+         if (a%lyapunov .or. a%rosenstein) call file%create_group('/brake/lyapunov')
+         if (a%lyapunov) then
+            call file%write_attribute_real('/brake/lyapunov', 'benettin_exponent', d%flow%current())
+            call file%write_attribute_real('/brake/lyapunov', 'benettin_transient', d%benettin%transient)
+            call file%write_attribute_real('/brake/lyapunov', 'benettin_duration', d%benettin%duration)
+            call file%write_attribute_real('/brake/lyapunov', 'benettin_renormalise', d%benettin%renormalise)
+            call file%write_attribute_real('/brake/lyapunov', 'benettin_d0', d%benettin%d0)
+            call file%write_vector('/brake/lyapunov/benettin_time', d%flow%time(1:d%flow%n), '1')
+            call file%write_vector('/brake/lyapunov/benettin_estimate', d%flow%estimate(1:d%flow%n), '1/tau')
+         end if
+         if (a%rosenstein) then
+            call file%write_attribute_real('/brake/lyapunov', 'rosenstein_exponent', d%series%exponent)
+            ! OpenTSTool's largelyap unit: log2 per sample of the series.
+            call file%write_attribute_real('/brake/lyapunov', 'rosenstein_log2_per_sample', &
+               & d%series%exponent * d%series_dt / log(2.0_wp))
+            call file%write_attribute_text('/brake/lyapunov', 'rosenstein_series', trim(a%series))
+            call file%write_attribute_real('/brake/lyapunov', 'rosenstein_sample_spacing', d%series_dt)
+            call file%write_attribute_integer('/brake/lyapunov', 'rosenstein_stride', int(a%rosenstein_stride, i8))
+            call file%write_attribute_integer('/brake/lyapunov', 'rosenstein_dimension', &
+               & int(a%rosenstein_dimension, i8))
+            call file%write_attribute_integer('/brake/lyapunov', 'rosenstein_delay', int(a%rosenstein_delay, i8))
+            call file%write_attribute_integer('/brake/lyapunov', 'rosenstein_theiler', int(a%rosenstein_theiler, i8))
+            call file%write_attribute_integer('/brake/lyapunov', 'rosenstein_horizon', int(a%rosenstein_horizon, i8))
+            call file%write_attribute_integer('/brake/lyapunov', 'rosenstein_fit_start', &
+               & int(a%rosenstein_fit_start, i8))
+            call file%write_attribute_integer('/brake/lyapunov', 'rosenstein_fit_end', int(a%rosenstein_fit_end, i8))
+            call file%write_vector('/brake/lyapunov/rosenstein_time', d%series%time, '1')
+            call file%write_vector('/brake/lyapunov/rosenstein_divergence', d%series%divergence, 'ln of the series unit')
+         end if
+      end associate
+   end subroutine write_diagnostics
 
 end module friction_brake_output

@@ -14,6 +14,8 @@ module friction_io_input
    use friction_afm_config, only: afm_config, potential_names, net_names, net_sites, max_species, max_defects
    use friction_io_files, only: file_exists
    use friction_brake_config, only: brake_config, model_names, units_names, brake_solver_defaults
+   use friction_analysis_settings, only: section_names
+   use friction_brake_diagnostics, only: series_names
    use friction_io_namelist_scan, only: mention, scan_namelist_file, lower, namelist_names, &
       & assigned_names, value_has_kind, kind_text
    implicit none
@@ -21,8 +23,8 @@ module friction_io_input
 
    public :: job_config, read_input, group_names
 
-   character(len=*), parameter :: group_names(8) = [character(len=17) :: &
-      & 'job', 'surface', 'tip', 'scan', 'integrator', 'brake', 'brake_dimensional', 'verify']
+   character(len=*), parameter :: group_names(9) = [character(len=17) :: &
+      & 'job', 'surface', 'tip', 'scan', 'integrator', 'brake', 'brake_dimensional', 'verify', 'analysis']
 
    !> Everything a run needs from its input files.
    type :: job_config
@@ -74,6 +76,14 @@ contains
       logical :: check
       character(len=16) :: check_method
       real(wp) :: check_rtol, check_atol, check_limit
+      ! &analysis (brake: chaos diagnostics; README: Girling brake, chaos)
+      logical :: spectrum, poincare, lyapunov, rosenstein
+      character(len=8) :: series, window
+      character(len=16) :: section
+      real(wp) :: window_start, window_end, strobe_period, strobe_start, strobe_end
+      real(wp) :: lyapunov_transient, lyapunov_duration, lyapunov_renormalise, lyapunov_d0
+      integer :: welch_segments, rosenstein_stride, rosenstein_dimension, rosenstein_delay, &
+         & rosenstein_theiler, rosenstein_horizon, rosenstein_fit_start, rosenstein_fit_end
 
       namelist /job/ scene
       namelist /surface/ potential, v0, ax, ay, a, net, net_file, shells, side, species, epsilon, sigma, &
@@ -86,6 +96,11 @@ contains
       namelist /brake_dimensional/ arm_length, drum_radius, crank_mass, block_mass, k1, k2, k3, gravity, &
          & epsilon_si, delta_si, v_dr_si
       namelist /verify/ check, check_method, check_rtol, check_atol, check_limit
+      namelist /analysis/ spectrum, series, window_start, window_end, window, welch_segments, &
+         & poincare, strobe_period, strobe_start, strobe_end, section, &
+         & lyapunov, lyapunov_transient, lyapunov_duration, lyapunov_renormalise, lyapunov_d0, &
+         & rosenstein, rosenstein_stride, rosenstein_dimension, rosenstein_delay, rosenstein_theiler, &
+         & rosenstein_horizon, rosenstein_fit_start, rosenstein_fit_end
 
       type(mention), allocatable :: mentions(:), all_mentions(:)
       character(len=4096), allocatable :: source(:)
@@ -138,7 +153,7 @@ contains
       call resolve_net_file()
       call validate()
       if (allocated(error)) return
-      ! Echo the groups the scene reads (the AFM's: 1-5; the brake's: job, integrator, 6-8).
+      ! Echo the groups the scene reads (the AFM's: 1-5; the brake's: job, integrator, 6-9).
       input_text = ''
       do g = 1, size(group_names)
          if (scene == 'brake' .and. any(g == [2, 3, 4])) cycle
@@ -164,6 +179,7 @@ contains
          case (6); read (unit, nml=brake, iostat=s, iomsg=msg)
          case (7); read (unit, nml=brake_dimensional, iostat=s, iomsg=msg)
          case (8); read (unit, nml=verify, iostat=s, iomsg=msg)
+         case (9); read (unit, nml=analysis, iostat=s, iomsg=msg)
          end select
          if (is_iostat_end(s)) return  ! absent: keep what we have
          if (s /= 0) then
@@ -199,6 +215,7 @@ contains
          case (6); write (scratch, nml=brake)
          case (7); write (scratch, nml=brake_dimensional)
          case (8); write (scratch, nml=verify)
+         case (9); write (scratch, nml=analysis)
          end select
          rewind (scratch)
          text = ''
@@ -242,6 +259,19 @@ contains
             epsilon_si = d%epsilon; delta_si = d%delta; v_dr_si = d%v_dr
             check = b%check%enabled; check_method = b%check%method; check_rtol = b%check%rtol
             check_atol = b%check%atol; check_limit = b%check%max_difference
+         end associate
+         associate (n => defaults%brake%analysis)
+            spectrum = n%spectrum; series = n%series; window_start = n%window_start
+            window_end = n%window_end; window = n%window; welch_segments = n%welch_segments
+            poincare = n%poincare; strobe_period = n%strobe_period; strobe_start = n%strobe_start
+            strobe_end = n%strobe_end; section = n%section
+            lyapunov = n%lyapunov; lyapunov_transient = n%lyapunov_transient
+            lyapunov_duration = n%lyapunov_duration; lyapunov_renormalise = n%lyapunov_renormalise
+            lyapunov_d0 = n%lyapunov_d0
+            rosenstein = n%rosenstein; rosenstein_stride = n%rosenstein_stride
+            rosenstein_dimension = n%rosenstein_dimension; rosenstein_delay = n%rosenstein_delay
+            rosenstein_theiler = n%rosenstein_theiler; rosenstein_horizon = n%rosenstein_horizon
+            rosenstein_fit_start = n%rosenstein_fit_start; rosenstein_fit_end = n%rosenstein_fit_end
          end associate
       end subroutine from_config
 
@@ -291,6 +321,22 @@ contains
             b%solver%method = method; b%solver%rtol = rtol; b%solver%atol = atol
             b%solver%h_start = h_start; b%solver%h_min = h_min; b%solver%max_steps = max_steps
             b%solver%max_wall_time = max_wall_time
+         end associate
+         series = lower(series)
+         window = lower(window)
+         section = lower(section)
+         associate (n => config%brake%analysis)
+            n%spectrum = spectrum; n%series = series; n%window_start = window_start
+            n%window_end = window_end; n%window = window; n%welch_segments = welch_segments
+            n%poincare = poincare; n%strobe_period = strobe_period; n%strobe_start = strobe_start
+            n%strobe_end = strobe_end; n%section = section
+            n%lyapunov = lyapunov; n%lyapunov_transient = lyapunov_transient
+            n%lyapunov_duration = lyapunov_duration; n%lyapunov_renormalise = lyapunov_renormalise
+            n%lyapunov_d0 = lyapunov_d0
+            n%rosenstein = rosenstein; n%rosenstein_stride = rosenstein_stride
+            n%rosenstein_dimension = rosenstein_dimension; n%rosenstein_delay = rosenstein_delay
+            n%rosenstein_theiler = rosenstein_theiler; n%rosenstein_horizon = rosenstein_horizon
+            n%rosenstein_fit_start = rosenstein_fit_start; n%rosenstein_fit_end = rosenstein_fit_end
          end associate
       end subroutine to_config
 
@@ -529,7 +575,48 @@ contains
          call require_nonnegative('verify', 'check_rtol', check_rtol, '0 for rtol / 1000')
          call require_nonnegative('verify', 'check_atol', check_atol, '0 for atol / 1000')
          call require_nonnegative('verify', 'check_limit', check_limit, 'm; 0 reports only')
+         call validate_analysis()
       end subroutine validate_brake
+
+      !> The chaos diagnostics' settings (README: Girling brake, chaos).
+      subroutine validate_analysis()
+         if (.not. any(series_names == series)) call reject('analysis', 'series', "'"//trim(series)//"'", &
+            & 'unknown variable (known: '//quoted(series_names)//')')
+         if (window /= 'hann' .and. window /= 'none') call reject('analysis', 'window', "'"//trim(window)//"'", &
+            & "unknown window (known: 'hann', 'none')")
+         if (.not. any(section_names == section)) call reject('analysis', 'section', "'"//trim(section)//"'", &
+            & 'unknown section (known: '//quoted(section_names)//')')
+         call require_finite('analysis', 'window_start', window_start)
+         if (.not. (window_end > window_start)) call reject('analysis', 'window_end', rtoa(window_end), &
+            & 'must be after window_start = '//rtoa(window_start))
+         if (welch_segments < 1) call reject('analysis', 'welch_segments', itoa(welch_segments), 'must be >= 1')
+         call require_nonnegative('analysis', 'strobe_period', strobe_period, 'τ; 0 for 1 / peak frequency')
+         call require_finite('analysis', 'strobe_start', strobe_start)
+         call require_nonnegative('analysis', 'strobe_end', strobe_end, 'τ; 0 for the end of the run')
+         call require_nonnegative('analysis', 'lyapunov_transient', lyapunov_transient, 'τ')
+         call require_nonnegative('analysis', 'lyapunov_duration', lyapunov_duration, 'τ; 0 for the rest of the run')
+         call require_positive('analysis', 'lyapunov_renormalise', lyapunov_renormalise, 'τ')
+         call require_positive('analysis', 'lyapunov_d0', lyapunov_d0, 'initial separation')
+         if (lyapunov .and. lyapunov_duration == 0.0_wp .and. &
+            & .not. (t_end - t_start - lyapunov_transient >= lyapunov_renormalise)) &
+            & call reject('analysis', 'lyapunov_transient', rtoa(lyapunov_transient), &
+            & 'leaves less than one renormalisation interval before t_end')
+         if (rosenstein_stride < 1) call reject('analysis', 'rosenstein_stride', itoa(rosenstein_stride), &
+            & 'must be >= 1')
+         if (rosenstein_dimension < 1) call reject('analysis', 'rosenstein_dimension', &
+            & itoa(rosenstein_dimension), 'must be >= 1')
+         if (rosenstein_delay < 1) call reject('analysis', 'rosenstein_delay', itoa(rosenstein_delay), &
+            & 'must be >= 1 (samples)')
+         if (rosenstein_theiler < 0) call reject('analysis', 'rosenstein_theiler', itoa(rosenstein_theiler), &
+            & 'must be >= 0 (samples)')
+         if (rosenstein_horizon < 1) call reject('analysis', 'rosenstein_horizon', itoa(rosenstein_horizon), &
+            & 'must be >= 1 (samples)')
+         if (rosenstein_fit_start < 0) call reject('analysis', 'rosenstein_fit_start', &
+            & itoa(rosenstein_fit_start), 'must be >= 0 (samples)')
+         if (rosenstein_fit_end <= rosenstein_fit_start .or. rosenstein_fit_end > rosenstein_horizon) &
+            & call reject('analysis', 'rosenstein_fit_end', itoa(rosenstein_fit_end), &
+            & 'must be in (rosenstein_fit_start, rosenstein_horizon]')
+      end subroutine validate_analysis
 
    end subroutine read_input
 

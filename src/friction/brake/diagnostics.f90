@@ -1,0 +1,229 @@
+!> The chaos diagnostics of a brake run (README: Girling brake, chaos):
+!> the spectrum of one variable over a window, the stroboscopic map and a
+!> section, and the maximum Lyapunov exponent from the equations (two runs
+!> through the same stick/slip logic, Benettin) and from the series
+!> (Rosenstein).  Deterministic: every rank computes the same numbers.
+module friction_brake_diagnostics
+   use friction_kinds, only: wp
+   use friction_error, only: error_type, fatal_error, error_input
+   use friction_brake_config, only: brake_config, model_switched
+   use friction_brake_record, only: brake_trajectory, brake_event_table, event_stick_to_slip
+   use friction_brake_simulate, only: initial_state
+   use friction_brake_switched, only: switched_integrator
+   use friction_brake_regularized, only: regularized_integrator
+   use friction_analysis_settings, only: analysis_settings
+   use friction_analysis_spectrum, only: spectrum_settings, spectrum_result, amplitude_spectrum
+   use friction_analysis_poincare, only: stroboscopic_map, upward_section
+   use friction_analysis_lyapunov_flow, only: benettin_settings, benettin_accumulator
+   use friction_analysis_lyapunov_series, only: rosenstein_settings, rosenstein_result, rosenstein_exponent
+   implicit none
+   private
+
+   public :: brake_diagnostics, diagnose_brake, brake_benettin, series_names
+
+   character(len=*), parameter :: series_names(4) = [character(len=1) :: 'x', 'v', 'y', 'w']
+
+   type :: brake_diagnostics
+      type(analysis_settings) :: settings
+      type(spectrum_result) :: spectrum
+      real(wp) :: strobe_period = 0.0_wp
+      real(wp), allocatable :: strobe_t(:), strobe_points(:, :)     !! (4, n): x, v, y, w
+      real(wp), allocatable :: section_t(:), section_points(:, :)   !! (4, n)
+      type(benettin_settings) :: benettin
+      type(benettin_accumulator) :: flow
+      type(rosenstein_result) :: series
+      real(wp) :: series_dt = 0.0_wp   !! sample spacing of the strided series
+   end type brake_diagnostics
+
+contains
+
+   !> Everything the settings switch on, from a finished run.
+   subroutine diagnose_brake(config, trajectory, events, result, error)
+      type(brake_config), intent(in) :: config
+      type(brake_trajectory), intent(in) :: trajectory
+      type(brake_event_table), intent(in) :: events
+      type(brake_diagnostics), intent(out) :: result
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), allocatable :: states(:, :), window_series(:)
+      integer :: first, last, k, column
+      real(wp) :: t_end
+
+      associate (a => config%analysis)
+         result%settings = a
+         allocate (states(4, size(trajectory%t)))
+         states(1, :) = trajectory%x
+         states(2, :) = trajectory%v
+         states(3, :) = trajectory%y
+         states(4, :) = trajectory%w
+         column = findloc(series_names, trim(a%series), 1)
+         if (column == 0) then
+            call fatal_error(error, "&analysis: unknown series '"//trim(a%series)//"'", error_input)
+            return
+         end if
+         first = count(trajectory%t < a%window_start) + 1
+         last = count(trajectory%t <= a%window_end)
+         if (a%spectrum .or. a%rosenstein .or. (a%poincare .and. a%strobe_period == 0.0_wp)) then
+            if (last - first + 1 < 16) then
+               call fatal_error(error, '&analysis: fewer than 16 output points in [window_start, window_end]', &
+                  & error_input)
+               return
+            end if
+            window_series = states(column, first:last)
+         end if
+         if (a%spectrum .or. (a%poincare .and. a%strobe_period == 0.0_wp)) then
+            call amplitude_spectrum(window_series, config%dt_out, &
+               & spectrum_settings(window=a%window, segments=a%welch_segments), result%spectrum, error)
+            if (allocated(error)) return
+         end if
+         if (a%poincare) then
+            result%strobe_period = a%strobe_period
+            if (result%strobe_period == 0.0_wp) then
+               if (.not. (result%spectrum%peak_frequency > 0.0_wp)) then
+                  call fatal_error(error, '&analysis: no spectral peak to strobe at; set strobe_period', &
+                     & error_input)
+                  return
+               end if
+               result%strobe_period = 1.0_wp / result%spectrum%peak_frequency
+            end if
+            t_end = a%strobe_end
+            if (t_end == 0.0_wp) t_end = config%t_end
+            call stroboscopic_map(trajectory%t, states, a%strobe_start, t_end, result%strobe_period, &
+               & result%strobe_t, result%strobe_points, error)
+            if (allocated(error)) return
+            select case (trim(a%section))
+            case ('stick_to_slip')
+               ! Located by the event machinery to event_tolerance.
+               k = count(events%kind(1:events%n) == event_stick_to_slip)
+               result%section_t = pack(events%t(1:events%n), events%kind(1:events%n) == event_stick_to_slip)
+               allocate (result%section_points(4, k))
+               do column = 1, 4
+                  result%section_points(column, :) = pack(events%state(column, 1:events%n), &
+                     & events%kind(1:events%n) == event_stick_to_slip)
+               end do
+            case ('w_zero_up')
+               call upward_section(trajectory%t, states, 4, 0.0_wp, a%strobe_start, t_end, &
+                  & result%section_t, result%section_points)
+            case default
+               allocate (result%section_t(0), result%section_points(4, 0))
+            end select
+         end if
+         if (a%lyapunov) then
+            result%benettin%transient = a%lyapunov_transient
+            result%benettin%duration = a%lyapunov_duration
+            if (result%benettin%duration == 0.0_wp) &
+               & result%benettin%duration = config%t_end - config%t_start - a%lyapunov_transient
+            result%benettin%renormalise = a%lyapunov_renormalise
+            result%benettin%d0 = a%lyapunov_d0
+            call brake_benettin(config, result%benettin, result%flow, error)
+            if (allocated(error)) return
+         end if
+         if (a%rosenstein) then
+            result%series_dt = config%dt_out * a%rosenstein_stride
+            call rosenstein_exponent(window_series(1::a%rosenstein_stride), result%series_dt, &
+               & rosenstein_settings(dimension=a%rosenstein_dimension, delay=a%rosenstein_delay, &
+               & theiler=a%rosenstein_theiler, horizon=a%rosenstein_horizon, &
+               & fit_start=a%rosenstein_fit_start, fit_end=a%rosenstein_fit_end), result%series, error)
+            if (allocated(error)) then
+               error%message = '&analysis: '//error%message//' (the window [window_start, window_end] ' &
+                  & //'strided by rosenstein_stride against the embedding and rosenstein_horizon)'
+               return
+            end if
+         end if
+      end associate
+   end subroutine diagnose_brake
+
+   !> Benettin for the brake: a reference and a perturbed run advanced in
+   !> lockstep through the same stick/slip logic; after each interval the
+   !> perturbed run restarts from the reference plus the separation scaled
+   !> back to d0.  In stick the perturbation is put on the positions only so
+   !> that both runs start in the same phase; a separation with a velocity
+   !> part restarts the perturbed run in slip, as the logic decides.
+   subroutine brake_benettin(config, settings, result, error)
+      type(brake_config), intent(in) :: config
+      type(benettin_settings), intent(in) :: settings
+      type(benettin_accumulator), intent(out) :: result
+      type(error_type), allocatable, intent(out) :: error
+      type(switched_integrator) :: reference_s, perturbed_s
+      type(regularized_integrator) :: reference_r, perturbed_r
+      type(brake_event_table) :: reference_events, perturbed_events
+      real(wp) :: t, reference(4), perturbed(4), direction(4)
+      integer :: k, intervals
+      logical :: switched
+
+      if (.not. (settings%renormalise > 0.0_wp .and. settings%duration >= settings%renormalise &
+         & .and. settings%d0 > 0.0_wp .and. settings%transient >= 0.0_wp)) then
+         call fatal_error(error, '&analysis: Benettin needs lyapunov_renormalise > 0, a duration of at ' &
+            & //'least one interval after lyapunov_transient, lyapunov_d0 > 0', error_input)
+         return
+      end if
+      switched = trim(config%model) == model_switched
+      t = config%t_start + settings%transient
+      reference = initial_state(config)
+      call start(reference_s, reference_r, reference_events, config%t_start, reference)
+      if (allocated(error)) return
+      call advance(reference_s, reference_r, reference_events, t, reference)
+      if (allocated(error)) return
+      direction = [1.0_wp, 1.0_wp, 1.0_wp, 1.0_wp]
+      if (is_sticking(reference_s, reference)) direction = [1.0_wp, 0.0_wp, 1.0_wp, 0.0_wp]
+      perturbed = reference + settings%d0 * direction / norm2(direction)
+      intervals = int(settings%duration / settings%renormalise + 1.0e-9_wp)
+      call result%start(settings%d0, intervals)
+      do k = 1, intervals
+         call start(perturbed_s, perturbed_r, perturbed_events, t, perturbed)
+         if (allocated(error)) return
+         t = config%t_start + settings%transient + k * settings%renormalise
+         call advance(reference_s, reference_r, reference_events, t, reference)
+         if (allocated(error)) return
+         call advance(perturbed_s, perturbed_r, perturbed_events, t, perturbed)
+         if (allocated(error)) return
+         call result%renormalise(reference, perturbed, settings%renormalise)
+         ! Long runs: keep the event tables from growing without bound.
+         call reference_events%clear()
+      end do
+
+   contains
+
+      subroutine start(run_s, run_r, events, t0, y0)
+         type(switched_integrator), target, intent(inout) :: run_s
+         type(regularized_integrator), target, intent(inout) :: run_r
+         type(brake_event_table), intent(inout) :: events
+         real(wp), intent(in) :: t0, y0(4)
+
+         if (switched) then
+            call run_s%init(config%params, config%solver, config%event_tolerance, t0, y0, events, error)
+         else
+            call run_r%init(config%params, config%stick_velocity, config%solver, config%event_tolerance, &
+               & t0, y0, events, error)
+         end if
+      end subroutine start
+
+      subroutine advance(run_s, run_r, events, t1, y)
+         type(switched_integrator), intent(inout) :: run_s
+         type(regularized_integrator), intent(inout) :: run_r
+         type(brake_event_table), intent(inout) :: events
+         real(wp), intent(in) :: t1
+         real(wp), intent(out) :: y(4)
+
+         if (switched) then
+            call run_s%advance_to(t1, events, error)
+            y = run_s%y
+         else
+            call run_r%advance_to(t1, events, error)
+            y = run_r%y
+         end if
+      end subroutine advance
+
+      logical function is_sticking(run_s, y)
+         type(switched_integrator), intent(in) :: run_s
+         real(wp), intent(in) :: y(4)
+
+         if (switched) then
+            is_sticking = run_s%sticking
+         else
+            is_sticking = abs(y(2) - config%params%v_dr) <= config%stick_velocity
+         end if
+      end function is_sticking
+
+   end subroutine brake_benettin
+
+end module friction_brake_diagnostics
