@@ -1,94 +1,3 @@
-!> Systems with known exponents for the chaos diagnostics.
-module analysis_test_systems
-   use friction_kinds, only: wp
-   use friction_ode_system, only: ode_system
-   use friction_ode_events, only: event_system
-   implicit none
-   private
-   public :: lorenz, oscillator
-
-   !> Lorenz (σ, ρ, β) = (10, 28, 8/3): maximum exponent 0.906.
-   type, extends(ode_system) :: lorenz
-      real(wp) :: sigma = 10.0_wp, rho = 28.0_wp, beta = 8.0_wp / 3.0_wp
-   contains
-      procedure :: dimension => lorenz_dimension
-      procedure :: rhs => lorenz_rhs
-      procedure :: jacobian => lorenz_jacobian
-   end type lorenz
-
-   !> x'' = -ω² x: every orbit periodic, exponent 0.  Event function: x'
-   !> (upward zero at the minimum of x), for a located section.
-   type, extends(event_system) :: oscillator
-      real(wp) :: omega = 1.0_wp
-   contains
-      procedure :: dimension => oscillator_dimension
-      procedure :: rhs => oscillator_rhs
-      procedure :: jacobian => oscillator_jacobian
-      procedure :: event_count => oscillator_event_count
-      procedure :: event_values => oscillator_event_values
-   end type oscillator
-
-contains
-
-   pure integer function lorenz_dimension(self) result(n)
-      class(lorenz), intent(in) :: self
-      n = 3
-   end function lorenz_dimension
-
-   pure subroutine lorenz_rhs(self, t, y, dydt)
-      class(lorenz), intent(in) :: self
-      real(wp), intent(in) :: t, y(:)
-      real(wp), intent(out) :: dydt(:)
-      dydt(1) = self%sigma * (y(2) - y(1))
-      dydt(2) = y(1) * (self%rho - y(3)) - y(2)
-      dydt(3) = y(1) * y(2) - self%beta * y(3)
-   end subroutine lorenz_rhs
-
-   pure subroutine lorenz_jacobian(self, t, y, dfdy, dfdt)
-      class(lorenz), intent(in) :: self
-      real(wp), intent(in) :: t, y(:)
-      real(wp), intent(out) :: dfdy(:, :), dfdt(:)
-      dfdy(1, :) = [-self%sigma, self%sigma, 0.0_wp]
-      dfdy(2, :) = [self%rho - y(3), -1.0_wp, -y(1)]
-      dfdy(3, :) = [y(2), y(1), -self%beta]
-      dfdt = 0.0_wp
-   end subroutine lorenz_jacobian
-
-   pure integer function oscillator_dimension(self) result(n)
-      class(oscillator), intent(in) :: self
-      n = 2
-   end function oscillator_dimension
-
-   pure subroutine oscillator_rhs(self, t, y, dydt)
-      class(oscillator), intent(in) :: self
-      real(wp), intent(in) :: t, y(:)
-      real(wp), intent(out) :: dydt(:)
-      dydt(1) = y(2)
-      dydt(2) = -self%omega**2 * y(1)
-   end subroutine oscillator_rhs
-
-   pure subroutine oscillator_jacobian(self, t, y, dfdy, dfdt)
-      class(oscillator), intent(in) :: self
-      real(wp), intent(in) :: t, y(:)
-      real(wp), intent(out) :: dfdy(:, :), dfdt(:)
-      dfdy = reshape([0.0_wp, -self%omega**2, 1.0_wp, 0.0_wp], [2, 2])
-      dfdt = 0.0_wp
-   end subroutine oscillator_jacobian
-
-   pure integer function oscillator_event_count(self) result(n)
-      class(oscillator), intent(in) :: self
-      n = 1
-   end function oscillator_event_count
-
-   pure subroutine oscillator_event_values(self, t, y, g)
-      class(oscillator), intent(in) :: self
-      real(wp), intent(in) :: t, y(:)
-      real(wp), intent(out) :: g(:)
-      g(1) = y(2)
-   end subroutine oscillator_event_values
-
-end module analysis_test_systems
-
 !> The chaos diagnostics against known answers: Lorenz and a periodic
 !> orbit from the equations (Benettin) and from the series (Rosenstein),
 !> the logistic map, tones in a spectrum, maps of a periodic orbit.
@@ -101,7 +10,7 @@ program test_analysis
    use friction_analysis_lyapunov_series, only: rosenstein_settings, rosenstein_result, rosenstein_exponent
    use friction_analysis_lyapunov_flow, only: benettin_settings, benettin_accumulator, benettin_exponent
    use friction_analysis_poincare, only: stroboscopic_map, upward_section, located_section
-   use analysis_test_systems, only: lorenz, oscillator
+   use test_systems, only: lorenz, oscillator
    use testing, only: test_suite, check, check_close
    implicit none
 

@@ -1,84 +1,10 @@
-!> Test systems with exact solutions.
-module stepper_test_systems
-   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
-   use friction_kinds, only: wp
-   use friction_ode_system, only: ode_system
-   implicit none
-   private
-   public :: oscillator, decay
-
-   !> x'' = -ω² x as (x, v).
-   type, extends(ode_system) :: oscillator
-      real(wp) :: omega = 1.0_wp
-   contains
-      procedure :: dimension => oscillator_dimension
-      procedure :: rhs => oscillator_rhs
-      procedure :: jacobian => oscillator_jacobian
-   end type oscillator
-
-   !> y' = -λ y, and a right-hand side that turns NaN after t_bad.
-   type, extends(ode_system) :: decay
-      real(wp) :: rate = 1.0_wp
-      real(wp) :: t_bad = huge(1.0_wp)
-   contains
-      procedure :: dimension => decay_dimension
-      procedure :: rhs => decay_rhs
-      procedure :: jacobian => decay_jacobian
-   end type decay
-
-contains
-
-   pure integer function oscillator_dimension(self) result(n)
-      class(oscillator), intent(in) :: self
-      n = 2
-   end function oscillator_dimension
-
-   pure subroutine oscillator_rhs(self, t, y, dydt)
-      class(oscillator), intent(in) :: self
-      real(wp), intent(in) :: t, y(:)
-      real(wp), intent(out) :: dydt(:)
-      dydt(1) = y(2)
-      dydt(2) = -self%omega**2 * y(1)
-   end subroutine oscillator_rhs
-
-   pure subroutine oscillator_jacobian(self, t, y, dfdy, dfdt)
-      class(oscillator), intent(in) :: self
-      real(wp), intent(in) :: t, y(:)
-      real(wp), intent(out) :: dfdy(:, :), dfdt(:)
-      dfdy = reshape([0.0_wp, -self%omega**2, 1.0_wp, 0.0_wp], [2, 2])
-      dfdt = 0.0_wp
-   end subroutine oscillator_jacobian
-
-   pure integer function decay_dimension(self) result(n)
-      class(decay), intent(in) :: self
-      n = 1
-   end function decay_dimension
-
-   pure subroutine decay_rhs(self, t, y, dydt)
-      class(decay), intent(in) :: self
-      real(wp), intent(in) :: t, y(:)
-      real(wp), intent(out) :: dydt(:)
-      dydt(1) = -self%rate * y(1)
-      if (t > self%t_bad) dydt(1) = ieee_value(1.0_wp, ieee_quiet_nan)
-   end subroutine decay_rhs
-
-   pure subroutine decay_jacobian(self, t, y, dfdy, dfdt)
-      class(decay), intent(in) :: self
-      real(wp), intent(in) :: t, y(:)
-      real(wp), intent(out) :: dfdy(:, :), dfdt(:)
-      dfdy(1, 1) = -self%rate
-      dfdt = 0.0_wp
-   end subroutine decay_jacobian
-
-end module stepper_test_systems
-
 !> Every GSL step type through the bridge: a harmonic oscillator and an
 !> exponential decay against their exact solutions; failures come back as
 !> errors that carry the time reached.
 program test_steppers
    use friction_kinds, only: wp, i8, pi
    use friction_error, only: error_type
-   use stepper_test_systems, only: oscillator, decay
+   use test_systems, only: oscillator, decay
    use friction_ode_solver, only: ode_solver, solver_settings, step_type_names, integrator_statistics
    use testing, only: test_suite, check, check_close, current_test
    implicit none
