@@ -71,6 +71,9 @@ int friction_afm_line(const char *potential, double v0, double ax, double ay, do
  *   needed     if not NULL, receives the number of grid points; when n is
  *              smaller the call fails with FRICTION_ERROR_INPUT and writes
  *              nothing else, so a caller may ask with n = 0 first. */
+/* Checks as the namelist: xi, kappa, t_end, dt_out, rtol, atol > 0; mu, mu_s,
+ * delta_prime >= 0; epsilon_prime > 0 for "regularized"; mu <= mu_s for
+ * "switched"; all finite.  An initial normal force N' <= 0 is an input error. */
 int friction_brake(const char *model, double xi, double kappa, double g_prime, double mu,
                    double mu_s, double epsilon_prime, double delta_prime, double v_dr,
                    double t_end, double dt_out, const char *stepper, double rtol, double atol,

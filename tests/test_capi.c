@@ -106,7 +106,7 @@ static int checks(void) {
 
   /* the brake: ask for the length, too small arrays, bad names and values */
   size_t needed = 0;
-  double small[4];
+  double small[4], times[4];
   expect_input_error(brake(NULL, NULL, NULL, NULL, NULL, 0, &needed, err), err, "too small", "length query");
   CHECK(needed == 81, "needed %zu points, expected 81", needed);
   expect_input_error(brake(small, small, small, small, small, 4, &needed, err), err, "81", "arrays of 4");
@@ -126,8 +126,18 @@ static int checks(void) {
                                     "rk8pd", 1e-10, 1e-12, small, NULL, small, small, small, 4, NULL, err),
                      err, "null", "null x");
 
+  expect_input_error(friction_brake("switched", 0.412, 1.5, -0.01, 0.59, 0.59, 3.5e7, 3.5, -0.0028, 1, 0.5,
+                                    "rk8pd", 1e-10, 1e-12, small, small, small, small, small, 4, NULL, err),
+                     err, "N'", "lift-off at the start");
+  /* the regularized model runs (mu > mu_s allowed there, as in the namelist) */
+  CHECK(friction_brake("regularized", 0.412, 1.5, 0.01778, 0.6, 0.59, 3.5121e7, 3.5121, -0.002788, 1, 0.5,
+                       "rk4imp", 1e-8, 1e-10, times, small, small, small, small, 4, &needed, err) == FRICTION_OK,
+        "regularized brake: status %d", friction_error_status(err));
+  CHECK(needed == 3 && times[2] == 1.0, "regularized brake: %zu points, last t = %g", needed, times[2]);
+
   /* a message truncated into a small buffer */
   char tiny[8];
+  friction_brake(NULL, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, NULL, 0, 0, NULL, NULL, NULL, NULL, NULL, 0, NULL, err);
   CHECK(friction_error_message(err, tiny, sizeof tiny) == FRICTION_ERROR_INPUT && strlen(tiny) == 7,
         "truncated message '%s'", tiny);
 

@@ -294,19 +294,22 @@ contains
       end if
       call require('xi', xi, .false., error)
       call require('kappa', kappa, .false., error)
-      call require('g_prime', g_prime, .true., error)
       call require('mu', mu, .true., error)
       call require('mu_s', mu_s, .true., error)
-      call require('epsilon_prime', epsilon_prime, .false., error)
+      ! As the namelist: epsilon' matters only to the regularized model.
+      if (name == 'regularized') call require('epsilon_prime', epsilon_prime, .false., error)
       call require('delta_prime', delta_prime, .true., error)
       call require('t_end', t_end, .false., error)
       call require('dt_out', dt_out, .false., error)
       call require('rtol', rtol, .false., error)
       call require('atol', atol, .false., error)
-      if (.not. allocated(error) .and. .not. (abs(v_dr) <= huge(v_dr))) &
-         & call fatal_error(error, 'v_dr must be finite', error_input)
-      if (.not. allocated(error) .and. mu_s < mu) &
-         & call fatal_error(error, 'mu_s must be >= mu', error_input)
+      if (.not. allocated(error) .and. .not. (abs(v_dr) <= huge(v_dr) .and. abs(g_prime) <= huge(g_prime) &
+         & .and. abs(epsilon_prime) <= huge(epsilon_prime))) &
+         & call fatal_error(error, 'v_dr, g_prime and epsilon_prime must be finite', error_input)
+      ! The switched model's stick/slip decision needs mu <= mu_s (as the namelist).
+      if (.not. allocated(error) .and. name == 'switched' .and. mu_s < mu) &
+         & call fatal_error(error, 'mu_s = '//rtoa(real(mu_s, wp))//': must be >= mu = '//rtoa(real(mu, wp)) &
+         & //' for the switched model', error_input)
       if (.not. allocated(error) .and. t_end / dt_out > 1.0e9_wp) &
          & call fatal_error(error, 't_end / dt_out is too large (> 1e9 points)', error_input)
       if (allocated(error)) then
