@@ -10,6 +10,8 @@ case "$1" in
   install)
     rm -rf "$3"
     cmake --install "$2" --prefix "$3" > /dev/null
+    # The installed program finds the installed shared library.
+    "$3/bin/friction" --version
     ;;
   cmake)
     rm -rf "$4"
