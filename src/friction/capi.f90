@@ -6,7 +6,7 @@
 !> handle, so threads may call the API at once.
 module friction_capi
    use, intrinsic :: iso_c_binding, only: c_ptr, c_char, c_int, c_double, c_size_t, c_null_char, &
-      & c_associated, c_f_pointer, c_loc, c_null_ptr
+      & c_associated, c_f_pointer, c_loc
    use friction_kinds, only: wp
    use friction_error, only: error_type, fatal_error, error_input
    use friction_version, only: version_string
@@ -143,10 +143,11 @@ contains
       type(c_ptr), value :: handle, buf
       integer(c_size_t), value :: len
       type(capi_error), pointer :: err
+      logical :: copied
 
       status = error_input
       if (.not. c_associated(handle)) then
-         if (copy_out('', buf, len)) continue
+         copied = copy_out('', buf, len)   ! an empty message, still a failure
          return
       end if
       call c_f_pointer(handle, err)
