@@ -75,8 +75,8 @@ contains
       real(wp) :: upper(2)
       integer :: i, c, n
 
-      self%epsilon = epsilon
-      self%sigma = sigma
+      allocate (self%epsilon, source=epsilon)
+      allocate (self%sigma, source=sigma)
       self%cutoff = cutoff
       n = net%size()
       self%origin = minval(net%position(1:2, :), dim=2) - 1.0e-9_wp
