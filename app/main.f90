@@ -15,6 +15,8 @@ program friction_main
    use friction_version, only: version_string
    use friction_strings, only: itoa
    use friction_io_input, only: job_config, read_input
+   use friction_io_h5_file, only: h5_file
+   use friction_io_run_summary, only: write_run_attributes
    use friction_io_files, only: file_exists, rename_file, remove_file
    use friction_ode_solver, only: integrator_statistics
    use friction_afm_scan, only: afm_scanner, trip_record, share_of, n_quantities
@@ -85,7 +87,9 @@ program friction_main
       call finish(exit_io)
    end if
 
-   if (config%scene == 'brake') then
+   if (config%sweep%enabled) then
+      call run_sweep()
+   else if (config%scene == 'brake') then
       call run_brake()
    else
       call run_afm()
@@ -268,6 +272,223 @@ contains
       call publish(temporary, trim(config%brake%model)//trim(line)//' '//trim(adjustl(seconds))//' s on ' &
          & //itoa(nranks)//trim(merge(' rank ', ' ranks', nranks == 1)))
    end subroutine run_brake
+
+   !> A parameter sweep of the brake (README: Parameter sweeps).  Each point
+   !> is the scene re-read from the input files plus a one-line override file,
+   !> so read_input validates it; an invalid or failing point is recorded as
+   !> failed with its reason and the sweep goes on.
+   !>
+   !> Load balancing: with sweep_schedule = 'dynamic' every rank takes the next
+   !> point from a counter on rank 0 with MPI_Fetch_and_op (passive target).
+   !> This is simpler than a master that serves requests between its own points
+   !> (no polling, rank 0 computes like the others) and hands out points on
+   !> demand, so a chaotic, long point does not hold up a whole static share.
+   !> Each point is computed alone and deterministically: the results do not
+   !> depend on which rank took it or on the number of ranks.
+   !>
+   !> Output: one rank-0 writer after reductions.  A point's results are a few
+   !> numbers and a few hundred maxima (kB), so the gathered data are small and
+   !> parallel HDF5's collective metadata would buy nothing.
+   subroutine run_sweep()
+      integer, parameter :: reason_length = 240
+      integer, parameter :: status_done = 1, status_failed = 2
+      type(job_config) :: point_config
+      type(brake_run), target :: point_run
+      type(brake_diagnostics) :: diagnostics
+      type(error_type), allocatable :: point_error
+      character(len=:), allocatable :: point_text, override, temporary, variable_group, variable_name
+      character(len=4096), allocatable :: point_files(:)
+      real(wp), allocatable :: values(:), peak(:), exponent(:), stick(:), cost(:), maxima(:), flat(:)
+      integer, allocatable :: status(:), events(:), counts(:), offsets(:), reason_codes(:, :), owner(:)
+      integer :: n, i, k, next, unit, dot, total, computed
+      integer(kind=MPI_ADDRESS_KIND) :: window_size
+      integer :: counter(1), one(1), fetched(1)
+      type(MPI_Win) :: window
+      type(h5_file) :: file
+      character(len=reason_length) :: reason
+      character(len=:), allocatable :: reasons
+      type(run_summary) :: summary
+      real(wp) :: wall, transient, t0
+      character(len=12) :: seconds
+      logical :: dynamic
+
+      values = config%sweep%values
+      n = size(values)
+      allocate (peak(n), exponent(n), stick(n), cost(n), source=0.0_wp)
+      allocate (status(n), events(n), counts(n), owner(n), source=0)
+      allocate (reason_codes(reason_length, n), source=0)
+      allocate (maxima(0))
+      dot = index(config%sweep%variable, '.')
+      variable_group = trim(config%sweep%variable(1:dot - 1))
+      variable_name = trim(config%sweep%variable(dot + 1:))
+      override = opts%output//'.point-'//itoa(friction_process_id())//'.nml'
+      point_files = [opts%files, [character(len=4096) :: override]]
+
+      counter = 0
+      one = 1
+      window_size = merge(4, 0, rank == 0)
+      ! (One rank needs no counter; Open MPI may have no one-sided component for it.)
+      dynamic = config%sweep%schedule == 'dynamic' .and. nranks > 1
+      if (dynamic) call MPI_Win_create(counter, window_size, 4, MPI_INFO_NULL, MPI_COMM_WORLD, window)
+      computed = 0
+      do
+         if (.not. dynamic) then
+            next = computed * nranks + rank
+         else
+            call MPI_Win_lock(MPI_LOCK_EXCLUSIVE, 0, 0, window)
+            call MPI_Fetch_and_op(one, fetched, MPI_INTEGER, 0, 0_MPI_ADDRESS_KIND, MPI_SUM, window)
+            call MPI_Win_unlock(0, window)
+            next = fetched(1)
+         end if
+         i = next + 1
+         if (i > n) exit
+         computed = computed + 1
+         owner(i) = rank + 1
+         t0 = MPI_Wtime()
+         open (newunit=unit, file=override, status='replace', action='write')
+         write (unit, '(a, es25.17e3, a)') '&'//variable_group//' '//variable_name//' = ', values(i), ' /'
+         close (unit)
+         call read_input(point_files, point_config, point_text, point_error)
+         if (.not. allocated(point_error)) call integrate_brake(point_run, point_config%brake, .false., &
+            & point_error)
+         if (.not. allocated(point_error)) then
+            associate (a => point_config%brake%analysis)
+               if (a%spectrum .or. a%lyapunov) then
+                  call diagnose_brake(point_config%brake, point_run%trajectory, point_run%events, &
+                     & diagnostics, point_error)
+                  if (.not. allocated(point_error)) then
+                     if (a%spectrum) peak(i) = diagnostics%spectrum%peak_frequency
+                     if (a%lyapunov) exponent(i) = diagnostics%flow%current()
+                  end if
+               end if
+               transient = a%window_start
+            end associate
+         end if
+         if (allocated(point_error)) then
+            status(i) = status_failed
+            reason = point_error%message
+            do k = 1, reason_length
+               reason_codes(k, i) = ichar(reason(k:k))
+            end do
+         else
+            status(i) = status_done
+            events(i) = point_run%events%n
+            stick(i) = point_run%stick_time() / (point_config%brake%t_end - point_config%brake%t_start)
+            call append_maxima(point_run, transient, maxima, counts(i))
+         end if
+         cost(i) = MPI_Wtime() - t0
+         if (rank == 0 .and. .not. opts%quiet) write (error_unit, '(a, i0, a, i0)') 'friction: sweep point ', &
+            & i, ' of ', n
+      end do
+      if (dynamic) call MPI_Win_free(window)
+      call remove_file(override)
+
+      ! Each point has exactly one owner; the others hold zeros, so a sum gathers it exactly.
+      call MPI_Allreduce(MPI_IN_PLACE, counts, n, MPI_INTEGER, MPI_SUM, MPI_COMM_WORLD)
+      allocate (offsets(n))
+      total = 0
+      do i = 1, n
+         offsets(i) = total
+         total = total + counts(i)
+      end do
+      allocate (flat(total), source=0.0_wp)
+      k = 0
+      do i = 1, n
+         if (owner(i) == 0) cycle
+         flat(offsets(i) + 1:offsets(i) + counts(i)) = maxima(k + 1:k + counts(i))
+         k = k + counts(i)
+      end do
+      call sum_to_root_real(flat)
+      call sum_to_root_real(peak)
+      call sum_to_root_real(exponent)
+      call sum_to_root_real(stick)
+      call sum_to_root_real(cost)
+      call sum_to_root_integer(status, n)
+      call sum_to_root_integer(events, n)
+      call sum_to_root_integer(owner, n)
+      call sum_to_root_integer(reason_codes, reason_length * n)
+
+      wall = MPI_Wtime() - t_start
+      call MPI_Allreduce(MPI_IN_PLACE, wall, 1, MPI_DOUBLE_PRECISION, MPI_MAX, MPI_COMM_WORLD)
+      summary = run_summary(input_text, version_string, nranks, wall, integrator_statistics(0, 0, 0, 0))
+      temporary = temporary_name()
+      if (rank == 0) then
+         reasons = ''
+         do i = 1, n
+            do k = 1, reason_length
+               reason(k:k) = achar(max(32, reason_codes(k, i)))
+            end do
+            reasons = reasons//trim(reason)//new_line('a')
+         end do
+         call file%create(temporary, MPI_COMM_SELF, error)
+         if (.not. allocated(error)) then
+            call write_run_attributes(file, 'brake_sweep', trim(config%brake%solver%method), summary)
+            call file%write_attribute_text('/', 'sweep_variable', trim(config%sweep%variable))
+            call file%write_attribute_text('/', 'sweep_schedule', trim(config%sweep%schedule))
+            call file%create_group('/sweep')
+            call file%write_vector('/sweep/values', values, trim(config%sweep%variable))
+            call file%write_vector('/sweep/maxima', flat, 'm')
+            call file%write_integer_vector('/sweep/maxima_offset', offsets)
+            call file%write_integer_vector('/sweep/maxima_count', counts)
+            call file%write_vector('/sweep/peak_frequency', peak, '1/tau')
+            call file%write_vector('/sweep/lyapunov', exponent, '1/tau')
+            call file%write_vector('/sweep/stick_fraction', stick, '1')
+            call file%write_integer_vector('/sweep/events', events)
+            call file%write_integer_vector('/sweep/status', status)
+            call file%write_attribute_text('/sweep/status', 'meaning', '0 pending, 1 done, 2 failed')
+            call file%write_attribute_text('/sweep/status', 'reason', reasons)
+            call file%write_vector('/sweep/compute_time', cost, 's')
+            call file%close(error)
+         end if
+      end if
+      write (seconds, '(f12.2)') wall
+      call publish(temporary, itoa(n)//' sweep points, '//itoa(count(status == status_failed)) &
+         & //' failed, '//trim(adjustl(seconds))//' s on '//itoa(nranks) &
+         & //trim(merge(' rank ', ' ranks', nranks == 1)))
+   end subroutine run_sweep
+
+   !> Local maxima of x after the transient, appended to `maxima`.
+   subroutine append_maxima(run, transient, maxima, found)
+      type(brake_run), intent(in) :: run
+      real(wp), intent(in) :: transient
+      real(wp), allocatable, intent(inout) :: maxima(:)
+      integer, intent(out) :: found
+      integer :: j
+
+      found = 0
+      associate (t => run%trajectory%t, x => run%trajectory%x)
+         do j = 2, run%n - 1
+            if (t(j) < transient) cycle
+            if (x(j) > x(j - 1) .and. x(j) >= x(j + 1)) then
+               maxima = [maxima, x(j)]
+               found = found + 1
+            end if
+         end do
+      end associate
+   end subroutine append_maxima
+
+   !> Sum a real array onto rank 0 (each entry has one non-zero contributor).
+   subroutine sum_to_root_real(values)
+      real(wp), intent(inout) :: values(:)
+
+      if (rank == 0) then
+         call MPI_Reduce(MPI_IN_PLACE, values, size(values), MPI_DOUBLE_PRECISION, MPI_SUM, 0, MPI_COMM_WORLD)
+      else
+         call MPI_Reduce(values, values, size(values), MPI_DOUBLE_PRECISION, MPI_SUM, 0, MPI_COMM_WORLD)
+      end if
+   end subroutine sum_to_root_real
+
+   !> Sum an integer array of `count` entries onto rank 0.
+   subroutine sum_to_root_integer(values, count)
+      integer, intent(inout) :: values(*)
+      integer, intent(in) :: count
+
+      if (rank == 0) then
+         call MPI_Reduce(MPI_IN_PLACE, values, count, MPI_INTEGER, MPI_SUM, 0, MPI_COMM_WORLD)
+      else
+         call MPI_Reduce(values, values, count, MPI_INTEGER, MPI_SUM, 0, MPI_COMM_WORLD)
+      end if
+   end subroutine sum_to_root_integer
 
    !> One brake run, in pieces so that long runs can show progress.
    subroutine integrate_brake(run, settings, show, error)
