@@ -39,6 +39,12 @@ program friction_main
          import :: c_int
          integer(c_int) :: pid
       end function friction_process_id
+      subroutine friction_catch_signals() bind(c)
+      end subroutine friction_catch_signals
+      function friction_interrupted() result(yes) bind(c)
+         import :: c_int
+         integer(c_int) :: yes
+      end function friction_interrupted
       !> The C library's exit: a status code without the runtime's backtrace.
       subroutine c_exit(status) bind(c, name='exit')
          import :: c_int
@@ -46,12 +52,14 @@ program friction_main
       end subroutine c_exit
    end interface
 
-   integer, parameter :: exit_usage = 2, exit_input = 3, exit_numerical = 4, exit_io = 5
+   integer, parameter :: reason_length = 240   !! characters of a failed sweep point's reason
+   integer, parameter :: exit_usage = 2, exit_input = 3, exit_numerical = 4, exit_io = 5, exit_interrupted = 6
 
    type :: options
       character(len=:), allocatable :: output
       logical :: force = .false.
       logical :: quiet = .false.
+      logical :: resume = .false.
       character(len=4096), allocatable :: files(:)
    end type options
 
@@ -73,7 +81,7 @@ program friction_main
    call read_input(opts%files, config, input_text, error)
    if (allocated(error)) call fail(error)
    if (.not. allocated(opts%output)) opts%output = default_output(opts%files(1))
-   if (file_exists(opts%output) .and. .not. opts%force) then
+   if (file_exists(opts%output) .and. .not. (opts%force .or. (opts%resume .and. config%sweep%enabled))) then
       call fatal_error(error, opts%output//': the output file exists; use --force to overwrite it', &
          & error_input)
       call fail(error)
@@ -290,7 +298,6 @@ contains
    !> numbers and a few hundred maxima (kB), so the gathered data are small and
    !> parallel HDF5's collective metadata would buy nothing.
    subroutine run_sweep()
-      integer, parameter :: reason_length = 240
       integer, parameter :: status_done = 1, status_failed = 2
       type(job_config) :: point_config
       type(brake_run), target :: point_run
@@ -310,18 +317,20 @@ contains
       type(run_summary) :: summary
       real(wp) :: wall, transient, t0
       character(len=12) :: seconds
-      logical :: dynamic
+      logical :: dynamic, interrupted, loaded
+      real(wp), allocatable :: loaded_maxima(:)
+      integer, allocatable :: computed_by_run(:)
 
       values = config%sweep%values
       n = size(values)
       allocate (peak(n), exponent(n), stick(n), cost(n), source=0.0_wp)
-      allocate (status(n), events(n), counts(n), owner(n), source=0)
+      allocate (status(n), events(n), counts(n), owner(n), computed_by_run(n), source=0)
       allocate (reason_codes(reason_length, n), source=0)
       allocate (maxima(0))
       dot = index(config%sweep%variable, '.')
       variable_group = trim(config%sweep%variable(1:dot - 1))
       variable_name = trim(config%sweep%variable(dot + 1:))
-      override = opts%output//'.point-'//itoa(friction_process_id())//'.nml'
+      override = opts%output//'.override-'//itoa(rank)//'-'//itoa(friction_process_id())//'.nml'
       point_files = [opts%files, [character(len=4096) :: override]]
 
       counter = 0
@@ -331,7 +340,14 @@ contains
       dynamic = config%sweep%schedule == 'dynamic' .and. nranks > 1
       if (dynamic) call MPI_Win_create(counter, window_size, 4, MPI_INFO_NULL, MPI_COMM_WORLD, window)
       computed = 0
+      interrupted = .false.
+      call friction_catch_signals()
       do
+         ! Between points: a signal stops the sweep here, the point in hand done.
+         if (friction_interrupted() /= 0) then
+            interrupted = .true.
+            exit
+         end if
          if (.not. dynamic) then
             next = computed * nranks + rank
          else
@@ -342,8 +358,25 @@ contains
          end if
          i = next + 1
          if (i > n) exit
+         if (config%sweep%stop_after > 0 .and. i > config%sweep%stop_after) then
+            interrupted = .true.   ! the test hook: as if a signal came after that point
+            exit
+         end if
          computed = computed + 1
          owner(i) = rank + 1
+         if (opts%resume) then
+            call load_point(checkpoint_name(i), values(i), status(i), events(i), peak(i), exponent(i), &
+               & stick(i), cost(i), reason, loaded_maxima, loaded)
+            if (loaded) then
+               counts(i) = size(loaded_maxima)
+               maxima = [maxima, loaded_maxima]
+               do k = 1, reason_length
+                  reason_codes(k, i) = ichar(reason(k:k))
+               end do
+               cycle
+            end if
+         end if
+         computed_by_run(i) = 1
          t0 = MPI_Wtime()
          open (newunit=unit, file=override, status='replace', action='write')
          write (unit, '(a, es25.17e3, a)') '&'//variable_group//' '//variable_name//' = ', values(i), ' /'
@@ -377,6 +410,8 @@ contains
             call append_maxima(point_run, transient, maxima, counts(i))
          end if
          cost(i) = MPI_Wtime() - t0
+         call save_point(checkpoint_name(i), values(i), status(i), events(i), peak(i), exponent(i), &
+            & stick(i), cost(i), reason_text(reason_codes(:, i)), maxima(size(maxima) - counts(i) + 1:))
          if (rank == 0 .and. .not. opts%quiet) write (error_unit, '(a, i0, a, i0)') 'friction: sweep point ', &
             & i, ' of ', n
       end do
@@ -406,6 +441,10 @@ contains
       call sum_to_root_integer(status, n)
       call sum_to_root_integer(events, n)
       call sum_to_root_integer(owner, n)
+      call sum_to_root_integer(computed_by_run, n)
+      code = merge(1, 0, interrupted)
+      call MPI_Allreduce(MPI_IN_PLACE, code, 1, MPI_INTEGER, MPI_MAX, MPI_COMM_WORLD)
+      interrupted = code /= 0
       call sum_to_root_integer(reason_codes, reason_length * n)
 
       wall = MPI_Wtime() - t_start
@@ -438,14 +477,104 @@ contains
             call file%write_attribute_text('/sweep/status', 'meaning', '0 pending, 1 done, 2 failed')
             call file%write_attribute_text('/sweep/status', 'reason', reasons)
             call file%write_vector('/sweep/compute_time', cost, 's')
+            call file%write_integer_vector('/sweep/computed_by_this_run', computed_by_run)
+            call file%write_attribute_integer('/sweep', 'complete', int(merge(0, 1, interrupted), i8))
             call file%close(error)
          end if
       end if
       write (seconds, '(f12.2)') wall
-      call publish(temporary, itoa(n)//' sweep points, '//itoa(count(status == status_failed)) &
-         & //' failed, '//trim(adjustl(seconds))//' s on '//itoa(nranks) &
+      call publish(temporary, itoa(count(status /= 0))//' of '//itoa(n)//' sweep points done, ' &
+         & //itoa(count(status == status_failed))//' failed, '//itoa(sum(computed_by_run)) &
+         & //' computed in this run, '//trim(adjustl(seconds))//' s on '//itoa(nranks) &
          & //trim(merge(' rank ', ' ranks', nranks == 1)))
+      if (interrupted) then
+         if (rank == 0) write (error_unit, '(a)') 'friction: sweep interrupted; the file marks the points ' &
+            & //'not done as pending (status 0): run again with --resume to compute only those'
+         call finish(exit_interrupted)
+      end if
+      ! Complete: the checkpoints have served.
+      if (rank == 0) then
+         do i = 1, n
+            call remove_file(checkpoint_name(i))
+         end do
+      end if
+
    end subroutine run_sweep
+
+   !> A finished sweep point's results, written under a temporary name and
+   !> renamed, so a checkpoint is whole or absent.  Reals with 17
+   !> significant digits read back to the same double.
+   subroutine save_point(path, value, status, events, peak, exponent, stick, cost, reason, maxima)
+      character(len=*), intent(in) :: path, reason
+      real(wp), intent(in) :: value, peak, exponent, stick, cost, maxima(:)
+      integer, intent(in) :: status, events
+      type(error_type), allocatable :: save_error
+      integer :: unit, stat
+
+      open (newunit=unit, file=path//'.tmp', status='replace', action='write', iostat=stat)
+      if (stat /= 0) return   ! no checkpoint: the point is computed again on --resume
+      write (unit, '(es26.17e3)') value
+      write (unit, '(3(i0, 1x))') status, events, size(maxima)
+      write (unit, '(4es26.17e3)') peak, exponent, stick, cost
+      write (unit, '(a)') trim(reason)
+      if (size(maxima) > 0) write (unit, '(es26.17e3)') maxima
+      close (unit)
+      call rename_file(path//'.tmp', path, save_error)
+   end subroutine save_point
+
+   !> A sweep point's checkpoint, if there is a whole one for the same value.
+   subroutine load_point(path, value, status, events, peak, exponent, stick, cost, reason, maxima, loaded)
+      character(len=*), intent(in) :: path
+      real(wp), intent(in) :: value
+      integer, intent(inout) :: status, events
+      real(wp), intent(inout) :: peak, exponent, stick, cost
+      character(len=reason_length), intent(out) :: reason
+      real(wp), allocatable, intent(out) :: maxima(:)
+      logical, intent(out) :: loaded
+      real(wp) :: saved_value, numbers(4)
+      integer :: unit, stat, found(3)
+
+      loaded = .false.
+      reason = ''
+      if (.not. file_exists(path)) return
+      open (newunit=unit, file=path, status='old', action='read', iostat=stat)
+      if (stat /= 0) return
+      read (unit, *, iostat=stat) saved_value
+      if (stat == 0 .and. saved_value == value) then
+         read (unit, *, iostat=stat) found
+         if (stat == 0) read (unit, *, iostat=stat) numbers
+         if (stat == 0) read (unit, '(a)', iostat=stat) reason
+         if (stat == 0) then
+            allocate (maxima(max(0, found(3))))
+            if (found(3) > 0) read (unit, *, iostat=stat) maxima
+         end if
+         if (stat == 0) then
+            status = found(1)
+            events = found(2)
+            peak = numbers(1); exponent = numbers(2); stick = numbers(3); cost = numbers(4)
+            loaded = .true.
+         end if
+      end if
+      close (unit)
+   end subroutine load_point
+
+   function reason_text(codes) result(text)
+      integer, intent(in) :: codes(reason_length)
+      character(len=reason_length) :: text
+      integer :: j
+
+      do j = 1, reason_length
+         text(j:j) = achar(max(32, codes(j)))
+      end do
+   end function reason_text
+
+   !> Where a sweep point's checkpoint lives: beside the output.
+   function checkpoint_name(i) result(name)
+      integer, intent(in) :: i
+      character(len=:), allocatable :: name
+
+      name = opts%output//'.point-'//itoa(i)//'.ckpt'
+   end function checkpoint_name
 
    !> Local maxima of x after the transient, appended to `maxima`.
    subroutine append_maxima(run, transient, maxima, found)
@@ -660,6 +789,8 @@ contains
             opts%force = .true.
          case ('-q', '--quiet')
             opts%quiet = .true.
+         case ('--resume')
+            opts%resume = .true.
          case default
             if (arg(1:1) == '-') then
                code = usage_error('unknown option '//trim(arg))
@@ -698,10 +829,13 @@ contains
          & '                     in the current directory)', &
          & '  -f, --force        overwrite an existing output file', &
          & '  -q, --quiet        no progress or summary on stderr', &
+         & '      --resume       sweeps: reuse the points an interrupted run completed', &
+         & '                     (its checkpoints beside the output); overwrites the output', &
          & '  -h, --help         this help', &
          & '  -V, --version      the version', &
          & '', &
-         & 'exit codes: 0 done, 2 usage, 3 bad input, 4 integration failed, 5 output failed'
+         & 'exit codes: 0 done, 2 usage, 3 bad input, 4 integration failed, 5 output failed,', &
+         & '            6 sweep interrupted (file written with the points done; --resume)'
    end subroutine print_help
 
    !> The name the output is written under until it is complete: unique per

@@ -7,14 +7,16 @@ Cases: datasets-naf, datasets-hopg, ranks, override, force, numerical-failure,
 and bad-<name> for each bad input in BAD_INPUTS; for the brake scene
 brake-run, brake-ranks, brake-dimensional, brake-verify, brake-failure, brake-analysis and
 bad-brake-<name> for each bad input in BAD_BRAKE_INPUTS; for sweeps sweep-ranks,
-sweep-failure and bad-sweep-<name> for each bad input in BAD_SWEEP_INPUTS.  Each asserts on exit codes,
+sweep-failure, sweep-resume, sweep-signal and bad-sweep-<name> for each bad input in BAD_SWEEP_INPUTS.  Each asserts on exit codes,
 messages and file contents (read with h5py); none asserts on timings.
 """
 import argparse
 import os
 import shutil
+import signal
 import subprocess
 import sys
+import time
 
 import h5py
 import numpy as np
@@ -655,6 +657,69 @@ def case_sweep_failure(args):
         fail(f"the failed point's reason lacks max_wall_time: {reasons[1]!r}")
 
 
+def case_sweep_resume(args):
+    """A sweep stopped after 3 of 7 points (the sweep_stop_after hook) leaves a
+    valid file (3 done, 4 pending) and its checkpoints; --resume on another
+    number of ranks computes only the 4 missing points and writes what an
+    uninterrupted run writes, then removes the checkpoints."""
+    brake = os.path.join(args.inputs, "brake.nml")
+    small = write(args, "small.nml", SWEEP_SMALL)
+    stop = write(args, "stop.nml", "&sweep sweep_stop_after = 3 /\n")
+    friction(args, "-o", "full.h5", brake, small, ranks=1)
+    friction(args, "-o", "part.h5", brake, small, stop, ranks=2, expect=6)
+    partial, _ = sweep_results(os.path.join(args.workdir, "part.h5"))
+    if list(partial["status"]) != [1, 1, 1, 0, 0, 0, 0]:
+        fail(f"interrupted file status {partial['status']}, expected 3 done and 4 pending")
+    with h5py.File(os.path.join(args.workdir, "part.h5"), "r") as handle:
+        if handle["sweep"].attrs["complete"] != 0:
+            fail("the interrupted file does not say it is incomplete")
+    if len([f for f in leftovers(args) if f.endswith(".ckpt")]) != 3:
+        fail(f"expected 3 checkpoints, found {leftovers(args)}")
+    friction(args, "--resume", "-o", "part.h5", brake, small, ranks=3)
+    full, _ = sweep_results(os.path.join(args.workdir, "full.h5"))
+    resumed, _ = sweep_results(os.path.join(args.workdir, "part.h5"))
+    for key in SWEEP_PER_POINT:
+        if not np.array_equal(full[key], resumed[key]):
+            fail(f"/sweep/{key} differs after resume: {full[key]} vs {resumed[key]}")
+    with h5py.File(os.path.join(args.workdir, "part.h5"), "r") as handle:
+        computed = list(handle["sweep/computed_by_this_run"][()])
+        if computed != [0, 0, 0, 1, 1, 1, 1]:
+            fail(f"the resumed run computed {computed}, expected only the 4 missing points")
+        if handle["sweep"].attrs["complete"] != 1:
+            fail("the resumed file does not say it is complete")
+    if leftovers(args) != ["full.h5", "part.h5"]:
+        fail(f"checkpoints left after a complete sweep: {leftovers(args)}")
+
+
+def case_sweep_signal(args):
+    """SIGTERM part-way: exit code 6, a valid file with the points done and the
+    rest pending; --resume completes it."""
+    brake = os.path.join(args.inputs, "brake.nml")
+    small = write(args, "small.nml", SWEEP_SMALL)
+    longer = write(args, "long.nml", "&brake t_end = 1500.0 /\n&sweep sweep_count = 40 /\n")
+    process = subprocess.Popen([args.binary, "--quiet", "-o", "cut.h5", brake, small, longer], cwd=args.workdir,
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    # Signal once the first point is checkpointed (not after a fixed time: no timing assumptions).
+    first = os.path.join(args.workdir, "cut.h5.point-1.ckpt")
+    deadline = time.monotonic() + 120
+    while not os.path.exists(first) and process.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.02)
+    process.send_signal(signal.SIGTERM)
+    _, stderr = process.communicate(timeout=120)
+    if process.returncode != 6:
+        fail(f"interrupted sweep exited {process.returncode}, expected 6: {stderr}")
+    cut, _ = sweep_results(os.path.join(args.workdir, "cut.h5"))
+    done = int(np.sum(cut["status"] == 1))
+    if not 0 < done < 40 or np.any(cut["status"][done:] != 0):
+        fail(f"expected the first points done and the rest pending, status {cut['status']}")
+    friction(args, "--resume", "-o", "cut.h5", brake, small, longer)
+    with h5py.File(os.path.join(args.workdir, "cut.h5"), "r") as handle:
+        if not np.all(handle["sweep/status"][()] == 1):
+            fail("the resumed sweep is not complete")
+        if int(np.sum(handle["sweep/computed_by_this_run"][()])) != 40 - done:
+            fail(f"the resumed run recomputed finished points: {handle['sweep/computed_by_this_run'][()]}")
+
+
 def case_bad_sweep(args, name):
     text, words = BAD_SWEEP_INPUTS[name]
     cmd = [os.path.join(args.inputs, "brake.nml"), write(args, "bad.nml", text)]
@@ -697,7 +762,8 @@ def main():
     elif args.case.startswith("bad-sweep-"):
         case_bad_sweep(args, args.case[len("bad-sweep-"):])
     elif args.case.startswith("sweep-"):
-        {"sweep-ranks": case_sweep_ranks, "sweep-failure": case_sweep_failure}[args.case](args)
+        {"sweep-ranks": case_sweep_ranks, "sweep-failure": case_sweep_failure,
+         "sweep-resume": case_sweep_resume, "sweep-signal": case_sweep_signal}[args.case](args)
     elif args.case.startswith("bad-brake-"):
         case_bad_brake(args, args.case[len("bad-brake-"):])
     elif args.case.startswith("bad-"):

@@ -37,6 +37,7 @@ module friction_io_input
       character(len=8) :: spacing = 'list'     !! 'list', 'linear' or 'log'
       real(wp), allocatable :: values(:)       !! the points, in order
       character(len=8) :: schedule = 'dynamic' !! 'dynamic' (on demand) or 'static' (round-robin)
+      integer :: stop_after = 0                !! test hook: > 0 acts as an interruption after this point
    end type sweep_settings
 
    !> Everything a run needs from its input files.
@@ -100,7 +101,7 @@ contains
       character(len=64) :: sweep_variable
       character(len=8) :: sweep_spacing, sweep_schedule
       real(wp) :: sweep_values(max_sweep_values), sweep_from, sweep_to
-      integer :: sweep_count
+      integer :: sweep_count, sweep_stop_after
       integer :: welch_segments, rosenstein_stride, rosenstein_dimension, rosenstein_delay, &
          & rosenstein_theiler, rosenstein_horizon, rosenstein_fit_start, rosenstein_fit_end
 
@@ -121,7 +122,7 @@ contains
          & rosenstein, rosenstein_stride, rosenstein_dimension, rosenstein_delay, rosenstein_theiler, &
          & rosenstein_horizon, rosenstein_fit_start, rosenstein_fit_end
       namelist /sweep/ sweep_variable, sweep_values, sweep_from, sweep_to, sweep_count, sweep_spacing, &
-         & sweep_schedule
+         & sweep_schedule, sweep_stop_after
 
       type(mention), allocatable :: mentions(:), all_mentions(:)
       character(len=4096), allocatable :: source(:)
@@ -299,6 +300,7 @@ contains
          end associate
          sweep_variable = ''; sweep_spacing = 'list'; sweep_schedule = 'dynamic'
          sweep_values = huge(1.0_wp); sweep_from = 0.0_wp; sweep_to = 0.0_wp; sweep_count = 0
+         sweep_stop_after = 0
       end subroutine from_config
 
       subroutine to_config()
@@ -371,6 +373,7 @@ contains
          config%sweep%variable = sweep_variable
          config%sweep%spacing = sweep_spacing
          config%sweep%schedule = sweep_schedule
+         config%sweep%stop_after = sweep_stop_after
       end subroutine to_config
 
       !> A relative net_file is relative to the namelist file that names it,
@@ -576,6 +579,8 @@ contains
             & "sweeps run the brake scene only for now (&job scene = 'brake')")
          if (sweep_schedule /= 'dynamic' .and. sweep_schedule /= 'static') call reject('sweep', &
             & 'sweep_schedule', "'"//trim(sweep_schedule)//"'", "unknown schedule (known: 'dynamic', 'static')")
+         if (sweep_stop_after < 0) call reject('sweep', 'sweep_stop_after', itoa(sweep_stop_after), &
+            & 'must be >= 0 (0: never; a test hook)')
          select case (trim(sweep_spacing))
          case ('list')
             n = 0
