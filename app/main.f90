@@ -461,7 +461,7 @@ contains
          end do
          call file%create(temporary, MPI_COMM_SELF, error)
          if (.not. allocated(error)) then
-            call write_run_attributes(file, 'brake_sweep', trim(config%brake%solver%method), summary)
+            call write_run_attributes(file, 'sweep', trim(config%brake%solver%method), summary)
             call file%write_attribute_text('/', 'sweep_variable', trim(config%sweep%variable))
             call file%write_attribute_text('/', 'sweep_schedule', trim(config%sweep%schedule))
             call file%create_group('/sweep')
