@@ -318,6 +318,8 @@ contains
       real(wp) :: wall, transient, t0
       character(len=12) :: seconds
       logical :: dynamic, interrupted, loaded
+      integer :: block_first, block_last
+      integer, allocatable :: memory(:)
       real(wp), allocatable :: loaded_maxima(:)
       integer, allocatable :: computed_by_run(:)
 
@@ -339,6 +341,8 @@ contains
       ! (One rank needs no counter; Open MPI may have no one-sided component for it.)
       dynamic = config%sweep%schedule == 'dynamic' .and. nranks > 1
       if (dynamic) call MPI_Win_create(counter, window_size, 4, MPI_INFO_NULL, MPI_COMM_WORLD, window)
+      block_first = int(int(n, i8) * rank / nranks)
+      block_last = int(int(n, i8) * (rank + 1) / nranks)
       computed = 0
       interrupted = .false.
       call friction_catch_signals()
@@ -349,7 +353,10 @@ contains
             exit
          end if
          if (.not. dynamic) then
-            next = computed * nranks + rank
+            ! The naive static split, for the benchmark: contiguous blocks of
+            ! points, so a run of expensive neighbours lands on one rank.
+            next = block_first + computed
+            if (next >= block_last) next = n
          else
             call MPI_Win_lock(MPI_LOCK_EXCLUSIVE, 0, 0, window)
             call MPI_Fetch_and_op(one, fetched, MPI_INTEGER, 0, 0_MPI_ADDRESS_KIND, MPI_SUM, window)
@@ -447,6 +454,9 @@ contains
       interrupted = code /= 0
       call sum_to_root_integer(reason_codes, reason_length * n)
 
+      ! Peak resident memory of every rank, for the benchmark (README: Parameter sweeps).
+      allocate (memory(nranks))
+      call MPI_Gather(peak_memory_kb(), 1, MPI_INTEGER, memory, 1, MPI_INTEGER, 0, MPI_COMM_WORLD)
       wall = MPI_Wtime() - t_start
       call MPI_Allreduce(MPI_IN_PLACE, wall, 1, MPI_DOUBLE_PRECISION, MPI_MAX, MPI_COMM_WORLD)
       summary = run_summary(input_text, version_string, nranks, wall, integrator_statistics(0, 0, 0, 0))
@@ -478,6 +488,8 @@ contains
             call file%write_attribute_text('/sweep/status', 'reason', reasons)
             call file%write_vector('/sweep/compute_time', cost, 's')
             call file%write_integer_vector('/sweep/computed_by_this_run', computed_by_run)
+            call file%write_integer_vector('/sweep/peak_memory_per_rank', memory)
+            call file%write_attribute_text('/sweep/peak_memory_per_rank', 'units', 'kB (VmHWM; 0: unknown)')
             call file%write_attribute_integer('/sweep', 'complete', int(merge(0, 1, interrupted), i8))
             call file%close(error)
          end if
@@ -567,6 +579,27 @@ contains
          text(j:j) = achar(max(32, codes(j)))
       end do
    end function reason_text
+
+   !> This process's peak resident set (VmHWM of /proc/self/status) in kB;
+   !> 0 where there is no such file.
+   integer function peak_memory_kb() result(kb)
+      integer :: unit, stat
+      character(len=256) :: line
+
+      kb = 0
+      open (newunit=unit, file='/proc/self/status', status='old', action='read', iostat=stat)
+      if (stat /= 0) return
+      do
+         read (unit, '(a)', iostat=stat) line
+         if (stat /= 0) exit
+         if (line(1:6) == 'VmHWM:') then
+            read (line(7:), *, iostat=stat) kb
+            if (stat /= 0) kb = 0
+            exit
+         end if
+      end do
+      close (unit)
+   end function peak_memory_kb
 
    !> Where a sweep point's checkpoint lives: beside the output.
    function checkpoint_name(i) result(name)
