@@ -7,7 +7,7 @@
 !> round-robin to the MPI ranks; the file is written collectively under a
 !> temporary name and renamed when complete.
 program friction_main
-   use, intrinsic :: iso_c_binding, only: c_int
+   use, intrinsic :: iso_c_binding, only: c_int, c_ptr, c_f_pointer
    use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
    use mpi_f08
    use friction_kinds, only: wp, i8
@@ -309,7 +309,9 @@ contains
       integer, allocatable :: status(:), events(:), counts(:), offsets(:), reason_codes(:, :), owner(:)
       integer :: n, i, k, next, unit, dot, total, computed
       integer(kind=MPI_ADDRESS_KIND) :: window_size
-      integer :: counter(1), one(1), fetched(1)
+      integer :: one(1), fetched(1)
+      type(c_ptr) :: counter_base
+      integer, pointer :: counter_value
       type(MPI_Win) :: window
       type(h5_file) :: file
       character(len=reason_length) :: reason
@@ -335,12 +337,25 @@ contains
       override = opts%output//'.override-'//itoa(rank)//'-'//itoa(friction_process_id())//'.nml'
       point_files = [opts%files, [character(len=4096) :: override]]
 
-      counter = 0
       one = 1
       window_size = merge(4, 0, rank == 0)
       ! (One rank needs no counter; Open MPI may have no one-sided component for it.)
       dynamic = config%sweep%schedule == 'dynamic' .and. nranks > 1
-      if (dynamic) call MPI_Win_create(counter, window_size, 4, MPI_INFO_NULL, MPI_COMM_WORLD, window)
+      ! MPI_Win_allocate (not MPI_Win_create on a Fortran variable) lets Open MPI
+      ! pick its shared-memory one-sided component on a node: the fetch is an
+      ! atomic in memory and needs no progress from rank 0, which is busy
+      ! computing.  (Measured: with MPI_Win_create a fetch waited for rank 0 to
+      ! finish its point, and the dynamic schedule lost to the static one.)
+      if (dynamic) then
+         call MPI_Win_allocate(window_size, 4, MPI_INFO_NULL, MPI_COMM_WORLD, counter_base, window)
+         if (rank == 0) then
+            call MPI_Win_lock(MPI_LOCK_EXCLUSIVE, 0, 0, window)
+            call c_f_pointer(counter_base, counter_value)
+            counter_value = 0
+            call MPI_Win_unlock(0, window)
+         end if
+         call MPI_Barrier(MPI_COMM_WORLD)
+      end if
       block_first = int(int(n, i8) * rank / nranks)
       block_last = int(int(n, i8) * (rank + 1) / nranks)
       computed = 0
