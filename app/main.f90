@@ -434,8 +434,8 @@ contains
          cost(i) = MPI_Wtime() - t0
          call save_point(checkpoint_name(i), values(i), status(i), events(i), peak(i), exponent(i), &
             & stick(i), cost(i), reason_text(reason_codes(:, i)), maxima(size(maxima) - counts(i) + 1:))
-         if (rank == 0 .and. .not. opts%quiet) write (error_unit, '(a, i0, a, i0)') 'friction: sweep point ', &
-            & i, ' of ', n
+         if (rank == 0 .and. .not. opts%quiet) write (error_unit, '(a, i0, a, i0, a)') 'friction: sweep: rank 0 ' &
+            & //'finished point ', i, ' of ', n, ' (points are taken in order)'
       end do
       if (dynamic) call MPI_Win_free(window)
       call remove_file(override)
@@ -624,23 +624,23 @@ contains
       name = opts%output//'.point-'//itoa(i)//'.ckpt'
    end function checkpoint_name
 
-   !> Local maxima of x after the transient, appended to `maxima`.
+   !> Local maxima of x after the transient, appended to `maxima` (once per
+   !> point: appending value by value would copy the array for every maximum).
    subroutine append_maxima(run, transient, maxima, found)
       type(brake_run), intent(in) :: run
       real(wp), intent(in) :: transient
       real(wp), allocatable, intent(inout) :: maxima(:)
       integer, intent(out) :: found
+      logical, allocatable :: peak(:)
       integer :: j
 
-      found = 0
+      allocate (peak(run%n), source=.false.)
       associate (t => run%trajectory%t, x => run%trajectory%x)
          do j = 2, run%n - 1
-            if (t(j) < transient) cycle
-            if (x(j) > x(j - 1) .and. x(j) >= x(j + 1)) then
-               maxima = [maxima, x(j)]
-               found = found + 1
-            end if
+            peak(j) = t(j) >= transient .and. x(j) > x(j - 1) .and. x(j) >= x(j + 1)
          end do
+         found = count(peak)
+         maxima = [maxima, pack(x(1:run%n), peak)]
       end associate
    end subroutine append_maxima
 
@@ -867,6 +867,8 @@ contains
          & 'scan lines shared among MPI ranks, results in one HDF5 file.', &
          & 'With &job scene = ''brake'': the stick-slip of a Girling brake (one', &
          & 'trajectory; inputs/brake.nml; groups &brake &brake_dimensional &verify &analysis).', &
+         & 'With a &sweep group: a brake parameter sweep over the MPI ranks (inputs/brake_sweep.nml;', &
+         & 'README: Parameter sweeps).', &
          & '', &
          & 'Input files are namelist files read in order; a later file overrides', &
          & 'earlier values variable by variable.  Groups: &job &surface &tip &scan', &
