@@ -7,7 +7,7 @@
 !> round-robin to the MPI ranks; the file is written collectively under a
 !> temporary name and renamed when complete.
 program friction_main
-   use, intrinsic :: iso_c_binding, only: c_int
+   use, intrinsic :: iso_c_binding, only: c_int, c_ptr, c_f_pointer
    use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
    use mpi_f08
    use friction_kinds, only: wp, i8
@@ -15,6 +15,8 @@ program friction_main
    use friction_version, only: version_string
    use friction_strings, only: itoa
    use friction_io_input, only: job_config, read_input
+   use friction_io_h5_file, only: h5_file
+   use friction_io_run_summary, only: write_run_attributes
    use friction_io_files, only: file_exists, rename_file, remove_file
    use friction_ode_solver, only: integrator_statistics
    use friction_afm_scan, only: afm_scanner, trip_record, share_of, n_quantities
@@ -37,6 +39,12 @@ program friction_main
          import :: c_int
          integer(c_int) :: pid
       end function friction_process_id
+      subroutine friction_catch_signals() bind(c)
+      end subroutine friction_catch_signals
+      function friction_interrupted() result(yes) bind(c)
+         import :: c_int
+         integer(c_int) :: yes
+      end function friction_interrupted
       !> The C library's exit: a status code without the runtime's backtrace.
       subroutine c_exit(status) bind(c, name='exit')
          import :: c_int
@@ -44,12 +52,14 @@ program friction_main
       end subroutine c_exit
    end interface
 
-   integer, parameter :: exit_usage = 2, exit_input = 3, exit_numerical = 4, exit_io = 5
+   integer, parameter :: reason_length = 240   !! characters of a failed sweep point's reason
+   integer, parameter :: exit_usage = 2, exit_input = 3, exit_numerical = 4, exit_io = 5, exit_interrupted = 6
 
    type :: options
       character(len=:), allocatable :: output
       logical :: force = .false.
       logical :: quiet = .false.
+      logical :: resume = .false.
       character(len=4096), allocatable :: files(:)
    end type options
 
@@ -71,7 +81,7 @@ program friction_main
    call read_input(opts%files, config, input_text, error)
    if (allocated(error)) call fail(error)
    if (.not. allocated(opts%output)) opts%output = default_output(opts%files(1))
-   if (file_exists(opts%output) .and. .not. opts%force) then
+   if (file_exists(opts%output) .and. .not. (opts%force .or. (opts%resume .and. config%sweep%enabled))) then
       call fatal_error(error, opts%output//': the output file exists; use --force to overwrite it', &
          & error_input)
       call fail(error)
@@ -85,7 +95,9 @@ program friction_main
       call finish(exit_io)
    end if
 
-   if (config%scene == 'brake') then
+   if (config%sweep%enabled) then
+      call run_sweep()
+   else if (config%scene == 'brake') then
       call run_brake()
    else
       call run_afm()
@@ -269,6 +281,392 @@ contains
          & //itoa(nranks)//trim(merge(' rank ', ' ranks', nranks == 1)))
    end subroutine run_brake
 
+   !> A parameter sweep of the brake (README: Parameter sweeps).  Each point
+   !> is the scene re-read from the input files plus a one-line override file,
+   !> so read_input validates it; an invalid or failing point is recorded as
+   !> failed with its reason and the sweep goes on.
+   !>
+   !> Load balancing: with sweep_schedule = 'dynamic' every rank takes the next
+   !> point from a counter on rank 0 with MPI_Fetch_and_op (passive target).
+   !> This is simpler than a master that serves requests between its own points
+   !> (no polling, rank 0 computes like the others) and hands out points on
+   !> demand, so a chaotic, long point does not hold up a whole static share.
+   !> Each point is computed alone and deterministically: the results do not
+   !> depend on which rank took it or on the number of ranks.
+   !>
+   !> Output: one rank-0 writer after reductions.  A point's results are a few
+   !> numbers and a few hundred maxima (kB), so the gathered data are small and
+   !> parallel HDF5's collective metadata would buy nothing.
+   subroutine run_sweep()
+      integer, parameter :: status_done = 1, status_failed = 2
+      type(job_config) :: point_config
+      type(brake_run), target :: point_run
+      type(brake_diagnostics) :: diagnostics
+      type(error_type), allocatable :: point_error
+      character(len=:), allocatable :: point_text, override, temporary, variable_group, variable_name
+      character(len=4096), allocatable :: point_files(:)
+      real(wp), allocatable :: values(:), peak(:), exponent(:), stick(:), cost(:), maxima(:), flat(:)
+      integer, allocatable :: status(:), events(:), counts(:), offsets(:), reason_codes(:, :), owner(:)
+      integer :: n, i, k, next, unit, dot, total, computed
+      integer(kind=MPI_ADDRESS_KIND) :: window_size
+      integer :: one(1), fetched(1)
+      type(c_ptr) :: counter_base
+      integer, pointer :: counter_value
+      type(MPI_Win) :: window
+      type(h5_file) :: file
+      character(len=reason_length) :: reason
+      character(len=:), allocatable :: reasons
+      type(run_summary) :: summary
+      real(wp) :: wall, transient, t0
+      character(len=12) :: seconds
+      logical :: dynamic, interrupted, loaded
+      integer :: block_first, block_last
+      integer, allocatable :: memory(:)
+      real(wp), allocatable :: loaded_maxima(:)
+      integer, allocatable :: computed_by_run(:)
+
+      values = config%sweep%values
+      n = size(values)
+      allocate (peak(n), exponent(n), stick(n), cost(n), source=0.0_wp)
+      allocate (status(n), events(n), counts(n), owner(n), computed_by_run(n), source=0)
+      allocate (reason_codes(reason_length, n), source=0)
+      allocate (maxima(0))
+      dot = index(config%sweep%variable, '.')
+      variable_group = trim(config%sweep%variable(1:dot - 1))
+      variable_name = trim(config%sweep%variable(dot + 1:))
+      override = opts%output//'.override-'//itoa(rank)//'-'//itoa(friction_process_id())//'.nml'
+      point_files = [opts%files, [character(len=4096) :: override]]
+
+      one = 1
+      window_size = merge(4, 0, rank == 0)
+      ! (One rank needs no counter; Open MPI may have no one-sided component for it.)
+      dynamic = config%sweep%schedule == 'dynamic' .and. nranks > 1
+      ! MPI_Win_allocate (not MPI_Win_create on a Fortran variable) lets Open MPI
+      ! pick its shared-memory one-sided component on a node: the fetch is an
+      ! atomic in memory and needs no progress from rank 0, which is busy
+      ! computing.  (Measured: with MPI_Win_create a fetch waited for rank 0 to
+      ! finish its point, and the dynamic schedule lost to the static one.)
+      if (dynamic) then
+         call MPI_Win_allocate(window_size, 4, MPI_INFO_NULL, MPI_COMM_WORLD, counter_base, window)
+         if (rank == 0) then
+            call MPI_Win_lock(MPI_LOCK_EXCLUSIVE, 0, 0, window)
+            call c_f_pointer(counter_base, counter_value)
+            counter_value = 0
+            call MPI_Win_unlock(0, window)
+         end if
+         call MPI_Barrier(MPI_COMM_WORLD)
+      end if
+      block_first = int(int(n, i8) * rank / nranks)
+      block_last = int(int(n, i8) * (rank + 1) / nranks)
+      computed = 0
+      interrupted = .false.
+      call friction_catch_signals()
+      do
+         ! Between points: a signal stops the sweep here, the point in hand done.
+         if (friction_interrupted() /= 0) then
+            interrupted = .true.
+            exit
+         end if
+         if (.not. dynamic) then
+            ! The naive static split, for the benchmark: contiguous blocks of
+            ! points, so a run of expensive neighbours lands on one rank.
+            next = block_first + computed
+            if (next >= block_last) next = n
+         else
+            call MPI_Win_lock(MPI_LOCK_EXCLUSIVE, 0, 0, window)
+            call MPI_Fetch_and_op(one, fetched, MPI_INTEGER, 0, 0_MPI_ADDRESS_KIND, MPI_SUM, window)
+            call MPI_Win_unlock(0, window)
+            next = fetched(1)
+         end if
+         i = next + 1
+         if (i > n) exit
+         if (config%sweep%stop_after > 0 .and. i > config%sweep%stop_after) then
+            interrupted = .true.   ! the test hook: as if a signal came after that point
+            exit
+         end if
+         computed = computed + 1
+         owner(i) = rank + 1
+         if (opts%resume) then
+            call load_point(checkpoint_name(i), values(i), status(i), events(i), peak(i), exponent(i), &
+               & stick(i), cost(i), reason, loaded_maxima, loaded)
+            if (loaded) then
+               counts(i) = size(loaded_maxima)
+               maxima = [maxima, loaded_maxima]
+               do k = 1, reason_length
+                  reason_codes(k, i) = ichar(reason(k:k))
+               end do
+               cycle
+            end if
+         end if
+         computed_by_run(i) = 1
+         t0 = MPI_Wtime()
+         open (newunit=unit, file=override, status='replace', action='write')
+         write (unit, '(a, es25.17e3, a)') '&'//variable_group//' '//variable_name//' = ', values(i), ' /'
+         close (unit)
+         call read_input(point_files, point_config, point_text, point_error)
+         if (.not. allocated(point_error)) call integrate_brake(point_run, point_config%brake, .false., &
+            & point_error)
+         if (.not. allocated(point_error)) then
+            associate (a => point_config%brake%analysis)
+               if (a%spectrum .or. a%lyapunov) then
+                  call diagnose_brake(point_config%brake, point_run%trajectory, point_run%events, &
+                     & diagnostics, point_error)
+                  if (.not. allocated(point_error)) then
+                     if (a%spectrum) peak(i) = diagnostics%spectrum%peak_frequency
+                     if (a%lyapunov) exponent(i) = diagnostics%flow%current()
+                  end if
+               end if
+               transient = a%window_start
+            end associate
+         end if
+         if (allocated(point_error)) then
+            status(i) = status_failed
+            reason = point_error%message
+            do k = 1, reason_length
+               reason_codes(k, i) = ichar(reason(k:k))
+            end do
+         else
+            status(i) = status_done
+            events(i) = point_run%events%n
+            stick(i) = point_run%stick_time() / (point_config%brake%t_end - point_config%brake%t_start)
+            call append_maxima(point_run, transient, maxima, counts(i))
+         end if
+         cost(i) = MPI_Wtime() - t0
+         call save_point(checkpoint_name(i), values(i), status(i), events(i), peak(i), exponent(i), &
+            & stick(i), cost(i), reason_text(reason_codes(:, i)), maxima(size(maxima) - counts(i) + 1:))
+         if (rank == 0 .and. .not. opts%quiet) write (error_unit, '(a, i0, a, i0, a)') 'friction: sweep: rank 0 ' &
+            & //'finished point ', i, ' of ', n, ' (points are taken in order)'
+      end do
+      if (dynamic) call MPI_Win_free(window)
+      call remove_file(override)
+
+      ! Each point has exactly one owner; the others hold zeros, so a sum gathers it exactly.
+      call MPI_Allreduce(MPI_IN_PLACE, counts, n, MPI_INTEGER, MPI_SUM, MPI_COMM_WORLD)
+      allocate (offsets(n))
+      total = 0
+      do i = 1, n
+         offsets(i) = total
+         total = total + counts(i)
+      end do
+      allocate (flat(total), source=0.0_wp)
+      k = 0
+      do i = 1, n
+         if (owner(i) == 0) cycle
+         flat(offsets(i) + 1:offsets(i) + counts(i)) = maxima(k + 1:k + counts(i))
+         k = k + counts(i)
+      end do
+      call sum_to_root_real(flat)
+      call sum_to_root_real(peak)
+      call sum_to_root_real(exponent)
+      call sum_to_root_real(stick)
+      call sum_to_root_real(cost)
+      call sum_to_root_integer(status, n)
+      call sum_to_root_integer(events, n)
+      call sum_to_root_integer(owner, n)
+      call sum_to_root_integer(computed_by_run, n)
+      code = merge(1, 0, interrupted)
+      call MPI_Allreduce(MPI_IN_PLACE, code, 1, MPI_INTEGER, MPI_MAX, MPI_COMM_WORLD)
+      interrupted = code /= 0
+      call sum_to_root_integer(reason_codes, reason_length * n)
+
+      ! Peak resident memory of every rank, for the benchmark (README: Parameter sweeps).
+      allocate (memory(nranks))
+      call MPI_Gather(peak_memory_kb(), 1, MPI_INTEGER, memory, 1, MPI_INTEGER, 0, MPI_COMM_WORLD)
+      wall = MPI_Wtime() - t_start
+      call MPI_Allreduce(MPI_IN_PLACE, wall, 1, MPI_DOUBLE_PRECISION, MPI_MAX, MPI_COMM_WORLD)
+      summary = run_summary(input_text, version_string, nranks, wall, integrator_statistics(0, 0, 0, 0))
+      temporary = temporary_name()
+      if (rank == 0) then
+         reasons = ''
+         do i = 1, n
+            do k = 1, reason_length
+               reason(k:k) = achar(max(32, reason_codes(k, i)))
+            end do
+            reasons = reasons//trim(reason)//new_line('a')
+         end do
+         call file%create(temporary, MPI_COMM_SELF, error)
+         if (.not. allocated(error)) then
+            call write_run_attributes(file, 'sweep', trim(config%brake%solver%method), summary)
+            call file%write_attribute_text('/', 'sweep_variable', trim(config%sweep%variable))
+            call file%write_attribute_text('/', 'sweep_schedule', trim(config%sweep%schedule))
+            call file%create_group('/sweep')
+            call file%write_vector('/sweep/values', values, trim(config%sweep%variable))
+            call file%write_vector('/sweep/maxima', flat, 'm')
+            call file%write_integer_vector('/sweep/maxima_offset', offsets)
+            call file%write_integer_vector('/sweep/maxima_count', counts)
+            call file%write_vector('/sweep/peak_frequency', peak, '1/tau')
+            call file%write_vector('/sweep/lyapunov', exponent, '1/tau')
+            call file%write_vector('/sweep/stick_fraction', stick, '1')
+            call file%write_integer_vector('/sweep/events', events)
+            call file%write_integer_vector('/sweep/status', status)
+            call file%write_attribute_text('/sweep/status', 'meaning', '0 pending, 1 done, 2 failed')
+            call file%write_attribute_text('/sweep/status', 'reason', reasons)
+            call file%write_vector('/sweep/compute_time', cost, 's')
+            call file%write_integer_vector('/sweep/computed_by_this_run', computed_by_run)
+            call file%write_integer_vector('/sweep/peak_memory_per_rank', memory)
+            call file%write_attribute_text('/sweep/peak_memory_per_rank', 'units', 'kB (VmHWM; 0: unknown)')
+            call file%write_attribute_integer('/sweep', 'complete', int(merge(0, 1, interrupted), i8))
+            call file%close(error)
+         end if
+      end if
+      write (seconds, '(f12.2)') wall
+      call publish(temporary, itoa(count(status /= 0))//' of '//itoa(n)//' sweep points done, ' &
+         & //itoa(count(status == status_failed))//' failed, '//itoa(sum(computed_by_run)) &
+         & //' computed in this run, '//trim(adjustl(seconds))//' s on '//itoa(nranks) &
+         & //trim(merge(' rank ', ' ranks', nranks == 1)))
+      if (interrupted) then
+         if (rank == 0) write (error_unit, '(a)') 'friction: sweep interrupted; the file marks the points ' &
+            & //'not done as pending (status 0): run again with --resume to compute only those'
+         call finish(exit_interrupted)
+      end if
+      ! Complete: the checkpoints have served.
+      if (rank == 0) then
+         do i = 1, n
+            call remove_file(checkpoint_name(i))
+         end do
+      end if
+
+   end subroutine run_sweep
+
+   !> A finished sweep point's results, written under a temporary name and
+   !> renamed, so a checkpoint is whole or absent.  Reals with 17
+   !> significant digits read back to the same double.
+   subroutine save_point(path, value, status, events, peak, exponent, stick, cost, reason, maxima)
+      character(len=*), intent(in) :: path, reason
+      real(wp), intent(in) :: value, peak, exponent, stick, cost, maxima(:)
+      integer, intent(in) :: status, events
+      type(error_type), allocatable :: save_error
+      integer :: unit, stat
+
+      open (newunit=unit, file=path//'.tmp', status='replace', action='write', iostat=stat)
+      if (stat /= 0) return   ! no checkpoint: the point is computed again on --resume
+      write (unit, '(es26.17e3)') value
+      write (unit, '(3(i0, 1x))') status, events, size(maxima)
+      write (unit, '(4es26.17e3)') peak, exponent, stick, cost
+      write (unit, '(a)') trim(reason)
+      if (size(maxima) > 0) write (unit, '(es26.17e3)') maxima
+      close (unit)
+      call rename_file(path//'.tmp', path, save_error)
+   end subroutine save_point
+
+   !> A sweep point's checkpoint, if there is a whole one for the same value.
+   subroutine load_point(path, value, status, events, peak, exponent, stick, cost, reason, maxima, loaded)
+      character(len=*), intent(in) :: path
+      real(wp), intent(in) :: value
+      integer, intent(inout) :: status, events
+      real(wp), intent(inout) :: peak, exponent, stick, cost
+      character(len=reason_length), intent(out) :: reason
+      real(wp), allocatable, intent(out) :: maxima(:)
+      logical, intent(out) :: loaded
+      real(wp) :: saved_value, numbers(4)
+      integer :: unit, stat, found(3)
+
+      loaded = .false.
+      reason = ''
+      if (.not. file_exists(path)) return
+      open (newunit=unit, file=path, status='old', action='read', iostat=stat)
+      if (stat /= 0) return
+      read (unit, *, iostat=stat) saved_value
+      if (stat == 0 .and. saved_value == value) then
+         read (unit, *, iostat=stat) found
+         if (stat == 0) read (unit, *, iostat=stat) numbers
+         if (stat == 0) read (unit, '(a)', iostat=stat) reason
+         if (stat == 0) then
+            allocate (maxima(max(0, found(3))))
+            if (found(3) > 0) read (unit, *, iostat=stat) maxima
+         end if
+         if (stat == 0) then
+            status = found(1)
+            events = found(2)
+            peak = numbers(1); exponent = numbers(2); stick = numbers(3); cost = numbers(4)
+            loaded = .true.
+         end if
+      end if
+      close (unit)
+   end subroutine load_point
+
+   function reason_text(codes) result(text)
+      integer, intent(in) :: codes(reason_length)
+      character(len=reason_length) :: text
+      integer :: j
+
+      do j = 1, reason_length
+         text(j:j) = achar(max(32, codes(j)))
+      end do
+   end function reason_text
+
+   !> This process's peak resident set (VmHWM of /proc/self/status) in kB;
+   !> 0 where there is no such file.
+   integer function peak_memory_kb() result(kb)
+      integer :: unit, stat
+      character(len=256) :: line
+
+      kb = 0
+      open (newunit=unit, file='/proc/self/status', status='old', action='read', iostat=stat)
+      if (stat /= 0) return
+      do
+         read (unit, '(a)', iostat=stat) line
+         if (stat /= 0) exit
+         if (line(1:6) == 'VmHWM:') then
+            read (line(7:), *, iostat=stat) kb
+            if (stat /= 0) kb = 0
+            exit
+         end if
+      end do
+      close (unit)
+   end function peak_memory_kb
+
+   !> Where a sweep point's checkpoint lives: beside the output.
+   function checkpoint_name(i) result(name)
+      integer, intent(in) :: i
+      character(len=:), allocatable :: name
+
+      name = opts%output//'.point-'//itoa(i)//'.ckpt'
+   end function checkpoint_name
+
+   !> Local maxima of x after the transient, appended to `maxima` (once per
+   !> point: appending value by value would copy the array for every maximum).
+   subroutine append_maxima(run, transient, maxima, found)
+      type(brake_run), intent(in) :: run
+      real(wp), intent(in) :: transient
+      real(wp), allocatable, intent(inout) :: maxima(:)
+      integer, intent(out) :: found
+      logical, allocatable :: peak(:)
+      integer :: j
+
+      allocate (peak(run%n), source=.false.)
+      associate (t => run%trajectory%t, x => run%trajectory%x)
+         do j = 2, run%n - 1
+            peak(j) = t(j) >= transient .and. x(j) > x(j - 1) .and. x(j) >= x(j + 1)
+         end do
+         found = count(peak)
+         maxima = [maxima, pack(x(1:run%n), peak)]
+      end associate
+   end subroutine append_maxima
+
+   !> Sum a real array onto rank 0 (each entry has one non-zero contributor).
+   subroutine sum_to_root_real(values)
+      real(wp), intent(inout) :: values(:)
+
+      if (rank == 0) then
+         call MPI_Reduce(MPI_IN_PLACE, values, size(values), MPI_DOUBLE_PRECISION, MPI_SUM, 0, MPI_COMM_WORLD)
+      else
+         call MPI_Reduce(values, values, size(values), MPI_DOUBLE_PRECISION, MPI_SUM, 0, MPI_COMM_WORLD)
+      end if
+   end subroutine sum_to_root_real
+
+   !> Sum an integer array of `count` entries onto rank 0.
+   subroutine sum_to_root_integer(values, count)
+      integer, intent(inout) :: values(*)
+      integer, intent(in) :: count
+
+      if (rank == 0) then
+         call MPI_Reduce(MPI_IN_PLACE, values, count, MPI_INTEGER, MPI_SUM, 0, MPI_COMM_WORLD)
+      else
+         call MPI_Reduce(values, values, count, MPI_INTEGER, MPI_SUM, 0, MPI_COMM_WORLD)
+      end if
+   end subroutine sum_to_root_integer
+
    !> One brake run, in pieces so that long runs can show progress.
    subroutine integrate_brake(run, settings, show, error)
       type(brake_run), target, intent(inout) :: run
@@ -439,6 +837,8 @@ contains
             opts%force = .true.
          case ('-q', '--quiet')
             opts%quiet = .true.
+         case ('--resume')
+            opts%resume = .true.
          case default
             if (arg(1:1) == '-') then
                code = usage_error('unknown option '//trim(arg))
@@ -467,6 +867,8 @@ contains
          & 'scan lines shared among MPI ranks, results in one HDF5 file.', &
          & 'With &job scene = ''brake'': the stick-slip of a Girling brake (one', &
          & 'trajectory; inputs/brake.nml; groups &brake &brake_dimensional &verify &analysis).', &
+         & 'With a &sweep group: a brake parameter sweep over the MPI ranks (inputs/brake_sweep.nml;', &
+         & 'README: Parameter sweeps).', &
          & '', &
          & 'Input files are namelist files read in order; a later file overrides', &
          & 'earlier values variable by variable.  Groups: &job &surface &tip &scan', &
@@ -477,10 +879,13 @@ contains
          & '                     in the current directory)', &
          & '  -f, --force        overwrite an existing output file', &
          & '  -q, --quiet        no progress or summary on stderr', &
+         & '      --resume       sweeps: reuse the points an interrupted run completed', &
+         & '                     (its checkpoints beside the output); overwrites the output', &
          & '  -h, --help         this help', &
          & '  -V, --version      the version', &
          & '', &
-         & 'exit codes: 0 done, 2 usage, 3 bad input, 4 integration failed, 5 output failed'
+         & 'exit codes: 0 done, 2 usage, 3 bad input, 4 integration failed, 5 output failed,', &
+         & '            6 sweep interrupted (file written with the points done; --resume)'
    end subroutine print_help
 
    !> The name the output is written under until it is complete: unique per

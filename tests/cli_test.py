@@ -6,14 +6,17 @@
 Cases: datasets-naf, datasets-hopg, ranks, override, force, numerical-failure,
 and bad-<name> for each bad input in BAD_INPUTS; for the brake scene
 brake-run, brake-ranks, brake-dimensional, brake-verify, brake-failure, brake-analysis and
-bad-brake-<name> for each bad input in BAD_BRAKE_INPUTS.  Each asserts on exit codes,
+bad-brake-<name> for each bad input in BAD_BRAKE_INPUTS; for sweeps sweep-ranks,
+sweep-failure, sweep-resume, sweep-signal and bad-sweep-<name> for each bad input in BAD_SWEEP_INPUTS.  Each asserts on exit codes,
 messages and file contents (read with h5py); none asserts on timings.
 """
 import argparse
 import os
 import shutil
+import signal
 import subprocess
 import sys
+import time
 
 import h5py
 import numpy as np
@@ -559,6 +562,175 @@ def case_brake_failure(args):
         fail(f"a failed run left files: {leftovers(args)}")
 
 
+# A small sweep of the belt velocity (README: Parameter sweeps).
+SWEEP_SMALL = ("&brake mu = 0.5, mu_s = 0.59, t_end = 300.0, dt_out = 0.1 /\n"
+               "&analysis window_start = 50.0, window_end = 300.0, lyapunov_transient = 50.0,"
+               " poincare = .false., rosenstein = .false. /\n"
+               "&sweep sweep_variable = 'brake.v_dr_prime', sweep_spacing = 'linear',"
+               " sweep_from = -0.004, sweep_to = -0.001, sweep_count = 7 /\n")
+SWEEP_PER_POINT = ["values", "maxima", "maxima_offset", "maxima_count", "peak_frequency", "lyapunov",
+                   "stick_fraction", "events", "status"]
+
+# Bad &sweep input: (override text, words of the message).
+BAD_SWEEP_INPUTS = {
+    "variable-unknown": ("&sweep sweep_variable = 'brake.v_belt', sweep_values = 1.0 /\n",
+                         ["bad.nml:1", "&sweep", "sweep_variable", "v_belt", "known"]),
+    "variable-no-group": ("&sweep\n sweep_values = 1.0\n sweep_variable = 'v_dr_prime'\n/\n",
+                          ["bad.nml:3", "&sweep", "sweep_variable", "group.name"]),
+    "variable-integer": ("&sweep sweep_variable = 'integrator.max_steps', sweep_values = 10 /\n",
+                         ["bad.nml:1", "&sweep", "sweep_variable", "real"]),
+    "spacing": ("&sweep sweep_variable = 'brake.mu', sweep_spacing = 'geometric' /\n",
+                ["bad.nml:1", "&sweep", "sweep_spacing", "'log'"]),
+    "log-negative": ("&sweep sweep_variable = 'brake.v_dr_prime', sweep_spacing = 'log',\n"
+                     " sweep_from = -0.004, sweep_to = -0.001, sweep_count = 3 /\n",
+                     ["bad.nml:2", "&sweep", "sweep_from", "> 0"]),
+    "count": ("&sweep sweep_variable = 'brake.mu', sweep_spacing = 'linear', sweep_count = 0 /\n",
+              ["bad.nml:1", "&sweep", "sweep_count"]),
+    "no-values": ("&sweep sweep_variable = 'brake.mu' /\n", ["&sweep", "sweep_values", "at least one"]),
+    "schedule": ("&sweep sweep_variable = 'brake.mu', sweep_values = 0.5, sweep_schedule = 'greedy' /\n",
+                 ["bad.nml:1", "&sweep", "sweep_schedule", "'dynamic'"]),
+}
+
+
+def sweep_results(path):
+    with h5py.File(path, "r") as handle:
+        return {key: handle["sweep"][key][()] for key in SWEEP_PER_POINT}, \
+            handle["sweep/status"].attrs["reason"].decode().split("\n")
+
+
+def case_sweep_ranks(args):
+    """1, 2 and 3 ranks (dynamic) and 2 ranks (static) write identical per-point results."""
+    small = write(args, "small.nml", SWEEP_SMALL)
+    static = write(args, "static.nml", "&sweep sweep_schedule = 'static' /\n")
+    brake = os.path.join(args.inputs, "brake.nml")
+    runs = {}
+    for label, ranks, extra in ((1, 1, []), (2, 2, []), (3, 3, []), ("2-static", 2, [static])):
+        friction(args, "-o", f"s{label}.h5", brake, small, *extra, ranks=ranks)
+        runs[label] = sweep_results(os.path.join(args.workdir, f"s{label}.h5"))
+    reference, _ = runs[1]
+    if not np.all(reference["status"] == 1):
+        fail(f"expected every point done, status {reference['status']}")
+    if not np.allclose(reference["values"], np.linspace(-0.004, -0.001, 7), rtol=1e-15, atol=0):
+        fail(f"values {reference['values']}")
+    counts, offsets = reference["maxima_count"], reference["maxima_offset"]
+    if counts.sum() != reference["maxima"].size or not np.array_equal(offsets[1:], np.cumsum(counts)[:-1]):
+        fail("maxima offsets and counts do not index the flat maxima")
+    for label in (2, 3, "2-static"):
+        for key in SWEEP_PER_POINT:
+            if not np.array_equal(reference[key], runs[label][0][key]):
+                fail(f"/sweep/{key} differs between 1 rank and {label}: {reference[key]} vs {runs[label][0][key]}")
+    with h5py.File(os.path.join(args.workdir, "s1.h5"), "r") as handle:
+        for key, unit in (("maxima", "m"), ("peak_frequency", "1/tau"), ("lyapunov", "1/tau")):
+            if handle["sweep"][key].attrs["units"].decode() != unit:
+                fail(f"/sweep/{key} units {handle['sweep'][key].attrs['units']!r}, expected {unit}")
+        for name in ("program", "version", "input", "nranks", "wall_time"):
+            if name not in handle.attrs:
+                fail(f"root attribute {name} missing")
+    if leftovers(args) != sorted(f"s{label}.h5" for label in runs):
+        fail(f"the sweep left files: {leftovers(args)}")
+
+
+def case_sweep_failure(args):
+    """A point with an invalid override (mu above mu_s) and a point whose
+    integration fails (a 1 ns wall-time budget) are recorded as failed with
+    their reasons; the others complete."""
+    brake = os.path.join(args.inputs, "brake.nml")
+    small = write(args, "small.nml", SWEEP_SMALL)
+    mu = write(args, "mu.nml", "&sweep sweep_variable = 'brake.mu', sweep_spacing = 'list',"
+               " sweep_values = 0.5, 0.7, 0.55 /\n")
+    friction(args, "-o", "mu.h5", brake, small, mu, ranks=2)
+    results, reasons = sweep_results(os.path.join(args.workdir, "mu.h5"))
+    if list(results["status"]) != [1, 2, 1]:
+        fail(f"status {results['status']}, expected [1, 2, 1]")
+    for word in ("mu", "mu_s", "0.59"):
+        if word not in reasons[1]:
+            fail(f"the failed point's reason lacks {word!r}: {reasons[1]!r}")
+    if reasons[0] or reasons[2]:
+        fail(f"completed points have reasons: {reasons}")
+    budget = write(args, "budget.nml", "&sweep sweep_variable = 'integrator.max_wall_time', sweep_spacing = 'list',"
+                   " sweep_values = 0.0, 1e-9, 0.0 /\n")
+    friction(args, "-o", "budget.h5", brake, small, budget, ranks=3)
+    results, reasons = sweep_results(os.path.join(args.workdir, "budget.h5"))
+    if list(results["status"]) != [1, 2, 1]:
+        fail(f"status {results['status']}, expected [1, 2, 1]")
+    if "max_wall_time" not in reasons[1]:
+        fail(f"the failed point's reason lacks max_wall_time: {reasons[1]!r}")
+
+
+def case_sweep_resume(args):
+    """A sweep stopped after 3 of 7 points (the sweep_stop_after hook) leaves a
+    valid file (3 done, 4 pending) and its checkpoints; --resume on another
+    number of ranks computes only the 4 missing points and writes what an
+    uninterrupted run writes, then removes the checkpoints."""
+    brake = os.path.join(args.inputs, "brake.nml")
+    small = write(args, "small.nml", SWEEP_SMALL)
+    stop = write(args, "stop.nml", "&sweep sweep_stop_after = 3 /\n")
+    friction(args, "-o", "full.h5", brake, small, ranks=1)
+    friction(args, "-o", "part.h5", brake, small, stop, ranks=2, expect=6)
+    partial, _ = sweep_results(os.path.join(args.workdir, "part.h5"))
+    if list(partial["status"]) != [1, 1, 1, 0, 0, 0, 0]:
+        fail(f"interrupted file status {partial['status']}, expected 3 done and 4 pending")
+    with h5py.File(os.path.join(args.workdir, "part.h5"), "r") as handle:
+        if handle["sweep"].attrs["complete"] != 0:
+            fail("the interrupted file does not say it is incomplete")
+    if len([f for f in leftovers(args) if f.endswith(".ckpt")]) != 3:
+        fail(f"expected 3 checkpoints, found {leftovers(args)}")
+    friction(args, "--resume", "-o", "part.h5", brake, small, ranks=3)
+    full, _ = sweep_results(os.path.join(args.workdir, "full.h5"))
+    resumed, _ = sweep_results(os.path.join(args.workdir, "part.h5"))
+    for key in SWEEP_PER_POINT:
+        if not np.array_equal(full[key], resumed[key]):
+            fail(f"/sweep/{key} differs after resume: {full[key]} vs {resumed[key]}")
+    with h5py.File(os.path.join(args.workdir, "part.h5"), "r") as handle:
+        computed = list(handle["sweep/computed_by_this_run"][()])
+        if computed != [0, 0, 0, 1, 1, 1, 1]:
+            fail(f"the resumed run computed {computed}, expected only the 4 missing points")
+        if handle["sweep"].attrs["complete"] != 1:
+            fail("the resumed file does not say it is complete")
+    if leftovers(args) != ["full.h5", "part.h5"]:
+        fail(f"checkpoints left after a complete sweep: {leftovers(args)}")
+
+
+def case_sweep_signal(args):
+    """SIGTERM part-way: exit code 6, a valid file with the points done and the
+    rest pending; --resume completes it."""
+    brake = os.path.join(args.inputs, "brake.nml")
+    small = write(args, "small.nml", SWEEP_SMALL)
+    longer = write(args, "long.nml", "&brake t_end = 1500.0 /\n&sweep sweep_count = 40 /\n")
+    process = subprocess.Popen([args.binary, "--quiet", "-o", "cut.h5", brake, small, longer], cwd=args.workdir,
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    # Signal once the first point is checkpointed (not after a fixed time: no timing assumptions).
+    first = os.path.join(args.workdir, "cut.h5.point-1.ckpt")
+    deadline = time.monotonic() + 120
+    while not os.path.exists(first) and process.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.02)
+    process.send_signal(signal.SIGTERM)
+    _, stderr = process.communicate(timeout=120)
+    if process.returncode != 6:
+        fail(f"interrupted sweep exited {process.returncode}, expected 6: {stderr}")
+    cut, _ = sweep_results(os.path.join(args.workdir, "cut.h5"))
+    done = int(np.sum(cut["status"] == 1))
+    if not 0 < done < 40 or np.any(cut["status"][done:] != 0):
+        fail(f"expected the first points done and the rest pending, status {cut['status']}")
+    friction(args, "--resume", "-o", "cut.h5", brake, small, longer)
+    with h5py.File(os.path.join(args.workdir, "cut.h5"), "r") as handle:
+        if not np.all(handle["sweep/status"][()] == 1):
+            fail("the resumed sweep is not complete")
+        if int(np.sum(handle["sweep/computed_by_this_run"][()])) != 40 - done:
+            fail(f"the resumed run recomputed finished points: {handle['sweep/computed_by_this_run'][()]}")
+
+
+def case_bad_sweep(args, name):
+    text, words = BAD_SWEEP_INPUTS[name]
+    cmd = [os.path.join(args.inputs, "brake.nml"), write(args, "bad.nml", text)]
+    result = friction(args, *cmd, expect=3)
+    for word in words:
+        if word not in result.stderr:
+            fail(f"message lacks {word!r}: {result.stderr!r}")
+    if leftovers(args):
+        fail(f"bad input left files: {leftovers(args)}")
+
+
 def case_bad_brake(args, name):
     text, code, words = BAD_BRAKE_INPUTS[name]
     cmd = [os.path.join(args.inputs, "brake.nml"), write(args, "bad.nml", text)]
@@ -587,6 +759,11 @@ def main():
     os.makedirs(args.workdir)
     if args.case.startswith("datasets-"):
         case_datasets(args, args.case.split("-", 1)[1])
+    elif args.case.startswith("bad-sweep-"):
+        case_bad_sweep(args, args.case[len("bad-sweep-"):])
+    elif args.case.startswith("sweep-"):
+        {"sweep-ranks": case_sweep_ranks, "sweep-failure": case_sweep_failure,
+         "sweep-resume": case_sweep_resume, "sweep-signal": case_sweep_signal}[args.case](args)
     elif args.case.startswith("bad-brake-"):
         case_bad_brake(args, args.case[len("bad-brake-"):])
     elif args.case.startswith("bad-"):

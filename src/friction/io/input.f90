@@ -21,16 +21,31 @@ module friction_io_input
    implicit none
    private
 
-   public :: job_config, read_input, group_names
+   public :: job_config, read_input, group_names, sweep_settings, max_sweep_values
 
-   character(len=*), parameter :: group_names(9) = [character(len=17) :: &
-      & 'job', 'surface', 'tip', 'scan', 'integrator', 'brake', 'brake_dimensional', 'verify', 'analysis']
+   character(len=*), parameter :: group_names(10) = [character(len=17) :: &
+      & 'job', 'surface', 'tip', 'scan', 'integrator', 'brake', 'brake_dimensional', 'verify', 'analysis', &
+      & 'sweep']
+
+   integer, parameter :: max_sweep_values = 1024
+
+   !> &sweep: one real namelist variable of the scene ('group.name') swept over
+   !> a list, a linspace or a logspace (README: Parameter sweeps).
+   type :: sweep_settings
+      logical :: enabled = .false.
+      character(len=64) :: variable = ''       !! 'group.name', e.g. 'brake.v_dr_prime'
+      character(len=8) :: spacing = 'list'     !! 'list', 'linear' or 'log'
+      real(wp), allocatable :: values(:)       !! the points, in order
+      character(len=8) :: schedule = 'dynamic' !! 'dynamic' (on demand) or 'static' (round-robin)
+      integer :: stop_after = 0                !! test hook: > 0 acts as an interruption after this point
+   end type sweep_settings
 
    !> Everything a run needs from its input files.
    type :: job_config
       character(len=16) :: scene = 'afm'
       type(afm_config) :: afm
       type(brake_config) :: brake
+      type(sweep_settings) :: sweep
    end type job_config
 
 contains
@@ -82,6 +97,11 @@ contains
       character(len=16) :: section
       real(wp) :: window_start, window_end, strobe_period, strobe_start, strobe_end
       real(wp) :: lyapunov_transient, lyapunov_duration, lyapunov_renormalise, lyapunov_d0
+      ! &sweep (README: Parameter sweeps)
+      character(len=64) :: sweep_variable
+      character(len=8) :: sweep_spacing, sweep_schedule
+      real(wp) :: sweep_values(max_sweep_values), sweep_from, sweep_to
+      integer :: sweep_count, sweep_stop_after
       integer :: welch_segments, rosenstein_stride, rosenstein_dimension, rosenstein_delay, &
          & rosenstein_theiler, rosenstein_horizon, rosenstein_fit_start, rosenstein_fit_end
 
@@ -101,6 +121,8 @@ contains
          & lyapunov, lyapunov_transient, lyapunov_duration, lyapunov_renormalise, lyapunov_d0, &
          & rosenstein, rosenstein_stride, rosenstein_dimension, rosenstein_delay, rosenstein_theiler, &
          & rosenstein_horizon, rosenstein_fit_start, rosenstein_fit_end
+      namelist /sweep/ sweep_variable, sweep_values, sweep_from, sweep_to, sweep_count, sweep_spacing, &
+         & sweep_schedule, sweep_stop_after
 
       type(mention), allocatable :: mentions(:), all_mentions(:)
       character(len=4096), allocatable :: source(:)
@@ -157,7 +179,8 @@ contains
       input_text = ''
       do g = 1, size(group_names)
          if (scene == 'brake' .and. any(g == [2, 3, 4])) cycle
-         if (scene /= 'brake' .and. g > 5) cycle
+         if (scene /= 'brake' .and. g > 5 .and. g < 10) cycle
+         if (g == 10 .and. .not. config%sweep%enabled) cycle
          input_text = input_text//group_as_text(g)
       end do
 
@@ -180,6 +203,7 @@ contains
          case (7); read (unit, nml=brake_dimensional, iostat=s, iomsg=msg)
          case (8); read (unit, nml=verify, iostat=s, iomsg=msg)
          case (9); read (unit, nml=analysis, iostat=s, iomsg=msg)
+         case (10); read (unit, nml=sweep, iostat=s, iomsg=msg)
          end select
          if (is_iostat_end(s)) return  ! absent: keep what we have
          if (s /= 0) then
@@ -216,6 +240,7 @@ contains
          case (7); write (scratch, nml=brake_dimensional)
          case (8); write (scratch, nml=verify)
          case (9); write (scratch, nml=analysis)
+         case (10); write (scratch, nml=sweep)
          end select
          rewind (scratch)
          text = ''
@@ -273,6 +298,9 @@ contains
             rosenstein_theiler = n%rosenstein_theiler; rosenstein_horizon = n%rosenstein_horizon
             rosenstein_fit_start = n%rosenstein_fit_start; rosenstein_fit_end = n%rosenstein_fit_end
          end associate
+         sweep_variable = ''; sweep_spacing = 'list'; sweep_schedule = 'dynamic'
+         sweep_values = huge(1.0_wp); sweep_from = 0.0_wp; sweep_to = 0.0_wp; sweep_count = 0
+         sweep_stop_after = 0
       end subroutine from_config
 
       subroutine to_config()
@@ -338,6 +366,14 @@ contains
             n%rosenstein_theiler = rosenstein_theiler; n%rosenstein_horizon = rosenstein_horizon
             n%rosenstein_fit_start = rosenstein_fit_start; n%rosenstein_fit_end = rosenstein_fit_end
          end associate
+         sweep_variable = lower(sweep_variable)
+         sweep_spacing = lower(sweep_spacing)
+         sweep_schedule = lower(sweep_schedule)
+         config%sweep%enabled = len_trim(sweep_variable) > 0
+         config%sweep%variable = sweep_variable
+         config%sweep%spacing = sweep_spacing
+         config%sweep%schedule = sweep_schedule
+         config%sweep%stop_after = sweep_stop_after
       end subroutine to_config
 
       !> A relative net_file is relative to the namelist file that names it,
@@ -499,7 +535,90 @@ contains
          if (max_steps < 1) call reject('integrator', 'max_steps', itoa(max_steps), 'must be >= 1')
          call require_nonnegative('integrator', 'max_wall_time', max_wall_time, 's; 0 for no limit')
          if (scene == 'brake') call validate_brake()
+         if (config%sweep%enabled) call validate_sweep()
       end subroutine validate
+
+      !> &sweep: a known real variable of a scene group, and its points.
+      subroutine validate_sweep()
+         character(len=32), allocatable :: known(:)
+         character, allocatable :: kinds(:)
+         integer :: dot, g, k, n
+         character(len=:), allocatable :: group, name
+
+         dot = index(sweep_variable, '.')
+         group = sweep_variable(1:max(0, dot - 1))
+         name = trim(sweep_variable(dot + 1:))
+         ! (Loops, not findloc: gfortran's findloc on these deferred-length strings
+         ! upset the one in the mention check above.)
+         g = 0
+         do k = 1, size(group_names)
+            if (group_names(k) == group) g = k
+         end do
+         if (dot == 0 .or. g == 0 .or. g == 1 .or. g == 10) then
+            call reject('sweep', 'sweep_variable', "'"//trim(sweep_variable)//"'", &
+               & "name a variable as 'group.name' of a scene group (e.g. 'brake.v_dr_prime')")
+            return
+         end if
+         call namelist_names(group_as_text(g), known, kinds)
+         dot = 0
+         do k = 1, size(known)
+            if (known(k) == name) dot = k
+         end do
+         k = dot
+         if (k == 0) then
+            call reject('sweep', 'sweep_variable', "'"//trim(sweep_variable)//"'", 'no variable '//name// &
+               & ' in &'//group//' (known: '//join(known)//')')
+            return
+         end if
+         if (kinds(k) /= 'r') then
+            call reject('sweep', 'sweep_variable', "'"//trim(sweep_variable)//"'", &
+               & 'only real variables can be swept')
+            return
+         end if
+         if (scene /= 'brake') call reject('sweep', 'sweep_variable', "'"//trim(sweep_variable)//"'", &
+            & "sweeps run the brake scene only for now (&job scene = 'brake')")
+         if (sweep_schedule /= 'dynamic' .and. sweep_schedule /= 'static') call reject('sweep', &
+            & 'sweep_schedule', "'"//trim(sweep_schedule)//"'", "unknown schedule (known: 'dynamic', 'static')")
+         if (sweep_stop_after < 0) call reject('sweep', 'sweep_stop_after', itoa(sweep_stop_after), &
+            & 'must be >= 0 (0: never; a test hook)')
+         select case (trim(sweep_spacing))
+         case ('list')
+            n = 0
+            do while (n < max_sweep_values)
+               if (sweep_values(n + 1) == huge(1.0_wp)) exit
+               n = n + 1
+            end do
+            if (n == 0) call reject('sweep', 'sweep_values', '(none)', "give at least one value for " &
+               & //"sweep_spacing = 'list'")
+            config%sweep%values = sweep_values(1:n)
+         case ('linear', 'log')
+            if (sweep_count < 1 .or. sweep_count > max_sweep_values) call reject('sweep', 'sweep_count', &
+               & itoa(sweep_count), 'must be in [1, '//itoa(max_sweep_values)//']')
+            call require_finite('sweep', 'sweep_from', sweep_from)
+            call require_finite('sweep', 'sweep_to', sweep_to)
+            if (sweep_spacing == 'log') then
+               if (.not. (sweep_from > 0.0_wp)) call reject('sweep', 'sweep_from', rtoa(sweep_from), &
+                  & "must be > 0 for sweep_spacing = 'log'")
+               if (.not. (sweep_to > 0.0_wp)) call reject('sweep', 'sweep_to', rtoa(sweep_to), &
+                  & "must be > 0 for sweep_spacing = 'log'")
+            end if
+            if (allocated(error)) return
+            allocate (config%sweep%values(sweep_count))
+            do k = 1, sweep_count
+               if (sweep_count == 1) then
+                  config%sweep%values(k) = sweep_from
+               else if (sweep_spacing == 'linear') then
+                  config%sweep%values(k) = sweep_from + (sweep_to - sweep_from) * (k - 1) / (sweep_count - 1)
+               else
+                  config%sweep%values(k) = exp(log(sweep_from) + (log(sweep_to) - log(sweep_from)) &
+                     & * (k - 1) / (sweep_count - 1))
+               end if
+            end do
+         case default
+            call reject('sweep', 'sweep_spacing', "'"//trim(sweep_spacing)//"'", &
+               & "unknown spacing (known: 'list', 'linear', 'log')")
+         end select
+      end subroutine validate_sweep
 
       !> The brake scene's settings (README: Girling brake, input reference).
       subroutine validate_brake()
