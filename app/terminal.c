@@ -3,6 +3,3 @@
 #include <unistd.h>
 
 int friction_stderr_is_terminal(void) { return isatty(STDERR_FILENO); }
-
-/* Process id, to make temporary output names unique. */
-int friction_process_id(void) { return (int)getpid(); }

@@ -577,8 +577,17 @@ BAD_SWEEP_INPUTS = {
                          ["bad.nml:1", "&sweep", "sweep_variable", "v_belt", "known"]),
     "variable-no-group": ("&sweep\n sweep_values = 1.0\n sweep_variable = 'v_dr_prime'\n/\n",
                           ["bad.nml:3", "&sweep", "sweep_variable", "group.name"]),
-    "variable-integer": ("&sweep sweep_variable = 'integrator.max_steps', sweep_values = 10 /\n",
-                         ["bad.nml:1", "&sweep", "sweep_variable", "real"]),
+    "integer-fraction": ("&sweep sweep_variable = 'integrator.max_steps', sweep_values = 10, 10.5 /\n",
+                         ["bad.nml:1", "&sweep", "sweep_values", "10.5", "whole"]),
+    "wrong-scene": ("&sweep sweep_variable = 'tip.kx', sweep_values = 1.0 /\n",
+                    ["bad.nml:1", "&sweep", "sweep_variable", "&tip", "not part of scene 'brake'"]),
+    "variable2-same": ("&sweep sweep_variable = 'brake.mu', sweep_values = 0.5,\n"
+                       " sweep_variable2 = 'brake.mu', sweep_values2 = 0.4 /\n",
+                       ["bad.nml:2", "&sweep", "sweep_variable2", "already"]),
+    "grid-too-large": ("&sweep sweep_variable = 'brake.mu', sweep_spacing = 'linear', sweep_from = 0.1,\n"
+                       " sweep_to = 0.5, sweep_count = 100, sweep_variable2 = 'brake.xi',\n"
+                       " sweep_spacing2 = 'linear', sweep_from2 = 0.1, sweep_to2 = 0.5, sweep_count2 = 11 /\n",
+                       ["&sweep", "sweep_count2", "100 x 11", "1024"]),
     "spacing": ("&sweep sweep_variable = 'brake.mu', sweep_spacing = 'geometric' /\n",
                 ["bad.nml:1", "&sweep", "sweep_spacing", "'log'"]),
     "log-negative": ("&sweep sweep_variable = 'brake.v_dr_prime', sweep_spacing = 'log',\n"

@@ -5,12 +5,13 @@ module friction_error
    private
 
    public :: error_type, fatal_error
-   public :: error_input, error_numerical, error_io, error_internal
+   public :: error_input, error_numerical, error_io, error_internal, error_interrupted
 
    integer, parameter :: error_input = 1     !! bad input: file, group, variable, value
    integer, parameter :: error_numerical = 2 !! integration failed or produced NaN/Inf
    integer, parameter :: error_io = 3        !! file system or HDF5 failure
    integer, parameter :: error_internal = 4  !! a broken invariant of the program
+   integer, parameter :: error_interrupted = 5 !! stopped on request; the output is valid and resumable
 
    !> An error: a category and a message for the user.
    type :: error_type

@@ -6,7 +6,7 @@ module friction_io_files
    implicit none
    private
 
-   public :: rename_file, remove_file, file_exists
+   public :: rename_file, remove_file, file_exists, process_id
 
    interface
       function c_rename(from, to) result(stat) bind(c, name='rename')
@@ -20,6 +20,12 @@ module friction_io_files
          character(kind=c_char), intent(in) :: path(*)
          integer(c_int) :: stat
       end function c_remove
+
+      !> POSIX getpid (pid_t is an int on the platforms we build for).
+      function c_getpid() result(pid) bind(c, name='getpid')
+         import :: c_int
+         integer(c_int) :: pid
+      end function c_getpid
    end interface
 
 contains
@@ -46,5 +52,10 @@ contains
 
       if (file_exists(path)) stat = c_remove(path//c_null_char)
    end subroutine remove_file
+
+   !> This process's id, to make temporary file names unique.
+   integer function process_id()
+      process_id = int(c_getpid())
+   end function process_id
 
 end module friction_io_files

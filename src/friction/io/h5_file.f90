@@ -170,6 +170,12 @@ contains
       call h5dcreate_f(self%id, name, type, filespace, dset, stat)
       call self%check(stat, 'creating dataset '//name)
       if (stat /= 0) return
+      if (n_total == 0) then   ! an empty dataset: nothing to write (and no buffer to point at)
+         if (len_trim(units) > 0) call attribute_text(self, dset, 'units', units)
+         call h5dclose_f(dset, stat)
+         call h5sclose_f(filespace, stat)
+         return
+      end if
       call h5screate_simple_f(rank, count(1:rank), memspace, stat)
       if (product(held) > 0) then
          call h5sselect_hyperslab_f(filespace, H5S_SELECT_SET_F, offset(1:rank), count(1:rank), stat, &

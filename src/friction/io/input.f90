@@ -29,14 +29,18 @@ module friction_io_input
 
    integer, parameter :: max_sweep_values = 1024
 
-   !> &sweep: one real namelist variable of the scene ('group.name') swept over
-   !> a list, a linspace or a logspace (README: Parameter sweeps).
+   !> &sweep: one or two numeric namelist variables of the scene ('group.name'),
+   !> each over a list, a linspace or a logspace; the points are the grid of
+   !> the two (the second varies fastest) (README: Parameter sweeps).
    type :: sweep_settings
       logical :: enabled = .false.
-      character(len=64) :: variable = ''       !! 'group.name', e.g. 'brake.v_dr_prime'
-      character(len=8) :: spacing = 'list'     !! 'list', 'linear' or 'log'
-      real(wp), allocatable :: values(:)       !! the points, in order
-      character(len=8) :: schedule = 'dynamic' !! 'dynamic' (on demand) or 'static' (round-robin)
+      integer :: n_variables = 0
+      character(len=64) :: variables(2) = ''   !! 'group.name', e.g. 'brake.v_dr_prime'
+      logical :: integer_valued(2) = .false.   !! an integer variable (values are whole numbers)
+      character(len=8) :: spacings(2) = 'list' !! 'list', 'linear' or 'log'
+      integer :: shape(2) = 1                  !! values per variable (1 for an absent second)
+      real(wp), allocatable :: values(:, :)    !! (n_variables, points): each point's values, in order
+      character(len=8) :: schedule = 'dynamic' !! 'dynamic' (on demand) or 'static' (contiguous blocks)
       integer :: stop_after = 0                !! test hook: > 0 acts as an interruption after this point
    end type sweep_settings
 
@@ -98,10 +102,11 @@ contains
       real(wp) :: window_start, window_end, strobe_period, strobe_start, strobe_end
       real(wp) :: lyapunov_transient, lyapunov_duration, lyapunov_renormalise, lyapunov_d0
       ! &sweep (README: Parameter sweeps)
-      character(len=64) :: sweep_variable
-      character(len=8) :: sweep_spacing, sweep_schedule
+      character(len=64) :: sweep_variable, sweep_variable2
+      character(len=8) :: sweep_spacing, sweep_schedule, sweep_spacing2
       real(wp) :: sweep_values(max_sweep_values), sweep_from, sweep_to
-      integer :: sweep_count, sweep_stop_after
+      real(wp) :: sweep_values2(max_sweep_values), sweep_from2, sweep_to2
+      integer :: sweep_count, sweep_stop_after, sweep_count2
       integer :: welch_segments, rosenstein_stride, rosenstein_dimension, rosenstein_delay, &
          & rosenstein_theiler, rosenstein_horizon, rosenstein_fit_start, rosenstein_fit_end
 
@@ -122,6 +127,7 @@ contains
          & rosenstein, rosenstein_stride, rosenstein_dimension, rosenstein_delay, rosenstein_theiler, &
          & rosenstein_horizon, rosenstein_fit_start, rosenstein_fit_end
       namelist /sweep/ sweep_variable, sweep_values, sweep_from, sweep_to, sweep_count, sweep_spacing, &
+         & sweep_variable2, sweep_values2, sweep_from2, sweep_to2, sweep_count2, sweep_spacing2, &
          & sweep_schedule, sweep_stop_after
 
       type(mention), allocatable :: mentions(:), all_mentions(:)
@@ -300,6 +306,8 @@ contains
          end associate
          sweep_variable = ''; sweep_spacing = 'list'; sweep_schedule = 'dynamic'
          sweep_values = huge(1.0_wp); sweep_from = 0.0_wp; sweep_to = 0.0_wp; sweep_count = 0
+         sweep_variable2 = ''; sweep_spacing2 = 'list'
+         sweep_values2 = huge(1.0_wp); sweep_from2 = 0.0_wp; sweep_to2 = 0.0_wp; sweep_count2 = 0
          sweep_stop_after = 0
       end subroutine from_config
 
@@ -368,10 +376,13 @@ contains
          end associate
          sweep_variable = lower(sweep_variable)
          sweep_spacing = lower(sweep_spacing)
+         sweep_variable2 = lower(sweep_variable2)
+         sweep_spacing2 = lower(sweep_spacing2)
          sweep_schedule = lower(sweep_schedule)
          config%sweep%enabled = len_trim(sweep_variable) > 0
-         config%sweep%variable = sweep_variable
-         config%sweep%spacing = sweep_spacing
+         config%sweep%n_variables = merge(2, 1, len_trim(sweep_variable2) > 0)
+         config%sweep%variables = [sweep_variable, sweep_variable2]
+         config%sweep%spacings = [sweep_spacing, sweep_spacing2]
          config%sweep%schedule = sweep_schedule
          config%sweep%stop_after = sweep_stop_after
       end subroutine to_config
@@ -538,16 +549,70 @@ contains
          if (config%sweep%enabled) call validate_sweep()
       end subroutine validate
 
-      !> &sweep: a known real variable of a scene group, and its points.
+      !> &sweep: one or two known numeric variables of the scene's groups, and
+      !> their points.
       subroutine validate_sweep()
+         real(wp), allocatable :: axes(:, :)
+         integer :: counts(2), v, i1, i2, p
+
+         if (sweep_schedule /= 'dynamic' .and. sweep_schedule /= 'static') call reject('sweep', &
+            & 'sweep_schedule', "'"//trim(sweep_schedule)//"'", "unknown schedule (known: 'dynamic', 'static')")
+         if (sweep_stop_after < 0) call reject('sweep', 'sweep_stop_after', itoa(sweep_stop_after), &
+            & 'must be >= 0 (0: never; a test hook)')
+         allocate (axes(max_sweep_values, 2), source=0.0_wp)
+         counts = 1
+         call sweep_axis('', sweep_variable, sweep_spacing, sweep_values, sweep_from, sweep_to, sweep_count, &
+            & config%sweep%integer_valued(1), axes(:, 1), counts(1))
+         if (config%sweep%n_variables == 2) then
+            if (sweep_variable2 == sweep_variable) call reject('sweep', 'sweep_variable2', &
+               & "'"//trim(sweep_variable2)//"'", 'is sweep_variable already')
+            call sweep_axis('2', sweep_variable2, sweep_spacing2, sweep_values2, sweep_from2, sweep_to2, &
+               & sweep_count2, config%sweep%integer_valued(2), axes(:, 2), counts(2))
+         end if
+         if (allocated(error)) return
+         if (counts(1) * counts(2) > max_sweep_values) then
+            call reject('sweep', 'sweep_count2', itoa(counts(2)), 'the grid of '//itoa(counts(1))//' x ' &
+               & //itoa(counts(2))//' points exceeds '//itoa(max_sweep_values)//' points')
+            return
+         end if
+         v = config%sweep%n_variables
+         config%sweep%shape = counts
+         allocate (config%sweep%values(v, counts(1) * counts(2)))
+         p = 0
+         do i1 = 1, counts(1)
+            do i2 = 1, counts(2)
+               p = p + 1
+               config%sweep%values(1, p) = axes(i1, 1)
+               if (v == 2) config%sweep%values(2, p) = axes(i2, 2)
+            end do
+         end do
+      end subroutine validate_sweep
+
+      !> One swept variable (`suffix` '' or '2' names its namelist variables):
+      !> a numeric variable of a group of this scene, and its values.
+      subroutine sweep_axis(suffix, variable, spacing, listed, from, to, count, whole, axis, n)
+         character(len=*), intent(in) :: suffix, variable, spacing
+         real(wp), intent(in) :: listed(:), from, to
+         integer, intent(in) :: count
+         logical, intent(out) :: whole
+         real(wp), intent(out) :: axis(:)
+         integer, intent(out) :: n
+         character(len=*), parameter :: afm_groups(*) = [character(len=17) :: 'surface', 'tip', 'scan', &
+            & 'integrator']
+         character(len=*), parameter :: brake_groups(*) = [character(len=17) :: 'brake', 'brake_dimensional', &
+            & 'integrator', 'verify', 'analysis']
          character(len=32), allocatable :: known(:)
          character, allocatable :: kinds(:)
-         integer :: dot, g, k, n
-         character(len=:), allocatable :: group, name
+         integer :: dot, g, k
+         logical :: ours
+         character(len=:), allocatable :: group, name, shown
 
-         dot = index(sweep_variable, '.')
-         group = sweep_variable(1:max(0, dot - 1))
-         name = trim(sweep_variable(dot + 1:))
+         n = 0
+         whole = .false.
+         shown = "'"//trim(variable)//"'"
+         dot = index(variable, '.')
+         group = variable(1:max(0, dot - 1))
+         name = trim(variable(dot + 1:))
          ! (Loops, not findloc: gfortran's findloc on these deferred-length strings
          ! upset the one in the mention check above.)
          g = 0
@@ -555,8 +620,23 @@ contains
             if (group_names(k) == group) g = k
          end do
          if (dot == 0 .or. g == 0 .or. g == 1 .or. g == 10) then
-            call reject('sweep', 'sweep_variable', "'"//trim(sweep_variable)//"'", &
+            call reject('sweep', 'sweep_variable'//suffix, shown, &
                & "name a variable as 'group.name' of a scene group (e.g. 'brake.v_dr_prime')")
+            return
+         end if
+         ours = .false.
+         if (scene == 'brake') then
+            do k = 1, size(brake_groups)
+               if (brake_groups(k) == group) ours = .true.
+            end do
+         else
+            do k = 1, size(afm_groups)
+               if (afm_groups(k) == group) ours = .true.
+            end do
+         end if
+         if (.not. ours) then
+            call reject('sweep', 'sweep_variable'//suffix, shown, 'group &'//group//' is not part of scene ' &
+               & //"'"//trim(scene)//"'")
             return
          end if
          call namelist_names(group_as_text(g), known, kinds)
@@ -566,59 +646,77 @@ contains
          end do
          k = dot
          if (k == 0) then
-            call reject('sweep', 'sweep_variable', "'"//trim(sweep_variable)//"'", 'no variable '//name// &
+            call reject('sweep', 'sweep_variable'//suffix, shown, 'no variable '//name// &
                & ' in &'//group//' (known: '//join(known)//')')
             return
          end if
-         if (kinds(k) /= 'r') then
-            call reject('sweep', 'sweep_variable', "'"//trim(sweep_variable)//"'", &
-               & 'only real variables can be swept')
+         if (kinds(k) /= 'r' .and. kinds(k) /= 'i') then
+            call reject('sweep', 'sweep_variable'//suffix, shown, &
+               & 'only numeric (real or integer) variables can be swept')
             return
          end if
-         if (scene /= 'brake') call reject('sweep', 'sweep_variable', "'"//trim(sweep_variable)//"'", &
-            & "sweeps run the brake scene only for now (&job scene = 'brake')")
-         if (sweep_schedule /= 'dynamic' .and. sweep_schedule /= 'static') call reject('sweep', &
-            & 'sweep_schedule', "'"//trim(sweep_schedule)//"'", "unknown schedule (known: 'dynamic', 'static')")
-         if (sweep_stop_after < 0) call reject('sweep', 'sweep_stop_after', itoa(sweep_stop_after), &
-            & 'must be >= 0 (0: never; a test hook)')
-         select case (trim(sweep_spacing))
+         whole = kinds(k) == 'i'
+         select case (trim(spacing))
          case ('list')
-            n = 0
             do while (n < max_sweep_values)
-               if (sweep_values(n + 1) == huge(1.0_wp)) exit
+               if (listed(n + 1) == huge(1.0_wp)) exit
                n = n + 1
             end do
-            if (n == 0) call reject('sweep', 'sweep_values', '(none)', "give at least one value for " &
-               & //"sweep_spacing = 'list'")
-            config%sweep%values = sweep_values(1:n)
+            if (n == 0) call reject('sweep', 'sweep_values'//suffix, '(none)', "give at least one value for " &
+               & //"sweep_spacing"//suffix//" = 'list'")
+            axis(1:n) = listed(1:n)
          case ('linear', 'log')
-            if (sweep_count < 1 .or. sweep_count > max_sweep_values) call reject('sweep', 'sweep_count', &
-               & itoa(sweep_count), 'must be in [1, '//itoa(max_sweep_values)//']')
-            call require_finite('sweep', 'sweep_from', sweep_from)
-            call require_finite('sweep', 'sweep_to', sweep_to)
-            if (sweep_spacing == 'log') then
-               if (.not. (sweep_from > 0.0_wp)) call reject('sweep', 'sweep_from', rtoa(sweep_from), &
-                  & "must be > 0 for sweep_spacing = 'log'")
-               if (.not. (sweep_to > 0.0_wp)) call reject('sweep', 'sweep_to', rtoa(sweep_to), &
-                  & "must be > 0 for sweep_spacing = 'log'")
+            if (count < 1 .or. count > max_sweep_values) then
+               call reject('sweep', 'sweep_count'//suffix, itoa(count), 'must be in [1, ' &
+                  & //itoa(max_sweep_values)//']')
+               return
+            end if
+            call require_finite('sweep', 'sweep_from'//suffix, from)
+            call require_finite('sweep', 'sweep_to'//suffix, to)
+            if (spacing == 'log') then
+               if (.not. (from > 0.0_wp)) call reject('sweep', 'sweep_from'//suffix, rtoa(from), &
+                  & "must be > 0 for sweep_spacing"//suffix//" = 'log'")
+               if (.not. (to > 0.0_wp)) call reject('sweep', 'sweep_to'//suffix, rtoa(to), &
+                  & "must be > 0 for sweep_spacing"//suffix//" = 'log'")
             end if
             if (allocated(error)) return
-            allocate (config%sweep%values(sweep_count))
-            do k = 1, sweep_count
-               if (sweep_count == 1) then
-                  config%sweep%values(k) = sweep_from
-               else if (sweep_spacing == 'linear') then
-                  config%sweep%values(k) = sweep_from + (sweep_to - sweep_from) * (k - 1) / (sweep_count - 1)
+            n = count
+            do k = 1, count
+               if (count == 1) then
+                  axis(k) = from
+               else if (spacing == 'linear') then
+                  axis(k) = from + (to - from) * (k - 1) / (count - 1)
                else
-                  config%sweep%values(k) = exp(log(sweep_from) + (log(sweep_to) - log(sweep_from)) &
-                     & * (k - 1) / (sweep_count - 1))
+                  axis(k) = exp(log(from) + (log(to) - log(from)) * (k - 1) / (count - 1))
                end if
             end do
+            ! An integer variable takes whole values: a spaced range is rounded
+            ! (and must not repeat a value).
+            if (whole) then
+               axis(1:n) = anint(axis(1:n))
+               do k = 2, n
+                  if (axis(k) == axis(k - 1)) then
+                     call reject('sweep', 'sweep_count'//suffix, itoa(count), 'integer variable '//name// &
+                        & ' takes whole values: '//itoa(count)//' points from '//rtoa(from)//' to '//rtoa(to) &
+                        & //' repeat '//rtoa(axis(k)))
+                     return
+                  end if
+               end do
+            end if
          case default
-            call reject('sweep', 'sweep_spacing', "'"//trim(sweep_spacing)//"'", &
+            call reject('sweep', 'sweep_spacing'//suffix, "'"//trim(spacing)//"'", &
                & "unknown spacing (known: 'list', 'linear', 'log')")
          end select
-      end subroutine validate_sweep
+         if (whole .and. n > 0) then
+            do k = 1, n
+               if (axis(k) /= anint(axis(k)) .or. abs(axis(k)) > 2.0_wp**30) then
+                  call reject('sweep', 'sweep_values'//suffix, rtoa(axis(k)), 'integer variable '//name// &
+                     & ' takes whole values')
+                  return
+               end if
+            end do
+         end if
+      end subroutine sweep_axis
 
       !> The brake scene's settings (README: Girling brake, input reference).
       subroutine validate_brake()

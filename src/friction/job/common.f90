@@ -1,0 +1,149 @@
+!> What every job shares: its communicator and clock, the output's
+!> temporary name and publication, and one error agreed on by all ranks.
+module friction_job_common
+   use mpi_f08
+   use friction_kinds, only: wp
+   use friction_error, only: error_type, fatal_error, error_io
+   use friction_strings, only: itoa
+   use friction_io_files, only: rename_file, remove_file, process_id
+   implicit none
+   private
+
+   public :: job_context, agree_on_error, temporary_name, publish, check_writable, default_output, &
+      & ranks_text, sum_to_root_real, sum_to_root_integer
+
+   !> One job's run: where it runs, since when, what it read and writes.
+   type :: job_context
+      type(MPI_Comm) :: comm
+      integer :: rank = 0
+      integer :: nranks = 1
+      real(wp) :: t_start = 0.0_wp            !! MPI_Wtime at the start of the job
+      character(len=:), allocatable :: output
+      character(len=:), allocatable :: input_text
+      character(len=4096), allocatable :: files(:)
+      logical :: resume = .false.
+   end type job_context
+
+contains
+
+   !> After work that may fail on some ranks: if any rank holds an error,
+   !> every rank returns with the error of the lowest such rank (its message
+   !> and category broadcast), so callers report it once, from rank 0.
+   subroutine agree_on_error(job, error)
+      type(job_context), intent(in) :: job
+      type(error_type), allocatable, intent(inout) :: error
+      integer :: failed, header(2)
+      character(len=:), allocatable :: message
+
+      failed = merge(job%rank, job%nranks, allocated(error))
+      call MPI_Allreduce(MPI_IN_PLACE, failed, 1, MPI_INTEGER, MPI_MIN, job%comm)
+      if (failed == job%nranks) return
+      if (job%rank == failed) then
+         header = [error%stat, len(error%message)]
+         message = error%message
+      end if
+      call MPI_Bcast(header, 2, MPI_INTEGER, failed, job%comm)
+      if (job%rank /= failed) allocate (character(len=header(2)) :: message)
+      call MPI_Bcast(message, header(2), MPI_CHARACTER, failed, job%comm)
+      if (allocated(error)) deallocate (error)
+      call fatal_error(error, message, header(1))
+   end subroutine agree_on_error
+
+   !> The name the output is written under until it is complete: unique per
+   !> run (rank 0's process id), beside the output so the rename is atomic.
+   function temporary_name(job) result(name)
+      type(job_context), intent(in) :: job
+      character(len=:), allocatable :: name
+      integer :: pid
+
+      pid = process_id()
+      call MPI_Bcast(pid, 1, MPI_INTEGER, 0, job%comm)
+      name = job%output//'.tmp-'//itoa(pid)
+   end function temporary_name
+
+   !> After the (collective or rank-0) write to `temporary`: on success on
+   !> every rank, rename it to the output; otherwise remove it.  Every rank
+   !> returns the same error or none.
+   subroutine publish(job, temporary, error)
+      type(job_context), intent(in) :: job
+      character(len=*), intent(in) :: temporary
+      type(error_type), allocatable, intent(inout) :: error
+      integer :: failed
+
+      failed = merge(1, 0, allocated(error))
+      call MPI_Allreduce(MPI_IN_PLACE, failed, 1, MPI_INTEGER, MPI_MAX, job%comm)
+      if (job%rank == 0) then
+         if (failed == 0) then
+            call rename_file(temporary, job%output, error)
+         else if (.not. allocated(error)) then
+            call fatal_error(error, temporary//': writing failed on another rank', error_io)
+         end if
+         if (allocated(error)) call remove_file(temporary)
+      end if
+      call agree_on_error(job, error)
+   end subroutine publish
+
+   !> Create and remove a probe file beside the output.
+   subroutine check_writable(path, error)
+      character(len=*), intent(in) :: path
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: probe
+      character(len=256) :: message
+      integer :: unit, stat
+
+      probe = path//'.tmp-'//itoa(process_id())
+      open (newunit=unit, file=probe, status='new', action='write', iostat=stat, iomsg=message)
+      if (stat /= 0) then
+         call fatal_error(error, path//': cannot write the output here ('//trim(message)//')', error_io)
+         return
+      end if
+      close (unit, status='delete')
+   end subroutine check_writable
+
+   !> inputs/hopg.nml -> hopg.h5
+   function default_output(path) result(name)
+      character(len=*), intent(in) :: path
+      character(len=:), allocatable :: name
+      integer :: slash, dot
+
+      slash = index(path, '/', back=.true.)
+      name = trim(path(slash + 1:))
+      dot = index(name, '.', back=.true.)
+      if (dot > 1) name = name(1:dot - 1)
+      name = name//'.h5'
+   end function default_output
+
+   !> "on 1 rank", "on 3 ranks"
+   function ranks_text(nranks) result(text)
+      integer, intent(in) :: nranks
+      character(len=:), allocatable :: text
+
+      text = 'on '//itoa(nranks)//trim(merge(' rank ', ' ranks', nranks == 1))
+   end function ranks_text
+
+   !> Sum a real array onto rank 0 (each entry has one non-zero contributor).
+   subroutine sum_to_root_real(job, values)
+      type(job_context), intent(in) :: job
+      real(wp), intent(inout) :: values(:)
+
+      if (job%rank == 0) then
+         call MPI_Reduce(MPI_IN_PLACE, values, size(values), MPI_DOUBLE_PRECISION, MPI_SUM, 0, job%comm)
+      else
+         call MPI_Reduce(values, values, size(values), MPI_DOUBLE_PRECISION, MPI_SUM, 0, job%comm)
+      end if
+   end subroutine sum_to_root_real
+
+   !> Sum an integer array of `count` entries onto rank 0.
+   subroutine sum_to_root_integer(job, values, count)
+      type(job_context), intent(in) :: job
+      integer, intent(inout) :: values(*)
+      integer, intent(in) :: count
+
+      if (job%rank == 0) then
+         call MPI_Reduce(MPI_IN_PLACE, values, count, MPI_INTEGER, MPI_SUM, 0, job%comm)
+      else
+         call MPI_Reduce(values, values, count, MPI_INTEGER, MPI_SUM, 0, job%comm)
+      end if
+   end subroutine sum_to_root_integer
+
+end module friction_job_common

@@ -1,0 +1,77 @@
+!> A whole job from namelist files to an output file: what the command line
+!> runs, and what the C API's friction_run_job runs.  Collective over `comm`;
+!> every rank returns the same error or none.  Progress and notes go to the
+!> caller's reporter (rank 0 only); nothing is printed.
+module friction_job
+   use mpi_f08
+   use friction_kinds, only: wp
+   use friction_error, only: error_type, fatal_error, error_input
+   use friction_io_input, only: job_config, read_input
+   use friction_io_files, only: file_exists
+   use friction_job_report, only: job_reporter
+   use friction_job_common, only: job_context, agree_on_error, check_writable, default_output
+   use friction_job_afm, only: run_afm_job
+   use friction_job_brake, only: run_brake_job
+   use friction_job_sweep, only: run_sweep_job
+   implicit none
+   private
+
+   public :: run_job, job_reporter, default_output
+
+contains
+
+   !> Read `files` (later files override earlier ones variable by variable),
+   !> run the scene or sweep they describe and write `output` (under a
+   !> temporary name, renamed when complete).  An existing output is an error
+   !> unless `force`, or `resume` for a sweep (which reuses the checkpoints an
+   !> interrupted run left beside it).  `summary` says what was written.
+   subroutine run_job(files, output, force, resume, comm, reporter, summary, error)
+      character(len=*), intent(in) :: files(:)
+      character(len=*), intent(in) :: output
+      logical, intent(in) :: force, resume
+      type(MPI_Comm), intent(in) :: comm
+      class(job_reporter), intent(inout) :: reporter
+      character(len=:), allocatable, intent(out) :: summary
+      type(error_type), allocatable, intent(out) :: error
+      type(job_context) :: job
+      type(job_config) :: config
+
+      job%t_start = MPI_Wtime()
+      job%comm = comm
+      call MPI_Comm_rank(comm, job%rank)
+      call MPI_Comm_size(comm, job%nranks)
+      job%output = output
+      job%resume = resume
+      allocate (job%files(size(files)))
+      job%files = files
+      if (size(files) == 0) then
+         call fatal_error(error, 'no input file given', error_input)
+         return
+      end if
+      if (len_trim(output) == 0) then
+         call fatal_error(error, 'no output file given', error_input)
+         return
+      end if
+
+      ! Every rank reads the input: an error in it is the same everywhere.
+      call read_input(files, config, job%input_text, error)
+      if (allocated(error)) return
+      if (file_exists(output) .and. .not. (force .or. (resume .and. config%sweep%enabled))) then
+         call fatal_error(error, output//': the output file exists; use --force to overwrite it', error_input)
+         return
+      end if
+      ! Find out now, not after the computation, whether the output can be written.
+      if (job%rank == 0) call check_writable(output, error)
+      call agree_on_error(job, error)
+      if (allocated(error)) return
+
+      if (config%sweep%enabled) then
+         call run_sweep_job(job, config, reporter, summary, error)
+      else if (config%scene == 'brake') then
+         call run_brake_job(job, config%brake, reporter, summary, error)
+      else
+         call run_afm_job(job, config%afm, reporter, summary, error)
+      end if
+   end subroutine run_job
+
+end module friction_job
