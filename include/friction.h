@@ -25,7 +25,8 @@ enum {
   FRICTION_ERROR_INPUT = 1,     /* bad argument: null, too small, unknown name, non-physical value */
   FRICTION_ERROR_NUMERICAL = 2, /* the integration failed */
   FRICTION_ERROR_IO = 3,
-  FRICTION_ERROR_INTERNAL = 4
+  FRICTION_ERROR_INTERNAL = 4,
+  FRICTION_INTERRUPTED = 5      /* friction_run_job: a sweep stopped early; its file is valid, resumable */
 };
 
 /* Opaque error handle. */
@@ -79,6 +80,29 @@ int friction_brake(const char *model, double xi, double kappa, double g_prime, d
                    double t_end, double dt_out, const char *stepper, double rtol, double atol,
                    double *t, double *x, double *v, double *y, double *w, size_t n,
                    size_t *needed, friction_error *err);
+
+/* A whole job, as the command line runs it: the namelist files (later files
+ * override earlier values variable by variable) are read, the scene or sweep
+ * they describe is computed and `output` (HDF5) is written under a temporary
+ * name and renamed when complete; nothing is written on an error.
+ *   files, nfiles  the namelist files, as on the command line
+ *   output         the HDF5 file to write
+ *   flags          FRICTION_JOB_FORCE: overwrite an existing output;
+ *                  FRICTION_JOB_RESUME: a sweep reuses the checkpoints of an
+ *                  interrupted run (as --resume)
+ *   report         if not NULL, called (on rank 0) with progress, message
+ *                  "12 of 64 lines" and fraction in [0, 1], and with notes
+ *                  (a verify result), fraction -1; user is passed through
+ * MPI: collective over MPI_COMM_WORLD when the caller has initialised MPI
+ * (every rank calls it with the same arguments); otherwise the library
+ * initialises MPI once (MPI_THREAD_FUNNELED), runs on this process alone and
+ * leaves MPI to the process's exit.  Unlike the other functions, call it from
+ * one thread at a time.  Returns FRICTION_OK, an error code, or
+ * FRICTION_INTERRUPTED. */
+enum { FRICTION_JOB_FORCE = 1, FRICTION_JOB_RESUME = 2 };
+typedef void (*friction_report_fn)(const char *message, double fraction, void *user);
+int friction_run_job(const char *const *files, int nfiles, const char *output, int flags,
+                     friction_report_fn report, void *user, friction_error *err);
 
 #ifdef __cplusplus
 }

@@ -3,6 +3,8 @@
     import friction_capi as fc
     fx, fy = fc.afm_line(potential="naf", v0=1.0, kx=10.0, ky=10.0, nx=128)
     run = fc.brake(t_end=100.0, dt_out=0.1)      # dict of numpy arrays t, x, v, y, w
+    fc.run_job(["inputs/naf.nml"], "naf.h5", force=True,
+               report=lambda message, fraction: print(message))   # the CLI's job, no MPI launcher
 
 Units are those of the namelist input (README: input reference).  A failed
 call raises FrictionError with the library's status and message.
@@ -18,9 +20,14 @@ import os
 
 import numpy as np
 
-__all__ = ["FrictionError", "library", "version", "afm_line", "brake"]
+__all__ = ["FrictionError", "library", "version", "afm_line", "brake", "run_job"]
 
 _double_array = np.ctypeslib.ndpointer(dtype=np.float64, flags="C_CONTIGUOUS")
+
+
+# void report(const char *message, double fraction, void *user)
+_REPORT = ctypes.CFUNCTYPE(None, ctypes.c_char_p, ctypes.c_double, ctypes.c_void_p)
+FORCE, RESUME = 1, 2
 
 
 class FrictionError(RuntimeError):
@@ -73,6 +80,9 @@ def _load():
     lib.friction_brake.argtypes = ([c_char_p] + [c_double] * 10 + [c_char_p, c_double, c_double]
                                    + [c_void_p] * 5 + [c_size_t, ctypes.POINTER(c_size_t), c_void_p])
     lib.friction_brake.restype = c_int
+    lib.friction_run_job.argtypes = [ctypes.POINTER(c_char_p), c_int, c_char_p, c_int, _REPORT, c_void_p,
+                                     c_void_p]
+    lib.friction_run_job.restype = c_int
     return lib
 
 
@@ -130,3 +140,17 @@ def brake(model="switched", xi=0.412, kappa=1.5, g_prime=0.01778, mu=0.59, mu_s=
     pointers = [out[key].ctypes.data_as(ctypes.c_void_p) for key in ("t", "x", "v", "y", "w")]
     _call(library.friction_brake, *args, *pointers, needed.value, None)
     return out
+
+
+def run_job(files, output, force=False, resume=False, report=None):
+    """Run a namelist job as the CLI does (friction.h: friction_run_job): read
+    `files` in order, compute, write `output`.  `report(message, fraction)` if
+    given receives progress (fraction in [0, 1]) and notes (fraction -1).  In
+    a process that has not initialised MPI the job runs on this process alone.
+    An interrupted sweep raises FrictionError with status 5."""
+    paths = [os.fsencode(os.fspath(path)) for path in files]
+    array = (ctypes.c_char_p * max(1, len(paths)))(*paths)
+    callback = _REPORT(lambda message, fraction, user: report(message.decode(errors="replace"), fraction)) \
+        if report is not None else _REPORT()
+    flags = (FORCE if force else 0) | (RESUME if resume else 0)
+    _call(library.friction_run_job, array, len(paths), os.fsencode(os.fspath(output)), flags, callback, None)

@@ -7,6 +7,9 @@ afm:   inputs/naf.nml with nx = 16, angle = 10, origin (0.7, 0.3) Å: the CLI's
        first trace and retrace line against `test_capi afm` (friction_afm_line).
 brake: inputs/brake.nml to t_end = 40, dt_out = 0.5 against `test_capi brake`
        (friction_brake).
+job:   friction_run_job (`test_capi job`) against the CLI on both scenes above:
+       every dataset and every attribute of the two files but the wall time
+       and the compute times must be equal.
 Both run the same kernel, so the numbers must agree to the last bit; the test
 allows 1e-12 relative in case a compiler reorders arithmetic.
 """
@@ -49,16 +52,62 @@ def compare(name, expected, actual):
     print(f"{name}: max |C API - CLI| = {difference:.3e} over {expected.size} values")
 
 
+# Attributes that measure the run rather than compute it.
+TIMINGS = {"wall_time", "compute_time", "check_compute_time"}
+
+
+def file_contents(path):
+    """Every dataset and attribute of an HDF5 file, by name."""
+    contents = {}
+
+    def visit(name, item):
+        if isinstance(item, h5py.Dataset):
+            contents[name] = item[()]
+        for key, value in item.attrs.items():
+            if key not in TIMINGS:
+                contents[f"{name}@{key}"] = value
+
+    with h5py.File(path, "r") as f:
+        for key, value in f.attrs.items():
+            if key not in TIMINGS:
+                contents[f"/@{key}"] = value
+        f.visititems(visit)
+    return contents
+
+
+def compare_jobs(args):
+    for scene, text in [("naf.nml", AFM), ("brake.nml", BRAKE)]:
+        override = os.path.join(args.workdir, "override-" + scene)
+        with open(override, "w") as f:
+            f.write(text)
+        inputs = [os.path.join(args.inputs, scene), override]
+        run([args.binary, "-q", "-o", "cli.h5", "--force"] + inputs, args.workdir)
+        run([args.capi, "job", "capi.h5"] + inputs, args.workdir)
+        cli = file_contents(os.path.join(args.workdir, "cli.h5"))
+        capi = file_contents(os.path.join(args.workdir, "capi.h5"))
+        if sorted(cli) != sorted(capi):
+            fail(f"{scene}: the files hold different items: {sorted(set(cli) ^ set(capi))}")
+        for name in cli:
+            a, b = np.asarray(cli[name]), np.asarray(capi[name])
+            if a.shape != b.shape or not np.array_equal(a, b):
+                fail(f"{scene}: {name} differs between friction_run_job and the CLI")
+        print(f"{scene}: friction_run_job and the CLI wrote the same {len(cli)} datasets and attributes")
+    print("1 passed, 0 failed")
+
+
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--binary", required=True)
     parser.add_argument("--capi", required=True)
     parser.add_argument("--inputs", required=True)
     parser.add_argument("--workdir", required=True)
-    parser.add_argument("case", choices=["afm", "brake"])
+    parser.add_argument("case", choices=["afm", "brake", "job"])
     args = parser.parse_args()
     shutil.rmtree(args.workdir, ignore_errors=True)
     os.makedirs(args.workdir)
+    if args.case == "job":
+        compare_jobs(args)
+        return
     override = os.path.join(args.workdir, "override.nml")
     with open(override, "w") as f:
         f.write(AFM if args.case == "afm" else BRAKE)

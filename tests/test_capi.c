@@ -4,8 +4,9 @@
  *   test_capi threads   two scan lines in two threads == one after another, bitwise
  *   test_capi afm       prints the scene of capi_test.py (trace then retrace): i fx fy
  *   test_capi brake     prints the brake of capi_test.py: t x v y w
+ *   test_capi job OUT FILE...   friction_run_job(FILE..., OUT); progress reports counted on stderr
  *
- * The last two are compared with the CLI's HDF5 output by capi_test.py.
+ * The last three are compared with the CLI's HDF5 output by capi_test.py.
  */
 #include <friction.h>
 
@@ -141,6 +142,19 @@ static int checks(void) {
   CHECK(friction_error_message(err, tiny, sizeof tiny) == FRICTION_ERROR_INPUT && strlen(tiny) == 7,
         "truncated message '%s'", tiny);
 
+  /* friction_run_job: bad arguments, then a file that is not there. */
+  {
+    const char *none[] = {NULL};
+    const char *missing[] = {"no-such-dir/missing.nml"};
+    expect_input_error(friction_run_job(NULL, 1, "out.h5", 0, NULL, NULL, err), err, "files", "run_job files NULL");
+    expect_input_error(friction_run_job(missing, 0, "out.h5", 0, NULL, NULL, err), err, "nfiles", "run_job nfiles 0");
+    expect_input_error(friction_run_job(missing, 1, NULL, 0, NULL, NULL, err), err, "output", "run_job output NULL");
+    expect_input_error(friction_run_job(none, 1, "out.h5", 0, NULL, NULL, err), err, "files[0]",
+                       "run_job files[0] NULL");
+    expect_input_error(friction_run_job(missing, 1, "out.h5", 8, NULL, NULL, err), err, "flags", "run_job flags");
+    expect_input_error(friction_run_job(missing, 1, "out.h5", 0, NULL, NULL, err), err, "missing.nml",
+                       "run_job missing file");
+  }
   friction_error_free(err);
   if (failures == 0) printf("checks: all passed\n");
   return failures != 0;
@@ -214,12 +228,54 @@ static int print_brake(void) {
   return 0;
 }
 
+struct reports {
+  int progress, notes;
+  double last_fraction;
+  int backwards;
+};
+
+static void count_report(const char *message, double fraction, void *user) {
+  struct reports *seen = user;
+  if (message == NULL) return;
+  if (fraction < 0.0) {
+    seen->notes++;
+    fprintf(stderr, "note: %s\n", message);
+    return;
+  }
+  if (fraction < seen->last_fraction) seen->backwards++;
+  seen->last_fraction = fraction;
+  seen->progress++;
+}
+
+/* friction_run_job on files argv[1..] writing argv[0]; the progress must
+ * reach 1 without going backwards. */
+static int run_job(int argc, char **argv) {
+  struct reports seen = {0, 0, 0.0, 0};
+  char message[512];
+  friction_error *err = friction_error_new();
+  if (argc < 2) return 2;
+  int status = friction_run_job((const char *const *)(argv + 1), argc - 1, argv[0], FRICTION_JOB_FORCE,
+                                count_report, &seen, err);
+  if (status != FRICTION_OK) {
+    friction_error_message(err, message, sizeof message);
+    fprintf(stderr, "friction_run_job: status %d: %s\n", status, message);
+    return 1;
+  }
+  CHECK(seen.progress > 0, "no progress reported");
+  CHECK(seen.backwards == 0, "progress went backwards %d times", seen.backwards);
+  CHECK(seen.last_fraction == 1.0, "progress ended at %g, not 1", seen.last_fraction);
+  fprintf(stderr, "job: %d progress reports, %d notes\n", seen.progress, seen.notes);
+  friction_error_free(err);
+  return failures != 0;
+}
+
 int main(int argc, char **argv) {
   const char *mode = argc > 1 ? argv[1] : "checks";
   if (strcmp(mode, "checks") == 0) return checks();
   if (strcmp(mode, "threads") == 0) return threads();
   if (strcmp(mode, "afm") == 0) return print_afm();
   if (strcmp(mode, "brake") == 0) return print_brake();
-  fprintf(stderr, "usage: test_capi checks|threads|afm|brake\n");
+  if (strcmp(mode, "job") == 0) return run_job(argc - 2, argv + 2);
+  fprintf(stderr, "usage: test_capi checks|threads|afm|brake|job OUT FILE...\n");
   return 2;
 }

@@ -6,7 +6,8 @@
 !> handle, so threads may call the API at once.
 module friction_capi
    use, intrinsic :: iso_c_binding, only: c_ptr, c_char, c_int, c_double, c_size_t, c_null_char, &
-      & c_associated, c_f_pointer, c_loc
+      & c_associated, c_f_pointer, c_loc, c_funptr, c_f_procpointer
+   use mpi_f08, only: MPI_Initialized, MPI_Init_thread, MPI_THREAD_FUNNELED, MPI_COMM_WORLD
    use friction_kinds, only: wp
    use friction_error, only: error_type, fatal_error, error_input
    use friction_version, only: version_string
@@ -17,17 +18,40 @@ module friction_capi
    use friction_brake_config, only: brake_config, model_names
    use friction_brake_simulate, only: brake_run
    use friction_strings, only: rtoa
+   use friction_job, only: run_job, job_reporter
    implicit none
    private
 
    public :: friction_version_c, friction_error_new, friction_error_free, friction_error_status, &
-      & friction_error_message, friction_afm_line, friction_brake
+      & friction_error_message, friction_afm_line, friction_brake, friction_run_job
 
    !> What an opaque `friction_error *` points to.
    type :: capi_error
       integer :: status = 0
       character(len=:), allocatable :: message
    end type capi_error
+
+   integer(c_int), parameter :: job_force = 1, job_resume = 2   !! friction_run_job flags
+
+   !> A job's progress and notes through the caller's C function (if any):
+   !> void report(const char *message, double fraction, void *user), with
+   !> fraction in [0, 1] for progress and -1 for a note.
+   type, extends(job_reporter) :: callback_reporter
+      procedure(report_function), pointer, nopass :: call => null()
+      type(c_ptr) :: user
+   contains
+      procedure :: progress => callback_progress
+      procedure :: note => callback_note
+   end type callback_reporter
+
+   abstract interface
+      subroutine report_function(message, fraction, user) bind(c)
+         import :: c_char, c_double, c_ptr
+         character(kind=c_char), intent(in) :: message(*)
+         real(c_double), value :: fraction
+         type(c_ptr), value :: user
+      end subroutine report_function
+   end interface
 
    interface
       pure function c_strlen(s) bind(c, name='strlen') result(n)
@@ -361,6 +385,90 @@ contains
       end if
       status = report(handle, error)
    end function friction_brake
+
+   !> int friction_run_job(const char *const *files, int nfiles, const char *output, int flags,
+   !>                      friction_report_fn report, void *user, friction_error *err)
+   !> The command line's job: namelist files in, an HDF5 file out.  Collective
+   !> over MPI_COMM_WORLD when the caller has initialised MPI; otherwise MPI
+   !> is initialised here (once, left for the process's exit) and the job runs
+   !> on this process alone.
+   integer(c_int) function friction_run_job(files, nfiles, output, flags, report_fn, user, handle) &
+      & bind(c, name='friction_run_job') result(status)
+      type(c_ptr), value :: files, output, user, handle
+      integer(c_int), value :: nfiles, flags
+      type(c_funptr), value :: report_fn
+      type(error_type), allocatable :: error
+      type(c_ptr), pointer :: names(:)
+      character(len=4096), allocatable :: paths(:)
+      character(len=:), allocatable :: summary, path
+      type(callback_reporter) :: reporter
+      logical :: ready
+      integer :: k, provided
+
+      allocate (paths(0))
+      if (.not. c_associated(files) .and. nfiles /= 0) then
+         call fatal_error(error, 'files is a null pointer', error_input)
+      else if (nfiles < 1) then
+         call fatal_error(error, 'nfiles = '//itoa(int(nfiles))//': give at least one namelist file', error_input)
+      else if (.not. c_associated(output)) then
+         call fatal_error(error, 'output is a null pointer', error_input)
+      else if (iand(flags, not(job_force + job_resume)) /= 0) then
+         call fatal_error(error, 'flags = '//itoa(int(flags))//': unknown bits (known: FRICTION_JOB_FORCE, ' &
+            & //'FRICTION_JOB_RESUME)', error_input)
+      else
+         call c_f_pointer(files, names, [nfiles])
+         deallocate (paths)
+         allocate (paths(nfiles))
+         do k = 1, nfiles
+            if (.not. c_associated(names(k))) then
+               call fatal_error(error, 'files['//itoa(k - 1)//'] is a null pointer', error_input)
+               exit
+            end if
+            path = c_string(names(k))
+            if (len(path) > len(paths)) then
+               call fatal_error(error, 'files['//itoa(k - 1)//'] is longer than '//itoa(len(paths)) &
+                  & //' characters', error_input)
+               exit
+            end if
+            paths(k) = path
+         end do
+      end if
+      if (allocated(error)) then
+         status = report(handle, error)
+         return
+      end if
+      call MPI_Initialized(ready)
+      if (.not. ready) call MPI_Init_thread(MPI_THREAD_FUNNELED, provided)
+      reporter%user = user
+      if (c_associated(report_fn)) call c_f_procpointer(report_fn, reporter%call)
+      call run_job(paths, c_string(output), iand(flags, job_force) /= 0, iand(flags, job_resume) /= 0, &
+         & MPI_COMM_WORLD, reporter, summary, error)
+      status = report(handle, error)
+   end function friction_run_job
+
+   subroutine callback_progress(self, done, total, what, last)
+      class(callback_reporter), intent(inout) :: self
+      real(wp), intent(in) :: done, total
+      character(len=*), intent(in) :: what
+      logical, intent(in) :: last
+      character(len=120) :: text
+
+      if (.not. associated(self%call)) return
+      if (what == 'tau') then
+         write (text, '(a, f0.1, a, f0.1)') 'τ = ', done, ' of ', total
+      else
+         write (text, '(i0, a, i0, a)') nint(done), ' of ', nint(total), ' '//what
+      end if
+      call self%call(trim(text)//c_null_char, real(max(0.0_wp, min(1.0_wp, done / max(total, tiny(total)))), &
+         & c_double), self%user)
+   end subroutine callback_progress
+
+   subroutine callback_note(self, text)
+      class(callback_reporter), intent(inout) :: self
+      character(len=*), intent(in) :: text
+
+      if (associated(self%call)) call self%call(text//c_null_char, -1.0_c_double, self%user)
+   end subroutine callback_note
 
    pure function itoa(i) result(text)
       integer, intent(in) :: i
