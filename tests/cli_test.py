@@ -639,6 +639,89 @@ def case_sweep_ranks(args):
         fail(f"the sweep left files: {leftovers(args)}")
 
 
+# inputs/afm_sweep.nml made small: a 4 x 2 grid of (V0, velocity), 3 lines of 32 samples.
+AFM_SWEEP_SMALL = ("&scan nx = 32, ny = 3 /\n"
+                   "&sweep sweep_count = 4, sweep_values2 = 100.0, 1000.0 /\n")
+AFM_SWEEP_PER_POINT = ["values", "values2", "mean_friction", "max_force", "status"]
+
+
+def map_friction(path):
+    """The mean friction and maximum lateral force of a map file, reduced here
+    (independently of the program's sweep code): half the mean of trace minus
+    retrace f_along, and the largest |(fx, fy)| of either trip."""
+    with h5py.File(path, "r") as handle:
+        trace, retrace = handle["afm/trace"], handle["afm/retrace"]
+        friction = 0.5 * (np.mean(trace["f_along"][()]) - np.mean(retrace["f_along"][()]))
+        largest = max(np.max(np.hypot(trip["fx"][()], trip["fy"][()])) for trip in (trace, retrace))
+    return friction, largest
+
+
+def case_sweep_afm(args):
+    """An AFM sweep over two variables: 1, 2 and 3 ranks identical; each point
+    equals the plain run of its values reduced independently; the viscous
+    limit at small V0; an integer variable (scan.nx) swept."""
+    scene = os.path.join(args.inputs, "afm_sweep.nml")
+    small = write(args, "small.nml", AFM_SWEEP_SMALL)
+    runs = {}
+    for ranks in (1, 2, 3):
+        friction(args, "-o", f"a{ranks}.h5", scene, small, ranks=ranks)
+        with h5py.File(os.path.join(args.workdir, f"a{ranks}.h5"), "r") as handle:
+            runs[ranks] = {key: handle["sweep"][key][()] for key in AFM_SWEEP_PER_POINT}
+            if ranks == 1:
+                for key in ("mean_friction", "max_force"):
+                    if handle["sweep"][key].attrs["units"].decode() != "nN":
+                        fail(f"/sweep/{key} units {handle['sweep'][key].attrs['units']!r}")
+                if handle.attrs["sweep_variable2"].decode() != "scan.velocity":
+                    fail(f"sweep_variable2 attribute {handle.attrs['sweep_variable2']!r}")
+                shape = [int(np.ravel(handle["sweep"].attrs[key])[0]) for key in ("shape", "shape2")]
+                if shape != [4, 2]:
+                    fail("/sweep shape attributes are not 4 x 2")
+    first = runs[1]
+    if not np.all(first["status"] == 1):
+        fail(f"expected every point done, status {first['status']}")
+    # The grid: V0 over rows, velocity fastest.
+    v0 = np.geomspace(0.05, 2.0, 4)
+    if not (np.allclose(first["values"], np.repeat(v0, 2), rtol=1e-14) and
+            np.array_equal(first["values2"], np.tile([100.0, 1000.0], 4))):
+        fail(f"grid {first['values']} x {first['values2']}")
+    for ranks in (2, 3):
+        for key in AFM_SWEEP_PER_POINT:
+            if not np.array_equal(first[key], runs[ranks][key]):
+                fail(f"/sweep/{key} differs between 1 and {ranks} ranks")
+    # Points 1 (smooth sliding) and 8 (stick-slip) as plain runs.  The same
+    # kernel computes the same map; the reductions differ only in summation
+    # order, so 1e-12 relative.
+    for i in (0, 7):
+        point = write(args, f"point{i}.nml", f"&surface v0 = {float(first['values'][i])!r} /\n"
+                      f"&scan velocity = {float(first['values2'][i])!r} /\n&sweep sweep_variable = '' /\n")
+        friction(args, "-o", f"p{i}.h5", scene, small, point)
+        expected = map_friction(os.path.join(args.workdir, f"p{i}.h5"))
+        for name, want, got in zip(("mean_friction", "max_force"), expected,
+                                   (first["mean_friction"][i], first["max_force"][i])):
+            if not abs(got - want) <= 1e-12 * abs(want):
+                fail(f"point {i + 1}: {name} {got!r} from the sweep, {want!r} from the plain run")
+    # Smooth sliding (Tomlinson eta = 0.15 at V0 = 0.05 eV): the friction is the
+    # viscous c v, plus a second-order corrugation term (+1.1 % at 100 A/s,
+    # from the linear response c w^2 F0^2 / (2 v k^2)) minus the first sample's
+    # share (1 of 32, the tip starting at rest): within 5 %.
+    for i in (0, 1):
+        viscous = 1.0e-3 * first["values2"][i] * 1e-10 * 1e9
+        if not abs(first["mean_friction"][i] / viscous - 1.0) < 0.05:
+            fail(f"smooth sliding at {first['values2'][i]} A/s: friction {first['mean_friction'][i]} nN, "
+                 f"c v = {viscous} nN")
+    # Stick-slip (eta = 6 at V0 = 2 eV) dissipates far more than c v.
+    if not first["mean_friction"][6] > 50 * 1.0e-3 * 100.0 * 1e-10 * 1e9:
+        fail(f"stick-slip at V0 = 2 eV: friction {first['mean_friction'][6]} nN, not >> c v")
+    # An integer variable: the override must say nx = 16, not 1.6e1.
+    whole = write(args, "whole.nml", "&sweep sweep_variable = 'scan.nx', sweep_spacing = 'list',\n"
+                  " sweep_values = 16, 24, sweep_variable2 = '' /\n")
+    friction(args, "-o", "whole.h5", scene, small, whole)
+    with h5py.File(os.path.join(args.workdir, "whole.h5"), "r") as handle:
+        if not (np.all(handle["sweep/status"][()] == 1) and
+                np.array_equal(handle["sweep/values"][()], [16.0, 24.0])):
+            fail(f"integer sweep: status {handle['sweep/status'][()]}, values {handle['sweep/values'][()]}")
+
+
 def case_sweep_failure(args):
     """A point with an invalid override (mu above mu_s) and a point whose
     integration fails (a 1 ns wall-time budget) are recorded as failed with
@@ -772,7 +855,8 @@ def main():
         case_bad_sweep(args, args.case[len("bad-sweep-"):])
     elif args.case.startswith("sweep-"):
         {"sweep-ranks": case_sweep_ranks, "sweep-failure": case_sweep_failure,
-         "sweep-resume": case_sweep_resume, "sweep-signal": case_sweep_signal}[args.case](args)
+         "sweep-resume": case_sweep_resume, "sweep-signal": case_sweep_signal,
+         "sweep-afm": case_sweep_afm}[args.case](args)
     elif args.case.startswith("bad-brake-"):
         case_bad_brake(args, args.case[len("bad-brake-"):])
     elif args.case.startswith("bad-"):

@@ -44,3 +44,23 @@ add_test(NAME scripts.plot_sweep.not_a_sweep
           -- ${_fw_plot} "${CMAKE_CURRENT_BINARY_DIR}/scripts_brake/brake_short.h5")
 set_tests_properties(scripts.plot_sweep.not_a_sweep PROPERTIES
   FIXTURES_REQUIRED scripts_brake_run LABELS scripts)
+
+# An AFM sweep over two variables (inputs/afm_sweep.nml made small): friction plot.
+set(_fw_afm "${_fw_work}/afm_sweep_small.h5")
+add_test(NAME scripts.afm_sweep_run
+  COMMAND $<TARGET_FILE:friction_app> --quiet --force -o "${_fw_afm}"
+          "${_fs_inputs}/afm_sweep.nml" "${_fs_tests}/data/afm_sweep_small.nml"
+  WORKING_DIRECTORY "${_fw_work}")
+set_tests_properties(scripts.afm_sweep_run PROPERTIES FIXTURES_SETUP scripts_afm_sweep_run LABELS scripts)
+
+add_test(NAME scripts.plot_sweep.afm.run
+  COMMAND ${_fw_plot} "${_fw_afm}" -o "${_fw_work}/plots"
+  WORKING_DIRECTORY "${_fw_work}")
+set_tests_properties(scripts.plot_sweep.afm.run PROPERTIES
+  FIXTURES_REQUIRED scripts_afm_sweep_run FIXTURES_SETUP scripts_plot_afm_sweep LABELS scripts)
+
+add_test(NAME scripts.plot_sweep.afm.png
+  COMMAND ${Python3_EXECUTABLE} "${_fs_tests}/check_png.py" --newer-than "${_fw_afm}"
+          "${_fw_work}/plots/afm_sweep_small_friction.png")
+set_tests_properties(scripts.plot_sweep.afm.png PROPERTIES
+  FIXTURES_REQUIRED "scripts_afm_sweep_run;scripts_plot_afm_sweep" LABELS scripts)

@@ -164,6 +164,13 @@ contains
                end if
             end do
          end do
+         ! A list given again replaces the earlier list whole (not element by
+         ! element, which would keep an earlier, longer list's tail).
+         do k = 1, size(mentions)
+            if (mentions(k)%group /= 'sweep') cycle
+            if (mentions(k)%name == 'sweep_values') sweep_values = huge(1.0_wp)
+            if (mentions(k)%name == 'sweep_values2') sweep_values2 = huge(1.0_wp)
+         end do
          open (newunit=unit, file=trim(paths(ifile)), status='old', action='read', iostat=stat)
          do g = 1, size(group_names)
             rewind (unit)
