@@ -14,7 +14,10 @@ Measures and prints (not a test; nothing fails on a missed target):
   Points/s = points / the file's wall_time (whole run: start-up, input,
   every point, output); the median of --repeats runs.
 * Peak resident memory (VmHWM) of every rank, from /sweep/peak_memory_per_rank,
-  for a large sweep (--large points of a short brake run) on 1 and 2 ranks.
+  for a large sweep (--large points of a short brake run) on 1 and 2 ranks,
+  and for a large AFM sweep (inputs/afm_sweep.nml as a 32 x 32 grid of V0 and
+  velocity, --large points in all, small maps), with a quarter of the points
+  for comparison: memory per rank must not grow with the points.
 
 Usage (normally through scripts/benchmark_sweep, which builds first):
 
@@ -94,7 +97,18 @@ def main():
                 (workdir / "count.nml").write_text(f"&sweep sweep_count = {n} /\n")
                 _, wall, memory, _ = run(args, workdir, ranks, [sweep, workdir / "large.nml",
                                                                workdir / "count.nml"], "large.h5")
-                print(f"memory: {n:>5} points on {ranks} rank(s): VmHWM per rank "
+                print(f"memory: brake, {n:>5} points on {ranks} rank(s): VmHWM per rank "
+                      f"{', '.join(f'{m / 1024:.1f}' for m in memory)} MiB ({wall:.1f} s)")
+        afm = ROOT / "inputs" / "afm_sweep.nml"
+        side = int(np.sqrt(args.large))
+        for ranks in (1, 2):
+            for rows in (side // 4, side):
+                (workdir / "afm_large.nml").write_text(
+                    "&scan nx = 64, ny = 2 /\n"
+                    f"&sweep sweep_count = {rows}, sweep_spacing2 = 'log', sweep_from2 = 100.0,"
+                    f" sweep_to2 = 10000.0, sweep_count2 = {side} /\n")
+                _, wall, memory, _ = run(args, workdir, ranks, [afm, workdir / "afm_large.nml"], "afm_large.h5")
+                print(f"memory: AFM,   {rows * side:>5} points on {ranks} rank(s): VmHWM per rank "
                       f"{', '.join(f'{m / 1024:.1f}' for m in memory)} MiB ({wall:.1f} s)")
     return 0
 
