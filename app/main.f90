@@ -28,6 +28,7 @@ program friction_main
    use friction_brake_simulate, only: brake_run, brake_comparison, compare_runs
    use friction_brake_output, only: brake_run_summary, brake_check_summary, write_brake_file
    use friction_brake_diagnostics, only: brake_diagnostics, diagnose_brake
+   use friction_netlist_spice, only: spice_netlist, write_text_file
    implicit none
 
    interface
@@ -57,6 +58,7 @@ program friction_main
 
    type :: options
       character(len=:), allocatable :: output
+      character(len=:), allocatable :: netlist   !! --netlist FILE: write the network model, do not integrate
       logical :: force = .false.
       logical :: quiet = .false.
       logical :: resume = .false.
@@ -80,6 +82,10 @@ program friction_main
 
    call read_input(opts%files, config, input_text, error)
    if (allocated(error)) call fail(error)
+   if (allocated(opts%netlist)) then
+      call export_netlist()
+      call finish(0)
+   end if
    if (.not. allocated(opts%output)) opts%output = default_output(opts%files(1))
    if (file_exists(opts%output) .and. .not. (opts%force .or. (opts%resume .and. config%sweep%enabled))) then
       call fatal_error(error, opts%output//': the output file exists; use --force to overwrite it', &
@@ -833,6 +839,19 @@ contains
             i = i + 1
             call get_command_argument(i, arg)
             opts%output = trim(arg)
+         case ('--netlist')
+            if (i == n) then
+               code = usage_error('option --netlist needs a file name (the SPICE netlist to write)')
+               return
+            end if
+            i = i + 1
+            call get_command_argument(i, arg)
+            if (len_trim(arg) == 0 .or. arg(1:1) == '-') then
+               code = usage_error('option --netlist needs a file name (the SPICE netlist to write), not "' &
+                  & //trim(arg)//'"')
+               return
+            end if
+            opts%netlist = trim(arg)
          case ('-f', '--force')
             opts%force = .true.
          case ('-q', '--quiet')
@@ -881,12 +900,49 @@ contains
          & '  -q, --quiet        no progress or summary on stderr', &
          & '      --resume       sweeps: reuse the points an interrupted run completed', &
          & '                     (its checkpoints beside the output); overwrites the output', &
+         & '      --netlist FILE write the scene as a SPICE netlist for ngspice (the paper''s', &
+         & '                     network model) and exit without integrating: the brake', &
+         & '                     (arctan law), or line 0 (trace) of a NaF or HOPG map;', &
+         & '                     ngspice -b FILE writes FILE.data (README: Network model)', &
          & '  -h, --help         this help', &
          & '  -V, --version      the version', &
          & '', &
          & 'exit codes: 0 done, 2 usage, 3 bad input, 4 integration failed, 5 output failed,', &
          & '            6 sweep interrupted (file written with the points done; --resume)'
    end subroutine print_help
+
+   !> --netlist: the scene's network model to opts%netlist (rank 0), with its
+   !> waveforms going to the same name with .data for .cir.
+   subroutine export_netlist()
+      character(len=:), allocatable :: text, note, data_file
+      integer :: dot
+
+      dot = index(opts%netlist, '.', back=.true.)
+      if (dot > index(opts%netlist, '/', back=.true.) + 1) then
+         data_file = opts%netlist(1:dot - 1)//'.data'
+      else
+         data_file = opts%netlist//'.data'
+      end if
+      call spice_netlist(config, data_file, version_string, text, note, error)
+      if (allocated(error)) call fail(error)
+      if (file_exists(opts%netlist) .and. .not. opts%force) then
+         call fatal_error(error, opts%netlist//': the netlist file exists; use --force to overwrite it', &
+            & error_input)
+         call fail(error)
+      end if
+      if (rank == 0) call write_text_file(opts%netlist, text, error)
+      code = merge(1, 0, allocated(error))
+      call MPI_Bcast(code, 1, MPI_INTEGER, 0, MPI_COMM_WORLD)
+      if (code /= 0) then
+         if (rank == 0) call report(error)
+         call finish(exit_io)
+      end if
+      if (rank == 0 .and. .not. opts%quiet) then
+         if (len(note) > 0) write (error_unit, '(a)') 'friction: note: '//note
+         write (error_unit, '(a)') 'friction: wrote '//opts%netlist//' (run: ngspice -b '//opts%netlist// &
+            & '; waveforms to '//data_file//')'
+      end if
+   end subroutine export_netlist
 
    !> The name the output is written under until it is complete: unique per
    !> run (rank 0's process id), beside the output so the rename is atomic.
