@@ -21,8 +21,9 @@ Times:
 * kernel: the brake's /brake attribute compute_time (the integration alone);
   for the microscope the file's wall_time (input, set-up and the one line; the
   line dominates);
-* ngspice: its own "Transient analysis time" (rusage trantime, CPU seconds,
-  1 ms resolution) and the wall time of the whole ngspice process.
+* ngspice: its own reported "Transient analysis time" (rusage trantime, s,
+  1 ms resolution; called cpu_time in the records) and the wall time of the
+  whole ngspice process.
 Each is the median of --repeats runs.
 
 Tolerances: the kernel runs with the input's &integrator (or --kernel-method,
@@ -413,7 +414,7 @@ def compare(args) -> dict:
                 inputs, args.ladder, t_ref, ref, binary=args.binary, ngspice=args.ngspice, atol=args.atol,
                 window=tuple(args.window) if args.window else None, repeats=args.repeats, extra=extra,
                 workdir=workdir / "ladder")
-        record["matched_ngspice_cpu_time"] = matched_time(record["ladder"], record.get("kernel_error"))
+            record["matched_ngspice_cpu_time"] = matched_time(record["ladder"], record.get("kernel_error"))
     return record
 
 
