@@ -13,7 +13,7 @@ program friction_main
    use mpi_f08
    use friction_error, only: error_type, error_input, error_io, error_interrupted
    use friction_version, only: version_string
-   use friction_job, only: run_job, default_output
+   use friction_job, only: run_job, write_netlist, default_output
    use friction_app_terminal, only: terminal_reporter
    implicit none
 
@@ -29,6 +29,7 @@ program friction_main
 
    type :: options
       character(len=:), allocatable :: output
+      character(len=:), allocatable :: netlist   !! --netlist FILE: write the network model, do not integrate
       logical :: force = .false.
       logical :: quiet = .false.
       logical :: resume = .false.
@@ -47,10 +48,14 @@ program friction_main
 
    code = parse_arguments(opts)
    if (code >= 0) call finish(code)
-   if (.not. allocated(opts%output)) opts%output = default_output(opts%files(1))
    reporter%quiet = opts%quiet
-
-   call run_job(opts%files, opts%output, opts%force, opts%resume, MPI_COMM_WORLD, reporter, summary, error)
+   if (allocated(opts%netlist)) then
+      call write_netlist(opts%files, opts%netlist, opts%force, MPI_COMM_WORLD, reporter, summary, error)
+      opts%output = opts%netlist
+   else
+      if (.not. allocated(opts%output)) opts%output = default_output(opts%files(1))
+      call run_job(opts%files, opts%output, opts%force, opts%resume, MPI_COMM_WORLD, reporter, summary, error)
+   end if
    ! An interrupted sweep has written its file: say what it holds, then why it stopped.
    if (rank == 0 .and. .not. opts%quiet .and. allocated(summary)) &
       & write (error_unit, '(a)') 'friction: wrote '//opts%output//' ('//summary//')'
@@ -99,6 +104,19 @@ contains
             i = i + 1
             call get_command_argument(i, arg)
             opts%output = trim(arg)
+         case ('--netlist')
+            if (i == n) then
+               code = usage_error('option --netlist needs a file name (the SPICE netlist to write)')
+               return
+            end if
+            i = i + 1
+            call get_command_argument(i, arg)
+            if (len_trim(arg) == 0 .or. arg(1:1) == '-') then
+               code = usage_error('option --netlist needs a file name (the SPICE netlist to write), not "' &
+                  & //trim(arg)//'"')
+               return
+            end if
+            opts%netlist = trim(arg)
          case ('-f', '--force')
             opts%force = .true.
          case ('-q', '--quiet')
@@ -147,6 +165,10 @@ contains
          & '  -q, --quiet        no progress or summary on stderr', &
          & '      --resume       sweeps: reuse the points an interrupted run completed', &
          & '                     (its checkpoints beside the output); overwrites the output', &
+         & '      --netlist FILE write the scene as a SPICE netlist for ngspice (the paper''s', &
+         & '                     network model) and exit without integrating: the brake', &
+         & '                     (arctan law), or line 0 (trace) of a NaF or HOPG map;', &
+         & '                     ngspice -b FILE writes FILE.data (README: Network model)', &
          & '  -h, --help         this help', &
          & '  -V, --version      the version', &
          & '', &

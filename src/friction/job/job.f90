@@ -8,6 +8,8 @@ module friction_job
    use friction_error, only: error_type, fatal_error, error_input
    use friction_io_input, only: job_config, read_input
    use friction_io_files, only: file_exists
+   use friction_version, only: version_string
+   use friction_netlist_spice, only: spice_netlist, write_text_file
    use friction_job_report, only: job_reporter
    use friction_job_common, only: job_context, agree_on_error, check_writable, default_output
    use friction_job_afm, only: run_afm_job
@@ -16,7 +18,7 @@ module friction_job
    implicit none
    private
 
-   public :: run_job, job_reporter, default_output
+   public :: run_job, write_netlist, job_reporter, default_output
 
 contains
 
@@ -73,5 +75,46 @@ contains
          call run_afm_job(job, config%afm, reporter, summary, error)
       end if
    end subroutine run_job
+
+   !> The scene of `files` as a SPICE netlist for ngspice (the paper's
+   !> network model, README: Network model) in `path`, its waveforms going to
+   !> the same name with .data; nothing is integrated.  Rank 0 writes; every
+   !> rank returns the same error or none.  `summary` says what was written.
+   subroutine write_netlist(files, path, force, comm, reporter, summary, error)
+      character(len=*), intent(in) :: files(:)
+      character(len=*), intent(in) :: path
+      logical, intent(in) :: force
+      type(MPI_Comm), intent(in) :: comm
+      class(job_reporter), intent(inout) :: reporter
+      character(len=:), allocatable, intent(out) :: summary
+      type(error_type), allocatable, intent(out) :: error
+      type(job_context) :: job
+      type(job_config) :: config
+      character(len=:), allocatable :: text, note, data_file
+      integer :: dot
+
+      job%comm = comm
+      call MPI_Comm_rank(comm, job%rank)
+      call MPI_Comm_size(comm, job%nranks)
+      call read_input(files, config, job%input_text, error)
+      if (allocated(error)) return
+      dot = index(path, '.', back=.true.)
+      if (dot > index(path, '/', back=.true.) + 1) then
+         data_file = path(1:dot - 1)//'.data'
+      else
+         data_file = path//'.data'
+      end if
+      call spice_netlist(config, data_file, version_string, text, note, error)
+      if (allocated(error)) return
+      if (file_exists(path) .and. .not. force) then
+         call fatal_error(error, path//': the netlist file exists; use --force to overwrite it', error_input)
+         return
+      end if
+      if (job%rank == 0) call write_text_file(path, text, error)
+      call agree_on_error(job, error)
+      if (allocated(error)) return
+      if (job%rank == 0 .and. len(note) > 0) call reporter%note('note: '//note)
+      summary = 'run: ngspice -b '//path//'; waveforms to '//data_file
+   end subroutine write_netlist
 
 end module friction_job
