@@ -141,73 +141,64 @@ contains
       class(lj_potential), intent(in) :: self
       real(wp), intent(in) :: r(3)
       real(wp) :: v
-      real(wp) :: d(3), r2, rc2, s6
-      integer :: lo(2), hi(2), cx, cy, i, s
+      real(wp) :: g(3), h(3, 3)
 
-      v = 0.0_wp
-      rc2 = merge(self%cutoff**2, huge(1.0_wp), self%cutoff > 0.0_wp)
-      call self%cell_range(r, lo, hi)
-      do cy = lo(2), hi(2)
-         do cx = lo(1), hi(1)
-            do i = self%cell_start(cx + cy * self%ncell(1) + 1), self%cell_start(cx + cy * self%ncell(1) + 2) - 1
-               d = r - self%position(:, i)
-               r2 = d(1)**2 + d(2)**2 + d(3)**2
-               if (r2 >= rc2) cycle
-               s = self%species(i)
-               s6 = (self%sigma(s)**2 / r2)**3
-               v = v + 4.0_wp * self%epsilon(s) * (s6 * s6 - s6)
-            end do
-         end do
-      end do
+      call sum_pairs(self, r, 0, v, g, h)
    end function energy
 
-   !> dV/dr = Σ -24ε (2 s¹² - s⁶)/r² d, with s = σ/r and d = r - r_i.
    pure subroutine gradient(self, r, g)
       class(lj_potential), intent(in) :: self
       real(wp), intent(in) :: r(3)
       real(wp), intent(out) :: g(3)
-      real(wp) :: d(3), r2, rc2, s6, factor
-      integer :: lo(2), hi(2), cx, cy, i, s
+      real(wp) :: v, h(3, 3)
 
-      g = 0.0_wp
-      rc2 = merge(self%cutoff**2, huge(1.0_wp), self%cutoff > 0.0_wp)
-      call self%cell_range(r, lo, hi)
-      do cy = lo(2), hi(2)
-         do cx = lo(1), hi(1)
-            do i = self%cell_start(cx + cy * self%ncell(1) + 1), self%cell_start(cx + cy * self%ncell(1) + 2) - 1
-               d = r - self%position(:, i)
-               r2 = d(1)**2 + d(2)**2 + d(3)**2
-               if (r2 >= rc2) cycle
-               s = self%species(i)
-               s6 = (self%sigma(s)**2 / r2)**3
-               factor = -24.0_wp * self%epsilon(s) * (2.0_wp * s6 * s6 - s6) / r2
-               g = g + factor * d
-            end do
-         end do
-      end do
+      call sum_pairs(self, r, 1, v, g, h)
    end subroutine gradient
 
-   !> d²V/dr_a dr_b = Σ [f δ_ab + 2 f' d_a d_b] with the pair gradient f d,
-   !> f = -24ε(2s¹² - s⁶)/r² and f' = df/d(r²) = 24ε(14s¹² - 4s⁶)/r⁴.
    pure subroutine hessian(self, r, h)
       class(lj_potential), intent(in) :: self
       real(wp), intent(in) :: r(3)
       real(wp), intent(out) :: h(3, 3)
-      real(wp) :: d(3), r2, rc2, s6, f, df
-      integer :: lo(2), hi(2), cx, cy, i, s, a
+      real(wp) :: v, g(3)
 
+      call sum_pairs(self, r, 2, v, g, h)
+   end subroutine hessian
+
+   !> The pair sums over the atoms within the cutoff of r: `order` 0 the
+   !> energy V, 1 the gradient, 2 the gradient and the Hessian, with s = σ/r,
+   !> d = r - r_i:
+   !>   V = Σ 4ε (s¹² - s⁶),   dV/dr = Σ f d,  f = -24ε(2s¹² - s⁶)/r²,
+   !>   d²V/dr_a dr_b = Σ [f δ_ab + 2 f' d_a d_b],  f' = df/d(r²) = 24ε(14s¹² - 4s⁶)/r⁴.
+   !> One loop for all three, so they cannot disagree on which atoms count.
+   pure subroutine sum_pairs(self, r, order, v, g, h)
+      class(lj_potential), intent(in) :: self
+      real(wp), intent(in) :: r(3)
+      integer, intent(in) :: order
+      real(wp), intent(out) :: v, g(3), h(3, 3)
+      real(wp) :: d(3), r2, rc2, s6, f, df
+      integer :: lo(2), hi(2), cx, cy, i, s, a, c
+
+      v = 0.0_wp
+      g = 0.0_wp
       h = 0.0_wp
       rc2 = merge(self%cutoff**2, huge(1.0_wp), self%cutoff > 0.0_wp)
       call self%cell_range(r, lo, hi)
       do cy = lo(2), hi(2)
          do cx = lo(1), hi(1)
-            do i = self%cell_start(cx + cy * self%ncell(1) + 1), self%cell_start(cx + cy * self%ncell(1) + 2) - 1
+            c = cx + cy * self%ncell(1) + 1
+            do i = self%cell_start(c), self%cell_start(c + 1) - 1
                d = r - self%position(:, i)
                r2 = d(1)**2 + d(2)**2 + d(3)**2
                if (r2 >= rc2) cycle
                s = self%species(i)
                s6 = (self%sigma(s)**2 / r2)**3
+               if (order == 0) then   ! (the energy only when asked: the gradient is the hot path)
+                  v = v + 4.0_wp * self%epsilon(s) * (s6 * s6 - s6)
+                  cycle
+               end if
                f = -24.0_wp * self%epsilon(s) * (2.0_wp * s6 * s6 - s6) / r2
+               g = g + f * d
+               if (order < 2) cycle
                ! s6 ~ r2^-3, so d(s6)/d(r2) = -3 s6/r2 and d(s12)/d(r2) = -6 s12/r2.
                df = 24.0_wp * self%epsilon(s) * (14.0_wp * s6 * s6 - 4.0_wp * s6) / r2**2
                do a = 1, 3
@@ -217,7 +208,7 @@ contains
             end do
          end do
       end do
-   end subroutine hessian
+   end subroutine sum_pairs
 
    pure function dimensions(self) result(n)
       class(lj_potential), intent(in) :: self
