@@ -21,6 +21,7 @@ program friction_main
    use friction_ode_solver, only: integrator_statistics
    use friction_afm_scan, only: afm_scanner, trip_record, share_of, n_quantities
    use friction_afm_output, only: write_afm_file, afm_surface_record
+   use friction_afm_validity, only: afm_model_warnings
    use friction_io_run_summary, only: run_summary
    use friction_afm_config, only: new_potential, species_count
    use friction_surface_potential, only: surface_potential
@@ -94,6 +95,10 @@ program friction_main
       if (rank == 0) call report(error)
       call finish(exit_io)
    end if
+
+   ! A reduced tip model outside where it holds (README: Reduced models (AFM)).
+   if (rank == 0 .and. config%scene == 'afm' .and. .not. config%sweep%enabled) &
+      & call warn(afm_model_warnings(config%afm))
 
    if (config%sweep%enabled) then
       call run_sweep()
@@ -954,6 +959,20 @@ contains
       if (dot > 1) name = name(1:dot - 1)
       name = name//'.h5'
    end function default_output
+
+   !> Each line of text as a warning on stderr.
+   subroutine warn(text)
+      character(len=*), intent(in) :: text
+      integer :: start, end
+
+      start = 1
+      do while (start <= len(text))
+         end = index(text(start:), new_line('a'))
+         end = merge(len(text), start + end - 2, end == 0)
+         write (error_unit, '(a)') 'friction: warning: '//text(start:end)
+         start = end + 2
+      end do
+   end subroutine warn
 
    subroutine report(error)
       type(error_type), intent(in) :: error
