@@ -4,6 +4,7 @@
     cli_test.py --binary BIN --mpiexec MPIEXEC --inputs DIR --workdir DIR CASE
 
 Cases: datasets-naf, datasets-hopg, ranks, override, force, numerical-failure, models,
+quasistatic-failure,
 and bad-<name> for each bad input in BAD_INPUTS; for the brake scene
 brake-run, brake-ranks, brake-dimensional, brake-verify, brake-failure, brake-analysis and
 bad-brake-<name> for each bad input in BAD_BRAKE_INPUTS; for sweeps sweep-ranks,
@@ -241,6 +242,21 @@ def case_models(args):
         if set(shapes["inertial"]) - set(shapes[model]) or extra - {"jumps"} or \
                 any(shapes[model][k] != shapes["inertial"][k] for k in shapes["inertial"]):
             fail(f"{model} datasets differ from the inertial ones: {shapes[model]} vs {shapes['inertial']}")
+
+
+def case_quasistatic_failure(args):
+    """A relaxation of the quasistatic tip that runs out of steps: exit 4, one
+    message saying where, nothing written."""
+    small = write(args, "small.nml", SMALL)
+    limit = write(args, "limit.nml", "&tip model = 'quasistatic' /\n&integrator max_steps = 3 /\n")
+    result = friction(args, os.path.join(args.inputs, "naf.nml"), small, limit, ranks=2, expect=4)
+    for word in ["max_steps", "t = ", "relaxing the quasistatic tip", "line", "support at"]:
+        if word not in result.stderr:
+            fail(f"failure message lacks {word!r}: {result.stderr}")
+    if result.stderr.count("friction: error:") != 1:
+        fail("expected exactly one error message: " + result.stderr)
+    if leftovers(args):
+        fail(f"a failed run left files: {leftovers(args)}")
 
 
 def case_graphite(args):
@@ -819,7 +835,7 @@ def main():
     else:
         {"ranks": case_ranks, "override": case_override, "force": case_force,
          "numerical-failure": case_numerical_failure, "wall-time": case_wall_time,
-         "graphite": case_graphite, "models": case_models,
+         "graphite": case_graphite, "models": case_models, "quasistatic-failure": case_quasistatic_failure,
          "graphite-ranks": case_graphite_ranks, "graphite-defects": case_graphite_defects}[args.case](args)
     print("1 passed, 0 failed")
 

@@ -390,7 +390,8 @@ contains
          if (.not. allocated(error) .and. .not. ok) call fatal_error(error, 'quasistatic: the tip found no ' &
             & //'minimum in '//rtoa(10.0_wp * max_stretches * tau)//' s of relaxation', error_numerical)
          if (allocated(error)) then
-            error%message = error%message//' (relaxing after a jump)'
+            error%message = error%message//' (relaxing the quasistatic tip into a minimum; t counts from ' &
+               & //'the start of the relaxation)'
          else
             u = minimum
          end if
