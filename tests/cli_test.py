@@ -3,7 +3,8 @@
 
     cli_test.py --binary BIN --mpiexec MPIEXEC --inputs DIR --workdir DIR CASE
 
-Cases: datasets-naf, datasets-hopg, ranks, override, force, numerical-failure,
+Cases: datasets-naf, datasets-hopg, ranks, override, force, numerical-failure, models,
+quasistatic-failure,
 and bad-<name> for each bad input in BAD_INPUTS; for the brake scene
 brake-run, brake-ranks, brake-dimensional, brake-verify, brake-failure, brake-analysis and
 bad-brake-<name> for each bad input in BAD_BRAKE_INPUTS; for sweeps sweep-ranks,
@@ -65,6 +66,13 @@ BAD_INPUTS = {
     "xyz-species": ("&surface potential = 'lj', net = 'file', net_file = 'net.xyz' /\n", 3,
                     ["net.xyz:3", "unknown species 'Au'"]),
     "unknown-option": (None, 2, ["--frobnicate"]),
+    # The reduced tip models (README: Reduced models (AFM)).
+    "tip-model-unknown": ("&tip model = 'massless' /\n", 3,
+                          ["bad.nml:1", "&tip", "model", "massless", "quasistatic"]),
+    "overdamped-no-damping": ("&tip\n  model = 'overdamped'\n  cy = 0.0\n/\n", 3,
+                              ["bad.nml:3", "&tip", "cy", "> 0", "overdamped"]),
+    "overdamped-no-damping-z": ("&surface potential = 'lj' /\n&tip model = 'overdamped', cz = 0.0 /\n", 3,
+                                ["bad.nml:2", "&tip", "cz", "overdamped"]),
 }
 
 DOCUMENTED = ["fx", "fy", "f_along", "f_across", "tip_x", "tip_y"]
@@ -197,6 +205,58 @@ def case_datasets(args, scene):
 
 
 GRAPHITE_SMALL = "&surface shells = 4 /\n&scan nx = 12, ny = 3, length = 2.0 /\n"
+
+
+def case_models(args):
+    """Each tip model on a small NaF map: the same datasets, the model
+    recorded, the quasistatic jumps, and the warnings on stderr."""
+    small = write(args, "small.nml", SMALL)
+    naf = os.path.join(args.inputs, "naf.nml")
+    shapes = {}
+    for model in ("inertial", "overdamped", "quasistatic"):
+        choice = write(args, f"{model}.nml", f"&tip model = '{model}' /\n")
+        result = friction(args, "-o", f"{model}.h5", naf, small, choice, ranks=2)
+        warnings = [line for line in result.stderr.splitlines() if line.startswith("friction: warning:")]
+        # NaF at 400 Å/s: c v = 0.04 nN is 1.8 % of the surface force (quasistatic
+        # warns); Q = sqrt(m k)/c = 0.32 (the overdamped model holds).
+        if model == "quasistatic":
+            if not any("viscous drag" in line for line in warnings):
+                fail(f"no drag warning for the quasistatic model: {result.stderr!r}")
+        elif warnings:
+            fail(f"{model}: unexpected warnings {warnings}")
+        with h5py.File(os.path.join(args.workdir, f"{model}.h5"), "r") as f:
+            if f["afm"].attrs["model"].decode() != model:
+                fail(f"/afm model attribute is {f['afm'].attrs['model']!r}, expected {model}")
+            if f'MODEL="{model.upper()}"' not in f.attrs["input"].decode().replace(" ", "").upper():
+                fail("the resolved input does not show the model")
+            shapes[model] = {name: f[f"afm/trace/{name}"].shape for name in f["afm/trace"]}
+            friction_lines = f["afm/friction"][()]
+            if not np.all(np.isfinite(friction_lines)) or not np.all(friction_lines > 0):
+                fail(f"{model}: friction not positive and finite: {friction_lines}")
+            if model == "quasistatic":
+                jumps = f["afm/trace/jumps"][()]
+                if jumps.shape != (7, 24) or jumps.sum() < 7 or np.any(jumps != np.round(jumps)):
+                    fail(f"implausible jump counts {jumps}")
+    for model in ("overdamped", "quasistatic"):
+        extra = set(shapes[model]) - set(shapes["inertial"])
+        if set(shapes["inertial"]) - set(shapes[model]) or extra - {"jumps"} or \
+                any(shapes[model][k] != shapes["inertial"][k] for k in shapes["inertial"]):
+            fail(f"{model} datasets differ from the inertial ones: {shapes[model]} vs {shapes['inertial']}")
+
+
+def case_quasistatic_failure(args):
+    """A relaxation of the quasistatic tip that runs out of steps: exit 4, one
+    message saying where, nothing written."""
+    small = write(args, "small.nml", SMALL)
+    limit = write(args, "limit.nml", "&tip model = 'quasistatic' /\n&integrator max_steps = 3 /\n")
+    result = friction(args, os.path.join(args.inputs, "naf.nml"), small, limit, ranks=2, expect=4)
+    for word in ["max_steps", "t = ", "relaxing the quasistatic tip", "line", "support at"]:
+        if word not in result.stderr:
+            fail(f"failure message lacks {word!r}: {result.stderr}")
+    if result.stderr.count("friction: error:") != 1:
+        fail("expected exactly one error message: " + result.stderr)
+    if leftovers(args):
+        fail(f"a failed run left files: {leftovers(args)}")
 
 
 def case_graphite(args):
@@ -868,7 +928,7 @@ def main():
     else:
         {"ranks": case_ranks, "override": case_override, "force": case_force,
          "numerical-failure": case_numerical_failure, "wall-time": case_wall_time,
-         "graphite": case_graphite,
+         "graphite": case_graphite, "models": case_models, "quasistatic-failure": case_quasistatic_failure,
          "graphite-ranks": case_graphite_ranks, "graphite-defects": case_graphite_defects}[args.case](args)
     print("1 passed, 0 failed")
 

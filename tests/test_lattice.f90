@@ -10,7 +10,7 @@ program test_lattice
       & cutoff_for_tolerance
    use friction_surface_potential, only: surface_potential
    use friction_afm_config, only: afm_config, new_potential
-   use friction_afm_scan, only: afm_scanner, trip_record, q_fx, q_fy, q_fz
+   use friction_afm_scan, only: afm_scanner, trip_record, q_fx, q_fy, q_fz, n_quantities
    use testing, only: test_suite, check, check_close
    implicit none
 
@@ -309,7 +309,7 @@ contains
 
       call new_potential(c, potential, error)
       if (.not. allocated(error)) call scanner%init(c, potential, error)
-      allocate (values(c%nx, c%ny, 8))
+      allocate (values(c%nx, c%ny, n_quantities))
       do j = 1, c%ny
          if (.not. allocated(error)) call scanner%run_trip(j - 1, .true., trip, error)
          if (.not. allocated(error)) values(:, j, :) = trip%values

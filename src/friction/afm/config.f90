@@ -11,15 +11,19 @@ module friction_afm_config
    use friction_surface_net, only: crystal_net, graphite_net, square_net, read_xyz
    use friction_surface_lennard_jones, only: new_lj_potential, cutoff_for_tolerance
    use friction_kinds, only: ev_per_angstrom_to_nn
-   use friction_afm_tip, only: afm_tip
+   use friction_afm_tip, only: afm_tip, model_inertial, model_overdamped, model_quasistatic
    implicit none
    private
 
-   public :: afm_config, potential_names, net_names, new_potential, new_tip, net_sites, max_species, &
+   public :: afm_config, potential_names, net_names, tip_model_names, new_potential, new_tip, net_sites, max_species, &
       & max_defects, species_count
 
    character(len=*), parameter :: potential_names(3) = [character(len=4) :: 'naf', 'hopg', 'lj']
    character(len=*), parameter :: net_names(3) = [character(len=8) :: 'graphite', 'square', 'file']
+   !> &tip model: the full equations of motion, without inertia, or the
+   !> equilibrium followed (README: Reduced models (AFM)).
+   character(len=*), parameter :: tip_model_names(3) = [character(len=11) :: 'inertial', 'overdamped', &
+      & 'quasistatic']
    integer, parameter :: max_species = 8, max_defects = 64
 
    type :: afm_config
@@ -45,6 +49,7 @@ module friction_afm_config
       real(wp) :: cutoff = 0.0_wp            !! Å; 0: from cutoff_tolerance
       real(wp) :: cutoff_tolerance = 1.0e-4_wp   !! largest force of the atoms beyond the cutoff, nN
       ! &tip
+      character(len=16) :: model = 'inertial'   !! 'inertial', 'overdamped' or 'quasistatic'
       real(wp) :: mass = 1.0e-8_wp     !! kg
       real(wp) :: kx = 10.0_wp         !! N/m
       real(wp) :: ky = 10.0_wp         !! N/m
@@ -206,7 +211,11 @@ contains
    end subroutine new_potential
 
    !> The tip model in internal units around a potential; the support path
-   !> is set per trip.
+   !> is set per trip.  The quasistatic model uses the damping only to relax
+   !> the tip into a new minimum after a jump (friction_afm_scan): with
+   !> damping in every moving direction that is the overdamped motion at a
+   !> fixed support; with none in some direction, plain steepest descent of
+   !> the total energy (the same damping, 1e-3 N s/m, in every direction).
    subroutine new_tip(config, potential, tip)
       type(afm_config), intent(in) :: config
       class(surface_potential), intent(in) :: potential
@@ -217,6 +226,15 @@ contains
       tip%mass = config%mass * kg_to_internal
       tip%spring = [config%kx, config%ky, config%kz] * n_per_m_to_internal
       tip%damping = [config%cx, config%cy, config%cz] * ns_per_m_to_internal
+      select case (trim(config%model))
+      case ('overdamped')
+         tip%model = model_overdamped
+      case ('quasistatic')
+         tip%model = model_quasistatic
+         if (.not. all(tip%damping(1:tip%ndim) > 0.0_wp)) tip%damping = 1.0e-3_wp * ns_per_m_to_internal
+      case default
+         tip%model = model_inertial
+      end select
    end subroutine new_tip
 
 end module friction_afm_config

@@ -6,7 +6,7 @@ module friction_afm_output
    use friction_error, only: error_type
    use friction_ode_solver, only: integrator_statistics
    use friction_afm_config, only: afm_config
-   use friction_afm_scan, only: quantity_names, quantity_units, quantity_count, q_f_along, &
+   use friction_afm_scan, only: quantity_names, quantity_units, quantity_count, q_f_along, q_jumps, &
       & support_along, support_across
    use friction_io_h5_file, only: h5_file
    use friction_io_run_summary, only: run_summary, write_run_attributes
@@ -68,6 +68,7 @@ contains
 
       call file%create_group('/afm')
       call file%write_attribute_text('/afm', 'potential', trim(config%potential))
+      call file%write_attribute_text('/afm', 'model', trim(config%model))
       call file%write_attribute_real('/afm', 'angle', config%angle)
       call file%write_attribute_real('/afm', 'origin_x', config%origin_x)
       call file%write_attribute_real('/afm', 'origin_y', config%origin_y)
@@ -102,6 +103,8 @@ contains
             call file%write_line_block(group//'/'//trim(quantity_names(q)), values(:, :, q), &
                & config%ny, first, stride, trim(quantity_units(q)))
          end do
+         if (config%model == 'quasistatic') call file%write_line_block(group//'/'//trim(quantity_names(q_jumps)), &
+            & values(:, :, q_jumps), config%ny, first, stride, trim(quantity_units(q_jumps)))
       end subroutine write_trips
 
    end subroutine write_afm_file

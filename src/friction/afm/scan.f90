@@ -6,31 +6,50 @@
 !> moves the support from s = -lead_in to s = length; a retrace trip from
 !> s = length + lead_in back to 0; samples are stored by i either way, so
 !> trace and retrace share the support_x axis.  Each trip starts with the tip
-!> at the support and at rest (paper §3.1, §5.1).
+!> at the support and at rest (paper §3.1, §5.1); the quasistatic tip starts
+!> in the minimum it relaxes into from there.
+!>
+!> The reduced models (README: Reduced models (AFM)): the overdamped tip is
+!> integrated like the full one (friction_afm_tip); the quasistatic tip is
+!> followed from sample to sample along its minimum of the total energy
+!> (friction_afm_quasistatic), and jumps to the next minimum where its own
+!> disappears (see follow).
 module friction_afm_scan
    use friction_kinds, only: wp, i8, pi, ev_per_angstrom_to_nn
    use friction_error, only: error_type, fatal_error, error_input, error_numerical
    use friction_ode_solver, only: ode_solver, integrator_statistics
    use friction_afm_config, only: afm_config, new_tip
-   use friction_afm_tip, only: afm_tip
+   use friction_afm_tip, only: afm_tip, model_inertial, model_quasistatic
+   use friction_afm_quasistatic, only: newton_equilibrium, equilibrium_tangent
    use friction_surface_potential, only: surface_potential
    use friction_strings, only: rtoa
    implicit none
    private
 
    public :: afm_scanner, trip_record, quantity_names, quantity_units, n_quantities, quantity_count
-   public :: q_fx, q_fy, q_f_along, q_f_across, q_tip_x, q_tip_y, q_fz, q_tip_z
-   public :: support_along, support_across, share_of
+   public :: q_fx, q_fy, q_f_along, q_f_across, q_tip_x, q_tip_y, q_fz, q_tip_z, q_jumps
+   public :: support_along, support_across, share_of, find_height
 
-   integer, parameter :: n_quantities = 8
+   integer, parameter :: n_quantities = 9
    integer, parameter :: q_fx = 1, q_fy = 2, q_f_along = 3, q_f_across = 4, q_tip_x = 5, q_tip_y = 6, &
-      & q_fz = 7, q_tip_z = 8
-   !> HDF5 dataset names and units of the recorded quantities; the last two
-   !> only for a tip that moves in z.
+      & q_fz = 7, q_tip_z = 8, q_jumps = 9
+   !> HDF5 dataset names and units of the recorded quantities; fz and tip_z
+   !> only for a tip that moves in z; jumps (those of the quasistatic tip
+   !> since the previous sample) only for the quasistatic model.
    character(len=*), parameter :: quantity_names(n_quantities) = [character(len=8) :: &
-      & 'fx', 'fy', 'f_along', 'f_across', 'tip_x', 'tip_y', 'fz', 'tip_z']
+      & 'fx', 'fy', 'f_along', 'f_across', 'tip_x', 'tip_y', 'fz', 'tip_z', 'jumps']
    character(len=*), parameter :: quantity_units(n_quantities) = [character(len=8) :: &
-      & 'nN', 'nN', 'nN', 'nN', 'angstrom', 'angstrom', 'nN', 'angstrom']
+      & 'nN', 'nN', 'nN', 'nN', 'angstrom', 'angstrom', 'nN', 'angstrom', '1']
+
+   !> Quasistatic tracking (see follow): the support travel, Å, to which a
+   !> fold is located (the force near a fold varies like the square root of
+   !> the distance to it: ~1e-4 nN here); the push, Å, that starts the tip
+   !> off the vanished minimum (small against any lattice period, large
+   !> against the ~sqrt(fold_resolution) ghost of the minimum); how close,
+   !> Å, the relaxed state must be to the minimum Newton's method finds from
+   !> it; relaxation stretches (of 10 relaxation times) before giving up.
+   real(wp), parameter :: fold_resolution = 1.0e-9_wp, jump_push = 0.05_wp, landing_distance = 0.05_wp
+   integer, parameter :: max_stretches = 100000
 
    !> One trip's samples: values(i, q) for sample i and quantity q (output units).
    type :: trip_record
@@ -50,15 +69,17 @@ module friction_afm_scan
       procedure :: init
       procedure :: run_trip
       procedure :: statistics
+      procedure, private :: follow
+      procedure, private :: relax
    end type afm_scanner
 
 contains
 
-   !> Quantities recorded for a tip moving in ndim dimensions.
+   !> Quantities recorded for a tip moving in ndim dimensions (jumps apart).
    pure integer function quantity_count(ndim)
       integer, intent(in) :: ndim
 
-      quantity_count = merge(n_quantities, q_tip_y, ndim == 3)
+      quantity_count = merge(q_tip_z, q_tip_y, ndim == 3)
    end function quantity_count
 
    !> Support positions along the line, Å.
@@ -117,11 +138,17 @@ contains
          if (allocated(error)) return
          self%support_height = self%contact_height + config%support_z
       end if
-      ! First step: a small fraction of the fastest time scale in sight.
+      ! First step: a small fraction of the fastest time scale in sight
+      ! (without inertia: the relaxation time c/k).
       sample_time = config%length / real(config%nx - 1, wp) / config%velocity
       period = sample_time
-      if (maxval(self%tip%spring) > 0.0_wp) &
-         & period = min(period, 2.0_wp * pi * sqrt(self%tip%mass / maxval(self%tip%spring)))
+      if (maxval(self%tip%spring) > 0.0_wp) then
+         if (self%tip%model == model_inertial) then
+            period = min(period, 2.0_wp * pi * sqrt(self%tip%mass / maxval(self%tip%spring)))
+         else
+            period = min(period, minval(self%tip%damping(1:self%tip%ndim)) / maxval(self%tip%spring))
+         end if
+      end if
       self%h_start = config%solver%h_start
       if (self%h_start <= 0.0_wp) self%h_start = 1.0e-3_wp * period
       call self%solver%init(self%tip, config%solver, self%h_start, error)
@@ -137,7 +164,7 @@ contains
       real(wp) :: along(3), across(3), line_start(3), s(self%config%nx), offset(self%config%ny)
       real(wp) :: y(6), t, t_sample, s_start, force(3), tip_r(3), z_start
       integer(i8) :: now
-      integer :: i, k, nx, nd
+      integer :: i, k, nx, nd, jumps
       character(len=96) :: where
 
       associate (c => self%config, tip => self%tip)
@@ -166,12 +193,20 @@ contains
             y(3) = z_start - self%support_height
          end if
          t = 0.0_wp
+         jumps = 0
          call self%solver%restart(self%h_start)
+         if (tip%model == model_quasistatic) call self%relax(t, y(1:nd), error)
          if (.not. allocated(record%values)) allocate (record%values(nx, n_quantities))
          do k = 1, nx
             i = merge(k, nx + 1 - k, forward)
             t_sample = abs(s(i) - s_start) / c%velocity
-            if (t_sample > t) call self%solver%advance(t, t_sample, y(1:2 * nd), error)
+            if (allocated(error)) then
+               continue
+            else if (tip%model == model_quasistatic) then
+               if (t_sample > t) call self%follow(t, t_sample, y(1:nd), jumps, error)
+            else
+               if (t_sample > t) call self%solver%advance(t, t_sample, y(1:tip%dimension()), error)
+            end if
             if (.not. allocated(error) .and. c%solver%max_wall_time > 0.0_wp) then
                call system_clock(now)
                if (real(now - self%clock_start, wp) / self%clock_rate > c%solver%max_wall_time) &
@@ -194,6 +229,8 @@ contains
             record%values(i, q_tip_y) = tip_r(2)
             record%values(i, q_fz) = force(3)
             record%values(i, q_tip_z) = tip_r(3)
+            record%values(i, q_jumps) = jumps
+            jumps = 0
          end do
       end associate
    end subroutine run_trip
@@ -246,6 +283,122 @@ contains
       end function force_balance
 
    end subroutine find_height
+
+   !> The quasistatic tip from support time t to t1 (the next sample), u its
+   !> displacement from the support (ndim components), jumps counted.
+   !>
+   !> Why this algorithm: the quasistatic model is the v -> 0 limit of the
+   !> full one, in which the tip sits in a minimum of the total energy E
+   !> while sticking and slips, faster than the support moves, when that
+   !> minimum ends at a fold (saddle-node).  So the tip is followed along
+   !> its minimum by continuation: a tangent predictor (J du/dt = -H v_M,
+   !> friction_afm_quasistatic) and Newton's method as corrector.  A step is
+   !> accepted only when Newton converges with J = K + H positive definite
+   !> at every iterate and lands within half a step (the larger of the
+   !> predicted move and the support's travel) of the prediction: it cannot
+   !> then have slipped into another well.  Otherwise the step is quartered;
+   !> once it is below fold_resolution of support travel the minimum has
+   !> ended: the tip is pushed jump_push along its motion (the direction in
+   !> which the minimum vanished) and relaxed into the minimum it falls
+   !> into at the support position just past the fold (relax), and the jump
+   !> is counted.  Where the minimum moves smoothly one predictor-corrector
+   !> step (2-3 Newton iterations) covers a whole sample interval: that is
+   !> what the model saves against integrating the motion.
+   subroutine follow(self, t, t1, u, jumps, error)
+      class(afm_scanner), intent(inout) :: self
+      real(wp), intent(inout) :: t
+      real(wp), intent(in) :: t1
+      real(wp), intent(inout) :: u(:)
+      integer, intent(inout) :: jumps
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: h, h_min, speed, dudt(size(u)), predicted(size(u)), corrected(size(u)), motion(size(u))
+      logical :: ok, last
+      integer :: steps
+
+      associate (tip => self%tip)
+         speed = norm2(tip%support_velocity)
+         h_min = fold_resolution / speed
+         h = t1 - t
+         steps = 0
+         do while (t < t1)
+            steps = steps + 1
+            if (steps > 1000000) then
+               call fatal_error(error, 'quasistatic: more than 1e6 continuation steps between two samples at t = ' &
+                  & //rtoa(t)//' s', error_numerical)
+               return
+            end if
+            last = t + h >= t1
+            if (last) h = t1 - t
+            call equilibrium_tangent(tip, t, u, dudt, ok)
+            if (.not. ok) dudt = 0.0_wp
+            predicted = u + h * dudt
+            call newton_equilibrium(tip, t + h, predicted, corrected, ok)
+            if (ok) ok = norm2(corrected - predicted) <= 0.5_wp * max(norm2(predicted - u), h * speed)
+            if (ok) then
+               t = merge(t1, t + h, last)
+               u = corrected
+               h = 2.0_wp * h
+            else if (h > h_min) then
+               h = 0.25_wp * h
+            else
+               ! The fold: off the ghost of the minimum in the tip's direction
+               ! of motion dr/dt = du/dt + v_M, then downhill.
+               motion = dudt + tip%support_velocity(1:size(u))
+               if (norm2(motion) > 0.0_wp) u = u + jump_push * motion / norm2(motion)
+               t = merge(t1, t + h, last)
+               call self%relax(t, u, error)
+               if (allocated(error)) return
+               jumps = jumps + 1
+               h = t1 - t
+            end if
+         end do
+      end associate
+   end subroutine follow
+
+   !> Relax the quasistatic tip, support held at its position of time t,
+   !> into a minimum of E: the first-order motion c u' = -(k u + dV/dr)
+   !> (friction_afm_tip with model_quasistatic) in stretches of ten
+   !> relaxation times, until Newton's method from the state converges, with
+   !> J positive definite, to a minimum within landing_distance.
+   subroutine relax(self, t, u, error)
+      class(afm_scanner), intent(inout) :: self
+      real(wp), intent(in) :: t
+      real(wp), intent(inout) :: u(:)
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: saved_start(3), saved_velocity(3), tau, s, minimum(size(u))
+      logical :: ok
+      integer :: k, nd
+
+      associate (tip => self%tip)
+         nd = size(u)
+         saved_start = tip%support_start
+         saved_velocity = tip%support_velocity
+         tip%support_start = tip%support(t)
+         tip%support_velocity = 0.0_wp
+         tau = maxval(tip%damping(1:nd) / max(tip%spring(1:nd), 1.0e-3_wp * maxval(tip%spring(1:nd)), &
+            & tiny(1.0_wp)))
+         call self%solver%restart(min(self%h_start, 1.0e-3_wp * tau))
+         s = 0.0_wp
+         ok = .false.
+         do k = 1, max_stretches
+            call newton_equilibrium(tip, 0.0_wp, u, minimum, ok)
+            if (ok) ok = norm2(minimum - u) <= landing_distance
+            if (ok) exit
+            call self%solver%advance(s, s + 10.0_wp * tau, u, error)
+            if (allocated(error)) exit
+         end do
+         if (.not. allocated(error) .and. .not. ok) call fatal_error(error, 'quasistatic: the tip found no ' &
+            & //'minimum in '//rtoa(10.0_wp * max_stretches * tau)//' s of relaxation', error_numerical)
+         if (allocated(error)) then
+            error%message = error%message//' (relaxing the quasistatic tip into a minimum; t counts from ' &
+               & //'the start of the relaxation)'
+         else
+            u = minimum
+         end if
+         tip%support_start = saved_start
+         tip%support_velocity = saved_velocity
+      end associate
+   end subroutine relax
 
    !> Integrator counters of all trips so far.
    function statistics(self) result(stats)

@@ -6,6 +6,12 @@
 !> rather than r makes the error control independent of where the scan lies
 !> on the surface, and the absolute tolerance (Å) bounds the lateral force
 !> error directly: |δF| <= k |δu|.  Internal units (friction_kinds): Å, eV, s.
+!>
+!> Reduced models (README: Reduced models): `model_overdamped` drops the
+!> inertia, c_i r_i' = k_i (r_M,i - r_i) - dV/dr_i, state y = u only;
+!> `model_quasistatic` follows the equilibrium (friction_afm_scan) and uses
+!> the same first-order system, at a fixed support, only to relax the tip
+!> into a new minimum after a jump.
 module friction_afm_tip
    use friction_kinds, only: wp
    use friction_ode_system, only: ode_system
@@ -13,11 +19,14 @@ module friction_afm_tip
    implicit none
    private
 
-   public :: afm_tip
+   public :: afm_tip, model_inertial, model_overdamped, model_quasistatic
+
+   integer, parameter :: model_inertial = 1, model_overdamped = 2, model_quasistatic = 3
 
    type, extends(ode_system) :: afm_tip
       class(surface_potential), allocatable :: potential
       integer :: ndim = 2                  !! moving coordinates
+      integer :: model = model_inertial    !! model_inertial: state (u, r'); else state u
       real(wp) :: mass = 0.0_wp            !! eV s²/Å²
       real(wp) :: spring(3) = 0.0_wp       !! k_x, k_y, k_z in eV/Å²
       real(wp) :: damping(3) = 0.0_wp      !! c_x, c_y, c_z in eV s/Å²
@@ -38,7 +47,7 @@ contains
       class(afm_tip), intent(in) :: self
       integer :: n
 
-      n = 2 * self%ndim
+      n = merge(2 * self%ndim, self%ndim, self%model == model_inertial)
    end function dimension
 
    !> Support position r_M(t) in Å.
@@ -76,7 +85,8 @@ contains
       r(1:nd) = r(1:nd) + y(1:nd)
    end function tip_position
 
-   !> Eq. 4 in (u, r'): u' = r' - v_M, m r'' = -k u - dV/dr - c r'.
+   !> Eq. 4 in (u, r'): u' = r' - v_M, m r'' = -k u - dV/dr - c r'; or,
+   !> without inertia, u' = (-k u - dV/dr) / c - v_M.
    !> The hot path: scalar loops, no array-valued calls.
    pure subroutine rhs(self, t, y, dydt)
       class(afm_tip), intent(in) :: self
@@ -92,6 +102,12 @@ contains
          r(i) = self%support_start(i) + self%support_velocity(i) * t + y(i)
       end do
       call self%potential%gradient(r, g)
+      if (self%model /= model_inertial) then
+         do i = 1, nd
+            dydt(i) = (-self%spring(i) * y(i) - g(i)) / self%damping(i) - self%support_velocity(i)
+         end do
+         return
+      end if
       inverse_mass = 1.0_wp / self%mass
       do i = 1, nd
          dydt(i) = y(nd + i) - self%support_velocity(i)
@@ -114,6 +130,14 @@ contains
       call self%potential%hessian(self%tip_position(t, y), h)
       dfdy = 0.0_wp
       dfdt = 0.0_wp
+      if (self%model /= model_inertial) then
+         do i = 1, nd
+            dfdy(i, 1:nd) = -h(i, 1:nd) / self%damping(i)
+            dfdy(i, i) = dfdy(i, i) - self%spring(i) / self%damping(i)
+            dfdt(i) = -dot_product(h(i, 1:nd), self%support_velocity(1:nd)) / self%damping(i)
+         end do
+         return
+      end if
       do i = 1, nd
          dfdy(i, nd + i) = 1.0_wp
          dfdy(nd + i, 1:nd) = -h(i, 1:nd) / self%mass

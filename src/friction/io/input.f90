@@ -11,7 +11,8 @@ module friction_io_input
    use friction_strings, only: itoa, rtoa, join, quoted
    use friction_error, only: error_type, fatal_error, error_input
    use friction_ode_solver, only: step_type_names, step_type_index
-   use friction_afm_config, only: afm_config, potential_names, net_names, net_sites, max_species, max_defects
+   use friction_afm_config, only: afm_config, potential_names, net_names, net_sites, max_species, max_defects, &
+      & tip_model_names
    use friction_io_files, only: file_exists
    use friction_brake_config, only: brake_config, model_names, units_names, brake_solver_defaults
    use friction_analysis_settings, only: section_names
@@ -72,8 +73,9 @@ contains
       character(len=8) :: species(max_species), substitution_species
       real(wp) :: epsilon(max_species), sigma(max_species)
       integer :: vacancies(max_defects), substitutions(max_defects)
-      ! &tip
+      ! &tip (its `model` is read in tip_group: the name is the brake's here)
       real(wp) :: mass, kx, ky, kz, cx, cy, cz, support_z
+      character(len=16) :: tip_model
       ! &scan
       real(wp) :: velocity, length, width, angle, origin_x, origin_y, lead_in
       integer :: nx, ny
@@ -113,7 +115,6 @@ contains
       namelist /job/ scene
       namelist /surface/ potential, v0, ax, ay, a, net, net_file, shells, side, species, epsilon, sigma, &
          & vacancies, substitutions, substitution_species, cutoff, cutoff_tolerance
-      namelist /tip/ mass, kx, ky, kz, cx, cy, cz, support_z
       namelist /scan/ velocity, length, width, angle, origin_x, origin_y, lead_in, nx, ny, retrace
       namelist /integrator/ method, rtol, atol, h_start, h_min, max_steps, max_wall_time
       namelist /brake/ model, units, xi, kappa, g_prime, mu, mu_s, epsilon_prime, delta_prime, v_dr_prime, &
@@ -209,7 +210,7 @@ contains
          select case (g)
          case (1); read (unit, nml=job, iostat=s, iomsg=msg)
          case (2); read (unit, nml=surface, iostat=s, iomsg=msg)
-         case (3); read (unit, nml=tip, iostat=s, iomsg=msg)
+         case (3); call tip_group(unit, .true., s, msg)
          case (4); read (unit, nml=scan, iostat=s, iomsg=msg)
          case (5); read (unit, nml=integrator, iostat=s, iomsg=msg)
          case (6); read (unit, nml=brake, iostat=s, iomsg=msg)
@@ -235,18 +236,39 @@ contains
          end if
       end subroutine read_group
 
+      !> Read (or write) &tip in a scope of its own: its variable `model`
+      !> would otherwise be the same variable as &brake's `model`.
+      subroutine tip_group(unit, reading, s, msg)
+         integer, intent(in) :: unit
+         logical, intent(in) :: reading
+         integer, intent(out) :: s
+         character(len=*), intent(inout) :: msg
+         character(len=16) :: model
+         namelist /tip/ model, mass, kx, ky, kz, cx, cy, cz, support_z
+
+         model = tip_model
+         s = 0
+         if (reading) then
+            read (unit, nml=tip, iostat=s, iomsg=msg)
+         else
+            write (unit, nml=tip)
+         end if
+         tip_model = model
+      end subroutine tip_group
+
       !> The group's current values as namelist text.
       function group_as_text(g) result(text)
          integer, intent(in) :: g
          character(len=:), allocatable :: text
          character(len=1024) :: buffer
+         character(len=512) :: msg
          integer :: scratch, s
 
          open (newunit=scratch, status='scratch', action='readwrite', form='formatted')
          select case (g)
          case (1); write (scratch, nml=job)
          case (2); write (scratch, nml=surface)
-         case (3); write (scratch, nml=tip)
+         case (3); call tip_group(scratch, .false., s, msg)
          case (4); write (scratch, nml=scan)
          case (5); write (scratch, nml=integrator)
          case (6); write (scratch, nml=brake)
@@ -276,6 +298,7 @@ contains
             vacancies = c%vacancies; substitutions = c%substitutions
             substitution_species = c%substitution_species; cutoff = c%cutoff
             cutoff_tolerance = c%cutoff_tolerance
+            tip_model = c%model
             mass = c%mass; kx = c%kx; ky = c%ky; kz = c%kz; cx = c%cx; cy = c%cy; cz = c%cz
             support_z = c%support_z
             velocity = c%velocity; length = c%length; width = c%width; angle = c%angle
@@ -321,6 +344,7 @@ contains
       subroutine to_config()
          method = lower(method)
          potential = lower(potential)
+         tip_model = lower(tip_model)
          net = lower(net)
          scene = lower(scene)
          config%scene = scene
@@ -331,6 +355,7 @@ contains
             c%vacancies = vacancies; c%substitutions = substitutions
             c%substitution_species = substitution_species; c%cutoff = cutoff
             c%cutoff_tolerance = cutoff_tolerance
+            c%model = tip_model
             c%mass = mass; c%kx = kx; c%ky = ky; c%kz = kz; c%cx = cx; c%cy = cy; c%cz = cz
             c%support_z = support_z
             c%velocity = velocity; c%length = length; c%width = width; c%angle = angle
@@ -460,6 +485,16 @@ contains
          if (.not. (value >= 0.0_wp)) call reject(group, name, rtoa(value), 'must be >= 0 ('//unit_text//')')
       end subroutine require_nonnegative
 
+      !> The overdamped model divides by the damping of every moving direction.
+      subroutine require_damped(name, value)
+         character(len=*), intent(in) :: name
+         real(wp), intent(in) :: value
+
+         if (.not. (value > 0.0_wp)) call reject('tip', name, rtoa(value), "must be > 0 (N s/m) for " &
+            & //"model = 'overdamped': c dr/dt = -k (r - r_M) - grad V has no motion without damping " &
+            & //"(use 'inertial', or 'quasistatic' for the slow limit)")
+      end subroutine require_damped
+
       subroutine require_finite(group, name, value)
          character(len=*), intent(in) :: group, name
          real(wp), intent(in) :: value
@@ -534,6 +569,14 @@ contains
          call require_nonnegative('tip', 'cy', cy, 'N s/m')
          call require_nonnegative('tip', 'cz', cz, 'N s/m')
          call require_finite('tip', 'support_z', support_z)
+         if (.not. any(tip_model_names == tip_model)) then
+            call reject('tip', 'model', "'"//trim(tip_model)//"'", 'unknown tip model (known: ' &
+               & //quoted(tip_model_names)//')')
+         else if (tip_model == 'overdamped') then
+            call require_damped('cx', cx)
+            call require_damped('cy', cy)
+            if (potential == 'lj') call require_damped('cz', cz)
+         end if
          if (potential == 'lj') call validate_net()
          call require_positive('scan', 'velocity', velocity, 'Å/s; the direction is set by angle')
          call require_positive('scan', 'length', length, 'Å')

@@ -11,6 +11,7 @@ module friction_job_afm
    use friction_afm_config, only: afm_config, new_potential, species_count
    use friction_afm_scan, only: afm_scanner, trip_record, share_of, n_quantities, q_fx, q_fy, q_f_along
    use friction_afm_output, only: write_afm_file, afm_surface_record
+   use friction_afm_validity, only: afm_model_warnings
    use friction_io_run_summary, only: run_summary
    use friction_job_report, only: job_reporter
    use friction_job_common, only: job_context, agree_on_error, temporary_name, publish, ranks_text
@@ -38,8 +39,22 @@ contains
       integer(i8) :: counts(4)
       integer :: first, count, j
       real(wp) :: wall
-      character(len=:), allocatable :: temporary
+      character(len=:), allocatable :: temporary, warnings
       character(len=12) :: seconds
+      integer :: start, end
+
+      ! A reduced tip model outside where it holds (README: Reduced models (AFM)):
+      ! one note per reason.
+      if (job%rank == 0) then
+         warnings = afm_model_warnings(c)
+         start = 1
+         do while (start <= len(warnings))
+            end = index(warnings(start:), new_line('a'))
+            end = merge(len(warnings), start + end - 2, end == 0)
+            call reporter%note('warning: '//warnings(start:end))
+            start = end + 2
+         end do
+      end if
 
       ! The surface first, identically on every rank: a bad net or defect is
       ! bad input, reported before any work.

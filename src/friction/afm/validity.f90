@@ -1,0 +1,162 @@
+!> Where the reduced tip models hold (README: Reduced models (AFM)).  The
+!> program warns, it does not refuse: a reduced model outside its limit
+!> still runs, and the README's table shows what it costs in accuracy.
+module friction_afm_validity
+   use friction_kinds, only: wp, ev_per_angstrom_to_nn, deg_to_rad
+   use friction_error, only: error_type
+   use friction_afm_config, only: afm_config, new_potential, new_tip
+   use friction_afm_tip, only: afm_tip
+   use friction_afm_scan, only: find_height
+   use friction_surface_potential, only: surface_potential
+   use friction_strings, only: rtoa, itoa
+   implicit none
+   private
+
+   public :: afm_model_warnings, surface_force_scale
+
+   !> quasistatic: largest viscous drag c v, as a share of the surface force
+   real(wp), parameter :: drag_share = 0.01_wp
+   !> overdamped: largest quality factor sqrt(m k)/c (damping ratio 1/2: a
+   !> slip overshoots its new minimum by exp(-π/√3) = 16 %)
+   real(wp), parameter :: quality_limit = 1.0_wp
+   !> grid points per side over the scan area for the surface force
+   integer, parameter :: grid = 64
+
+contains
+
+   !> Why the settings' reduced model may not hold, one reason per line
+   !> ('' when it holds or the model is the full one).  Settings as in the
+   !> namelist (SI for the tip, Å/s for the scan); the potential is built
+   !> here, and an error in it gives '' (the run reports it).
+   !>   quasistatic: the viscous drag c v along the scan is more than 1 % of
+   !>     the largest lateral surface force (damping then raises the
+   !>     friction with the velocity), or the full tip takes longer to settle
+   !>     after a slip (5 decay times, to 1 %) than the support takes to the
+   !>     next sample (samples then catch it still moving; undamped it
+   !>     never settles);
+   !>   overdamped: in some moving direction sqrt(m k)/c > 1 (the tip
+   !>     overshoots after a slip, which needs inertia).
+   function afm_model_warnings(config) result(text)
+      type(afm_config), intent(in) :: config
+      character(len=:), allocatable :: text
+      real(wp) :: mass, spring(3), damping(3), drag, scale, settle, spacing, quality, theta
+      integer :: nd, i
+      character(len=:), allocatable :: axes
+      character(len=1), parameter :: axis(3) = ['x', 'y', 'z']
+
+      text = ''
+      if (config%model /= 'quasistatic' .and. config%model /= 'overdamped') return
+      nd = merge(3, 2, config%potential == 'lj')
+      mass = config%mass
+      spring = [config%kx, config%ky, config%kz]
+      damping = [config%cx, config%cy, config%cz]
+      if (config%model == 'overdamped') then
+         axes = ''
+         do i = 1, nd
+            if (.not. (damping(i) > 0.0_wp)) cycle
+            quality = sqrt(mass * spring(i)) / damping(i)
+            if (quality > quality_limit) axes = axes//merge(', ', '  ', len(axes) > 0)//axis(i)//' (' &
+               & //fixed(quality, 2)//')'
+         end do
+         if (len(axes) > 0) call add('overdamped model with an underdamped tip: sqrt(m k)/c > ' &
+            & //fixed(quality_limit, 1)//' along '//axes(3:)//'; it overshoots after a slip, which the ' &
+            & //"overdamped model leaves out (use 'inertial')")
+         return
+      end if
+      ! Quasistatic: drag against the surface force.
+      theta = config%angle * deg_to_rad
+      drag = (config%cx * cos(theta)**2 + config%cy * sin(theta)**2) * config%velocity * 0.1_wp  ! nN
+      scale = surface_force_scale(config)
+      if (scale > 0.0_wp .and. drag > drag_share * scale) call add('quasistatic model at a speed where ' &
+         & //'the viscous drag c v = '//fixed(drag, 4)//' nN is '//fixed(100 * drag / scale, 1) &
+         & //' % of the largest surface force '//fixed(scale, 2)//' nN (> '//itoa(nint(100 * drag_share)) &
+         & //" %): damping raises the friction, which the quasistatic model leaves out (use 'inertial')")
+      ! Settling after a slip against the time between samples.
+      spacing = config%length / real(config%nx - 1, wp)
+      settle = 0.0_wp
+      do i = 1, nd
+         if (.not. (damping(i) > 0.0_wp)) then
+            call add('quasistatic model for an undamped tip (c'//axis(i)//' = 0): the full tip rings ' &
+               & //'after every slip, the quasistatic one lands at rest in the next minimum')
+            return
+         end if
+         settle = max(settle, 5.0_wp * decay_time(mass, spring(i), damping(i)))
+      end do
+      if (settle * config%velocity > spacing) call add('quasistatic model while the tip takes ' &
+         & //rtoa(settle)//' s to settle after a slip, '//fixed(settle * config%velocity, 3) &
+         & //' Å of support travel, more than the sample spacing '//fixed(spacing, 3) &
+         & //" Å: samples after a slip see the full tip still moving (use 'inertial' or a lower velocity)")
+
+   contains
+
+      subroutine add(line)
+         character(len=*), intent(in) :: line
+
+         if (len(text) > 0) text = text//new_line('a')
+         text = text//line
+      end subroutine add
+
+   end function afm_model_warnings
+
+   !> The slowest decay time of m x'' + c x' + k x = 0, s (SI inputs): the
+   !> envelope 2m/c when underdamped, else the slow root's 1/|λ|.
+   pure real(wp) function decay_time(m, k, c) result(tau)
+      real(wp), intent(in) :: m, k, c
+
+      if (c**2 <= 4.0_wp * m * k) then
+         tau = 2.0_wp * m / c
+      else
+         tau = 2.0_wp * m / (c - sqrt(c**2 - 4.0_wp * m * k))
+      end if
+   end function decay_time
+
+   !> The largest lateral force of the surface over the scan area, nN, on a
+   !> 64 x 64 grid: for a lattice sum at the height the loaded tip rests at
+   !> above the scan origin.  0 if the potential cannot be built.
+   function surface_force_scale(config) result(scale)
+      type(afm_config), intent(in) :: config
+      real(wp) :: scale
+      class(surface_potential), allocatable :: potential
+      type(afm_tip) :: tip
+      type(error_type), allocatable :: error
+      real(wp) :: origin(3), height, contact, r(3), g(3)
+      integer :: i, j
+
+      scale = 0.0_wp
+      call new_potential(config, potential, error)
+      if (allocated(error)) return
+      origin = [config%origin_x, config%origin_y, 0.0_wp]
+      height = 0.0_wp
+      if (potential%dimensions() == 3) then
+         call new_tip(config, potential, tip)
+         call find_height(tip, origin, 0.0_wp, contact, error)
+         if (allocated(error)) return
+         call find_height(tip, [origin(1), origin(2), contact + config%support_z], tip%spring(3), height, error)
+         if (allocated(error)) return
+      end if
+      do j = 0, grid - 1
+         do i = 0, grid - 1
+            r = origin + config%length * i / (grid - 1) * config%scan_direction() &
+               & + config%width * j / (grid - 1) * config%across_direction()
+            r(3) = height
+            call potential%gradient(r, g)
+            scale = max(scale, norm2(g(1:2)))
+         end do
+      end do
+      scale = scale * ev_per_angstrom_to_nn
+   end function surface_force_scale
+
+   !> A number with `digits` decimals, no padding.
+   function fixed(value, digits) result(text)
+      real(wp), intent(in) :: value
+      integer, intent(in) :: digits
+      character(len=:), allocatable :: text
+      character(len=32) :: buffer, form
+
+      write (form, '(a, i0, a)') '(f0.', digits, ')'
+      write (buffer, form) value
+      text = trim(adjustl(buffer))
+      if (text(1:1) == '.') text = '0'//text
+   end function fixed
+
+end module friction_afm_validity
