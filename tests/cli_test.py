@@ -237,6 +237,20 @@ def case_models(args):
                 jumps = f["afm/trace/jumps"][()]
                 if jumps.shape != (7, 24) or jumps.sum() < 7 or np.any(jumps != np.round(jumps)):
                     fail(f"implausible jump counts {jumps}")
+    # HOPG at 400 Å/s: c v = 0.04 nN is 0.96 % of the surface force (no warning
+    # before the run) but about 2 % of the friction the map finds (a warning
+    # after it, with the friction from the map's own f_along).
+    hopg = os.path.join(args.inputs, "hopg.nml")
+    choice = write(args, "hopg-quasistatic.nml", "&tip model = 'quasistatic' /\n")
+    result = friction(args, "-o", "hopg.h5", hopg, small, choice, ranks=2)
+    warnings = [line for line in result.stderr.splitlines() if line.startswith("friction: warning:")]
+    if len(warnings) != 1 or "of the mean friction of this map" not in warnings[0]:
+        fail(f"HOPG quasistatic: expected one warning on the map's friction, got {warnings}")
+    with h5py.File(os.path.join(args.workdir, "hopg.h5"), "r") as f:
+        found = float(np.mean(f["afm/friction"][()]))
+    stated = float(warnings[0].split("of this map, ")[1].split(" nN")[0])
+    if not abs(stated - found) <= 1e-4 + 1e-6 * found:
+        fail(f"the warning states a friction of {stated} nN, the file's /afm/friction averages {found} nN")
     for model in ("overdamped", "quasistatic"):
         extra = set(shapes[model]) - set(shapes["inertial"])
         if set(shapes["inertial"]) - set(shapes[model]) or extra - {"jumps"} or \

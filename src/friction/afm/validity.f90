@@ -12,7 +12,7 @@ module friction_afm_validity
    implicit none
    private
 
-   public :: afm_model_warnings, surface_force_scale
+   public :: afm_model_warnings, surface_force_scale, quasistatic_friction_warning
 
    !> quasistatic: largest viscous drag c v, as a share of the surface force
    real(wp), parameter :: drag_share = 0.01_wp
@@ -97,6 +97,28 @@ contains
       end subroutine add
 
    end function afm_model_warnings
+
+   !> After a quasistatic map: '' or a warning when the viscous drag c v
+   !> along the scan is more than 1 % of the mean friction the map found
+   !> (nN), the friction the full model would add to.  The rule before the
+   !> run compares the drag with the surface force, which can be far above
+   !> the friction (HOPG at 400 Å/s: drag 0.96 % of the force, 3 % of the
+   !> friction; README: Reduced models (AFM)).
+   function quasistatic_friction_warning(config, friction) result(text)
+      type(afm_config), intent(in) :: config
+      real(wp), intent(in) :: friction
+      character(len=:), allocatable :: text
+      real(wp) :: theta, drag
+
+      text = ''
+      if (config%model /= 'quasistatic' .or. .not. (friction > 0.0_wp)) return
+      theta = config%angle * deg_to_rad
+      drag = (config%cx * cos(theta)**2 + config%cy * sin(theta)**2) * config%velocity * 0.1_wp  ! nN
+      if (drag > drag_share * friction) text = 'quasistatic model: the viscous drag c v = '//fixed(drag, 4) &
+         & //' nN is '//fixed(100 * drag / friction, 1)//' % of the mean friction of this map, ' &
+         & //fixed(friction, 4)//" nN (> "//itoa(nint(100 * drag_share))//" %): the full model's friction is " &
+         & //"higher by at least that (use 'inertial' or a lower velocity)"
+   end function quasistatic_friction_warning
 
    !> The slowest decay time of m x'' + c x' + k x = 0, s (SI inputs): the
    !> envelope 2m/c when underdamped, else the slow root's 1/|λ|.

@@ -11,7 +11,7 @@ module friction_job_afm
    use friction_afm_config, only: afm_config, new_potential, species_count
    use friction_afm_scan, only: afm_scanner, trip_record, share_of, n_quantities, q_fx, q_fy, q_f_along
    use friction_afm_output, only: write_afm_file, afm_surface_record
-   use friction_afm_validity, only: afm_model_warnings
+   use friction_afm_validity, only: afm_model_warnings, quasistatic_friction_warning
    use friction_io_run_summary, only: run_summary
    use friction_job_report, only: job_reporter
    use friction_job_common, only: job_context, agree_on_error, temporary_name, publish, ranks_text
@@ -87,6 +87,7 @@ contains
       ! A failure on any rank stops all of them here, before anything is written.
       call agree_on_error(job, error)
       if (allocated(error)) return
+      if (c%model == 'quasistatic') call check_friction()
 
       stats = scanner%statistics()
       counts = [stats%steps, stats%failed_steps, stats%rhs_evaluations, stats%jacobian_evaluations]
@@ -115,6 +116,18 @@ contains
          & //ranks_text(job%nranks)
 
    contains
+
+      !> The quasistatic map's mean friction against the drag it leaves out.
+      subroutine check_friction()
+         real(wp) :: sums(2)
+         character(len=:), allocatable :: warning
+
+         sums = [sum(trace(:, :, q_f_along)), real(size(trace(:, :, q_f_along)), wp)]
+         if (c%retrace) sums(1) = 0.5_wp * (sums(1) - sum(retrace(:, :, q_f_along)))
+         call MPI_Allreduce(MPI_IN_PLACE, sums, 2, MPI_DOUBLE_PRECISION, MPI_SUM, job%comm)
+         warning = quasistatic_friction_warning(c, sums(1) / max(1.0_wp, sums(2)))
+         if (job%rank == 0 .and. len(warning) > 0) call reporter%note('warning: '//warning)
+      end subroutine check_friction
 
       integer function lines_done(done)
          integer, intent(in) :: done
