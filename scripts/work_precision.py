@@ -71,6 +71,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import re
 import shutil
 import statistics
@@ -592,6 +593,8 @@ def load_extras(path: Path | None, scenes) -> dict:
         for ex in data:
             if ex["scene"] not in scenes:
                 raise ValueError(f"unknown scene '{ex['scene']}' (known: {', '.join(scenes)})")
+            if "/" in str(ex["label"]) or not str(ex["label"]):
+                raise ValueError(f"label '{ex['label']}': must be nonempty, without '/' (an HDF5 group name)")
             if len(ex["error"]) != len(ex["cpu_time"]) or not ex["error"]:
                 raise ValueError(f"{ex['label']}: error and cpu_time need the same, nonzero length")
             out.setdefault(ex["scene"], []).append(
@@ -635,13 +638,17 @@ def main(argv=None) -> int:
                    help=f"naf and brake_switched, {', '.join(QUICK_METHODS)}, rtol "
                         f"{', '.join(f'{t:g}' for t in QUICK_TOLS)}, one run each, a small failure map")
     p.add_argument("--out", type=Path, default=Path("."), help="output directory (default: .)")
-    p.add_argument("--extra", type=Path, help="JSON series to add to the charts (see above)")
+    p.add_argument("--extra", type=Path, metavar="FILE",
+                   help='series measured elsewhere, drawn dashed on their scene\'s chart and stored '
+                        'under /<scene>/extra: a JSON list of {"scene": ..., "label": ..., '
+                        '"error": [...], "cpu_time": [...]} in the chart\'s units (nN or m, s)')
     p.add_argument("--repeats", type=int, default=None, help="runs per timing (default 3; 1 with --quick)")
     p.add_argument("--cap", type=float, default=None, help="max_wall_time per run, s (default 10; 3 with --quick)")
     p.add_argument("--scenes", help="comma-separated subset of the scenes")
     p.add_argument("--methods", help="comma-separated subset of the methods")
     p.add_argument("--no-failure-map", action="store_true", help="skip the failure map")
-    p.add_argument("--binary", type=Path, default=ROOT / "build" / "friction")
+    p.add_argument("--binary", type=Path, default=ROOT / "build" / "friction",
+                   help="the friction executable (default: build/friction)")
     args = p.parse_args(argv)
     repeats = args.repeats or (1 if args.quick else 3)
     cap = args.cap or (3.0 if args.quick else 10.0)
@@ -658,6 +665,9 @@ def main(argv=None) -> int:
     if not args.binary.exists():
         p.error(f"{args.binary}: no such program (run scripts/build)")
     extras = load_extras(args.extra, scenes)
+    for n in extras:
+        if n not in names:
+            log(f"--extra: scene '{n}' is not run this time; its series are left out")
     args.out.mkdir(parents=True, exist_ok=True)
 
     t0 = time.perf_counter()
@@ -665,6 +675,17 @@ def main(argv=None) -> int:
     try:
         snapshot = workdir / "friction"
         shutil.copy2(args.binary, snapshot)
+        # The program finds libfriction.so through its run path, in the build
+        # tree: a rebuild during the run would swap it under the running
+        # measurements.  Copies, found first through LD_LIBRARY_PATH, keep
+        # the whole run on one build.
+        libs = sorted(args.binary.resolve().parent.glob("libfriction.so*"))
+        if libs:
+            (workdir / "lib").mkdir()
+            for lib in libs:
+                shutil.copy2(lib, workdir / "lib" / lib.name, follow_symlinks=True)
+            os.environ["LD_LIBRARY_PATH"] = os.pathsep.join(
+                [str(workdir / "lib")] + [d for d in os.environ.get("LD_LIBRARY_PATH", "").split(os.pathsep) if d])
         shutil.copytree(INPUTS, workdir / "inputs")
         afm_fr = benchmark_afm.Friction(snapshot, [], workdir)
         brake_fr = benchmark_brake.Friction(snapshot, workdir, cap)
