@@ -31,7 +31,8 @@ BRAKE_SHORT = ("&brake model = '{model}', t_end = 40.0, dt_out = 0.5 /\n"
                "&analysis spectrum = .false., poincare = .false., lyapunov = .false., rosenstein = .false. /\n")
 TABLE = [
     ("naf", "naf.nml", AFM_SMALL, 1e-3, "rkck"),
-    ("naf", "naf.nml", AFM_SMALL, 1e-6, "rk8pd"),
+    ("naf", "naf.nml", AFM_SMALL, 1e-7, "rkck"),
+    ("naf", "naf.nml", AFM_SMALL, 1e-9, "rk8pd"),
     ("hopg", "hopg.nml", AFM_SMALL, 1e-4, "rkck"),
     ("hopg", "hopg.nml", AFM_SMALL, 1e-8, "rk8pd"),
     ("graphite", "graphite.nml", LJ_SMALL, 1e-4, "rk8pd"),

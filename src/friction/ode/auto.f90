@@ -54,7 +54,7 @@ contains
          case ('lj')
             method = 'rk8pd'
          case default  ! 'naf'
-            method = merge('rkck ', 'rk8pd', rtol >= 1.0e-4_wp)
+            method = merge('rkck ', 'rk8pd', rtol >= 1.0e-7_wp)
          end select
       end select
    end function auto_method
