@@ -27,8 +27,9 @@ What is measured:
   that the 3 ms of input and set-up in wall_time do not dominate); graphite
   with inputs/graphite_damped.nml (damping ratio 0.2: the undamped tip is
   chaotic and no tolerance resolves its line), one line of 32 samples, trace
-  only (its 600-atom lattice sum makes the reference cost about 30 s).  Brake: x, largest |x - x_ref| in m over the window
-  tau in [100, 1000] (the paper's Fig. 13 window) on an output grid of 1 tau.
+  only (its 600-atom lattice sum costs 0.1 to 10 s per run).  Brake: x,
+  largest |x - x_ref| in m over the window tau in [100, 1000] (the paper's
+  Fig. 13 window) on an output grid of 1 tau.
 * CPU time: what the program records about the integration, from the output
   file: /brake compute_time (the integration alone) and, for the AFM, the root
   attribute wall_time on one rank (input, set-up and integration, without
@@ -50,9 +51,13 @@ What is measured:
 Failure map categories at the asked tolerance (rtol = 1e-6): 'failed' (error
 exit other than the time cap), 'wrong' (success reported but the error is
 more than 100x the asked tolerance expressed in the measured quantity:
-atol + rtol max|x_ref| in m for the brake, k (atol + rtol max|u_ref|) in nN
-for the tip), 'slow' (more than 10x the CPU time of the fastest method that
+atol + rtol max|x_ref| in m for the brake, k atol + rtol max|F_ref| in nN
+for the tip, k in nN/Å), 'slow' (more than 10x the CPU time of the fastest method that
 is neither failed nor wrong; the time cap counts as slow), else 'ok'.
+
+The printed ranking behind method = 'auto' (README): at each rung, the
+methods not silently wrong at that rtol, ordered by the CPU time they need
+to reach the asked tolerance (log-log interpolation between rungs).
 
 --extra FILE adds series measured elsewhere (e.g. a circuit simulator) to the
 charts: a JSON list of {"scene": "<scene>", "label": "...", "error": [...],
