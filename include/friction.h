@@ -56,7 +56,8 @@ int friction_error_message(const friction_error *err, char *buf, size_t len);
  *   forward    non-zero: trace (support from x0,y0 outwards); zero: retrace
  *              (from the far end back; still stored by position i)
  *   stepper    GSL step type: rk2 rk4 rkf45 rkck rk8pd rk1imp rk2imp rk4imp
- *              bsimp msadams msbdf; rtol, atol > 0
+ *              bsimp msadams msbdf, or "auto" (README: Speed against accuracy);
+ *              rtol, atol > 0
  *   fx, fy     caller arrays of nx doubles */
 int friction_afm_line(const char *potential, double v0, double ax, double ay, double a,
                       double mass, double kx, double ky, double cx, double cy,

@@ -149,13 +149,17 @@ class Friction:
         path.write_text(text + "\n")
         return path
 
-    def run(self, inputs: list[Path], ranks: int) -> Run:
+    def run(self, inputs: list[Path], ranks: int, timeout: float | None = None) -> Run:
+        """Run once; RuntimeError on a non-zero exit, subprocess.TimeoutExpired
+        after `timeout` seconds (None: no limit).  An empty launcher runs the
+        program directly (one rank, MPI singleton)."""
         self._count += 1
         out = self.workdir / f"run{self._count:04d}.h5"
-        cmd = self.mpirun + ["-n", str(ranks), str(self.binary), "--quiet", "--force",
-                             "-o", str(out)] + [str(p) for p in inputs]
+        launch = self.mpirun + ["-n", str(ranks)] if self.mpirun else []
+        cmd = launch + [str(self.binary), "--quiet", "--force",
+                        "-o", str(out)] + [str(p) for p in inputs]
         t0 = time.perf_counter()
-        proc = subprocess.run(cmd, env=self.env, cwd=self.workdir,
+        proc = subprocess.run(cmd, env=self.env, cwd=self.workdir, timeout=timeout,
                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         elapsed = time.perf_counter() - t0
         if proc.returncode != 0:

@@ -86,19 +86,25 @@ class Friction:
         self.count = 0
 
     def run(self, model: str, method: str, rtol: float, atol: float, t_end: float, dt_out: float,
-            event_tolerance: float = 1e-10) -> Run:
+            event_tolerance: float = 1e-10, brake_vars: str = "") -> Run:
+        """One run; `brake_vars` are more &brake settings (e.g. "epsilon_prime = 1e5").
+        A run still going 60 s after its max_wall_time is killed and reported failed."""
         self.count += 1
         nml = self.workdir / f"run{self.count}.nml"
         out = self.workdir / f"run{self.count}.h5"
         nml.write_text(
             f"&brake model = '{model}', t_end = {t_end!r}, dt_out = {dt_out!r}, "
-            f"event_tolerance = {event_tolerance!r} /\n"
+            f"event_tolerance = {event_tolerance!r}{', ' + brake_vars if brake_vars else ''} /\n"
             f"&integrator method = '{method}', rtol = {rtol!r}, atol = {atol!r}, "
             f"max_steps = 200000000, max_wall_time = {self.max_wall!r} /\n"
             # The integration alone is measured: no chaos diagnostics.
             "&analysis spectrum = .false., poincare = .false., lyapunov = .false., rosenstein = .false. /\n")
-        proc = subprocess.run([str(self.binary), "--quiet", "--force", "-o", str(out), str(INPUT), str(nml)],
-                              capture_output=True, text=True, cwd=self.workdir)
+        try:
+            proc = subprocess.run([str(self.binary), "--quiet", "--force", "-o", str(out), str(INPUT), str(nml)],
+                                  capture_output=True, text=True, cwd=self.workdir,
+                                  timeout=(self.max_wall + 60.0) if self.max_wall > 0 else None)
+        except subprocess.TimeoutExpired:
+            return Run(False, f"killed: still running {self.max_wall + 60.0:g} s after its start")
         if proc.returncode != 0:
             return Run(False, proc.stderr.strip().replace("friction: error: ", ""))
         with h5py.File(out, "r") as f:

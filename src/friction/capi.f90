@@ -12,6 +12,7 @@ module friction_capi
    use friction_error, only: error_type, fatal_error, error_input
    use friction_version, only: version_string
    use friction_ode_solver, only: step_type_index
+   use friction_ode_auto, only: auto_name, auto_method
    use friction_surface_potential, only: surface_potential
    use friction_afm_config, only: afm_config, new_potential
    use friction_afm_scan, only: afm_scanner, trip_record, q_fx, q_fy
@@ -216,6 +217,7 @@ contains
 
       name = c_string(potential)
       method = c_string(stepper)
+      if (method == auto_name) method = auto_method('afm', name, real(rtol, wp))
       if (.not. c_associated(potential)) then
          call fatal_error(error, 'potential name is a null pointer', error_input)
       else if (.not. c_associated(stepper)) then
@@ -308,6 +310,7 @@ contains
 
       name = c_string(model)
       method = c_string(stepper)
+      if (method == auto_name) method = auto_method('brake', name, real(rtol, wp))
       if (.not. c_associated(model)) then
          call fatal_error(error, 'model name is a null pointer', error_input)
       else if (.not. c_associated(stepper)) then

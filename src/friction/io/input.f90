@@ -11,6 +11,7 @@ module friction_io_input
    use friction_strings, only: itoa, rtoa, join, quoted
    use friction_error, only: error_type, fatal_error, error_input
    use friction_ode_solver, only: step_type_names, step_type_index
+   use friction_ode_auto, only: auto_name, auto_method
    use friction_afm_config, only: afm_config, potential_names, net_names, net_sites, max_species, max_defects, &
       & tip_model_names
    use friction_io_files, only: file_exists
@@ -390,6 +391,13 @@ contains
             b%solver%h_start = h_start; b%solver%h_min = h_min; b%solver%max_steps = max_steps
             b%solver%max_wall_time = max_wall_time
          end associate
+         ! method = 'auto': the stepper the work-precision charts show fastest for
+         ! the scene at this rtol; the input text keeps 'auto', the file's root
+         ! attribute `method` records the choice.
+         if (method == auto_name) then
+            config%afm%solver%method = auto_method('afm', potential, config%afm%solver%rtol)
+            config%brake%solver%method = auto_method('brake', model, rtol)
+         end if
          series = lower(series)
          window = lower(window)
          section = lower(section)
@@ -587,8 +595,9 @@ contains
          call require_nonnegative('scan', 'lead_in', lead_in, 'Å')
          if (nx < 2) call reject('scan', 'nx', itoa(nx), 'must be >= 2 (sample points per line)')
          if (ny < 1) call reject('scan', 'ny', itoa(ny), 'must be >= 1 (lines)')
-         if (step_type_index(method) == 0) call reject('integrator', 'method', "'"//trim(method)//"'", &
-            & 'unknown GSL step type (known: '//quoted(step_type_names)//')')
+         if (method /= auto_name .and. step_type_index(method) == 0) call reject('integrator', 'method', &
+            & "'"//trim(method)//"'", 'unknown GSL step type (known: '//quoted(step_type_names)//', or '// &
+            & quoted([auto_name])//' to choose by scene and rtol)')
          call require_positive('integrator', 'rtol', rtol, 'relative tolerance')
          call require_positive('integrator', 'atol', atol, 'absolute tolerance, Å and Å/s')
          call require_nonnegative('integrator', 'h_start', h_start, 's; 0 chooses automatically')

@@ -1,0 +1,748 @@
+#!/usr/bin/env python3
+"""Speed against accuracy: work-precision charts and a failure map for friction.
+
+For each scene (NaF, HOPG, graphite, the brake's regularized law and its
+switched model) every applicable GSL stepper climbs a ladder of tolerances;
+each run's error against a far tighter reference is set against its CPU time.
+Writes, into --out (default: the current directory):
+
+  work_precision.h5             a group per scene, a group per method with the
+                                datasets tolerance, atol, error, cpu_time
+                                (median of the repeats), rhs_evaluations,
+                                status, message; the reference and its own
+                                convergence check as the scene's attributes
+  work_precision_<scene>.png    error against CPU time, log-log, a line per method
+  failure_map.h5, failure_map.png
+                                at one asked tolerance, every method against
+                                the brake's epsilon_prime (1e3 ... 1e9) and the
+                                NaF tip's damping ratio (2 ... 0): ok, slow,
+                                failed, or silently wrong
+
+What is measured:
+
+* Error, on what users look at.  AFM: the lateral force along the scan line
+  (/afm/trace/f_along and /afm/retrace/f_along), largest |F - F_ref| in nN,
+  on a reduced run: NaF and HOPG 8 lines (ny = 8) of 64 samples over the
+  input file's 20 x 20 Å area, trace and retrace (enough work, 10 to 100 ms,
+  that the 3 ms of input and set-up in wall_time do not dominate); graphite
+  with inputs/graphite_damped.nml (damping ratio 0.2: the undamped tip is
+  chaotic and no tolerance resolves its line), one line of 32 samples, trace
+  only (its 600-atom lattice sum costs 0.1 to 10 s per run).  Brake: x,
+  largest |x - x_ref| in m over the window tau in [100, 1000] (the paper's
+  Fig. 13 window) on an output grid of 1 tau.
+* CPU time: what the program records about the integration, from the output
+  file: /brake compute_time (the integration alone) and, for the AFM, the root
+  attribute wall_time on one rank (input, set-up and integration, without
+  MPI start-up and the write).  The median of --repeats runs (one run when
+  the first takes over 2 s).  The command line, not the C API, because it has
+  the max_wall_time guard, the right-hand-side counts and the graphite net.
+* Reference: rk8pd far tighter than the ladder (AFM rtol = atol = 1e-12,
+  graphite 1e-11, brake rtol 1e-13 / 1e-14 for the switched model), checked
+  against itself at a tolerance 10x looser.  That difference is recorded as
+  the scene's attribute reference_check and must lie 10x below the smallest
+  error plotted (attribute reference_converged); a point whose error is
+  within 10x of reference_check is kept in the file with status 'unresolved'
+  and not drawn.
+* Each run carries max_wall_time = --cap seconds in its namelist; a stepper
+  that hits it is recorded as 'capped' and is not tried at tighter
+  tolerances.  A run that does not stop on its own is killed 60 s after the
+  cap ('killed').  Any other error exit is 'failed' with the program's message.
+
+Failure map categories at the asked tolerance (rtol = 1e-6): 'failed' (error
+exit other than the time cap), 'wrong' (success reported but the error is
+more than 100x the asked tolerance expressed in the measured quantity:
+atol + rtol max|x_ref| in m for the brake, k atol + rtol max|F_ref| in nN
+for the tip, k in nN/Å), 'slow' (more than 10x the CPU time of the fastest method that
+is neither failed nor wrong; the time cap counts as slow), else 'ok'.
+
+The printed ranking behind method = 'auto' (README): at each rung, the
+methods not silently wrong at that rtol, ordered by the CPU time they need
+to reach the asked tolerance (log-log interpolation between rungs).
+
+--extra FILE adds series measured elsewhere (e.g. a circuit simulator) to the
+charts: a JSON list of {"scene": "<scene>", "label": "...", "error": [...],
+"cpu_time": [...]} in the units of that scene's chart.  They are drawn dashed
+in black and stored under /<scene>/extra/<label>.
+
+Usage (normally through scripts/work_precision, which builds first):
+
+    python3 scripts/work_precision.py [--quick] [--out DIR] [--extra FILE]
+                                      [--repeats N] [--cap S] [--binary PATH]
+                                      [--scenes a,b] [--no-failure-map]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import re
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+try:
+    import h5py
+    import numpy as np
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.colors import ListedColormap
+except ImportError as exc:  # pragma: no cover - environment problem
+    sys.exit(f"work_precision: {exc}; run scripts/install-deps")
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import benchmark_afm  # noqa: E402  (the AFM runner: env, snapshot, attributes)
+import benchmark_brake  # noqa: E402  (the brake runner: namelist, compute_time, x(t))
+
+ROOT = Path(__file__).resolve().parent.parent
+INPUTS = ROOT / "inputs"
+METHODS = benchmark_brake.METHODS  # all 11 GSL step types
+QUICK_METHODS = ("rkf45", "rk8pd", "rk4imp")
+QUICK_TOLS = (1e-4, 1e-6, 1e-8)
+REPEAT_BELOW = 2.0  # s: repeat runs faster than this (median), one run above
+BRAKE_WINDOW = (100.0, 1000.0)
+FAILURE_RTOL = 1e-6
+EPSILON_PRIMES = tuple(10.0 ** k for k in range(3, 10))
+DAMPING_RATIOS = (2.0, 1.0, 0.3, 0.1, 0.01, 0.0)
+CATEGORIES = ("ok", "slow", "failed", "wrong")  # codes 0..3; -1: no reference
+LEVELS = (1e-6, 1e-9)
+REFERENCE_CAP = 300.0  # s: max_wall_time of the reference runs  # error levels reported in the summary (nN or m)
+
+
+def log(msg: str) -> None:
+    print(f"work_precision: {msg}", file=sys.stderr, flush=True)
+
+
+def ladder(first: int, last: int) -> tuple[float, ...]:
+    return tuple(10.0 ** -k for k in range(first, last + 1))
+
+
+# --------------------------------------------------------------------------
+# One run of a setting and what it gives
+# --------------------------------------------------------------------------
+
+
+@dataclass
+class Point:
+    """One setting of one method: status, error, median time, cost."""
+
+    method: str
+    rtol: float
+    atol: float
+    status: str  # ok, unresolved, capped, killed, failed, skipped
+    message: str = ""
+    error: float = math.nan
+    time: float = math.nan
+    rhs: int = 0
+    times: list = field(default_factory=list)
+    scale: float = math.nan  # the asked tolerance in the measured quantity
+
+
+def classify_failure(message: str) -> str:
+    if "max_wall_time" in message:
+        return "capped"
+    if message.startswith("killed"):
+        return "killed"
+    return "failed"
+
+
+class AfmScene:
+    """A reduced AFM run of one input file; error on f_along in nN."""
+
+    kind = "afm"
+
+    def __init__(self, name, input_names, reduce, tols, ref_tol, title, what):
+        self.name, self.input_names, self.reduce_text = name, input_names, reduce
+        self.tols, self.ref_tol, self.title, self.what = tols, ref_tol, title, what
+        self.unit = "nN"
+        self.quantity = "lateral force along the line, f_along"
+        self.time_source = "root attribute wall_time, 1 rank"
+
+    def setup(self, fr: benchmark_afm.Friction, cap: float, extra: str = "", tag: str = ""):
+        self.fr, self.cap, self.extra, self.tag = fr, cap, extra, tag or self.name
+        text = (INPUTS / self.input_names[0]).read_text()
+        k = re.search(r"^\s*kx\s*=\s*([-+0-9.eEdD]+)", text, re.M)
+        # 1 N/m times 1 Å is 0.1 nN: the force of an error of 1 Å in u.
+        self.k_nn_per_a = float(k.group(1)) * 0.1
+        self.base = [fr.inputs / n for n in self.input_names]
+        self.base.append(fr.override(f"{self.tag}_reduce", self.reduce_text))
+        if extra:
+            self.base.append(fr.override(f"{self.tag}_extra", extra))
+
+    def run(self, method, rtol, atol, cap=None):
+        cap = cap or self.cap
+        o = self.fr.override(
+            f"{self.tag}_{method}_{rtol:g}",
+            f"&integrator method = '{method}', rtol = {rtol!r}, atol = {atol!r}, "
+            f"max_steps = 2000000000, max_wall_time = {cap!r} /")
+        try:
+            r = self.fr.run(self.base + [o], 1, timeout=cap + 60.0)
+        except subprocess.TimeoutExpired:
+            return None, f"killed: still running {cap + 60:g} s after its start"
+        except RuntimeError as exc:
+            msg = [ln for ln in str(exc).splitlines() if "error:" in ln]
+            return None, (msg[-1].split("error:", 1)[1].strip() if msg else str(exc).splitlines()[0])
+        with h5py.File(r.path, "r") as f:
+            q = [f["afm/trace/f_along"][()].ravel()]
+            if "afm/retrace/f_along" in f:
+                q.append(f["afm/retrace/f_along"][()].ravel())
+        r.path.unlink()
+        return {"q": np.concatenate(q), "time": r.wall, "rhs": r.rhs}, ""
+
+    def atol_for(self, rtol):
+        return rtol
+
+    def scale(self, ref_q, rtol, atol):
+        return self.k_nn_per_a * atol + rtol * float(np.max(np.abs(ref_q)))
+
+    @staticmethod
+    def error(q, ref_q):
+        return float(np.max(np.abs(q - ref_q)))
+
+
+class BrakeScene:
+    """The paper's brake to tau = 1000; error on x over the window, in m."""
+
+    kind = "brake"
+
+    def __init__(self, name, model, tols, ref_rtol, title):
+        self.name, self.model, self.tols, self.ref_tol, self.title = name, model, tols, ref_rtol, title
+        self.unit = "m"
+        self.quantity = f"x over tau in [{BRAKE_WINDOW[0]:g}, {BRAKE_WINDOW[1]:g}]"
+        self.what = f"tau in [0, {BRAKE_WINDOW[1]:g}], output every 1 tau"
+        self.time_source = "/brake attribute compute_time"
+
+    def setup(self, fr: benchmark_brake.Friction, cap: float, extra: str = "", tag: str = ""):
+        self.fr, self.extra, self.cap = fr, extra, cap
+
+    def run(self, method, rtol, atol, cap=None):
+        kw = {"event_tolerance": min(1e-10, rtol / 10)} if self.model == "switched" else {}
+        self.fr.max_wall = cap or self.cap
+        r = self.fr.run(self.model, method, rtol, atol, BRAKE_WINDOW[1], 1.0, brake_vars=self.extra, **kw)
+        if not r.ok:
+            return None, r.message
+        window = r.t >= BRAKE_WINDOW[0] - 1e-9
+        return {"q": r.x[window], "time": r.compute_time, "rhs": r.rhs}, ""
+
+    def atol_for(self, rtol):
+        return rtol / 100
+
+    @staticmethod
+    def scale(ref_q, rtol, atol):
+        return atol + rtol * float(np.max(np.abs(ref_q)))
+
+    @staticmethod
+    def error(q, ref_q):
+        if q.shape != ref_q.shape:
+            raise RuntimeError("output grids differ")
+        return float(np.max(np.abs(q - ref_q)))
+
+
+def make_scenes(quick: bool) -> dict:
+    afm_tols = QUICK_TOLS if quick else ladder(3, 10)
+    return {
+        "naf": AfmScene("naf", ("naf.nml",), "&scan nx = 64, ny = 8 /", afm_tols, 1e-12,
+                        "NaF, 8 lines, trace + retrace", "inputs/naf.nml, ny = 8, nx = 64"),
+        "hopg": AfmScene("hopg", ("hopg.nml",), "&scan nx = 64, ny = 8 /", afm_tols, 1e-12,
+                         "HOPG, 8 lines at 7°, trace + retrace", "inputs/hopg.nml, ny = 8, nx = 64"),
+        # the failure map's NaF case: the first line alone
+        "naf_line": AfmScene("naf_line", ("naf.nml",), "&scan nx = 64, ny = 1 /", afm_tols, 1e-12,
+                             "NaF, one line, trace + retrace", "inputs/naf.nml, ny = 1, nx = 64"),
+        # Damped (ratio 0.2): the paper's undamped tip is chaotic, and its line
+        # force is not determined to better than about 0.06 nN at any tolerance
+        # (rk8pd at 1e-11 against 1e-10; README: Speed against accuracy).
+        "graphite": AfmScene("graphite", ("graphite.nml", "graphite_damped.nml"),
+                             "&scan nx = 32, ny = 1, retrace = .false. /",
+                             QUICK_TOLS if quick else ladder(3, 10), 1e-11,
+                             "graphite (Lennard-Jones, 600 atoms), damping ratio 0.2, one line, trace",
+                             "inputs/graphite.nml + graphite_damped.nml, ny = 1, nx = 32, trace only"),
+        "brake_regularized": BrakeScene("brake_regularized", "regularized",
+                                        QUICK_TOLS if quick else ladder(3, 11), 1e-13,
+                                        "brake, regularized law (ε' = 3.5121e7)"),
+        "brake_switched": BrakeScene("brake_switched", "switched",
+                                     QUICK_TOLS if quick else ladder(3, 11), 1e-14,
+                                     "brake, switched model"),
+    }
+
+
+def measure(scene, method, rtol, atol, repeats, ref_q=None, cap=None) -> Point:
+    out, msg = scene.run(method, rtol, atol, cap)
+    if out is None:
+        return Point(method, rtol, atol, classify_failure(msg), msg)
+    times = [out["time"]]
+    if out["time"] < REPEAT_BELOW:
+        for _ in range(repeats - 1):
+            again, msg = scene.run(method, rtol, atol, cap)
+            if again is None:  # did not repeat: report it rather than hide it
+                return Point(method, rtol, atol, classify_failure(msg), "repeat: " + msg)
+            times.append(again["time"])
+    p = Point(method, rtol, atol, "ok", error=math.nan, time=statistics.median(times),
+              rhs=out["rhs"], times=times)
+    p.q = out["q"]
+    if ref_q is not None:
+        p.error = scene.error(out["q"], ref_q)
+        p.scale = scene.scale(ref_q, rtol, atol)
+    return p
+
+
+def reference(scene):
+    """The reference run and its own convergence check (10x looser)."""
+    rtol = scene.ref_tol
+    ref = measure(scene, "rk8pd", rtol, scene.atol_for(rtol), 1, cap=REFERENCE_CAP)
+    chk = measure(scene, "rk8pd", rtol * 10, scene.atol_for(rtol * 10), 1, cap=REFERENCE_CAP)
+    if ref.status != "ok" or chk.status != "ok":
+        bad = ref if ref.status != "ok" else chk
+        raise RuntimeError(f"{scene.name}: reference rk8pd {bad.rtol:g} {bad.status}: {bad.message}")
+    return ref, scene.error(chk.q, ref.q)
+
+
+# --------------------------------------------------------------------------
+# Work-precision
+# --------------------------------------------------------------------------
+
+
+def run_scene(scene, methods, repeats) -> dict:
+    log(f"{scene.name}: reference")
+    ref, check = reference(scene)
+    log(f"{scene.name}: reference rk8pd {scene.ref_tol:g} in {ref.time:.3f} s; "
+        f"vs 10x looser: {check:.2e} {scene.unit}")
+    rows = {}
+    for method in methods:
+        pts, stop = [], None
+        for rtol in scene.tols:
+            atol = scene.atol_for(rtol)
+            if stop:
+                pts.append(Point(method, rtol, atol, "skipped", f"not tried: {stop}"))
+                continue
+            p = measure(scene, method, rtol, atol, repeats, ref.q)
+            if p.status == "ok" and p.error <= 10 * check:
+                p.status = "unresolved"
+                p.message = f"error within 10x of the reference's own ({check:.1e})"
+            if p.status in ("capped", "killed"):
+                stop = f"{p.status} at rtol {rtol:g}"
+            log(f"  {scene.name} {method:7s} rtol {rtol:.0e}: {p.status:10s} "
+                + (f"error {p.error:.2e} {scene.unit}, {p.time:.4f} s, {p.rhs} rhs" if p.status in
+                   ("ok", "unresolved") else p.message[:100]))
+            pts.append(p)
+        rows[method] = pts
+    ok_errors = [p.error for pts in rows.values() for p in pts if p.status == "ok"]
+    smallest = min(ok_errors) if ok_errors else math.nan
+    return {"scene": scene, "ref": ref, "check": check, "rows": rows, "smallest": smallest,
+            "converged": bool(ok_errors) and 10 * check < smallest}
+
+
+def time_to_reach(points, level):
+    """CPU time a method needs for error <= level: log-log interpolation
+    between its ladder points (ok ones, loosest first); None if never."""
+    pts = [p for p in points if p.status == "ok" and p.error > 0]
+    prev = None
+    for p in pts:
+        if p.error <= level:
+            if prev is None or prev.error <= level:
+                return p.time
+            f = (math.log(level) - math.log(prev.error)) / (math.log(p.error) - math.log(prev.error))
+            return math.exp(math.log(prev.time) + f * (math.log(p.time) - math.log(prev.time)))
+        prev = p
+    return None
+
+
+def best_at(rows, level):
+    """(method, time) of the fastest method at error <= level, or None."""
+    cands = [(t, m) for m, pts in rows.items() if (t := time_to_reach(pts, level)) is not None]
+    return (min(cands)[1], min(cands)[0]) if cands else None
+
+
+def auto_evidence(res) -> list:
+    """For each asked tolerance rtol of the ladder, the candidates for
+    method = 'auto', best first: the methods that at rtol itself are not
+    silently wrong (error within 100x the asked tolerance atol + rtol x
+    scale, in the measured quantity: the failure map's rule), ranked by the
+    CPU time they need to reach that asked tolerance (time_to_reach)."""
+    scene, rows, out = res["scene"], res["rows"], []
+    for rtol in scene.tols:
+        level = scene.scale(res["ref"].q, rtol, scene.atol_for(rtol))
+        cands = []
+        for m, pts in rows.items():
+            p = next((p for p in pts if p.rtol == rtol), None)
+            if p is None or p.status not in ("ok", "unresolved") or p.error > 100 * level:
+                continue
+            t = time_to_reach(pts, level)
+            if t is not None:
+                cands.append((t, m))
+        cands.sort()
+        out.append({"rtol": rtol, "level": level, "ranking": [[m, t] for t, m in cands]})
+    return out
+
+
+STYLE = {"rk2": ("tab:gray", "o"), "rk4": ("tab:brown", "s"), "rkf45": ("tab:blue", "o"),
+         "rkck": ("tab:cyan", "^"), "rk8pd": ("tab:red", "D"), "rk1imp": ("tab:olive", "v"),
+         "rk2imp": ("tab:pink", "<"), "rk4imp": ("tab:green", ">"), "bsimp": ("tab:purple", "p"),
+         "msadams": ("gold", "h"), "msbdf": ("tab:orange", "*"), "switched": ("k", "x")}
+
+
+def plot_scene(res, extras, path: Path) -> None:
+    scene = res["scene"]
+    fig, ax = plt.subplots(figsize=(7.5, 5.2))
+    for method, pts in res["rows"].items():
+        ok = [p for p in pts if p.status == "ok"]
+        if not ok:
+            continue
+        color, marker = STYLE.get(method, ("k", "."))
+        ax.loglog([p.error for p in ok], [p.time for p in ok], marker=marker, color=color,
+                  label=method, lw=1.2, ms=5)
+    for ex in extras:
+        ax.loglog(ex["error"], ex["cpu_time"], "k--", marker="+", label=ex["label"])
+    ax.axvline(res["check"], color="0.6", ls=":", lw=1)
+    ax.text(res["check"], ax.get_ylim()[1], " reference\n self-check", va="top", fontsize=7, color="0.4")
+    ax.set_xlabel(f"error: max |{'x' if scene.kind == 'brake' else 'F'} - reference| ({scene.unit})")
+    ax.set_ylabel("CPU time (s, median)")
+    ax.set_title(f"{scene.title}\n{scene.quantity}; {scene.what}", fontsize=9)
+    ax.grid(True, which="major", alpha=0.3)
+    ax.legend(fontsize=7, ncol=2, loc="best")
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
+def write_scene(f: h5py.File, res, extras) -> None:
+    scene = res["scene"]
+    g = f.create_group(scene.name)
+    a = g.attrs
+    a["title"] = scene.title
+    a["run"] = scene.what
+    a["quantity"] = scene.quantity
+    a["unit"] = scene.unit
+    a["error"] = f"max |q - q_ref| over the samples, {scene.unit}"
+    a["cpu_time"] = f"{scene.time_source}, median of the repeats, s"
+    a["reference_method"] = "rk8pd"
+    a["reference_rtol"] = scene.ref_tol
+    a["reference_atol"] = scene.atol_for(scene.ref_tol)
+    a["reference_time"] = res["ref"].time
+    a["reference_check_rtol"] = scene.ref_tol * 10
+    a["reference_check"] = res["check"]
+    a["smallest_error"] = res["smallest"]
+    a["reference_converged"] = res["converged"]
+    for method, pts in res["rows"].items():
+        m = g.create_group(method)
+        m.create_dataset("tolerance", data=np.array([p.rtol for p in pts]))
+        m.create_dataset("atol", data=np.array([p.atol for p in pts]))
+        m.create_dataset("error", data=np.array([p.error for p in pts]))
+        m.create_dataset("cpu_time", data=np.array([p.time for p in pts]))
+        m.create_dataset("rhs_evaluations", data=np.array([p.rhs for p in pts], dtype=np.int64))
+        m.create_dataset("status", data=[p.status for p in pts], dtype=h5py.string_dtype())
+        m.create_dataset("message", data=[p.message for p in pts], dtype=h5py.string_dtype())
+    if extras:
+        e = g.create_group("extra")
+        for ex in extras:
+            s = e.create_group(ex["label"])
+            s.create_dataset("error", data=np.asarray(ex["error"], dtype=float))
+            s.create_dataset("cpu_time", data=np.asarray(ex["cpu_time"], dtype=float))
+    ev = auto_evidence(res)
+    a["auto_evidence"] = json.dumps(ev)
+    levels = {}
+    for level in LEVELS:
+        b = best_at(res["rows"], level)
+        r = time_to_reach(res["rows"].get("rkf45", []), level)
+        levels[f"{level:g}"] = {"best": b[0] if b else None, "time": b[1] if b else None,
+                                "rkf45_time": r}
+    a["best_at_levels"] = json.dumps(levels)
+    res["levels"], res["evidence"] = levels, ev
+
+
+# --------------------------------------------------------------------------
+# Failure map
+# --------------------------------------------------------------------------
+
+
+def failure_column(scene, methods, label) -> dict:
+    """Every method at FAILURE_RTOL on one setting, categorised."""
+    rtol, atol = FAILURE_RTOL, scene.atol_for(FAILURE_RTOL)
+    try:
+        ref, check = reference(scene)
+    except RuntimeError as exc:
+        log(f"failure map {label}: no reference ({exc})")
+        return {"label": label, "ref_check": math.nan, "points": [
+            Point(m, rtol, atol, "no reference", str(exc)) for m in methods], "codes": [-1] * len(methods)}
+    pts = [measure(scene, m, rtol, atol, 1, ref.q) for m in methods]
+    codes = []
+    for p in pts:
+        # Wrong only where the reference resolves it: its own difference
+        # (10x looser) must stay 10x below the error called wrong.
+        if p.status == "ok" and p.error > 100 * p.scale and p.error > 10 * check:
+            p.status = "wrong"
+    good = [p.time for p in pts if p.status == "ok"]
+    best = min(good) if good else math.nan
+    for p in pts:
+        if p.status == "ok" and p.time > 10 * best:
+            codes.append(1)
+        elif p.status == "ok":
+            codes.append(0)
+        elif p.status in ("capped", "killed"):
+            codes.append(1)
+        elif p.status == "wrong":
+            codes.append(3)
+        else:
+            codes.append(2)
+        log(f"  failure map {label} {p.method:7s}: {CATEGORIES[codes[-1]]:6s} "
+            + (f"error {p.error:.1e} (100x asked {100 * p.scale:.1e}), {p.time:.4f} s"
+               if p.status in ("ok", "wrong") else p.message[:90]))
+    return {"label": label, "ref_check": check, "points": pts, "codes": codes}
+
+
+def failure_maps(afm_fr, brake_fr, methods, cap, quick) -> list:
+    maps = []
+    eps = (1e5, 1e7) if quick else EPSILON_PRIMES
+    scene = make_scenes(quick)["brake_regularized"]
+    cols = []
+    for e in eps:
+        scene.setup(brake_fr, cap, extra=f"epsilon_prime = {e!r}")
+        cols.append(failure_column(scene, methods, f"ε' = {e:.0e}"))
+    maps.append({"name": "brake_regularized", "parameter": "epsilon_prime", "values": eps,
+                 "title": f"brake, regularized law: x over τ ∈ [{BRAKE_WINDOW[0]:g}, {BRAKE_WINDOW[1]:g}], "
+                          f"rtol {FAILURE_RTOL:g}, atol {FAILURE_RTOL / 100:g}",
+                 "unit": "m", "columns": cols})
+    zetas = (1.0, 0.0) if quick else DAMPING_RATIOS
+    scene = make_scenes(quick)["naf_line"]
+    text = (INPUTS / "naf.nml").read_text()
+    mass = float(re.search(r"^\s*mass\s*=\s*([-+0-9.eE]+)", text, re.M).group(1))
+    kx = float(re.search(r"^\s*kx\s*=\s*([-+0-9.eE]+)", text, re.M).group(1))
+    ky = float(re.search(r"^\s*ky\s*=\s*([-+0-9.eE]+)", text, re.M).group(1))
+    cols, cs = [], []
+    for z in zetas:
+        cx, cy = z * 2 * math.sqrt(mass * kx), z * 2 * math.sqrt(mass * ky)
+        cs.append(cx)
+        scene.setup(afm_fr, cap, extra=f"&tip cx = {cx!r}, cy = {cy!r} /", tag=f"naf_zeta{z:g}")
+        cols.append(failure_column(scene, methods, f"ζ = {z:g}"))
+    maps.append({"name": "naf_damping", "parameter": "damping_ratio", "values": zetas, "c": cs,
+                 "title": f"NaF line: lateral force, rtol = atol = {FAILURE_RTOL:g}; "
+                          f"damping ratio ζ = c / (2 √(m k))",
+                 "unit": "nN", "columns": cols})
+    return maps
+
+
+def write_failure_maps(path: Path, maps, methods, meta) -> None:
+    with h5py.File(path, "w") as f:
+        for k, v in meta.items():
+            f.attrs[k] = v
+        f.attrs["categories"] = json.dumps({"-1": "no reference", **{str(i): c for i, c in enumerate(CATEGORIES)}})
+        f.attrs["rules"] = ("failed: error exit other than the time cap; wrong: success but error > 100x "
+                            "the asked tolerance in the measured quantity; slow: > 10x the time of the "
+                            "fastest method neither failed nor wrong, or stopped by max_wall_time; ok: else")
+        f.attrs["rtol"] = FAILURE_RTOL
+        for mp in maps:
+            g = f.create_group(mp["name"])
+            g.attrs["title"] = mp["title"]
+            g.attrs["unit"] = mp["unit"]
+            g.create_dataset(mp["parameter"], data=np.array(mp["values"], dtype=float))
+            if "c" in mp:
+                g.create_dataset("c", data=np.array(mp["c"]))
+                g["c"].attrs["unit"] = "N s/m (cx; cy likewise from ky)"
+            g.create_dataset("methods", data=list(methods), dtype=h5py.string_dtype())
+            cols = mp["columns"]
+            g.create_dataset("category", data=np.array([c["codes"] for c in cols], dtype=np.int8).T)
+            g.create_dataset("error", data=np.array([[p.error for p in c["points"]] for c in cols]).T)
+            g.create_dataset("cpu_time", data=np.array([[p.time for p in c["points"]] for c in cols]).T)
+            g.create_dataset("asked_tolerance", data=np.array([[p.scale for p in c["points"]] for c in cols]).T)
+            g.create_dataset("status", data=np.array([[p.status for p in c["points"]] for c in cols],
+                                                      dtype=object).T, dtype=h5py.string_dtype())
+            g.create_dataset("message", data=np.array([[p.message for p in c["points"]] for c in cols],
+                                                       dtype=object).T, dtype=h5py.string_dtype())
+            g.create_dataset("reference_check", data=np.array([c["ref_check"] for c in cols]))
+            for d in ("category", "error", "cpu_time", "status"):
+                g[d].attrs["axes"] = f"methods x {mp['parameter']}"
+
+
+def plot_failure_maps(path: Path, maps, methods) -> None:
+    colors = ["#dddddd", "#4daf4a", "#ffd92f", "#e41a1c", "#984ea3"]  # none, ok, slow, failed, wrong
+    cmap = ListedColormap(colors)
+    fig, axes = plt.subplots(1, len(maps), figsize=(5.5 * len(maps), 0.42 * len(methods) + 2.2))
+    axes = np.atleast_1d(axes)
+    for ax, mp in zip(axes, maps):
+        cat = np.array([c["codes"] for c in mp["columns"]]).T
+        ax.imshow(cat + 1, cmap=cmap, vmin=0, vmax=4, aspect="auto")
+        ax.set_yticks(range(len(methods)), methods, fontsize=8)
+        ax.set_xticks(range(len(mp["columns"])), [c["label"] for c in mp["columns"]], fontsize=7,
+                      rotation=30)
+        for j, c in enumerate(mp["columns"]):
+            for i, p in enumerate(c["points"]):
+                txt = {"capped": "cap", "killed": "kill"}.get(p.status, "")
+                if p.status in ("ok", "wrong") and math.isfinite(p.time):
+                    txt = f"{p.time * 1e3:.0f}" if p.time >= 0.01 else f"{p.time * 1e3:.1f}"
+                ax.text(j, i, txt, ha="center", va="center", fontsize=6)
+        ax.set_title(mp["title"], fontsize=8)
+    handles = [plt.Rectangle((0, 0), 1, 1, color=colors[i + 1]) for i in range(4)]
+    fig.legend(handles, ["ok", "slow (>10x best, or time cap)", "fails with an error",
+                         "silently wrong (>100x asked)"], loc="lower center", ncol=4, fontsize=8)
+    fig.text(0.01, 0.01, "numbers: CPU time in ms", fontsize=7)
+    fig.tight_layout(rect=(0, 0.07, 1, 1))
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
+# --------------------------------------------------------------------------
+
+
+def load_extras(path: Path | None, scenes) -> dict:
+    if path is None:
+        return {}
+    try:
+        data = json.loads(path.read_text())
+        out = {}
+        for ex in data:
+            if ex["scene"] not in scenes:
+                raise ValueError(f"unknown scene '{ex['scene']}' (known: {', '.join(scenes)})")
+            if "/" in str(ex["label"]) or not str(ex["label"]):
+                raise ValueError(f"label '{ex['label']}': must be nonempty, without '/' (an HDF5 group name)")
+            if len(ex["error"]) != len(ex["cpu_time"]) or not ex["error"]:
+                raise ValueError(f"{ex['label']}: error and cpu_time need the same, nonzero length")
+            out.setdefault(ex["scene"], []).append(
+                {"label": str(ex["label"]), "error": [float(v) for v in ex["error"]],
+                 "cpu_time": [float(v) for v in ex["cpu_time"]]})
+        return out
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        sys.exit(f"work_precision: --extra {path}: {exc}")
+
+
+def summary_table(results) -> str:
+    lines = ["| scene | error level | best method | time | rkf45 time | rkf45 / best |",
+             "|---|---|---|---|---|---|"]
+    for res in results:
+        s = res["scene"]
+        for lv, v in res["levels"].items():
+            if v["best"] is None:
+                lines.append(f"| {s.name} | {lv} {s.unit} | not reached | | | |")
+                continue
+            r = v["rkf45_time"]
+            lines.append(f"| {s.name} | {lv} {s.unit} | {v['best']} | {v['time'] * 1e3:.2f} ms | "
+                         + (f"{r * 1e3:.2f} ms | {r / v['time']:.1f} |" if r else "not reached | |"))
+    tols = sorted({t for res in results for t in res["scene"].tols}, reverse=True)
+    lines += ["", "Candidates for method = 'auto' at each asked rtol: not silently wrong at that rtol,",
+              "ranked by the CPU time to reach its asked tolerance (atol + rtol max|q_ref|); ms:",
+              "", "| scene | " + " | ".join(f"{t:.0e}" for t in tols) + " |",
+              "|---|" + "---|" * len(tols)]
+    for res in results:
+        cells = {e["rtol"]: e for e in res["evidence"]}
+        lines.append(f"| {res['scene'].name} | " + " | ".join(
+            (", ".join(f"{m} {t * 1e3:.0f}" for m, t in cells[t]["ranking"][:3])
+             if t in cells and cells[t]["ranking"] else "-") for t in tols) + " |")
+    return "\n".join(lines)
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
+                                formatter_class=argparse.RawDescriptionHelpFormatter,
+                                epilog="See the module docstring (or README: Speed against accuracy).")
+    p.add_argument("--quick", action="store_true",
+                   help=f"naf and brake_switched, {', '.join(QUICK_METHODS)}, rtol "
+                        f"{', '.join(f'{t:g}' for t in QUICK_TOLS)}, one run each, a small failure map")
+    p.add_argument("--out", type=Path, default=Path("."), help="output directory (default: .)")
+    p.add_argument("--extra", type=Path, metavar="FILE",
+                   help='series measured elsewhere, drawn dashed on their scene\'s chart and stored '
+                        'under /<scene>/extra: a JSON list of {"scene": ..., "label": ..., '
+                        '"error": [...], "cpu_time": [...]} in the chart\'s units (nN or m, s)')
+    p.add_argument("--repeats", type=int, default=None, help="runs per timing (default 3; 1 with --quick)")
+    p.add_argument("--cap", type=float, default=None, help="max_wall_time per run, s (default 10; 3 with --quick)")
+    p.add_argument("--scenes", help="comma-separated subset of the scenes")
+    p.add_argument("--methods", help="comma-separated subset of the methods")
+    p.add_argument("--no-failure-map", action="store_true", help="skip the failure map")
+    p.add_argument("--binary", type=Path, default=ROOT / "build" / "friction",
+                   help="the friction executable (default: build/friction)")
+    args = p.parse_args(argv)
+    repeats = args.repeats or (1 if args.quick else 3)
+    cap = args.cap or (3.0 if args.quick else 10.0)
+    scenes = make_scenes(args.quick)
+    names = (args.scenes.split(",") if args.scenes else
+             (["naf", "brake_switched"] if args.quick else [n for n in scenes if n != "naf_line"]))
+    methods = tuple(args.methods.split(",")) if args.methods else (QUICK_METHODS if args.quick else METHODS)
+    for n in names:
+        if n not in scenes:
+            p.error(f"unknown scene '{n}' (known: {', '.join(scenes)})")
+    for m in methods:
+        if m not in METHODS:
+            p.error(f"unknown method '{m}' (known: {', '.join(METHODS)})")
+    if not args.binary.exists():
+        p.error(f"{args.binary}: no such program (run scripts/build)")
+    extras = load_extras(args.extra, scenes)
+    for n in extras:
+        if n not in names:
+            log(f"--extra: scene '{n}' is not run this time; its series are left out")
+    args.out.mkdir(parents=True, exist_ok=True)
+
+    t0 = time.perf_counter()
+    workdir = Path(tempfile.mkdtemp(prefix="friction-wp-"))
+    try:
+        snapshot = workdir / "friction"
+        shutil.copy2(args.binary, snapshot)
+        # The program finds libfriction.so through its run path, in the build
+        # tree: a rebuild during the run would swap it under the running
+        # measurements.  Copies, found first through LD_LIBRARY_PATH, keep
+        # the whole run on one build.
+        libs = sorted(args.binary.resolve().parent.glob("libfriction.so*"))
+        if libs:
+            (workdir / "lib").mkdir()
+            for lib in libs:
+                shutil.copy2(lib, workdir / "lib" / lib.name, follow_symlinks=True)
+            os.environ["LD_LIBRARY_PATH"] = os.pathsep.join(
+                [str(workdir / "lib")] + [d for d in os.environ.get("LD_LIBRARY_PATH", "").split(os.pathsep) if d])
+        shutil.copytree(INPUTS, workdir / "inputs")
+        afm_fr = benchmark_afm.Friction(snapshot, [], workdir)
+        brake_fr = benchmark_brake.Friction(snapshot, workdir, cap)
+        results = []
+        for n in names:
+            s = scenes[n]
+            s.setup(afm_fr if s.kind == "afm" else brake_fr, cap)
+            results.append(run_scene(s, methods, repeats))
+        maps = [] if args.no_failure_map else failure_maps(afm_fr, brake_fr, methods, cap, args.quick)
+    except RuntimeError as exc:
+        log(str(exc))
+        return 1
+    finally:
+        shutil.rmtree(workdir, ignore_errors=True)
+    total = time.perf_counter() - t0
+
+    meta = {"program": "work_precision", "created": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
+            "source": benchmark_afm.git_state(), "quick": args.quick, "repeats": repeats,
+            "max_wall_time": cap, "seconds": total}
+    with h5py.File(args.out / "work_precision.h5", "w") as f:
+        for k, v in meta.items():
+            f.attrs[k] = v
+        f.attrs["methods"] = ",".join(methods)
+        for res in results:
+            write_scene(f, res, extras.get(res["scene"].name, []))
+    for res in results:
+        plot_scene(res, extras.get(res["scene"].name, []), args.out / f"work_precision_{res['scene'].name}.png")
+    if maps:
+        write_failure_maps(args.out / "failure_map.h5", maps, methods, meta)
+        plot_failure_maps(args.out / "failure_map.png", maps, methods)
+
+    print("# Speed against accuracy\n")
+    for res in results:
+        s = res["scene"]
+        print(f"- {s.name}: {s.what}; reference rk8pd rtol {s.ref_tol:g} ({res['ref'].time:.3f} s), "
+              f"vs 10x looser {res['check']:.1e} {s.unit}; smallest error drawn {res['smallest']:.1e} "
+              f"{s.unit}; converged: {res['converged']}")
+    print()
+    print(summary_table(results))
+    for mp in maps:
+        print(f"\nFailure map: {mp['title']}\n")
+        print("| method | " + " | ".join(c["label"] for c in mp["columns"]) + " |")
+        print("|---|" + "---|" * len(mp["columns"]))
+        for i, m in enumerate(methods):
+            print(f"| {m} | " + " | ".join(
+                (CATEGORIES[c["codes"][i]] if c["codes"][i] >= 0 else "no ref")
+                + (f" {c['points'][i].time * 1e3:.1f} ms" if c["points"][i].status in ("ok", "wrong") else
+                   f" ({c['points'][i].status})" if c["points"][i].status in ("capped", "killed") else "")
+                for c in mp["columns"]) + " |")
+    print(f"\n(took {total:.0f} s; files in {args.out})")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

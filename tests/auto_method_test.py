@@ -1,0 +1,135 @@
+#!/usr/bin/env python3
+"""method = 'auto' resolves to the README's table, and runs as that method.
+
+    auto_method_test.py --binary BIN --inputs DIR --workdir DIR [--library SO]
+
+For each scene (naf, hopg, graphite, brake regularized, brake switched) and
+each asked rtol of the table below (the README's "method = 'auto'" table,
+the oracle here): a short run with method = 'auto' must record the table's
+stepper in the root attribute `method`, keep 'auto' in the `input`
+attribute, and give the same numbers, bit for bit, as the same run with the
+stepper named (same kernel, same steps: anything else means auto ran
+something else).  With --library, the C API's stepper "auto" likewise
+against the named stepper (friction_afm_line for naf and hopg,
+friction_brake for both models).
+"""
+import argparse
+import os
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+# (scene, input file, override, rtol, the README table's stepper)
+AFM_SMALL = "&scan nx = 8, ny = 2, length = 4.0, width = 2.0 /\n"
+LJ_SMALL = "&scan nx = 4, ny = 1, length = 1.0 /\n"
+BRAKE_SHORT = ("&brake model = '{model}', t_end = 40.0, dt_out = 0.5 /\n"
+               "&analysis spectrum = .false., poincare = .false., lyapunov = .false., rosenstein = .false. /\n")
+TABLE = [
+    ("naf", "naf.nml", AFM_SMALL, 1e-3, "rkck"),
+    ("naf", "naf.nml", AFM_SMALL, 1e-7, "rkck"),
+    ("naf", "naf.nml", AFM_SMALL, 1e-9, "rk8pd"),
+    ("hopg", "hopg.nml", AFM_SMALL, 1e-4, "rkck"),
+    ("hopg", "hopg.nml", AFM_SMALL, 1e-8, "rk8pd"),
+    ("graphite", "graphite.nml", LJ_SMALL, 1e-4, "rk8pd"),
+    ("brake_regularized", "brake.nml", BRAKE_SHORT.format(model="regularized"), 1e-3, "rk2"),
+    ("brake_regularized", "brake.nml", BRAKE_SHORT.format(model="regularized"), 1e-5, "rk4imp"),
+    ("brake_regularized", "brake.nml", BRAKE_SHORT.format(model="regularized"), 1e-8, "rkck"),
+    ("brake_regularized", "brake.nml", BRAKE_SHORT.format(model="regularized"), 1e-10, "rk8pd"),
+    ("brake_switched", "brake.nml", BRAKE_SHORT.format(model="switched"), 1e-8, "rk8pd"),
+]
+
+
+def fail(message):
+    print("FAIL: " + message)
+    sys.exit(1)
+
+
+def run(binary, inputs, workdir, name, override):
+    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    nml = workdir / f"{name}.nml"
+    nml.write_text(override)
+    out = workdir / f"{name}.h5"
+    result = subprocess.run([binary, "--quiet", "--force", "-o", str(out), str(inputs), str(nml)],
+                            capture_output=True, text=True, env=env)
+    if result.returncode != 0:
+        fail(f"{name}: exit code {result.returncode}: {result.stderr}")
+    return out
+
+
+def datasets(path):
+    found = {}
+    with h5py.File(path, "r") as f:
+        def visit(name, obj):
+            if isinstance(obj, h5py.Dataset):
+                found[name] = obj[()]
+        f.visititems(visit)
+        attrs = {k: f.attrs[k] for k in ("method", "input", "rhs_evaluations", "integrator_steps")}
+    return found, attrs
+
+
+def text(value):
+    return value.decode() if isinstance(value, bytes) else str(value)
+
+
+def main():
+    p = argparse.ArgumentParser()
+    p.add_argument("--binary", required=True)
+    p.add_argument("--inputs", required=True, type=Path)
+    p.add_argument("--workdir", required=True, type=Path)
+    p.add_argument("--library")
+    args = p.parse_args()
+    shutil.rmtree(args.workdir, ignore_errors=True)
+    args.workdir.mkdir(parents=True)
+    if not TABLE:
+        fail("empty table")
+    for scene, nml, override, rtol, expected in TABLE:
+        integ = f"&integrator rtol = {rtol!r}, atol = {rtol / 100 if 'brake' in scene else rtol!r}, method = '{{m}}' /\n"
+        auto = run(args.binary, args.inputs / nml, args.workdir, f"{scene}_{rtol:g}_auto",
+                   override + integ.format(m="auto"))
+        named = run(args.binary, args.inputs / nml, args.workdir, f"{scene}_{rtol:g}_named",
+                    override + integ.format(m=expected))
+        a_data, a_attr = datasets(auto)
+        n_data, n_attr = datasets(named)
+        if text(a_attr["method"]) != expected:
+            fail(f"{scene} rtol {rtol:g}: auto resolved to '{text(a_attr['method'])}', the table says '{expected}'")
+        if not re.search(r"""method\s*=\s*["']auto\s*["']""", text(a_attr["input"]), re.I):
+            fail(f"{scene}: the input attribute should keep method = 'auto'")
+        for key in ("rhs_evaluations", "integrator_steps"):
+            if int(a_attr[key]) != int(n_attr[key]):
+                fail(f"{scene} rtol {rtol:g}: {key} {a_attr[key]} (auto) vs {n_attr[key]} ({expected})")
+        if set(a_data) != set(n_data):
+            fail(f"{scene}: datasets differ: {sorted(set(a_data) ^ set(n_data))}")
+        for name in a_data:
+            if not np.array_equal(a_data[name], n_data[name]):
+                fail(f"{scene} rtol {rtol:g}: /{name} differs between auto and {expected}")
+        print(f"{scene} rtol {rtol:g}: auto -> {expected}, {len(a_data)} datasets identical")
+
+    if args.library:
+        os.environ["FRICTION_LIBRARY"] = args.library
+        sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "scripts"))
+        import friction_capi as fc
+        for scene, _, _, rtol, expected in TABLE:
+            if scene in ("naf", "hopg"):
+                kw = dict(potential=scene, nx=32, rtol=rtol, atol=rtol)
+                if scene == "hopg":
+                    kw.update(v0=0.5, kx=25.0, ky=25.0, angle=7.0)
+                a, n = fc.afm_line(stepper="auto", **kw), fc.afm_line(stepper=expected, **kw)
+            elif scene.startswith("brake_"):
+                kw = dict(model=scene[len("brake_"):], t_end=40.0, dt_out=0.5, rtol=rtol, atol=rtol / 100)
+                ra, rn = fc.brake(stepper="auto", **kw), fc.brake(stepper=expected, **kw)
+                a, n = [ra[k] for k in "txvyw"], [rn[k] for k in "txvyw"]
+            else:
+                continue
+            if not all(np.array_equal(x, y) for x, y in zip(a, n)):
+                fail(f"C API {scene} rtol {rtol:g}: stepper 'auto' differs from '{expected}'")
+            print(f"C API {scene} rtol {rtol:g}: 'auto' identical to '{expected}'")
+    print("PASS")
+
+
+if __name__ == "__main__":
+    main()
