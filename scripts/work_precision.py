@@ -100,6 +100,7 @@ except ImportError as exc:  # pragma: no cover - environment problem
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import benchmark_afm  # noqa: E402  (the AFM runner: env, snapshot, attributes)
 import benchmark_brake  # noqa: E402  (the brake runner: namelist, compute_time, x(t))
+import ngspice_compare  # noqa: E402  (the paper's network model in ngspice, as a peer)
 
 ROOT = Path(__file__).resolve().parent.parent
 INPUTS = ROOT / "inputs"
@@ -255,6 +256,10 @@ def make_scenes(quick: bool) -> dict:
         # the failure map's NaF case: the first line alone
         "naf_line": AfmScene("naf_line", ("naf.nml",), "&scan nx = 64, ny = 1 /", afm_tols, 1e-12,
                              "NaF, one line, trace + retrace", "inputs/naf.nml, ny = 1, nx = 64"),
+        # The line the SPICE netlist models (line 0, trace): ngspice's peer chart.
+        "naf_trace": AfmScene("naf_trace", ("naf.nml",), "&scan nx = 64, ny = 1, retrace = .false. /", afm_tols,
+                              1e-12, "NaF, line 0, trace only (the SPICE netlist's line)",
+                              "inputs/naf.nml, ny = 1, nx = 64, trace only"),
         # Damped (ratio 0.2): the paper's undamped tip is chaotic, and its line
         # force is not determined to better than about 0.06 nN at any tolerance
         # (rk8pd at 1e-11 against 1e-10; README: Speed against accuracy).
@@ -336,6 +341,52 @@ def run_scene(scene, methods, repeats) -> dict:
     smallest = min(ok_errors) if ok_errors else math.nan
     return {"scene": scene, "ref": ref, "check": check, "rows": rows, "smallest": smallest,
             "converged": bool(ok_errors) and 10 * check < smallest}
+
+
+# ngspice's reltol ladders (the charts' own rtol ladders, less the loosest rungs,
+# where trap integration misses slips: README: Network model).
+NGSPICE_LADDERS = {"naf_trace": [10.0 ** -k for k in range(4, 11)],
+                   "brake_regularized": [10.0 ** -k for k in range(4, 12)]}
+NGSPICE_QUICK = {"naf_trace": [1e-6, 1e-8]}  # --quick --ngspice: seconds, for the test
+
+
+def ngspice_series(res, fr_inputs: Path, binary: Path, workdir: Path, ladders: dict) -> dict:
+    """The scene's netlist in ngspice along a reltol ladder, each rung's error
+    measured against the chart's own reference on the chart's own samples;
+    ngspice's vntol = chgtol = abstol is the chart's atol for that rtol.  CPU
+    time is ngspice's reported transient analysis time."""
+    scene, ref = res["scene"], res["ref"]
+    if scene.kind == "brake":
+        inputs = [fr_inputs / "brake.nml",
+                  benchmark_afm_override(workdir, "ngspice_brake",
+                                         f"&brake model = 'regularized', t_end = {BRAKE_WINDOW[1]!r}, "
+                                         "dt_out = 1.0 /\n")]
+        t = np.arange(ref.q.size) * 1.0 + BRAKE_WINDOW[0]
+        window = BRAKE_WINDOW
+    else:
+        inputs = [fr_inputs / "naf.nml", benchmark_afm_override(workdir, "ngspice_naf", scene.reduce_text + "\n")]
+        text = (fr_inputs / "naf.nml").read_text()
+        velocity = float(re.search(r"^\s*velocity\s*=\s*([-+0-9.eE]+)", text, re.M).group(1))
+        length = float(re.search(r"^\s*length\s*=\s*([-+0-9.eE]+)", text, re.M).group(1))
+        t = np.arange(ref.q.size) * (length / (ref.q.size - 1)) / velocity
+        window = None
+    errors, times = [], []
+    for reltol in ladders[scene.name]:
+        row = ngspice_compare.ngspice_work_precision(inputs, [reltol], t, ref.q, binary=binary,
+                                                      atol=scene.atol_for(reltol), window=window,
+                                                      repeats=1, workdir=workdir / "ngspice")[0]
+        log(f"  {scene.name} ngspice reltol {reltol:.0e}: error {row['error']:.2e} {scene.unit}, "
+            f"{row['cpu_time']:.4f} s")
+        errors.append(row["error"])
+        times.append(row["cpu_time"])
+    return {"label": "ngspice (network model, trap)", "error": errors, "cpu_time": times,
+            "reltol": ladders[scene.name]}
+
+
+def benchmark_afm_override(workdir: Path, name: str, text: str) -> Path:
+    path = workdir / f"{name}.nml"
+    path.write_text(text)
+    return path
 
 
 def time_to_reach(points, level):
@@ -610,6 +661,40 @@ def load_extras(path: Path | None, scenes) -> dict:
         sys.exit(f"work_precision: --extra {path}: {exc}")
 
 
+def replot(path: Path, out: Path, extras: dict) -> int:
+    """Redraw the charts of a work_precision.h5 without measuring again; the
+    --extra series (and any already in the file) are added to the file and
+    drawn.  The measured data are not changed."""
+    scenes = make_scenes(False)
+    with h5py.File(path, "r+") as f:
+        for name in f:
+            if name not in scenes:
+                continue
+            g = f[name]
+            rows = {}
+            for method in g:
+                if method == "extra":
+                    continue
+                m = g[method]
+                status = [v.decode() if isinstance(v, bytes) else str(v) for v in m["status"][()]]
+                rows[method] = [Point(method, float(r), float(a), st, error=float(e), time=float(t))
+                                for r, a, st, e, t in zip(m["tolerance"][()], m["atol"][()], status,
+                                                          m["error"][()], m["cpu_time"][()])]
+            for ex in extras.get(name, []):
+                e = g.require_group("extra")
+                if ex["label"] in e:
+                    del e[ex["label"]]
+                s = e.create_group(ex["label"])
+                s.create_dataset("error", data=np.asarray(ex["error"], dtype=float))
+                s.create_dataset("cpu_time", data=np.asarray(ex["cpu_time"], dtype=float))
+            series = [{"label": label, "error": g["extra"][label]["error"][()],
+                       "cpu_time": g["extra"][label]["cpu_time"][()]} for label in g.get("extra", {})]
+            res = {"scene": scenes[name], "rows": rows, "check": float(g.attrs["reference_check"])}
+            plot_scene(res, series, out / f"work_precision_{name}.png")
+            log(f"replotted {name} ({len(series)} extra series)")
+    return 0
+
+
 def summary_table(results) -> str:
     lines = ["| scene | error level | best method | time | rkf45 time | rkf45 / best |",
              "|---|---|---|---|---|---|"]
@@ -652,14 +737,31 @@ def main(argv=None) -> int:
     p.add_argument("--scenes", help="comma-separated subset of the scenes")
     p.add_argument("--methods", help="comma-separated subset of the methods")
     p.add_argument("--no-failure-map", action="store_true", help="skip the failure map")
+    p.add_argument("--ngspice", action="store_true",
+                   help="also chart the paper's network model in ngspice (friction --netlist) on its two "
+                        "scenes, brake_regularized and naf_trace (added to the scenes run)")
+    p.add_argument("--replot", type=Path, metavar="H5",
+                   help="measure nothing: redraw the charts of this work_precision.h5 into --out, adding "
+                        "the --extra series to the file")
     p.add_argument("--binary", type=Path, default=ROOT / "build" / "friction",
                    help="the friction executable (default: build/friction)")
     args = p.parse_args(argv)
+    if args.replot:
+        if not args.replot.exists():
+            p.error(f"--replot {args.replot}: no such file")
+        args.out.mkdir(parents=True, exist_ok=True)
+        return replot(args.replot, args.out, load_extras(args.extra, make_scenes(False)))
     repeats = args.repeats or (1 if args.quick else 3)
     cap = args.cap or (3.0 if args.quick else 10.0)
     scenes = make_scenes(args.quick)
     names = (args.scenes.split(",") if args.scenes else
-             (["naf", "brake_switched"] if args.quick else [n for n in scenes if n != "naf_line"]))
+             (["naf", "brake_switched"] if args.quick else
+              [n for n in scenes if n not in ("naf_line", "naf_trace")]))
+    if args.ngspice:
+        if not shutil.which("ngspice"):
+            p.error("--ngspice: no ngspice on PATH (scripts/install-deps installs it)")
+        ladders = NGSPICE_QUICK if args.quick else NGSPICE_LADDERS
+        names += [n for n in ladders if n not in names]
     methods = tuple(args.methods.split(",")) if args.methods else (QUICK_METHODS if args.quick else METHODS)
     for n in names:
         if n not in scenes:
@@ -699,6 +801,9 @@ def main(argv=None) -> int:
             s = scenes[n]
             s.setup(afm_fr if s.kind == "afm" else brake_fr, cap)
             results.append(run_scene(s, methods, repeats))
+            if args.ngspice and n in ladders:
+                extras.setdefault(n, []).append(ngspice_series(results[-1], workdir / "inputs", snapshot, workdir,
+                                                               ladders))
         maps = [] if args.no_failure_map else failure_maps(afm_fr, brake_fr, methods, cap, args.quick)
     except RuntimeError as exc:
         log(str(exc))

@@ -39,3 +39,15 @@ add_test(NAME auto-method
           --binary $<TARGET_FILE:friction_app> --inputs "${_fs_inputs}"
           --workdir "${CMAKE_CURRENT_BINARY_DIR}/auto_method" --library $<TARGET_FILE:friction>)
 set_tests_properties(auto-method PROPERTIES LABELS "cli;capi" TIMEOUT 300)
+
+# The paper's network model in ngspice on the chart of the line it models.
+add_test(NAME work_precision.ngspice
+  COMMAND ${Python3_EXECUTABLE} "${_fs_scripts}/work_precision.py" --quick --ngspice --scenes naf_trace
+          --methods rkf45 --no-failure-map --binary $<TARGET_FILE:friction_app> --out "${_wp_work}/ngspice"
+  WORKING_DIRECTORY "${_wp_work}")
+set_tests_properties(work_precision.ngspice PROPERTIES FIXTURES_SETUP work_precision_ngspice
+  LABELS "scripts;netlist" TIMEOUT 300)
+add_test(NAME work_precision.ngspice_data
+  COMMAND ${Python3_EXECUTABLE} "${_fs_tests}/check_ngspice_series.py" "${_wp_work}/ngspice")
+set_tests_properties(work_precision.ngspice_data PROPERTIES FIXTURES_REQUIRED work_precision_ngspice
+  LABELS "scripts;netlist")
