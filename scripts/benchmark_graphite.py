@@ -54,6 +54,8 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
+from benchmark_afm import git_state  # the source commit, shared by the benchmarks
+
 try:
     import h5py
     import numpy as np
@@ -294,16 +296,6 @@ class Benchmark:
               f"{c['rhs_full']} (full sum), wall {c['wall_default_s']:.2f} s vs "
               f"{c['wall_full_s']:.2f} s")
         return "\n".join(lines)
-
-
-def git_state() -> str:
-    """The source commit, with '-dirty' when the working tree has changes."""
-    try:
-        out = subprocess.run(["git", "-C", str(ROOT), "describe", "--always", "--dirty"],
-                             capture_output=True, text=True, timeout=30)
-        return out.stdout.strip() or "unknown"
-    except (OSError, subprocess.SubprocessError):
-        return "unknown"
 
 
 def main(argv=None) -> int:

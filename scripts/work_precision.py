@@ -358,13 +358,13 @@ def ngspice_series(res, fr_inputs: Path, binary: Path, workdir: Path, ladders: d
     scene, ref = res["scene"], res["ref"]
     if scene.kind == "brake":
         inputs = [fr_inputs / "brake.nml",
-                  benchmark_afm_override(workdir, "ngspice_brake",
+                  write_override(workdir, "ngspice_brake",
                                          f"&brake model = 'regularized', t_end = {BRAKE_WINDOW[1]!r}, "
                                          "dt_out = 1.0 /\n")]
         t = np.arange(ref.q.size) * 1.0 + BRAKE_WINDOW[0]
         window = BRAKE_WINDOW
     else:
-        inputs = [fr_inputs / "naf.nml", benchmark_afm_override(workdir, "ngspice_naf", scene.reduce_text + "\n")]
+        inputs = [fr_inputs / "naf.nml", write_override(workdir, "ngspice_naf", scene.reduce_text + "\n")]
         text = (fr_inputs / "naf.nml").read_text()
         velocity = float(re.search(r"^\s*velocity\s*=\s*([-+0-9.eE]+)", text, re.M).group(1))
         length = float(re.search(r"^\s*length\s*=\s*([-+0-9.eE]+)", text, re.M).group(1))
@@ -383,7 +383,7 @@ def ngspice_series(res, fr_inputs: Path, binary: Path, workdir: Path, ladders: d
             "reltol": ladders[scene.name]}
 
 
-def benchmark_afm_override(workdir: Path, name: str, text: str) -> Path:
+def write_override(workdir: Path, name: str, text: str) -> Path:
     path = workdir / f"{name}.nml"
     path.write_text(text)
     return path
