@@ -397,6 +397,24 @@ class Benchmark:
         return "\n".join(lines)
 
 
+def snapshot_program(binary: Path, workdir: Path) -> Path:
+    """A private copy of the program and of its shared library (libfriction.so,
+    found first through LD_LIBRARY_PATH), so that a rebuild during a
+    benchmark neither breaks it nor mixes two builds in one table.  (The
+    program alone is not enough: it loads the library from the build tree
+    through its run path.)"""
+    snapshot = workdir / "friction"
+    shutil.copy2(binary, snapshot)
+    libraries = sorted(Path(binary).resolve().parent.glob("libfriction.so*"))
+    if libraries:
+        (workdir / "lib").mkdir(exist_ok=True)
+        for library in libraries:
+            shutil.copy2(library, workdir / "lib" / library.name, follow_symlinks=True)
+        os.environ["LD_LIBRARY_PATH"] = os.pathsep.join(
+            [str(workdir / "lib")] + [d for d in os.environ.get("LD_LIBRARY_PATH", "").split(os.pathsep) if d])
+    return snapshot
+
+
 def git_state() -> str:
     """The source commit, with '-dirty' when the working tree has changes."""
     try:
@@ -447,11 +465,10 @@ def main(argv=None) -> int:
         cpus = os.cpu_count() or 1
 
     workdir = Path(tempfile.mkdtemp(prefix="friction-bench-"))
-    # Run private copies of the executable and the input files, so a rebuild
-    # or an edit during the benchmark neither breaks it nor mixes two versions
-    # in one table (the library is linked statically).
-    snapshot = workdir / "friction"
-    shutil.copy2(binary, snapshot)
+    # Run private copies of the program, its library and the input files, so
+    # a rebuild or an edit during the benchmark neither breaks it nor mixes
+    # two versions in one table.
+    snapshot = snapshot_program(binary, workdir)
     shutil.copytree(INPUTS, workdir / "inputs")
     fr = Friction(snapshot, shlex.split(args.mpirun), workdir)
     bench = Benchmark(args, fr)

@@ -54,7 +54,7 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from benchmark_afm import git_state  # the source commit, shared by the benchmarks
+from benchmark_afm import git_state, snapshot_program  # shared by the benchmarks
 
 try:
     import h5py
@@ -326,8 +326,7 @@ def main(argv=None) -> int:
     workdir = Path(tempfile.mkdtemp(prefix="friction-graphite-bench-"))
     # Private copies of the executable and the inputs, so a rebuild or an edit
     # during the benchmark neither breaks it nor mixes two versions in a table.
-    snapshot = workdir / "friction"
-    shutil.copy2(binary, snapshot)
+    snapshot = snapshot_program(binary, workdir)
     shutil.copytree(INPUTS, workdir / "inputs")
     fr = Friction(snapshot, workdir)
     try:

@@ -780,19 +780,7 @@ def main(argv=None) -> int:
     t0 = time.perf_counter()
     workdir = Path(tempfile.mkdtemp(prefix="friction-wp-"))
     try:
-        snapshot = workdir / "friction"
-        shutil.copy2(args.binary, snapshot)
-        # The program finds libfriction.so through its run path, in the build
-        # tree: a rebuild during the run would swap it under the running
-        # measurements.  Copies, found first through LD_LIBRARY_PATH, keep
-        # the whole run on one build.
-        libs = sorted(args.binary.resolve().parent.glob("libfriction.so*"))
-        if libs:
-            (workdir / "lib").mkdir()
-            for lib in libs:
-                shutil.copy2(lib, workdir / "lib" / lib.name, follow_symlinks=True)
-            os.environ["LD_LIBRARY_PATH"] = os.pathsep.join(
-                [str(workdir / "lib")] + [d for d in os.environ.get("LD_LIBRARY_PATH", "").split(os.pathsep) if d])
+        snapshot = benchmark_afm.snapshot_program(args.binary, workdir)
         shutil.copytree(INPUTS, workdir / "inputs")
         afm_fr = benchmark_afm.Friction(snapshot, [], workdir)
         brake_fr = benchmark_brake.Friction(snapshot, workdir, cap)
