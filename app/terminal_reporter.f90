@@ -55,14 +55,6 @@ contains
 
       if (self%quiet) return
       now = MPI_Wtime()
-      if (what == 'points') then
-         ! Sweep points finish seconds to minutes apart: say each one.
-         write (text, '(a, i0, a, i0, a)') 'friction: sweep: rank 0 finished point ', nint(done), ' of ', &
-            & nint(total), ' (points are taken in order)'
-         write (error_unit, '(a)') trim(text)
-         flush (error_unit)
-         return
-      end if
       tty = friction_stderr_is_terminal() /= 0
       interval = 0.5_wp
       if (.not. tty) interval = max(2.0_wp, 0.1_wp * (now - self%t_start))
@@ -78,6 +70,11 @@ contains
       write (seconds(2), '(f12.1)') remaining
       if (what == 'tau') then
          write (text, '(a, f0.1, a, f0.1, a)') 'friction: τ = ', done, ' of ', total, ', '
+      else if (what == 'points') then
+         ! Rank 0 knows the index of the point it last took: points are handed
+         ! out in order, so that many have been started across the ranks.
+         write (text, '(a, i0, a, i0, a)') 'friction: sweep: ', nint(done), ' of ', nint(total), &
+            & ' points started, '
       else
          write (text, '(a, i0, a, i0, a)') 'friction: ', nint(done), ' of ', nint(total), ' '//what//', '
       end if
