@@ -13,10 +13,10 @@
 !> error: the block lifts off); 2., 3. v_rel ∓ stick_velocity, the edges of
 !> the creep band the output counts as stick.
 module friction_brake_regularized
-   use friction_kinds, only: wp, i8, pi
+   use friction_kinds, only: wp, pi
    use friction_error, only: error_type, fatal_error, error_numerical
    use friction_strings, only: rtoa
-   use friction_ode_solver, only: solver_settings, integrator_statistics, is_implicit_step_type
+   use friction_ode_solver, only: solver_settings, is_implicit_step_type
    use friction_ode_events, only: event_system, event_locator, event_falling, event_either, &
       & event_rising
    use friction_brake_params, only: brake_parameters
@@ -49,8 +49,6 @@ module friction_brake_regularized
    contains
       procedure :: init => integrator_init
       procedure :: advance_to => integrator_advance_to
-      procedure :: statistics => integrator_statistics_of
-      procedure :: steps_taken => integrator_steps_taken
    end type regularized_integrator
 
 contains
@@ -210,19 +208,5 @@ contains
          end do
       end do
    end subroutine integrator_advance_to
-
-   function integrator_statistics_of(self) result(stats)
-      class(regularized_integrator), intent(in) :: self
-      type(integrator_statistics) :: stats
-
-      stats = self%locator%statistics()
-   end function integrator_statistics_of
-
-   function integrator_steps_taken(self) result(n)
-      class(regularized_integrator), intent(in) :: self
-      integer(i8) :: n
-
-      n = self%locator%steps_taken()
-   end function integrator_steps_taken
 
 end module friction_brake_regularized

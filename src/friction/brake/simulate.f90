@@ -122,9 +122,9 @@ contains
       type(integrator_statistics) :: stats
 
       if (trim(self%config%model) == model_switched) then
-         stats = self%switched%statistics()
+         stats = self%switched%locator%statistics()
       else
-         stats = self%regularized%statistics()
+         stats = self%regularized%locator%statistics()
       end if
    end function statistics
 
@@ -133,9 +133,9 @@ contains
       integer(i8) :: n
 
       if (trim(self%config%model) == model_switched) then
-         n = self%switched%steps_taken()
+         n = self%switched%locator%steps_taken()
       else
-         n = self%regularized%steps_taken()
+         n = self%regularized%locator%steps_taken()
       end if
    end function steps_taken
 

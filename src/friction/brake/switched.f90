@@ -17,10 +17,10 @@
 !>   drives the block away from the belt.  Then s x'' = |2x - y| - μ N' >= 0
 !>   because μ <= μs (checked on input: μ > μs would make the model chatter).
 module friction_brake_switched
-   use friction_kinds, only: wp, i8
+   use friction_kinds, only: wp
    use friction_error, only: error_type, fatal_error, error_numerical
    use friction_strings, only: rtoa
-   use friction_ode_solver, only: solver_settings, integrator_statistics
+   use friction_ode_solver, only: solver_settings
    use friction_ode_events, only: event_system, event_locator, event_falling
    use friction_brake_params, only: brake_parameters
    use friction_brake_stick, only: stick_motion, stick_end_lift_off
@@ -57,8 +57,6 @@ module friction_brake_switched
    contains
       procedure :: init
       procedure :: advance_to
-      procedure :: statistics
-      procedure :: steps_taken
    end type switched_integrator
 
 contains
@@ -248,19 +246,5 @@ contains
       self%slip%direction = s
       call self%locator%restart(self%t, self%y, h_start)
    end subroutine start_slip_in
-
-   function statistics(self) result(stats)
-      class(switched_integrator), intent(in) :: self
-      type(integrator_statistics) :: stats
-
-      stats = self%locator%statistics()
-   end function statistics
-
-   function steps_taken(self) result(n)
-      class(switched_integrator), intent(in) :: self
-      integer(i8) :: n
-
-      n = self%locator%steps_taken()
-   end function steps_taken
 
 end module friction_brake_switched
