@@ -54,6 +54,7 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
+import benchmark_afm  # the runner, shared with the AFM benchmark
 from benchmark_afm import git_state, snapshot_program  # shared by the benchmarks
 
 try:
@@ -101,22 +102,12 @@ class Run:
     near: int  # atoms within the cutoff of the scan centre
 
 
-class Friction:
-    def __init__(self, binary: Path, workdir: Path):
-        self.binary = binary
-        self.workdir = workdir
-        self.inputs = workdir / "inputs"
-        self.env = dict(os.environ)
-        if hasattr(os, "geteuid") and os.geteuid() == 0:
-            # Open MPI refuses to run as root unless both are set.
-            self.env["OMPI_ALLOW_RUN_AS_ROOT"] = "1"
-            self.env["OMPI_ALLOW_RUN_AS_ROOT_CONFIRM"] = "1"
-        self._count = 0
+class Friction(benchmark_afm.Friction):
+    """The AFM benchmark's runner (environment, overrides), run on one rank
+    on the graphite case, reading the lattice-sum attributes."""
 
-    def override(self, name: str, text: str) -> Path:
-        path = self.workdir / f"{name}.nml"
-        path.write_text(text + "\n")
-        return path
+    def __init__(self, binary: Path, workdir: Path):
+        super().__init__(binary, [], workdir)
 
     def run(self, overrides: list[Path]) -> Run:
         """friction on one rank (no mpirun: the single-process cost is measured)."""

@@ -240,28 +240,35 @@ contains
    subroutine warnings(failure)
       character(len=:), allocatable, intent(out) :: failure
       type(afm_config) :: c
+      class(surface_potential), allocatable :: surface
+      type(error_type), allocatable :: error
 
       c%potential = 'naf'
+      call new_potential(c, surface, error)
+      if (allocated(error)) then
+         failure = error%message
+         return
+      end if
       ! The largest lateral force of Eq. 1 is 2πV0/a = 2.1757 nN, on the grid
       ! to (2π/a × grid spacing)²/2 ~ 0.3 % (the scan's 20 Å on 64 points).
-      call check_close(failure, surface_force_scale(c), 2 * pi / 4.62_wp * ev_per_angstrom_to_nn, &
+      call check_close(failure, surface_force_scale(c, surface), 2 * pi / 4.62_wp * ev_per_angstrom_to_nn, &
          & 0.01_wp * 2 * pi / 4.62_wp * ev_per_angstrom_to_nn, 'NaF surface force scale, nN')
-      call check(failure, afm_model_warnings(c) == '', 'a warning for the full model')
+      call check(failure, afm_model_warnings(c, surface) == '', 'a warning for the full model')
       c%model = 'quasistatic'
       ! 400 Å/s: c v = 0.04 nN is 1.8 % of 2.18 nN.
-      call check(failure, index(afm_model_warnings(c), 'viscous drag') > 0, 'no drag warning at 400 Å/s')
+      call check(failure, index(afm_model_warnings(c, surface), 'viscous drag') > 0, 'no drag warning at 400 Å/s')
       c%velocity = 1.0_wp
-      call check(failure, afm_model_warnings(c) == '', 'a quasistatic warning at 1 Å/s: ' &
-         & //afm_model_warnings(c))
+      call check(failure, afm_model_warnings(c, surface) == '', 'a quasistatic warning at 1 Å/s: ' &
+         & //afm_model_warnings(c, surface))
       c%cx = 0.0_wp
-      call check(failure, index(afm_model_warnings(c), 'undamped') > 0, 'no warning for an undamped tip')
+      call check(failure, index(afm_model_warnings(c, surface), 'undamped') > 0, 'no warning for an undamped tip')
       c%cx = 1.0e-3_wp
       c%model = 'overdamped'
       ! Q = sqrt(1e-8 × 10)/1e-3 = 0.32: inside; with c ten times smaller 3.2.
-      call check(failure, afm_model_warnings(c) == '', 'an overdamped warning at Q = 0.32')
+      call check(failure, afm_model_warnings(c, surface) == '', 'an overdamped warning at Q = 0.32')
       c%cy = 1.0e-4_wp
-      call check(failure, index(afm_model_warnings(c), 'along y (3.16)') > 0, 'no warning at Q = 3.16: ' &
-         & //afm_model_warnings(c))
+      call check(failure, index(afm_model_warnings(c, surface), 'along y (3.16)') > 0, 'no warning at Q = 3.16: ' &
+         & //afm_model_warnings(c, surface))
    end subroutine warnings
 
 end program test_models

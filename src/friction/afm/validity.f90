@@ -4,7 +4,7 @@
 module friction_afm_validity
    use friction_kinds, only: wp, ev_per_angstrom_to_nn, deg_to_rad
    use friction_error, only: error_type
-   use friction_afm_config, only: afm_config, new_potential, new_tip
+   use friction_afm_config, only: afm_config, new_tip
    use friction_afm_tip, only: afm_tip
    use friction_afm_scan, only: find_height
    use friction_surface_potential, only: surface_potential
@@ -26,8 +26,8 @@ contains
 
    !> Why the settings' reduced model may not hold, one reason per line
    !> ('' when it holds or the model is the full one).  Settings as in the
-   !> namelist (SI for the tip, Å/s for the scan); the potential is built
-   !> here, and an error in it gives '' (the run reports it).
+   !> namelist (SI for the tip, Å/s for the scan), with the run's surface
+   !> (so a lattice sum is not built twice).
    !>   quasistatic: the viscous drag c v along the scan is more than 1 % of
    !>     the largest lateral surface force (damping then raises the
    !>     friction with the velocity), or the full tip takes longer to settle
@@ -36,8 +36,9 @@ contains
    !>     never settles);
    !>   overdamped: in some moving direction sqrt(m k)/c > 1 (the tip
    !>     overshoots after a slip, which needs inertia).
-   function afm_model_warnings(config) result(text)
+   function afm_model_warnings(config, potential) result(text)
       type(afm_config), intent(in) :: config
+      class(surface_potential), intent(in) :: potential   !! the run's surface, built from config
       character(len=:), allocatable :: text
       real(wp) :: mass, spring(3), damping(3), drag, scale, settle, spacing, quality, theta
       integer :: nd, i
@@ -66,7 +67,7 @@ contains
       ! Quasistatic: drag against the surface force.
       theta = config%angle * deg_to_rad
       drag = (config%cx * cos(theta)**2 + config%cy * sin(theta)**2) * config%velocity * 0.1_wp  ! nN
-      scale = surface_force_scale(config)
+      scale = surface_force_scale(config, potential)
       if (scale > 0.0_wp .and. drag > drag_share * scale) call add('quasistatic model at a speed where ' &
          & //'the viscous drag c v = '//fixed(drag, 4)//' nN is '//fixed(100 * drag / scale, 1) &
          & //' % of the largest surface force '//fixed(scale, 2)//' nN (> '//itoa(nint(100 * drag_share)) &
@@ -134,19 +135,17 @@ contains
 
    !> The largest lateral force of the surface over the scan area, nN, on a
    !> 64 x 64 grid: for a lattice sum at the height the loaded tip rests at
-   !> above the scan origin.  0 if the potential cannot be built.
-   function surface_force_scale(config) result(scale)
+   !> above the scan origin (0 if that height cannot be found).
+   function surface_force_scale(config, potential) result(scale)
       type(afm_config), intent(in) :: config
+      class(surface_potential), intent(in) :: potential
       real(wp) :: scale
-      class(surface_potential), allocatable :: potential
       type(afm_tip) :: tip
       type(error_type), allocatable :: error
       real(wp) :: origin(3), height, contact, r(3), g(3)
       integer :: i, j
 
       scale = 0.0_wp
-      call new_potential(config, potential, error)
-      if (allocated(error)) return
       origin = [config%origin_x, config%origin_y, 0.0_wp]
       height = 0.0_wp
       if (potential%dimensions() == 3) then

@@ -43,10 +43,14 @@ contains
       character(len=12) :: seconds
       integer :: start, end
 
+      ! The surface first, identically on every rank: a bad net or defect is
+      ! bad input, reported before any work.
+      call new_potential(c, potential, error, surface%net, surface%cutoff)
+      if (allocated(error)) return
       ! A reduced tip model outside where it holds (README: Reduced models (AFM)):
       ! one note per reason.
       if (job%rank == 0) then
-         warnings = afm_model_warnings(c)
+         warnings = afm_model_warnings(c, potential)
          start = 1
          do while (start <= len(warnings))
             end = index(warnings(start:), new_line('a'))
@@ -55,11 +59,6 @@ contains
             start = end + 2
          end do
       end if
-
-      ! The surface first, identically on every rank: a bad net or defect is
-      ! bad input, reported before any work.
-      call new_potential(c, potential, error, surface%net, surface%cutoff)
-      if (allocated(error)) return
       surface%species_names = c%species(1:species_count(c))
       call share_of(c%ny, job%nranks, job%rank, first, count)
       allocate (trace(c%nx, count, n_quantities))
