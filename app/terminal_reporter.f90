@@ -6,6 +6,7 @@ module friction_app_terminal
    use mpi_f08, only: MPI_Wtime
    use friction_kinds, only: wp
    use friction_job, only: job_reporter
+   use friction_job_report, only: progress_text
    implicit none
    private
 
@@ -68,17 +69,10 @@ contains
       ! (f0.1 would drop the leading zero of 0.5 s.)
       write (seconds(1), '(f12.1)') elapsed
       write (seconds(2), '(f12.1)') remaining
-      if (what == 'tau') then
-         write (text, '(a, f0.1, a, f0.1, a)') 'friction: τ = ', done, ' of ', total, ', '
-      else if (what == 'points') then
-         ! Rank 0 knows the index of the point it last took: points are handed
-         ! out in order, so that many have been started across the ranks.
-         write (text, '(a, i0, a, i0, a)') 'friction: sweep: ', nint(done), ' of ', nint(total), &
-            & ' points started, '
-      else
-         write (text, '(a, i0, a, i0, a)') 'friction: ', nint(done), ' of ', nint(total), ' '//what//', '
-      end if
-      text = trim(text)//' '//trim(adjustl(seconds(1)))//' s elapsed, '//trim(adjustl(seconds(2)))//' s remaining'
+      text = 'friction:'
+      if (what == 'points') text = 'friction: sweep:'
+      text = trim(text)//' '//progress_text(done, total, what)//', '//trim(adjustl(seconds(1)))//' s elapsed, ' &
+         & //trim(adjustl(seconds(2)))//' s remaining'
       if (tty) then
          write (error_unit, '(a)', advance='no') achar(13)//trim(text)//'   '
          if (last) write (error_unit, '(a)') ''

@@ -20,6 +20,7 @@ module friction_capi
    use friction_brake_simulate, only: brake_run
    use friction_strings, only: rtoa
    use friction_job, only: run_job, job_reporter
+   use friction_job_report, only: progress_text
    implicit none
    private
 
@@ -457,11 +458,7 @@ contains
       character(len=120) :: text
 
       if (.not. associated(self%call)) return
-      if (what == 'tau') then
-         write (text, '(a, f0.1, a, f0.1)') 'τ = ', done, ' of ', total
-      else
-         write (text, '(i0, a, i0, a)') nint(done), ' of ', nint(total), ' '//what
-      end if
+      text = progress_text(done, total, what)
       call self%call(trim(text)//c_null_char, real(max(0.0_wp, min(1.0_wp, done / max(total, tiny(total)))), &
          & c_double), self%user)
    end subroutine callback_progress

@@ -7,7 +7,7 @@ module friction_job_report
    implicit none
    private
 
-   public :: job_reporter
+   public :: job_reporter, progress_text
 
    type :: job_reporter
    contains
@@ -23,6 +23,25 @@ module friction_job_report
    end type job_reporter
 
 contains
+
+   !> What a progress report says, for any reporter: "τ = 120.0 of 3200.0",
+   !> "12 of 64 lines", "20 of 48 points started" (rank 0 knows the index of
+   !> the point it last took; points are handed out in order, so that many
+   !> have been started across the ranks).
+   function progress_text(done, total, what) result(text)
+      real(wp), intent(in) :: done, total
+      character(len=*), intent(in) :: what
+      character(len=:), allocatable :: text
+      character(len=80) :: buffer
+
+      if (what == 'tau') then
+         write (buffer, '(a, f0.1, a, f0.1)') 'τ = ', done, ' of ', total
+      else
+         write (buffer, '(i0, a, i0, a)') nint(done), ' of ', nint(total), ' '//what
+         if (what == 'points') buffer = trim(buffer)//' started'
+      end if
+      text = trim(buffer)
+   end function progress_text
 
    subroutine silent_progress(self, done, total, what, last)
       class(job_reporter), intent(inout) :: self
