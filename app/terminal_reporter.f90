@@ -6,7 +6,7 @@ module friction_app_terminal
    use mpi_f08, only: MPI_Wtime
    use friction_kinds, only: wp
    use friction_job, only: job_reporter
-   use friction_job_report, only: progress_text
+   use friction_scene_report, only: progress_text
    implicit none
    private
 

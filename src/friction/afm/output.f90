@@ -8,8 +8,8 @@ module friction_afm_output
    use friction_afm_config, only: afm_config
    use friction_afm_scan, only: quantity_names, quantity_units, quantity_count, q_f_along, q_jumps, &
       & support_along, support_across
-   use friction_io_h5_file, only: h5_file
-   use friction_io_run_summary, only: run_summary, write_run_attributes
+   use friction_output_h5, only: h5_file
+   use friction_output_summary, only: run_summary, write_run_attributes
    use friction_surface_net, only: crystal_net
    use friction_strings, only: join
    implicit none

@@ -28,7 +28,7 @@ module friction_afm_scan
 
    public :: afm_scanner, trip_record, quantity_names, quantity_units, n_quantities, quantity_count
    public :: q_fx, q_fy, q_f_along, q_f_across, q_tip_x, q_tip_y, q_fz, q_tip_z, q_jumps
-   public :: support_along, support_across, share_of, find_height
+   public :: support_along, support_across, find_height
 
    integer, parameter :: n_quantities = 9
    integer, parameter :: q_fx = 1, q_fy = 2, q_f_along = 3, q_f_across = 4, q_tip_x = 5, q_tip_y = 6, &
@@ -103,20 +103,6 @@ contains
          t = [(config%width * real(j, wp) / real(config%ny - 1, wp), j = 0, config%ny - 1)]
       end if
    end function support_across
-
-   !> A rank's share of n items, dealt round-robin: items first, first +
-   !> nranks, ... (0-based), count of them.  Neighbouring lines cost alike
-   !> (they cross the same rows of atoms), so dealing them out in turn
-   !> balances uneven maps better than contiguous blocks (HOPG at 7°, rk8pd
-   !> 1e-11: blocks left one rank idle 40 % of the run).  Each rank still
-   !> writes one regular, strided hyperslab.
-   pure subroutine share_of(n, nranks, rank, first, count)
-      integer, intent(in) :: n, nranks, rank
-      integer, intent(out) :: first, count
-
-      first = rank
-      count = max(0, (n - rank + nranks - 1) / nranks)
-   end subroutine share_of
 
    subroutine init(self, config, potential, error)
       class(afm_scanner), intent(inout) :: self

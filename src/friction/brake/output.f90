@@ -12,8 +12,8 @@ module friction_brake_output
    use friction_brake_record, only: brake_trajectory, brake_event_table, event_kind_names
    use friction_brake_simulate, only: brake_comparison
    use friction_brake_diagnostics, only: brake_diagnostics
-   use friction_io_h5_file, only: h5_file
-   use friction_io_run_summary, only: run_summary, write_run_attributes
+   use friction_output_h5, only: h5_file
+   use friction_output_summary, only: run_summary, write_run_attributes
    implicit none
    private
 

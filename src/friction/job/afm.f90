@@ -9,12 +9,12 @@ module friction_job_afm
    use friction_ode_solver, only: integrator_statistics
    use friction_surface_potential, only: surface_potential
    use friction_afm_config, only: afm_config, new_potential, species_count
-   use friction_afm_scan, only: afm_scanner, trip_record, share_of, n_quantities, q_fx, q_fy, q_f_along
+   use friction_afm_scan, only: afm_scanner, trip_record, n_quantities, q_fx, q_fy, q_f_along
    use friction_afm_output, only: write_afm_file, afm_surface_record
    use friction_afm_validity, only: afm_model_warnings, quasistatic_friction_warning
-   use friction_io_run_summary, only: run_summary
-   use friction_job_report, only: job_reporter
-   use friction_job_common, only: job_context, agree_on_error, temporary_name, publish, ranks_text
+   use friction_output_summary, only: run_summary
+   use friction_scene_report, only: job_reporter
+   use friction_scene_context, only: job_context, agree_on_error, temporary_name, publish, ranks_text, share_of
    implicit none
    private
 

@@ -14,8 +14,8 @@ module friction_job_brake
    use friction_brake_simulate, only: brake_run, compare_runs
    use friction_brake_output, only: brake_run_summary, brake_check_summary, write_brake_file
    use friction_brake_diagnostics, only: brake_diagnostics, diagnose_brake
-   use friction_job_report, only: job_reporter
-   use friction_job_common, only: job_context, agree_on_error, temporary_name, publish, ranks_text
+   use friction_scene_report, only: job_reporter
+   use friction_scene_context, only: job_context, agree_on_error, temporary_name, publish, ranks_text
    implicit none
    private
 

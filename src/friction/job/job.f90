@@ -6,12 +6,12 @@ module friction_job
    use mpi_f08
    use friction_kinds, only: wp
    use friction_error, only: error_type, fatal_error, error_input
-   use friction_io_input, only: job_config, read_input
-   use friction_io_files, only: file_exists
+   use friction_input, only: job_config, read_input
    use friction_version, only: version_string
-   use friction_netlist_spice, only: spice_netlist, write_text_file
-   use friction_job_report, only: job_reporter
-   use friction_job_common, only: job_context, agree_on_error, check_writable, default_output
+   use friction_netlist_spice, only: spice_netlist
+   use friction_files, only: file_exists, write_text_file
+   use friction_scene_report, only: job_reporter
+   use friction_scene_context, only: job_context, agree_on_error, check_writable, default_output
    use friction_job_afm, only: run_afm_job
    use friction_job_brake, only: run_brake_job
    use friction_job_sweep, only: run_sweep_job

@@ -24,14 +24,14 @@ module friction_job_sweep
    use friction_strings, only: itoa
    use friction_version, only: version_string
    use friction_ode_solver, only: integrator_statistics
-   use friction_io_input, only: job_config, read_input
-   use friction_io_h5_file, only: h5_file
-   use friction_io_run_summary, only: run_summary, write_run_attributes
-   use friction_io_files, only: file_exists, rename_file, remove_file, process_id
+   use friction_input, only: job_config, read_input
+   use friction_output_h5, only: h5_file
+   use friction_output_summary, only: run_summary, write_run_attributes
+   use friction_files, only: file_exists, rename_file, remove_file, process_id
    use friction_brake_simulate, only: brake_run
    use friction_brake_diagnostics, only: brake_diagnostics, diagnose_brake
-   use friction_job_report, only: job_reporter
-   use friction_job_common, only: job_context, temporary_name, publish, ranks_text, sum_to_root_real, &
+   use friction_scene_report, only: job_reporter
+   use friction_scene_context, only: job_context, temporary_name, publish, ranks_text, sum_to_root_real, &
       & sum_to_root_integer
    use friction_job_brake, only: integrate_brake
    use friction_job_afm, only: afm_friction

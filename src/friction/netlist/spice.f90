@@ -34,15 +34,15 @@ module friction_netlist_spice
       & ns_per_m_to_internal
    use friction_error, only: error_type, fatal_error, error_input, error_io
    use friction_strings, only: rtoa
-   use friction_io_input, only: job_config
-   use friction_io_files, only: rename_file, remove_file
+   use friction_input, only: job_config
+   use friction_files, only: rename_file, remove_file
    use friction_brake_config, only: brake_config, model_switched
    use friction_afm_config, only: afm_config
    use friction_afm_scan, only: support_across
    implicit none
    private
 
-   public :: spice_netlist, write_text_file
+   public :: spice_netlist
 
    character(len=*), parameter :: nl = new_line('a')
 
@@ -291,32 +291,5 @@ contains
       write (buffer, '(es24.16e3)') x
       text = trim(adjustl(buffer))
    end function num
-
-   !> Write text to path, complete or not at all (a temporary name beside it,
-   !> renamed when written).
-   subroutine write_text_file(path, text, error)
-      character(len=*), intent(in) :: path, text
-      type(error_type), allocatable, intent(out) :: error
-      character(len=:), allocatable :: temporary
-      character(len=256) :: message
-      integer :: unit, stat
-
-      temporary = path//'.tmp'
-      open (newunit=unit, file=temporary, status='replace', action='write', form='unformatted', &
-         & access='stream', iostat=stat, iomsg=message)
-      if (stat /= 0) then
-         call fatal_error(error, path//': cannot write the netlist here ('//trim(message)//')', error_io)
-         return
-      end if
-      write (unit, iostat=stat, iomsg=message) text
-      if (stat /= 0) then
-         close (unit, status='delete')
-         call fatal_error(error, path//': writing failed ('//trim(message)//')', error_io)
-         return
-      end if
-      close (unit)
-      call rename_file(temporary, path, error)
-      if (allocated(error)) call remove_file(temporary)
-   end subroutine write_text_file
 
 end module friction_netlist_spice

@@ -3,7 +3,7 @@
 !> of scan lines collectively.  Every call is collective: all ranks call it
 !> with the same names and the same small data.  A `units` attribute goes on
 !> every dataset.
-module friction_io_h5_file
+module friction_output_h5
    use, intrinsic :: iso_fortran_env, only: int64
    use, intrinsic :: iso_c_binding, only: c_ptr, c_loc
    use mpi_f08, only: MPI_Comm, MPI_INFO_NULL, MPI_Comm_rank
@@ -336,4 +336,4 @@ contains
       end if
    end subroutine check
 
-end module friction_io_h5_file
+end module friction_output_h5

@@ -1,9 +1,9 @@
 !> What every output file records about its run, at the root: program,
 !> version, scene, the resolved input, ranks, wall time and integrator cost.
-module friction_io_run_summary
+module friction_output_summary
    use friction_kinds, only: wp, i8
    use friction_ode_solver, only: integrator_statistics
-   use friction_io_h5_file, only: h5_file
+   use friction_output_h5, only: h5_file
    implicit none
    private
 
@@ -38,4 +38,4 @@ contains
       call file%write_attribute_integer('/', 'jacobian_evaluations', summary%stats%jacobian_evaluations)
    end subroutine write_run_attributes
 
-end module friction_io_run_summary
+end module friction_output_summary

@@ -2,7 +2,7 @@
 !> library calls these hooks (on rank 0 only) and the caller decides what to
 !> show.  The base type is silent and never asks to stop; the command line
 !> (app/) and the C API extend it.
-module friction_job_report
+module friction_scene_report
    use friction_kinds, only: wp
    implicit none
    private
@@ -61,4 +61,4 @@ contains
       never_stop = .false.
    end function never_stop
 
-end module friction_job_report
+end module friction_scene_report

@@ -1,12 +1,12 @@
 !> File-system operations Fortran lacks: atomic rename and removal through
 !> the C library, so output appears under its final name only when complete.
-module friction_io_files
+module friction_files
    use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char
    use friction_error, only: error_type, fatal_error, error_io
    implicit none
    private
 
-   public :: rename_file, remove_file, file_exists, process_id
+   public :: rename_file, remove_file, file_exists, process_id, write_text_file
 
    interface
       function c_rename(from, to) result(stat) bind(c, name='rename')
@@ -58,4 +58,32 @@ contains
       process_id = int(c_getpid())
    end function process_id
 
-end module friction_io_files
+
+   !> Write text to path, complete or not at all (a temporary name beside it,
+   !> renamed when written).
+   subroutine write_text_file(path, text, error)
+      character(len=*), intent(in) :: path, text
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: temporary
+      character(len=256) :: message
+      integer :: unit, stat
+
+      temporary = path//'.tmp'
+      open (newunit=unit, file=temporary, status='replace', action='write', form='unformatted', &
+         & access='stream', iostat=stat, iomsg=message)
+      if (stat /= 0) then
+         call fatal_error(error, path//': cannot write the file here ('//trim(message)//')', error_io)
+         return
+      end if
+      write (unit, iostat=stat, iomsg=message) text
+      if (stat /= 0) then
+         close (unit, status='delete')
+         call fatal_error(error, path//': writing failed ('//trim(message)//')', error_io)
+         return
+      end if
+      close (unit)
+      call rename_file(temporary, path, error)
+      if (allocated(error)) call remove_file(temporary)
+   end subroutine write_text_file
+
+end module friction_files

@@ -1,10 +1,10 @@
-!> Text helpers for messages: numbers and lists as text.
+!> Text helpers: numbers and lists as text for messages, case folding.
 module friction_strings
    use friction_kinds, only: wp, i8
    implicit none
    private
 
-   public :: itoa, rtoa, join, quoted
+   public :: itoa, rtoa, join, quoted, lower
 
    !> An integer as text, without blanks.
    interface itoa
@@ -12,6 +12,18 @@ module friction_strings
    end interface itoa
 
 contains
+
+   !> ASCII letters in lower case.
+   pure function lower(text) result(out)
+      character(len=*), intent(in) :: text
+      character(len=len(text)) :: out
+      integer :: i
+
+      out = text
+      do i = 1, len(text)
+         if (text(i:i) >= 'A' .and. text(i:i) <= 'Z') out(i:i) = achar(iachar(text(i:i)) + 32)
+      end do
+   end function lower
 
    pure function itoa4(i) result(text)
       integer, intent(in) :: i

@@ -6,7 +6,7 @@
 !> variables, unreadable values and non-physical settings are errors naming
 !> the file, the group and the variable.  The resolved input comes back as
 !> namelist text for the output file.
-module friction_io_input
+module friction_input
    use friction_kinds, only: wp, i8
    use friction_strings, only: itoa, rtoa, join, quoted
    use friction_error, only: error_type, fatal_error, error_input
@@ -14,11 +14,12 @@ module friction_io_input
    use friction_ode_auto, only: auto_name, auto_method
    use friction_afm_config, only: afm_config, potential_names, net_names, net_sites, max_species, max_defects, &
       & tip_model_names
-   use friction_io_files, only: file_exists
+   use friction_files, only: file_exists
    use friction_brake_config, only: brake_config, model_names, units_names, brake_solver_defaults
    use friction_analysis_settings, only: section_names
    use friction_brake_diagnostics, only: series_names
-   use friction_io_namelist_scan, only: mention, scan_namelist_file, lower, namelist_names, &
+   use friction_strings, only: lower
+   use friction_input_scan, only: mention, scan_namelist_file, namelist_names, &
       & assigned_names, value_has_kind, kind_text
    implicit none
    private
@@ -896,4 +897,4 @@ contains
 
    end subroutine read_input
 
-end module friction_io_input
+end module friction_input

@@ -20,7 +20,7 @@ module friction_capi
    use friction_brake_simulate, only: brake_run
    use friction_strings, only: rtoa
    use friction_job, only: run_job, job_reporter
-   use friction_job_report, only: progress_text
+   use friction_scene_report, only: progress_text
    implicit none
    private
 

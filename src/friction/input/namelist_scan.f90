@@ -2,15 +2,15 @@
 !> not offer: which groups a file has and which variables each one sets,
 !> with line numbers.  It lets the input reader reject unknown groups and
 !> variables with a precise message, and name the file a value came from.
-module friction_io_namelist_scan
+module friction_input_scan
    use, intrinsic :: iso_fortran_env, only: int64
    use friction_kinds, only: wp
-   use friction_strings, only: join
+   use friction_strings, only: join, lower
    use friction_error, only: error_type, fatal_error, error_input
    implicit none
    private
 
-   public :: mention, scan_namelist_file, lower, namelist_names, assigned_names, value_has_kind, &
+   public :: mention, scan_namelist_file, namelist_names, assigned_names, value_has_kind, &
       & kind_text
 
    !> One assignment `name = value` inside group `&group` of a file; value
@@ -23,17 +23,6 @@ module friction_io_namelist_scan
    end type mention
 
 contains
-
-   pure function lower(text) result(out)
-      character(len=*), intent(in) :: text
-      character(len=len(text)) :: out
-      integer :: i
-
-      out = text
-      do i = 1, len(text)
-         if (text(i:i) >= 'A' .and. text(i:i) <= 'Z') out(i:i) = achar(iachar(text(i:i)) + 32)
-      end do
-   end function lower
 
    pure logical function is_name_char(c)
       character, intent(in) :: c
@@ -328,4 +317,4 @@ contains
       end do
    end function assigned_names
 
-end module friction_io_namelist_scan
+end module friction_input_scan
