@@ -54,7 +54,8 @@ program friction_main
       opts%output = opts%netlist
    else
       if (.not. allocated(opts%output)) opts%output = default_output(opts%files(1))
-      call run_job(opts%files, opts%output, opts%force, opts%resume, MPI_COMM_WORLD, reporter, summary, error)
+      call run_job(opts%files, opts%output, opts%force, opts%resume, MPI_COMM_WORLD, reporter, summary, error, &
+         & stop_after=test_stop_after())
    end if
    ! An interrupted sweep has written its file: say what it holds, then why it stopped.
    if (rank == 0 .and. .not. opts%quiet .and. allocated(summary)) &
@@ -73,6 +74,20 @@ program friction_main
    call finish(0)
 
 contains
+
+   !> The test suite's hook for an interrupted sweep (docs/testing.md):
+   !> FRICTION_TEST_STOP_AFTER=N stops a sweep after point N as SIGTERM
+   !> would; unset or not a number, nothing stops.
+   integer function test_stop_after() result(n)
+      character(len=32) :: text
+      integer :: length, stat
+
+      n = 0
+      call get_environment_variable('FRICTION_TEST_STOP_AFTER', text, length, stat)
+      if (stat /= 0 .or. length == 0) return
+      read (text, *, iostat=stat) n
+      if (stat /= 0 .or. n < 0) n = 0
+   end function test_stop_after
 
    !> Arguments; returns -1 to go on, else the exit code to finish with.
    integer function parse_arguments(opts) result(code)

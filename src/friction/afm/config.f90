@@ -12,6 +12,11 @@ module friction_afm_config
    use friction_surface_lennard_jones, only: new_lj_potential, cutoff_for_tolerance
    use friction_kinds, only: ev_per_angstrom_to_nn
    use friction_afm_tip, only: afm_tip, model_inertial, model_overdamped, model_quasistatic
+   use friction_strings, only: itoa, rtoa, quoted
+   use friction_files, only: file_exists
+   use friction_parameters, only: parameter_visitor
+   use friction_checks, only: config_checker
+   use friction_ode_settings, only: visit_integrator, check_integrator
    implicit none
    private
 
@@ -72,11 +77,163 @@ module friction_afm_config
       ! &integrator
       type(solver_settings) :: solver
    contains
+      procedure :: visit
+      procedure :: validate
       procedure :: scan_direction
       procedure :: across_direction
    end type afm_config
 
 contains
+
+   !> The groups &surface, &tip, &scan and &integrator (README: input reference).
+   subroutine visit(self, v)
+      class(afm_config), intent(inout) :: self
+      type(parameter_visitor), intent(inout) :: v
+
+      call v%begin_group('surface')
+      call v%item('potential', self%potential, fold=.true.)
+      call v%item('v0', self%v0, 'eV')
+      call v%item('ax', self%ax, 'Å')
+      call v%item('ay', self%ay, 'Å')
+      call v%item('a', self%a, 'Å')
+      call v%item('net', self%net, fold=.true.)
+      call v%item('net_file', self%net_file, path=.true.)
+      call v%item('shells', self%shells)
+      call v%item('side', self%side)
+      call v%item('species', self%species)
+      call v%item('epsilon', self%epsilon, 'eV')
+      call v%item('sigma', self%sigma, 'Å')
+      call v%item('vacancies', self%vacancies)
+      call v%item('substitutions', self%substitutions)
+      call v%item('substitution_species', self%substitution_species)
+      call v%item('cutoff', self%cutoff, 'Å')
+      call v%item('cutoff_tolerance', self%cutoff_tolerance, 'nN')
+      call v%end_group()
+      call v%begin_group('tip')
+      call v%item('model', self%model, fold=.true.)
+      call v%item('mass', self%mass, 'kg')
+      call v%item('kx', self%kx, 'N/m')
+      call v%item('ky', self%ky, 'N/m')
+      call v%item('kz', self%kz, 'N/m')
+      call v%item('cx', self%cx, 'N s/m')
+      call v%item('cy', self%cy, 'N s/m')
+      call v%item('cz', self%cz, 'N s/m')
+      call v%item('support_z', self%support_z, 'Å')
+      call v%end_group()
+      call v%begin_group('scan')
+      call v%item('velocity', self%velocity, 'Å/s')
+      call v%item('length', self%length, 'Å')
+      call v%item('width', self%width, 'Å')
+      call v%item('angle', self%angle, 'degree')
+      call v%item('origin_x', self%origin_x, 'Å')
+      call v%item('origin_y', self%origin_y, 'Å')
+      call v%item('lead_in', self%lead_in, 'Å')
+      call v%item('nx', self%nx)
+      call v%item('ny', self%ny)
+      call v%item('retrace', self%retrace)
+      call v%end_group()
+      call visit_integrator(self%solver, v, 's')
+   end subroutine visit
+
+   !> Every value of the map's groups, or the first bad one to `c`.
+   subroutine validate(self, c)
+      class(afm_config), intent(in) :: self
+      type(config_checker), intent(inout) :: c
+
+      if (.not. any(potential_names == self%potential)) call c%reject('surface', 'potential', &
+         & "'"//trim(self%potential)//"'", 'unknown potential (known: '//quoted(potential_names)//')')
+      call c%nonnegative('surface', 'v0', self%v0, 'eV')
+      call c%positive('surface', 'ax', self%ax, 'Å')
+      call c%positive('surface', 'ay', self%ay, 'Å')
+      call c%positive('surface', 'a', self%a, 'Å')
+      call c%positive('tip', 'mass', self%mass, 'kg')
+      call c%nonnegative('tip', 'kx', self%kx, 'N/m')
+      call c%nonnegative('tip', 'ky', self%ky, 'N/m')
+      call c%nonnegative('tip', 'cx', self%cx, 'N s/m')
+      call c%nonnegative('tip', 'cy', self%cy, 'N s/m')
+      call c%nonnegative('tip', 'cz', self%cz, 'N s/m')
+      call c%finite('tip', 'support_z', self%support_z)
+      if (.not. any(tip_model_names == self%model)) then
+         call c%reject('tip', 'model', "'"//trim(self%model)//"'", 'unknown tip model (known: ' &
+            & //quoted(tip_model_names)//')')
+      else if (self%model == 'overdamped') then
+         call require_damped('cx', self%cx)
+         call require_damped('cy', self%cy)
+         if (self%potential == 'lj') call require_damped('cz', self%cz)
+      end if
+      if (self%potential == 'lj') call check_net()
+      call c%positive('scan', 'velocity', self%velocity, 'Å/s; the direction is set by angle')
+      call c%positive('scan', 'length', self%length, 'Å')
+      call c%nonnegative('scan', 'width', self%width, 'Å')
+      call c%finite('scan', 'angle', self%angle)
+      call c%finite('scan', 'origin_x', self%origin_x)
+      call c%finite('scan', 'origin_y', self%origin_y)
+      call c%nonnegative('scan', 'lead_in', self%lead_in, 'Å')
+      if (self%nx < 2) call c%reject('scan', 'nx', itoa(self%nx), 'must be >= 2 (sample points per line)')
+      if (self%ny < 1) call c%reject('scan', 'ny', itoa(self%ny), 'must be >= 1 (lines)')
+      call check_integrator(self%solver, c)
+
+   contains
+
+      !> The overdamped model divides by the damping of every moving direction.
+      subroutine require_damped(name, value)
+         character(len=*), intent(in) :: name
+         real(wp), intent(in) :: value
+
+         if (.not. (value > 0.0_wp)) call c%reject('tip', name, rtoa(value), "must be > 0 (N s/m) for " &
+            & //"model = 'overdamped': c dr/dt = -k (r - r_M) - grad V has no motion without damping " &
+            & //"(use 'inertial', or 'quasistatic' for the slow limit)")
+      end subroutine require_damped
+
+      !> The Lennard-Jones sum and its crystal net (Eq. 3).
+      subroutine check_net()
+         integer :: ns, k, sites
+
+         call c%positive('tip', 'kz', self%kz, 'N/m; the tip moves in z over a lattice sum')
+         if (.not. any(net_names == self%net)) call c%reject('surface', 'net', "'"//trim(self%net)//"'", &
+            & 'unknown net (known: '//quoted(net_names)//')')
+         ns = species_count(self)
+         if (ns == 0) call c%reject('surface', 'species', "''", 'name at least one species')
+         do k = 1, ns
+            if (.not. (self%sigma(k) > 0.0_wp)) call c%reject('surface', 'sigma', rtoa(self%sigma(k)), &
+               & 'must be > 0 (Å) for species '//trim(self%species(k)), k)
+            if (.not. (self%epsilon(k) >= 0.0_wp)) call c%reject('surface', 'epsilon', rtoa(self%epsilon(k)), &
+               & 'must be >= 0 (eV) for species '//trim(self%species(k)), k)
+         end do
+         if (self%cutoff < 0.0_wp) call c%reject('surface', 'cutoff', rtoa(self%cutoff), &
+            & 'must be >= 0 (Å; 0 chooses it)')
+         if (ns > 0 .and. self%cutoff > 0.0_wp .and. self%cutoff < maxval(self%sigma(1:max(ns, 1)))) &
+            & call c%reject('surface', 'cutoff', rtoa(self%cutoff), 'must not be below sigma ('// &
+            & rtoa(maxval(self%sigma(1:max(ns, 1))))//' Å): the sum would miss the repulsive core')
+         call c%positive('surface', 'cutoff_tolerance', self%cutoff_tolerance, 'nN')
+         select case (trim(self%net))
+         case ('graphite')
+            if (self%shells < 0) call c%reject('surface', 'shells', itoa(self%shells), 'must be >= 0')
+         case ('square')
+            if (self%side < 1) call c%reject('surface', 'side', itoa(self%side), 'must be >= 1')
+         case ('file')
+            if (len_trim(self%net_file) == 0) then
+               call c%reject('surface', 'net_file', "''", "name an XYZ file for net = 'file'")
+            else if (.not. file_exists(trim(self%net_file))) then
+               call c%reject('surface', 'net_file', "'"//trim(self%net_file)//"'", 'no such file')
+            end if
+         end select
+         if (c%failed()) return
+         sites = net_sites(self)
+         do k = 1, max_defects
+            if (self%vacancies(k) < 0 .or. (sites >= 0 .and. self%vacancies(k) > sites)) &
+               & call c%reject('surface', 'vacancies', itoa(self%vacancies(k)), &
+               & 'site outside the net of '//itoa(sites)//' sites', k)
+            if (self%substitutions(k) < 0 .or. (sites >= 0 .and. self%substitutions(k) > sites)) &
+               & call c%reject('surface', 'substitutions', itoa(self%substitutions(k)), &
+               & 'site outside the net of '//itoa(sites)//' sites', k)
+         end do
+         if (any(self%substitutions > 0) .and. .not. any(self%species(1:max(ns, 1)) == self%substitution_species)) &
+            & call c%reject('surface', 'substitution_species', "'"//trim(self%substitution_species)//"'", &
+            & 'not in the species table (known: '//quoted(self%species(1:max(ns, 1)))//')')
+      end subroutine check_net
+
+   end subroutine validate
 
    !> Unit vector along the scan, lattice frame.
    pure function scan_direction(self) result(u)

@@ -4,6 +4,9 @@
 module friction_analysis_settings
    use friction_kinds, only: wp
    use friction_analysis_spectrum, only: window_hann
+   use friction_strings, only: itoa, rtoa, quoted
+   use friction_parameters, only: parameter_visitor
+   use friction_checks, only: config_checker
    implicit none
    private
 
@@ -40,6 +43,92 @@ module friction_analysis_settings
       integer :: rosenstein_horizon = 150
       integer :: rosenstein_fit_start = 0
       integer :: rosenstein_fit_end = 50
+   contains
+      procedure :: visit
+      procedure :: validate
    end type analysis_settings
+
+contains
+
+   !> The group &analysis; `time_unit` is the unit of the scene's time.
+   subroutine visit(self, v, time_unit)
+      class(analysis_settings), intent(inout) :: self
+      type(parameter_visitor), intent(inout) :: v
+      character(len=*), intent(in) :: time_unit
+
+      call v%begin_group('analysis')
+      call v%item('spectrum', self%spectrum)
+      call v%item('series', self%series, fold=.true.)
+      call v%item('window_start', self%window_start, time_unit)
+      call v%item('window_end', self%window_end, time_unit)
+      call v%item('window', self%window, fold=.true.)
+      call v%item('welch_segments', self%welch_segments)
+      call v%item('poincare', self%poincare)
+      call v%item('strobe_period', self%strobe_period, time_unit)
+      call v%item('strobe_start', self%strobe_start, time_unit)
+      call v%item('strobe_end', self%strobe_end, time_unit)
+      call v%item('section', self%section, fold=.true.)
+      call v%item('lyapunov', self%lyapunov)
+      call v%item('lyapunov_transient', self%lyapunov_transient, time_unit)
+      call v%item('lyapunov_duration', self%lyapunov_duration, time_unit)
+      call v%item('lyapunov_renormalise', self%lyapunov_renormalise, time_unit)
+      call v%item('lyapunov_d0', self%lyapunov_d0)
+      call v%item('rosenstein', self%rosenstein)
+      call v%item('rosenstein_stride', self%rosenstein_stride, 'samples')
+      call v%item('rosenstein_dimension', self%rosenstein_dimension)
+      call v%item('rosenstein_delay', self%rosenstein_delay, 'samples')
+      call v%item('rosenstein_theiler', self%rosenstein_theiler, 'samples')
+      call v%item('rosenstein_horizon', self%rosenstein_horizon, 'samples')
+      call v%item('rosenstein_fit_start', self%rosenstein_fit_start, 'samples')
+      call v%item('rosenstein_fit_end', self%rosenstein_fit_end, 'samples')
+      call v%end_group()
+   end subroutine visit
+
+   !> The diagnostics' settings over a run from t_start to t_end; `series`
+   !> names the scene's variables that can be analysed.
+   subroutine validate(self, c, t_start, t_end, series)
+      class(analysis_settings), intent(in) :: self
+      type(config_checker), intent(inout) :: c
+      real(wp), intent(in) :: t_start, t_end
+      character(len=*), intent(in) :: series(:)
+
+      if (.not. any(series == self%series)) call c%reject('analysis', 'series', "'"//trim(self%series)//"'", &
+         & 'unknown variable (known: '//quoted(series)//')')
+      if (self%window /= 'hann' .and. self%window /= 'none') call c%reject('analysis', 'window', &
+         & "'"//trim(self%window)//"'", "unknown window (known: 'hann', 'none')")
+      if (.not. any(section_names == self%section)) call c%reject('analysis', 'section', &
+         & "'"//trim(self%section)//"'", 'unknown section (known: '//quoted(section_names)//')')
+      call c%finite('analysis', 'window_start', self%window_start)
+      if (.not. (self%window_end > self%window_start)) call c%reject('analysis', 'window_end', &
+         & rtoa(self%window_end), 'must be after window_start = '//rtoa(self%window_start))
+      if (self%welch_segments < 1) call c%reject('analysis', 'welch_segments', itoa(self%welch_segments), &
+         & 'must be >= 1')
+      call c%nonnegative('analysis', 'strobe_period', self%strobe_period, 'τ; 0 for 1 / peak frequency')
+      call c%finite('analysis', 'strobe_start', self%strobe_start)
+      call c%nonnegative('analysis', 'strobe_end', self%strobe_end, 'τ; 0 for the end of the run')
+      call c%nonnegative('analysis', 'lyapunov_transient', self%lyapunov_transient, 'τ')
+      call c%nonnegative('analysis', 'lyapunov_duration', self%lyapunov_duration, 'τ; 0 for the rest of the run')
+      call c%positive('analysis', 'lyapunov_renormalise', self%lyapunov_renormalise, 'τ')
+      call c%positive('analysis', 'lyapunov_d0', self%lyapunov_d0, 'initial separation')
+      if (self%lyapunov .and. self%lyapunov_duration == 0.0_wp .and. &
+         & .not. (t_end - t_start - self%lyapunov_transient >= self%lyapunov_renormalise)) &
+         & call c%reject('analysis', 'lyapunov_transient', rtoa(self%lyapunov_transient), &
+         & 'leaves less than one renormalisation interval before t_end')
+      if (self%rosenstein_stride < 1) call c%reject('analysis', 'rosenstein_stride', &
+         & itoa(self%rosenstein_stride), 'must be >= 1')
+      if (self%rosenstein_dimension < 1) call c%reject('analysis', 'rosenstein_dimension', &
+         & itoa(self%rosenstein_dimension), 'must be >= 1')
+      if (self%rosenstein_delay < 1) call c%reject('analysis', 'rosenstein_delay', itoa(self%rosenstein_delay), &
+         & 'must be >= 1 (samples)')
+      if (self%rosenstein_theiler < 0) call c%reject('analysis', 'rosenstein_theiler', &
+         & itoa(self%rosenstein_theiler), 'must be >= 0 (samples)')
+      if (self%rosenstein_horizon < 1) call c%reject('analysis', 'rosenstein_horizon', &
+         & itoa(self%rosenstein_horizon), 'must be >= 1 (samples)')
+      if (self%rosenstein_fit_start < 0) call c%reject('analysis', 'rosenstein_fit_start', &
+         & itoa(self%rosenstein_fit_start), 'must be >= 0 (samples)')
+      if (self%rosenstein_fit_end <= self%rosenstein_fit_start .or. &
+         & self%rosenstein_fit_end > self%rosenstein_horizon) call c%reject('analysis', 'rosenstein_fit_end', &
+         & itoa(self%rosenstein_fit_end), 'must be in (rosenstein_fit_start, rosenstein_horizon]')
+   end subroutine validate
 
 end module friction_analysis_settings

@@ -7,15 +7,21 @@ module friction_brake_config
    use friction_ode_solver, only: solver_settings
    use friction_brake_params, only: brake_parameters, brake_dimensional, derive_parameters
    use friction_analysis_settings, only: analysis_settings
+   use friction_strings, only: rtoa, quoted
+   use friction_parameters, only: parameter_visitor
+   use friction_checks, only: config_checker
+   use friction_ode_solver, only: step_type_names, step_type_index
+   use friction_ode_settings, only: visit_integrator, check_integrator
    implicit none
    private
 
    public :: brake_config, brake_check, model_names, units_names, brake_solver_defaults
-   public :: model_regularized, model_switched
+   public :: model_regularized, model_switched, series_names
 
    character(len=*), parameter :: model_names(2) = [character(len=11) :: 'switched', 'regularized']
    character(len=*), parameter :: units_names(2) = [character(len=14) :: 'nondimensional', 'dimensional']
    character(len=*), parameter :: model_switched = 'switched', model_regularized = 'regularized'
+   character(len=*), parameter :: series_names(4) = [character(len=1) :: 'x', 'v', 'y', 'w']
 
    !> &integrator defaults for the brake when no file sets them: rk8pd, tight
    !> (the benchmark: the switched model reaches 1e-8 on x this way); times in τ.
@@ -53,6 +59,8 @@ module friction_brake_config
       type(brake_check) :: check
       type(analysis_settings) :: analysis   !! chaos diagnostics (&analysis)
    contains
+      procedure :: visit
+      procedure :: validate
       procedure :: resolve
       procedure :: grid_size
       procedure :: grid_time
@@ -60,6 +68,145 @@ module friction_brake_config
    end type brake_config
 
 contains
+
+   !> The groups &integrator, &brake, &brake_dimensional, &verify and
+   !> &analysis (README: input reference).
+   subroutine visit(self, v)
+      class(brake_config), intent(inout) :: self
+      type(parameter_visitor), intent(inout) :: v
+
+      call visit_integrator(self%solver, v, 'tau')
+      call v%begin_group('brake')
+      call v%item('model', self%model, fold=.true.)
+      call v%item('units', self%units, fold=.true.)
+      associate (p => self%params)
+         call v%item('xi', p%xi, '1')
+         call v%item('kappa', p%kappa, '1')
+         call v%item('g_prime', p%g_prime, 'm')
+         call v%item('mu', p%mu, '1')
+         call v%item('mu_s', p%mu_s, '1')
+         call v%item('epsilon_prime', p%epsilon_prime, 'tau/m')
+         call v%item('delta_prime', p%delta_prime, 'tau/m')
+         call v%item('v_dr_prime', p%v_dr, 'm/tau')
+      end associate
+      call v%item('x0', self%x0, 'm')
+      call v%item('y0', self%y0, 'm')
+      call v%item('v_rel0', self%v_rel0, 'm/tau')
+      call v%item('w0', self%w0, 'm/tau')
+      call v%item('t_start', self%t_start, 'tau')
+      call v%item('t_end', self%t_end, 'tau')
+      call v%item('dt_out', self%dt_out, 'tau')
+      call v%item('event_tolerance', self%event_tolerance, 'tau')
+      call v%item('stick_velocity', self%stick_velocity, 'm/tau')
+      call v%end_group()
+      call v%begin_group('brake_dimensional')
+      associate (d => self%dimensional)
+         call v%item('arm_length', d%arm_length, 'm')
+         call v%item('drum_radius', d%drum_radius, 'm')
+         call v%item('crank_mass', d%crank_mass, 'kg')
+         call v%item('block_mass', d%block_mass, 'kg')
+         call v%item('k1', d%k1, 'N/m')
+         call v%item('k2', d%k2, 'N/m')
+         call v%item('k3', d%k3, 'N/m')
+         call v%item('gravity', d%gravity, 'm/s^2')
+         call v%item('epsilon_si', d%epsilon, 's/m')
+         call v%item('delta_si', d%delta, 's/m')
+         call v%item('v_dr_si', d%v_dr, 'm/s')
+      end associate
+      call v%end_group()
+      call v%begin_group('verify')
+      call v%item('check', self%check%enabled)
+      call v%item('check_method', self%check%method, fold=.true.)
+      call v%item('check_rtol', self%check%rtol, '1')
+      call v%item('check_atol', self%check%atol, 'm')
+      call v%item('check_limit', self%check%max_difference, 'm')
+      call v%end_group()
+      call self%analysis%visit(v, 'tau')
+   end subroutine visit
+
+   !> Every value of the brake's groups, or the first bad one to `c`.
+   subroutine validate(self, c)
+      class(brake_config), intent(in) :: self
+      type(config_checker), intent(inout) :: c
+      type(brake_config) :: resolved
+      type(error_type), allocatable :: derive_error
+      real(wp) :: normal
+      logical :: regularized, dimensional
+
+      call check_integrator(self%solver, c)
+      if (.not. any(model_names == self%model)) call c%reject('brake', 'model', "'"//trim(self%model)//"'", &
+         & 'unknown friction model (known: '//quoted(model_names)//')')
+      if (.not. any(units_names == self%units)) call c%reject('brake', 'units', "'"//trim(self%units)//"'", &
+         & 'unknown parameter set (known: '//quoted(units_names)//')')
+      if (c%failed()) return
+      regularized = self%model == 'regularized'
+      dimensional = self%units == 'dimensional'
+      associate (p => self%params, d => self%dimensional)
+         call c%nonnegative('brake', 'mu', p%mu, 'kinetic friction coefficient')
+         call c%nonnegative('brake', 'mu_s', p%mu_s, 'static friction coefficient')
+         if (.not. regularized .and. p%mu > p%mu_s) call c%reject('brake', 'mu', rtoa(p%mu), &
+            & 'the switched model needs mu <= mu_s = '//rtoa(p%mu_s)//' (a kinetic coefficient above the ' &
+            & //'static one makes every slip stop at once: use the regularized model)')
+         if (dimensional) then
+            call c%positive('brake_dimensional', 'arm_length', d%arm_length, 'm')
+            call c%nonnegative('brake_dimensional', 'drum_radius', d%drum_radius, 'm')
+            call c%positive('brake_dimensional', 'crank_mass', d%crank_mass, 'kg')
+            call c%positive('brake_dimensional', 'block_mass', d%block_mass, 'kg')
+            call c%positive('brake_dimensional', 'k1', d%k1, 'N/m')
+            call c%positive('brake_dimensional', 'k2', d%k2, 'N/m')
+            call c%nonnegative('brake_dimensional', 'k3', d%k3, 'N/m')
+            call c%nonnegative('brake_dimensional', 'gravity', d%gravity, 'm/s²')
+            if (regularized) call c%positive('brake_dimensional', 'epsilon_si', d%epsilon, &
+               & 's/m; the regularized law needs a steepness')
+            call c%nonnegative('brake_dimensional', 'delta_si', d%delta, 's/m')
+            call c%finite('brake_dimensional', 'v_dr_si', d%v_dr)
+            if (abs(d%k2 - d%k1) > 1.0e-9_wp * d%k1) call c%reject('brake_dimensional', 'k2', rtoa(d%k2), &
+               & 'must equal k1 = '//rtoa(d%k1)//': Eq. 10 assumes k2 = k1 (paper §4.1)')
+         else
+            call c%positive('brake', 'xi', p%xi, 'J/(m L²)')
+            call c%positive('brake', 'kappa', p%kappa, '(k1 + k3)/k1')
+            call c%finite('brake', 'g_prime', p%g_prime)
+            if (regularized) call c%positive('brake', 'epsilon_prime', p%epsilon_prime, &
+               & 'the regularized law needs a steepness')
+            call c%nonnegative('brake', 'delta_prime', p%delta_prime, 'velocity weakening')
+            call c%finite('brake', 'v_dr_prime', p%v_dr)
+         end if
+      end associate
+      if (c%failed()) return
+      resolved = self
+      call resolved%resolve(derive_error)
+      if (allocated(derive_error)) then
+         call c%reject('brake_dimensional', 'k2', rtoa(self%dimensional%k2), derive_error%message)
+         return
+      end if
+      call c%finite('brake', 'x0', self%x0)
+      call c%finite('brake', 'y0', self%y0)
+      call c%finite('brake', 'v_rel0', self%v_rel0)
+      call c%finite('brake', 'w0', self%w0)
+      call c%finite('brake', 't_start', self%t_start)
+      call c%finite('brake', 't_end', self%t_end)
+      if (.not. (self%t_end > self%t_start)) call c%reject('brake', 't_end', rtoa(self%t_end), &
+         & 'must be after t_start = '//rtoa(self%t_start))
+      call c%positive('brake', 'dt_out', self%dt_out, 'output grid step in τ')
+      call c%positive('brake', 'event_tolerance', self%event_tolerance, 'τ')
+      call c%positive('brake', 'stick_velocity', self%stick_velocity, 'm per unit τ')
+      if (c%failed()) return
+      if ((self%t_end - self%t_start) / self%dt_out > 1.0e7_wp) call c%reject('brake', 'dt_out', &
+         & rtoa(self%dt_out), 'gives more than 1e7 output points over [t_start, t_end]')
+      associate (p => resolved%params)
+         normal = p%normal_force(self%y0)
+         if (.not. (normal > 0.0_wp)) call c%reject('brake', 'y0', rtoa(self%y0), &
+            & "the initial normal force N' = (1 - kappa) y0 + g_prime = "//rtoa(normal) &
+            & //' must be > 0 (kappa = '//rtoa(p%kappa)//', g_prime = '//rtoa(p%g_prime)//')')
+      end associate
+      if (len_trim(self%check%method) > 0 .and. step_type_index(self%check%method) == 0) &
+         & call c%reject('verify', 'check_method', "'"//trim(self%check%method)//"'", &
+         & "unknown GSL step type (known: ''"//', '//quoted(step_type_names)//')')
+      call c%nonnegative('verify', 'check_rtol', self%check%rtol, '0 for rtol / 1000')
+      call c%nonnegative('verify', 'check_atol', self%check%atol, '0 for atol / 1000')
+      call c%nonnegative('verify', 'check_limit', self%check%max_difference, 'm; 0 reports only')
+      call self%analysis%validate(c, self%t_start, self%t_end, series_names)
+   end subroutine validate
 
    !> With units = 'dimensional', derive params from the §6.2 data
    !> (keeping μ and μs); otherwise params stand as given.

@@ -6,11 +6,10 @@
 module friction_brake_diagnostics
    use friction_kinds, only: wp
    use friction_error, only: error_type, fatal_error, error_input
-   use friction_brake_config, only: brake_config, model_switched
+   use friction_brake_config, only: brake_config, model_switched, series_names
    use friction_brake_record, only: brake_trajectory, brake_event_table, event_stick_to_slip
-   use friction_brake_simulate, only: initial_state
-   use friction_brake_switched, only: switched_integrator
-   use friction_brake_regularized, only: regularized_integrator
+   use friction_brake_simulate, only: initial_state, new_brake_integrator
+   use friction_brake_integrator, only: brake_integrator
    use friction_analysis_settings, only: analysis_settings
    use friction_analysis_spectrum, only: spectrum_settings, spectrum_result, amplitude_spectrum
    use friction_analysis_poincare, only: stroboscopic_map, upward_section
@@ -21,7 +20,6 @@ module friction_brake_diagnostics
 
    public :: brake_diagnostics, diagnose_brake, brake_benettin, series_names
 
-   character(len=*), parameter :: series_names(4) = [character(len=1) :: 'x', 'v', 'y', 'w']
 
    type :: brake_diagnostics
       type(analysis_settings) :: settings
@@ -143,12 +141,10 @@ contains
       type(benettin_settings), intent(in) :: settings
       type(benettin_accumulator), intent(out) :: result
       type(error_type), allocatable, intent(out) :: error
-      type(switched_integrator) :: reference_s, perturbed_s
-      type(regularized_integrator) :: reference_r, perturbed_r
+      class(brake_integrator), allocatable, target :: reference_run, perturbed_run
       type(brake_event_table) :: reference_events, perturbed_events
       real(wp) :: t, reference(4), perturbed(4), direction(4)
       integer :: k, intervals
-      logical :: switched
 
       if (.not. (settings%renormalise > 0.0_wp .and. settings%duration >= settings%renormalise &
          & .and. settings%d0 > 0.0_wp .and. settings%transient >= 0.0_wp)) then
@@ -156,25 +152,26 @@ contains
             & //'least one interval after lyapunov_transient, lyapunov_d0 > 0', error_input)
          return
       end if
-      switched = trim(config%model) == model_switched
+      call new_brake_integrator(config%model, reference_run)
+      call new_brake_integrator(config%model, perturbed_run)
       t = config%t_start + settings%transient
       reference = initial_state(config)
-      call start(reference_s, reference_r, reference_events, config%t_start, reference)
+      call reference_run%start(config, config%t_start, reference, reference_events, error)
       if (allocated(error)) return
-      call advance(reference_s, reference_r, reference_events, t, reference)
+      call advance(reference_run, reference_events, t, reference)
       if (allocated(error)) return
       direction = [1.0_wp, 1.0_wp, 1.0_wp, 1.0_wp]
-      if (is_sticking(reference_s, reference)) direction = [1.0_wp, 0.0_wp, 1.0_wp, 0.0_wp]
+      if (reference_run%is_sticking()) direction = [1.0_wp, 0.0_wp, 1.0_wp, 0.0_wp]
       perturbed = reference + settings%d0 * direction / norm2(direction)
       intervals = int(settings%duration / settings%renormalise + 1.0e-9_wp)
       call result%start(settings%d0, intervals)
       do k = 1, intervals
-         call start(perturbed_s, perturbed_r, perturbed_events, t, perturbed)
+         call perturbed_run%start(config, t, perturbed, perturbed_events, error)
          if (allocated(error)) return
          t = config%t_start + settings%transient + k * settings%renormalise
-         call advance(reference_s, reference_r, reference_events, t, reference)
+         call advance(reference_run, reference_events, t, reference)
          if (allocated(error)) return
-         call advance(perturbed_s, perturbed_r, perturbed_events, t, perturbed)
+         call advance(perturbed_run, perturbed_events, t, perturbed)
          if (allocated(error)) return
          call result%renormalise(reference, perturbed, settings%renormalise)
          ! Long runs: keep the event tables from growing without bound.
@@ -183,46 +180,15 @@ contains
 
    contains
 
-      subroutine start(run_s, run_r, events, t0, y0)
-         type(switched_integrator), target, intent(inout) :: run_s
-         type(regularized_integrator), target, intent(inout) :: run_r
-         type(brake_event_table), intent(inout) :: events
-         real(wp), intent(in) :: t0, y0(4)
-
-         if (switched) then
-            call run_s%init(config%params, config%solver, config%event_tolerance, t0, y0, events, error)
-         else
-            call run_r%init(config%params, config%stick_velocity, config%solver, config%event_tolerance, &
-               & t0, y0, events, error)
-         end if
-      end subroutine start
-
-      subroutine advance(run_s, run_r, events, t1, y)
-         type(switched_integrator), intent(inout) :: run_s
-         type(regularized_integrator), intent(inout) :: run_r
+      subroutine advance(run, events, t1, y)
+         class(brake_integrator), intent(inout) :: run
          type(brake_event_table), intent(inout) :: events
          real(wp), intent(in) :: t1
          real(wp), intent(out) :: y(4)
 
-         if (switched) then
-            call run_s%advance_to(t1, events, error)
-            y = run_s%y
-         else
-            call run_r%advance_to(t1, events, error)
-            y = run_r%y
-         end if
+         call run%advance_to(t1, events, error)
+         y = run%y
       end subroutine advance
-
-      logical function is_sticking(run_s, y)
-         type(switched_integrator), intent(in) :: run_s
-         real(wp), intent(in) :: y(4)
-
-         if (switched) then
-            is_sticking = run_s%sticking
-         else
-            is_sticking = abs(y(2) - config%params%v_dr) <= config%stick_velocity
-         end if
-      end function is_sticking
 
    end subroutine brake_benettin
 

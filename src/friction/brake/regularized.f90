@@ -17,9 +17,11 @@ module friction_brake_regularized
    use friction_error, only: error_type, fatal_error, error_numerical
    use friction_strings, only: rtoa
    use friction_ode_solver, only: solver_settings, is_implicit_step_type
-   use friction_ode_events, only: event_system, event_locator, event_falling, event_either, &
+   use friction_ode_events, only: event_system, event_falling, event_either, &
       & event_rising
    use friction_brake_params, only: brake_parameters
+   use friction_brake_config, only: brake_config
+   use friction_brake_integrator, only: brake_integrator
    use friction_brake_record, only: brake_event_table, event_stick_to_slip, event_slip_to_stick
    implicit none
    private
@@ -40,15 +42,14 @@ module friction_brake_regularized
 
    !> Integrates the regularized model forward from an initial state; records
    !> when |v_rel| enters and leaves the creep band as events.
-   type :: regularized_integrator
+   type, extends(brake_integrator) :: regularized_integrator
       type(brake_regularized), allocatable :: system
-      type(event_locator) :: locator
       character(len=16) :: method = ''
-      real(wp) :: t = 0.0_wp
-      real(wp) :: y(4) = 0.0_wp
    contains
       procedure :: init => integrator_init
+      procedure :: start => regularized_start
       procedure :: advance_to => integrator_advance_to
+      procedure :: is_sticking => regularized_sticking
    end type regularized_integrator
 
 contains
@@ -144,6 +145,24 @@ contains
          g(3) = y(2) - p%v_dr + self%stick_velocity
       end associate
    end subroutine event_values
+
+   subroutine regularized_start(self, config, t0, y0, events, error)
+      class(regularized_integrator), target, intent(inout) :: self
+      type(brake_config), intent(in) :: config
+      real(wp), intent(in) :: t0, y0(4)
+      type(brake_event_table), intent(inout) :: events
+      type(error_type), allocatable, intent(out) :: error
+
+      call self%init(config%params, config%stick_velocity, config%solver, config%event_tolerance, t0, y0, &
+         & events, error)
+   end subroutine regularized_start
+
+   !> Within the creep band |v_rel| <= stick_velocity counts as stick.
+   logical function regularized_sticking(self)
+      class(regularized_integrator), intent(in) :: self
+
+      regularized_sticking = abs(self%y(2) - self%system%params%v_dr) <= self%system%stick_velocity
+   end function regularized_sticking
 
    subroutine integrator_init(self, p, stick_velocity, settings, event_tolerance, t0, y0, events, error)
       class(regularized_integrator), target, intent(inout) :: self

@@ -9,19 +9,19 @@ module friction_brake_simulate
    use friction_ode_solver, only: integrator_statistics
    use friction_brake_config, only: brake_config, model_switched
    use friction_brake_record, only: brake_trajectory, brake_event_table
+   use friction_brake_integrator, only: brake_integrator
    use friction_brake_switched, only: switched_integrator
    use friction_brake_regularized, only: regularized_integrator
    implicit none
    private
 
-   public :: brake_run, brake_comparison, compare_runs, simulate_brake, initial_state
+   public :: brake_run, brake_comparison, compare_runs, simulate_brake, initial_state, new_brake_integrator
 
    type :: brake_run
       type(brake_config) :: config
       type(brake_trajectory) :: trajectory
       type(brake_event_table) :: events
-      type(switched_integrator) :: switched
-      type(regularized_integrator) :: regularized
+      class(brake_integrator), allocatable :: integrator   !! the friction model
       integer :: n = 0             !! grid points
       integer :: done = 0          !! grid points filled so far
       real(wp) :: compute_time = 0.0_wp   !! wall-clock seconds spent integrating
@@ -29,7 +29,6 @@ module friction_brake_simulate
       procedure :: init
       procedure :: run_until
       procedure :: statistics
-      procedure :: steps_taken
       procedure :: stick_time
       procedure :: time_reached
    end type brake_run
@@ -71,13 +70,8 @@ contains
                & //rtoa(p%normal_force(y0(3)))//': must be > 0 (the pad presses on the belt)', error_input)
             return
          end if
-         if (trim(config%model) == model_switched) then
-            call self%switched%init(p, config%solver, config%event_tolerance, config%t_start, y0, &
-               & self%events, error)
-         else
-            call self%regularized%init(p, config%stick_velocity, config%solver, config%event_tolerance, &
-               & config%t_start, y0, self%events, error)
-         end if
+         call new_brake_integrator(config%model, self%integrator)
+         call self%integrator%start(config, config%t_start, y0, self%events, error)
       end associate
    end subroutine init
 
@@ -95,15 +89,9 @@ contains
       call system_clock(start, rate)
       do i = self%done + 1, min(last, self%n)
          t = self%config%grid_time(i)
-         if (trim(self%config%model) == model_switched) then
-            call self%switched%advance_to(t, self%events, error)
-            y = self%switched%y
-            stick = self%switched%sticking
-         else
-            call self%regularized%advance_to(t, self%events, error)
-            y = self%regularized%y
-            stick = abs(y(2) - self%config%params%v_dr) <= self%config%stick_velocity
-         end if
+         call self%integrator%advance_to(t, self%events, error)
+         y = self%integrator%y
+         stick = self%integrator%is_sticking()
          if (allocated(error)) exit
          self%trajectory%t(i) = t
          self%trajectory%x(i) = y(1)
@@ -121,31 +109,16 @@ contains
       class(brake_run), intent(in) :: self
       type(integrator_statistics) :: stats
 
-      if (trim(self%config%model) == model_switched) then
-         stats = self%switched%locator%statistics()
-      else
-         stats = self%regularized%locator%statistics()
-      end if
+      stats = self%integrator%statistics()
    end function statistics
-
-   function steps_taken(self) result(n)
-      class(brake_run), intent(in) :: self
-      integer(i8) :: n
-
-      if (trim(self%config%model) == model_switched) then
-         n = self%switched%locator%steps_taken()
-      else
-         n = self%regularized%locator%steps_taken()
-      end if
-   end function steps_taken
 
    !> Time spent in stick: exact for the switched model; for the regularized
    !> one the grid's share of stick points times the span.
    pure real(wp) function stick_time(self)
       class(brake_run), intent(in) :: self
 
-      if (trim(self%config%model) == model_switched) then
-         stick_time = self%switched%stick_time
+      if (self%integrator%stick_time >= 0.0_wp) then
+         stick_time = self%integrator%stick_time
       else if (self%done > 1) then
          stick_time = real(count(self%trajectory%stick(1:self%done) == 1), wp) / self%done &
             & * (self%trajectory%t(self%done) - self%trajectory%t(1))
@@ -157,12 +130,20 @@ contains
    pure real(wp) function time_reached(self)
       class(brake_run), intent(in) :: self
 
-      if (trim(self%config%model) == model_switched) then
-         time_reached = self%switched%t
-      else
-         time_reached = self%regularized%t
-      end if
+      time_reached = self%integrator%t
    end function time_reached
+
+   !> The integrator of a friction model ('switched' or 'regularized').
+   subroutine new_brake_integrator(model, integrator)
+      character(len=*), intent(in) :: model
+      class(brake_integrator), allocatable, intent(out) :: integrator
+
+      if (trim(model) == model_switched) then
+         allocate (switched_integrator :: integrator)
+      else
+         allocate (regularized_integrator :: integrator)
+      end if
+   end subroutine new_brake_integrator
 
    !> A whole run in one call.
    subroutine simulate_brake(config, run, error)

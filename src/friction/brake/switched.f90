@@ -21,8 +21,10 @@ module friction_brake_switched
    use friction_error, only: error_type, fatal_error, error_numerical
    use friction_strings, only: rtoa
    use friction_ode_solver, only: solver_settings
-   use friction_ode_events, only: event_system, event_locator, event_falling
+   use friction_ode_events, only: event_system, event_falling
    use friction_brake_params, only: brake_parameters
+   use friction_brake_config, only: brake_config
+   use friction_brake_integrator, only: brake_integrator
    use friction_brake_stick, only: stick_motion, stick_end_lift_off
    use friction_brake_record, only: brake_event_table, event_stick_to_slip, event_slip_to_stick, &
       & event_slip_reversal
@@ -44,19 +46,17 @@ module friction_brake_switched
    end type brake_slip
 
    !> Integrates the switched model forward from an initial state.
-   type :: switched_integrator
+   type, extends(brake_integrator) :: switched_integrator
       type(brake_parameters) :: p
       type(brake_slip), allocatable :: slip
-      type(event_locator) :: locator
       type(stick_motion) :: stick
       logical :: sticking = .true.
-      real(wp) :: t = 0.0_wp
-      real(wp) :: y(4) = 0.0_wp
       real(wp) :: h_start = 0.0_wp
-      real(wp) :: stick_time = 0.0_wp   !! total time spent in stick so far
    contains
       procedure :: init
+      procedure :: start => switched_start
       procedure :: advance_to
+      procedure :: is_sticking => switched_sticking
    end type switched_integrator
 
 contains
@@ -135,6 +135,22 @@ contains
       g(1) = self%direction * (y(2) - self%params%v_dr)
       g(2) = (1.0_wp - self%params%kappa) * y(3) + self%params%g_prime
    end subroutine event_values
+
+   subroutine switched_start(self, config, t0, y0, events, error)
+      class(switched_integrator), target, intent(inout) :: self
+      type(brake_config), intent(in) :: config
+      real(wp), intent(in) :: t0, y0(4)
+      type(brake_event_table), intent(inout) :: events
+      type(error_type), allocatable, intent(out) :: error
+
+      call self%init(config%params, config%solver, config%event_tolerance, t0, y0, events, error)
+   end subroutine switched_start
+
+   logical function switched_sticking(self)
+      class(switched_integrator), intent(in) :: self
+
+      switched_sticking = self%sticking
+   end function switched_sticking
 
    !> Start at (t0, y0).  v_rel0 = 0 within the static limit sticks, else the
    !> block slips (in the direction of v_rel, or of the unbalanced force).

@@ -6,14 +6,12 @@ module friction_job
    use mpi_f08
    use friction_kinds, only: wp
    use friction_error, only: error_type, fatal_error, error_input
-   use friction_input, only: job_config, read_input
+   use friction_job_config, only: job_config, read_input
    use friction_version, only: version_string
-   use friction_netlist_spice, only: spice_netlist
    use friction_files, only: file_exists, write_text_file
    use friction_scene_report, only: job_reporter
-   use friction_scene_context, only: job_context, agree_on_error, check_writable, default_output
-   use friction_job_afm, only: run_afm_job
-   use friction_job_brake, only: run_brake_job
+   use friction_scene_context, only: job_context, agree_on_error, check_writable, default_output, temporary_name, &
+      & publish
    use friction_job_sweep, only: run_sweep_job
    implicit none
    private
@@ -27,18 +25,22 @@ contains
    !> temporary name, renamed when complete).  An existing output is an error
    !> unless `force`, or `resume` for a sweep (which reuses the checkpoints an
    !> interrupted run left beside it).  `summary` says what was written.
-   subroutine run_job(files, output, force, resume, comm, reporter, summary, error)
+   subroutine run_job(files, output, force, resume, comm, reporter, summary, error, stop_after)
       character(len=*), intent(in) :: files(:)
       character(len=*), intent(in) :: output
       logical, intent(in) :: force, resume
+      !> A test hook: > 0 stops a sweep after that point as a stop request would.
+      integer, intent(in), optional :: stop_after
       type(MPI_Comm), intent(in) :: comm
       class(job_reporter), intent(inout) :: reporter
       character(len=:), allocatable, intent(out) :: summary
       type(error_type), allocatable, intent(out) :: error
       type(job_context) :: job
       type(job_config) :: config
+      character(len=:), allocatable :: temporary
 
       job%t_start = MPI_Wtime()
+      if (present(stop_after)) job%stop_after = stop_after
       job%comm = comm
       call MPI_Comm_rank(comm, job%rank)
       call MPI_Comm_size(comm, job%nranks)
@@ -58,7 +60,7 @@ contains
       ! Every rank reads the input: an error in it is the same everywhere.
       call read_input(files, config, job%input_text, error)
       if (allocated(error)) return
-      if (file_exists(output) .and. .not. (force .or. (resume .and. config%sweep%enabled))) then
+      if (file_exists(output) .and. .not. (force .or. (resume .and. config%sweep%enabled()))) then
          call fatal_error(error, output//': the output file exists; use --force to overwrite it', error_input)
          return
       end if
@@ -67,13 +69,17 @@ contains
       call agree_on_error(job, error)
       if (allocated(error)) return
 
-      if (config%sweep%enabled) then
+      if (config%sweep%enabled()) then
          call run_sweep_job(job, config, reporter, summary, error)
-      else if (config%scene == 'brake') then
-         call run_brake_job(job, config%brake, reporter, summary, error)
-      else
-         call run_afm_job(job, config%afm, reporter, summary, error)
+         return
       end if
+      call config%scene%run(job, reporter, error)
+      if (allocated(error)) return
+      temporary = temporary_name(job)
+      call config%scene%write_output(temporary, job, error)
+      call publish(job, temporary, error)
+      if (allocated(error)) return
+      summary = config%scene%summary(job)
    end subroutine run_job
 
    !> The scene of `files` as a SPICE netlist for ngspice (the paper's
@@ -104,7 +110,12 @@ contains
       else
          data_file = path//'.data'
       end if
-      call spice_netlist(config, data_file, version_string, text, note, error)
+      if (config%sweep%enabled()) then
+         call fatal_error(error, '--netlist writes one scene: a &sweep group is not supported '// &
+            & '(write one point with an override file instead)', error_input)
+         return
+      end if
+      call config%scene%netlist(data_file, version_string, text, note, error)
       if (allocated(error)) return
       if (file_exists(path) .and. .not. force) then
          call fatal_error(error, path//': the netlist file exists; use --force to overwrite it', error_input)

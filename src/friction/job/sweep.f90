@@ -1,7 +1,7 @@
 !> Parameter sweeps over the MPI ranks (README: Parameter sweeps).  Each
-!> point is the scene re-read from the input files plus a one-line override
-!> file, so read_input validates it; an invalid or failing point is recorded
-!> as failed with its reason and the sweep goes on.
+!> point is a copy of the job's scene with the swept variables set in memory
+!> and checked by the scene's own checks; an invalid or failing point is
+!> recorded as failed with its reason and the sweep goes on.
 !>
 !> Load balancing: with sweep_schedule = 'dynamic' every rank takes the next
 !> point from a counter on rank 0 with MPI_Fetch_and_op (passive target).
@@ -20,41 +20,37 @@ module friction_job_sweep
    use, intrinsic :: iso_c_binding, only: c_ptr, c_f_pointer
    use mpi_f08
    use friction_kinds, only: wp, i8
-   use friction_error, only: error_type, fatal_error, error_interrupted
+   use friction_error, only: error_type, fatal_error, error_interrupted, error_input
    use friction_strings, only: itoa
    use friction_version, only: version_string
    use friction_ode_solver, only: integrator_statistics
-   use friction_input, only: job_config, read_input
+   use friction_parameters, only: set_parameter_number, split_name
+   use friction_checks, only: config_checker
+   use friction_scene, only: scene, point_result
+   use friction_job_config, only: job_config
    use friction_output_h5, only: h5_file
    use friction_output_summary, only: run_summary, write_run_attributes
    use friction_files, only: file_exists, rename_file, remove_file, process_id
-   use friction_brake_simulate, only: brake_run
-   use friction_brake_diagnostics, only: brake_diagnostics, diagnose_brake
    use friction_scene_report, only: job_reporter
    use friction_scene_context, only: job_context, temporary_name, publish, ranks_text, sum_to_root_real, &
       & sum_to_root_integer
-   use friction_job_brake, only: integrate_brake
-   use friction_job_afm, only: afm_friction
    implicit none
    private
 
    public :: run_sweep_job
 
-   integer, parameter :: reason_length = 240   !! characters of a failed point's reason
-   integer, parameter :: status_done = 1, status_failed = 2
+   !> A failed point's reason ('' for the others).
+   type :: reason_text
+      character(len=:), allocatable :: text
+   end type reason_text
 
-   !> Per-point results of a scene: names, units and what they mean.
-   character(len=*), parameter :: brake_results(4) = [character(len=16) :: 'events', 'peak_frequency', &
-      & 'lyapunov', 'stick_fraction']
-   character(len=*), parameter :: brake_units(4) = [character(len=16) :: '1', '1/tau', '1/tau', '1']
-   character(len=*), parameter :: afm_results(2) = [character(len=16) :: 'mean_friction', 'max_force']
-   character(len=*), parameter :: afm_units(2) = [character(len=16) :: 'nN', 'nN']
+   integer, parameter :: status_done = 1, status_failed = 2
 
 contains
 
-   !> Run the sweep of `config`; `interrupted` when a stop request or the
-   !> stop_after hook ended it early (the file then marks the points not done
-   !> as pending and the error says so, with stat error_interrupted).
+   !> Run the sweep of `config`; a stop request or the stop_after hook of the
+   !> job's options ends it early (the file then marks the points not done as
+   !> pending and the error says so, with stat error_interrupted).
    subroutine run_sweep_job(job, config, reporter, summary, error)
       type(job_context), intent(in) :: job
       type(job_config), intent(in) :: config
@@ -62,11 +58,11 @@ contains
       character(len=:), allocatable, intent(out) :: summary
       type(error_type), allocatable, intent(out) :: error
       type(error_type), allocatable :: point_error
-      character(len=:), allocatable :: override, temporary
-      character(len=4096), allocatable :: point_files(:)
-      character(len=16), allocatable :: names(:), units(:)
+      character(len=:), allocatable :: temporary, series_name, series_unit, reason
+      type(point_result), allocatable :: names(:)
+      type(reason_text), allocatable :: reasons(:)
       real(wp), allocatable :: results(:, :), cost(:), maxima(:), point_maxima(:), flat(:)
-      integer, allocatable :: status(:), counts(:), offsets(:), reason_codes(:, :), owner(:), computed_by_run(:)
+      integer, allocatable :: status(:), counts(:), offsets(:), owner(:), computed_by_run(:)
       integer, allocatable :: memory(:)
       integer :: n, i, k, next, total, computed, flag
       integer(kind=MPI_ADDRESS_KIND) :: window_size
@@ -74,27 +70,18 @@ contains
       type(c_ptr) :: counter_base
       integer, pointer :: counter_value
       type(MPI_Win) :: window
-      character(len=reason_length) :: reason
       type(run_summary) :: record
       real(wp) :: wall, t0
       character(len=12) :: seconds
-      logical :: dynamic, interrupted, loaded, brake
+      logical :: dynamic, interrupted, loaded
 
-      brake = config%scene == 'brake'
-      if (brake) then
-         names = brake_results
-         units = brake_units
-      else
-         names = afm_results
-         units = afm_units
-      end if
+      names = config%scene%point_results()
+      call config%scene%point_series(series_name, series_unit)
       n = size(config%sweep%values, 2)
       allocate (results(size(names), n), cost(n), source=0.0_wp)
       allocate (status(n), counts(n), owner(n), computed_by_run(n), source=0)
-      allocate (reason_codes(reason_length, n), source=0)
+      allocate (reasons(n))
       allocate (maxima(0))
-      override = job%output//'.override-'//itoa(job%rank)//'-'//itoa(process_id())//'.nml'
-      point_files = [job%files, [character(len=4096) :: override]]
 
       one = 1
       window_size = merge(4, 0, job%rank == 0)
@@ -138,7 +125,7 @@ contains
          end if
          i = next + 1
          if (i > n) exit
-         if (config%sweep%stop_after > 0 .and. i > config%sweep%stop_after) then
+         if (job%stop_after > 0 .and. i > job%stop_after) then
             interrupted = .true.   ! the test hook: as if a signal came after that point
             exit
          end if
@@ -150,43 +137,33 @@ contains
             if (loaded) then
                counts(i) = size(point_maxima)
                maxima = [maxima, point_maxima]
-               call encode(reason, reason_codes(:, i))
+               reasons(i)%text = reason
                cycle
             end if
          end if
          computed_by_run(i) = 1
          t0 = MPI_Wtime()
-         call write_override(override, config, i, point_error)
-         if (.not. allocated(point_error)) then
-            if (brake) then
-               call brake_point(point_files, results(:, i), point_maxima, point_error)
-            else
-               call afm_point(point_files, results(:, i), point_error)
-               allocate (point_maxima(0))
-            end if
-         end if
+         call run_point(config, i, results(:, i), point_maxima, point_error)
          if (allocated(point_error)) then
             status(i) = status_failed
-            reason = point_error%message
+            reasons(i)%text = point_error%message
             results(:, i) = 0.0_wp
             if (allocated(point_maxima)) deallocate (point_maxima)
             allocate (point_maxima(0))
          else
             status(i) = status_done
-            reason = ''
+            reasons(i)%text = ''
          end if
-         call encode(reason, reason_codes(:, i))
          counts(i) = size(point_maxima)
          maxima = [maxima, point_maxima]
          cost(i) = MPI_Wtime() - t0
          call save_point(checkpoint_name(job, i), config%sweep%values(:, i), status(i), results(:, i), &
-            & cost(i), reason, point_maxima)
+            & cost(i), reasons(i)%text, point_maxima)
          deallocate (point_maxima)
          if (allocated(point_error)) deallocate (point_error)
          if (job%rank == 0) call reporter%progress(real(i, wp), real(n, wp), 'points', .false.)
       end do
       if (dynamic) call MPI_Win_free(window)
-      call remove_file(override)
 
       ! Each point has exactly one owner; the others hold zeros, so a sum gathers it exactly.
       call MPI_Allreduce(MPI_IN_PLACE, counts, n, MPI_INTEGER, MPI_SUM, job%comm)
@@ -209,9 +186,9 @@ contains
       end do
       call sum_to_root_real(job, cost)
       call sum_to_root_integer(job, status, n)
+      call gather_reasons(job, owner, reasons)
       call sum_to_root_integer(job, owner, n)
       call sum_to_root_integer(job, computed_by_run, n)
-      call sum_to_root_integer(job, reason_codes, reason_length * n)
       flag = merge(1, 0, interrupted)
       call MPI_Allreduce(MPI_IN_PLACE, flag, 1, MPI_INTEGER, MPI_MAX, job%comm)
       interrupted = flag /= 0
@@ -229,8 +206,8 @@ contains
       record%wall_time = wall
       record%stats = integrator_statistics(0, 0, 0, 0)
       temporary = temporary_name(job)
-      if (job%rank == 0) call write_sweep_file(temporary, config, record, names, units, results, flat, offsets, &
-         & counts, status, reason_codes, cost, computed_by_run, memory, interrupted, error)
+      if (job%rank == 0) call write_sweep_file(temporary, config, record, names, series_name, series_unit, &
+         & results, flat, offsets, counts, status, reasons, cost, computed_by_run, memory, interrupted, error)
       call publish(job, temporary, error)
       if (allocated(error)) return
       write (seconds, '(f12.2)') wall
@@ -250,115 +227,110 @@ contains
       end if
    end subroutine run_sweep_job
 
-   !> The one-line namelist file that sets point i's values.
-   subroutine write_override(path, config, i, error)
-      character(len=*), intent(in) :: path
+   !> Point i: a copy of the scene with the swept variables set in memory,
+   !> checked as the input is, then run on this process.
+   subroutine run_point(config, i, results, series, error)
       type(job_config), intent(in) :: config
       integer, intent(in) :: i
+      real(wp), intent(out) :: results(:)
+      real(wp), allocatable, intent(out) :: series(:)
       type(error_type), allocatable, intent(out) :: error
-      character(len=64) :: variable
-      character(len=40) :: value
-      integer :: unit, stat, v, dot
+      class(scene), allocatable :: point
+      type(config_checker) :: checker
+      character(len=:), allocatable :: group, name, problem
+      integer :: v
 
-      open (newunit=unit, file=path, status='replace', action='write', iostat=stat)
-      if (stat /= 0) then
-         call fatal_error(error, path//': cannot write the point''s override file')
+      results = 0.0_wp
+      allocate (series(0))
+      allocate (point, source=config%scene)
+      do v = 1, config%sweep%n_variables
+         call split_name(config%sweep%variables(v), group, name)
+         call set_parameter_number(point, group, name, config%sweep%values(v, i), problem)
+         if (len(problem) > 0) then
+            call fatal_error(error, 'sweep point '//itoa(i)//': &'//group//': '//name//': '//problem, error_input)
+            return
+         end if
+         call checker%set_origin(group, name, 'sweep point '//itoa(i))
+      end do
+      call point%check(checker)
+      if (checker%failed()) then
+         call move_alloc(checker%error, error)
          return
       end if
-      do v = 1, config%sweep%n_variables
-         variable = config%sweep%variables(v)
-         dot = index(variable, '.')
-         if (config%sweep%integer_valued(v)) then
-            write (value, '(i0)') nint(config%sweep%values(v, i))
-         else
-            write (value, '(es25.17e3)') config%sweep%values(v, i)
-         end if
-         write (unit, '(a)') '&'//variable(1:dot - 1)//' '//trim(variable(dot + 1:))//' = '//trim(adjustl(value)) &
-            & //' /'
+      deallocate (series)
+      call point%run_point(results, series, error)
+   end subroutine run_point
+
+   !> Every failed point's reason to rank 0, as text: each rank sends the
+   !> reasons of the points it owns, in order.
+   subroutine gather_reasons(job, owner, reasons)
+      type(job_context), intent(in) :: job
+      integer, intent(in) :: owner(:)
+      type(reason_text), intent(inout) :: reasons(:)
+      integer, allocatable :: lengths(:), sizes(:), displacements(:), owners(:)
+      character(len=:), allocatable :: mine, all
+      integer :: i, r, at, total
+
+      allocate (lengths(size(owner)), source=0)
+      mine = ''
+      do i = 1, size(owner)
+         if (owner(i) /= job%rank + 1) cycle
+         if (.not. allocated(reasons(i)%text)) reasons(i)%text = ''
+         lengths(i) = len(reasons(i)%text)
+         mine = mine//reasons(i)%text
       end do
-      close (unit)
-   end subroutine write_override
-
-   !> A brake point: the run, its diagnostics and the local maxima of x after
-   !> the transient (the bifurcation diagram).
-   subroutine brake_point(files, results, maxima, error)
-      character(len=*), intent(in) :: files(:)
-      real(wp), intent(out) :: results(:)
-      real(wp), allocatable, intent(out) :: maxima(:)
-      type(error_type), allocatable, intent(out) :: error
-      type(job_config) :: point
-      character(len=:), allocatable :: text
-      type(brake_run), target :: run
-      type(brake_diagnostics) :: diagnostics
-      type(job_reporter) :: silent
-      logical, allocatable :: peak(:)
-      integer :: j
-
-      results = 0.0_wp
-      call read_input(files, point, text, error)
-      if (allocated(error)) return
-      call integrate_brake(run, point%brake, silent, error)
-      if (allocated(error)) return
-      associate (a => point%brake%analysis)
-         if (a%spectrum .or. a%lyapunov) then
-            call diagnose_brake(point%brake, run%trajectory, run%events, diagnostics, error)
-            if (allocated(error)) return
-            if (a%spectrum) results(2) = diagnostics%spectrum%peak_frequency
-            if (a%lyapunov) results(3) = diagnostics%flow%current()
-         end if
-         results(1) = run%events%n
-         results(4) = run%stick_time() / (point%brake%t_end - point%brake%t_start)
-         allocate (peak(run%n), source=.false.)
-         associate (t => run%trajectory%t, x => run%trajectory%x)
-            do j = 2, run%n - 1
-               peak(j) = t(j) >= a%window_start .and. x(j) > x(j - 1) .and. x(j) >= x(j + 1)
-            end do
-            maxima = pack(x(1:run%n), peak)
-         end associate
-      end associate
-   end subroutine brake_point
-
-   !> An AFM point: the whole map on this rank; its mean friction and maximum force.
-   subroutine afm_point(files, results, error)
-      character(len=*), intent(in) :: files(:)
-      real(wp), intent(out) :: results(:)
-      type(error_type), allocatable, intent(out) :: error
-      type(job_config) :: point
-      character(len=:), allocatable :: text
-
-      results = 0.0_wp
-      call read_input(files, point, text, error)
-      if (allocated(error)) return
-      call afm_friction(point%afm, results(1), results(2), error)
-   end subroutine afm_point
+      allocate (sizes(job%nranks), displacements(job%nranks))
+      call MPI_Gather(len(mine), 1, MPI_INTEGER, sizes, 1, MPI_INTEGER, 0, job%comm)
+      call sum_to_root_integer(job, lengths, size(lengths))
+      owners = owner
+      call sum_to_root_integer(job, owners, size(owners))
+      total = 0
+      if (job%rank == 0) then
+         do r = 1, job%nranks
+            displacements(r) = total
+            total = total + sizes(r)
+         end do
+      end if
+      allocate (character(len=max(1, total)) :: all)
+      call MPI_Gatherv(mine, len(mine), MPI_CHARACTER, all, sizes, displacements, MPI_CHARACTER, 0, job%comm)
+      if (job%rank /= 0) return
+      ! Walk the ranks' texts in rank order, each its own points in order.
+      do r = 1, job%nranks
+         at = displacements(r)
+         do i = 1, size(owners)
+            if (owners(i) /= r) cycle
+            reasons(i)%text = all(at + 1:at + lengths(i))
+            at = at + lengths(i)
+         end do
+      end do
+   end subroutine gather_reasons
 
    !> The sweep file, written by rank 0 alone.
-   subroutine write_sweep_file(path, config, record, names, units, results, flat, offsets, counts, status, &
-      & reason_codes, cost, computed_by_run, memory, interrupted, error)
+   subroutine write_sweep_file(path, config, record, names, series_name, series_unit, results, flat, offsets, &
+      & counts, status, reasons, cost, computed_by_run, memory, interrupted, error)
       character(len=*), intent(in) :: path
       type(job_config), intent(in) :: config
       type(run_summary), intent(in) :: record
-      character(len=*), intent(in) :: names(:), units(:)
+      type(point_result), intent(in) :: names(:)
+      character(len=*), intent(in) :: series_name, series_unit
       real(wp), intent(in) :: results(:, :), flat(:), cost(:)
-      integer, intent(in) :: offsets(:), counts(:), status(:), reason_codes(:, :), computed_by_run(:), memory(:)
+      integer, intent(in) :: offsets(:), counts(:), status(:), computed_by_run(:), memory(:)
+      type(reason_text), intent(in) :: reasons(:)
       logical, intent(in) :: interrupted
       type(error_type), allocatable, intent(out) :: error
       type(h5_file) :: file
-      character(len=:), allocatable :: reasons, method
-      character(len=reason_length) :: reason
+      character(len=:), allocatable :: text
       integer :: i, k
 
-      reasons = ''
+      text = ''
       do i = 1, size(status)
-         call decode(reason_codes(:, i), reason)
-         reasons = reasons//trim(reason)//new_line('a')
+         if (allocated(reasons(i)%text)) text = text//reasons(i)%text
+         text = text//new_line('a')
       end do
-      method = trim(config%afm%solver%method)
-      if (config%scene == 'brake') method = trim(config%brake%solver%method)
       call file%create(path, MPI_COMM_SELF, error)
       if (allocated(error)) return
-      call write_run_attributes(file, 'sweep', method, record)
-      call file%write_attribute_text('/', 'sweep_scene', trim(config%scene))
+      call write_run_attributes(file, 'sweep', config%scene%method(), record)
+      call file%write_attribute_text('/', 'sweep_scene', trim(config%scene_name))
       call file%write_attribute_text('/', 'sweep_variable', trim(config%sweep%variables(1)))
       if (config%sweep%n_variables == 2) &
          & call file%write_attribute_text('/', 'sweep_variable2', trim(config%sweep%variables(2)))
@@ -370,20 +342,20 @@ contains
       if (config%sweep%n_variables == 2) call file%write_vector('/sweep/values2', config%sweep%values(2, :), &
          & trim(config%sweep%variables(2)))
       do k = 1, size(names)
-         if (trim(names(k)) == 'events') then
-            call file%write_integer_vector('/sweep/events', nint(results(k, :)))
+         if (names(k)%whole) then
+            call file%write_integer_vector('/sweep/'//trim(names(k)%name), nint(results(k, :)))
          else
-            call file%write_vector('/sweep/'//trim(names(k)), results(k, :), trim(units(k)))
+            call file%write_vector('/sweep/'//trim(names(k)%name), results(k, :), trim(names(k)%unit))
          end if
       end do
-      if (config%scene == 'brake') then
-         call file%write_vector('/sweep/maxima', flat, 'm')
-         call file%write_integer_vector('/sweep/maxima_offset', offsets)
-         call file%write_integer_vector('/sweep/maxima_count', counts)
+      if (len(series_name) > 0) then
+         call file%write_vector('/sweep/'//series_name, flat, series_unit)
+         call file%write_integer_vector('/sweep/'//series_name//'_offset', offsets)
+         call file%write_integer_vector('/sweep/'//series_name//'_count', counts)
       end if
       call file%write_integer_vector('/sweep/status', status)
       call file%write_attribute_text('/sweep/status', 'meaning', '0 pending, 1 done, 2 failed')
-      call file%write_attribute_text('/sweep/status', 'reason', reasons)
+      call file%write_attribute_text('/sweep/status', 'reason', text)
       call file%write_vector('/sweep/compute_time', cost, 's')
       call file%write_integer_vector('/sweep/computed_by_this_run', computed_by_run)
       call file%write_integer_vector('/sweep/peak_memory_per_rank', memory)
@@ -391,29 +363,6 @@ contains
       call file%write_attribute_integer('/sweep', 'complete', int(merge(0, 1, interrupted), i8))
       call file%close(error)
    end subroutine write_sweep_file
-
-   !> Text as character codes, so a sum over ranks gathers it.
-   pure subroutine encode(text, codes)
-      character(len=*), intent(in) :: text
-      integer, intent(out) :: codes(:)
-      integer :: k
-
-      codes = 0
-      do k = 1, min(len(text), size(codes))
-         codes(k) = ichar(text(k:k))
-      end do
-   end subroutine encode
-
-   pure subroutine decode(codes, text)
-      integer, intent(in) :: codes(:)
-      character(len=*), intent(out) :: text
-      integer :: k
-
-      text = ''
-      do k = 1, min(len(text), size(codes))
-         text(k:k) = achar(max(32, codes(k)))
-      end do
-   end subroutine decode
 
    !> A finished point's results, written under a temporary name and renamed,
    !> so a checkpoint is whole or absent.  Reals with 17 significant digits
@@ -442,11 +391,12 @@ contains
       real(wp), intent(in) :: values(:)
       integer, intent(inout) :: status
       real(wp), intent(inout) :: results(:), cost
-      character(len=reason_length), intent(out) :: reason
+      character(len=:), allocatable, intent(out) :: reason
       real(wp), allocatable, intent(out) :: maxima(:)
       logical, intent(out) :: loaded
       real(wp) :: saved_values(size(values)), numbers(size(results) + 1)
       integer :: unit, stat, found(3)
+      character(len=4096) :: line
 
       loaded = .false.
       reason = ''
@@ -458,7 +408,8 @@ contains
          read (unit, *, iostat=stat) found
          if (stat == 0 .and. found(2) /= size(results)) stat = 1
          if (stat == 0) read (unit, *, iostat=stat) numbers
-         if (stat == 0) read (unit, '(a)', iostat=stat) reason
+         if (stat == 0) read (unit, '(a)', iostat=stat) line
+         if (stat == 0) reason = trim(line)
          if (stat == 0) then
             allocate (maxima(max(0, found(3))))
             if (found(3) > 0) read (unit, *, iostat=stat) maxima

@@ -22,6 +22,7 @@ module friction_scene_context
       character(len=:), allocatable :: input_text
       character(len=4096), allocatable :: files(:)
       logical :: resume = .false.
+      integer :: stop_after = 0              !! test hook: > 0 stops a sweep after that point
    end type job_context
 
 contains

@@ -1,0 +1,305 @@
+!> The friction-force map as a scene: the tip dragged over a surface line
+!> by line (README: The model).  Lines are dealt round-robin over the ranks;
+!> the file is written together, each rank its own lines.
+module friction_afm_scene
+   use mpi_f08
+   use friction_kinds, only: wp, i8
+   use friction_error, only: error_type
+   use friction_strings, only: itoa
+   use friction_version, only: version_string
+   use friction_parameters, only: parameter_visitor
+   use friction_checks, only: config_checker
+   use friction_ode_solver, only: integrator_statistics
+   use friction_ode_auto, only: auto_name, auto_method
+   use friction_surface_potential, only: surface_potential
+   use friction_output_summary, only: run_summary
+   use friction_scene, only: scene, point_result
+   use friction_scene_report, only: job_reporter
+   use friction_scene_context, only: job_context, agree_on_error, ranks_text, share_of
+   use friction_afm_config, only: afm_config, new_potential, species_count
+   use friction_afm_scan, only: afm_scanner, trip_record, n_quantities, q_fx, q_fy, q_f_along
+   use friction_afm_output, only: write_afm_file, afm_surface_record
+   use friction_afm_validity, only: afm_model_warnings, quasistatic_friction_warning
+   use friction_afm_netlist, only: afm_netlist
+   implicit none
+   private
+
+   public :: afm_scene, afm_friction
+
+   type, extends(scene) :: afm_scene
+      type(afm_config) :: config                 !! as the input gives it ('auto' unresolved)
+      ! The run's results on this rank
+      type(afm_config), private :: ran           !! the settings that ran
+      real(wp), allocatable, private :: trace(:, :, :), retrace(:, :, :)
+      type(afm_surface_record), private :: surface
+      type(run_summary), private :: record
+      integer, private :: first = 0
+      logical, private :: three_d = .false.
+   contains
+      procedure :: name => afm_name
+      procedure :: groups => afm_groups
+      procedure :: visit => afm_visit
+      procedure :: check => afm_check
+      procedure :: method => afm_method
+      procedure :: run => afm_run
+      procedure :: write_output => afm_write
+      procedure :: summary => afm_summary
+      procedure :: point_results => afm_point_results
+      procedure :: point_series => afm_point_series
+      procedure :: run_point => afm_run_point
+      procedure :: netlist => afm_netlist_text
+      procedure :: resolved
+   end type afm_scene
+
+contains
+
+   function afm_name(self) result(name)
+      class(afm_scene), intent(in) :: self
+      character(len=:), allocatable :: name
+
+      name = 'afm'
+   end function afm_name
+
+   subroutine afm_groups(self, names)
+      class(afm_scene), intent(in) :: self
+      character(len=32), allocatable, intent(out) :: names(:)
+
+      names = [character(len=32) :: 'surface', 'tip', 'scan', 'integrator']
+   end subroutine afm_groups
+
+   subroutine afm_visit(self, v)
+      class(afm_scene), intent(inout) :: self
+      type(parameter_visitor), intent(inout) :: v
+
+      call self%config%visit(v)
+   end subroutine afm_visit
+
+   subroutine afm_check(self, checker)
+      class(afm_scene), intent(in) :: self
+      type(config_checker), intent(inout) :: checker
+
+      call self%config%validate(checker)
+   end subroutine afm_check
+
+   !> The settings that run: method = 'auto' becomes the stepper the
+   !> work-precision charts show fastest for the potential at this rtol.
+   function resolved(self) result(c)
+      class(afm_scene), intent(in) :: self
+      type(afm_config) :: c
+
+      c = self%config
+      if (c%solver%method == auto_name) c%solver%method = auto_method('afm', c%potential, c%solver%rtol)
+   end function resolved
+
+   function afm_method(self) result(name)
+      class(afm_scene), intent(in) :: self
+      character(len=:), allocatable :: name
+      type(afm_config) :: c
+
+      c = self%resolved()
+      name = trim(c%solver%method)
+   end function afm_method
+
+   !> Compute this rank's lines of the map.
+   subroutine afm_run(self, job, reporter, error)
+      class(afm_scene), intent(inout) :: self
+      type(job_context), intent(in) :: job
+      class(job_reporter), intent(inout) :: reporter
+      type(error_type), allocatable, intent(out) :: error
+      type(afm_scanner), target :: scanner
+      class(surface_potential), allocatable :: potential
+      type(trip_record) :: trip
+      type(integrator_statistics) :: stats
+      integer(i8) :: counts(4)
+      integer :: count, j
+      real(wp) :: wall
+      character(len=:), allocatable :: warnings
+      integer :: start, end
+
+      self%ran = self%resolved()
+      associate (c => self%ran)
+         ! The surface first, identically on every rank: a bad net or defect is
+         ! bad input, reported before any work.
+         call new_potential(c, potential, error, self%surface%net, self%surface%cutoff)
+         if (allocated(error)) return
+         ! A reduced tip model outside where it holds (README: Reduced models (AFM)):
+         ! one note per reason.
+         if (job%rank == 0) then
+            warnings = afm_model_warnings(c, potential)
+            start = 1
+            do while (start <= len(warnings))
+               end = index(warnings(start:), new_line('a'))
+               end = merge(len(warnings), start + end - 2, end == 0)
+               call reporter%note('warning: '//warnings(start:end))
+               start = end + 2
+            end do
+         end if
+         self%surface%species_names = c%species(1:species_count(c))
+         call share_of(c%ny, job%nranks, job%rank, self%first, count)
+         if (allocated(self%trace)) deallocate (self%trace)
+         if (allocated(self%retrace)) deallocate (self%retrace)
+         allocate (self%trace(c%nx, count, n_quantities))
+         allocate (self%retrace(c%nx, merge(count, 0, c%retrace), n_quantities))
+         call scanner%init(c, potential, error)
+         self%surface%contact_height = scanner%contact_height
+         self%surface%support_height = scanner%support_height
+         self%three_d = scanner%tip%ndim == 3
+         do j = 1, count
+            if (allocated(error)) exit
+            call scanner%run_trip(self%first + (j - 1) * job%nranks, .true., trip, error)
+            if (allocated(error)) exit
+            self%trace(:, j, :) = trip%values
+            if (c%retrace) then
+               call scanner%run_trip(self%first + (j - 1) * job%nranks, .false., trip, error)
+               if (allocated(error)) exit
+               self%retrace(:, j, :) = trip%values
+            end if
+            ! Rank 0's share is as large as any other and spread over the whole
+            ! map, so its fraction done is the map's fraction done.
+            if (job%rank == 0) call reporter%progress(real(lines_done(j), wp), real(c%ny, wp), 'lines', .false.)
+         end do
+         if (job%rank == 0 .and. .not. allocated(error)) &
+            & call reporter%progress(real(lines_done(count), wp), real(c%ny, wp), 'lines', .true.)
+
+         ! A failure on any rank stops all of them here, before anything is written.
+         call agree_on_error(job, error)
+         if (allocated(error)) return
+         if (c%model == 'quasistatic') call check_friction()
+
+         stats = scanner%statistics()
+         counts = [stats%steps, stats%failed_steps, stats%rhs_evaluations, stats%jacobian_evaluations]
+         call MPI_Allreduce(MPI_IN_PLACE, counts, 4, MPI_INTEGER8, MPI_SUM, job%comm)
+         stats = integrator_statistics(counts(1), counts(2), counts(3), counts(4))
+         wall = MPI_Wtime() - job%t_start
+         call MPI_Allreduce(MPI_IN_PLACE, wall, 1, MPI_DOUBLE_PRECISION, MPI_MAX, job%comm)
+         ! (Component by component: gfortran's structure constructor mis-sizes a
+         ! deferred-length component copied from another derived type's.)
+         self%record%input_text = job%input_text
+         self%record%nranks = job%nranks
+         self%record%wall_time = wall
+         self%record%stats = stats
+      end associate
+
+   contains
+
+      !> The quasistatic map's mean friction against the drag it leaves out.
+      subroutine check_friction()
+         real(wp) :: sums(2)
+         character(len=:), allocatable :: warning
+
+         sums = [sum(self%trace(:, :, q_f_along)), real(size(self%trace(:, :, q_f_along)), wp)]
+         if (self%ran%retrace) sums(1) = 0.5_wp * (sums(1) - sum(self%retrace(:, :, q_f_along)))
+         call MPI_Allreduce(MPI_IN_PLACE, sums, 2, MPI_DOUBLE_PRECISION, MPI_SUM, job%comm)
+         warning = quasistatic_friction_warning(self%ran, sums(1) / max(1.0_wp, sums(2)))
+         if (job%rank == 0 .and. len(warning) > 0) call reporter%note('warning: '//warning)
+      end subroutine check_friction
+
+      integer function lines_done(done)
+         integer, intent(in) :: done
+
+         lines_done = min(self%ran%ny, int(real(done, wp) / max(1, count) * self%ran%ny))
+      end function lines_done
+
+   end subroutine afm_run
+
+   subroutine afm_write(self, path, job, error)
+      class(afm_scene), intent(inout) :: self
+      character(len=*), intent(in) :: path
+      type(job_context), intent(in) :: job
+      type(error_type), allocatable, intent(out) :: error
+
+      self%record%version = version_string
+      if (self%three_d) then
+         call write_afm_file(path, job%comm, self%ran, self%first, job%nranks, self%trace, self%retrace, &
+            & self%record, error, self%surface)
+      else
+         call write_afm_file(path, job%comm, self%ran, self%first, job%nranks, self%trace, self%retrace, &
+            & self%record, error)
+      end if
+   end subroutine afm_write
+
+   function afm_summary(self, job) result(text)
+      class(afm_scene), intent(in) :: self
+      type(job_context), intent(in) :: job
+      character(len=:), allocatable :: text
+      character(len=12) :: seconds
+
+      write (seconds, '(f12.2)') self%record%wall_time
+      text = itoa(self%ran%ny)//' lines x '//itoa(self%ran%nx)//' points, '//trim(adjustl(seconds))//' s ' &
+         & //ranks_text(job%nranks)
+   end function afm_summary
+
+   function afm_point_results(self) result(results)
+      class(afm_scene), intent(in) :: self
+      type(point_result), allocatable :: results(:)
+
+      results = [point_result('mean_friction', 'nN', .false.), point_result('max_force', 'nN', .false.)]
+   end function afm_point_results
+
+   subroutine afm_point_series(self, name, unit)
+      class(afm_scene), intent(in) :: self
+      character(len=:), allocatable, intent(out) :: name, unit
+
+      name = ''
+      unit = ''
+   end subroutine afm_point_series
+
+   subroutine afm_run_point(self, results, series, error)
+      class(afm_scene), intent(inout) :: self
+      real(wp), intent(out) :: results(:)
+      real(wp), allocatable, intent(out) :: series(:)
+      type(error_type), allocatable, intent(out) :: error
+
+      results = 0.0_wp
+      allocate (series(0))
+      call afm_friction(self%resolved(), results(1), results(2), error)
+   end subroutine afm_run_point
+
+   subroutine afm_netlist_text(self, data_file, version, text, note, error)
+      class(afm_scene), intent(in) :: self
+      character(len=*), intent(in) :: data_file, version
+      character(len=:), allocatable, intent(out) :: text, note
+      type(error_type), allocatable, intent(out) :: error
+
+      note = ''
+      call afm_netlist(self%resolved(), data_file, version, text, error)
+   end subroutine afm_netlist_text
+
+   !> The whole map of `c` on this process, reduced to the numbers a
+   !> parameter scan charts: the mean friction (half the width of the
+   !> friction loop, the mean of (trace - retrace) f_along / 2 over the map;
+   !> the mean trace f_along without retrace) and the maximum lateral force
+   !> |(fx, fy)| over all samples, both nN.  Holds one trip at a time.
+   subroutine afm_friction(c, mean_friction, max_force, error)
+      type(afm_config), intent(in) :: c
+      real(wp), intent(out) :: mean_friction, max_force
+      type(error_type), allocatable, intent(out) :: error
+      type(afm_scanner), target :: scanner
+      class(surface_potential), allocatable :: potential
+      type(trip_record) :: trip
+      real(wp) :: total
+      integer :: j
+
+      mean_friction = 0.0_wp
+      max_force = 0.0_wp
+      call new_potential(c, potential, error)
+      if (allocated(error)) return
+      call scanner%init(c, potential, error)
+      if (allocated(error)) return
+      total = 0.0_wp
+      do j = 0, c%ny - 1
+         call scanner%run_trip(j, .true., trip, error)
+         if (allocated(error)) return
+         total = total + sum(trip%values(:, q_f_along))
+         max_force = max(max_force, maxval(hypot(trip%values(:, q_fx), trip%values(:, q_fy))))
+         if (c%retrace) then
+            call scanner%run_trip(j, .false., trip, error)
+            if (allocated(error)) return
+            total = total - sum(trip%values(:, q_f_along))
+            max_force = max(max_force, maxval(hypot(trip%values(:, q_fx), trip%values(:, q_fy))))
+         end if
+      end do
+      mean_friction = total / (real(c%nx, wp) * c%ny * merge(2, 1, c%retrace))
+   end subroutine afm_friction
+
+end module friction_afm_scene

@@ -1,0 +1,66 @@
+!> What every friction model of the brake is to a run: an integrator that
+!> starts from a state, advances to a time through its events, and says
+!> whether the block sticks.  The models (switched.f90, regularized.f90)
+!> extend it; only brake_run's factory (simulate.f90) names them.
+module friction_brake_integrator
+   use friction_kinds, only: wp
+   use friction_error, only: error_type
+   use friction_ode_solver, only: integrator_statistics
+   use friction_ode_events, only: event_locator
+   use friction_brake_config, only: brake_config
+   use friction_brake_record, only: brake_event_table
+   implicit none
+   private
+
+   public :: brake_integrator
+
+   type, abstract :: brake_integrator
+      real(wp) :: t = 0.0_wp                !! time reached, τ
+      real(wp) :: y(4) = 0.0_wp             !! state there: x, x', y, y'
+      real(wp) :: stick_time = -1.0_wp      !! time spent in stick, when the model tracks it exactly; else < 0
+      type(event_locator) :: locator
+   contains
+      !> Start at (t0, y0) with the settings of `config`; the event table is cleared.
+      procedure(start_interface), deferred :: start
+      !> Advance to t_target; events go into the table.  On error, t is the time reached.
+      procedure(advance_interface), deferred :: advance_to
+      !> Whether the block sticks to the belt now.
+      procedure(sticking_interface), deferred :: is_sticking
+      procedure :: statistics
+   end type brake_integrator
+
+   abstract interface
+      subroutine start_interface(self, config, t0, y0, events, error)
+         import :: brake_integrator, brake_config, wp, brake_event_table, error_type
+         class(brake_integrator), target, intent(inout) :: self
+         type(brake_config), intent(in) :: config
+         real(wp), intent(in) :: t0, y0(4)
+         type(brake_event_table), intent(inout) :: events
+         type(error_type), allocatable, intent(out) :: error
+      end subroutine start_interface
+
+      subroutine advance_interface(self, t_target, events, error)
+         import :: brake_integrator, wp, brake_event_table, error_type
+         class(brake_integrator), intent(inout) :: self
+         real(wp), intent(in) :: t_target
+         type(brake_event_table), intent(inout) :: events
+         type(error_type), allocatable, intent(out) :: error
+      end subroutine advance_interface
+
+      logical function sticking_interface(self)
+         import :: brake_integrator
+         class(brake_integrator), intent(in) :: self
+      end function sticking_interface
+   end interface
+
+contains
+
+   !> The stepper's cost counters.
+   function statistics(self) result(stats)
+      class(brake_integrator), intent(in) :: self
+      type(integrator_statistics) :: stats
+
+      stats = self%locator%statistics()
+   end function statistics
+
+end module friction_brake_integrator

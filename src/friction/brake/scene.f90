@@ -1,0 +1,348 @@
+!> The Girling brake as a scene (README: Girling brake): one trajectory.
+!> Rank 0 integrates it; with verify on, the check run goes to rank 1 when
+!> there is one (concurrently), else rank 0 runs it after the main run.  The
+!> results are broadcast (a few MB at most) so that every rank takes part in
+!> the collective writes with the same data; the file does not depend on
+!> the number of ranks.
+module friction_brake_scene
+   use mpi_f08
+   use friction_kinds, only: wp, i8
+   use friction_error, only: error_type, fatal_error, error_numerical
+   use friction_version, only: version_string
+   use friction_parameters, only: parameter_visitor
+   use friction_checks, only: config_checker
+   use friction_ode_solver, only: integrator_statistics
+   use friction_ode_auto, only: auto_name, auto_method
+   use friction_scene, only: scene, point_result
+   use friction_scene_report, only: job_reporter
+   use friction_scene_context, only: job_context, agree_on_error, ranks_text
+   use friction_brake_config, only: brake_config, model_switched
+   use friction_brake_simulate, only: brake_run, compare_runs
+   use friction_brake_output, only: brake_run_summary, brake_check_summary, write_brake_file
+   use friction_brake_diagnostics, only: brake_diagnostics, diagnose_brake
+   use friction_brake_netlist, only: brake_netlist
+   implicit none
+   private
+
+   public :: brake_scene, integrate_brake
+
+   type, extends(scene) :: brake_scene
+      type(brake_config) :: config                 !! as the input gives it
+      type(brake_config), private :: ran           !! resolved: dimensional data derived, 'auto' chosen
+      type(brake_run), private :: main_run
+      type(brake_run_summary), private :: record
+      type(brake_check_summary), private :: check_record
+      type(brake_diagnostics), private :: diagnostics
+      logical, private :: analysing = .false.
+   contains
+      procedure :: name => brake_name
+      procedure :: groups => brake_groups
+      procedure :: visit => brake_visit
+      procedure :: check => brake_check_values
+      procedure :: method => brake_method
+      procedure :: run => brake_run_scene
+      procedure :: write_output => brake_write
+      procedure :: summary => brake_summary
+      procedure :: point_results => brake_point_results
+      procedure :: point_series => brake_point_series
+      procedure :: run_point => brake_run_point
+      procedure :: netlist => brake_netlist_text
+      procedure :: resolved
+   end type brake_scene
+
+contains
+
+   function brake_name(self) result(name)
+      class(brake_scene), intent(in) :: self
+      character(len=:), allocatable :: name
+
+      name = 'brake'
+   end function brake_name
+
+   subroutine brake_groups(self, names)
+      class(brake_scene), intent(in) :: self
+      character(len=32), allocatable, intent(out) :: names(:)
+
+      names = [character(len=32) :: 'integrator', 'brake', 'brake_dimensional', 'verify', 'analysis']
+   end subroutine brake_groups
+
+   subroutine brake_visit(self, v)
+      class(brake_scene), intent(inout) :: self
+      type(parameter_visitor), intent(inout) :: v
+
+      call self%config%visit(v)
+   end subroutine brake_visit
+
+   subroutine brake_check_values(self, checker)
+      class(brake_scene), intent(in) :: self
+      type(config_checker), intent(inout) :: checker
+
+      call self%config%validate(checker)
+   end subroutine brake_check_values
+
+   !> The settings that run: the parameters of Eq. 10 derived from the
+   !> dimensional data (units = 'dimensional'), and method = 'auto' resolved
+   !> to the stepper the work-precision charts show fastest for the model.
+   !> The configuration must have passed its checks.
+   function resolved(self) result(c)
+      class(brake_scene), intent(in) :: self
+      type(brake_config) :: c
+      type(error_type), allocatable :: error
+
+      c = self%config
+      if (c%solver%method == auto_name) c%solver%method = auto_method('brake', c%model, c%solver%rtol)
+      call c%resolve(error)   ! (cannot fail on checked settings)
+   end function resolved
+
+   function brake_method(self) result(name)
+      class(brake_scene), intent(in) :: self
+      character(len=:), allocatable :: name
+      type(brake_config) :: c
+
+      c = self%resolved()
+      name = trim(c%solver%method)
+   end function brake_method
+
+   subroutine brake_run_scene(self, job, reporter, error)
+      class(brake_scene), intent(inout) :: self
+      type(job_context), intent(in) :: job
+      class(job_reporter), intent(inout) :: reporter
+      type(error_type), allocatable, intent(out) :: error
+      type(brake_run), target :: check_run
+      type(brake_config) :: check_config
+      type(error_type), allocatable :: check_error
+      integer :: check_rank
+      real(wp) :: wall, stick_time
+      integer(i8) :: counts(4)
+      character(len=240) :: line
+
+      self%ran = self%resolved()
+      associate (settings => self%ran, check => self%check_record, record => self%record, &
+         & main_run => self%main_run)
+         check%enabled = settings%check%enabled
+         check_rank = merge(1, 0, job%nranks > 1)
+         if (job%rank == 0) call integrate_brake(main_run, settings, reporter, error)
+         if (check%enabled) then
+            check_config = settings%check_settings()
+            if (job%rank == check_rank) then
+               if (check_rank == 0) then
+                  call integrate_brake(check_run, check_config, reporter, check_error)
+               else
+                  block
+                     type(job_reporter) :: silent
+                     call integrate_brake(check_run, check_config, silent, check_error)
+                  end block
+               end if
+            end if
+            if (allocated(check_error) .and. .not. allocated(error)) then
+               call move_alloc(check_error, error)
+               error%message = 'verify run: '//error%message
+            end if
+         end if
+         call agree_on_error(job, error)
+         if (allocated(error)) return
+
+         call share_brake_run(job, main_run, 0, settings%grid_size(), counts, record%compute_time, stick_time)
+         record%stats = integrator_statistics(counts(1), counts(2), counts(3), counts(4))
+         record%stick_time = stick_time
+         if (check%enabled) then
+            call share_brake_run(job, check_run, check_rank, settings%grid_size(), counts, check%compute_time, &
+               & stick_time)
+            check%stats = integrator_statistics(counts(1), counts(2), counts(3), counts(4))
+            check%config = check_config
+            check%comparison = compare_runs(main_run, check_run)
+            associate (d => check%comparison, c => check_config%solver)
+               if (job%rank == 0) then
+                  write (line, '(a, es8.2, a, es8.2, a, es8.2, a, i0, a, i0)') 'verify: '//trim(c%method) &
+                     & //' at rtol ', c%rtol, ', atol ', c%atol, ': max |dx| = ', d%max_difference(1), &
+                     & ' m over the grid; events ', d%events, ' vs ', d%check_events
+                  call reporter%note(trim(line))
+               end if
+               if (settings%check%max_difference > 0.0_wp .and. &
+                  & .not. (d%max_difference(1) <= settings%check%max_difference)) then
+                  write (line, '(a, es8.2, a, es8.2, a)') 'verify failed: the check run differs by ', &
+                     & d%max_difference(1), ' m in x, more than check_limit = ', settings%check%max_difference, &
+                     & ' m (README: Girling brake, which steppers need verify)'
+                  call fatal_error(error, trim(line), error_numerical)
+                  return
+               end if
+            end associate
+         end if
+
+         ! The diagnostics are deterministic functions of the shared run (and, for
+         ! Benettin, of the settings): every rank computes the same numbers, so
+         ! the file does not depend on the number of ranks.
+         associate (a => settings%analysis)
+            self%analysing = a%spectrum .or. a%poincare .or. a%lyapunov .or. a%rosenstein
+         end associate
+         if (self%analysing) then
+            call diagnose_brake(settings, main_run%trajectory, main_run%events, self%diagnostics, error)
+            if (allocated(error)) return
+         end if
+
+         wall = MPI_Wtime() - job%t_start
+         call MPI_Allreduce(MPI_IN_PLACE, wall, 1, MPI_DOUBLE_PRECISION, MPI_MAX, job%comm)
+         record%input_text = job%input_text
+         record%version = version_string
+         record%nranks = job%nranks
+         record%wall_time = wall
+      end associate
+   end subroutine brake_run_scene
+
+   subroutine brake_write(self, path, job, error)
+      class(brake_scene), intent(inout) :: self
+      character(len=*), intent(in) :: path
+      type(job_context), intent(in) :: job
+      type(error_type), allocatable, intent(out) :: error
+
+      if (self%analysing) then
+         call write_brake_file(path, job%comm, self%ran, self%main_run%trajectory, self%main_run%events, &
+            & self%record, self%check_record, error, self%diagnostics)
+      else
+         call write_brake_file(path, job%comm, self%ran, self%main_run%trajectory, self%main_run%events, &
+            & self%record, self%check_record, error)
+      end if
+   end subroutine brake_write
+
+   function brake_summary(self, job) result(text)
+      class(brake_scene), intent(in) :: self
+      type(job_context), intent(in) :: job
+      character(len=:), allocatable :: text
+      character(len=240) :: line
+      character(len=12) :: seconds
+
+      write (seconds, '(f12.3)') self%record%wall_time
+      write (line, '(a, i0, a, f0.1, a, i0, a)') ' model, ', self%main_run%n, ' points to τ = ', &
+         & self%ran%grid_time(self%main_run%n), ', ', self%main_run%events%n, ' events, '
+      text = trim(self%ran%model)//trim(line)//' '//trim(adjustl(seconds))//' s '//ranks_text(job%nranks)
+   end function brake_summary
+
+   function brake_point_results(self) result(results)
+      class(brake_scene), intent(in) :: self
+      type(point_result), allocatable :: results(:)
+
+      results = [point_result('events', '1', .true.), point_result('peak_frequency', '1/tau', .false.), &
+         & point_result('lyapunov', '1/tau', .false.), point_result('stick_fraction', '1', .false.)]
+   end function brake_point_results
+
+   subroutine brake_point_series(self, name, unit)
+      class(brake_scene), intent(in) :: self
+      character(len=:), allocatable, intent(out) :: name, unit
+
+      name = 'maxima'
+      unit = 'm'
+   end subroutine brake_point_series
+
+   !> A sweep point: the run, its diagnostics and the local maxima of x after
+   !> the transient (the bifurcation diagram).
+   subroutine brake_run_point(self, results, series, error)
+      class(brake_scene), intent(inout) :: self
+      real(wp), intent(out) :: results(:)
+      real(wp), allocatable, intent(out) :: series(:)
+      type(error_type), allocatable, intent(out) :: error
+      type(brake_config) :: point
+      type(brake_run), target :: run
+      type(brake_diagnostics) :: diagnostics
+      type(job_reporter) :: silent
+      logical, allocatable :: peak(:)
+      integer :: j
+
+      results = 0.0_wp
+      point = self%resolved()
+      call integrate_brake(run, point, silent, error)
+      if (allocated(error)) return
+      associate (a => point%analysis)
+         if (a%spectrum .or. a%lyapunov) then
+            call diagnose_brake(point, run%trajectory, run%events, diagnostics, error)
+            if (allocated(error)) return
+            if (a%spectrum) results(2) = diagnostics%spectrum%peak_frequency
+            if (a%lyapunov) results(3) = diagnostics%flow%current()
+         end if
+         results(1) = run%events%n
+         results(4) = run%stick_time() / (point%t_end - point%t_start)
+         allocate (peak(run%n), source=.false.)
+         associate (t => run%trajectory%t, x => run%trajectory%x)
+            do j = 2, run%n - 1
+               peak(j) = t(j) >= a%window_start .and. x(j) > x(j - 1) .and. x(j) >= x(j + 1)
+            end do
+            series = pack(x(1:run%n), peak)
+         end associate
+      end associate
+   end subroutine brake_run_point
+
+   subroutine brake_netlist_text(self, data_file, version, text, note, error)
+      class(brake_scene), intent(in) :: self
+      character(len=*), intent(in) :: data_file, version
+      character(len=:), allocatable, intent(out) :: text, note
+      type(error_type), allocatable, intent(out) :: error
+
+      call brake_netlist(self%resolved(), data_file, version, text, note, error)
+   end subroutine brake_netlist_text
+
+   !> One brake run, in pieces so that long runs can report progress in τ.
+   subroutine integrate_brake(run, settings, reporter, error)
+      type(brake_run), target, intent(inout) :: run
+      type(brake_config), intent(in) :: settings
+      class(job_reporter), intent(inout) :: reporter
+      type(error_type), allocatable, intent(out) :: error
+      integer :: piece, last
+
+      call run%init(settings, error)
+      if (allocated(error)) return
+      piece = max(1, run%n / 200)
+      do last = piece, run%n + piece - 1, piece
+         call run%run_until(min(last, run%n), error)
+         if (allocated(error)) return
+         call reporter%progress(run%time_reached() - settings%t_start, settings%t_end - settings%t_start, &
+            & 'tau', .false.)
+      end do
+      call reporter%progress(run%time_reached() - settings%t_start, settings%t_end - settings%t_start, &
+         & 'tau', .true.)
+   end subroutine integrate_brake
+
+   !> Give every rank root's trajectory, events and counters.
+   subroutine share_brake_run(job, run, root, n, counts, compute_time, stick_time)
+      type(job_context), intent(in) :: job
+      type(brake_run), intent(inout) :: run
+      integer, intent(in) :: root, n
+      integer(i8), intent(out) :: counts(4)
+      real(wp), intent(out) :: compute_time, stick_time
+      type(integrator_statistics) :: stats
+      integer :: n_events
+      real(wp) :: times(2)
+
+      if (job%rank == root) then
+         stats = run%statistics()
+         counts = [stats%steps, stats%failed_steps, stats%rhs_evaluations, stats%jacobian_evaluations]
+         times = [run%compute_time, run%stick_time()]
+         n_events = run%events%n
+      else
+         call run%trajectory%allocate_points(n)
+         run%n = n
+         run%done = n
+      end if
+      call MPI_Bcast(counts, 4, MPI_INTEGER8, root, job%comm)
+      call MPI_Bcast(times, 2, MPI_DOUBLE_PRECISION, root, job%comm)
+      call MPI_Bcast(n_events, 1, MPI_INTEGER, root, job%comm)
+      compute_time = times(1)
+      stick_time = times(2)
+      call MPI_Bcast(run%trajectory%t, n, MPI_DOUBLE_PRECISION, root, job%comm)
+      call MPI_Bcast(run%trajectory%x, n, MPI_DOUBLE_PRECISION, root, job%comm)
+      call MPI_Bcast(run%trajectory%v, n, MPI_DOUBLE_PRECISION, root, job%comm)
+      call MPI_Bcast(run%trajectory%y, n, MPI_DOUBLE_PRECISION, root, job%comm)
+      call MPI_Bcast(run%trajectory%w, n, MPI_DOUBLE_PRECISION, root, job%comm)
+      call MPI_Bcast(run%trajectory%stick, n, MPI_INTEGER, root, job%comm)
+      if (job%rank /= root) then
+         run%events%n = n_events
+         if (allocated(run%events%t)) deallocate (run%events%t, run%events%kind, run%events%state)
+         allocate (run%events%t(max(1, n_events)), run%events%kind(max(1, n_events)), &
+            & run%events%state(4, max(1, n_events)))
+      end if
+      if (n_events > 0) then
+         call MPI_Bcast(run%events%t, n_events, MPI_DOUBLE_PRECISION, root, job%comm)
+         call MPI_Bcast(run%events%kind, n_events, MPI_INTEGER, root, job%comm)
+         call MPI_Bcast(run%events%state, 4 * n_events, MPI_DOUBLE_PRECISION, root, job%comm)
+      end if
+   end subroutine share_brake_run
+
+end module friction_brake_scene

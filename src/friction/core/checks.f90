@@ -1,0 +1,138 @@
+!> The checks a configuration makes of its own values, and the message a
+!> failed one gives: where the value was set (a file and line, a sweep
+!> point, or nothing for the C API), the group, the variable, the value and
+!> the reason.  Every configuration type checks itself through a checker,
+!> so the namelist, the sweep and the C API reject the same values with the
+!> same words.
+module friction_checks
+   use friction_kinds, only: wp
+   use friction_error, only: error_type, fatal_error, error_input
+   use friction_strings, only: itoa, rtoa
+   implicit none
+   private
+
+   public :: config_checker
+
+   !> Where a variable was last set.
+   type :: origin_entry
+      character(len=32) :: group = ''
+      character(len=32) :: name = ''
+      character(len=:), allocatable :: where   !! 'file.nml:3', 'sweep point 2', or '' (set in memory)
+   end type origin_entry
+
+   !> The first rejected value (later ones are not reported: one message).
+   type :: config_checker
+      type(error_type), allocatable :: error
+      type(origin_entry), allocatable :: origins(:)
+   contains
+      procedure :: set_origin
+      procedure :: origin
+      procedure :: is_set
+      procedure :: failed
+      procedure :: reject
+      procedure :: positive
+      procedure :: nonnegative
+      procedure :: finite
+   end type config_checker
+
+contains
+
+   !> Record where group.name was set (the latest wins).
+   subroutine set_origin(self, group, name, where)
+      class(config_checker), intent(inout) :: self
+      character(len=*), intent(in) :: group, name, where
+      type(origin_entry), allocatable :: more(:)
+      integer :: k
+
+      if (.not. allocated(self%origins)) allocate (self%origins(0))
+      do k = 1, size(self%origins)
+         if (self%origins(k)%group == group .and. self%origins(k)%name == name) then
+            self%origins(k)%where = where
+            return
+         end if
+      end do
+      ! (Element by element: gfortran's array constructors mishandle
+      ! deferred-length character components.)
+      allocate (more(size(self%origins) + 1))
+      do k = 1, size(self%origins)
+         more(k)%group = self%origins(k)%group
+         more(k)%name = self%origins(k)%name
+         call move_alloc(self%origins(k)%where, more(k)%where)
+      end do
+      more(k)%group = group
+      more(k)%name = name
+      more(k)%where = where
+      call move_alloc(more, self%origins)
+   end subroutine set_origin
+
+   !> Where group.name was set: '(default)' when nowhere.
+   function origin(self, group, name) result(text)
+      class(config_checker), intent(in) :: self
+      character(len=*), intent(in) :: group, name
+      character(len=:), allocatable :: text
+      integer :: k
+
+      text = '(default)'
+      if (.not. allocated(self%origins)) return
+      do k = 1, size(self%origins)
+         if (self%origins(k)%group == group .and. self%origins(k)%name == name) then
+            text = self%origins(k)%where
+            return
+         end if
+      end do
+   end function origin
+
+   logical function is_set(self, group, name)
+      class(config_checker), intent(in) :: self
+      character(len=*), intent(in) :: group, name
+
+      is_set = self%origin(group, name) /= '(default)'
+   end function is_set
+
+   logical function failed(self)
+      class(config_checker), intent(in) :: self
+
+      failed = allocated(self%error)
+   end function failed
+
+   !> A bad value: where it was set, group, variable (with its array index
+   !> when given), value and reason.  Only the first is kept.
+   subroutine reject(self, group, name, value, reason, index)
+      class(config_checker), intent(inout) :: self
+      character(len=*), intent(in) :: group, name, value, reason
+      integer, intent(in), optional :: index
+      character(len=:), allocatable :: shown, where
+
+      if (allocated(self%error)) return
+      shown = name
+      if (present(index)) shown = name//'('//itoa(index)//')'
+      where = self%origin(group, name)
+      if (len(where) > 0) where = where//': '
+      call fatal_error(self%error, where//'&'//group//': '//shown//' = '//value//': '//reason, error_input)
+   end subroutine reject
+
+   subroutine positive(self, group, name, value, unit_text)
+      class(config_checker), intent(inout) :: self
+      character(len=*), intent(in) :: group, name, unit_text
+      real(wp), intent(in) :: value
+
+      if (.not. (value > 0.0_wp)) call self%reject(group, name, rtoa(value), 'must be > 0 ('//unit_text//')')
+   end subroutine positive
+
+   subroutine nonnegative(self, group, name, value, unit_text)
+      class(config_checker), intent(inout) :: self
+      character(len=*), intent(in) :: group, name, unit_text
+      real(wp), intent(in) :: value
+
+      if (.not. (value >= 0.0_wp)) call self%reject(group, name, rtoa(value), 'must be >= 0 ('//unit_text//')')
+   end subroutine nonnegative
+
+   subroutine finite(self, group, name, value)
+      class(config_checker), intent(inout) :: self
+      character(len=*), intent(in) :: group, name
+      real(wp), intent(in) :: value
+
+      if (.not. (abs(value) <= huge(value))) call self%reject(group, name, rtoa(value), 'must be a finite number')
+   end subroutine finite
+
+end module friction_checks

@@ -1,0 +1,765 @@
+!> Named parameters of a configuration, reached by visiting: a configurable
+!> type lists each of its variables once, with its namelist group, name and
+!> unit (`call v%item('mass', self%mass, 'kg')`), and the visitor does what
+!> its mode says with each one: list them, set one from namelist text or a
+!> number, get one as text, or write them all as namelist text that reads
+!> back to the same values.  Reading files, the sweep's in-memory override,
+!> the C API's set and get, and the echo of a run's input all go through
+!> this one description, so a variable declared once is known everywhere.
+module friction_parameters
+   use friction_kinds, only: wp, i8
+   use friction_strings, only: lower, itoa
+   implicit none
+   private
+
+   public :: configurable, parameter_visitor, parameter_info
+   public :: list_parameters, set_parameter, set_parameter_number, get_parameter, parameters_text
+   public :: kind_text, value_has_kind, split_name
+
+   integer, parameter :: mode_list = 1, mode_set = 2, mode_get = 3, mode_write = 4
+
+   !> One variable: where it lives, its kind ('r' real, 'i' integer, 'l'
+   !> logical, 'c' text), its number of elements (1 for a scalar) and unit.
+   type :: parameter_info
+      character(len=32) :: group = ''
+      character(len=32) :: name = ''
+      character :: kind = 'r'
+      integer :: size = 1
+      character(len=40) :: unit = ''
+   end type parameter_info
+
+   type :: parameter_visitor
+      integer :: mode = mode_list
+      character(len=32) :: group = ''          !! the group being visited
+      character(len=32) :: want_group = ''     !! set, get: the variable's group (or '' for all, write)
+      character(len=32) :: want_name = ''      !! set, get: the variable's name
+      integer :: first = 0                     !! set: first element given, name(first) = ...; 0 whole
+      logical :: from_number = .false.         !! set: take `number` instead of `text`
+      real(wp) :: number = 0.0_wp
+      character(len=:), allocatable :: text    !! set: value text; get: the value; write: the namelist
+      character(len=:), allocatable :: base    !! set: directory that relative paths are relative to
+      character(len=:), allocatable :: problem !! set: why the value does not fit ('' when it did)
+      logical :: found = .false.
+      type(parameter_info), allocatable :: list(:)
+      character(len=32), allocatable :: only(:)  !! write: the groups to write (all when unallocated)
+      logical :: in_group = .false.
+   contains
+      procedure :: begin_group
+      procedure :: end_group
+      procedure, private :: real_scalar, real_array, integer_scalar, integer_array, long_scalar, &
+         & logical_scalar, text_scalar, text_array
+      generic :: item => real_scalar, real_array, integer_scalar, integer_array, long_scalar, &
+         & logical_scalar, text_scalar, text_array
+      procedure, private :: wants, add_info, add_line
+   end type parameter_visitor
+
+   !> A type whose variables can be visited.
+   type, abstract :: configurable
+   contains
+      procedure(visit_interface), deferred :: visit
+   end type configurable
+
+   abstract interface
+      subroutine visit_interface(self, v)
+         import :: configurable, parameter_visitor
+         class(configurable), intent(inout) :: self
+         type(parameter_visitor), intent(inout) :: v
+      end subroutine visit_interface
+   end interface
+
+
+contains
+
+   ! ---- visiting ----
+
+   !> Start the variables of a namelist group.
+   subroutine begin_group(self, name)
+      class(parameter_visitor), intent(inout) :: self
+      character(len=*), intent(in) :: name
+      logical :: shown
+
+      self%group = name
+      if (self%mode /= mode_write) return
+      shown = .true.
+      if (allocated(self%only)) shown = any(self%only == name)
+      self%in_group = shown
+      if (shown) self%text = self%text//'&'//trim(name)//new_line('a')
+   end subroutine begin_group
+
+   subroutine end_group(self)
+      class(parameter_visitor), intent(inout) :: self
+
+      if (self%mode == mode_write .and. self%in_group) self%text = self%text//'/'//new_line('a')
+      self%in_group = .false.
+      self%group = ''
+   end subroutine end_group
+
+   !> Whether this variable is the one to set or get.
+   logical function wants(self, name)
+      class(parameter_visitor), intent(in) :: self
+      character(len=*), intent(in) :: name
+
+      wants = (self%mode == mode_set .or. self%mode == mode_get) .and. .not. self%found &
+         & .and. self%group == self%want_group .and. name == self%want_name
+   end function wants
+
+   subroutine add_info(self, name, kind, n, unit)
+      class(parameter_visitor), intent(inout) :: self
+      character(len=*), intent(in) :: name
+      character, intent(in) :: kind
+      integer, intent(in) :: n
+      character(len=*), intent(in), optional :: unit
+      type(parameter_info) :: info
+
+      info%group = self%group
+      info%name = name
+      info%kind = kind
+      info%size = n
+      if (present(unit)) info%unit = unit
+      if (.not. allocated(self%list)) allocate (self%list(0))
+      self%list = [self%list, info]
+   end subroutine add_info
+
+   subroutine add_line(self, name, value)
+      class(parameter_visitor), intent(inout) :: self
+      character(len=*), intent(in) :: name, value
+
+      if (self%in_group) self%text = self%text//'  '//name//' = '//value//new_line('a')
+   end subroutine add_line
+
+   subroutine real_scalar(self, name, value, unit)
+      class(parameter_visitor), intent(inout) :: self
+      character(len=*), intent(in) :: name
+      real(wp), intent(inout) :: value
+      character(len=*), intent(in), optional :: unit
+      real(wp) :: values(1)
+
+      values(1) = value
+      call real_array(self, name, values, unit)
+      value = values(1)
+   end subroutine real_scalar
+
+   !> A real array; with `fill`, a list given whole replaces the whole array
+   !> (the elements after it take `fill`), not only its first elements.
+   subroutine real_array(self, name, value, unit, fill)
+      class(parameter_visitor), intent(inout) :: self
+      character(len=*), intent(in) :: name
+      real(wp), intent(inout) :: value(:)
+      character(len=*), intent(in), optional :: unit
+      real(wp), intent(in), optional :: fill
+      integer, allocatable :: from(:), to(:)
+      integer :: k, stat, n
+
+      select case (self%mode)
+      case (mode_list)
+         call self%add_info(name, 'r', size(value), unit)
+      case (mode_write)
+         if (present(fill)) then
+            n = size(value)
+            do while (n > 0)
+               if (value(n) /= fill) exit
+               n = n - 1
+            end do
+            if (n > 0) call self%add_line(name, run_lengths(real_words(value(1:n))))
+         else
+            call self%add_line(name, run_lengths(real_words(value)))
+         end if
+      case default
+         if (.not. self%wants(name)) return
+         self%found = .true.
+         if (self%mode == mode_get) then
+            self%text = run_lengths(real_words(value))
+            return
+         end if
+         if (self%from_number) then
+            value(max(1, self%first)) = self%number
+            return
+         end if
+         call value_items(self%text, size(value), self%first, from, to, self%problem)
+         if (len(self%problem) > 0) return
+         if (present(fill) .and. self%first == 0) value = fill
+         do k = 1, size(from)
+            if (to(k) < from(k)) cycle   ! a null value leaves the element
+            read (self%text(from(k):to(k)), *, iostat=stat) value(max(1, self%first) + k - 1)
+            if (stat /= 0) then
+               self%problem = 'expected '//kind_text('r')
+               return
+            end if
+         end do
+      end select
+   end subroutine real_array
+
+   subroutine integer_scalar(self, name, value, unit)
+      class(parameter_visitor), intent(inout) :: self
+      character(len=*), intent(in) :: name
+      integer, intent(inout) :: value
+      character(len=*), intent(in), optional :: unit
+      integer :: values(1)
+
+      values(1) = value
+      call integer_array(self, name, values, unit)
+      value = values(1)
+   end subroutine integer_scalar
+
+   subroutine integer_array(self, name, value, unit)
+      class(parameter_visitor), intent(inout) :: self
+      character(len=*), intent(in) :: name
+      integer, intent(inout) :: value(:)
+      character(len=*), intent(in), optional :: unit
+      integer(i8) :: wide(size(value))
+
+      wide = value
+      call long_values(self, name, wide, unit, int(huge(value), i8))
+      value = int(wide)
+   end subroutine integer_array
+
+   subroutine long_scalar(self, name, value, unit)
+      class(parameter_visitor), intent(inout) :: self
+      character(len=*), intent(in) :: name
+      integer(i8), intent(inout) :: value
+      character(len=*), intent(in), optional :: unit
+      integer(i8) :: values(1)
+
+      values(1) = value
+      call long_values(self, name, values, unit, huge(value))
+      value = values(1)
+   end subroutine long_scalar
+
+   !> Integers of either width; `largest` bounds the magnitude.
+   subroutine long_values(self, name, value, unit, largest)
+      class(parameter_visitor), intent(inout) :: self
+      character(len=*), intent(in) :: name
+      integer(i8), intent(inout) :: value(:)
+      character(len=*), intent(in), optional :: unit
+      integer(i8), intent(in) :: largest
+      integer, allocatable :: from(:), to(:)
+      character(len=24), allocatable :: words(:)
+      integer :: k, stat
+      integer(i8) :: m
+
+      select case (self%mode)
+      case (mode_list)
+         call self%add_info(name, 'i', size(value), unit)
+      case (mode_write, mode_get)
+         if (self%mode == mode_get) then
+            if (.not. self%wants(name)) return
+            self%found = .true.
+         end if
+         allocate (words(size(value)))
+         do k = 1, size(value)
+            write (words(k), '(i0)') value(k)
+         end do
+         if (self%mode == mode_get) then
+            self%text = run_lengths(words)
+         else
+            call self%add_line(name, run_lengths(words))
+         end if
+      case default
+         if (.not. self%wants(name)) return
+         self%found = .true.
+         if (self%from_number) then
+            if (self%number /= anint(self%number) .or. .not. abs(self%number) <= real(largest, wp)) then
+               self%problem = 'expected '//kind_text('i')
+            else
+               value(max(1, self%first)) = nint(self%number, i8)
+            end if
+            return
+         end if
+         call value_items(self%text, size(value), self%first, from, to, self%problem)
+         if (len(self%problem) > 0) return
+         do k = 1, size(from)
+            if (to(k) < from(k)) cycle
+            read (self%text(from(k):to(k)), *, iostat=stat) m
+            if (stat /= 0 .or. verify(self%text(from(k):to(k)), '0123456789+-') /= 0 .or. abs(m) > largest) then
+               self%problem = 'expected '//kind_text('i')
+               return
+            end if
+            value(max(1, self%first) + k - 1) = m
+         end do
+      end select
+   end subroutine long_values
+
+   subroutine logical_scalar(self, name, value, unit)
+      class(parameter_visitor), intent(inout) :: self
+      character(len=*), intent(in) :: name
+      logical, intent(inout) :: value
+      character(len=*), intent(in), optional :: unit
+      integer, allocatable :: from(:), to(:)
+
+      select case (self%mode)
+      case (mode_list)
+         call self%add_info(name, 'l', 1, unit)
+      case (mode_write)
+         call self%add_line(name, trim(merge('.true. ', '.false.', value)))
+      case default
+         if (.not. self%wants(name)) return
+         self%found = .true.
+         if (self%mode == mode_get) then
+            self%text = trim(merge('.true. ', '.false.', value))
+            return
+         end if
+         if (self%from_number) then
+            self%problem = 'expected '//kind_text('l')
+            return
+         end if
+         call value_items(self%text, 1, self%first, from, to, self%problem)
+         if (len(self%problem) > 0) return
+         if (to(1) < from(1)) return
+         select case (lower(self%text(from(1):to(1))))
+         case ('t', '.t.', '.true.', 'true')
+            value = .true.
+         case ('f', '.f.', '.false.', 'false')
+            value = .false.
+         case default
+            self%problem = 'expected '//kind_text('l')
+         end select
+      end select
+   end subroutine logical_scalar
+
+   !> Text; `fold` stores it in lower case (names of models, methods, ...);
+   !> `path` makes a relative file name relative to the namelist file's
+   !> directory when set from a file.
+   subroutine text_scalar(self, name, value, unit, fold, path)
+      class(parameter_visitor), intent(inout) :: self
+      character(len=*), intent(in) :: name
+      character(len=*), intent(inout) :: value
+      character(len=*), intent(in), optional :: unit
+      logical, intent(in), optional :: fold, path
+      character(len=len(value)) :: values(1)
+      logical :: found_before
+
+      found_before = self%found
+      values(1) = value
+      call text_array(self, name, values, unit, fold)
+      value = values(1)
+      if (self%mode == mode_set .and. present(path) .and. self%found .and. .not. found_before &
+         & .and. len(self%problem) == 0) then
+         if (path .and. allocated(self%base) .and. len_trim(value) > 0) then
+            if (value(1:1) /= '/' .and. len(self%base) > 0) value = self%base//trim(value)
+         end if
+      end if
+   end subroutine text_scalar
+
+   subroutine text_array(self, name, value, unit, fold)
+      class(parameter_visitor), intent(inout) :: self
+      character(len=*), intent(in) :: name
+      character(len=*), intent(inout) :: value(:)
+      character(len=*), intent(in), optional :: unit
+      logical, intent(in), optional :: fold
+      integer, allocatable :: from(:), to(:)
+      character(len=len(value) + 2), allocatable :: words(:)
+      integer :: k
+      logical :: folding
+
+      folding = .false.
+      if (present(fold)) folding = fold
+      select case (self%mode)
+      case (mode_list)
+         call self%add_info(name, 'c', size(value), unit)
+      case (mode_write, mode_get)
+         if (self%mode == mode_get) then
+            if (.not. self%wants(name)) return
+            self%found = .true.
+         end if
+         allocate (words(size(value)))
+         do k = 1, size(value)
+            words(k) = quote(trim(value(k)))
+         end do
+         if (self%mode == mode_get) then
+            self%text = run_lengths(words)
+         else
+            call self%add_line(name, run_lengths(words))
+         end if
+      case default
+         if (.not. self%wants(name)) return
+         self%found = .true.
+         if (self%from_number) then
+            self%problem = 'expected '//kind_text('c')
+            return
+         end if
+         call value_items(self%text, size(value), self%first, from, to, self%problem)
+         if (len(self%problem) > 0) return
+         do k = 1, size(from)
+            if (to(k) < from(k)) cycle
+            if (.not. is_quoted(self%text(from(k):to(k)))) then
+               self%problem = 'expected '//kind_text('c')
+               return
+            end if
+            value(max(1, self%first) + k - 1) = unquote(self%text(from(k):to(k)))
+            if (folding) value(max(1, self%first) + k - 1) = lower(value(max(1, self%first) + k - 1))
+         end do
+      end select
+   end subroutine text_array
+
+   ! ---- operations on a configurable ----
+
+   !> Every variable of obj, in the order it visits them.
+   function list_parameters(obj) result(list)
+      class(configurable), intent(inout) :: obj
+      type(parameter_info), allocatable :: list(:)
+      type(parameter_visitor) :: v
+
+      v%mode = mode_list
+      allocate (v%list(0))
+      call obj%visit(v)
+      call move_alloc(v%list, list)
+   end function list_parameters
+
+   !> Set group.name (elements from `first` on, 0 for the whole variable)
+   !> from namelist value text; `base` is the directory of the file it came
+   !> from ('' for none).  `problem` says why it failed ('' on success).
+   subroutine set_parameter(obj, group, name, text, first, base, problem)
+      class(configurable), intent(inout) :: obj
+      character(len=*), intent(in) :: group, name, text, base
+      integer, intent(in) :: first
+      character(len=:), allocatable, intent(out) :: problem
+      type(parameter_visitor) :: v
+
+      v%mode = mode_set
+      v%want_group = group
+      v%want_name = name
+      v%first = first
+      v%text = text
+      v%base = base
+      v%problem = ''
+      call obj%visit(v)
+      if (.not. v%found) then
+         problem = 'no variable '//trim(name)//' in &'//trim(group)
+      else
+         problem = v%problem
+      end if
+   end subroutine set_parameter
+
+   !> Set a numeric scalar group.name to a number (an integer variable takes
+   !> it when it is whole): the sweep's override, no text in between.
+   subroutine set_parameter_number(obj, group, name, number, problem)
+      class(configurable), intent(inout) :: obj
+      character(len=*), intent(in) :: group, name
+      real(wp), intent(in) :: number
+      character(len=:), allocatable, intent(out) :: problem
+      type(parameter_visitor) :: v
+
+      v%mode = mode_set
+      v%want_group = group
+      v%want_name = name
+      v%from_number = .true.
+      v%number = number
+      v%problem = ''
+      call obj%visit(v)
+      if (.not. v%found) then
+         problem = 'no variable '//trim(name)//' in &'//trim(group)
+      else
+         problem = v%problem
+      end if
+   end subroutine set_parameter_number
+
+   !> The value of group.name as namelist text; found is false if there is
+   !> no such variable.
+   subroutine get_parameter(obj, group, name, text, found)
+      class(configurable), intent(inout) :: obj
+      character(len=*), intent(in) :: group, name
+      character(len=:), allocatable, intent(out) :: text
+      logical, intent(out) :: found
+      type(parameter_visitor) :: v
+
+      v%mode = mode_get
+      v%want_group = group
+      v%want_name = name
+      v%text = ''
+      call obj%visit(v)
+      found = v%found
+      text = v%text
+   end subroutine get_parameter
+
+   !> All variables as namelist text (the groups in `only` when present),
+   !> reals with 17 significant digits so the text reads back to the same
+   !> doubles.
+   function parameters_text(obj, only) result(text)
+      class(configurable), intent(inout) :: obj
+      character(len=*), intent(in), optional :: only(:)
+      character(len=:), allocatable :: text
+      type(parameter_visitor) :: v
+
+      v%mode = mode_write
+      v%text = ''
+      if (present(only)) then
+         allocate (v%only(size(only)))
+         v%only = only
+      end if
+      call obj%visit(v)
+      text = v%text
+   end function parameters_text
+
+   ! ---- value text ----
+
+   !> 'group.name' into its parts ('' group when there is no dot).
+   subroutine split_name(full, group, name)
+      character(len=*), intent(in) :: full
+      character(len=:), allocatable, intent(out) :: group, name
+      integer :: dot
+
+      dot = index(full, '.')
+      group = lower(trim(adjustl(full(1:max(0, dot - 1)))))
+      name = lower(trim(adjustl(full(dot + 1:))))
+   end subroutine split_name
+
+   !> Reals as text that reads back to the same doubles: the fewest
+   !> significant digits that do.
+   pure function real_words(values) result(words)
+      real(wp), intent(in) :: values(:)
+      character(len=26) :: words(size(values))
+      integer :: k
+
+      do k = 1, size(values)
+         words(k) = shortest(values(k))
+      end do
+   end function real_words
+
+   pure function shortest(x) result(word)
+      real(wp), intent(in) :: x
+      character(len=26) :: word
+      character(len=32) :: buffer
+      character(len=16) :: form
+      real(wp) :: back
+      integer :: digits, stat, e, cut
+
+      if (x == 0.0_wp) then
+         word = '0.0'
+         return
+      end if
+      if (abs(x) >= 1.0e-3_wp .and. abs(x) < 1.0e15_wp .and. x == anint(x)) then
+         write (word, '(f0.1)') x
+         return
+      end if
+      do digits = 1, 17
+         write (form, '(a, i0, a)') '(es32.', digits - 1, 'e3)'
+         write (buffer, form) x
+         read (buffer, *, iostat=stat) back
+         if (stat == 0 .and. back == x) exit
+      end do
+      buffer = adjustl(buffer)
+      ! 1.50000e-003 -> 1.5e-3; plain decimals for moderate exponents.
+      e = index(buffer, 'E')
+      read (buffer(e + 1:), *) stat
+      if (stat >= -3 .and. stat < 15) then
+         write (form, '(a, i0, a)') '(f0.', max(1, digits - 1 - stat), ')'
+         write (buffer, form) x
+         buffer = adjustl(buffer)
+         if (buffer(1:1) == '.') buffer = '0'//buffer
+         if (buffer(1:2) == '-.') buffer = '-0'//buffer(2:)
+         word = buffer
+         return
+      end if
+      cut = e - 1
+      do while (buffer(cut:cut) == '0')
+         cut = cut - 1
+      end do
+      if (buffer(cut:cut) == '.') cut = cut - 1
+      write (word, '(a, a, i0)') buffer(1:cut), 'e', stat
+   end function shortest
+
+   !> Values joined by ', ', repeats as n*value.
+   pure function run_lengths(words) result(text)
+      character(len=*), intent(in) :: words(:)
+      character(len=:), allocatable :: text
+      integer :: k, n
+
+      text = ''
+      k = 1
+      do while (k <= size(words))
+         n = 1
+         do while (k + n <= size(words))
+            if (words(k + n) /= words(k)) exit
+            n = n + 1
+         end do
+         if (len(text) > 0) text = text//', '
+         if (n > 1) then
+            text = text//itoa(n)//'*'//trim(words(k))
+         else
+            text = text//trim(words(k))
+         end if
+         k = k + n
+      end do
+   end function run_lengths
+
+   pure function quote(text) result(out)
+      character(len=*), intent(in) :: text
+      character(len=:), allocatable :: out
+      integer :: i
+
+      out = "'"
+      do i = 1, len(text)
+         out = out//text(i:i)
+         if (text(i:i) == "'") out = out//"'"
+      end do
+      out = out//"'"
+   end function quote
+
+   pure logical function is_quoted(item)
+      character(len=*), intent(in) :: item
+
+      is_quoted = .false.
+      if (len(item) < 2) return
+      is_quoted = (item(1:1) == '"' .or. item(1:1) == "'") .and. item(len(item):len(item)) == item(1:1)
+   end function is_quoted
+
+   !> A quoted item's text, with doubled quotes undone.
+   pure function unquote(item) result(text)
+      character(len=*), intent(in) :: item
+      character(len=:), allocatable :: text
+      integer :: i
+      character :: q
+
+      q = item(1:1)
+      text = ''
+      i = 2
+      do while (i < len(item))
+         text = text//item(i:i)
+         if (item(i:i) == q .and. i + 1 < len(item)) then
+            if (item(i + 1:i + 1) == q) i = i + 1
+         end if
+         i = i + 1
+      end do
+   end function unquote
+
+   !> The items of a value (separated by commas or blanks outside quotes;
+   !> r*value repeats; an empty item between commas is a null value, which
+   !> leaves its element alone), at most `room` of them from element
+   !> `first` (0: the whole variable from its first element), as the bounds
+   !> of each item in the text (an empty item has to < from).  (Bounds, not
+   !> an array of strings: gfortran mishandles deferred-length arrays.)
+   subroutine value_items(text, room, first, from, to, problem)
+      character(len=*), intent(in) :: text
+      integer, intent(in) :: room, first
+      integer, allocatable, intent(out) :: from(:), to(:)
+      character(len=:), allocatable, intent(out) :: problem
+      integer, allocatable :: word_from(:), word_to(:)
+      integer :: i, n, star, repeat, stat, k, start
+      character :: q, c
+      logical :: comma_last, in_word
+
+      problem = ''
+      allocate (word_from(0), word_to(0), from(0), to(0))
+      q = ' '
+      comma_last = .true.
+      in_word = .false.
+      start = 1
+      do i = 1, len(text) + 1
+         c = ','
+         if (i <= len(text)) c = text(i:i)
+         if (q /= ' ') then
+            if (c == q) q = ' '
+            if (i <= len(text)) cycle
+         end if
+         if (i <= len(text) .and. (c == '"' .or. c == "'")) then
+            q = c
+            if (.not. in_word) start = i
+            in_word = .true.
+            cycle
+         end if
+         if (c /= ',' .and. c /= ' ' .and. c /= achar(9) .and. c /= new_line('a')) then
+            if (.not. in_word) start = i
+            in_word = .true.
+            cycle
+         end if
+         if (in_word) then
+            word_from = [word_from, start]
+            word_to = [word_to, i - 1]
+            in_word = .false.
+            comma_last = .false.
+         else if (i <= len(text) .and. c == ',') then
+            if (comma_last) then   ! a null value
+               word_from = [word_from, i]
+               word_to = [word_to, i - 1]
+            end if
+         end if
+         if (i <= len(text) .and. c == ',') comma_last = .true.
+      end do
+      if (q /= ' ') then
+         problem = 'the quoted text is not closed'
+         return
+      end if
+      do k = 1, size(word_from)
+         repeat = 1
+         if (word_to(k) >= word_from(k)) then
+            star = index(text(word_from(k):word_to(k)), '*')
+            if (star > 1 .and. .not. is_quoted(text(word_from(k):word_to(k)))) then
+               if (verify(text(word_from(k):word_from(k) + star - 2), '0123456789') == 0) then
+                  read (text(word_from(k):word_from(k) + star - 2), *, iostat=stat) repeat
+                  if (stat /= 0 .or. repeat < 1) then
+                     problem = 'bad repeat count in '//text(word_from(k):word_to(k))
+                     return
+                  end if
+                  word_from(k) = word_from(k) + star
+               end if
+            end if
+         end if
+         if (size(from) + repeat > room) then
+            problem = 'more values than the '//itoa(room)//' elements'
+            return
+         end if
+         do n = 1, repeat
+            from = [from, word_from(k)]
+            to = [to, word_to(k)]
+         end do
+      end do
+      n = size(from)
+      if (n == 0) then
+         problem = 'no value'
+         return
+      end if
+      if (max(1, first) + n - 1 > room) problem = 'more values than the '//itoa(room)//' elements'
+   end subroutine value_items
+
+   !> What a kind code means, for messages.
+   pure function kind_text(kind) result(text)
+      character, intent(in) :: kind
+      character(len=:), allocatable :: text
+
+      select case (kind)
+      case ('c'); text = "quoted text, like 'rkf45'"
+      case ('l'); text = '.true. or .false.'
+      case ('r'); text = 'a number'
+      case default; text = 'an integer'
+      end select
+   end function kind_text
+
+   !> Whether every item of a value reads as the kind.
+   logical function value_has_kind(text, kind) result(ok)
+      character(len=*), intent(in) :: text
+      character, intent(in) :: kind
+      character(len=:), allocatable :: problem
+      integer, allocatable :: from(:), to(:)
+      integer :: k, stat
+      real(wp) :: x
+      integer(i8) :: m
+
+      call value_items(text, huge(1) - 1, 0, from, to, problem)
+      ok = .true.
+      if (len(problem) > 0) then
+         ok = problem == 'no value' .or. index(problem, 'elements') > 0   ! left to the setter
+         return
+      end if
+      do k = 1, size(from)
+         if (to(k) < from(k)) cycle
+         select case (kind)
+         case ('c')
+            ok = is_quoted(text(from(k):to(k)))
+         case ('l')
+            select case (lower(text(from(k):to(k))))
+            case ('t', 'f', '.t.', '.f.', '.true.', '.false.', 'true', 'false')
+            case default
+               ok = .false.
+            end select
+         case ('r')
+            read (text(from(k):to(k)), *, iostat=stat) x
+            ok = stat == 0 .and. verify(lower(text(from(k):to(k))), '0123456789+-.ed') == 0
+         case default
+            read (text(from(k):to(k)), *, iostat=stat) m
+            ok = stat == 0 .and. verify(text(from(k):to(k)), '0123456789+-') == 0
+         end select
+         if (.not. ok) return
+      end do
+   end function value_has_kind
+
+end module friction_parameters

@@ -1,0 +1,320 @@
+!> A job's configuration: &job (which scene), the scene's own groups, and
+!> &sweep; read from namelist files (later files override earlier values
+!> variable by variable) and checked by the configurations themselves.
+module friction_job_config
+   use friction_kinds, only: wp
+   use friction_strings, only: itoa, rtoa, join, quoted, lower
+   use friction_error, only: error_type, fatal_error, error_input
+   use friction_parameters, only: configurable, parameter_visitor, parameter_info, list_parameters, &
+      & parameters_text, split_name
+   use friction_checks, only: config_checker
+   use friction_input_reader, only: namelist_source, scan_files, apply_files
+   use friction_scene, only: scene
+   use friction_job_factory, only: scene_names, new_scene
+   implicit none
+   private
+
+   public :: job_config, sweep_settings, read_input, check_job, max_sweep_values, all_parameters, job_text
+
+   integer, parameter :: max_sweep_values = 1024
+
+   !> &sweep: one or two numeric variables of the scene ('group.name'), each
+   !> over a list, a linspace or a logspace; the points are the grid of the
+   !> two, the second varying fastest (README: Parameter sweeps).
+   type :: sweep_settings
+      ! As the input gives them
+      character(len=64) :: variables(2) = ''       !! 'group.name', e.g. 'brake.v_dr_prime'
+      character(len=8) :: spacings(2) = 'list'     !! 'list', 'linear' or 'log'
+      real(wp) :: listed(max_sweep_values, 2) = huge(1.0_wp)   !! sweep_values, sweep_values2 (huge: unused)
+      real(wp) :: from(2) = 0.0_wp, to(2) = 0.0_wp
+      integer :: count(2) = 0
+      character(len=8) :: schedule = 'dynamic'     !! 'dynamic' (on demand) or 'static' (contiguous blocks)
+      ! Derived by check_job
+      integer :: n_variables = 0
+      logical :: integer_valued(2) = .false.       !! an integer variable (values are whole numbers)
+      integer :: shape(2) = 1                      !! values per variable (1 for an absent second)
+      real(wp), allocatable :: values(:, :)        !! (n_variables, points): each point's values, in order
+   contains
+      procedure :: enabled => sweep_enabled
+      procedure :: visit => sweep_visit
+   end type sweep_settings
+
+   !> Everything a run needs from its input files.
+   type, extends(configurable) :: job_config
+      character(len=16) :: scene_name = 'afm'
+      class(scene), allocatable :: scene
+      type(sweep_settings) :: sweep
+   contains
+      procedure :: visit => job_visit
+   end type job_config
+
+contains
+
+   logical function sweep_enabled(self)
+      class(sweep_settings), intent(in) :: self
+
+      sweep_enabled = len_trim(self%variables(1)) > 0
+   end function sweep_enabled
+
+   subroutine sweep_visit(self, v)
+      class(sweep_settings), intent(inout) :: self
+      type(parameter_visitor), intent(inout) :: v
+
+      call v%begin_group('sweep')
+      call v%item('sweep_variable', self%variables(1), fold=.true.)
+      call v%item('sweep_values', self%listed(:, 1), fill=huge(1.0_wp))
+      call v%item('sweep_from', self%from(1))
+      call v%item('sweep_to', self%to(1))
+      call v%item('sweep_count', self%count(1))
+      call v%item('sweep_spacing', self%spacings(1), fold=.true.)
+      call v%item('sweep_variable2', self%variables(2), fold=.true.)
+      call v%item('sweep_values2', self%listed(:, 2), fill=huge(1.0_wp))
+      call v%item('sweep_from2', self%from(2))
+      call v%item('sweep_to2', self%to(2))
+      call v%item('sweep_count2', self%count(2))
+      call v%item('sweep_spacing2', self%spacings(2), fold=.true.)
+      call v%item('sweep_schedule', self%schedule, fold=.true.)
+      call v%end_group()
+   end subroutine sweep_visit
+
+   !> &job, the scene's groups, &sweep.
+   subroutine job_visit(self, v)
+      class(job_config), intent(inout) :: self
+      type(parameter_visitor), intent(inout) :: v
+
+      call v%begin_group('job')
+      call v%item('scene', self%scene_name, fold=.true.)
+      call v%end_group()
+      if (allocated(self%scene)) call self%scene%visit(v)
+      call self%sweep%visit(v)
+   end subroutine job_visit
+
+   !> Every variable of every scene's job (the names a file may use).
+   function all_parameters() result(list)
+      type(parameter_info), allocatable :: list(:), more(:)
+      type(job_config) :: probe
+      integer :: k, m
+
+      allocate (list(0))
+      do k = 1, size(scene_names)
+         call new_scene(scene_names(k), probe%scene)
+         more = list_parameters(probe)
+         do m = 1, size(more)
+            if (.not. any(list%group == more(m)%group .and. list%name == more(m)%name)) list = [list, more(m)]
+         end do
+         deallocate (probe%scene)
+      end do
+   end function all_parameters
+
+   !> Read and check the files in order into config; input_text is the
+   !> resolved input as namelist text that reads back to the same run.
+   subroutine read_input(paths, config, input_text, error)
+      character(len=*), intent(in) :: paths(:)
+      type(job_config), intent(out) :: config
+      character(len=:), allocatable, intent(out) :: input_text
+      type(error_type), allocatable, intent(out) :: error
+      type(namelist_source), allocatable :: sources(:)
+      type(parameter_info), allocatable :: universe(:)
+      type(config_checker) :: checker
+      character(len=32), allocatable :: groups(:)
+      integer :: k
+
+      universe = all_parameters()
+      allocate (groups(0))
+      do k = 1, size(universe)
+         if (.not. any(groups == universe(k)%group)) groups = [character(len=32) :: groups, universe(k)%group]
+      end do
+      call scan_files(paths, groups, sources, error)
+      if (allocated(error)) return
+      ! &job and &sweep first (every assignment of every file is checked here),
+      ! then the scene they name.
+      call apply_files(sources, universe, config, checker, error)
+      if (allocated(error)) return
+      call new_scene(config%scene_name, config%scene)
+      if (.not. allocated(config%scene)) then
+         call checker%reject('job', 'scene', "'"//trim(config%scene_name)//"'", 'unknown scene (known: ' &
+            & //quoted(scene_names)//')')
+         call move_alloc(checker%error, error)
+         return
+      end if
+      call apply_files(sources, universe, config, checker, error)
+      if (allocated(error)) return
+      call check_job(config, checker)
+      if (checker%failed()) then
+         call move_alloc(checker%error, error)
+         return
+      end if
+      input_text = job_text(config)
+   end subroutine read_input
+
+   !> The groups the job reads as namelist text.
+   function job_text(config) result(text)
+      type(job_config), intent(inout) :: config
+      character(len=:), allocatable :: text
+      character(len=32), allocatable :: groups(:), own(:)
+
+      call config%scene%groups(own)
+      allocate (groups(size(own) + 1))
+      groups(1) = 'job'
+      groups(2:) = own
+      if (config%sweep%enabled()) groups = [character(len=32) :: groups, 'sweep']
+      text = parameters_text(config, groups)
+   end function job_text
+
+   !> The scene's checks, then the sweep's: one or two known numeric
+   !> variables of the scene's groups, and their points.
+   subroutine check_job(config, c)
+      type(job_config), intent(inout) :: config
+      type(config_checker), intent(inout) :: c
+      type(parameter_info), allocatable :: mine(:), universe(:)
+      real(wp), allocatable :: axes(:, :)
+      integer :: counts(2), v, i1, i2, p
+
+      call config%scene%check(c)
+      if (c%failed() .or. .not. config%sweep%enabled()) return
+      associate (s => config%sweep)
+         s%n_variables = merge(2, 1, len_trim(s%variables(2)) > 0)
+         if (s%schedule /= 'dynamic' .and. s%schedule /= 'static') call c%reject('sweep', 'sweep_schedule', &
+            & "'"//trim(s%schedule)//"'", "unknown schedule (known: 'dynamic', 'static')")
+         mine = list_parameters(config%scene)
+         universe = all_parameters()
+         allocate (axes(max_sweep_values, 2), source=0.0_wp)
+         counts = 1
+         call sweep_axis(1, '', axes(:, 1), counts(1))
+         if (s%n_variables == 2) then
+            if (s%variables(2) == s%variables(1)) call c%reject('sweep', 'sweep_variable2', &
+               & "'"//trim(s%variables(2))//"'", 'is sweep_variable already')
+            call sweep_axis(2, '2', axes(:, 2), counts(2))
+         end if
+         if (c%failed()) return
+         if (counts(1) * counts(2) > max_sweep_values) then
+            call c%reject('sweep', 'sweep_count2', itoa(counts(2)), 'the grid of '//itoa(counts(1))//' x ' &
+               & //itoa(counts(2))//' points exceeds '//itoa(max_sweep_values)//' points')
+            return
+         end if
+         v = s%n_variables
+         s%shape = counts
+         if (allocated(s%values)) deallocate (s%values)
+         allocate (s%values(v, counts(1) * counts(2)))
+         p = 0
+         do i1 = 1, counts(1)
+            do i2 = 1, counts(2)
+               p = p + 1
+               s%values(1, p) = axes(i1, 1)
+               if (v == 2) s%values(2, p) = axes(i2, 2)
+            end do
+         end do
+      end associate
+
+   contains
+
+      !> One swept variable (`suffix` '' or '2' names its namelist variables):
+      !> a numeric variable of a group of this scene, and its values.
+      subroutine sweep_axis(a, suffix, axis, n)
+         integer, intent(in) :: a
+         character(len=*), intent(in) :: suffix
+         real(wp), intent(out) :: axis(:)
+         integer, intent(out) :: n
+         character(len=:), allocatable :: group, name, shown
+         integer :: k, found
+         logical :: whole
+
+         n = 0
+         associate (s => config%sweep)
+            shown = "'"//trim(s%variables(a))//"'"
+            call split_name(s%variables(a), group, name)
+            if (index(s%variables(a), '.') == 0 .or. group == 'job' .or. group == 'sweep' &
+               & .or. .not. any(universe%group == group)) then
+               call c%reject('sweep', 'sweep_variable'//suffix, shown, &
+                  & "name a variable as 'group.name' of a scene group (e.g. 'brake.v_dr_prime')")
+               return
+            end if
+            if (.not. any(mine%group == group)) then
+               call c%reject('sweep', 'sweep_variable'//suffix, shown, 'group &'//group//' is not part of scene ' &
+                  & //"'"//trim(config%scene_name)//"'")
+               return
+            end if
+            found = 0
+            do k = 1, size(mine)
+               if (mine(k)%group == group .and. mine(k)%name == name) found = k
+            end do
+            if (found == 0) then
+               call c%reject('sweep', 'sweep_variable'//suffix, shown, 'no variable '//name// &
+                  & ' in &'//group//' (known: '//join(pack(mine%name, mine%group == group))//')')
+               return
+            end if
+            if ((mine(found)%kind /= 'r' .and. mine(found)%kind /= 'i') .or. mine(found)%size /= 1) then
+               call c%reject('sweep', 'sweep_variable'//suffix, shown, &
+                  & 'only numeric (real or integer) variables can be swept')
+               return
+            end if
+            whole = mine(found)%kind == 'i'
+            s%integer_valued(a) = whole
+            select case (trim(s%spacings(a)))
+            case ('list')
+               do while (n < max_sweep_values)
+                  if (s%listed(n + 1, a) == huge(1.0_wp)) exit
+                  n = n + 1
+               end do
+               if (n == 0) call c%reject('sweep', 'sweep_values'//suffix, '(none)', "give at least one value for " &
+                  & //"sweep_spacing"//suffix//" = 'list'")
+               axis(1:n) = s%listed(1:n, a)
+            case ('linear', 'log')
+               if (s%count(a) < 1 .or. s%count(a) > max_sweep_values) then
+                  call c%reject('sweep', 'sweep_count'//suffix, itoa(s%count(a)), 'must be in [1, ' &
+                     & //itoa(max_sweep_values)//']')
+                  return
+               end if
+               call c%finite('sweep', 'sweep_from'//suffix, s%from(a))
+               call c%finite('sweep', 'sweep_to'//suffix, s%to(a))
+               if (s%spacings(a) == 'log') then
+                  if (.not. (s%from(a) > 0.0_wp)) call c%reject('sweep', 'sweep_from'//suffix, rtoa(s%from(a)), &
+                     & "must be > 0 for sweep_spacing"//suffix//" = 'log'")
+                  if (.not. (s%to(a) > 0.0_wp)) call c%reject('sweep', 'sweep_to'//suffix, rtoa(s%to(a)), &
+                     & "must be > 0 for sweep_spacing"//suffix//" = 'log'")
+               end if
+               if (c%failed()) return
+               n = s%count(a)
+               associate (from => s%from(a), to => s%to(a), count => s%count(a))
+                  do k = 1, count
+                     if (count == 1) then
+                        axis(k) = from
+                     else if (s%spacings(a) == 'linear') then
+                        axis(k) = from + (to - from) * (k - 1) / (count - 1)
+                     else
+                        axis(k) = exp(log(from) + (log(to) - log(from)) * (k - 1) / (count - 1))
+                     end if
+                  end do
+                  ! An integer variable takes whole values: a spaced range is rounded
+                  ! (and must not repeat a value).
+                  if (whole) then
+                     axis(1:n) = anint(axis(1:n))
+                     do k = 2, n
+                        if (axis(k) == axis(k - 1)) then
+                           call c%reject('sweep', 'sweep_count'//suffix, itoa(count), 'integer variable '//name &
+                              & //' takes whole values: '//itoa(count)//' points from '//rtoa(from)//' to ' &
+                              & //rtoa(to)//' repeat '//rtoa(axis(k)))
+                           return
+                        end if
+                     end do
+                  end if
+               end associate
+            case default
+               call c%reject('sweep', 'sweep_spacing'//suffix, "'"//trim(s%spacings(a))//"'", &
+                  & "unknown spacing (known: 'list', 'linear', 'log')")
+            end select
+            if (whole .and. n > 0) then
+               do k = 1, n
+                  if (axis(k) /= anint(axis(k)) .or. abs(axis(k)) > 2.0_wp**30) then
+                     call c%reject('sweep', 'sweep_values'//suffix, rtoa(axis(k)), 'integer variable '//name// &
+                        & ' takes whole values')
+                     return
+                  end if
+               end do
+            end if
+         end associate
+      end subroutine sweep_axis
+
+   end subroutine check_job
+
+end module friction_job_config

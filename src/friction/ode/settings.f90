@@ -1,0 +1,50 @@
+!> &integrator: the stepper settings as a namelist group, shared by every
+!> scene (each scene keeps its own defaults), and their checks.
+module friction_ode_settings
+   use friction_kinds, only: wp
+   use friction_strings, only: itoa, quoted
+   use friction_parameters, only: parameter_visitor
+   use friction_checks, only: config_checker
+   use friction_ode_solver, only: solver_settings, step_type_names, step_type_index
+   use friction_ode_auto, only: auto_name
+   implicit none
+   private
+
+   public :: visit_integrator, check_integrator
+
+contains
+
+   !> The group &integrator of a scene; `time_unit` is the unit of its times
+   !> ('s' for the microscope, 'tau' for the brake).
+   subroutine visit_integrator(s, v, time_unit)
+      type(solver_settings), intent(inout) :: s
+      type(parameter_visitor), intent(inout) :: v
+      character(len=*), intent(in) :: time_unit
+
+      call v%begin_group('integrator')
+      call v%item('method', s%method, fold=.true.)
+      call v%item('rtol', s%rtol, '1')
+      call v%item('atol', s%atol, 'state units')
+      call v%item('h_start', s%h_start, time_unit)
+      call v%item('h_min', s%h_min, time_unit)
+      call v%item('max_steps', s%max_steps, '1')
+      call v%item('max_wall_time', s%max_wall_time, 's')
+      call v%end_group()
+   end subroutine visit_integrator
+
+   subroutine check_integrator(s, c)
+      type(solver_settings), intent(in) :: s
+      type(config_checker), intent(inout) :: c
+
+      if (s%method /= auto_name .and. step_type_index(s%method) == 0) call c%reject('integrator', 'method', &
+         & "'"//trim(s%method)//"'", 'unknown GSL step type (known: '//quoted(step_type_names)//', or '// &
+         & quoted([auto_name])//' to choose by scene and rtol)')
+      call c%positive('integrator', 'rtol', s%rtol, 'relative tolerance')
+      call c%positive('integrator', 'atol', s%atol, 'absolute tolerance, Å and Å/s')
+      call c%nonnegative('integrator', 'h_start', s%h_start, 's; 0 chooses automatically')
+      call c%nonnegative('integrator', 'h_min', s%h_min, 's; 0 for no limit')
+      if (s%max_steps < 1) call c%reject('integrator', 'max_steps', itoa(s%max_steps), 'must be >= 1')
+      call c%nonnegative('integrator', 'max_wall_time', s%max_wall_time, 's; 0 for no limit')
+   end subroutine check_integrator
+
+end module friction_ode_settings

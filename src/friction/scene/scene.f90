@@ -1,0 +1,126 @@
+!> A scene: what the program computes (a friction-force map, the brake, and
+!> whatever comes next), as one type the job, the sweep, the netlist and the
+!> C API call without knowing which scene it is.  A scene owns its namelist
+!> groups (it visits its variables and checks its values), runs on a
+!> communicator, writes its part of the output file, reduces itself to a
+!> sweep point's named results, and describes itself as a SPICE netlist.
+!> Only the factory (job/factory.f90) knows the concrete types.
+module friction_scene
+   use friction_kinds, only: wp
+   use friction_error, only: error_type
+   use friction_parameters, only: configurable, parameter_visitor
+   use friction_checks, only: config_checker
+   use friction_scene_report, only: job_reporter
+   use friction_scene_context, only: job_context
+   implicit none
+   private
+
+   public :: scene, point_result
+
+   !> One named result of a sweep point (README: Parameter sweeps).
+   type :: point_result
+      character(len=24) :: name = ''
+      character(len=16) :: unit = ''
+      logical :: whole = .false.   !! written as integers (counts)
+   end type point_result
+
+   type, abstract, extends(configurable) :: scene
+   contains
+      !> The scene's name in &job scene = '...'.
+      procedure(name_interface), deferred :: name
+      !> The namelist groups it reads, in the order of the echo.
+      procedure(groups_interface), deferred :: groups
+      !> Check every value (the first bad one goes to the checker).
+      procedure(check_interface), deferred :: check
+      !> The stepper that runs (after 'auto' is resolved), for the file's root.
+      procedure(name_interface), deferred :: method
+      !> Compute, collectively over the job's communicator; every rank
+      !> returns the same error or none.
+      procedure(run_interface), deferred :: run
+      !> Write the computed results to a new file `path` (collective).
+      procedure(write_interface), deferred :: write_output
+      !> What was computed, in one line, after a run.
+      procedure(summary_interface), deferred :: summary
+      !> The results a sweep point reduces to, and the name and unit of its
+      !> variable-length series ('' when it has none).
+      procedure(results_interface), deferred :: point_results
+      procedure(series_interface), deferred :: point_series
+      !> One sweep point on this process alone: its results, in the order of
+      !> point_results, and its series.
+      procedure(point_interface), deferred :: run_point
+      !> The scene as a SPICE netlist for ngspice.
+      procedure(netlist_interface), deferred :: netlist
+   end type scene
+
+   abstract interface
+      function name_interface(self) result(name)
+         import :: scene
+         class(scene), intent(in) :: self
+         character(len=:), allocatable :: name
+      end function name_interface
+
+      subroutine groups_interface(self, names)
+         import :: scene
+         class(scene), intent(in) :: self
+         character(len=32), allocatable, intent(out) :: names(:)
+      end subroutine groups_interface
+
+      subroutine check_interface(self, checker)
+         import :: scene, config_checker
+         class(scene), intent(in) :: self
+         type(config_checker), intent(inout) :: checker
+      end subroutine check_interface
+
+      subroutine run_interface(self, job, reporter, error)
+         import :: scene, job_context, job_reporter, error_type
+         class(scene), intent(inout) :: self
+         type(job_context), intent(in) :: job
+         class(job_reporter), intent(inout) :: reporter
+         type(error_type), allocatable, intent(out) :: error
+      end subroutine run_interface
+
+      subroutine write_interface(self, path, job, error)
+         import :: scene, job_context, error_type
+         class(scene), intent(inout) :: self
+         character(len=*), intent(in) :: path
+         type(job_context), intent(in) :: job
+         type(error_type), allocatable, intent(out) :: error
+      end subroutine write_interface
+
+      function summary_interface(self, job) result(text)
+         import :: scene, job_context
+         class(scene), intent(in) :: self
+         type(job_context), intent(in) :: job
+         character(len=:), allocatable :: text
+      end function summary_interface
+
+      function results_interface(self) result(results)
+         import :: scene, point_result
+         class(scene), intent(in) :: self
+         type(point_result), allocatable :: results(:)
+      end function results_interface
+
+      subroutine series_interface(self, name, unit)
+         import :: scene
+         class(scene), intent(in) :: self
+         character(len=:), allocatable, intent(out) :: name, unit
+      end subroutine series_interface
+
+      subroutine point_interface(self, results, series, error)
+         import :: scene, wp, error_type
+         class(scene), intent(inout) :: self
+         real(wp), intent(out) :: results(:)
+         real(wp), allocatable, intent(out) :: series(:)
+         type(error_type), allocatable, intent(out) :: error
+      end subroutine point_interface
+
+      subroutine netlist_interface(self, data_file, version, text, note, error)
+         import :: scene, error_type
+         class(scene), intent(in) :: self
+         character(len=*), intent(in) :: data_file, version
+         character(len=:), allocatable, intent(out) :: text, note
+         type(error_type), allocatable, intent(out) :: error
+      end subroutine netlist_interface
+   end interface
+
+end module friction_scene
