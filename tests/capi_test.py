@@ -53,7 +53,7 @@ def compare(name, expected, actual):
 
 
 # Attributes that measure the run rather than compute it.
-TIMINGS = {"wall_time", "compute_time", "check_compute_time"}
+TIMINGS = {"wall_time", "compute_time", "check_compute_time", "created"}
 
 
 def file_contents(path):

@@ -17,6 +17,7 @@ import shutil
 import signal
 import subprocess
 import sys
+import re
 import time
 
 import h5py
@@ -164,6 +165,41 @@ def leftovers(args):
     return sorted(f for f in os.listdir(args.workdir) if not f.endswith(".nml"))
 
 
+def case_input_roundtrip(args):
+    """The root `input` attribute is a namelist that reads back to the same
+    run: for every scene (a NaF map, a graphite map with its net file, the
+    brake, a sweep) the file written from the echoed input alone has the same
+    datasets bit for bit and echoes the same text again."""
+    runs = {
+        "naf": [os.path.join(args.inputs, "naf.nml"), write(args, "naf_small.nml", SMALL)],
+        "graphite": [os.path.join(args.inputs, "graphite.nml"),
+                     os.path.join(args.inputs, "graphite_defects.nml"),
+                     write(args, "graphite_small.nml", "&scan nx = 12, ny = 2 /\n")],
+        "brake": [os.path.join(args.inputs, "brake.nml"), write(args, "brake_short.nml", BRAKE_SHORT)],
+        "sweep": [os.path.join(args.inputs, "brake.nml"), write(args, "sweep_small.nml", SWEEP_SMALL)],
+    }
+    for label, files in runs.items():
+        first, second = f"{label}_1.h5", f"{label}_2.h5"
+        friction(args, "-o", first, *files)
+        with h5py.File(os.path.join(args.workdir, first), "r") as f:
+            echoed = f.attrs["input"].decode()
+        again = write(args, f"{label}_echo.nml", echoed)
+        friction(args, "-o", second, again)
+        with h5py.File(os.path.join(args.workdir, first), "r") as a, \
+                h5py.File(os.path.join(args.workdir, second), "r") as b:
+            if b.attrs["input"].decode() != echoed:
+                fail(f"{label}: the echo of the echo differs:\n{echoed}\n---\n{b.attrs['input'].decode()}")
+            names = []
+            a.visit(lambda name: names.append(name) if isinstance(a[name], h5py.Dataset) else None)
+            if not names:
+                fail(f"{label}: no datasets")
+            for name in names:
+                if name.endswith("compute_time") or name.endswith("peak_memory_per_rank"):
+                    continue
+                if name not in b or not np.array_equal(a[name][()], b[name][()], equal_nan=True):
+                    fail(f"{label}: /{name} differs when run from the echoed input")
+
+
 def case_datasets(args, scene):
     small = write(args, "small.nml", SMALL)
     friction(args, os.path.join(args.inputs, scene + ".nml"), small)
@@ -176,6 +212,21 @@ def case_datasets(args, scene):
         text = namelist_text(f)
         if "NX=24" not in text or "&SCAN" not in text:
             fail("resolved input does not show the override nx = 24:\n" + text)
+        # The file describes itself: when, from which source, and the physical
+        # parameters with their units (no namelist parsing needed).
+        if not re.fullmatch(r"\d{4}-\d\d-\d\dT\d\d:\d\d:\d\dZ", f.attrs["created"].decode()):
+            fail(f"root attribute created = {f.attrs['created']!r} is not ISO 8601 UTC")
+        if not f.attrs["revision"].decode():
+            fail("root attribute revision is empty")
+        if f.attrs["wall_time_units"].decode() != "s":
+            fail("wall_time has no unit")
+        for name, value, unit in (("kx", 10.0, "N/m") if scene == "naf" else ("kx", 25.0, "N/m"),
+                                  ("mass", 1e-8, "kg"), ("angle", None, "degree"), ("velocity", None, "angstrom/s"),
+                                  ("v0", None, "eV")):
+            if name not in f["afm"].attrs or f["afm"].attrs[name + "_units"].decode() != unit:
+                fail(f"/afm attribute {name} with units {unit} missing: {dict(f['afm'].attrs)}")
+            if value is not None and f["afm"].attrs[name] != value:
+                fail(f"/afm attribute {name} = {f['afm'].attrs[name]}, expected {value}")
         if f.attrs["integrator_steps"] <= 0 or f.attrs["rhs_evaluations"] < f.attrs["integrator_steps"]:
             fail("integrator statistics implausible")
         expect = {"afm/support_x": (24,), "afm/support_y": (7,), "afm/friction": (7,)}
@@ -352,7 +403,7 @@ def comparable(path):
                 items[name] = obj[()]
         f.visititems(visit)
         for key, value in f.attrs.items():
-            if key not in ("wall_time", "nranks"):
+            if key not in ("wall_time", "nranks", "created"):   # (when and how it ran)
                 items["@" + key] = value
     return items
 
@@ -951,7 +1002,8 @@ def main():
         {"ranks": case_ranks, "override": case_override, "force": case_force,
          "numerical-failure": case_numerical_failure, "wall-time": case_wall_time,
          "graphite": case_graphite, "models": case_models, "quasistatic-failure": case_quasistatic_failure,
-         "graphite-ranks": case_graphite_ranks, "graphite-defects": case_graphite_defects}[args.case](args)
+         "graphite-ranks": case_graphite_ranks, "graphite-defects": case_graphite_defects,
+         "input-roundtrip": case_input_roundtrip}[args.case](args)
     print("1 passed, 0 failed")
 
 

@@ -14,7 +14,7 @@ module friction_afm_config
    use friction_afm_tip, only: afm_tip, model_inertial, model_overdamped, model_quasistatic
    use friction_strings, only: itoa, rtoa, quoted
    use friction_files, only: file_exists
-   use friction_parameters, only: parameter_visitor
+   use friction_parameters, only: configurable, parameter_visitor
    use friction_checks, only: config_checker
    use friction_ode_settings, only: visit_integrator, check_integrator
    implicit none
@@ -31,7 +31,7 @@ module friction_afm_config
       & 'quasistatic']
    integer, parameter :: max_species = 8, max_defects = 64
 
-   type :: afm_config
+   type, extends(configurable) :: afm_config
       ! &surface
       character(len=16) :: potential = 'naf'  !! 'naf' (Eq. 1) or 'hopg' (Eq. 2)
       real(wp) :: v0 = 1.0_wp          !! potential amplitude, eV
@@ -93,20 +93,20 @@ contains
       call v%begin_group('surface')
       call v%item('potential', self%potential, fold=.true.)
       call v%item('v0', self%v0, 'eV')
-      call v%item('ax', self%ax, 'Å')
-      call v%item('ay', self%ay, 'Å')
-      call v%item('a', self%a, 'Å')
+      call v%item('ax', self%ax, 'angstrom')
+      call v%item('ay', self%ay, 'angstrom')
+      call v%item('a', self%a, 'angstrom')
       call v%item('net', self%net, fold=.true.)
       call v%item('net_file', self%net_file, path=.true.)
       call v%item('shells', self%shells)
       call v%item('side', self%side)
       call v%item('species', self%species)
       call v%item('epsilon', self%epsilon, 'eV')
-      call v%item('sigma', self%sigma, 'Å')
+      call v%item('sigma', self%sigma, 'angstrom')
       call v%item('vacancies', self%vacancies)
       call v%item('substitutions', self%substitutions)
       call v%item('substitution_species', self%substitution_species)
-      call v%item('cutoff', self%cutoff, 'Å')
+      call v%item('cutoff', self%cutoff, 'angstrom')
       call v%item('cutoff_tolerance', self%cutoff_tolerance, 'nN')
       call v%end_group()
       call v%begin_group('tip')
@@ -118,16 +118,16 @@ contains
       call v%item('cx', self%cx, 'N s/m')
       call v%item('cy', self%cy, 'N s/m')
       call v%item('cz', self%cz, 'N s/m')
-      call v%item('support_z', self%support_z, 'Å')
+      call v%item('support_z', self%support_z, 'angstrom')
       call v%end_group()
       call v%begin_group('scan')
-      call v%item('velocity', self%velocity, 'Å/s')
-      call v%item('length', self%length, 'Å')
-      call v%item('width', self%width, 'Å')
+      call v%item('velocity', self%velocity, 'angstrom/s')
+      call v%item('length', self%length, 'angstrom')
+      call v%item('width', self%width, 'angstrom')
       call v%item('angle', self%angle, 'degree')
-      call v%item('origin_x', self%origin_x, 'Å')
-      call v%item('origin_y', self%origin_y, 'Å')
-      call v%item('lead_in', self%lead_in, 'Å')
+      call v%item('origin_x', self%origin_x, 'angstrom')
+      call v%item('origin_y', self%origin_y, 'angstrom')
+      call v%item('lead_in', self%lead_in, 'angstrom')
       call v%item('nx', self%nx)
       call v%item('ny', self%ny)
       call v%item('retrace', self%retrace)
@@ -143,9 +143,9 @@ contains
       if (.not. any(potential_names == self%potential)) call c%reject('surface', 'potential', &
          & "'"//trim(self%potential)//"'", 'unknown potential (known: '//quoted(potential_names)//')')
       call c%nonnegative('surface', 'v0', self%v0, 'eV')
-      call c%positive('surface', 'ax', self%ax, 'Å')
-      call c%positive('surface', 'ay', self%ay, 'Å')
-      call c%positive('surface', 'a', self%a, 'Å')
+      call c%positive('surface', 'ax', self%ax, 'angstrom')
+      call c%positive('surface', 'ay', self%ay, 'angstrom')
+      call c%positive('surface', 'a', self%a, 'angstrom')
       call c%positive('tip', 'mass', self%mass, 'kg')
       call c%nonnegative('tip', 'kx', self%kx, 'N/m')
       call c%nonnegative('tip', 'ky', self%ky, 'N/m')
@@ -163,12 +163,12 @@ contains
       end if
       if (self%potential == 'lj') call check_net()
       call c%positive('scan', 'velocity', self%velocity, 'Å/s; the direction is set by angle')
-      call c%positive('scan', 'length', self%length, 'Å')
-      call c%nonnegative('scan', 'width', self%width, 'Å')
+      call c%positive('scan', 'length', self%length, 'angstrom')
+      call c%nonnegative('scan', 'width', self%width, 'angstrom')
       call c%finite('scan', 'angle', self%angle)
       call c%finite('scan', 'origin_x', self%origin_x)
       call c%finite('scan', 'origin_y', self%origin_y)
-      call c%nonnegative('scan', 'lead_in', self%lead_in, 'Å')
+      call c%nonnegative('scan', 'lead_in', self%lead_in, 'angstrom')
       if (self%nx < 2) call c%reject('scan', 'nx', itoa(self%nx), 'must be >= 2 (sample points per line)')
       if (self%ny < 1) call c%reject('scan', 'ny', itoa(self%ny), 'must be >= 1 (lines)')
       call check_integrator(self%solver, c)

@@ -9,6 +9,7 @@ module friction_afm_output
    use friction_afm_scan, only: quantity_names, quantity_units, quantity_count, q_f_along, q_jumps, &
       & support_along, support_across
    use friction_output_h5, only: h5_file
+   use friction_output_parameters, only: write_parameter_attributes
    use friction_output_summary, only: run_summary, write_run_attributes
    use friction_surface_net, only: crystal_net
    use friction_strings, only: join
@@ -57,6 +58,7 @@ contains
       type(afm_surface_record), intent(in), optional :: surface
       type(h5_file) :: file
       type(error_type), allocatable :: close_error
+      type(afm_config) :: copy
       integer :: q, nq
 
       call file%create(path, comm, error)
@@ -69,21 +71,23 @@ contains
       call file%create_group('/afm')
       call file%write_attribute_text('/afm', 'potential', trim(config%potential))
       call file%write_attribute_text('/afm', 'model', trim(config%model))
-      call file%write_attribute_real('/afm', 'angle', config%angle)
-      call file%write_attribute_real('/afm', 'origin_x', config%origin_x)
-      call file%write_attribute_real('/afm', 'origin_y', config%origin_y)
+      call file%write_attribute_real('/afm', 'angle', config%angle, 'degree')
+      call file%write_attribute_real('/afm', 'origin_x', config%origin_x, 'angstrom')
+      call file%write_attribute_real('/afm', 'origin_y', config%origin_y, 'angstrom')
       call file%write_vector('/afm/support_x', support_along(config), 'angstrom')
       call file%write_vector('/afm/support_y', support_across(config), 'angstrom')
       nq = quantity_count(merge(3, 2, present(surface)))
       if (present(surface)) then
-         call file%write_attribute_real('/afm', 'contact_height', surface%contact_height)
-         call file%write_attribute_real('/afm', 'support_height', surface%support_height)
+         call file%write_attribute_real('/afm', 'contact_height', surface%contact_height, 'angstrom')
+         call file%write_attribute_real('/afm', 'support_height', surface%support_height, 'angstrom')
          call file%create_group('/surface')
          call file%write_matrix('/surface/atoms', surface%net%position, 'angstrom')
          call file%write_integer_vector('/surface/species', surface%net%species)
          call file%write_attribute_text('/surface', 'species_names', join(surface%species_names))
-         call file%write_attribute_real('/surface', 'cutoff', surface%cutoff)
+         call file%write_attribute_real('/surface', 'cutoff', surface%cutoff, 'angstrom')
       end if
+      copy = config
+      call write_parameter_attributes(file, '/afm', copy, [character(len=8) :: 'surface', 'tip', 'scan'])
       call write_trips('/afm/trace', trace)
       if (config%retrace) then
          call write_trips('/afm/retrace', retrace)

@@ -8,7 +8,7 @@ module friction_brake_config
    use friction_brake_params, only: brake_parameters, brake_dimensional, derive_parameters
    use friction_analysis_settings, only: analysis_settings
    use friction_strings, only: rtoa, quoted
-   use friction_parameters, only: parameter_visitor
+   use friction_parameters, only: configurable, parameter_visitor
    use friction_checks, only: config_checker
    use friction_ode_solver, only: step_type_names, step_type_index
    use friction_ode_settings, only: visit_integrator, check_integrator
@@ -38,7 +38,7 @@ module friction_brake_config
       real(wp) :: max_difference = 0.0_wp  !! > 0: a larger difference in x fails the run
    end type brake_check
 
-   type :: brake_config
+   type, extends(configurable) :: brake_config
       character(len=16) :: model = model_switched      !! 'switched' (Fig. 10) or 'regularized' (Eq. 10)
       character(len=16) :: units = 'nondimensional'    !! which parameter set is read
       type(brake_parameters) :: params                 !! Eq. 10 (given, or derived from dimensional)

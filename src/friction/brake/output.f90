@@ -13,6 +13,7 @@ module friction_brake_output
    use friction_brake_simulate, only: brake_comparison
    use friction_brake_diagnostics, only: brake_diagnostics
    use friction_output_h5, only: h5_file
+   use friction_output_parameters, only: write_parameter_attributes
    use friction_output_summary, only: run_summary, write_run_attributes
    implicit none
    private
@@ -48,6 +49,7 @@ contains
       type(brake_diagnostics), intent(in), optional :: diagnostics   !! with &analysis on
       type(h5_file) :: file
       type(error_type), allocatable :: close_error
+      type(brake_config) :: copy
       real(wp) :: f(2)
       integer :: n
       character(len=32) :: codes(size(event_kind_names))
@@ -66,27 +68,33 @@ contains
          ! The parameters of Eq. 10 the run used (derived when units = 'dimensional').
          call file%write_attribute_real('/brake', 'xi', p%xi)
          call file%write_attribute_real('/brake', 'kappa', p%kappa)
-         call file%write_attribute_real('/brake', 'g_prime', p%g_prime)
+         call file%write_attribute_real('/brake', 'g_prime', p%g_prime, 'm')
          call file%write_attribute_real('/brake', 'mu', p%mu)
          call file%write_attribute_real('/brake', 'mu_s', p%mu_s)
-         call file%write_attribute_real('/brake', 'epsilon_prime', p%epsilon_prime)
-         call file%write_attribute_real('/brake', 'delta_prime', p%delta_prime)
-         call file%write_attribute_real('/brake', 'v_dr_prime', p%v_dr)
+         call file%write_attribute_real('/brake', 'epsilon_prime', p%epsilon_prime, 'tau/m')
+         call file%write_attribute_real('/brake', 'delta_prime', p%delta_prime, 'tau/m')
+         call file%write_attribute_real('/brake', 'v_dr_prime', p%v_dr, 'm/tau')
          f = p%natural_frequencies()
-         call file%write_attribute_real('/brake', 'natural_frequency_1', f(1))
-         call file%write_attribute_real('/brake', 'natural_frequency_2', f(2))
+         call file%write_attribute_real('/brake', 'natural_frequency_1', f(1), '1/tau')
+         call file%write_attribute_real('/brake', 'natural_frequency_2', f(2), '1/tau')
       end associate
       if (trim(config%units) == 'dimensional') &
-         & call file%write_attribute_real('/brake', 'time_scale', time_scale(config%dimensional))
-      call file%write_attribute_real('/brake', 't_start', config%t_start)
-      call file%write_attribute_real('/brake', 't_end', config%t_end)
-      call file%write_attribute_real('/brake', 'dt_out', config%dt_out)
-      call file%write_attribute_real('/brake', 'event_tolerance', config%event_tolerance)
-      call file%write_attribute_real('/brake', 'stick_velocity', config%stick_velocity)
-      call file%write_attribute_real('/brake', 'compute_time', summary%compute_time)
-      call file%write_attribute_real('/brake', 'stick_time', summary%stick_time)
+         & call file%write_attribute_real('/brake', 'time_scale', time_scale(config%dimensional), 's')
+      call file%write_attribute_real('/brake', 't_start', config%t_start, 'tau')
+      call file%write_attribute_real('/brake', 't_end', config%t_end, 'tau')
+      call file%write_attribute_real('/brake', 'dt_out', config%dt_out, 'tau')
+      call file%write_attribute_real('/brake', 'event_tolerance', config%event_tolerance, 'tau')
+      call file%write_attribute_real('/brake', 'stick_velocity', config%stick_velocity, 'm/tau')
+      call file%write_attribute_real('/brake', 'compute_time', summary%compute_time, 's')
+      call file%write_attribute_real('/brake', 'stick_time', summary%stick_time, 'tau')
       call file%write_attribute_real('/brake', 'rtol', config%solver%rtol)
       call file%write_attribute_real('/brake', 'atol', config%solver%atol)
+      copy = config
+      if (trim(config%units) == 'dimensional') then
+         call write_parameter_attributes(file, '/brake', copy, [character(len=17) :: 'brake', 'brake_dimensional'])
+      else
+         call write_parameter_attributes(file, '/brake', copy, [character(len=17) :: 'brake'])
+      end if
 
       call file%write_vector('/brake/t', trajectory%t, '1')
       call file%write_vector('/brake/x', trajectory%x, 'm')
@@ -115,19 +123,19 @@ contains
             call file%write_attribute_text('/brake/verify', 'method', trim(c%solver%method))
             call file%write_attribute_real('/brake/verify', 'rtol', c%solver%rtol)
             call file%write_attribute_real('/brake/verify', 'atol', c%solver%atol)
-            call file%write_attribute_real('/brake/verify', 'event_tolerance', c%event_tolerance)
-            call file%write_attribute_real('/brake/verify', 'max_difference_x', d%max_difference(1))
-            call file%write_attribute_real('/brake/verify', 'max_difference_v', d%max_difference(2))
-            call file%write_attribute_real('/brake/verify', 'max_difference_y', d%max_difference(3))
-            call file%write_attribute_real('/brake/verify', 'max_difference_w', d%max_difference(4))
-            call file%write_attribute_real('/brake/verify', 'end_difference_x', d%end_difference(1))
+            call file%write_attribute_real('/brake/verify', 'event_tolerance', c%event_tolerance, 'tau')
+            call file%write_attribute_real('/brake/verify', 'max_difference_x', d%max_difference(1), 'm')
+            call file%write_attribute_real('/brake/verify', 'max_difference_v', d%max_difference(2), 'm/tau')
+            call file%write_attribute_real('/brake/verify', 'max_difference_y', d%max_difference(3), 'm')
+            call file%write_attribute_real('/brake/verify', 'max_difference_w', d%max_difference(4), 'm/tau')
+            call file%write_attribute_real('/brake/verify', 'end_difference_x', d%end_difference(1), 'm')
             call file%write_attribute_integer('/brake/verify', 'events', int(d%events, i8))
             call file%write_attribute_integer('/brake/verify', 'check_events', int(d%check_events, i8))
             ! Events pair up in order only when both runs have as many.
             if (d%events == d%check_events) call file%write_attribute_real('/brake/verify', &
                & 'max_event_time_difference', d%max_event_time_difference)
             call file%write_attribute_integer('/brake/verify', 'rhs_evaluations', check%stats%rhs_evaluations)
-            call file%write_attribute_real('/brake/verify', 'compute_time', check%compute_time)
+            call file%write_attribute_real('/brake/verify', 'compute_time', check%compute_time, 's')
          end associate
       end if
       if (present(diagnostics)) call write_diagnostics(file, diagnostics)
@@ -174,20 +182,20 @@ contains
             call file%write_attribute_integer('/brake/spectrum', 'welch_segments', int(a%welch_segments, i8))
             call file%write_attribute_integer('/brake/spectrum', 'segment_length', &
                & int(d%spectrum%segment_length, i8))
-            call file%write_attribute_real('/brake/spectrum', 'window_start', a%window_start)
-            call file%write_attribute_real('/brake/spectrum', 'window_end', a%window_end)
-            call file%write_attribute_real('/brake/spectrum', 'peak_frequency', d%spectrum%peak_frequency)
+            call file%write_attribute_real('/brake/spectrum', 'window_start', a%window_start, 'tau')
+            call file%write_attribute_real('/brake/spectrum', 'window_end', a%window_end, 'tau')
+            call file%write_attribute_real('/brake/spectrum', 'peak_frequency', d%spectrum%peak_frequency, '1/tau')
             call file%write_attribute_real('/brake/spectrum', 'peak_amplitude', d%spectrum%peak_amplitude)
-            call file%write_attribute_real('/brake/spectrum', 'resolution', d%spectrum%resolution)
+            call file%write_attribute_real('/brake/spectrum', 'resolution', d%spectrum%resolution, '1/tau')
             call file%write_vector('/brake/spectrum/frequency', d%spectrum%frequency, frequency_unit)
             k = findloc(names, trim(a%series), 1)
             call file%write_vector('/brake/spectrum/amplitude', d%spectrum%amplitude, trim(units(max(k, 1))))
          end if
          if (a%poincare) then
             call file%create_group('/brake/poincare')
-            call file%write_attribute_real('/brake/poincare', 'strobe_period', d%strobe_period)
-            call file%write_attribute_real('/brake/poincare', 'strobe_start', a%strobe_start)
-            call file%write_attribute_real('/brake/poincare', 'strobe_end', a%strobe_end)
+            call file%write_attribute_real('/brake/poincare', 'strobe_period', d%strobe_period, 'tau')
+            call file%write_attribute_real('/brake/poincare', 'strobe_start', a%strobe_start, 'tau')
+            call file%write_attribute_real('/brake/poincare', 'strobe_end', a%strobe_end, 'tau')
             call file%write_attribute_text('/brake/poincare', 'section', trim(a%section))
             call file%write_vector('/brake/poincare/strobe_t', d%strobe_t, '1')
             call file%write_vector('/brake/poincare/section_t', d%section_t, '1')
@@ -198,16 +206,16 @@ contains
          end if
          if (a%lyapunov .or. a%rosenstein) call file%create_group('/brake/lyapunov')
          if (a%lyapunov) then
-            call file%write_attribute_real('/brake/lyapunov', 'benettin_exponent', d%flow%current())
-            call file%write_attribute_real('/brake/lyapunov', 'benettin_transient', d%benettin%transient)
-            call file%write_attribute_real('/brake/lyapunov', 'benettin_duration', d%benettin%duration)
-            call file%write_attribute_real('/brake/lyapunov', 'benettin_renormalise', d%benettin%renormalise)
+            call file%write_attribute_real('/brake/lyapunov', 'benettin_exponent', d%flow%current(), '1/tau')
+            call file%write_attribute_real('/brake/lyapunov', 'benettin_transient', d%benettin%transient, 'tau')
+            call file%write_attribute_real('/brake/lyapunov', 'benettin_duration', d%benettin%duration, 'tau')
+            call file%write_attribute_real('/brake/lyapunov', 'benettin_renormalise', d%benettin%renormalise, 'tau')
             call file%write_attribute_real('/brake/lyapunov', 'benettin_d0', d%benettin%d0)
             call file%write_vector('/brake/lyapunov/benettin_time', d%flow%time(1:d%flow%n), '1')
             call file%write_vector('/brake/lyapunov/benettin_estimate', d%flow%estimate(1:d%flow%n), '1/tau')
          end if
          if (a%rosenstein) then
-            call file%write_attribute_real('/brake/lyapunov', 'rosenstein_exponent', d%series%exponent)
+            call file%write_attribute_real('/brake/lyapunov', 'rosenstein_exponent', d%series%exponent, '1/tau')
             ! OpenTSTool's largelyap unit: log2 per sample of the series.
             call file%write_attribute_real('/brake/lyapunov', 'rosenstein_log2_per_sample', &
                & d%series%exponent * d%series_dt / log(2.0_wp))

@@ -76,8 +76,11 @@ contains
 
       mine = list_parameters(target)
       do f = 1, size(sources)
+         ! Relative file names in a file are relative to its directory, made
+         ! absolute so that the echoed input reads back from anywhere.
          slash = index(sources(f)%path, '/', back=.true.)
          base = sources(f)%path(1:slash)
+         if (sources(f)%path(1:1) /= '/') base = working_directory()//base
          ! Names and kinds first, for the whole file: nothing is set from a file
          ! with a bad assignment.
          do k = 1, size(sources(f)%mentions)
@@ -126,6 +129,17 @@ contains
       end function find
 
    end subroutine apply_files
+
+   !> The working directory with a trailing '/' ('' if unknown).
+   function working_directory() result(path)
+      character(len=:), allocatable :: path
+      character(len=4096) :: buffer
+      integer :: stat
+
+      call getcwd(buffer, stat)
+      path = ''
+      if (stat == 0) path = trim(buffer)//'/'
+   end function working_directory
 
    !> A value's text on one line, for messages.
    pure function one_line(text) result(out)

@@ -24,7 +24,7 @@ module friction_job_sweep
    use friction_strings, only: itoa
    use friction_version, only: version_string
    use friction_ode_solver, only: integrator_statistics
-   use friction_parameters, only: set_parameter_number, split_name
+   use friction_parameters, only: set_parameter_number, split_name, parameter_info, list_parameters
    use friction_checks, only: config_checker
    use friction_scene, only: scene, point_result
    use friction_job_config, only: job_config
@@ -319,7 +319,7 @@ contains
       logical, intent(in) :: interrupted
       type(error_type), allocatable, intent(out) :: error
       type(h5_file) :: file
-      character(len=:), allocatable :: text
+      character(len=:), allocatable :: text, name
       integer :: i, k
 
       text = ''
@@ -338,9 +338,12 @@ contains
       call file%create_group('/sweep')
       call file%write_attribute_integer('/sweep', 'shape', int(config%sweep%shape(1), i8))
       call file%write_attribute_integer('/sweep', 'shape2', int(config%sweep%shape(2), i8))
-      call file%write_vector('/sweep/values', config%sweep%values(1, :), trim(config%sweep%variables(1)))
-      if (config%sweep%n_variables == 2) call file%write_vector('/sweep/values2', config%sweep%values(2, :), &
-         & trim(config%sweep%variables(2)))
+      do k = 1, config%sweep%n_variables
+         name = '/sweep/values'
+         if (k == 2) name = '/sweep/values2'
+         call file%write_vector(name, config%sweep%values(k, :), variable_unit(k))
+         call file%write_attribute_text(name, 'variable', trim(config%sweep%variables(k)))
+      end do
       do k = 1, size(names)
          if (names(k)%whole) then
             call file%write_integer_vector('/sweep/'//trim(names(k)%name), nint(results(k, :)))
@@ -362,6 +365,28 @@ contains
       call file%write_attribute_text('/sweep/peak_memory_per_rank', 'units', 'kB (VmHWM; 0: unknown)')
       call file%write_attribute_integer('/sweep', 'complete', int(merge(0, 1, interrupted), i8))
       call file%close(error)
+
+   contains
+
+      !> The unit of swept variable k, as its configuration declares it.
+      function variable_unit(k) result(unit)
+         integer, intent(in) :: k
+         character(len=:), allocatable :: unit
+         type(parameter_info), allocatable :: list(:)
+         character(len=:), allocatable :: group, variable
+         class(scene), allocatable :: copy
+         integer :: m
+
+         unit = '1'
+         allocate (copy, source=config%scene)
+         list = list_parameters(copy)
+         call split_name(config%sweep%variables(k), group, variable)
+         do m = 1, size(list)
+            if (list(m)%group == group .and. list(m)%name == variable .and. len_trim(list(m)%unit) > 0) &
+               & unit = trim(list(m)%unit)
+         end do
+      end function variable_unit
+
    end subroutine write_sweep_file
 
    !> A finished point's results, written under a temporary name and renamed,

@@ -34,6 +34,7 @@ module friction_output_h5
       procedure :: write_attribute_text
       procedure :: write_attribute_real
       procedure :: write_attribute_integer
+      procedure :: has_attribute
       procedure :: close
       procedure, private :: check
    end type h5_file
@@ -269,21 +270,39 @@ contains
       call h5sclose_f(space, stat)
    end subroutine attribute_text
 
-   subroutine write_attribute_real(self, object, name, value)
+   !> A real attribute; with `units`, its unit goes beside it as the text
+   !> attribute NAME_units (attributes cannot carry attributes).
+   subroutine write_attribute_real(self, object, name, value, units)
       class(h5_file), intent(inout) :: self
       character(len=*), intent(in) :: object, name
       real(wp), intent(in), target :: value
+      character(len=*), intent(in), optional :: units
 
       call scalar_attribute(self, object, name, H5T_NATIVE_DOUBLE, c_loc(value))
+      if (present(units)) call self%write_attribute_text(object, name//'_units', units)
    end subroutine write_attribute_real
 
-   subroutine write_attribute_integer(self, object, name, value)
+   subroutine write_attribute_integer(self, object, name, value, units)
       class(h5_file), intent(inout) :: self
       character(len=*), intent(in) :: object, name
       integer(i8), intent(in), target :: value
+      character(len=*), intent(in), optional :: units
 
       call scalar_attribute(self, object, name, h5kind_to_type(int64, H5_INTEGER_KIND), c_loc(value))
+      if (present(units)) call self%write_attribute_text(object, name//'_units', units)
    end subroutine write_attribute_integer
+
+   !> Whether the object at path object has an attribute of that name.
+   logical function has_attribute(self, object, name)
+      class(h5_file), intent(inout) :: self
+      character(len=*), intent(in) :: object, name
+      integer :: stat
+
+      has_attribute = .false.
+      if (self%status /= 0) return
+      call h5aexists_by_name_f(self%id, object, name, has_attribute, stat)
+      call self%check(stat, 'looking for attribute '//name)
+   end function has_attribute
 
    !> A scalar numeric attribute of HDF5 type `type` read from `value`.
    subroutine scalar_attribute(self, object, name, type, value)

@@ -1,9 +1,12 @@
 !> What every output file records about its run, at the root: program,
-!> version, scene, the resolved input, ranks, wall time and integrator cost.
+!> version, source revision, creation time (UTC), scene, the resolved input,
+!> ranks, wall time and integrator cost.
 module friction_output_summary
    use friction_kinds, only: wp, i8
    use friction_ode_solver, only: integrator_statistics
    use friction_output_h5, only: h5_file
+   use friction_version, only: revision_string
+   use friction_clock, only: utc_now
    implicit none
    private
 
@@ -30,7 +33,9 @@ contains
       call file%write_attribute_text('/', 'scene', scene)
       call file%write_attribute_text('/', 'input', summary%input_text)
       call file%write_attribute_integer('/', 'nranks', int(summary%nranks, i8))
-      call file%write_attribute_real('/', 'wall_time', summary%wall_time)
+      call file%write_attribute_real('/', 'wall_time', summary%wall_time, 's')
+      call file%write_attribute_text('/', 'created', utc_now())
+      call file%write_attribute_text('/', 'revision', revision_string)
       call file%write_attribute_text('/', 'method', method)
       call file%write_attribute_integer('/', 'integrator_steps', summary%stats%steps)
       call file%write_attribute_integer('/', 'integrator_rejected_steps', summary%stats%failed_steps)

@@ -1,0 +1,44 @@
+!> The physical parameters of a run as attributes with units on its scene's
+!> group, so scripts read `kx` and `kx_units` instead of parsing the echoed
+!> namelist: every real scalar variable of the given namelist groups that
+!> declares a unit (core/parameters.f90).  An attribute the scene's writer
+!> already wrote keeps its value and gets its unit beside it.
+module friction_output_parameters
+   use friction_kinds, only: wp
+   use friction_parameters, only: configurable, parameter_info, list_parameters, get_parameter
+   use friction_output_h5, only: h5_file
+   implicit none
+   private
+
+   public :: write_parameter_attributes
+
+contains
+
+   subroutine write_parameter_attributes(file, object, config, groups)
+      type(h5_file), intent(inout) :: file
+      character(len=*), intent(in) :: object
+      class(configurable), intent(inout) :: config
+      character(len=*), intent(in) :: groups(:)
+      type(parameter_info), allocatable :: list(:)
+      character(len=:), allocatable :: text
+      real(wp) :: value
+      integer :: k, stat
+      logical :: found
+
+      list = list_parameters(config)
+      do k = 1, size(list)
+         associate (p => list(k))
+            if (.not. any(groups == p%group) .or. p%kind /= 'r' .or. p%size /= 1 .or. len_trim(p%unit) == 0) cycle
+            if (file%has_attribute(object, trim(p%name))) then
+               if (.not. file%has_attribute(object, trim(p%name)//'_units')) &
+                  & call file%write_attribute_text(object, trim(p%name)//'_units', trim(p%unit))
+               cycle
+            end if
+            call get_parameter(config, trim(p%group), trim(p%name), text, found)
+            read (text, *, iostat=stat) value
+            if (found .and. stat == 0) call file%write_attribute_real(object, trim(p%name), value, trim(p%unit))
+         end associate
+      end do
+   end subroutine write_parameter_attributes
+
+end module friction_output_parameters
