@@ -2,11 +2,11 @@
 !> the C library, so output appears under its final name only when complete.
 module friction_files
    use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char
-   use friction_error, only: error_type, fatal_error, error_io
+   use friction_error, only: error_type, fatal_error, error_io, error_input
    implicit none
    private
 
-   public :: rename_file, remove_file, file_exists, process_id, write_text_file
+   public :: rename_file, remove_file, file_exists, process_id, write_text_file, open_for_reading
 
    interface
       function c_rename(from, to) result(stat) bind(c, name='rename')
@@ -29,6 +29,26 @@ module friction_files
    end interface
 
 contains
+
+   !> Open an existing file to read: a missing file is bad input, one that
+   !> cannot be opened an error of `category` (bad input by default).
+   subroutine open_for_reading(path, unit, error, category)
+      character(len=*), intent(in) :: path
+      integer, intent(out) :: unit
+      type(error_type), allocatable, intent(out) :: error
+      integer, intent(in), optional :: category
+      integer :: stat
+
+      if (.not. file_exists(path)) then
+         call fatal_error(error, path//': no such file', error_input)
+         return
+      end if
+      open (newunit=unit, file=path, status='old', action='read', iostat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, path//': cannot open the file', error_input)
+         if (present(category)) error%stat = category
+      end if
+   end subroutine open_for_reading
 
    logical function file_exists(path)
       character(len=*), intent(in) :: path

@@ -6,6 +6,7 @@
 module friction_input_scan
    use friction_strings, only: join, lower, itoa
    use friction_error, only: error_type, fatal_error, error_input
+   use friction_files, only: open_for_reading
    implicit none
    private
 
@@ -172,18 +173,9 @@ contains
       character(len=4096) :: buffer
       character :: quote
       integer :: unit, stat, line, i, n
-      logical :: exists
 
-      inquire (file=path, exist=exists)
-      if (.not. exists) then
-         call fatal_error(error, path//': no such file', error_input)
-         return
-      end if
-      open (newunit=unit, file=path, status='old', action='read', iostat=stat)
-      if (stat /= 0) then
-         call fatal_error(error, path//': cannot open the file', error_input)
-         return
-      end if
+      call open_for_reading(path, unit, error)
+      if (allocated(error)) return
       text = ''
       allocate (line_of(0))
       line = 0

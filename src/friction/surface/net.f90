@@ -11,6 +11,7 @@ module friction_surface_net
    use friction_kinds, only: wp
    use friction_error, only: error_type, fatal_error, error_input, error_io
    use friction_strings, only: itoa, join
+   use friction_files, only: open_for_reading
    implicit none
    private
 
@@ -147,18 +148,9 @@ contains
       integer, allocatable :: species(:)
       logical, allocatable :: vacant(:)
       integer :: unit, stat, n, i, k
-      logical :: exists
 
-      inquire (file=path, exist=exists)
-      if (.not. exists) then
-         call fatal_error(error, path//': no such file', error_input)
-         return
-      end if
-      open (newunit=unit, file=path, status='old', action='read', iostat=stat)
-      if (stat /= 0) then
-         call fatal_error(error, path//': cannot open the file', error_io)
-         return
-      end if
+      call open_for_reading(path, unit, error, error_io)
+      if (allocated(error)) return
       read (unit, '(a)', iostat=stat) line
       if (stat == 0) read (line, *, iostat=stat) n
       if (stat /= 0 .or. n < 1) then

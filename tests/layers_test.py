@@ -1,0 +1,67 @@
+#!/usr/bin/env python3
+"""The library's layers (docs/layout.md) hold: a module may use only modules
+of the layers below its own, so no folder depends on one above it or beside
+it, and there is no cycle.  Reads the `use friction_*` statements of src/
+and app/.
+
+    tests/layers_test.py SOURCE_ROOT
+"""
+import os
+import re
+import sys
+
+# Lowest first; folders on one line are beside each other and may not use
+# one another.
+LAYERS = [
+    ["core"],
+    ["ode", "surface"],
+    ["analysis"],
+    ["input", "output", "netlist"],
+    ["scene"],
+    ["afm", "brake"],
+    ["job"],
+    ["capi", "."],          # "." is the umbrella module src/friction/friction.f90
+    ["app"],
+]
+RANK = {folder: rank for rank, folders in enumerate(LAYERS) for folder in folders}
+
+
+def fortran_files(top):
+    for root, _, files in os.walk(top):
+        for name in files:
+            if name.endswith((".f90", ".f90.in")):
+                yield os.path.join(root, name)
+
+
+def main():
+    root = sys.argv[1]
+    sources = list(fortran_files(os.path.join(root, "src", "friction"))) + \
+        list(fortran_files(os.path.join(root, "app")))
+    folder_of = {}
+    for path in sources:
+        folder = os.path.relpath(os.path.dirname(path), os.path.join(root, "src", "friction"))
+        if folder.startswith(".."):
+            folder = "app"
+        if folder not in RANK:
+            print(f"FAILED: {path}: folder {folder!r} is in no layer (add it to docs/layout.md and this test)")
+            sys.exit(1)
+        for module in re.findall(r"^\s*module\s+(\w+)\s*$", open(path).read(), re.M | re.I):
+            folder_of[module.lower()] = folder
+    problems = []
+    for path in sources:
+        folder = os.path.relpath(os.path.dirname(path), os.path.join(root, "src", "friction"))
+        folder = "app" if folder.startswith("..") else folder
+        for line, used in re.findall(r"^(\s*use\s+(friction\w*))", open(path).read(), re.M | re.I):
+            target = folder_of.get(used.lower())
+            if target is None or target == folder:
+                continue
+            if RANK[target] >= RANK[folder]:
+                problems.append(f"{os.path.relpath(path, root)}: {folder}/ uses {used} of {target}/")
+    if problems:
+        print("FAILED: layer violations:\n  " + "\n  ".join(problems))
+        sys.exit(1)
+    print(f"{len(sources)} files, {len(folder_of)} modules: every use goes down the layers")
+
+
+if __name__ == "__main__":
+    main()
