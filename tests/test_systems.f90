@@ -1,6 +1,7 @@
 !> ODE systems with known answers, shared by the test suites: an oscillator
 !> (exact solution, zero exponent, an event function for sections), an
-!> exponential decay that can turn NaN, and Lorenz (exponent 0.906).
+!> exponential decay that can turn NaN, and Lorenz (exponent 0.906); and the
+!> step types the suites have a case for.
 module test_systems
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
    use friction_kinds, only: wp
@@ -8,7 +9,15 @@ module test_systems
    use friction_ode_events, only: event_system
    implicit none
    private
-   public :: lorenz, oscillator, decay
+   public :: lorenz, oscillator, decay, step_types_with_cases
+
+   !> The GSL step types that test_steppers.pf and test_events.pf have cases
+   !> for, one each (and so one CTest test each).  Their guard cases require
+   !> the library's step_type_names to be this list, so that a new step type
+   !> cannot go untested.
+   character(len=*), parameter :: step_types_with_cases(*) = [character(len=7) :: &
+      & 'rk2', 'rk4', 'rkf45', 'rkck', 'rk8pd', 'rk1imp', 'rk2imp', 'rk4imp', 'bsimp', &
+      & 'msadams', 'msbdf']
 
    !> Lorenz (σ, ρ, β) = (10, 28, 8/3): maximum exponent 0.906.
    type, extends(ode_system) :: lorenz
