@@ -70,10 +70,12 @@ program test_events
 
    type(test_suite) :: suite
    integer :: m
+   character(len=:), allocatable :: names(:)
 
    suite%name = 'events'
-   do m = 1, size(step_type_names)
-      call suite%add('crossings_'//trim(step_type_names(m)), crossings_case)
+   names = step_type_names()
+   do m = 1, size(names)
+      call suite%add('crossings_'//trim(names(m)), crossings_case)
    end do
    call suite%add('terminal_stops_at_the_event', terminal_stops_at_the_event)
    call suite%add('time_error_within_tolerance', time_error_within_tolerance)

@@ -11,11 +11,13 @@ program test_steppers
 
    type(test_suite) :: suite
    integer :: m
+   character(len=:), allocatable :: names(:)
 
    suite%name = 'steppers'
-   do m = 1, size(step_type_names)
-      call suite%add('oscillator_'//trim(step_type_names(m)), oscillator_case)
-      call suite%add('decay_'//trim(step_type_names(m)), decay_case)
+   names = step_type_names()
+   do m = 1, size(names)
+      call suite%add('oscillator_'//trim(names(m)), oscillator_case)
+      call suite%add('decay_'//trim(names(m)), decay_case)
    end do
    call suite%add('max_steps_reported', max_steps_reported)
    call suite%add('nan_reported', nan_reported)
@@ -160,10 +162,12 @@ contains
       type(error_type), allocatable :: error
       real(wp) :: t, y(1)
       integer :: m
+      character(len=:), allocatable :: methods(:)
 
       system%t_bad = 0.5_wp
-      do m = 1, size(step_type_names)
-         settings%method = step_type_names(m)
+      methods = step_type_names()
+      do m = 1, size(methods)
+         settings%method = methods(m)
          call solver%init(system, settings, 1.0e-3_wp, error)
          t = 0.0_wp
          y = 1.0_wp

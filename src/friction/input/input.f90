@@ -597,7 +597,7 @@ contains
          if (nx < 2) call reject('scan', 'nx', itoa(nx), 'must be >= 2 (sample points per line)')
          if (ny < 1) call reject('scan', 'ny', itoa(ny), 'must be >= 1 (lines)')
          if (method /= auto_name .and. step_type_index(method) == 0) call reject('integrator', 'method', &
-            & "'"//trim(method)//"'", 'unknown GSL step type (known: '//quoted(step_type_names)//', or '// &
+            & "'"//trim(method)//"'", 'unknown GSL step type (known: '//quoted(step_type_names())//', or '// &
             & quoted([auto_name])//' to choose by scene and rtol)')
          call require_positive('integrator', 'rtol', rtol, 'relative tolerance')
          call require_positive('integrator', 'atol', atol, 'absolute tolerance, Å and Å/s')
@@ -848,7 +848,7 @@ contains
          end associate
          if (len_trim(check_method) > 0 .and. step_type_index(check_method) == 0) &
             & call reject('verify', 'check_method', "'"//trim(check_method)//"'", &
-            & "unknown GSL step type (known: ''"//', '//quoted(step_type_names)//')')
+            & "unknown GSL step type (known: ''"//', '//quoted(step_type_names())//')')
          call require_nonnegative('verify', 'check_rtol', check_rtol, '0 for rtol / 1000')
          call require_nonnegative('verify', 'check_atol', check_atol, '0 for atol / 1000')
          call require_nonnegative('verify', 'check_limit', check_limit, 'm; 0 reports only')
