@@ -201,7 +201,7 @@ contains
       end associate
       if (len_trim(self%check%method) > 0 .and. step_type_index(self%check%method) == 0) &
          & call c%reject('verify', 'check_method', "'"//trim(self%check%method)//"'", &
-         & "unknown GSL step type (known: ''"//', '//quoted(step_type_names)//')')
+         & "unknown GSL step type (known: ''"//', '//quoted(step_type_names())//')')
       call c%nonnegative('verify', 'check_rtol', self%check%rtol, '0 for rtol / 1000')
       call c%nonnegative('verify', 'check_atol', self%check%atol, '0 for atol / 1000')
       call c%nonnegative('verify', 'check_limit', self%check%max_difference, 'm; 0 reports only')

@@ -178,7 +178,7 @@ contains
       if (present(time_unit)) self%time_unit = time_unit
       self%h_first = h_first
       if (settings%h_start > 0.0_wp) self%h_first = settings%h_start
-      ! GSL refuses an h_min above the current step (and would ignore it).
+      ! GSL refuses an h_min above the current step (the solver reports that).
       self%h_first = max(self%h_first, settings%h_min)
       if (.not. (self%h_first > 0.0_wp)) then
          call fatal_error(error, 'event locator: the first step must be > 0', error_internal)

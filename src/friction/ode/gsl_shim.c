@@ -1,56 +1,253 @@
-/* The few things of GSL odeiv2 that Fortran cannot reach directly.
+/* Every call of the library into GSL odeiv2 goes through here.
  *
- * GSL exposes its step types as global pointer variables; gfortran cannot
- * import those through bind(c) (it defines a zero copy of its own), so they
- * are handed out here by index.  The driver's counters live in structs whose
- * layout Fortran should not mirror, so they are read here too. */
+ * 1. The table of step types (names, GSL types, whether they use the
+ *    Jacobian): the only list of them.  Fortran reads it through
+ *    friction_gsl_step_type_count / _name / _index / _uses_jacobian;
+ *    include/friction.h documents the same names (a test compares).
+ *    GSL exposes its step types as global pointer variables, which
+ *    gfortran cannot import through bind(c) (it defines a zero copy of its
+ *    own), so the table holds their addresses.
+ * 2. GSL's error handler: a process-wide variable that belongs to the
+ *    program.  The library neither leaves it changed nor lets GSL abort
+ *    (the default handler) or call the program's handler for an error of
+ *    the library's own calls: see quiet_begin / quiet_end below.
+ * 3. The driver's counters live in structs whose layout Fortran should not
+ *    mirror, so they are read here too.
+ *
+ * Every function that calls GSL returns a GSL status, never GSL_SUCCESS when
+ * GSL reported an error, even where GSL itself returns 0 after reporting
+ * one (its GSL_ERROR_NULL in an int function: set_hmin, reset_hstart,
+ * driver_apply).  friction_gsl_error_reason gives GSL's own words for the
+ * last such error of the calling thread. */
 #include <math.h>
+#include <pthread.h>
 #include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_odeiv2.h>
 
-/* Keep this order in step with step_type_names in solver.f90. */
-const gsl_odeiv2_step_type *friction_gsl_step_type(int index)
+/* ---- the step types ---- */
+
+static const struct step_type_entry {
+    const char *name;                          /* as the input and the C API spell it */
+    const gsl_odeiv2_step_type *const *type;   /* GSL's global pointer to the type */
+    int uses_jacobian;                         /* implicit and BDF methods */
+} step_types[] = {
+    {"rk2", &gsl_odeiv2_step_rk2, 0},
+    {"rk4", &gsl_odeiv2_step_rk4, 0},
+    {"rkf45", &gsl_odeiv2_step_rkf45, 0},
+    {"rkck", &gsl_odeiv2_step_rkck, 0},
+    {"rk8pd", &gsl_odeiv2_step_rk8pd, 0},
+    {"rk1imp", &gsl_odeiv2_step_rk1imp, 1},
+    {"rk2imp", &gsl_odeiv2_step_rk2imp, 1},
+    {"rk4imp", &gsl_odeiv2_step_rk4imp, 1},
+    {"bsimp", &gsl_odeiv2_step_bsimp, 1},
+    {"msadams", &gsl_odeiv2_step_msadams, 0},
+    {"msbdf", &gsl_odeiv2_step_msbdf, 1},
+};
+enum { step_type_count = (int)(sizeof step_types / sizeof step_types[0]) };
+
+/* Number of step types; they are numbered 1..count. */
+int friction_gsl_step_type_count(void)
 {
-    switch (index) {
-    case 1: return gsl_odeiv2_step_rk2;
-    case 2: return gsl_odeiv2_step_rk4;
-    case 3: return gsl_odeiv2_step_rkf45;
-    case 4: return gsl_odeiv2_step_rkck;
-    case 5: return gsl_odeiv2_step_rk8pd;
-    case 6: return gsl_odeiv2_step_rk1imp;
-    case 7: return gsl_odeiv2_step_rk2imp;
-    case 8: return gsl_odeiv2_step_rk4imp;
-    case 9: return gsl_odeiv2_step_bsimp;
-    case 10: return gsl_odeiv2_step_msadams;
-    case 11: return gsl_odeiv2_step_msbdf;
-    default: return NULL;
+    return step_type_count;
+}
+
+/* Name of step type index (1-based), NUL-terminated; NULL outside 1..count. */
+const char *friction_gsl_step_type_name(int index)
+{
+    if (index < 1 || index > step_type_count) return NULL;
+    return step_types[index - 1].name;
+}
+
+/* The same for Fortran: copies at most len characters of the name (no NUL)
+ * into buffer, leaving the rest of it alone; nothing outside 1..count. */
+void friction_gsl_step_type_name_copy(int index, char *buffer, size_t len)
+{
+    const char *name = friction_gsl_step_type_name(index);
+    size_t n;
+    if (name == NULL) return;
+    n = strlen(name);
+    memcpy(buffer, name, n < len ? n : len);
+}
+
+/* Index (1-based) of the step type called name[0..len-1] (exact, case
+ * sensitive); 0 if there is none. */
+int friction_gsl_step_type_index(const char *name, size_t len)
+{
+    int i;
+    if (name == NULL) return 0;
+    for (i = 0; i < step_type_count; i++)
+        if (strlen(step_types[i].name) == len && memcmp(step_types[i].name, name, len) == 0)
+            return i + 1;
+    return 0;
+}
+
+/* 1 if step type index uses the Jacobian, 0 if not or unknown. */
+int friction_gsl_step_type_uses_jacobian(int index)
+{
+    if (index < 1 || index > step_type_count) return 0;
+    return step_types[index - 1].uses_jacobian;
+}
+
+/* ---- GSL's error handler, per call ----
+ *
+ * For the duration of each call into GSL the library installs its own
+ * handler, `record`, which keeps the first error of the calling thread's
+ * call (a thread-local slot) instead of aborting; afterwards the handler
+ * that was in place before is put back.  The handler is one process-wide
+ * variable while the C API lets threads call the library at once, so a
+ * plain save/set/restore per call would race: thread A saves the
+ * program's handler and installs `record`, thread B then saves `record`
+ * as "the caller's", A restores the program's, B restores `record` -- and
+ * the process is left with the library's handler.  Hence a count of the
+ * calls in progress under a mutex: the first call to begin saves the
+ * program's handler and installs `record`, later ones only count, and the
+ * last to end restores the saved handler.  While any library call is in
+ * progress the variable is not written at all, so GSL, reading it from
+ * several library threads, always finds `record`.
+ *
+ * Other threads of the program may use GSL while a library call is in
+ * progress and then meet `record` too: an error there (no library call in
+ * progress on that thread) is passed on to the program's saved handler,
+ * or to GSL's default behaviour (report and abort) when it had none, as if
+ * the library were not there.  If the program installs a handler of its
+ * own while a library call is in progress, that one stays when the last
+ * call ends.  (Only GSL's reading of its variable while a program thread
+ * writes it cannot be guarded from here.) */
+
+static pthread_mutex_t quiet_lock = PTHREAD_MUTEX_INITIALIZER;
+static int quiet_calls = 0;                        /* library calls in progress, all threads */
+static gsl_error_handler_t *program_handler = NULL; /* in place before the first of them */
+
+static _Thread_local int quiet_depth = 0;          /* this thread is in a library call */
+static _Thread_local int recorded_errno = 0;       /* first GSL error of this thread's call */
+static _Thread_local const char *recorded_reason = NULL;
+
+static void record(const char *reason, const char *file, int line, int gsl_errno)
+{
+    gsl_error_handler_t *handler;
+
+    if (quiet_depth > 0) {
+        if (recorded_errno == 0) {
+            recorded_errno = gsl_errno != GSL_SUCCESS ? gsl_errno : GSL_FAILURE;
+            recorded_reason = reason;
+        }
+        return;
     }
+    /* Not ours: the program's own GSL call on another thread. */
+    pthread_mutex_lock(&quiet_lock);
+    handler = program_handler;
+    pthread_mutex_unlock(&quiet_lock);
+    if (handler != NULL) {
+        handler(reason, file, line, gsl_errno);
+        return;
+    }
+    gsl_stream_printf("ERROR", file, line, reason);
+    fflush(stdout);
+    fprintf(stderr, "Default GSL error handler invoked.\n");
+    fflush(stderr);
+    abort();
 }
 
-/* A driver with GSL's abort-on-error handler switched off: every failure
- * then comes back as a status code.  The handler is process-wide; setting it
- * off again is harmless, so every driver does it. */
-gsl_odeiv2_driver *friction_gsl_driver_new(const gsl_odeiv2_system *sys, int index,
-                                           double hstart, double epsabs, double epsrel)
+static void quiet_begin(void)
 {
-    const gsl_odeiv2_step_type *type = friction_gsl_step_type(index);
-    gsl_set_error_handler_off();
-    if (type == NULL) return NULL;
-    return gsl_odeiv2_driver_alloc_y_new(sys, type, hstart, epsabs, epsrel);
+    if (quiet_depth++ == 0) {
+        recorded_errno = 0;
+        recorded_reason = NULL;
+    }
+    pthread_mutex_lock(&quiet_lock);
+    if (quiet_calls++ == 0) program_handler = gsl_set_error_handler(&record);
+    pthread_mutex_unlock(&quiet_lock);
 }
 
-/* Accepted steps and rejected (failed) steps since the last reset. */
-void friction_gsl_driver_counts(const gsl_odeiv2_driver *d, long *steps, long *failed)
+/* Ends a quiet section: status, or the error GSL reported if it returned
+ * success all the same. */
+static int quiet_end(int status)
 {
-    *steps = (long)d->e->count;
-    *failed = (long)d->e->failed_steps;
+    pthread_mutex_lock(&quiet_lock);
+    if (--quiet_calls == 0) {
+        gsl_error_handler_t *current = gsl_set_error_handler(program_handler);
+        if (current != &record) gsl_set_error_handler(current);   /* the program's newer choice */
+        /* program_handler stays: a program thread that read `record` just
+         * before this restore still reaches the program's handler. */
+    }
+    pthread_mutex_unlock(&quiet_lock);
+    quiet_depth--;
+    if (status == GSL_SUCCESS && recorded_errno != 0) status = recorded_errno;
+    return status;
 }
 
-/* The current step size the driver will try next. */
-double friction_gsl_driver_step(const gsl_odeiv2_driver *d)
+/* GSL's words for the error it reported during this thread's last call
+ * into it, or "" if it reported none (a status returned without a report). */
+const char *friction_gsl_error_reason(void)
 {
-    return d->h;
+    return recorded_reason != NULL ? recorded_reason : "";
+}
+
+/* ---- the driver ---- */
+
+/* A driver for system sys with step type index (1-based), first step
+ * hstart (non-zero) and the y_new error control; *driver is NULL
+ * unless GSL_SUCCESS is returned. */
+int friction_gsl_driver_new(gsl_odeiv2_driver **driver, const gsl_odeiv2_system *sys, int index,
+                            double hstart, double epsabs, double epsrel)
+{
+    gsl_odeiv2_driver *d;
+    int status;
+
+    *driver = NULL;
+    if (index < 1 || index > step_type_count) return GSL_EINVAL;
+    /* GSL's own check of hstart (non-zero) comes after its allocations and
+     * leaks them. */
+    if (!(hstart > 0.0 || hstart < 0.0)) return GSL_EINVAL;
+    quiet_begin();
+    d = gsl_odeiv2_driver_alloc_y_new(sys, *step_types[index - 1].type, hstart, epsabs, epsrel);
+    status = quiet_end(GSL_SUCCESS);
+    if (d == NULL) return status != GSL_SUCCESS ? status : GSL_ENOMEM;
+    if (status != GSL_SUCCESS) {
+        quiet_begin();
+        gsl_odeiv2_driver_free(d);
+        quiet_end(GSL_SUCCESS);
+        return status;
+    }
+    *driver = d;
+    return GSL_SUCCESS;
+}
+
+/* The step budget per apply (0: none) and, if hmin > 0, the smallest step.
+ * GSL refuses an hmin above the current step (reporting an error but
+ * returning success): that comes back as GSL_EINVAL. */
+int friction_gsl_driver_set_limits(gsl_odeiv2_driver *d, long nmax, double hmin)
+{
+    int status;
+
+    quiet_begin();
+    status = gsl_odeiv2_driver_set_nmax(d, (unsigned long)nmax);
+    if (status == GSL_SUCCESS && hmin > 0.0) status = gsl_odeiv2_driver_set_hmin(d, hmin);
+    return quiet_end(status);
+}
+
+/* Forget the history (multistep methods) and the counters; the next step
+ * tried is hstart, which GSL requires within [hmin, hmax] and non-zero. */
+int friction_gsl_driver_reset(gsl_odeiv2_driver *d, double hstart)
+{
+    int status;
+
+    quiet_begin();
+    status = gsl_odeiv2_driver_reset(d);
+    /* reset_hstart resets again (harmlessly) but drops that status. */
+    if (status == GSL_SUCCESS) status = gsl_odeiv2_driver_reset_hstart(d, hstart);
+    return quiet_end(status);
+}
+
+/* gsl_odeiv2_driver_apply: from *t to t1. */
+int friction_gsl_driver_apply(gsl_odeiv2_driver *d, double *t, double t1, double y[])
+{
+    quiet_begin();
+    return quiet_end(gsl_odeiv2_driver_apply(d, t, t1, y));
 }
 
 /* One accepted step from *t towards t1 (never past it), with the checks of
@@ -64,9 +261,33 @@ double friction_gsl_driver_step(const gsl_odeiv2_driver *d)
 int friction_gsl_driver_step_once(gsl_odeiv2_driver *d, double *t, double t1, double y[])
 {
     double t0 = *t;
-    int status = gsl_odeiv2_evolve_apply(d->e, d->c, d->s, d->sys, t, t1, &d->h, y);
+    int status;
+
+    quiet_begin();
+    status = quiet_end(gsl_odeiv2_evolve_apply(d->e, d->c, d->s, d->sys, t, t1, &d->h, y));
     if (status != GSL_SUCCESS) return status;
     if (fabs(d->h) > d->hmax) d->h = copysign(d->hmax, d->h);
     if (*t != t1 && (fabs(d->h) < d->hmin || fabs(*t - t0) < d->hmin)) return GSL_ENOPROG;
     return GSL_SUCCESS;
+}
+
+void friction_gsl_driver_free(gsl_odeiv2_driver *d)
+{
+    if (d == NULL) return;
+    quiet_begin();
+    gsl_odeiv2_driver_free(d);
+    quiet_end(GSL_SUCCESS);
+}
+
+/* Accepted steps and rejected (failed) steps since the last reset. */
+void friction_gsl_driver_counts(const gsl_odeiv2_driver *d, long *steps, long *failed)
+{
+    *steps = (long)d->e->count;
+    *failed = (long)d->e->failed_steps;
+}
+
+/* The current step size the driver will try next. */
+double friction_gsl_driver_step(const gsl_odeiv2_driver *d)
+{
+    return d->h;
 }

@@ -37,7 +37,7 @@ contains
       type(config_checker), intent(inout) :: c
 
       if (s%method /= auto_name .and. step_type_index(s%method) == 0) call c%reject('integrator', 'method', &
-         & "'"//trim(s%method)//"'", 'unknown GSL step type (known: '//quoted(step_type_names)//', or '// &
+         & "'"//trim(s%method)//"'", 'unknown GSL step type (known: '//quoted(step_type_names())//', or '// &
          & quoted([auto_name])//' to choose by scene and rtol)')
       call c%positive('integrator', 'rtol', s%rtol, 'relative tolerance')
       call c%positive('integrator', 'atol', s%atol, 'absolute tolerance, Å and Å/s')

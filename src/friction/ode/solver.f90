@@ -1,8 +1,11 @@
 !> Bridge to GSL's odeiv2 driver through ISO_C_BINDING.
 !>
 !> Every GSL step type is selectable by name; the implicit ones receive the
-!> system's analytic Jacobian.  GSL's abort-on-error handler is switched off
-!> (in the C shim), and every failure (GSL status, too many steps, step size
+!> system's analytic Jacobian.  The names and types are the C shim's table
+!> (gsl_shim.c), the only list of them.  Every call into GSL goes through
+!> the shim, which keeps GSL's abort-on-error handler out of the way for
+!> that call only and gives the program's handler back afterwards; every
+!> failure (GSL status, an error GSL reported, too many steps, step size
 !> below the minimum, NaN or Inf in the state) comes back as an error that
 !> carries the time reached.
 module friction_ode_solver
@@ -10,22 +13,21 @@ module friction_ode_solver
       & c_null_ptr, c_associated, c_loc, c_funloc, c_f_pointer, c_char, c_null_char
    use friction_kinds, only: wp, i8
    use friction_error, only: error_type, fatal_error, error_numerical, error_input, error_internal
+   use friction_strings, only: rtoa
    use friction_ode_system, only: ode_system
    implicit none
    private
 
    public :: ode_solver, solver_settings, integrator_statistics
-   public :: step_type_names, step_type_index, is_implicit_step_type
+   public :: step_type_names, step_type_index, is_implicit_step_type, step_type_name_length
 
-   !> GSL step types, in the order of the C shim's friction_gsl_step_type.
-   character(len=*), parameter :: step_type_names(11) = [character(len=7) :: &
-      & 'rk2', 'rk4', 'rkf45', 'rkck', 'rk8pd', 'rk1imp', 'rk2imp', 'rk4imp', 'bsimp', &
-      & 'msadams', 'msbdf']
+   !> Room for a step type name (as solver_settings%method).
+   integer, parameter :: step_type_name_length = 16
 
    integer, parameter :: max_dimension = 8
 
    !> GSL status codes used here (gsl_errno.h).
-   integer(c_int), parameter :: gsl_success = 0, gsl_ebadfunc = 9
+   integer(c_int), parameter :: gsl_success = 0, gsl_enomem = 8, gsl_ebadfunc = 9
 
    !> What the user chooses about the integration.
    type :: solver_settings
@@ -77,9 +79,12 @@ module friction_ode_solver
       character(len=8) :: time_name = 't', time_unit = ' s'
       !> counters of the finished restarts
       type(integrator_statistics) :: done
+      !> a restart GSL refused, not yet reported (restart without error)
+      character(len=:), allocatable :: failed_restart
    contains
       procedure :: init
       procedure :: restart
+      procedure, private :: report_failed_restart
       procedure :: advance
       procedure :: step
       procedure :: step_size
@@ -91,55 +96,70 @@ module friction_ode_solver
    end type ode_solver
 
    interface
-      function friction_gsl_driver_new(sys, index, hstart, epsabs, epsrel) &
-         & result(driver) bind(c, name='friction_gsl_driver_new')
+      pure function friction_gsl_step_type_count() result(n) bind(c, name='friction_gsl_step_type_count')
+         import :: c_int
+         integer(c_int) :: n
+      end function friction_gsl_step_type_count
+
+      pure subroutine friction_gsl_step_type_name_copy(index, buffer, length) &
+         & bind(c, name='friction_gsl_step_type_name_copy')
+         import :: c_int, c_char, c_size_t
+         integer(c_int), value :: index
+         character(kind=c_char), intent(inout) :: buffer(*)
+         integer(c_size_t), value :: length
+      end subroutine friction_gsl_step_type_name_copy
+
+      pure function friction_gsl_step_type_index(name, length) result(index) &
+         & bind(c, name='friction_gsl_step_type_index')
+         import :: c_int, c_char, c_size_t
+         character(kind=c_char), intent(in) :: name(*)
+         integer(c_size_t), value :: length
+         integer(c_int) :: index
+      end function friction_gsl_step_type_index
+
+      pure function friction_gsl_step_type_uses_jacobian(index) result(uses) &
+         & bind(c, name='friction_gsl_step_type_uses_jacobian')
+         import :: c_int
+         integer(c_int), value :: index
+         integer(c_int) :: uses
+      end function friction_gsl_step_type_uses_jacobian
+
+      function friction_gsl_driver_new(driver, sys, index, hstart, epsabs, epsrel) &
+         & result(status) bind(c, name='friction_gsl_driver_new')
          import :: c_ptr, c_int, c_double
+         type(c_ptr), intent(out) :: driver
          type(c_ptr), value :: sys
          integer(c_int), value :: index
          real(c_double), value :: hstart, epsabs, epsrel
-         type(c_ptr) :: driver
+         integer(c_int) :: status
       end function friction_gsl_driver_new
 
-      subroutine friction_gsl_driver_counts(driver, steps, failed) &
-         & bind(c, name='friction_gsl_driver_counts')
-         import :: c_ptr, c_long
+      function friction_gsl_driver_set_limits(driver, nmax, hmin) result(status) &
+         & bind(c, name='friction_gsl_driver_set_limits')
+         import :: c_ptr, c_long, c_double, c_int
          type(c_ptr), value :: driver
-         integer(c_long), intent(out) :: steps, failed
-      end subroutine friction_gsl_driver_counts
+         integer(c_long), value :: nmax
+         real(c_double), value :: hmin
+         integer(c_int) :: status
+      end function friction_gsl_driver_set_limits
 
-      function gsl_odeiv2_driver_apply(driver, t, t1, y) result(status) &
-         & bind(c, name='gsl_odeiv2_driver_apply')
+      function friction_gsl_driver_reset(driver, hstart) result(status) &
+         & bind(c, name='friction_gsl_driver_reset')
+         import :: c_ptr, c_double, c_int
+         type(c_ptr), value :: driver
+         real(c_double), value :: hstart
+         integer(c_int) :: status
+      end function friction_gsl_driver_reset
+
+      function friction_gsl_driver_apply(driver, t, t1, y) result(status) &
+         & bind(c, name='friction_gsl_driver_apply')
          import :: c_ptr, c_double, c_int
          type(c_ptr), value :: driver
          real(c_double), intent(inout) :: t
          real(c_double), value :: t1
          real(c_double), intent(inout) :: y(*)
          integer(c_int) :: status
-      end function gsl_odeiv2_driver_apply
-
-      function gsl_odeiv2_driver_reset_hstart(driver, hstart) result(status) &
-         & bind(c, name='gsl_odeiv2_driver_reset_hstart')
-         import :: c_ptr, c_double, c_int
-         type(c_ptr), value :: driver
-         real(c_double), value :: hstart
-         integer(c_int) :: status
-      end function gsl_odeiv2_driver_reset_hstart
-
-      function gsl_odeiv2_driver_set_nmax(driver, nmax) result(status) &
-         & bind(c, name='gsl_odeiv2_driver_set_nmax')
-         import :: c_ptr, c_long, c_int
-         type(c_ptr), value :: driver
-         integer(c_long), value :: nmax
-         integer(c_int) :: status
-      end function gsl_odeiv2_driver_set_nmax
-
-      function gsl_odeiv2_driver_set_hmin(driver, hmin) result(status) &
-         & bind(c, name='gsl_odeiv2_driver_set_hmin')
-         import :: c_ptr, c_double, c_int
-         type(c_ptr), value :: driver
-         real(c_double), value :: hmin
-         integer(c_int) :: status
-      end function gsl_odeiv2_driver_set_hmin
+      end function friction_gsl_driver_apply
 
       function friction_gsl_driver_step_once(driver, t, t1, y) result(status) &
          & bind(c, name='friction_gsl_driver_step_once')
@@ -151,16 +171,28 @@ module friction_ode_solver
          integer(c_int) :: status
       end function friction_gsl_driver_step_once
 
+      subroutine friction_gsl_driver_counts(driver, steps, failed) &
+         & bind(c, name='friction_gsl_driver_counts')
+         import :: c_ptr, c_long
+         type(c_ptr), value :: driver
+         integer(c_long), intent(out) :: steps, failed
+      end subroutine friction_gsl_driver_counts
+
       function friction_gsl_driver_step(driver) result(h) bind(c, name='friction_gsl_driver_step')
          import :: c_ptr, c_double
          type(c_ptr), value :: driver
          real(c_double) :: h
       end function friction_gsl_driver_step
 
-      subroutine gsl_odeiv2_driver_free(driver) bind(c, name='gsl_odeiv2_driver_free')
+      subroutine friction_gsl_driver_free(driver) bind(c, name='friction_gsl_driver_free')
          import :: c_ptr
          type(c_ptr), value :: driver
-      end subroutine gsl_odeiv2_driver_free
+      end subroutine friction_gsl_driver_free
+
+      function friction_gsl_error_reason() result(reason) bind(c, name='friction_gsl_error_reason')
+         import :: c_ptr
+         type(c_ptr) :: reason
+      end function friction_gsl_error_reason
 
       function gsl_strerror(status) result(message) bind(c, name='gsl_strerror')
          import :: c_int, c_ptr
@@ -171,27 +203,34 @@ module friction_ode_solver
 
 contains
 
-   !> Index of a GSL step type name (case-sensitive, lower case), 0 if unknown.
+   !> The GSL step type names, in the order of the C shim's table.
+   pure function step_type_names() result(names)
+      character(len=step_type_name_length), allocatable :: names(:)
+      character(kind=c_char) :: buffer(step_type_name_length)
+      integer :: i
+
+      allocate (names(friction_gsl_step_type_count()))
+      do i = 1, size(names)
+         buffer = ' '
+         call friction_gsl_step_type_name_copy(int(i, c_int), buffer, int(step_type_name_length, c_size_t))
+         names(i) = transfer(buffer, names(i))
+      end do
+   end function step_type_names
+
+   !> Index of a GSL step type name (case-sensitive, lower case; trailing
+   !> blanks ignored), 0 if unknown.
    pure function step_type_index(name) result(index)
       character(len=*), intent(in) :: name
       integer :: index
 
-      do index = 1, size(step_type_names)
-         if (trim(step_type_names(index)) == trim(name)) return
-      end do
-      index = 0
+      index = int(friction_gsl_step_type_index(name, int(len_trim(name), c_size_t)))
    end function step_type_index
 
    !> Whether a step type uses the Jacobian (implicit and BDF methods).
    pure logical function is_implicit_step_type(name)
       character(len=*), intent(in) :: name
 
-      select case (trim(name))
-      case ('rk1imp', 'rk2imp', 'rk4imp', 'bsimp', 'msbdf')
-         is_implicit_step_type = .true.
-      case default
-         is_implicit_step_type = .false.
-      end select
+      is_implicit_step_type = friction_gsl_step_type_uses_jacobian(int(step_type_index(name), c_int)) /= 0
    end function is_implicit_step_type
 
    !> Bind a driver to a system.  h_start must be > 0 here.
@@ -221,34 +260,67 @@ contains
       self%sys%jacobian = c_funloc(gsl_jacobian)
       self%sys%dimension = int(self%box%n, c_size_t)
       self%sys%params = c_loc(self%box)
-      self%driver = friction_gsl_driver_new(c_loc(self%sys), int(index, c_int), &
+      status = friction_gsl_driver_new(self%driver, c_loc(self%sys), int(index, c_int), &
          & real(h_start, c_double), real(settings%atol, c_double), real(settings%rtol, c_double))
-      if (.not. c_associated(self%driver)) then
-         call fatal_error(error, 'GSL could not allocate a driver for '//trim(settings%method), &
-            & error_internal)
+      if (status /= gsl_success) then
+         if (status == gsl_enomem) then
+            call fatal_error(error, 'GSL could not allocate a driver for '//trim(settings%method), &
+               & error_internal)
+         else
+            call fatal_error(error, 'GSL refused a driver for '//trim(settings%method)//' (first step ' &
+               & //rtoa(h_start)//', atol = '//rtoa(settings%atol)//', rtol = '//rtoa(settings%rtol) &
+               & //'): '//gsl_description(status), error_input)
+         end if
          return
       end if
       self%max_steps = settings%max_steps
       self%h_min = settings%h_min
       self%method = settings%method
-      status = gsl_odeiv2_driver_set_nmax(self%driver, int(settings%max_steps, c_long))
-      if (settings%h_min > 0.0_wp) &
-         & status = gsl_odeiv2_driver_set_hmin(self%driver, real(settings%h_min, c_double))
+      status = friction_gsl_driver_set_limits(self%driver, int(settings%max_steps, c_long), &
+         & real(max(settings%h_min, 0.0_wp), c_double))
+      if (status /= gsl_success) then
+         call fatal_error(error, trim(settings%method)//': GSL refused h_min = '//rtoa(settings%h_min) &
+            & //' with the first step '//rtoa(h_start)//' (h_min must not exceed it): ' &
+            & //gsl_description(status), error_input)
+         call self%destroy()
+         return
+      end if
       self%done = integrator_statistics()
    end subroutine init
 
    !> Start afresh (new initial condition or changed model parameters):
-   !> multistep methods forget their history; counters are kept.
-   subroutine restart(self, h_start)
+   !> multistep methods forget their history; counters are kept.  GSL
+   !> refuses a first step outside [h_min, h_max] or zero: the error comes
+   !> back in error if present, else from the next advance or step.
+   subroutine restart(self, h_start, error)
       class(ode_solver), intent(inout) :: self
       real(wp), intent(in) :: h_start
+      type(error_type), allocatable, intent(out), optional :: error
       integer(c_int) :: status
 
+      if (allocated(self%failed_restart)) deallocate (self%failed_restart)
       self%done = self%statistics()
       self%box%rhs_evaluations = 0
       self%box%jacobian_evaluations = 0
-      status = gsl_odeiv2_driver_reset_hstart(self%driver, real(h_start, c_double))
+      status = friction_gsl_driver_reset(self%driver, real(h_start, c_double))
+      if (status /= gsl_success) then
+         self%failed_restart = trim(self%method)//': GSL could not restart the integration with the first step ' &
+            & //rtoa(h_start)
+         if (self%h_min > 0.0_wp) self%failed_restart = self%failed_restart//' (h_min = '//rtoa(self%h_min)//')'
+         self%failed_restart = self%failed_restart//': '//gsl_description(status)
+         if (present(error)) call self%report_failed_restart(error)
+      end if
    end subroutine restart
+
+   !> The error of a refused restart, once.
+   subroutine report_failed_restart(self, error)
+      class(ode_solver), intent(inout) :: self
+      type(error_type), allocatable, intent(out) :: error
+
+      if (.not. allocated(self%failed_restart)) return
+      call fatal_error(error, self%failed_restart, error_numerical)
+      deallocate (self%failed_restart)
+   end subroutine report_failed_restart
 
    !> Advance y from t to t1.  On failure t holds the time reached.
    subroutine advance(self, t, t1, y, error)
@@ -260,7 +332,9 @@ contains
       integer(c_int) :: status
       integer(c_long) :: steps, failed
 
-      status = gsl_odeiv2_driver_apply(self%driver, t, t1, y)
+      call self%report_failed_restart(error)
+      if (allocated(error)) return
+      status = friction_gsl_driver_apply(self%driver, t, t1, y)
       call friction_gsl_driver_counts(self%driver, steps, failed)
       if (status /= gsl_success) then
          if (status == gsl_ebadfunc) then
@@ -268,7 +342,7 @@ contains
                & //self%time_at(t), error_numerical)
          else
             call fatal_error(error, trim(self%method)//' failed at '//self%time_at(t) &
-               & //': '//gsl_message(status)//step_hint(status), error_numerical)
+               & //': '//gsl_description(status)//step_hint(status), error_numerical)
          end if
       else if (.not. all(abs(y) <= huge(y))) then
          call fatal_error(error, trim(self%method)//': the state became NaN or Inf at ' &
@@ -291,13 +365,15 @@ contains
       type(error_type), allocatable, intent(out) :: error
       integer(c_int) :: status
 
+      call self%report_failed_restart(error)
+      if (allocated(error)) return
       status = friction_gsl_driver_step_once(self%driver, t, t1, y)
       if (status == gsl_ebadfunc) then
          call fatal_error(error, trim(self%method)//': the right-hand side became NaN or Inf at ' &
             & //self%time_at(t), error_numerical)
       else if (status /= gsl_success) then
          call fatal_error(error, trim(self%method)//' failed at '//self%time_at(t) &
-            & //': '//gsl_message(status)//step_hint(status), error_numerical)
+            & //': '//gsl_description(status)//step_hint(status), error_numerical)
       else if (.not. all(abs(y) <= huge(y))) then
          call fatal_error(error, trim(self%method)//': the state became NaN or Inf at ' &
             & //self%time_at(t), error_numerical)
@@ -352,8 +428,9 @@ contains
    subroutine destroy(self)
       class(ode_solver), intent(inout) :: self
 
-      if (c_associated(self%driver)) call gsl_odeiv2_driver_free(self%driver)
+      if (c_associated(self%driver)) call friction_gsl_driver_free(self%driver)
       self%driver = c_null_ptr
+      if (allocated(self%failed_restart)) deallocate (self%failed_restart)
       if (associated(self%sys)) deallocate (self%sys)
       if (associated(self%box)) deallocate (self%box)
    end subroutine destroy
@@ -378,18 +455,38 @@ contains
    function gsl_message(status) result(message)
       integer(c_int), intent(in) :: status
       character(len=:), allocatable :: message
-      character(kind=c_char), pointer :: text(:)
+
+      message = c_text(gsl_strerror(status))
+   end function gsl_message
+
+   !> GSL's text for a status code, and in parentheses what GSL reported
+   !> when it did (the shim keeps that of this thread's last call).
+   function gsl_description(status) result(message)
+      integer(c_int), intent(in) :: status
+      character(len=:), allocatable :: message, reason
+
+      message = gsl_message(status)
+      reason = c_text(friction_gsl_error_reason())
+      if (len(reason) > 0) message = message//' ('//reason//')'
+   end function gsl_description
+
+   !> A NUL-terminated C string (at most 256 characters); '' for NULL.
+   function c_text(pointer) result(text)
+      type(c_ptr), intent(in) :: pointer
+      character(len=:), allocatable :: text
+      character(kind=c_char), pointer :: chars(:)
       integer :: n
 
-      call c_f_pointer(gsl_strerror(status), text, [256])
+      text = ''
+      if (.not. c_associated(pointer)) return
+      call c_f_pointer(pointer, chars, [256])
       n = 0
       do while (n < 256)
-         if (text(n + 1) == c_null_char) exit
+         if (chars(n + 1) == c_null_char) exit
          n = n + 1
       end do
-      allocate (character(len=n) :: message)
-      message = transfer(text(1:n), message)
-   end function gsl_message
+      text = transfer(chars(1:n), repeat(' ', n))
+   end function c_text
 
    !> What a user can do about a failure status.
    pure function step_hint(status) result(hint)

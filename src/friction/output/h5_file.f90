@@ -3,9 +3,16 @@
 !> of scan lines collectively.  Every call is collective: all ranks call it
 !> with the same names and the same small data.  A `units` attribute goes on
 !> every dataset.
+!>
+!> HDF5's automatic error printing is the program's: every operation saves
+!> the setting of the default error stack, switches printing off for its
+!> own HDF5 calls (their failures come back through stat) and restores the
+!> saved setting before it returns.  (HDF5 built without thread safety, as
+!> the parallel builds are, keeps one such setting per process; the writer
+!> is for one thread at a time, as friction_run_job says.)
 module friction_output_h5
    use, intrinsic :: iso_fortran_env, only: int64
-   use, intrinsic :: iso_c_binding, only: c_ptr, c_loc
+   use, intrinsic :: iso_c_binding, only: c_ptr, c_loc, c_funptr, c_int, c_int64_t, c_null_ptr, c_null_funptr
    use mpi_f08, only: MPI_Comm, MPI_INFO_NULL, MPI_Comm_rank
    use hdf5
    use friction_kinds, only: wp, i8
@@ -14,6 +21,39 @@ module friction_output_h5
    private
 
    public :: h5_file
+
+   !> H5E_DEFAULT of the C API: the default error stack (hid_t is int64_t
+   !> since HDF5 1.10).
+   integer(c_int64_t), parameter :: default_error_stack = 0
+
+   !> The program's automatic error printing, while an operation runs.
+   type :: error_printing
+      private
+      logical :: saved = .false.
+      type(c_funptr) :: func = c_null_funptr
+      type(c_ptr) :: data = c_null_ptr
+   contains
+      procedure :: silence => printing_silence
+      procedure :: restore => printing_restore
+   end type error_printing
+
+   interface
+      function h5e_get_auto2(stack, func, data) result(status) bind(c, name='H5Eget_auto2')
+         import :: c_int64_t, c_funptr, c_ptr, c_int
+         integer(c_int64_t), value :: stack
+         type(c_funptr), intent(out) :: func
+         type(c_ptr), intent(out) :: data
+         integer(c_int) :: status
+      end function h5e_get_auto2
+
+      function h5e_set_auto2(stack, func, data) result(status) bind(c, name='H5Eset_auto2')
+         import :: c_int64_t, c_funptr, c_ptr, c_int
+         integer(c_int64_t), value :: stack
+         type(c_funptr), value :: func
+         type(c_ptr), value :: data
+         integer(c_int) :: status
+      end function h5e_set_auto2
+   end interface
 
    type :: h5_file
       private
@@ -49,14 +89,15 @@ contains
       type(error_type), allocatable, intent(out) :: error
       integer(hid_t) :: fapl
       integer :: stat
+      type(error_printing) :: printing
 
       self%path = path
       self%status = 0
       call MPI_Comm_rank(comm, self%rank)
+      ! The library never prints: failures come back through stat.
+      call printing%silence()
       call h5open_f(stat)
       call self%check(stat, 'initialising HDF5')
-      ! The library never prints: failures come back through stat.
-      call h5eset_auto_f(0, stat)
       call h5pcreate_f(H5P_FILE_ACCESS_F, fapl, stat)
       call self%check(stat, 'creating the file access list')
       call h5pset_fapl_mpio_f(fapl, comm%MPI_VAL, MPI_INFO_NULL%MPI_VAL, stat)
@@ -64,6 +105,7 @@ contains
       call h5fcreate_f(path, H5F_ACC_TRUNC_F, self%id, stat, access_prp=fapl)
       call self%check(stat, 'creating the file')
       call h5pclose_f(fapl, stat)
+      call printing%restore()
       if (self%status /= 0) call fatal_error(error, path//': HDF5 failed '//self%failed_at, error_io)
    end subroutine create
 
@@ -72,11 +114,14 @@ contains
       character(len=*), intent(in) :: name
       integer(hid_t) :: group
       integer :: stat
+      type(error_printing) :: printing
 
       if (self%status /= 0) return
+      call printing%silence()
       call h5gcreate_f(self%id, name, group, stat)
       call self%check(stat, 'creating group '//name)
       if (stat == 0) call h5gclose_f(group, stat)
+      call printing%restore()
    end subroutine create_group
 
    !> A 1-D dataset that every rank holds whole; rank 0 writes it.
@@ -149,6 +194,21 @@ contains
       type(c_ptr), intent(in) :: buffer
       integer, intent(in) :: held(2), n_total, first, stride
       logical, intent(in) :: one_d
+      type(error_printing) :: printing
+
+      if (self%status /= 0) return
+      call printing%silence()
+      call write_block_silently(self, name, type, buffer, held, n_total, first, stride, units, one_d)
+      call printing%restore()
+   end subroutine write_block
+
+   subroutine write_block_silently(self, name, type, buffer, held, n_total, first, stride, units, one_d)
+      class(h5_file), intent(inout) :: self
+      character(len=*), intent(in) :: name, units
+      integer(hid_t), intent(in) :: type
+      type(c_ptr), intent(in) :: buffer
+      integer, intent(in) :: held(2), n_total, first, stride
+      logical, intent(in) :: one_d
       integer(hid_t) :: filespace, memspace, dset, xfer
       integer(hsize_t) :: dims(2), count(2), offset(2), step(2)
       integer :: stat, rank
@@ -196,7 +256,7 @@ contains
       call h5sclose_f(filespace, stat)
       if (len_trim(units) > 0) call attribute_text(self, dset, 'units', units)
       call h5dclose_f(dset, stat)
-   end subroutine write_block
+   end subroutine write_block_silently
 
    !> A 1-D integer dataset that every rank holds whole; rank 0 writes it
    !> (flags, codes).  Collective like the others.
@@ -204,11 +264,22 @@ contains
       class(h5_file), intent(inout) :: self
       character(len=*), intent(in) :: name, units
       integer, intent(in) :: values(:)
+      type(error_printing) :: printing
+
+      if (self%status /= 0) return
+      call printing%silence()
+      call write_vector_integer_silently(self, name, values, units)
+      call printing%restore()
+   end subroutine write_vector_integer
+
+   subroutine write_vector_integer_silently(self, name, values, units)
+      class(h5_file), intent(inout) :: self
+      character(len=*), intent(in) :: name, units
+      integer, intent(in) :: values(:)
       integer(hid_t) :: filespace, memspace, dset, xfer
       integer(hsize_t) :: dims(1)
       integer :: stat
 
-      if (self%status /= 0) return
       dims = [int(size(values), hsize_t)]
       call h5screate_simple_f(1, dims, filespace, stat)
       call h5dcreate_f(self%id, name, H5T_NATIVE_INTEGER, filespace, dset, stat)
@@ -229,7 +300,7 @@ contains
       call h5sclose_f(filespace, stat)
       call attribute_text(self, dset, 'units', units)
       call h5dclose_f(dset, stat)
-   end subroutine write_vector_integer
+   end subroutine write_vector_integer_silently
 
    !> A text attribute on the object at path object ('/' for the root).
    subroutine write_attribute_text(self, object, name, text)
@@ -237,13 +308,17 @@ contains
       character(len=*), intent(in) :: object, name, text
       integer(hid_t) :: obj
       integer :: stat
+      type(error_printing) :: printing
 
       if (self%status /= 0) return
+      call printing%silence()
       call h5oopen_f(self%id, object, obj, stat)
       call self%check(stat, 'opening '//object)
-      if (stat /= 0) return
-      call attribute_text(self, obj, name, text)
-      call h5oclose_f(obj, stat)
+      if (stat == 0) then
+         call attribute_text(self, obj, name, text)
+         call h5oclose_f(obj, stat)
+      end if
+      call printing%restore()
    end subroutine write_attribute_text
 
    subroutine attribute_text(self, obj, name, text)
@@ -312,21 +387,25 @@ contains
       type(c_ptr), intent(in) :: value
       integer(hid_t) :: obj, space, attr
       integer :: stat
+      type(error_printing) :: printing
 
       if (self%status /= 0) return
+      call printing%silence()
       call h5oopen_f(self%id, object, obj, stat)
       call self%check(stat, 'opening '//object)
-      if (stat /= 0) return
-      call h5screate_f(H5S_SCALAR_F, space, stat)
-      call h5acreate_f(obj, name, type, space, attr, stat)
-      call self%check(stat, 'creating attribute '//name)
       if (stat == 0) then
-         call h5awrite_f(attr, type, value, stat)
-         call self%check(stat, 'writing attribute '//name)
-         call h5aclose_f(attr, stat)
+         call h5screate_f(H5S_SCALAR_F, space, stat)
+         call h5acreate_f(obj, name, type, space, attr, stat)
+         call self%check(stat, 'creating attribute '//name)
+         if (stat == 0) then
+            call h5awrite_f(attr, type, value, stat)
+            call self%check(stat, 'writing attribute '//name)
+            call h5aclose_f(attr, stat)
+         end if
+         call h5sclose_f(space, stat)
+         call h5oclose_f(obj, stat)
       end if
-      call h5sclose_f(space, stat)
-      call h5oclose_f(obj, stat)
+      call printing%restore()
    end subroutine scalar_attribute
 
    !> Close the file; report the first failure since create, if any.
@@ -334,15 +413,38 @@ contains
       class(h5_file), intent(inout) :: self
       type(error_type), allocatable, intent(out) :: error
       integer :: stat
+      type(error_printing) :: printing
 
+      call printing%silence()
       if (self%id >= 0) then
          call h5fclose_f(self%id, stat)
          call self%check(stat, 'closing the file')
          self%id = -1
       end if
       call h5close_f(stat)
+      call printing%restore()
       if (self%status /= 0) call fatal_error(error, self%path//': HDF5 failed '//self%failed_at, error_io)
    end subroutine close
+
+   !> Save the program's automatic error printing and switch it off.  If
+   !> HDF5 cannot tell the setting (a program that set it through the
+   !> deprecated H5Eset_auto1), it is left alone: it could not be restored.
+   subroutine printing_silence(self)
+      class(error_printing), intent(inout) :: self
+      integer(c_int) :: status
+
+      self%saved = h5e_get_auto2(default_error_stack, self%func, self%data) >= 0
+      if (self%saved) status = h5e_set_auto2(default_error_stack, c_null_funptr, c_null_ptr)
+   end subroutine printing_silence
+
+   !> Put the saved setting back.
+   subroutine printing_restore(self)
+      class(error_printing), intent(inout) :: self
+      integer(c_int) :: status
+
+      if (self%saved) status = h5e_set_auto2(default_error_stack, self%func, self%data)
+      self%saved = .false.
+   end subroutine printing_restore
 
    subroutine check(self, stat, what)
       class(h5_file), intent(inout) :: self
