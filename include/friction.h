@@ -1,20 +1,44 @@
-/* friction: C API of the dry-friction kernel (AFM scan lines, Girling brake).
+/* friction: C API of the dry-friction simulator (AFM tip over a surface,
+ * Girling brake), API version 2.  Reference: docs/capi.md.
  *
- * Every function returns an int status: FRICTION_OK (0) on success, else one
- * of the FRICTION_ERROR_* codes.  Functions that take a friction_error handle
- * also store the status and a message in it when the handle is not NULL; the
- * handle is owned by the caller (friction_error_new / friction_error_free).
- * The library never prints and never stops the process.
+ * Handles.  A friction_config is a scene's configuration: made with the
+ * scene's defaults (friction_config_new), changed by namelist files
+ * (friction_config_read) or by name ("tip.kx", friction_config_set), checked
+ * by the scene's own checks, the very code that checks the program's input
+ * (friction_config_check; every computation runs it first).  Computations on
+ * the calling process (friction_afm_line, friction_compute) need no MPI;
+ * a friction_result holds a whole computation's arrays.  Jobs
+ * (friction_run_job, friction_run_config) run the program's job and write
+ * its HDF5 file.
  *
- * Reentrant: the library keeps no mutable global state, so threads may call
- * it at once, each with its own arrays and its own error handle.
+ * Errors.  Every function that can fail returns an int status: FRICTION_OK
+ * (0) or one of the FRICTION_ERROR_* codes.  Functions that take a
+ * friction_error handle also store the status and a message in it when the
+ * handle is not NULL; the handle is owned by the caller (friction_error_new /
+ * friction_error_free).  The messages are the program's: a value refused by
+ * a check reads "&tip: mass = -1.000000E-8: must be > 0 (kg)", preceded by
+ * "file:line: " when the value came from a file.  The library never prints
+ * and never stops the process.
  *
- * Units are those of the namelist input (README: input reference).
+ * Threads.  The library keeps no global state: handles are independent, and
+ * threads may work at once, each on its own handles (configuration, result,
+ * error).  A handle must not be used by two threads at once.  The job
+ * functions use MPI and must be called from one thread at a time.
+ *
+ * Units are those of the namelist input (README: Input reference).
  */
 #ifndef FRICTION_H
 #define FRICTION_H
 
 #include <stddef.h>
+
+/* The library's version (CMake's project version; a test checks that it
+ * matches friction_version()) and the version of this API: 2 is the API of
+ * handles (version 1 had positional friction_afm_line and friction_brake). */
+#define FRICTION_VERSION_MAJOR 0
+#define FRICTION_VERSION_MINOR 1
+#define FRICTION_VERSION_PATCH 0
+#define FRICTION_API_VERSION 2
 
 #ifdef __cplusplus
 extern "C" {
@@ -22,19 +46,25 @@ extern "C" {
 
 enum {
   FRICTION_OK = 0,
-  FRICTION_ERROR_INPUT = 1,     /* bad argument: null, too small, unknown name, non-physical value */
+  FRICTION_ERROR_INPUT = 1,     /* bad argument or value: null, too small, unknown name, refused by a check */
   FRICTION_ERROR_NUMERICAL = 2, /* the integration failed */
   FRICTION_ERROR_IO = 3,
   FRICTION_ERROR_INTERNAL = 4,
-  FRICTION_INTERRUPTED = 5      /* friction_run_job: a sweep stopped early; its file is valid, resumable */
+  FRICTION_INTERRUPTED = 5      /* a job's sweep stopped early; its file is valid, resumable */
 };
 
-/* Opaque error handle. */
-typedef struct friction_error friction_error;
+typedef struct friction_error friction_error;   /* opaque: status and message of the last call */
+typedef struct friction_config friction_config; /* opaque: a scene's configuration */
+typedef struct friction_result friction_result; /* opaque: the arrays of a computation */
+
+/* ---- versions and errors ---- */
 
 /* Library version ("major.minor.patch") into buf of len bytes, NUL-terminated.
  * FRICTION_ERROR_INPUT if buf is NULL or too small (then truncated). */
 int friction_version(char *buf, size_t len);
+/* FRICTION_API_VERSION of the library (a program loaded at run time, e.g.
+ * through Python's ctypes, compares it with the version it was written for). */
+int friction_api_version(void);
 
 /* A new error handle (status FRICTION_OK, empty message); NULL if out of memory. */
 friction_error *friction_error_new(void);
@@ -47,63 +77,139 @@ int friction_error_status(const friction_error *err);
  * small (then truncated). */
 int friction_error_message(const friction_error *err, char *buf, size_t len);
 
-/* One AFM scan line (the CLI's first line of a map with the same settings):
- * the lateral force fx[i], fy[i] (nN) with the support at
- * (x0, y0) + i length/(nx-1) (cos angle, sin angle), i = 0..nx-1.
- *   potential  "naf" (V0 eV, periods ax, ay Å) or "hopg" (V0 eV, lattice a Å)
- *   mass kg > 0; kx, ky N/m >= 0; cx, cy N s/m >= 0; velocity Å/s > 0
- *   x0, y0 Å; angle degrees; length Å > 0; nx >= 2
- *   forward    non-zero: trace (support from x0,y0 outwards); zero: retrace
- *              (from the far end back; still stored by position i)
- *   stepper    GSL step type: rk2 rk4 rkf45 rkck rk8pd rk1imp rk2imp rk4imp
- *              bsimp msadams msbdf, or "auto" (README: Speed against accuracy);
- *              rtol, atol > 0
- *   fx, fy     caller arrays of nx doubles */
-int friction_afm_line(const char *potential, double v0, double ax, double ay, double a,
-                      double mass, double kx, double ky, double cx, double cy,
-                      double velocity, double x0, double y0, double angle, double length,
-                      int nx, int forward, const char *stepper, double rtol, double atol,
-                      double *fx, double *fy, friction_error *err);
+/* ---- configurations ---- */
 
-/* The Girling brake (Eq. 10, nondimensional parameters as in &brake) from the
- * state x = y = 0, x' = v_dr, y' = 0 on the grid t = 0, dt_out, ..., t_end (τ):
- * block displacement x, velocity v, crank arm displacement y and velocity w
- * into caller arrays of length n.
- *   model      "switched" or "regularized"
- *   needed     if not NULL, receives the number of grid points; when n is
- *              smaller the call fails with FRICTION_ERROR_INPUT and writes
- *              nothing else, so a caller may ask with n = 0 first. */
-/* Checks as the namelist: xi, kappa, t_end, dt_out, rtol, atol > 0; mu, mu_s,
- * delta_prime >= 0; epsilon_prime > 0 for "regularized"; mu <= mu_s for
- * "switched"; all finite.  An initial normal force N' <= 0 is an input error. */
-int friction_brake(const char *model, double xi, double kappa, double g_prime, double mu,
-                   double mu_s, double epsilon_prime, double delta_prime, double v_dr,
-                   double t_end, double dt_out, const char *stepper, double rtol, double atol,
-                   double *t, double *x, double *v, double *y, double *w, size_t n,
-                   size_t *needed, friction_error *err);
+/* A configuration of scene "afm" (friction-force map) or "brake" (Girling
+ * brake) with the scene's defaults: &job, the scene's groups and &sweep, as
+ * the program's input has them.  NULL (and a message) for an unknown scene.
+ * Free it with friction_config_free (NULL is ignored). */
+friction_config *friction_config_new(const char *scene, friction_error *err);
+void friction_config_free(friction_config *cfg);
+
+/* Apply the namelist file `path` over the current values, as the program
+ * reads a later file over an earlier one (same reader, same messages, with
+ * file:line).  All or nothing: a file with a bad assignment changes nothing.
+ * A file whose &job names another scene, or that has groups of another
+ * scene, is refused.  Values are not checked here (friction_config_check). */
+int friction_config_read(friction_config *cfg, const char *path, friction_error *err);
+
+/* Set one variable.  `name` is "group.variable" ("tip.kx",
+ * "surface.potential"), optionally with an element: "surface.sigma(2)" (the
+ * value's items then fill from that element on).  `value` is namelist value
+ * text: "5.0", "'hopg'", ".true.", "1, 2", "3*0.0".  An unknown group or
+ * variable, or a value of the wrong kind, is FRICTION_ERROR_INPUT with the
+ * reader's message ("&scan: nx = 'many': expected an integer"); the value is
+ * then left as it was.  The scene itself (job.scene) cannot change. */
+int friction_config_set(friction_config *cfg, const char *name, const char *value, friction_error *err);
+/* The same for a number, without text in between: a real variable, or an
+ * integer one when x is whole; NaN and infinities are set (and refused by
+ * friction_config_check). */
+int friction_config_set_real(friction_config *cfg, const char *name, double x, friction_error *err);
+
+/* The value of "group.variable" (or one element, "surface.sigma(2)") as
+ * namelist text ("10.0", "'naf'", ".true.", "2*0.0") into buf of len bytes.
+ * FRICTION_ERROR_INPUT for an unknown name or a NULL or too small buf (the
+ * message says how many bytes are needed). */
+int friction_config_get(const friction_config *cfg, const char *name, char *buf, size_t len,
+                        friction_error *err);
+
+/* The whole configuration as namelist text: &job, the scene's groups, and
+ * &sweep when a sweep is set; reals with the digits that read back to the
+ * same doubles, so friction_config_read of this text gives the same
+ * configuration.  *needed (if not NULL) gets the bytes it takes, NUL
+ * included.  Returns FRICTION_OK, or FRICTION_ERROR_INPUT if cfg is NULL or
+ * buf is NULL or too small (truncated); buf = NULL with len = 0 and needed
+ * not NULL is a size query and returns FRICTION_OK. */
+int friction_config_text(const friction_config *cfg, char *buf, size_t len, size_t *needed);
+
+/* Every variable, one line each: "group.variable<TAB>kind<TAB>elements<TAB>unit\n"
+ * with kind "real", "integer", "logical" or "text"; buffer as friction_config_text. */
+int friction_config_names(const friction_config *cfg, char *buf, size_t len, size_t *needed);
+
+/* The scene's checks (and the sweep's): the first value refused, as the
+ * program refuses it: "&tip: mass = -1.000000E-8: must be > 0 (kg)"
+ * (preceded by "file:line: " when the value was read from a file). */
+int friction_config_check(const friction_config *cfg, friction_error *err);
+
+/* ---- computations on the calling process (no MPI) ---- */
+
+/* Line `line` (0-based, < scan.ny) of the map of an "afm" configuration:
+ * trace (forward != 0) or retrace (still stored by position), the lateral
+ * force fx[i], fy[i] (nN) at the nx = scan.nx support positions of the
+ * line, exactly as the program's file holds line `line` of /afm/trace
+ * (/afm/retrace).  Every tip model, surface and potential.  n is the length
+ * of fx and fy: n < scan.nx is FRICTION_ERROR_INPUT and nothing is written. */
+int friction_afm_line(const friction_config *cfg, int line, int forward, double *fx, double *fy, size_t n,
+                      friction_error *err);
+
+/* The configuration's whole computation on the calling process, checked
+ * first; NULL (and a message) on an error.  Free with friction_result_free.
+ *   afm:   as /afm of the program's file: "support_x" (nx), "support_y" (ny);
+ *          "trace/fx", "trace/fy", "trace/f_along", "trace/f_across",
+ *          "trace/tip_x", "trace/tip_y" as (ny, nx) maps (also "trace/fz",
+ *          "trace/tip_z" for a tip moving in z, "trace/jumps" for the
+ *          quasistatic model); the same under "retrace/" and "friction"
+ *          (ny, nN) when scan.retrace.
+ *   brake: as /brake: "t", "x", "v", "y", "w", "stick" (1 stick, 0 slip) on
+ *          the output grid; the events "events/t", "events/kind", "events/x",
+ *          "events/v", "events/y", "events/w".  (&analysis and &verify are
+ *          for jobs: friction_run_config.)
+ * A configuration with a &sweep is refused: run it with friction_run_config. */
+friction_result *friction_compute(const friction_config *cfg, friction_error *err);
+
+/* Copy the array `name` into out[0..n-1] as doubles, maps row-major (ny, nx):
+ * out[j * nx + i] is sample i of line j.  *needed (if not NULL) gets its
+ * number of values.  n smaller than that is FRICTION_ERROR_INPUT and nothing
+ * is written, except that out = NULL with n = 0 is a size query
+ * (FRICTION_OK).  An unknown name is FRICTION_ERROR_INPUT (the message lists
+ * the names). */
+int friction_result_get(const friction_result *res, const char *name, double *out, size_t n, size_t *needed,
+                        friction_error *err);
+/* The shape of `name`: {rows, columns}; {ny, nx} for a map, {n, 1} for a series. */
+int friction_result_shape(const friction_result *res, const char *name, size_t shape[2], friction_error *err);
+/* The names of the result's arrays, separated by '\n', into buf of len
+ * bytes; FRICTION_ERROR_INPUT if res or buf is NULL or buf is too small. */
+int friction_result_names(const friction_result *res, char *buf, size_t len);
+void friction_result_free(friction_result *res);
+
+/* ---- jobs: the program's computation and HDF5 file ---- */
+
+enum {
+  FRICTION_JOB_FORCE = 1,   /* overwrite an existing output */
+  FRICTION_JOB_RESUME = 2,  /* a sweep reuses the checkpoints of an interrupted run (as --resume) */
+  FRICTION_JOB_INIT_MPI = 4 /* MPI not initialised: the library may initialise it (see below) */
+};
+/* Progress ("12 of 64 lines", fraction in [0, 1]) and notes (a verify
+ * result; fraction -1), called on rank 0 only. */
+typedef void (*friction_report_fn)(const char *message, double fraction, void *user);
 
 /* A whole job, as the command line runs it: the namelist files (later files
- * override earlier values variable by variable) are read, the scene or sweep
- * they describe is computed and `output` (HDF5) is written under a temporary
- * name and renamed when complete; nothing is written on an error.
+ * override earlier values variable by variable) are read and checked, the
+ * scene or sweep they describe is computed and `output` (HDF5) is written
+ * under a temporary name and renamed when complete; nothing is written on an
+ * error.
  *   files, nfiles  the namelist files, as on the command line
- *   output         the HDF5 file to write
- *   flags          FRICTION_JOB_FORCE: overwrite an existing output;
- *                  FRICTION_JOB_RESUME: a sweep reuses the checkpoints of an
- *                  interrupted run (as --resume)
- *   report         if not NULL, called (on rank 0) with progress, message
- *                  "12 of 64 lines" and fraction in [0, 1], and with notes
- *                  (a verify result), fraction -1; user is passed through
- * MPI: collective over MPI_COMM_WORLD when the caller has initialised MPI
- * (every rank calls it with the same arguments); otherwise the library
- * initialises MPI once (MPI_THREAD_FUNNELED), runs on this process alone and
- * leaves MPI to the process's exit.  Unlike the other functions, call it from
- * one thread at a time.  Returns FRICTION_OK, an error code, or
- * FRICTION_INTERRUPTED. */
-enum { FRICTION_JOB_FORCE = 1, FRICTION_JOB_RESUME = 2 };
-typedef void (*friction_report_fn)(const char *message, double fraction, void *user);
+ *   flags          FRICTION_JOB_FORCE, FRICTION_JOB_RESUME, FRICTION_JOB_INIT_MPI
+ *   report         if not NULL, gets progress and notes; user is passed through
+ * MPI is the caller's choice:
+ *   - the caller initialised MPI (MPI_Init or MPI_Init_thread): the job is
+ *     collective over MPI_COMM_WORLD (every rank calls it with the same
+ *     arguments), e.g. under mpirun -n 4 it spreads as the program does;
+ *   - MPI is not initialised and flags has FRICTION_JOB_INIT_MPI: the
+ *     library initialises MPI (MPI_THREAD_FUNNELED), runs the job on this
+ *     process alone and leaves MPI initialised for the process's exit (MPI
+ *     cannot be initialised twice: the caller must not call MPI_Init later);
+ *   - otherwise FRICTION_ERROR_INPUT: call MPI_Init first or pass the flag.
+ * Returns FRICTION_OK, an error code, or FRICTION_INTERRUPTED. */
 int friction_run_job(const char *const *files, int nfiles, const char *output, int flags,
                      friction_report_fn report, void *user, friction_error *err);
+
+/* The job of a configuration handle, as friction_run_job runs one read from
+ * files: checked, computed (every group: &analysis, &verify, &sweep), and
+ * written to `output`, whose `input` attribute is the configuration's text
+ * (friction_config_text).  MPI and flags as friction_run_job. */
+int friction_run_config(const friction_config *cfg, const char *output, int flags, friction_report_fn report,
+                        void *user, friction_error *err);
 
 #ifdef __cplusplus
 }

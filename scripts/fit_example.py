@@ -25,14 +25,17 @@ TRUE = {"v0": 0.8, "k": 6.0}
 START = {"v0": 0.5, "k": 12.0}
 NOISE = 0.05          # nN, standard deviation of the measurement noise
 TOLERANCE = 0.02      # relative, on each recovered parameter
-SCENE = dict(potential="naf", ax=4.62, ay=4.62, mass=1.0e-8, cx=1.0e-3, cy=1.0e-3, velocity=400.0,
-             x0=0.0, y0=0.0, angle=0.0, length=20.0, nx=128, forward=True, stepper="rkf45",
-             rtol=1.0e-6, atol=1.0e-7)
+# One line of a map: the scene's defaults (inputs/naf.nml's values) but these.
+SCENE = {"surface.potential": "naf", "scan.angle": 0.0, "scan.length": 20.0, "scan.nx": 128, "scan.ny": 1,
+         "scan.retrace": False, "integrator.method": "rkf45", "integrator.rtol": 1.0e-6,
+         "integrator.atol": 1.0e-7}
+MODEL = friction_capi.Config("afm", values=SCENE)
 
 
 def model_line(v0, k):
     """fx (nN) of the scene for potential amplitude v0 (eV) and springs k (N/m)."""
-    fx, _ = friction_capi.afm_line(v0=v0, kx=k, ky=k, **SCENE)
+    MODEL.set("surface.v0", v0).set("tip.kx", k).set("tip.ky", k)
+    fx, _ = MODEL.afm_line(0)
     return fx
 
 
@@ -90,14 +93,14 @@ def main():
 
     best, residual, evaluations = nelder_mead(cost, [np.log(START["v0"]), np.log(START["k"])])
     fitted = {"v0": float(np.exp(best[0])), "k": float(np.exp(best[1]))}
-    print(f"friction {friction_capi.version()}: NaF line, {SCENE['nx']} samples, noise {NOISE} nN")
+    print(f"friction {friction_capi.version()}: NaF line, {SCENE['scan.nx']} samples, noise {NOISE} nN")
     print(f"start  V0 = {START['v0']:.4f} eV, k = {START['k']:.4f} N/m")
     errors = {}
     for key, unit in (("v0", "eV"), ("k", "N/m")):
         errors[key] = abs(fitted[key] - TRUE[key]) / TRUE[key]
         print(f"{key:>5}: fitted {fitted[key]:.4f} {unit}, true {TRUE[key]:.4f} {unit}, "
               f"relative error {errors[key]:.2e}")
-    rms = np.sqrt(residual / SCENE["nx"])
+    rms = np.sqrt(residual / SCENE["scan.nx"])
     print(f"rms residual {rms:.4f} nN (noise {NOISE} nN), {evaluations} line evaluations")
     if args.check and not all(e <= TOLERANCE for e in errors.values()):
         print(f"FAIL: a parameter is off by more than {TOLERANCE:.0%}")

@@ -1,13 +1,27 @@
-"""Python access to the friction C API (include/friction.h) through ctypes.
+"""Python access to the friction C API (include/friction.h, API version 2) through ctypes.
 
     import friction_capi as fc
-    fx, fy = fc.afm_line(potential="naf", v0=1.0, kx=10.0, ky=10.0, nx=128)
-    run = fc.brake(t_end=100.0, dt_out=0.1)      # dict of numpy arrays t, x, v, y, w
-    fc.run_job(["inputs/naf.nml"], "naf.h5", force=True,
-               report=lambda message, fraction: print(message))   # the CLI's job, no MPI launcher
 
-Units are those of the namelist input (README: input reference).  A failed
-call raises FrictionError with the library's status and message.
+    with fc.Config("afm", files=["inputs/naf.nml"]) as cfg:
+        cfg.set("tip.kx", 5.0)                  # numbers, True/False, text, lists
+        cfg.set("scan.nx", 64)
+        cfg.set("surface.potential", "hopg")    # text is quoted for you; set_text takes namelist text
+        fx, fy = cfg.afm_line(0)                # line 0 of the map, trace (forward=False: retrace)
+        maps = cfg.compute()                    # dict of numpy arrays: maps["trace/fx"] is (ny, nx)
+
+    run = fc.Config("brake", values={"brake.t_end": 100.0}).compute()   # run["t"], run["x"], run["events/t"]
+    fc.run_job(["inputs/naf.nml"], "naf.h5", force=True,
+               report=lambda message, fraction: print(message))     # the program's job, no MPI launcher
+
+A configuration has its scene's defaults and the variables of the namelist
+input, by "group.variable" ("tip.kx", "surface.sigma(2)"), in its units
+(README: Input reference).  Every value is checked by the scene's own checks,
+as the program checks its input; a call the library refuses raises
+FrictionError with the library's status and message.  A Config is freed with
+close(), at the end of a `with` block, or when it is collected.  ctypes
+releases the GIL during each call, so different Config objects compute at
+once in different threads; one Config must not be used by two threads at
+once.
 
 The library is found, in order: the path in the environment variable
 FRICTION_LIBRARY; build/libfriction.so next to this script's repository;
@@ -16,26 +30,27 @@ lib/libfriction.so of an installation this script was installed into
 """
 import ctypes
 import ctypes.util
+import numbers
 import os
 
 import numpy as np
 
-__all__ = ["FrictionError", "library", "version", "afm_line", "brake", "run_job"]
+__all__ = ["FrictionError", "Config", "library", "version", "api_version", "run_job", "API_VERSION"]
 
-_double_array = np.ctypeslib.ndpointer(dtype=np.float64, flags="C_CONTIGUOUS")
-
+API_VERSION = 2   # the C API this module is written for (FRICTION_API_VERSION)
 
 # void report(const char *message, double fraction, void *user)
 _REPORT = ctypes.CFUNCTYPE(None, ctypes.c_char_p, ctypes.c_double, ctypes.c_void_p)
-FORCE, RESUME = 1, 2
+FORCE, RESUME, INIT_MPI = 1, 2, 4
 
 
 class FrictionError(RuntimeError):
-    """A call the library refused or could not finish; .status is its code."""
+    """A call the library refused or could not finish; .status is its code, .message its message."""
 
     def __init__(self, status, message):
         super().__init__(f"{message} (status {status})")
         self.status = status
+        self.message = message
 
 
 def _candidates():
@@ -61,28 +76,44 @@ def _load():
         break
     else:
         raise OSError("libfriction not found (set FRICTION_LIBRARY); tried: " + ", ".join(tried))
-    c_double, c_int, c_size_t, c_char_p, c_void_p = (ctypes.c_double, ctypes.c_int, ctypes.c_size_t,
-                                                     ctypes.c_char_p, ctypes.c_void_p)
-    lib.friction_version.argtypes = [ctypes.c_char_p, c_size_t]
-    lib.friction_version.restype = c_int
-    lib.friction_error_new.argtypes = []
-    lib.friction_error_new.restype = c_void_p
-    lib.friction_error_free.argtypes = [c_void_p]
-    lib.friction_error_free.restype = None
-    lib.friction_error_status.argtypes = [c_void_p]
-    lib.friction_error_status.restype = c_int
-    lib.friction_error_message.argtypes = [c_void_p, ctypes.c_char_p, c_size_t]
-    lib.friction_error_message.restype = c_int
-    lib.friction_afm_line.argtypes = ([c_char_p] + [c_double] * 14 + [c_int, c_int, c_char_p, c_double,
-                                                                         c_double, _double_array, _double_array,
-                                                                         c_void_p])
-    lib.friction_afm_line.restype = c_int
-    lib.friction_brake.argtypes = ([c_char_p] + [c_double] * 10 + [c_char_p, c_double, c_double]
-                                   + [c_void_p] * 5 + [c_size_t, ctypes.POINTER(c_size_t), c_void_p])
-    lib.friction_brake.restype = c_int
-    lib.friction_run_job.argtypes = [ctypes.POINTER(c_char_p), c_int, c_char_p, c_int, _REPORT, c_void_p,
-                                     c_void_p]
-    lib.friction_run_job.restype = c_int
+    if not hasattr(lib, "friction_api_version"):
+        raise OSError(f"{path}: a libfriction of API version 1; this module needs API version {API_VERSION}")
+    lib.friction_api_version.restype = ctypes.c_int
+    if lib.friction_api_version() != API_VERSION:
+        raise OSError(f"{path}: libfriction of API version {lib.friction_api_version()}; this module needs "
+                      f"{API_VERSION}")
+    c_int, c_size_t, c_char_p, c_void_p, c_double = (ctypes.c_int, ctypes.c_size_t, ctypes.c_char_p,
+                                                     ctypes.c_void_p, ctypes.c_double)
+    size_p = ctypes.POINTER(c_size_t)
+    signatures = {
+        "friction_version": (c_int, [c_char_p, c_size_t]),
+        "friction_error_new": (c_void_p, []),
+        "friction_error_free": (None, [c_void_p]),
+        "friction_error_status": (c_int, [c_void_p]),
+        "friction_error_message": (c_int, [c_void_p, c_char_p, c_size_t]),
+        "friction_config_new": (c_void_p, [c_char_p, c_void_p]),
+        "friction_config_free": (None, [c_void_p]),
+        "friction_config_read": (c_int, [c_void_p, c_char_p, c_void_p]),
+        "friction_config_set": (c_int, [c_void_p, c_char_p, c_char_p, c_void_p]),
+        "friction_config_set_real": (c_int, [c_void_p, c_char_p, c_double, c_void_p]),
+        "friction_config_get": (c_int, [c_void_p, c_char_p, c_char_p, c_size_t, c_void_p]),
+        "friction_config_text": (c_int, [c_void_p, c_char_p, c_size_t, size_p]),
+        "friction_config_names": (c_int, [c_void_p, c_char_p, c_size_t, size_p]),
+        "friction_config_check": (c_int, [c_void_p, c_void_p]),
+        "friction_afm_line": (c_int, [c_void_p, c_int, c_int, c_void_p, c_void_p, c_size_t, c_void_p]),
+        "friction_compute": (c_void_p, [c_void_p, c_void_p]),
+        "friction_result_get": (c_int, [c_void_p, c_char_p, c_void_p, c_size_t, size_p, c_void_p]),
+        "friction_result_shape": (c_int, [c_void_p, c_char_p, ctypes.POINTER(c_size_t * 2), c_void_p]),
+        "friction_result_names": (c_int, [c_void_p, c_char_p, c_size_t]),
+        "friction_result_free": (None, [c_void_p]),
+        "friction_run_job": (c_int, [ctypes.POINTER(c_char_p), c_int, c_char_p, c_int, _REPORT, c_void_p,
+                                     c_void_p]),
+        "friction_run_config": (c_int, [c_void_p, c_char_p, c_int, _REPORT, c_void_p, c_void_p]),
+    }
+    for name, (restype, argtypes) in signatures.items():
+        function = getattr(lib, name)
+        function.restype = restype
+        function.argtypes = argtypes
     return lib
 
 
@@ -96,61 +127,211 @@ def version():
     return buf.value.decode()
 
 
-def _call(function, *args):
-    """Call with a fresh error handle; raise FrictionError on failure."""
-    handle = library.friction_error_new()
-    if not handle:
-        raise MemoryError("friction_error_new")
-    try:
-        status = function(*args, handle)
+def api_version():
+    """The library's C API version (FRICTION_API_VERSION)."""
+    return library.friction_api_version()
+
+
+class _ErrorHandle:
+    """A friction_error for one call; raise() turns a failure into FrictionError."""
+
+    def __enter__(self):
+        self.handle = library.friction_error_new()
+        if not self.handle:
+            raise MemoryError("friction_error_new")
+        return self
+
+    def __exit__(self, *exc):
+        library.friction_error_free(self.handle)
+
+    def check(self, status):
         if status != 0:
-            buf = ctypes.create_string_buffer(1024)
-            library.friction_error_message(handle, buf, len(buf))
+            buf = ctypes.create_string_buffer(4096)
+            library.friction_error_message(self.handle, buf, len(buf))
             raise FrictionError(status, buf.value.decode(errors="replace"))
-    finally:
-        library.friction_error_free(handle)
+
+    def status(self):
+        return library.friction_error_status(self.handle)
 
 
-def afm_line(potential="naf", v0=1.0, ax=4.62, ay=4.62, a=2.46, mass=1.0e-8, kx=10.0, ky=10.0,
-             cx=1.0e-3, cy=1.0e-3, velocity=400.0, x0=0.0, y0=0.0, angle=0.0, length=20.0, nx=128,
-             forward=True, stepper="rkf45", rtol=1.0e-3, atol=1.0e-4):
-    """One scan line: fx, fy (nN) at nx support positions from (x0, y0) Å
-    along `angle` degrees over `length` Å (see friction.h)."""
-    nx = int(nx)
-    fx = np.zeros(max(nx, 0))
-    fy = np.zeros(max(nx, 0))
-    _call(library.friction_afm_line, potential.encode(), v0, ax, ay, a, mass, kx, ky, cx, cy, velocity,
-          x0, y0, angle, length, nx, int(bool(forward)), stepper.encode(), rtol, atol, fx, fy)
-    return fx, fy
+def _call(function, *args):
+    """Call with a fresh error handle as the last argument; raise FrictionError on failure."""
+    with _ErrorHandle() as err:
+        err.check(function(*args, err.handle))
 
 
-def brake(model="switched", xi=0.412, kappa=1.5, g_prime=0.01778, mu=0.59, mu_s=0.59,
-          epsilon_prime=3.5121e7, delta_prime=3.5121, v_dr=-0.002788, t_end=100.0, dt_out=0.1,
-          stepper="rk8pd", rtol=1.0e-10, atol=1.0e-12):
-    """The brake of Eq. 10 from the state of §4.1: dict of t, x, v, y, w."""
-    args = (model.encode(), xi, kappa, g_prime, mu, mu_s, epsilon_prime, delta_prime, v_dr, t_end, dt_out,
-            stepper.encode(), rtol, atol)
-    needed = ctypes.c_size_t(0)
-    try:
-        _call(library.friction_brake, *args, None, None, None, None, None, 0, ctypes.byref(needed))
-    except FrictionError:
-        if needed.value == 0:
-            raise
-    out = {key: np.zeros(needed.value) for key in ("t", "x", "v", "y", "w")}
-    pointers = [out[key].ctypes.data_as(ctypes.c_void_p) for key in ("t", "x", "v", "y", "w")]
-    _call(library.friction_brake, *args, *pointers, needed.value, None)
-    return out
+def _quote(text):
+    return "'" + str(text).replace("'", "''") + "'"
 
 
-def run_job(files, output, force=False, resume=False, report=None):
-    """Run a namelist job as the CLI does (friction.h: friction_run_job): read
+def _item(value):
+    if isinstance(value, (bool, np.bool_)):
+        return ".true." if value else ".false."
+    if isinstance(value, numbers.Integral):
+        return str(int(value))
+    if isinstance(value, numbers.Real):
+        return repr(float(value))
+    return _quote(value)
+
+
+def _callback(report):
+    if report is None:
+        return _REPORT()
+    return _REPORT(lambda message, fraction, user: report(message.decode(errors="replace"), fraction))
+
+
+class Config:
+    """A configuration of scene "afm" or "brake" (friction.h: friction_config).
+
+    files: namelist files read in order over the defaults (read());
+    values: {"group.variable": value} set after them (set())."""
+
+    def __init__(self, scene="afm", files=(), values=None):
+        self._lib = library
+        self._handle = None
+        with _ErrorHandle() as err:
+            handle = library.friction_config_new(scene.encode(), err.handle)
+            if not handle:
+                err.check(err.status())
+        self._handle = handle
+        self.scene = scene
+        for path in files:
+            self.read(path)
+        for name, value in (values or {}).items():
+            self.set(name, value)
+
+    # ---- lifetime ----
+    def close(self):
+        """Free the configuration (also at the end of a `with` block, or when collected)."""
+        if self._handle:
+            self._lib.friction_config_free(self._handle)
+            self._handle = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def __del__(self):
+        self.close()
+
+    @property
+    def handle(self):
+        if not self._handle:
+            raise ValueError("the configuration is closed")
+        return self._handle
+
+    # ---- values ----
+    def read(self, path):
+        """Apply a namelist file over the current values (all or nothing)."""
+        _call(library.friction_config_read, self.handle, os.fsencode(os.fspath(path)))
+        return self
+
+    def set(self, name, value):
+        """Set "group.variable" (or "group.variable(k)"): a number, True/False, a
+        text (quoted for you), or a list of them."""
+        if isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_)):
+            _call(library.friction_config_set_real, self.handle, name.encode(), float(value))
+        elif isinstance(value, (list, tuple, np.ndarray)):
+            self.set_text(name, ", ".join(_item(v) for v in value))
+        else:
+            self.set_text(name, _item(value))
+        return self
+
+    def set_text(self, name, text):
+        """Set a variable from namelist value text ("5.0", "'hopg'", ".true.", "3*0.0")."""
+        _call(library.friction_config_set, self.handle, name.encode(), text.encode())
+        return self
+
+    def get(self, name):
+        """A variable's value as namelist text ("10.0", "'naf'", ".true.", "2*0.0")."""
+        buf = ctypes.create_string_buffer(1 << 16)
+        _call(library.friction_config_get, self.handle, name.encode(), buf, len(buf))
+        return buf.value.decode()
+
+    def _text(self, function):
+        needed = ctypes.c_size_t(0)
+        if function(self.handle, None, 0, ctypes.byref(needed)) != 0:
+            raise FrictionError(1, f"{function.__name__}: the size query failed")
+        buf = ctypes.create_string_buffer(needed.value)
+        if function(self.handle, buf, len(buf), None) != 0:
+            raise FrictionError(1, f"{function.__name__}: the text did not fit")
+        return buf.value.decode()
+
+    def text(self):
+        """The whole configuration as namelist text (read() reads it back)."""
+        return self._text(library.friction_config_text)
+
+    def names(self):
+        """Every variable: a list of (name, kind, elements, unit), kind "real",
+        "integer", "logical" or "text"."""
+        rows = []
+        for line in self._text(library.friction_config_names).splitlines():
+            name, kind, size, unit = line.split("\t")
+            rows.append((name, kind, int(size), unit))
+        return rows
+
+    def check(self):
+        """The scene's checks; FrictionError with the first value refused."""
+        _call(library.friction_config_check, self.handle)
+        return self
+
+    # ---- computations on this process ----
+    def afm_line(self, line=0, forward=True):
+        """Line `line` (0-based) of the map, trace or retrace: fx, fy (nN) at scan.nx points."""
+        nx = int(self.get("scan.nx")) if self.scene == "afm" else 1
+        fx, fy = np.zeros(nx), np.zeros(nx)
+        _call(library.friction_afm_line, self.handle, int(line), int(bool(forward)),
+              fx.ctypes.data_as(ctypes.c_void_p), fy.ctypes.data_as(ctypes.c_void_p), nx)
+        return fx, fy
+
+    def compute(self):
+        """The whole scene on this process: a dict of numpy arrays, maps (ny, nx),
+        series 1-D (friction.h: friction_compute)."""
+        with _ErrorHandle() as err:
+            result = library.friction_compute(self.handle, err.handle)
+            if not result:
+                err.check(err.status())
+            try:
+                return _result_arrays(result, err)
+            finally:
+                library.friction_result_free(result)
+
+    def run(self, output, force=False, resume=False, report=None, init_mpi=True):
+        """The configuration's job to the HDF5 file `output` (friction.h: friction_run_config);
+        `report(message, fraction)` as for run_job."""
+        flags = (FORCE if force else 0) | (RESUME if resume else 0) | (INIT_MPI if init_mpi else 0)
+        callback = _callback(report)
+        _call(library.friction_run_config, self.handle, os.fsencode(os.fspath(output)), flags, callback, None)
+
+
+def _result_arrays(result, err):
+    buf = ctypes.create_string_buffer(1 << 16)
+    if library.friction_result_names(result, buf, len(buf)) != 0:
+        raise FrictionError(1, "friction_result_names: the names did not fit")
+    arrays = {}
+    for name in buf.value.decode().split("\n"):
+        shape = (ctypes.c_size_t * 2)()
+        err.check(library.friction_result_shape(result, name.encode(), ctypes.byref(shape), err.handle))
+        rows, columns = shape[0], shape[1]
+        values = np.zeros(rows * columns)
+        err.check(library.friction_result_get(result, name.encode(), values.ctypes.data_as(ctypes.c_void_p),
+                                              values.size, None, err.handle))
+        arrays[name] = values.reshape(rows, columns) if columns > 1 else values
+    return arrays
+
+
+def run_job(files, output, force=False, resume=False, report=None, init_mpi=True):
+    """Run a namelist job as the program does (friction.h: friction_run_job): read
     `files` in order, compute, write `output`.  `report(message, fraction)` if
-    given receives progress (fraction in [0, 1]) and notes (fraction -1).  In
-    a process that has not initialised MPI the job runs on this process alone.
-    An interrupted sweep raises FrictionError with status 5."""
+    given receives progress (fraction in [0, 1]) and notes (fraction -1).
+    init_mpi: in a process that has not initialised MPI the library does
+    (MPI_THREAD_FUNNELED, for the rest of the process) and the job runs on this
+    process alone; False refuses instead.  An interrupted sweep raises
+    FrictionError with status 5."""
     paths = [os.fsencode(os.fspath(path)) for path in files]
     array = (ctypes.c_char_p * max(1, len(paths)))(*paths)
-    callback = _REPORT(lambda message, fraction, user: report(message.decode(errors="replace"), fraction)) \
-        if report is not None else _REPORT()
-    flags = (FORCE if force else 0) | (RESUME if resume else 0)
+    flags = (FORCE if force else 0) | (RESUME if resume else 0) | (INIT_MPI if init_mpi else 0)
+    callback = _callback(report)
     _call(library.friction_run_job, array, len(paths), os.fsencode(os.fspath(output)), flags, callback, None)

@@ -4,8 +4,7 @@
 !> program can report progress between them.
 module friction_brake_simulate
    use friction_kinds, only: wp, i8
-   use friction_error, only: error_type, fatal_error, error_input
-   use friction_strings, only: rtoa
+   use friction_error, only: error_type
    use friction_ode_solver, only: integrator_statistics
    use friction_brake_config, only: brake_config, model_switched
    use friction_brake_record, only: brake_trajectory, brake_event_table
@@ -51,28 +50,22 @@ contains
       y = [config%x0, config%params%v_dr + config%v_rel0, config%y0, config%w0]
    end function initial_state
 
-   !> Set up a run of a resolved configuration (parameters of Eq. 10 set).
+   !> Set up a run of a resolved configuration (parameters of Eq. 10 set)
+   !> that has passed its checks (brake_config%validate: among them a
+   !> positive normal force N' at the start; the job, the sweep and the C
+   !> API all check before they run).
    subroutine init(self, config, error)
       class(brake_run), target, intent(inout) :: self
       type(brake_config), intent(in) :: config
       type(error_type), allocatable, intent(out) :: error
-      real(wp) :: y0(4)
 
       self%config = config
       self%n = config%grid_size()
       self%done = 0
       self%compute_time = 0.0_wp
       call self%trajectory%allocate_points(self%n)
-      y0 = initial_state(config)
-      associate (p => config%params)
-         if (.not. (p%normal_force(y0(3)) > 0.0_wp)) then
-            call fatal_error(error, "&brake: the initial state has N' = (1 - kappa) y0 + g_prime = " &
-               & //rtoa(p%normal_force(y0(3)))//': must be > 0 (the pad presses on the belt)', error_input)
-            return
-         end if
-         call new_brake_integrator(config%model, self%integrator)
-         call self%integrator%start(config, config%t_start, y0, self%events, error)
-      end associate
+      call new_brake_integrator(config%model, self%integrator)
+      call self%integrator%start(config, config%t_start, initial_state(config), self%events, error)
    end subroutine init
 
    !> Fill the grid up to point last (or the end).  On error the points

@@ -1,31 +1,60 @@
-!> The C API (include/friction.h): bind(c) functions over the kernel for
-!> callers that compute without files.  Every call returns a status (0 on
-!> success, else one of the friction_error codes) and, when the caller passes
-!> an error handle, fills it with the status and a message.  No module
-!> variables: all context lives in the call's locals or in the caller's
-!> handle, so threads may call the API at once.
+!> The C API (include/friction.h), version 2: handles over the kernel.
+!>
+!> A configuration handle is a job's configuration (&job, the scene's
+!> groups, &sweep) made with its scene's defaults and changed by namelist
+!> files or by name ("tip.kx"), through the same description of the
+!> variables (core/parameters.f90) and the same checks (the scene's own)
+!> as the program's input.  Computations on the calling process (a scan
+!> line, a whole scene into a result handle) use the scanner and the brake
+!> run directly, without MPI; jobs run the program's job routine.
+!>
+!> Every call returns a status (0 on success, else one of the friction_error
+!> codes) and, when the caller passes an error handle, fills it with the
+!> status and a message.  No module variables: all state lives in the
+!> caller's handles or in the call's locals, so threads may work at once on
+!> different handles.
 module friction_capi
-   use, intrinsic :: iso_c_binding, only: c_ptr, c_char, c_int, c_double, c_size_t, c_null_char, &
+   use, intrinsic :: iso_c_binding, only: c_ptr, c_char, c_int, c_double, c_size_t, c_null_char, c_null_ptr, &
       & c_associated, c_f_pointer, c_loc, c_funptr, c_f_procpointer
-   use mpi_f08, only: MPI_Initialized, MPI_Init_thread, MPI_THREAD_FUNNELED, MPI_COMM_WORLD
+   use mpi_f08, only: MPI_Initialized, MPI_Finalized, MPI_Init_thread, MPI_THREAD_FUNNELED, MPI_COMM_WORLD
    use friction_kinds, only: wp
    use friction_error, only: error_type, fatal_error, error_input
+   use friction_strings, only: itoa, rtoa, join, quoted
    use friction_version, only: version_string
-   use friction_ode_solver, only: step_type_index
-   use friction_ode_auto, only: auto_name, auto_method
+   use friction_parameters, only: parameter_info, list_parameters, set_parameter, set_parameter_number, &
+      & get_parameter, kind_text, value_has_kind, split_name
+   use friction_checks, only: config_checker
+   use friction_input_reader, only: namelist_source, scan_files, apply_files
    use friction_surface_potential, only: surface_potential
    use friction_afm_config, only: afm_config, new_potential
-   use friction_afm_scan, only: afm_scanner, trip_record, q_fx, q_fy
-   use friction_brake_config, only: brake_config, model_names
+   use friction_afm_scan, only: afm_scanner, trip_record, quantity_names, quantity_count, q_fx, q_fy, q_jumps, &
+      & support_along, support_across
+   use friction_afm_output, only: line_friction
+   use friction_afm_scene, only: afm_scene
+   use friction_brake_config, only: brake_config
    use friction_brake_simulate, only: brake_run
-   use friction_strings, only: rtoa
-   use friction_job, only: run_job, job_reporter
+   use friction_brake_scene, only: brake_scene
+   use friction_job_factory, only: scene_names, new_scene
+   use friction_job_config, only: job_config, check_job, job_text, all_parameters, parameter_groups
+   use friction_job, only: run_job, run_job_config, job_reporter
    use friction_scene_report, only: progress_text
    implicit none
    private
 
-   public :: friction_version_c, friction_error_new, friction_error_free, friction_error_status, &
-      & friction_error_message, friction_afm_line, friction_brake, friction_run_job
+   public :: friction_version_c, friction_api_version, friction_error_new, friction_error_free, &
+      & friction_error_status, friction_error_message
+   public :: friction_config_new, friction_config_free, friction_config_read, friction_config_set, &
+      & friction_config_set_real, friction_config_get, friction_config_text, friction_config_names, &
+      & friction_config_check
+   public :: friction_afm_line, friction_compute, friction_result_get, friction_result_shape, &
+      & friction_result_names, friction_result_free
+   public :: friction_run_job, friction_run_config
+
+   !> FRICTION_API_VERSION of include/friction.h.
+   integer(c_int), parameter :: api_version = 2
+
+   !> friction_run_job / friction_run_config flags.
+   integer(c_int), parameter :: job_force = 1, job_resume = 2, job_init_mpi = 4
 
    !> What an opaque `friction_error *` points to.
    type :: capi_error
@@ -33,7 +62,26 @@ module friction_capi
       character(len=:), allocatable :: message
    end type capi_error
 
-   integer(c_int), parameter :: job_force = 1, job_resume = 2   !! friction_run_job flags
+   !> What an opaque `friction_config *` points to: the configuration and
+   !> where each value was last set (a file and line; '' when set by name),
+   !> for the checks' messages.
+   type :: capi_config
+      type(job_config) :: job
+      type(config_checker) :: origins
+   end type capi_config
+
+   !> One named array of a result: rows x columns, row-major (a series is
+   !> one column).
+   type :: result_item
+      character(len=32) :: name = ''
+      integer :: rows = 0, columns = 1
+      real(c_double), allocatable :: values(:)
+   end type result_item
+
+   !> What an opaque `friction_result *` points to.
+   type :: capi_result
+      type(result_item), allocatable :: items(:)
+   end type capi_result
 
    !> A job's progress and notes through the caller's C function (if any):
    !> void report(const char *message, double fraction, void *user), with
@@ -65,26 +113,45 @@ module friction_capi
 
 contains
 
-   !> Copy text into a caller buffer of len bytes, NUL-terminated; false if
-   !> the buffer is null or too small (nothing written but a NUL then).
-   function copy_out(text, buf, len) result(ok)
+   ! ---- strings, buffers, errors ----
+
+   !> Copy text and a NUL into a caller buffer of len bytes; `needed` is the
+   !> bytes it takes (NUL included).  False if the buffer is null or too
+   !> small: then as much as fits is written, NUL-terminated (if len > 0).
+   function copy_text(text, buf, len, needed) result(ok)
       character(len=*), intent(in) :: text
       type(c_ptr), intent(in) :: buf
       integer(c_size_t), intent(in) :: len
+      type(c_ptr), intent(in), optional :: needed
       logical :: ok
       character(kind=c_char), pointer :: out(:)
+      integer(c_size_t), pointer :: needed_out
       integer :: i, n
 
+      if (present(needed)) then
+         if (c_associated(needed)) then
+            call c_f_pointer(needed, needed_out)
+            needed_out = int(len_text(text) + 1, c_size_t)
+         end if
+      end if
       ok = .false.
       if (.not. c_associated(buf) .or. len < 1) return
       call c_f_pointer(buf, out, [len])
-      n = min(len_trim(text), int(len) - 1)
+      n = int(min(int(len_text(text), c_size_t), len - 1))
       do i = 1, n
          out(i) = text(i:i)
       end do
       out(n + 1) = c_null_char
-      ok = len_trim(text) < len
-   end function copy_out
+      ok = len_text(text) < len
+   end function copy_text
+
+   !> len(text), for the procedures whose argument `len` (the C name) hides
+   !> the intrinsic.
+   pure integer function len_text(text)
+      character(len=*), intent(in) :: text
+
+      len_text = len(text)
+   end function len_text
 
    !> A C string as Fortran text; '' for a null pointer.
    function c_string(s) result(text)
@@ -123,14 +190,31 @@ contains
       end if
    end function report
 
+   !> An input error with a message, stored in the handle; its status.
+   integer(c_int) function refuse(handle, message) result(status)
+      type(c_ptr), intent(in) :: handle
+      character(len=*), intent(in) :: message
+      type(error_type), allocatable :: error
+
+      call fatal_error(error, message, error_input)
+      status = report(handle, error)
+   end function refuse
+
+   ! ---- version and error handles ----
+
    !> int friction_version(char *buf, size_t len)
    integer(c_int) function friction_version_c(buf, len) bind(c, name='friction_version') result(status)
       type(c_ptr), value :: buf
       integer(c_size_t), value :: len
 
       status = 0
-      if (.not. copy_out(version_string, buf, len)) status = error_input
+      if (.not. copy_text(version_string, buf, len)) status = error_input
    end function friction_version_c
+
+   !> int friction_api_version(void)
+   integer(c_int) function friction_api_version() bind(c, name='friction_api_version') result(version)
+      version = api_version
+   end function friction_api_version
 
    !> friction_error *friction_error_new(void)
    type(c_ptr) function friction_error_new() bind(c, name='friction_error_new') result(handle)
@@ -173,229 +257,793 @@ contains
 
       status = error_input
       if (.not. c_associated(handle)) then
-         copied = copy_out('', buf, len)   ! an empty message, still a failure
+         copied = copy_text('', buf, len)   ! an empty message, still a failure
          return
       end if
       call c_f_pointer(handle, err)
-      if (copy_out(err%message, buf, len)) status = 0
+      if (copy_text(err%message, buf, len)) status = 0
    end function friction_error_message
 
-   !> Check a real is finite and above (or, when allow_zero, at least) zero.
-   subroutine require(name, value, allow_zero, error)
-      character(len=*), intent(in) :: name
-      real(c_double), intent(in) :: value
-      logical, intent(in) :: allow_zero
+   ! ---- configurations ----
+
+   !> friction_config *friction_config_new(const char *scene, friction_error *err):
+   !> a configuration of the scene with its defaults; NULL on an unknown scene.
+   type(c_ptr) function friction_config_new(scene_name, handle) bind(c, name='friction_config_new') result(cfg)
+      type(c_ptr), value :: scene_name, handle
+      type(capi_config), pointer :: config
+      character(len=:), allocatable :: name
+      integer(c_int) :: status
+      type(error_type), allocatable :: none
+
+      cfg = c_null_ptr
+      if (.not. c_associated(scene_name)) then
+         status = refuse(handle, 'scene is a null pointer (known: '//quoted(scene_names)//')')
+         return
+      end if
+      name = c_string(scene_name)
+      allocate (config)
+      call new_scene(name, config%job%scene)
+      if (.not. allocated(config%job%scene) .or. len(name) > len(config%job%scene_name)) then
+         deallocate (config)
+         status = refuse(handle, "unknown scene '"//name//"' (known: "//quoted(scene_names)//')')
+         return
+      end if
+      config%job%scene_name = name
+      cfg = c_loc(config)
+      status = report(handle, none)
+   end function friction_config_new
+
+   !> void friction_config_free(friction_config *cfg); null is ignored.
+   subroutine friction_config_free(cfg) bind(c, name='friction_config_free')
+      type(c_ptr), value :: cfg
+      type(capi_config), pointer :: config
+
+      if (.not. c_associated(cfg)) return
+      call c_f_pointer(cfg, config)
+      deallocate (config)
+   end subroutine friction_config_free
+
+   !> The configuration behind a handle; false (and an error) for null.
+   function config_of(cfg, config, error) result(ok)
+      type(c_ptr), intent(in) :: cfg
+      type(capi_config), pointer, intent(out) :: config
+      type(error_type), allocatable, intent(inout) :: error
+      logical :: ok
+
+      ok = c_associated(cfg)
+      nullify (config)
+      if (ok) then
+         call c_f_pointer(cfg, config)
+      else
+         call fatal_error(error, 'the configuration is a null pointer', error_input)
+      end if
+   end function config_of
+
+   !> The groups of a configuration (&job, its scene's, &sweep), as a
+   !> message lists them.
+   function own_groups(job) result(text)
+      type(job_config), intent(inout) :: job
+      character(len=:), allocatable :: text
+
+      text = join(parameter_groups(list_parameters(job)), ' ', '&')
+   end function own_groups
+
+   !> A name 'group.variable' or 'group.variable(k)' for set and get, in
+   !> `job` (the handle's copy): its group, variable, element (0 for none)
+   !> and the variable's description.  The messages are the namelist
+   !> reader's where it has one.
+   subroutine resolve_name(job, full, group, name, first, info, error)
+      type(job_config), intent(inout) :: job
+      character(len=*), intent(in) :: full
+      character(len=:), allocatable, intent(out) :: group, name
+      integer, intent(out) :: first
+      type(parameter_info), intent(out) :: info
+      type(error_type), allocatable, intent(out) :: error
+      type(parameter_info), allocatable :: universe(:), mine(:)
+      character(len=32), allocatable :: known(:)
+      integer :: paren, stat, k
+
+      first = 0
+      call split_name(full, group, name)
+      if (index(full, '.') == 0 .or. len(group) == 0 .or. len(name) == 0) then
+         call fatal_error(error, "name '"//full//"': give a variable as 'group.variable', e.g. 'tip.kx' or " &
+            & //"'surface.sigma(2)'", error_input)
+         return
+      end if
+      paren = index(name, '(')
+      if (paren > 0) then
+         stat = 1
+         if (name(len(name):) == ')' .and. paren < len(name) - 1) then
+            if (verify(name(paren + 1:len(name) - 1), '0123456789') == 0) &
+               & read (name(paren + 1:len(name) - 1), *, iostat=stat) first
+         end if
+         if (stat /= 0 .or. first < 1) then
+            call fatal_error(error, "name '"//full//"': the element is a whole number >= 1 in parentheses, " &
+               & //"e.g. 'surface.sigma(2)'", error_input)
+            return
+         end if
+         name = name(1:paren - 1)
+      end if
+      universe = all_parameters()
+      known = parameter_groups(universe)
+      if (.not. any(known == group)) then
+         call fatal_error(error, 'unknown namelist group &'//group//' (known: '//join(known, ' ', '&')//')', &
+            & error_input)
+         return
+      end if
+      mine = list_parameters(job)
+      if (.not. any(mine%group == group)) then
+         call fatal_error(error, 'group &'//group//" is not part of scene '"//trim(job%scene_name) &
+            & //"' (its groups: "//own_groups(job)//')', error_input)
+         return
+      end if
+      do k = 1, size(mine)
+         if (mine(k)%group == group .and. mine(k)%name == name) then
+            info = mine(k)
+            return
+         end if
+      end do
+      known = pack(universe%name, universe%group == group)
+      call fatal_error(error, '&'//group//": unknown variable '"//name//"' (known: "//join(known)//')', error_input)
+   end subroutine resolve_name
+
+   !> After a set of work's &job: the scene cannot change.
+   subroutine check_scene_kept(config, work, value, error)
+      type(capi_config), intent(in) :: config
+      type(job_config), intent(in) :: work
+      character(len=*), intent(in) :: value
       type(error_type), allocatable, intent(inout) :: error
 
-      if (allocated(error)) return
-      if (.not. (abs(value) <= huge(value))) then
-         call fatal_error(error, name//' must be finite', error_input)
-      else if (allow_zero .and. value < 0.0_wp) then
-         call fatal_error(error, name//' = '//rtoa(real(value, wp))//': must be >= 0', error_input)
-      else if (.not. allow_zero .and. value <= 0.0_wp) then
-         call fatal_error(error, name//' = '//rtoa(real(value, wp))//': must be > 0', error_input)
-      end if
-   end subroutine require
+      if (allocated(error) .or. work%scene_name == config%job%scene_name) return
+      call fatal_error(error, '&job: scene = '//value//": the configuration is of scene '" &
+         & //trim(config%job%scene_name)//"' (friction_config_new chooses the scene)", error_input)
+   end subroutine check_scene_kept
 
-   !> One AFM scan line: the lateral force fx, fy (nN) at nx support positions
-   !> from (x0, y0) along angle (degrees) over length (Å), forward (trace) or
-   !> backward (retrace, still stored by position).  Units as the namelist:
-   !> V0 eV, lattice Å, mass kg, k N/m, c N s/m, velocity Å/s.
-   integer(c_int) function friction_afm_line(potential, v0, ax, ay, a, mass, kx, ky, cx, cy, velocity, &
-      & x0, y0, angle, length, nx, forward, stepper, rtol, atol, fx, fy, handle) &
-      & bind(c, name='friction_afm_line') result(status)
-      type(c_ptr), value :: potential, stepper, fx, fy, handle
-      real(c_double), value :: v0, ax, ay, a, mass, kx, ky, cx, cy, velocity, x0, y0, angle, length, &
-         & rtol, atol
-      integer(c_int), value :: nx, forward
+   !> int friction_config_set(friction_config *cfg, const char *name, const char *value,
+   !>                         friction_error *err)
+   integer(c_int) function friction_config_set(cfg, name_c, value_c, handle) bind(c, name='friction_config_set') &
+      & result(status)
+      type(c_ptr), value :: cfg, name_c, value_c, handle
+      type(capi_config), pointer :: config
       type(error_type), allocatable :: error
-      type(afm_config) :: config
-      class(surface_potential), allocatable :: surface
-      type(afm_scanner) :: scanner
-      type(trip_record) :: record
-      real(c_double), pointer :: fx_out(:), fy_out(:)
-      character(len=:), allocatable :: name, method
+      type(job_config) :: work
+      type(parameter_info) :: info
+      character(len=:), allocatable :: full, value, group, name, problem, shown
+      integer :: first
 
-      name = c_string(potential)
-      method = c_string(stepper)
-      if (method == auto_name) method = auto_method('afm', name, real(rtol, wp))
-      if (.not. c_associated(potential)) then
-         call fatal_error(error, 'potential name is a null pointer', error_input)
-      else if (.not. c_associated(stepper)) then
-         call fatal_error(error, 'stepper name is a null pointer', error_input)
-      else if (.not. (c_associated(fx) .and. c_associated(fy))) then
-         call fatal_error(error, 'fx and fy must not be null', error_input)
-      else if (name /= 'naf' .and. name /= 'hopg') then
-         call fatal_error(error, "unknown potential '"//name//"': expected 'naf' or 'hopg'", error_input)
-      else if (len(method) > len(config%solver%method) .or. step_type_index(method) == 0) then
-         call fatal_error(error, "unknown stepper '"//method//"'", error_input)
-      else if (nx < 2) then
-         call fatal_error(error, 'nx must be >= 2', error_input)
+      if (.not. config_of(cfg, config, error)) then
+         status = report(handle, error)
+         return
       end if
-      call require('V0', v0, .true., error)
-      if (name == 'naf') then
-         call require('ax', ax, .false., error)
-         call require('ay', ay, .false., error)
-      else
-         call require('a', a, .false., error)
+      if (.not. c_associated(name_c) .or. .not. c_associated(value_c)) then
+         status = refuse(handle, 'name and value must not be null pointers')
+         return
       end if
-      call require('mass', mass, .false., error)
-      call require('kx', kx, .true., error)
-      call require('ky', ky, .true., error)
-      call require('cx', cx, .true., error)
-      call require('cy', cy, .true., error)
-      call require('velocity', velocity, .false., error)
-      call require('length', length, .false., error)
-      call require('rtol', rtol, .false., error)
-      call require('atol', atol, .false., error)
-      if (.not. allocated(error) .and. .not. (abs(x0) <= huge(x0) .and. abs(y0) <= huge(y0) &
-         & .and. abs(angle) <= huge(angle))) call fatal_error(error, 'x0, y0 and angle must be finite', error_input)
+      full = c_string(name_c)
+      value = c_string(value_c)
+      ! On a copy: a value refused changes nothing.
+      work = config%job
+      call resolve_name(work, full, group, name, first, info, error)
+      if (.not. allocated(error) .and. .not. value_has_kind(value, info%kind)) &
+         & call fatal_error(error, '&'//group//': '//name//' = '//value//': expected '//kind_text(info%kind), &
+         & error_input)
       if (allocated(error)) then
          status = report(handle, error)
          return
       end if
-
-      config%potential = name
-      config%v0 = v0
-      config%ax = ax
-      config%ay = ay
-      config%a = a
-      config%mass = mass
-      config%kx = kx
-      config%ky = ky
-      config%cx = cx
-      config%cy = cy
-      config%velocity = velocity
-      config%origin_x = x0
-      config%origin_y = y0
-      config%angle = angle
-      config%length = length
-      config%width = 0.0_wp
-      config%lead_in = 0.0_wp
-      config%nx = nx
-      config%ny = 1
-      config%solver%method = method
-      config%solver%rtol = rtol
-      config%solver%atol = atol
-
-      call new_potential(config, surface, error)
-      if (.not. allocated(error)) call scanner%init(config, surface, error)
-      if (.not. allocated(error)) call scanner%run_trip(0, forward /= 0, record, error)
+      call set_parameter(work, group, name, value, first, '', problem)
+      if (len(problem) > 0) then
+         shown = name
+         if (first > 0) shown = shown//'('//itoa(first)//')'
+         call fatal_error(error, '&'//group//': '//shown//' = '//value//': '//problem, error_input)
+      end if
+      call check_scene_kept(config, work, value, error)
       if (.not. allocated(error)) then
-         call c_f_pointer(fx, fx_out, [nx])
-         call c_f_pointer(fy, fy_out, [nx])
-         fx_out = record%values(:, q_fx)
-         fy_out = record%values(:, q_fy)
+         config%job = work
+         call config%origins%set_origin(group, name, '')
+      end if
+      status = report(handle, error)
+   end function friction_config_set
+
+   !> int friction_config_set_real(friction_config *cfg, const char *name, double x,
+   !>                              friction_error *err)
+   integer(c_int) function friction_config_set_real(cfg, name_c, x, handle) &
+      & bind(c, name='friction_config_set_real') result(status)
+      type(c_ptr), value :: cfg, name_c, handle
+      real(c_double), value :: x
+      type(capi_config), pointer :: config
+      type(error_type), allocatable :: error
+      type(job_config) :: work
+      type(parameter_info) :: info
+      character(len=:), allocatable :: full, group, name, problem, shown
+      integer :: first
+
+      if (.not. config_of(cfg, config, error)) then
+         status = report(handle, error)
+         return
+      end if
+      if (.not. c_associated(name_c)) then
+         status = refuse(handle, 'name must not be a null pointer')
+         return
+      end if
+      full = c_string(name_c)
+      work = config%job
+      call resolve_name(work, full, group, name, first, info, error)
+      if (allocated(error)) then
+         status = report(handle, error)
+         return
+      end if
+      call set_parameter_number(work, group, name, real(x, wp), problem, first)
+      if (len(problem) > 0) then
+         shown = name
+         if (first > 0) shown = shown//'('//itoa(first)//')'
+         call fatal_error(error, '&'//group//': '//shown//' = '//rtoa(real(x, wp))//': '//problem, error_input)
+      else
+         config%job = work
+         call config%origins%set_origin(group, name, '')
+      end if
+      status = report(handle, error)
+   end function friction_config_set_real
+
+   !> int friction_config_get(const friction_config *cfg, const char *name, char *buf,
+   !>                         size_t len, friction_error *err)
+   integer(c_int) function friction_config_get(cfg, name_c, buf, len, handle) bind(c, name='friction_config_get') &
+      & result(status)
+      type(c_ptr), value :: cfg, name_c, buf, handle
+      integer(c_size_t), value :: len
+      type(capi_config), pointer :: config
+      type(error_type), allocatable :: error
+      type(job_config) :: work
+      type(parameter_info) :: info
+      character(len=:), allocatable :: full, group, name, text, problem
+      integer :: first
+
+      if (.not. config_of(cfg, config, error)) then
+         status = report(handle, error)
+         return
+      end if
+      if (.not. c_associated(name_c)) then
+         status = refuse(handle, 'name must not be a null pointer')
+         return
+      end if
+      full = c_string(name_c)
+      work = config%job   ! (visiting writes each value back: a copy leaves the handle untouched)
+      call resolve_name(work, full, group, name, first, info, error)
+      if (allocated(error)) then
+         status = report(handle, error)
+         return
+      end if
+      call get_parameter(work, group, name, first, text, problem)
+      if (len_text(problem) > 0) then
+         call fatal_error(error, "name '"//full//"': "//problem, error_input)
+      else if (.not. c_associated(buf)) then
+         call fatal_error(error, 'buf is a null pointer', error_input)
+      else if (.not. copy_text(text, buf, len)) then
+         call fatal_error(error, 'a buffer of '//itoa(int(len))//' bytes is too small for the value of '//full &
+            & //': '//itoa(len_text(text) + 1)//' bytes needed', error_input)
+      end if
+      status = report(handle, error)
+   end function friction_config_get
+
+   !> int friction_config_text(const friction_config *cfg, char *buf, size_t len, size_t *needed)
+   integer(c_int) function friction_config_text(cfg, buf, len, needed) bind(c, name='friction_config_text') &
+      & result(status)
+      type(c_ptr), value :: cfg, buf, needed
+      integer(c_size_t), value :: len
+      type(capi_config), pointer :: config
+      type(job_config) :: work
+
+      status = error_input
+      if (.not. c_associated(cfg)) return
+      call c_f_pointer(cfg, config)
+      work = config%job
+      status = text_status(job_text(work), buf, len, needed)
+   end function friction_config_text
+
+   !> Text into a buffer: 0 when it fits; a size query (buf null, len 0)
+   !> also succeeds; a buffer too small (truncated) or null is an input error.
+   integer(c_int) function text_status(text, buf, len, needed) result(status)
+      character(len=*), intent(in) :: text
+      type(c_ptr), intent(in) :: buf, needed
+      integer(c_size_t), intent(in) :: len
+
+      status = 0
+      if (copy_text(text, buf, len, needed)) return
+      if (.not. (.not. c_associated(buf) .and. len == 0 .and. c_associated(needed))) status = error_input
+   end function text_status
+
+   !> int friction_config_names(const friction_config *cfg, char *buf, size_t len, size_t *needed):
+   !> one line per variable: group.name, kind, elements, unit, tab-separated.
+   integer(c_int) function friction_config_names(cfg, buf, len, needed) bind(c, name='friction_config_names') &
+      & result(status)
+      type(c_ptr), value :: cfg, buf, needed
+      integer(c_size_t), value :: len
+      type(capi_config), pointer :: config
+      type(job_config) :: work
+      type(parameter_info), allocatable :: list(:)
+      character(len=:), allocatable :: text
+      character(len=8) :: kind
+      integer :: k
+
+      status = error_input
+      if (.not. c_associated(cfg)) return
+      call c_f_pointer(cfg, config)
+      work = config%job
+      list = list_parameters(work)
+      text = ''
+      do k = 1, size(list)
+         select case (list(k)%kind)
+         case ('r'); kind = 'real'
+         case ('i'); kind = 'integer'
+         case ('l'); kind = 'logical'
+         case default; kind = 'text'
+         end select
+         text = text//trim(list(k)%group)//'.'//trim(list(k)%name)//achar(9)//trim(kind)//achar(9) &
+            & //itoa(list(k)%size)//achar(9)//trim(list(k)%unit)//new_line('a')
+      end do
+      status = text_status(text, buf, len, needed)
+   end function friction_config_names
+
+   !> int friction_config_read(friction_config *cfg, const char *path, friction_error *err):
+   !> the file's values over the current ones, all or nothing.
+   integer(c_int) function friction_config_read(cfg, path_c, handle) bind(c, name='friction_config_read') &
+      & result(status)
+      type(c_ptr), value :: cfg, path_c, handle
+      type(capi_config), pointer :: config
+      type(error_type), allocatable :: error
+      type(namelist_source), allocatable :: sources(:)
+      type(parameter_info), allocatable :: universe(:), mine(:)
+      type(job_config) :: work, probe
+      type(config_checker) :: origins
+      character(len=:), allocatable :: path, problem, where
+      character(len=4096) :: paths(1)
+      integer :: k
+
+      if (.not. config_of(cfg, config, error)) then
+         status = report(handle, error)
+         return
+      end if
+      if (.not. c_associated(path_c)) then
+         status = refuse(handle, 'path is a null pointer')
+         return
+      end if
+      path = c_string(path_c)
+      if (len(path) > len(paths) .or. len(path) == 0) then
+         status = refuse(handle, "path '"//path//"': give a file name of 1 to "//itoa(len(paths))//' characters')
+         return
+      end if
+      paths(1) = path
+      universe = all_parameters()
+      call scan_files(paths, parameter_groups(universe), sources, error)
+      if (allocated(error)) then
+         status = report(handle, error)
+         return
+      end if
+      ! The file may name this configuration's scene, no other; and only its groups.
+      work = config%job
+      mine = list_parameters(work)
+      do k = 1, size(sources(1)%mentions)
+         associate (m => sources(1)%mentions(k))
+            where = path//':'//itoa(m%line)//': '
+            if (m%group == 'job' .and. m%name == 'scene') then
+               call set_parameter(probe, 'job', 'scene', m%value, 0, '', problem)
+               if (len(problem) == 0 .and. probe%scene_name /= config%job%scene_name) then
+                  call fatal_error(error, where//'&job: scene = '//trim(m%value)//": the configuration is of " &
+                     & //"scene '"//trim(config%job%scene_name)//"' (friction_config_new chooses the scene)", &
+                     & error_input)
+                  exit
+               end if
+            end if
+            if (.not. any(mine%group == m%group)) then
+               call fatal_error(error, where//'group &'//trim(m%group)//" is not part of scene '" &
+                  & //trim(config%job%scene_name)//"' (its groups: "//own_groups(work)//')', error_input)
+               exit
+            end if
+         end associate
+      end do
+      if (.not. allocated(error)) then
+         origins = config%origins
+         call apply_files(sources, universe, work, origins, error)
+      end if
+      if (.not. allocated(error)) then
+         config%job = work
+         config%origins = origins
+      end if
+      status = report(handle, error)
+   end function friction_config_read
+
+   !> The configuration's checks (those of a job read from files), on a copy.
+   subroutine check_config(config, work, error)
+      type(capi_config), intent(in) :: config
+      type(job_config), intent(out) :: work
+      type(error_type), allocatable, intent(out) :: error
+      type(config_checker) :: checker
+
+      work = config%job
+      checker = config%origins
+      call check_job(work, checker)
+      if (checker%failed()) call move_alloc(checker%error, error)
+   end subroutine check_config
+
+   !> int friction_config_check(const friction_config *cfg, friction_error *err)
+   integer(c_int) function friction_config_check(cfg, handle) bind(c, name='friction_config_check') result(status)
+      type(c_ptr), value :: cfg, handle
+      type(capi_config), pointer :: config
+      type(error_type), allocatable :: error
+      type(job_config) :: work
+
+      if (config_of(cfg, config, error)) call check_config(config, work, error)
+      status = report(handle, error)
+   end function friction_config_check
+
+   ! ---- computations on this process ----
+
+   !> int friction_afm_line(const friction_config *cfg, int line, int forward,
+   !>                       double *fx, double *fy, size_t n, friction_error *err)
+   integer(c_int) function friction_afm_line(cfg, line, forward, fx, fy, n, handle) &
+      & bind(c, name='friction_afm_line') result(status)
+      type(c_ptr), value :: cfg, fx, fy, handle
+      integer(c_int), value :: line, forward
+      integer(c_size_t), value :: n
+      type(capi_config), pointer :: config
+      type(error_type), allocatable :: error
+      type(job_config) :: work
+      type(afm_config) :: c
+      class(surface_potential), allocatable :: potential
+      type(afm_scanner), target :: scanner
+      type(trip_record) :: trip
+      real(c_double), pointer :: out(:)
+
+      if (.not. config_of(cfg, config, error)) then
+         status = report(handle, error)
+         return
+      end if
+      if (.not. (c_associated(fx) .and. c_associated(fy))) then
+         status = refuse(handle, 'fx and fy must not be null pointers')
+         return
+      end if
+      if (config%job%scene_name /= 'afm') then
+         status = refuse(handle, "friction_afm_line needs a configuration of scene 'afm', not '" &
+            & //trim(config%job%scene_name)//"'")
+         return
+      end if
+      call check_config(config, work, error)
+      if (allocated(error)) then
+         status = report(handle, error)
+         return
+      end if
+      select type (s => work%scene)
+      type is (afm_scene)
+         c = s%resolved()
+      end select
+      if (line < 0 .or. line >= c%ny) then
+         status = refuse(handle, 'line = '//itoa(int(line))//': the map has lines 0 to '//itoa(c%ny - 1) &
+            & //' (scan.ny = '//itoa(c%ny)//')')
+         return
+      end if
+      if (n < c%nx) then
+         status = refuse(handle, 'n = '//itoa(int(n))//': fx and fy must hold scan.nx = '//itoa(c%nx)//' values')
+         return
+      end if
+      call new_potential(c, potential, error)
+      if (.not. allocated(error)) call scanner%init(c, potential, error)
+      if (.not. allocated(error)) call scanner%run_trip(int(line), forward /= 0, trip, error)
+      if (.not. allocated(error)) then
+         call c_f_pointer(fx, out, [c%nx])
+         out = trip%values(:, q_fx)
+         call c_f_pointer(fy, out, [c%nx])
+         out = trip%values(:, q_fy)
       end if
       status = report(handle, error)
    end function friction_afm_line
 
-   !> The brake (Eq. 10, nondimensional parameters) from the state of §4.1
-   !> on the grid 0, dt_out, ..., t_end (τ) into t, x, v, y, w of length n.
-   !> If n is too small, *needed gets the length and the status is an
-   !> input error; needed may be null.
-   integer(c_int) function friction_brake(model, xi, kappa, g_prime, mu, mu_s, epsilon_prime, delta_prime, &
-      & v_dr, t_end, dt_out, stepper, rtol, atol, t, x, v, y, w, n, needed, handle) &
-      & bind(c, name='friction_brake') result(status)
-      type(c_ptr), value :: model, stepper, t, x, v, y, w, needed, handle
-      real(c_double), value :: xi, kappa, g_prime, mu, mu_s, epsilon_prime, delta_prime, v_dr, t_end, &
-         & dt_out, rtol, atol
-      integer(c_size_t), value :: n
+   !> friction_result *friction_compute(const friction_config *cfg, friction_error *err)
+   type(c_ptr) function friction_compute(cfg, handle) bind(c, name='friction_compute') result(res)
+      type(c_ptr), value :: cfg, handle
+      type(capi_config), pointer :: config
+      type(capi_result), pointer :: result
       type(error_type), allocatable :: error
-      type(brake_config) :: config
-      type(brake_run), target :: run
-      character(len=:), allocatable :: name, method
-      integer(c_size_t), pointer :: needed_out
-      real(c_double), pointer :: out(:)
-      integer :: points
+      type(job_config) :: work
+      integer(c_int) :: status
 
-      name = c_string(model)
-      method = c_string(stepper)
-      if (method == auto_name) method = auto_method('brake', name, real(rtol, wp))
-      if (.not. c_associated(model)) then
-         call fatal_error(error, 'model name is a null pointer', error_input)
-      else if (.not. c_associated(stepper)) then
-         call fatal_error(error, 'stepper name is a null pointer', error_input)
-      else if (.not. any(name == model_names)) then
-         call fatal_error(error, "unknown model '"//name//"': expected 'switched' or 'regularized'", error_input)
-      else if (len(method) > len(config%solver%method) .or. step_type_index(method) == 0) then
-         call fatal_error(error, "unknown stepper '"//method//"'", error_input)
-      end if
-      call require('xi', xi, .false., error)
-      call require('kappa', kappa, .false., error)
-      call require('mu', mu, .true., error)
-      call require('mu_s', mu_s, .true., error)
-      ! As the namelist: epsilon' matters only to the regularized model.
-      if (name == 'regularized') call require('epsilon_prime', epsilon_prime, .false., error)
-      call require('delta_prime', delta_prime, .true., error)
-      call require('t_end', t_end, .false., error)
-      call require('dt_out', dt_out, .false., error)
-      call require('rtol', rtol, .false., error)
-      call require('atol', atol, .false., error)
-      if (.not. allocated(error) .and. .not. (abs(v_dr) <= huge(v_dr) .and. abs(g_prime) <= huge(g_prime) &
-         & .and. abs(epsilon_prime) <= huge(epsilon_prime))) &
-         & call fatal_error(error, 'v_dr, g_prime and epsilon_prime must be finite', error_input)
-      ! The switched model's stick/slip decision needs mu <= mu_s (as the namelist).
-      if (.not. allocated(error) .and. name == 'switched' .and. mu_s < mu) &
-         & call fatal_error(error, 'mu_s = '//rtoa(real(mu_s, wp))//': must be >= mu = '//rtoa(real(mu, wp)) &
-         & //' for the switched model', error_input)
-      if (.not. allocated(error) .and. t_end / dt_out > 1.0e9_wp) &
-         & call fatal_error(error, 't_end / dt_out is too large (> 1e9 points)', error_input)
+      res = c_null_ptr
+      if (config_of(cfg, config, error)) call check_config(config, work, error)
+      if (.not. allocated(error) .and. work%sweep%enabled()) call fatal_error(error, "&sweep: sweep_variable = '" &
+         & //trim(work%sweep%variables(1))//"': friction_compute computes one scene; run the sweep with " &
+         & //'friction_run_config', error_input)
       if (allocated(error)) then
          status = report(handle, error)
          return
       end if
+      allocate (result)
+      allocate (result%items(0))
+      select type (s => work%scene)
+      type is (afm_scene)
+         call compute_afm(s%resolved(), result, error)
+      type is (brake_scene)
+         call compute_brake(s%resolved(), result, error)
+      class default
+         call fatal_error(error, "friction_compute: no computation for scene '"//trim(work%scene_name)//"'", &
+            & error_input)
+      end select
+      status = report(handle, error)
+      if (allocated(error)) then
+         deallocate (result)
+      else
+         res = c_loc(result)
+      end if
+   end function friction_compute
 
-      config%model = name
-      config%params%xi = xi
-      config%params%kappa = kappa
-      config%params%g_prime = g_prime
-      config%params%mu = mu
-      config%params%mu_s = mu_s
-      config%params%epsilon_prime = epsilon_prime
-      config%params%delta_prime = delta_prime
-      config%params%v_dr = v_dr
-      config%t_start = 0.0_wp
-      config%t_end = t_end
-      config%dt_out = dt_out
-      config%solver%method = method
-      config%solver%rtol = rtol
-      config%solver%atol = atol
-      points = config%grid_size()
-      if (c_associated(needed)) then
-         call c_f_pointer(needed, needed_out)
-         needed_out = int(points, c_size_t)
+   !> Append an item of rows x columns values (row-major).
+   subroutine add_item(result, name, rows, columns, values)
+      type(capi_result), intent(inout) :: result
+      character(len=*), intent(in) :: name
+      integer, intent(in) :: rows, columns
+      real(wp), intent(in) :: values(:)
+      type(result_item), allocatable :: items(:)
+      integer :: k
+
+      allocate (items(size(result%items) + 1))
+      do k = 1, size(result%items)
+         items(k)%name = result%items(k)%name
+         items(k)%rows = result%items(k)%rows
+         items(k)%columns = result%items(k)%columns
+         call move_alloc(result%items(k)%values, items(k)%values)
+      end do
+      k = size(items)
+      items(k)%name = name
+      items(k)%rows = rows
+      items(k)%columns = columns
+      items(k)%values = values
+      call move_alloc(items, result%items)
+   end subroutine add_item
+
+   !> The whole map on this process: every line's trace (and retrace), as
+   !> the program's file holds them under /afm.
+   subroutine compute_afm(c, result, error)
+      type(afm_config), intent(in) :: c
+      type(capi_result), intent(inout) :: result
+      type(error_type), allocatable, intent(out) :: error
+      class(surface_potential), allocatable :: potential
+      type(afm_scanner), target :: scanner
+      type(trip_record) :: trip
+      real(wp), allocatable :: trace(:, :, :), retrace(:, :, :)
+      integer :: j, q
+
+      call new_potential(c, potential, error)
+      if (allocated(error)) return
+      call scanner%init(c, potential, error)
+      if (allocated(error)) return
+      ! (line j's samples are trace(:, j, q): row-major (ny, nx) as it lies)
+      allocate (trace(c%nx, c%ny, size(quantity_names)), retrace(c%nx, merge(c%ny, 0, c%retrace), &
+         & size(quantity_names)))
+      do j = 1, c%ny
+         call scanner%run_trip(j - 1, .true., trip, error)
+         if (allocated(error)) return
+         trace(:, j, :) = trip%values
+         if (c%retrace) then
+            call scanner%run_trip(j - 1, .false., trip, error)
+            if (allocated(error)) return
+            retrace(:, j, :) = trip%values
+         end if
+      end do
+      call add_item(result, 'support_x', c%nx, 1, support_along(c))
+      call add_item(result, 'support_y', c%ny, 1, support_across(c))
+      call add_trips('trace', trace)
+      if (c%retrace) then
+         call add_trips('retrace', retrace)
+         call add_item(result, 'friction', c%ny, 1, line_friction(trace, retrace))
       end if
-      if (n < points) then
-         call fatal_error(error, 'arrays of length '//itoa(int(n))//' are too small: '//itoa(points) &
-            & //' points needed', error_input)
-      else if (.not. (c_associated(t) .and. c_associated(x) .and. c_associated(v) .and. c_associated(y) &
-         & .and. c_associated(w))) then
-         call fatal_error(error, 't, x, v, y and w must not be null', error_input)
+
+   contains
+
+      subroutine add_trips(trip_name, values)
+         character(len=*), intent(in) :: trip_name
+         real(wp), intent(in) :: values(:, :, :)
+
+         do q = 1, quantity_count(scanner%tip%ndim)
+            call add_item(result, trip_name//'/'//trim(quantity_names(q)), c%ny, c%nx, &
+               & reshape(values(:, :, q), [c%nx * c%ny]))
+         end do
+         if (c%model == 'quasistatic') call add_item(result, trip_name//'/'//trim(quantity_names(q_jumps)), &
+            & c%ny, c%nx, reshape(values(:, :, q_jumps), [c%nx * c%ny]))
+      end subroutine add_trips
+
+   end subroutine compute_afm
+
+   !> The brake's trajectory and events on this process, as the program's
+   !> file holds them under /brake.
+   subroutine compute_brake(c, result, error)
+      type(brake_config), intent(in) :: c
+      type(capi_result), intent(inout) :: result
+      type(error_type), allocatable, intent(out) :: error
+      type(brake_run), target :: run
+      integer :: n, k
+
+      call run%init(c, error)
+      if (allocated(error)) return
+      call run%run_until(run%n, error)
+      if (allocated(error)) return
+      n = run%n
+      associate (r => run%trajectory)
+         call add_item(result, 't', n, 1, r%t(1:n))
+         call add_item(result, 'x', n, 1, r%x(1:n))
+         call add_item(result, 'v', n, 1, r%v(1:n))
+         call add_item(result, 'y', n, 1, r%y(1:n))
+         call add_item(result, 'w', n, 1, r%w(1:n))
+         call add_item(result, 'stick', n, 1, real(r%stick(1:n), wp))
+      end associate
+      n = run%events%n
+      if (n == 0) then
+         call add_item(result, 'events/t', 0, 1, [real(wp) ::])
+         call add_item(result, 'events/kind', 0, 1, [real(wp) ::])
+         do k = 1, 4
+            call add_item(result, 'events/'//trim(column(k)), 0, 1, [real(wp) ::])
+         end do
+         return
       end if
-      if (.not. allocated(error)) call run%init(config, error)
-      if (.not. allocated(error)) call run%run_until(points, error)
-      if (.not. allocated(error)) then
-         call c_f_pointer(t, out, [points])
-         out = run%trajectory%t(1:points)
-         call c_f_pointer(x, out, [points])
-         out = run%trajectory%x(1:points)
-         call c_f_pointer(v, out, [points])
-         out = run%trajectory%v(1:points)
-         call c_f_pointer(y, out, [points])
-         out = run%trajectory%y(1:points)
-         call c_f_pointer(w, out, [points])
-         out = run%trajectory%w(1:points)
+      call add_item(result, 'events/t', n, 1, run%events%t(1:n))
+      call add_item(result, 'events/kind', n, 1, real(run%events%kind(1:n), wp))
+      do k = 1, 4
+         call add_item(result, 'events/'//trim(column(k)), n, 1, run%events%state(k, 1:n))
+      end do
+
+   contains
+
+      pure function column(k) result(name)
+         integer, intent(in) :: k
+         character(len=1) :: name
+
+         name = 'xvyw'(k:k)
+      end function column
+
+   end subroutine compute_brake
+
+   ! ---- results ----
+
+   !> The item of a result named by a C string; 0 (and an error) if none.
+   integer function find_item(res, name_c, result, error) result(found)
+      type(c_ptr), intent(in) :: res, name_c
+      type(capi_result), pointer, intent(out) :: result
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: name
+      integer :: k
+
+      found = 0
+      nullify (result)
+      if (.not. c_associated(res)) then
+         call fatal_error(error, 'the result is a null pointer', error_input)
+         return
+      end if
+      call c_f_pointer(res, result)
+      if (.not. c_associated(name_c)) then
+         call fatal_error(error, 'name must not be a null pointer', error_input)
+         return
+      end if
+      name = c_string(name_c)
+      do k = 1, size(result%items)
+         if (result%items(k)%name == name) then
+            found = k
+            return
+         end if
+      end do
+      call fatal_error(error, "no result named '"//name//"' (known: "//join(result%items%name)//')', error_input)
+   end function find_item
+
+   !> int friction_result_get(const friction_result *res, const char *name, double *out,
+   !>                         size_t n, size_t *needed, friction_error *err)
+   integer(c_int) function friction_result_get(res, name_c, out, n, needed, handle) &
+      & bind(c, name='friction_result_get') result(status)
+      type(c_ptr), value :: res, name_c, out, needed, handle
+      integer(c_size_t), value :: n
+      type(capi_result), pointer :: result
+      type(error_type), allocatable :: error
+      integer(c_size_t), pointer :: needed_out
+      real(c_double), pointer :: values(:)
+      integer :: k, count
+
+      k = find_item(res, name_c, result, error)
+      if (k > 0) then
+         count = size(result%items(k)%values)
+         if (c_associated(needed)) then
+            call c_f_pointer(needed, needed_out)
+            needed_out = int(count, c_size_t)
+         end if
+         if (n < count) then
+            ! A size query (out null, n 0) is not an error.
+            if (c_associated(out) .or. n /= 0) call fatal_error(error, 'n = '//itoa(int(n))//': '// &
+               & trim(result%items(k)%name)//' has '//itoa(count)//' values', error_input)
+         else if (count > 0 .and. .not. c_associated(out)) then
+            call fatal_error(error, 'out is a null pointer', error_input)
+         else if (count > 0) then
+            call c_f_pointer(out, values, [count])
+            values = result%items(k)%values
+         end if
       end if
       status = report(handle, error)
-   end function friction_brake
+   end function friction_result_get
+
+   !> int friction_result_shape(const friction_result *res, const char *name, size_t shape[2],
+   !>                           friction_error *err)
+   integer(c_int) function friction_result_shape(res, name_c, shape, handle) bind(c, name='friction_result_shape') &
+      & result(status)
+      type(c_ptr), value :: res, name_c, shape, handle
+      type(capi_result), pointer :: result
+      type(error_type), allocatable :: error
+      integer(c_size_t), pointer :: out(:)
+      integer :: k
+
+      k = find_item(res, name_c, result, error)
+      if (k > 0) then
+         if (.not. c_associated(shape)) then
+            call fatal_error(error, 'shape is a null pointer', error_input)
+         else
+            call c_f_pointer(shape, out, [2])
+            out = int([result%items(k)%rows, result%items(k)%columns], c_size_t)
+         end if
+      end if
+      status = report(handle, error)
+   end function friction_result_shape
+
+   !> int friction_result_names(const friction_result *res, char *buf, size_t len)
+   integer(c_int) function friction_result_names(res, buf, len) bind(c, name='friction_result_names') &
+      & result(status)
+      type(c_ptr), value :: res, buf
+      integer(c_size_t), value :: len
+      type(capi_result), pointer :: result
+
+      status = error_input
+      if (.not. c_associated(res)) return
+      call c_f_pointer(res, result)
+      if (copy_text(join(result%items%name, new_line('a')), buf, len)) status = 0
+   end function friction_result_names
+
+   !> void friction_result_free(friction_result *res); null is ignored.
+   subroutine friction_result_free(res) bind(c, name='friction_result_free')
+      type(c_ptr), value :: res
+      type(capi_result), pointer :: result
+
+      if (.not. c_associated(res)) return
+      call c_f_pointer(res, result)
+      deallocate (result)
+   end subroutine friction_result_free
+
+   ! ---- jobs ----
+
+   !> The flags' checks and MPI: initialised by the caller, or here when the
+   !> caller passes FRICTION_JOB_INIT_MPI.
+   subroutine prepare_job(flags, error)
+      integer(c_int), intent(in) :: flags
+      type(error_type), allocatable, intent(inout) :: error
+      logical :: ready, finished
+      integer :: provided, ierror
+
+      if (allocated(error)) return
+      if (iand(flags, not(job_force + job_resume + job_init_mpi)) /= 0) then
+         call fatal_error(error, 'flags = '//itoa(int(flags))//': unknown bits (known: FRICTION_JOB_FORCE, ' &
+            & //'FRICTION_JOB_RESUME, FRICTION_JOB_INIT_MPI)', error_input)
+         return
+      end if
+      call MPI_Finalized(finished)
+      if (finished) then
+         call fatal_error(error, 'MPI has been finalized: a job needs MPI (call it before MPI_Finalize)', &
+            & error_input)
+         return
+      end if
+      call MPI_Initialized(ready)
+      if (ready) return
+      if (iand(flags, job_init_mpi) == 0) then
+         call fatal_error(error, 'MPI is not initialised: call MPI_Init (or MPI_Init_thread) first, or pass ' &
+            & //'FRICTION_JOB_INIT_MPI to let the library initialise it (MPI_THREAD_FUNNELED, left for the ' &
+            & //"process's exit)", error_input)
+         return
+      end if
+      call MPI_Init_thread(MPI_THREAD_FUNNELED, provided, ierror)
+      if (ierror /= 0) call fatal_error(error, 'MPI_Init_thread failed (error '//itoa(ierror)//')', error_input)
+   end subroutine prepare_job
 
    !> int friction_run_job(const char *const *files, int nfiles, const char *output, int flags,
    !>                      friction_report_fn report, void *user, friction_error *err)
-   !> The command line's job: namelist files in, an HDF5 file out.  Collective
-   !> over MPI_COMM_WORLD when the caller has initialised MPI; otherwise MPI
-   !> is initialised here (once, left for the process's exit) and the job runs
-   !> on this process alone.
    integer(c_int) function friction_run_job(files, nfiles, output, flags, report_fn, user, handle) &
       & bind(c, name='friction_run_job') result(status)
       type(c_ptr), value :: files, output, user, handle
@@ -406,8 +1054,7 @@ contains
       character(len=4096), allocatable :: paths(:)
       character(len=:), allocatable :: summary, path
       type(callback_reporter) :: reporter
-      logical :: ready
-      integer :: k, provided
+      integer :: k
 
       allocate (paths(0))
       if (.not. c_associated(files) .and. nfiles /= 0) then
@@ -416,9 +1063,6 @@ contains
          call fatal_error(error, 'nfiles = '//itoa(int(nfiles))//': give at least one namelist file', error_input)
       else if (.not. c_associated(output)) then
          call fatal_error(error, 'output is a null pointer', error_input)
-      else if (iand(flags, not(job_force + job_resume)) /= 0) then
-         call fatal_error(error, 'flags = '//itoa(int(flags))//': unknown bits (known: FRICTION_JOB_FORCE, ' &
-            & //'FRICTION_JOB_RESUME)', error_input)
       else
          call c_f_pointer(files, names, [nfiles])
          deallocate (paths)
@@ -437,18 +1081,44 @@ contains
             paths(k) = path
          end do
       end if
+      call prepare_job(flags, error)
       if (allocated(error)) then
          status = report(handle, error)
          return
       end if
-      call MPI_Initialized(ready)
-      if (.not. ready) call MPI_Init_thread(MPI_THREAD_FUNNELED, provided)
       reporter%user = user
       if (c_associated(report_fn)) call c_f_procpointer(report_fn, reporter%call)
       call run_job(paths, c_string(output), iand(flags, job_force) /= 0, iand(flags, job_resume) /= 0, &
          & MPI_COMM_WORLD, reporter, summary, error)
       status = report(handle, error)
    end function friction_run_job
+
+   !> int friction_run_config(const friction_config *cfg, const char *output, int flags,
+   !>                         friction_report_fn report, void *user, friction_error *err)
+   integer(c_int) function friction_run_config(cfg, output, flags, report_fn, user, handle) &
+      & bind(c, name='friction_run_config') result(status)
+      type(c_ptr), value :: cfg, output, user, handle
+      integer(c_int), value :: flags
+      type(c_funptr), value :: report_fn
+      type(capi_config), pointer :: config
+      type(error_type), allocatable :: error
+      character(len=:), allocatable :: summary
+      type(callback_reporter) :: reporter
+
+      if (config_of(cfg, config, error)) then
+         if (.not. c_associated(output)) call fatal_error(error, 'output is a null pointer', error_input)
+      end if
+      call prepare_job(flags, error)
+      if (allocated(error)) then
+         status = report(handle, error)
+         return
+      end if
+      reporter%user = user
+      if (c_associated(report_fn)) call c_f_procpointer(report_fn, reporter%call)
+      call run_job_config(config%job, c_string(output), iand(flags, job_force) /= 0, iand(flags, job_resume) /= 0, &
+         & MPI_COMM_WORLD, reporter, summary, error, config%origins)
+      status = report(handle, error)
+   end function friction_run_config
 
    subroutine callback_progress(self, done, total, what, last)
       class(callback_reporter), intent(inout) :: self
@@ -469,14 +1139,5 @@ contains
 
       if (associated(self%call)) call self%call(text//c_null_char, -1.0_c_double, self%user)
    end subroutine callback_note
-
-   pure function itoa(i) result(text)
-      integer, intent(in) :: i
-      character(len=:), allocatable :: text
-      character(len=12) :: buffer
-
-      write (buffer, '(i0)') i
-      text = trim(buffer)
-   end function itoa
 
 end module friction_capi

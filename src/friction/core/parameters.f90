@@ -33,7 +33,7 @@ module friction_parameters
       character(len=32) :: group = ''          !! the group being visited
       character(len=32) :: want_group = ''     !! set, get: the variable's group (or '' for all, write)
       character(len=32) :: want_name = ''      !! set, get: the variable's name
-      integer :: first = 0                     !! set: first element given, name(first) = ...; 0 whole
+      integer :: first = 0                     !! set, get: the element given, name(first); 0 whole
       logical :: from_number = .false.         !! set: take `number` instead of `text`
       real(wp) :: number = 0.0_wp
       character(len=:), allocatable :: text    !! set: value text; get: the value; write: the namelist
@@ -50,7 +50,7 @@ module friction_parameters
          & logical_scalar, text_scalar, text_array
       generic :: item => real_scalar, real_array, integer_scalar, integer_array, long_scalar, &
          & logical_scalar, text_scalar, text_array
-      procedure, private :: wants, add_info, add_line
+      procedure, private :: wants, add_info, add_line, element_ok
    end type parameter_visitor
 
    !> A type whose variables can be visited.
@@ -102,6 +102,21 @@ contains
       wants = (self%mode == mode_set .or. self%mode == mode_get) .and. .not. self%found &
          & .and. self%group == self%want_group .and. name == self%want_name
    end function wants
+
+   !> Whether the element asked for (first, 0 for all) is one of the n; if
+   !> not, the problem says so.
+   logical function element_ok(self, n) result(ok)
+      class(parameter_visitor), intent(inout) :: self
+      integer, intent(in) :: n
+
+      ok = self%first <= n
+      if (ok) return
+      if (self%mode == mode_get) then
+         self%problem = 'index '//itoa(self%first)//' is outside the '//itoa(n)//' elements'
+      else
+         self%problem = 'more values than the '//itoa(n)//' elements'
+      end if
+   end function element_ok
 
    subroutine add_info(self, name, kind, n, unit)
       class(parameter_visitor), intent(inout) :: self
@@ -168,10 +183,18 @@ contains
          if (.not. self%wants(name)) return
          self%found = .true.
          if (self%mode == mode_get) then
-            self%text = run_lengths(real_words(value))
+            if (self%element_ok(size(value))) then
+               if (self%first > 0) then
+                  self%text = run_lengths(real_words(value(self%first:self%first)))
+               else
+                  self%text = run_lengths(real_words(value))
+               end if
+            end if
             return
          end if
          if (self%from_number) then
+            if (.not. self%element_ok(size(value))) return
+            if (present(fill) .and. self%first == 0) value = fill
             value(max(1, self%first)) = self%number
             return
          end if
@@ -244,13 +267,18 @@ contains
          if (self%mode == mode_get) then
             if (.not. self%wants(name)) return
             self%found = .true.
+            if (.not. self%element_ok(size(value))) return
          end if
          allocate (words(size(value)))
          do k = 1, size(value)
             write (words(k), '(i0)') value(k)
          end do
          if (self%mode == mode_get) then
-            self%text = run_lengths(words)
+            if (self%first > 0) then
+               self%text = trim(words(self%first))
+            else
+               self%text = run_lengths(words)
+            end if
          else
             call self%add_line(name, run_lengths(words))
          end if
@@ -258,6 +286,7 @@ contains
          if (.not. self%wants(name)) return
          self%found = .true.
          if (self%from_number) then
+            if (.not. self%element_ok(size(value))) return
             if (self%number /= anint(self%number) .or. .not. abs(self%number) <= real(largest, wp)) then
                self%problem = 'expected '//kind_text('i')
             else
@@ -295,7 +324,7 @@ contains
          if (.not. self%wants(name)) return
          self%found = .true.
          if (self%mode == mode_get) then
-            self%text = trim(merge('.true. ', '.false.', value))
+            if (self%element_ok(1)) self%text = trim(merge('.true. ', '.false.', value))
             return
          end if
          if (self%from_number) then
@@ -360,13 +389,18 @@ contains
          if (self%mode == mode_get) then
             if (.not. self%wants(name)) return
             self%found = .true.
+            if (.not. self%element_ok(size(value))) return
          end if
          allocate (words(size(value)))
          do k = 1, size(value)
             words(k) = quote(trim(value(k)))
          end do
          if (self%mode == mode_get) then
-            self%text = run_lengths(words)
+            if (self%first > 0) then
+               self%text = trim(words(self%first))
+            else
+               self%text = run_lengths(words)
+            end if
          else
             call self%add_line(name, run_lengths(words))
          end if
@@ -430,18 +464,22 @@ contains
       end if
    end subroutine set_parameter
 
-   !> Set a numeric scalar group.name to a number (an integer variable takes
-   !> it when it is whole): the sweep's override, no text in between.
-   subroutine set_parameter_number(obj, group, name, number, problem)
+   !> Set a numeric group.name (element `first` of an array, 0 for the
+   !> first element of a whole one) to a number (an integer variable takes
+   !> it when it is whole): the sweep's override and the C API's, no text in
+   !> between.
+   subroutine set_parameter_number(obj, group, name, number, problem, first)
       class(configurable), intent(inout) :: obj
       character(len=*), intent(in) :: group, name
       real(wp), intent(in) :: number
       character(len=:), allocatable, intent(out) :: problem
+      integer, intent(in), optional :: first
       type(parameter_visitor) :: v
 
       v%mode = mode_set
       v%want_group = group
       v%want_name = name
+      if (present(first)) v%first = first
       v%from_number = .true.
       v%number = number
       v%problem = ''
@@ -453,22 +491,28 @@ contains
       end if
    end subroutine set_parameter_number
 
-   !> The value of group.name as namelist text; found is false if there is
-   !> no such variable.
-   subroutine get_parameter(obj, group, name, text, found)
+   !> The value of group.name (its element `first`, 0 for all of it) as
+   !> namelist text; `problem` says why there is none ('' when there is).
+   subroutine get_parameter(obj, group, name, first, text, problem)
       class(configurable), intent(inout) :: obj
       character(len=*), intent(in) :: group, name
-      character(len=:), allocatable, intent(out) :: text
-      logical, intent(out) :: found
+      integer, intent(in) :: first
+      character(len=:), allocatable, intent(out) :: text, problem
       type(parameter_visitor) :: v
 
       v%mode = mode_get
       v%want_group = group
       v%want_name = name
+      v%first = first
       v%text = ''
+      v%problem = ''
       call obj%visit(v)
-      found = v%found
       text = v%text
+      if (.not. v%found) then
+         problem = 'no variable '//trim(name)//' in &'//trim(group)
+      else
+         problem = v%problem
+      end if
    end subroutine get_parameter
 
    !> All variables as namelist text (the groups in `only` when present),

@@ -94,7 +94,7 @@ contains
                   return
                end if
                if (.not. value_has_kind(m%value, universe(u)%kind)) then
-                  call fatal_error(error, where//trim(m%name)//' = '//one_line(m%value)//': expected ' &
+                  call fatal_error(error, where//trim(m%name)//' = '//trim(one_line(m%value))//': expected ' &
                      & //kind_text(universe(u)%kind), error_input)
                   return
                end if
@@ -108,7 +108,7 @@ contains
                if (len(problem) > 0) then
                   shown = trim(m%name)
                   if (m%first > 0) shown = shown//'('//itoa(m%first)//')'
-                  call fatal_error(error, where//': &'//trim(m%group)//': '//shown//' = '//one_line(m%value) &
+                  call fatal_error(error, where//': &'//trim(m%group)//': '//shown//' = '//trim(one_line(m%value)) &
                      & //': '//problem, error_input)
                   return
                end if

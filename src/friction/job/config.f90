@@ -14,7 +14,8 @@ module friction_job_config
    implicit none
    private
 
-   public :: job_config, sweep_settings, read_input, check_job, max_sweep_values, all_parameters, job_text
+   public :: job_config, sweep_settings, read_input, check_job, max_sweep_values, all_parameters, job_text, &
+      & parameter_groups
 
    integer, parameter :: max_sweep_values = 1024
 
@@ -106,6 +107,18 @@ contains
       end do
    end function all_parameters
 
+   !> The groups of a list of variables, in order of first appearance.
+   function parameter_groups(list) result(groups)
+      type(parameter_info), intent(in) :: list(:)
+      character(len=32), allocatable :: groups(:)
+      integer :: k
+
+      allocate (groups(0))
+      do k = 1, size(list)
+         if (.not. any(groups == list(k)%group)) groups = [character(len=32) :: groups, list(k)%group]
+      end do
+   end function parameter_groups
+
    !> Read and check the files in order into config; input_text is the
    !> resolved input as namelist text that reads back to the same run.
    subroutine read_input(paths, config, input_text, error)
@@ -117,13 +130,9 @@ contains
       type(parameter_info), allocatable :: universe(:)
       type(config_checker) :: checker
       character(len=32), allocatable :: groups(:)
-      integer :: k
 
       universe = all_parameters()
-      allocate (groups(0))
-      do k = 1, size(universe)
-         if (.not. any(groups == universe(k)%group)) groups = [character(len=32) :: groups, universe(k)%group]
-      end do
+      groups = parameter_groups(universe)
       call scan_files(paths, groups, sources, error)
       if (allocated(error)) return
       ! &job and &sweep first (every assignment of every file is checked here),

@@ -1,12 +1,14 @@
-!> A whole job from namelist files to an output file: what the command line
-!> runs, and what the C API's friction_run_job runs.  Collective over `comm`;
+!> A whole job from namelist files (or a configuration made in memory) to
+!> an output file: what the command line runs, and what the C API's
+!> friction_run_job (friction_run_config) runs.  Collective over `comm`;
 !> every rank returns the same error or none.  Progress and notes go to the
 !> caller's reporter (rank 0 only); nothing is printed.
 module friction_job
    use mpi_f08
    use friction_kinds, only: wp
    use friction_error, only: error_type, fatal_error, error_input
-   use friction_job_config, only: job_config, read_input
+   use friction_job_config, only: job_config, read_input, check_job, job_text
+   use friction_checks, only: config_checker
    use friction_version, only: version_string
    use friction_files, only: file_exists, write_text_file
    use friction_scene_report, only: job_reporter
@@ -16,7 +18,7 @@ module friction_job
    implicit none
    private
 
-   public :: run_job, write_netlist, job_reporter, default_output
+   public :: run_job, run_job_config, write_netlist, job_reporter, default_output
 
 contains
 
@@ -37,15 +39,9 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(job_context) :: job
       type(job_config) :: config
-      character(len=:), allocatable :: temporary
 
-      job%t_start = MPI_Wtime()
+      call start_job(comm, output, resume, job)
       if (present(stop_after)) job%stop_after = stop_after
-      job%comm = comm
-      call MPI_Comm_rank(comm, job%rank)
-      call MPI_Comm_size(comm, job%nranks)
-      job%output = output
-      job%resume = resume
       allocate (job%files(size(files)))
       job%files = files
       if (size(files) == 0) then
@@ -56,16 +52,83 @@ contains
          call fatal_error(error, 'no output file given', error_input)
          return
       end if
-
       ! Every rank reads the input: an error in it is the same everywhere.
       call read_input(files, config, job%input_text, error)
       if (allocated(error)) return
-      if (file_exists(output) .and. .not. (force .or. (resume .and. config%sweep%enabled()))) then
-         call fatal_error(error, output//': the output file exists; use --force to overwrite it', error_input)
+      call run_configured(job, config, force, reporter, summary, error)
+   end subroutine run_job
+
+   !> The job of a configuration made in memory (the C API's
+   !> friction_run_config) rather than read from files: checked as the
+   !> files' would be (`origins`, if given, says where values were set, for
+   !> the messages), echoed into the file as its namelist text, then run as
+   !> run_job runs it.  Collective over `comm`; `config` is not changed.
+   subroutine run_job_config(config, output, force, resume, comm, reporter, summary, error, origins)
+      type(job_config), intent(in) :: config
+      character(len=*), intent(in) :: output
+      logical, intent(in) :: force, resume
+      type(MPI_Comm), intent(in) :: comm
+      class(job_reporter), intent(inout) :: reporter
+      character(len=:), allocatable, intent(out) :: summary
+      type(error_type), allocatable, intent(out) :: error
+      type(config_checker), intent(in), optional :: origins
+      type(job_context) :: job
+      type(job_config) :: work
+      type(config_checker) :: checker
+
+      call start_job(comm, output, resume, job)
+      allocate (job%files(0))
+      if (len_trim(output) == 0) then
+         call fatal_error(error, 'no output file given', error_input)
+         return
+      end if
+      if (.not. allocated(config%scene)) then
+         call fatal_error(error, 'the configuration has no scene', error_input)
+         return
+      end if
+      work = config
+      if (present(origins)) checker = origins
+      call check_job(work, checker)
+      if (checker%failed()) then
+         call move_alloc(checker%error, error)
+         return
+      end if
+      job%input_text = job_text(work)
+      call run_configured(job, work, force, reporter, summary, error)
+   end subroutine run_job_config
+
+   !> A job's context on `comm`, its clock started.
+   subroutine start_job(comm, output, resume, job)
+      type(MPI_Comm), intent(in) :: comm
+      character(len=*), intent(in) :: output
+      logical, intent(in) :: resume
+      type(job_context), intent(out) :: job
+
+      job%t_start = MPI_Wtime()
+      job%comm = comm
+      call MPI_Comm_rank(comm, job%rank)
+      call MPI_Comm_size(comm, job%nranks)
+      job%output = output
+      job%resume = resume
+   end subroutine start_job
+
+   !> The common body of run_job and run_job_config: a checked
+   !> configuration, its echo in job%input_text, run and written.
+   subroutine run_configured(job, config, force, reporter, summary, error)
+      type(job_context), intent(inout) :: job
+      type(job_config), intent(inout) :: config
+      logical, intent(in) :: force
+      class(job_reporter), intent(inout) :: reporter
+      character(len=:), allocatable, intent(out) :: summary
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: temporary
+
+      if (file_exists(job%output) .and. .not. (force .or. (job%resume .and. config%sweep%enabled()))) then
+         call fatal_error(error, job%output//': the output file exists; use --force to overwrite it', error_input)
          return
       end if
       ! Find out now, not after the computation, whether the output can be written.
-      if (job%rank == 0) call check_writable(output, error)
+      if (job%rank == 0) call check_writable(job%output, error)
       call agree_on_error(job, error)
       if (allocated(error)) return
 
@@ -80,7 +143,7 @@ contains
       call publish(job, temporary, error)
       if (allocated(error)) return
       summary = config%scene%summary(job)
-   end subroutine run_job
+   end subroutine run_configured
 
    !> The scene of `files` as a SPICE netlist for ngspice (the paper's
    !> network model, README: Network model) in `path`, its waveforms going to
