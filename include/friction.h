@@ -18,12 +18,16 @@
  * friction_error_free).  The messages are the program's: a value refused by
  * a check reads "&tip: mass = -1.000000E-8: must be > 0 (kg)", preceded by
  * "file:line: " when the value came from a file.  The library never prints
- * and never stops the process.
+ * and never stops the process.  It leaves GSL's error handler and HDF5's
+ * automatic error printing as the host set them: each call installs its own
+ * for its duration and restores the host's.
  *
- * Threads.  The library keeps no global state: handles are independent, and
- * threads may work at once, each on its own handles (configuration, result,
- * error).  A handle must not be used by two threads at once.  The job
- * functions use MPI and must be called from one thread at a time.
+ * Threads.  Handles are independent, and threads may work at once, each on
+ * its own handles (configuration, result, error).  A handle must not be used
+ * by two threads at once.  The only state shared between calls is a
+ * mutex-guarded count of the threads inside GSL, so that the host's GSL
+ * handler is back when the last of them returns.  The job functions use MPI
+ * and must be called from one thread at a time.
  *
  * Units are those of the namelist input (README: Input reference).
  */
@@ -99,7 +103,9 @@ int friction_config_read(friction_config *cfg, const char *path, friction_error 
  * text: "5.0", "'hopg'", ".true.", "1, 2", "3*0.0".  An unknown group or
  * variable, or a value of the wrong kind, is FRICTION_ERROR_INPUT with the
  * reader's message ("&scan: nx = 'many': expected an integer"); the value is
- * then left as it was.  The scene itself (job.scene) cannot change. */
+ * then left as it was.  The scene itself (job.scene) cannot change.
+ *   integrator.method  GSL step type: rk2 rk4 rkf45 rkck rk8pd rk1imp rk2imp
+ *                      rk4imp bsimp msadams msbdf, or "auto" (docs/speed.md) */
 int friction_config_set(friction_config *cfg, const char *name, const char *value, friction_error *err);
 /* The same for a number, without text in between: a real variable, or an
  * integer one when x is whole; NaN and infinities are set (and refused by

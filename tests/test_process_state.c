@@ -62,17 +62,33 @@ static void own_gsl_error(void) {
 
 enum { NX = 16 };
 
-/* The scene of test_capi.c, from origin (x0, y0). */
+/* A NaF line of NX samples from origin (x0, y0) at 10 degrees over `length`
+ * Å at `velocity` Å/s, the rest the defaults (rkf45 at rtol 1e-3). */
+static int line(double x0, double y0, double velocity, double length, double *fx, double *fy,
+                friction_error *err) {
+  friction_config *cfg = friction_config_new("afm", err);
+  if (cfg == NULL) return friction_error_status(err);
+  int status = FRICTION_OK;
+  if (status == FRICTION_OK) status = friction_config_set(cfg, "scan.nx", "16", err);
+  if (status == FRICTION_OK) status = friction_config_set(cfg, "scan.ny", "1", err);
+  if (status == FRICTION_OK) status = friction_config_set(cfg, "scan.angle", "10.0", err);
+  if (status == FRICTION_OK) status = friction_config_set_real(cfg, "scan.origin_x", x0, err);
+  if (status == FRICTION_OK) status = friction_config_set_real(cfg, "scan.origin_y", y0, err);
+  if (status == FRICTION_OK) status = friction_config_set_real(cfg, "scan.velocity", velocity, err);
+  if (status == FRICTION_OK) status = friction_config_set_real(cfg, "scan.length", length, err);
+  if (status == FRICTION_OK) status = friction_afm_line(cfg, 0, 1, fx, fy, NX, err);
+  friction_config_free(cfg);
+  return status;
+}
+
 static int naf_line(double x0, double y0, double *fx, double *fy, friction_error *err) {
-  return friction_afm_line("naf", 1.0, 4.62, 4.62, 2.46, 1.0e-8, 10.0, 10.0, 1.0e-3, 1.0e-3, 400.0, x0, y0,
-                           10.0, 20.0, NX, 1, "rkf45", 1.0e-3, 1.0e-4, fx, fy, err);
+  return line(x0, y0, 400.0, 20.0, fx, fy, err);
 }
 
 /* A line whose right-hand side overflows at once (the support races at
  * 1e308 Å/s over 1e-10 Å): a numerical failure inside the integration. */
 static int failing_line(double *fx, double *fy, friction_error *err) {
-  return friction_afm_line("naf", 1.0, 4.62, 4.62, 2.46, 1.0e-8, 10.0, 10.0, 1.0e-3, 1.0e-3, 1.0e308, 0.7, 0.3,
-                           10.0, 1.0e-10, NX, 1, "rkf45", 1.0e-3, 1.0e-4, fx, fy, err);
+  return line(0.7, 0.3, 1.0e308, 1.0e-10, fx, fy, err);
 }
 
 static void message_of(friction_error *err, char *buf, size_t len) {
@@ -106,7 +122,7 @@ static int gsl_mode(const char *namelist) {
     fputs("&integrator h_start = 1e-12, h_min = 1e-9 /\n", f);
     fclose(f);
     remove(output);
-    int status = friction_run_job(files, 2, output, FRICTION_JOB_FORCE, NULL, NULL, err);
+    int status = friction_run_job(files, 2, output, FRICTION_JOB_FORCE | FRICTION_JOB_INIT_MPI, NULL, NULL, err);
     message_of(err, message, sizeof message);
     CHECK(status == FRICTION_ERROR_INPUT, "h_min job: status %d (%s)", status, message);
     CHECK(strstr(message, "h_min") != NULL && strstr(message, "hmin <= fabs(h) <= hmax required") != NULL,
@@ -205,7 +221,7 @@ static void job(const char *namelist, const char *output) {
   FILE *f;
 
   remove(output);
-  status = friction_run_job(files, 1, output, FRICTION_JOB_FORCE, NULL, NULL, err);
+  status = friction_run_job(files, 1, output, FRICTION_JOB_FORCE | FRICTION_JOB_INIT_MPI, NULL, NULL, err);
   message_of(err, message, sizeof message);
   CHECK(status == FRICTION_OK, "job into %s: status %d (%s)", output, status, message);
   f = fopen(output, "rb");

@@ -20,10 +20,9 @@ contains
       class(configurable), intent(inout) :: config
       character(len=*), intent(in) :: groups(:)
       type(parameter_info), allocatable :: list(:)
-      character(len=:), allocatable :: text
+      character(len=:), allocatable :: text, problem
       real(wp) :: value
       integer :: k, stat
-      logical :: found
 
       list = list_parameters(config)
       do k = 1, size(list)
@@ -34,9 +33,10 @@ contains
                   & call file%write_attribute_text(object, trim(p%name)//'_units', trim(p%unit))
                cycle
             end if
-            call get_parameter(config, trim(p%group), trim(p%name), text, found)
+            call get_parameter(config, trim(p%group), trim(p%name), 0, text, problem)
+            if (len(problem) > 0) cycle
             read (text, *, iostat=stat) value
-            if (found .and. stat == 0) call file%write_attribute_real(object, trim(p%name), value, trim(p%unit))
+            if (stat == 0) call file%write_attribute_real(object, trim(p%name), value, trim(p%unit))
          end associate
       end do
    end subroutine write_parameter_attributes
