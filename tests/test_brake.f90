@@ -101,7 +101,8 @@ contains
 
 end module brake_test_systems
 
-!> The Girling brake (paper §4, §6.2; PHYSICS §2): derived parameters, the
+!> The Girling brake (paper §4, §6.2; docs/physics.md, The Girling brake):
+!> derived parameters, the
 !> exact stick phase, the linear motion for μ = 0, the regularized law's
 !> approach to the switched model, event-time convergence, Jacobians, and
 !> the failure guards.  Each property against an oracle computed here.
@@ -197,7 +198,8 @@ contains
       call check_close(failure, p%epsilon_prime / 3.5121e7_wp, 1.0_wp, 2.0e-5_wp, 'epsilon_prime against the paper')
       call check_close(failure, p%delta_prime / 3.5121_wp, 1.0_wp, 2.0e-5_wp, 'delta_prime against the paper')
       call check_close(failure, p%v_dr, -0.002788_wp, 5.0e-7_wp, 'v_dr_prime against the paper (m)')
-      ! PHYSICS §2 prints 0.028474 s; the data give 0.0284734 s.
+      ! 0.028474 s is often quoted (docs/physics.md, Equations and parameters);
+      ! the data give 0.0284734 s.
       call check_close(failure, time_scale(data), sqrt(0.174_wp / 214.62_wp), 1.0e-17_wp, 'sqrt(m/k1) (s)')
       call check_close(failure, time_scale(data), 0.028473_wp, 1.0e-6_wp, 'sqrt(m/k1) (s), rounded')
       call check(failure, p%mu == 0.59_wp .and. p%mu_s == 0.59_wp, 'mu, mu_s not passed through')
@@ -208,7 +210,8 @@ contains
    end subroutine derived_parameters_of_section_6_2
 
    !> μ = 0: the eigenvalues of M⁻¹K = [2 -1; -1/ξ κ/ξ] from its trace and
-   !> determinant, against PHYSICS §2's 0.1638 and 0.3406 cycles per unit τ.
+   !> determinant, against 0.1638 and 0.3406 cycles per unit τ (docs/physics.md,
+   !> Equations and parameters).
    subroutine natural_frequencies(failure)
       character(len=:), allocatable, intent(out) :: failure
       type(brake_parameters) :: p
@@ -220,8 +223,8 @@ contains
       lambda = [trace - sqrt(trace**2 - 4 * det), trace + sqrt(trace**2 - 4 * det)] / 2
       call check_close(failure, f(1), sqrt(lambda(1)) / (2 * pi), 1.0e-14_wp, 'lower frequency')
       call check_close(failure, f(2), sqrt(lambda(2)) / (2 * pi), 1.0e-14_wp, 'upper frequency')
-      call check_close(failure, f(1), 0.1638_wp, 5.0e-5_wp, 'lower frequency against PHYSICS §2')
-      call check_close(failure, f(2), 0.3406_wp, 1.0e-4_wp, 'upper frequency against PHYSICS §2')
+      call check_close(failure, f(1), 0.1638_wp, 5.0e-5_wp, 'lower frequency against docs/physics.md')
+      call check_close(failure, f(2), 0.3406_wp, 1.0e-4_wp, 'upper frequency against docs/physics.md')
    end subroutine natural_frequencies
 
    !> In stick, x' is v'_dr exactly (bitwise), at every grid point flagged

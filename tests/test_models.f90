@@ -1,6 +1,6 @@
 !> The reduced tip models against the full one in their own limits, and the
 !> quasistatic model against the exact Prandtl–Tomlinson results
-!> (PHYSICS.md §1; README: Reduced models (AFM)).
+!> (docs/physics.md, Prandtl–Tomlinson and Reduced tip models).
 !>   - quasistatic vs inertial as the velocity goes to 0;
 !>   - overdamped vs inertial as the mass goes to 0 at fixed damping;
 !>   - quasistatic on the 1D NaF cut: the largest force F* = 2πU0/a and a
@@ -45,8 +45,8 @@ contains
    end function naf_line
 
    !> Trace and retrace of line 0; the first sample of each trip dropped:
-   !> there the full tip is at rest at the support by definition (README:
-   !> Output) and the quasistatic one already in its minimum.
+   !> there the full tip is at rest at the support by definition (docs/physics.md,
+   !> Scan geometry, trips and the lateral force) and the quasistatic one already in its minimum.
    subroutine scan_line(c, trace, retrace, failure)
       type(afm_config), intent(in) :: c
       real(wp), allocatable, intent(out) :: trace(:, :), retrace(:, :)

@@ -1,4 +1,4 @@
-!> Prandtl–Tomlinson exact results (PHYSICS.md §1) on a 1D cut of the NaF
+!> Prandtl–Tomlinson exact results (docs/physics.md, Prandtl–Tomlinson) on a 1D cut of the NaF
 !> potential: along y = 0 the y-gradient vanishes, so the tip moves on the
 !> line V = -U0 cos(2πx/a) with U0 = V0.  At very low velocity the
 !> integrated motion must approach the quasi-static results:

@@ -24,7 +24,7 @@ contains
 
    subroutine spring(failure)
       character(len=:), allocatable, intent(out) :: failure
-      ! PHYSICS.md: 1 N/m = 0.06241509 eV/Å² (to its 7 digits); damping shares the factor.
+      ! docs/physics.md (Units): 1 N/m = 0.06241509 eV/Å² (to its 7 digits); damping shares the factor.
       call check_close(failure, n_per_m_to_internal, 0.06241509_wp, 5.0e-9_wp, '1 N/m in eV/Å²')
       call check_close(failure, ns_per_m_to_internal, n_per_m_to_internal, 0.0_wp, '1 N s/m in eV s/Å²')
       ! k in eV/Å² times 1 Å² is an energy; back in J it must be k in N/m times 1e-20 m².
@@ -38,7 +38,7 @@ contains
       call check_close(failure, kg_to_internal, 0.06241509_wp, 5.0e-9_wp, '1 kg in eV s²/Å²')
    end subroutine mass
 
-   !> PHYSICS.md §1 quotes the Prandtl–Tomlinson parameter η = 4π²U0/(k a²):
+   !> docs/physics.md (Prandtl–Tomlinson) quotes the parameter η = 4π²U0/(k a²):
    !> NaF along a row ≈ 2.96, HOPG along a row ≈ 4.18 (its two digits).
    subroutine tomlinson_parameters(failure)
       character(len=:), allocatable, intent(out) :: failure
