@@ -9,7 +9,7 @@
  * Reentrant: the library keeps no mutable global state, so threads may call
  * it at once, each with its own arrays and its own error handle.
  *
- * Units are those of the namelist input (README: input reference).
+ * Units are those of the namelist input (docs/input.md).
  */
 #ifndef FRICTION_H
 #define FRICTION_H
@@ -56,7 +56,7 @@ int friction_error_message(const friction_error *err, char *buf, size_t len);
  *   forward    non-zero: trace (support from x0,y0 outwards); zero: retrace
  *              (from the far end back; still stored by position i)
  *   stepper    GSL step type: rk2 rk4 rkf45 rkck rk8pd rk1imp rk2imp rk4imp
- *              bsimp msadams msbdf, or "auto" (README: Speed against accuracy);
+ *              bsimp msadams msbdf, or "auto" (docs/speed.md);
  *              rtol, atol > 0
  *   fx, fy     caller arrays of nx doubles */
 int friction_afm_line(const char *potential, double v0, double ax, double ay, double a,

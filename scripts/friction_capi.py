@@ -6,7 +6,7 @@
     fc.run_job(["inputs/naf.nml"], "naf.h5", force=True,
                report=lambda message, fraction: print(message))   # the CLI's job, no MPI launcher
 
-Units are those of the namelist input (README: input reference).  A failed
+Units are those of the namelist input (docs/input.md).  A failed
 call raises FrictionError with the library's status and message.
 
 The library is found, in order: the path in the environment variable
