@@ -235,15 +235,16 @@ def make_scratch(source: Path, build: Path, parent: Path, name: str) -> Path:
 def block_script(block: Block, status_file: Path, expect: int | None) -> str:
     """bash text that runs the block's commands in order and records, for
     each, its page line and exit code."""
-    out = [f"__doc_status() {{ printf '%s %s\\n' \"$1\" \"$2\" >> {shlex.quote(str(status_file))}; }}"]
+    out = [f"__doc_status() {{ printf '%s %s %s\\n' \"$1\" \"$2\" \"$3\" >> {shlex.quote(str(status_file))}; }}"]
     for n, cmd in enumerate(block.commands):
         last = n == len(block.commands) - 1
-        out.append(f"printf '$ %s\\n' {shlex.quote(cmd.text)}")
+        out.append(f"printf '$ %s\\n' {shlex.quote(cmd.text)}; __t=$EPOCHREALTIME")
         out.append(cmd.text)
+        status = f"__s=$?; __doc_status {cmd.line} $__s $__t-$EPOCHREALTIME"
         if last and expect is not None:
-            out.append(f"__s=$?; __doc_status {cmd.line} $__s; exit 0")
+            out.append(f"{status}; exit 0")
         else:
-            out.append(f"__s=$?; __doc_status {cmd.line} $__s; [ $__s -eq 0 ] || exit 100")
+            out.append(f"{status}; [ $__s -eq 0 ] || exit 100")
     return "\n".join(out) + "\n"
 
 
@@ -254,16 +255,20 @@ def tail(text: str, n: int = 40) -> str:
     return "\n".join(prefix + ["    " + l for l in cut])
 
 
-def run_block(block: Block, scratch: Path, env: dict, timeout: float) -> str | None:
-    """None when the block behaved, else the failure message."""
+def run_block(block: Block, scratch: Path, env: dict, timeout: float,
+              timings: list[tuple[float, str, str]]) -> str | None:
+    """None when the block behaved, else the failure message.  Appends
+    (seconds, page:line, command) of each command run to `timings`."""
     if block.lang == "python":
         script = scratch / f".doc_block_{block.line}.py"
         script.write_text("\n".join(block.body) + "\n", encoding="utf-8")
+        start = time.monotonic()
         try:
             r = subprocess.run([sys.executable, script.name], cwd=scratch, env=env, stdin=subprocess.DEVNULL,
                                stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=timeout)
         except subprocess.TimeoutExpired:
             return f"{block.where()}: python block still running after {timeout:.0f} s"
+        timings.append((time.monotonic() - start, block.where(), "python block"))
         if r.returncode != 0:
             return f"{block.where()}: python block exited with {r.returncode}\n{tail(r.stdout)}"
         return None
@@ -285,6 +290,14 @@ def run_block(block: Block, scratch: Path, env: dict, timeout: float) -> str | N
         line = block.commands[min(len([d for d in done if d]), len(block.commands) - 1)].line
         return f"{block.where(line)}: still running after {timeout:.0f} s\n{tail(out)}"
     records = [l.split() for l in status.read_text().splitlines()] if status.exists() else []
+    text_of = {c.line: c.text for c in block.commands}
+    for rec in records:
+        begin, _, end = rec[2].partition("-") if len(rec) > 2 else ("", "", "")
+        try:
+            seconds = float(end.replace(",", ".")) - float(begin.replace(",", "."))
+        except ValueError:
+            continue
+        timings.append((seconds, block.where(int(rec[0])), text_of.get(int(rec[0]), "")))
     if len(records) < len(block.commands):
         # The shell stopped before the status of a command was recorded.
         line = records[-1][0] if records and records[-1][1] != "0" else block.commands[len(records)].line
@@ -367,6 +380,7 @@ def main(argv=None) -> int:
     work_parent = args.work.resolve() if args.work else Path(tempfile.gettempdir())
     work_parent.mkdir(parents=True, exist_ok=True)
     start_all = time.monotonic()
+    timings: list[tuple[float, str, str]] = []
     for page, blocks in plan:
         if not blocks:
             continue
@@ -375,7 +389,7 @@ def main(argv=None) -> int:
         page_failures = 0
         try:
             for b in blocks:
-                message = run_block(b, scratch, env, args.timeout)
+                message = run_block(b, scratch, env, args.timeout, timings)
                 if message:
                     failures.append(message)
                     page_failures += 1
@@ -394,7 +408,9 @@ def main(argv=None) -> int:
         if before[name] != after[name]:
             failures.append(f"the commands changed {name} in the source tree")
 
-    print(f"doc-commands: {time.monotonic() - start_all:.1f} s in all")
+    print(f"doc-commands: {time.monotonic() - start_all:.1f} s in all; the slowest commands:")
+    for seconds, where, text in sorted(timings, reverse=True)[:5]:
+        print(f"    {seconds:6.1f} s  {where}  {text.split(chr(10))[0].split('  #')[0].strip()}")
     for f in failures:
         print(f"doc-commands: FAIL {f}", file=sys.stderr)
     return 1 if failures else 0
