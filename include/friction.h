@@ -29,7 +29,7 @@
  * handler is back when the last of them returns.  The job functions use MPI
  * and must be called from one thread at a time.
  *
- * Units are those of the namelist input (README: Input reference).
+ * Units are those of the namelist input (docs/input.md).
  */
 #ifndef FRICTION_H
 #define FRICTION_H

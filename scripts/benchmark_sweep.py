@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Benchmark friction's parameter sweeps (README: Parameter sweeps).
+"""Benchmark friction's parameter sweeps (docs/sweeps.md).
 
 Measures and prints (not a test; nothing fails on a missed target):
 

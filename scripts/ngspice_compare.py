@@ -276,7 +276,7 @@ def ngspice_work_precision(inputs, reltols, reference_t, reference_values, *, bi
         directory = Path(workdir or scratch)
         directory.mkdir(parents=True, exist_ok=True)
         for k, reltol in enumerate(reltols):
-            spice = run_ngspice(ngspice, Path(binary), inputs, extra + _integrator(None, reltol, atol),
+            spice = run_ngspice(ngspice, Path(binary).resolve(), inputs, extra + _integrator(None, reltol, atol),
                                 directory, f"ladder{k}", repeats)
             error, where = max_difference(spice, np.asarray(reference_t), np.asarray(reference_values), window)
             rows.append({"reltol": reltol, "atol": atol, "error": error, "t_error": where,
@@ -348,6 +348,8 @@ def parse_arguments(argv):
             parser.error(f"{path}: no such file")
     if not Path(args.binary).is_file():
         parser.error(f"{args.binary}: no friction program (build first, or --binary)")
+    # The runs happen in a scratch directory: a relative --binary is relative to here.
+    args.binary = Path(args.binary).resolve()
     if shutil.which(args.ngspice) is None:
         parser.error(f"{args.ngspice}: ngspice not found (scripts/install-deps installs it)")
     if args.repeats < 1:

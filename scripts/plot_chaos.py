@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Plot the chaos diagnostics of a Girling brake run (`friction` with an
-&analysis group; README: Girling brake, chaos).
+&analysis group; docs/physics.md, Chaos diagnostics).
 
 Reads one output file and writes into the output directory (default: the
 current directory, like `friction` itself) the PNGs of what the file holds:

@@ -1,6 +1,5 @@
 #!/usr/bin/env python3
-"""Plot a parameter sweep (`friction` with a &sweep group; README:
-Parameter sweeps).
+"""Plot a parameter sweep (`friction` with a &sweep group; docs/sweeps.md).
 
 Writes into the output directory (default: the current directory), for a
 brake sweep:

@@ -55,7 +55,7 @@ atol + rtol max|x_ref| in m for the brake, k atol + rtol max|F_ref| in nN
 for the tip, k in nN/Å), 'slow' (more than 10x the CPU time of the fastest method that
 is neither failed nor wrong; the time cap counts as slow), else 'ok'.
 
-The printed ranking behind method = 'auto' (README): at each rung, the
+The printed ranking behind method = 'auto' (docs/speed.md): at each rung, the
 methods not silently wrong at that rtol, ordered by the CPU time they need
 to reach the asked tolerance (log-log interpolation between rungs).
 
@@ -262,7 +262,7 @@ def make_scenes(quick: bool) -> dict:
                               "inputs/naf.nml, ny = 1, nx = 64, trace only"),
         # Damped (ratio 0.2): the paper's undamped tip is chaotic, and its line
         # force is not determined to better than about 0.06 nN at any tolerance
-        # (rk8pd at 1e-11 against 1e-10; README: Speed against accuracy).
+        # (rk8pd at 1e-11 against 1e-10; docs/speed.md).
         "graphite": AfmScene("graphite", ("graphite.nml", "graphite_damped.nml"),
                              "&scan nx = 32, ny = 1, retrace = .false. /",
                              QUICK_TOLS if quick else ladder(3, 10), 1e-11,
@@ -344,7 +344,7 @@ def run_scene(scene, methods, repeats) -> dict:
 
 
 # ngspice's reltol ladders (the charts' own rtol ladders, less the loosest rungs,
-# where trap integration misses slips: README: Network model).
+# where trap integration misses slips: docs/netlist.md).
 NGSPICE_LADDERS = {"naf_trace": [10.0 ** -k for k in range(4, 11)],
                    "brake_regularized": [10.0 ** -k for k in range(4, 12)]}
 NGSPICE_QUICK = {"naf_trace": [1e-6, 1e-8]}  # --quick --ngspice: seconds, for the test
@@ -723,7 +723,7 @@ def summary_table(results) -> str:
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
                                 formatter_class=argparse.RawDescriptionHelpFormatter,
-                                epilog="See the module docstring (or README: Speed against accuracy).")
+                                epilog="See the module docstring (or docs/speed.md).")
     p.add_argument("--quick", action="store_true",
                    help=f"naf and brake_switched, {', '.join(QUICK_METHODS)}, rtol "
                         f"{', '.join(f'{t:g}' for t in QUICK_TOLS)}, one run each, a small failure map")

@@ -1,10 +1,10 @@
 #!/usr/bin/env python3
-"""method = 'auto' resolves to the README's table, and runs as that method.
+"""method = 'auto' resolves to the table of docs/speed.md, and runs as that method.
 
     auto_method_test.py --binary BIN --inputs DIR --workdir DIR [--library SO]
 
 For each scene (naf, hopg, graphite, brake regularized, brake switched) and
-each asked rtol of the table below (the README's "method = 'auto'" table,
+each asked rtol of the table below (docs/speed.md's "method = 'auto'" table,
 the oracle here): a short run with method = 'auto' must record the table's
 stepper in the root attribute `method`, keep 'auto' in the `input`
 attribute, and give the same numbers, bit for bit, as the same run with the
@@ -24,7 +24,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-# (scene, input file, override, rtol, the README table's stepper)
+# (scene, input file, override, rtol, the table's stepper)
 AFM_SMALL = "&scan nx = 8, ny = 2, length = 4.0, width = 2.0 /\n"
 LJ_SMALL = "&scan nx = 4, ny = 1, length = 1.0 /\n"
 BRAKE_SHORT = ("&brake model = '{model}', t_end = 40.0, dt_out = 0.5 /\n"

@@ -26,7 +26,8 @@ import numpy as np
 SMALL = "&scan nx = 24, ny = 7 /\n"
 
 # name: (override text, expected exit code, words the message must contain)
-# The message names the file, the group and the variable (PHYSICS units).
+# The message names the file, the group and the variable (in the namelist's
+# units: docs/input.md; internal units: docs/physics.md, Units).
 BAD_INPUTS = {
     "unknown-variable": ("&tip mas = 1e-8 /\n", 3, ["bad.nml:1", "&tip", "mas"]),
     "wrong-type": ("&scan nx = 'many' /\n", 3, ["bad.nml:1", "&scan", "nx", "integer"]),
@@ -67,7 +68,7 @@ BAD_INPUTS = {
     "xyz-species": ("&surface potential = 'lj', net = 'file', net_file = 'net.xyz' /\n", 3,
                     ["net.xyz:3", "unknown species 'Au'"]),
     "unknown-option": (None, 2, ["--frobnicate"]),
-    # The reduced tip models (README: Reduced models (AFM)).
+    # The reduced tip models (docs/physics.md, Reduced tip models).
     "tip-model-unknown": ("&tip model = 'massless' /\n", 3,
                           ["bad.nml:1", "&tip", "model", "massless", "quasistatic"]),
     "overdamped-no-damping": ("&tip\n  model = 'overdamped'\n  cy = 0.0\n/\n", 3,
@@ -695,7 +696,7 @@ def case_brake_failure(args):
         fail(f"a failed run left files: {leftovers(args)}")
 
 
-# A small sweep of the belt velocity (README: Parameter sweeps).
+# A small sweep of the belt velocity (docs/sweeps.md).
 SWEEP_SMALL = ("&brake mu = 0.5, mu_s = 0.59, t_end = 300.0, dt_out = 0.1 /\n"
                "&analysis window_start = 50.0, window_end = 300.0, lyapunov_transient = 50.0,"
                " poincare = .false., rosenstein = .false. /\n"

@@ -82,7 +82,7 @@ def agreement(args, work, inputs, extra, bound, unit):
 
 def case_brake(args, work):
     # tau in [0, 300]: about 44 cycles of the stick-slip.  On the arctan law
-    # the motion settles on a periodic orbit, not a chaotic one (README:
+    # the motion settles on a periodic orbit, not a chaotic one (docs/speed.md:
     # rk8pd at 1e-13 and rk4imp at 1e-12 agree to 1.2e-11 m at tau = 1000),
     # so differences grow linearly with tau (a phase drift: 7e-5, 1.8e-4,
     # 3.9e-4, 5.7e-4 m at tau = 50, 100, 200, 300 at reltol 1e-6), not
@@ -100,7 +100,7 @@ def case_naf(args, work):
     # Line 0 of inputs/naf.nml (20 angstrom, 128 samples, three stick-slip
     # cycles).  Bound: measured 2.0e-5 nN at reltol 1e-9, at the slip where
     # the force falls by 2.8 nN within a few microseconds; 1e-4 nN leaves a
-    # factor 5 and is the kernel's own default accuracy (README: 1e-4 nN).
+    # factor 5 and is the kernel's own default accuracy (docs/input.md: 1e-4 nN).
     inputs = [Path(args.inputs) / "naf.nml"]
     header = agreement(args, work, inputs, "", 1.0e-4, "nN")
     require(header == ["time", "tip_x", "tip_y", "vx", "vy", "f_along", "d_f_along"],

@@ -6,7 +6,7 @@
 #                          (rkf45, rk8pd), the reference passes its own check,
 #                          the failure map's categories (tests/check_work_precision.py)
 #   work_precision.png     the three PNGs are complete images
-#   auto-method            method = 'auto' resolves to the README's table and
+#   auto-method            method = 'auto' resolves to docs/speed.md's table and
 #                          runs as the named method (CLI and C API)
 # Included from tests/CMakeLists.txt after scripts.cmake (which checks for
 # h5py and matplotlib and defines the helpers used here).

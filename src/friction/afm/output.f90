@@ -31,7 +31,7 @@ module friction_afm_output
 contains
 
    !> Friction of each line: half the difference of the mean force along
-   !> the scan on trace and retrace (PHYSICS §1), nN.
+   !> the scan on trace and retrace (docs/physics.md, Scan geometry, trips and the lateral force), nN.
    pure function line_friction(trace, retrace) result(friction)
       real(wp), intent(in) :: trace(:, :, :), retrace(:, :, :)
       real(wp) :: friction(size(trace, 2))

@@ -4,7 +4,7 @@
 !> Hessian), which is also the Hessian of the total energy
 !> E = V(r) + ½ Σ k_i (r_i - r_M,i)².  A minimum of E has J positive
 !> definite; the tip follows such a minimum as the support moves, and the
-!> minimum ends at a fold, where J becomes singular (PHYSICS §1: the slip of
+!> minimum ends at a fold, where J becomes singular (docs/physics.md, Prandtl–Tomlinson: the slip of
 !> the Prandtl–Tomlinson model).  The tracking loop and the jump at a fold
 !> live in friction_afm_scan; here are the pure pieces: Newton's method
 !> kept inside the convex region, and the tangent of the branch.
