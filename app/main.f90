@@ -167,11 +167,11 @@ contains
          & 'With &job scene = ''brake'': the stick-slip of a Girling brake (one', &
          & 'trajectory; inputs/brake.nml; groups &brake &brake_dimensional &verify &analysis).', &
          & 'With a &sweep group: a parameter sweep of either scene over the MPI ranks, one or two', &
-         & 'variables (inputs/brake_sweep.nml, inputs/afm_sweep.nml; README: Parameter sweeps).', &
+         & 'variables (inputs/brake_sweep.nml, inputs/afm_sweep.nml; docs/sweeps.md).', &
          & '', &
          & 'Input files are namelist files read in order; a later file overrides', &
          & 'earlier values variable by variable.  Groups: &job &surface &tip &scan', &
-         & '&integrator (see README.md, input reference).', &
+         & '&integrator (see docs/input.md).', &
          & '', &
          & 'options:', &
          & '  -o, --output FILE  output file (default: first input''s name with .h5,', &
@@ -183,7 +183,7 @@ contains
          & '      --netlist FILE write the scene as a SPICE netlist for ngspice (the paper''s', &
          & '                     network model) and exit without integrating: the brake', &
          & '                     (arctan law), or line 0 (trace) of a NaF or HOPG map;', &
-         & '                     ngspice -b FILE writes FILE.data (README: Network model)', &
+         & '                     ngspice -b FILE writes FILE.data (docs/netlist.md)', &
          & '  -h, --help         this help', &
          & '  -V, --version      the version', &
          & '', &

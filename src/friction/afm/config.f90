@@ -1,5 +1,5 @@
 !> Settings of a friction-force-map scene, in the units of the namelist
-!> (see README: input reference), and the conversion to the internal model.
+!> (see docs/input.md), and the conversion to the internal model.
 module friction_afm_config
    use friction_kinds, only: wp, pi, kg_to_internal, n_per_m_to_internal, ns_per_m_to_internal, &
       & deg_to_rad
@@ -26,7 +26,7 @@ module friction_afm_config
    character(len=*), parameter :: potential_names(3) = [character(len=4) :: 'naf', 'hopg', 'lj']
    character(len=*), parameter :: net_names(3) = [character(len=8) :: 'graphite', 'square', 'file']
    !> &tip model: the full equations of motion, without inertia, or the
-   !> equilibrium followed (README: Reduced models (AFM)).
+   !> equilibrium followed (docs/physics.md, reduced tip models).
    character(len=*), parameter :: tip_model_names(3) = [character(len=11) :: 'inertial', 'overdamped', &
       & 'quasistatic']
    integer, parameter :: max_species = 8, max_defects = 64
@@ -85,7 +85,7 @@ module friction_afm_config
 
 contains
 
-   !> The groups &surface, &tip, &scan and &integrator (README: input reference).
+   !> The groups &surface, &tip, &scan and &integrator (docs/input.md).
    subroutine visit(self, v)
       class(afm_config), intent(inout) :: self
       type(parameter_visitor), intent(inout) :: v

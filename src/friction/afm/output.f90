@@ -1,4 +1,4 @@
-!> The friction-force-map file (README: output reference).  Collective: all
+!> The friction-force-map file (docs/output.md).  Collective: all
 !> ranks call it; each passes the block of lines it computed.
 module friction_afm_output
    use mpi_f08, only: MPI_Comm

@@ -9,7 +9,7 @@
 !> at the support and at rest (paper §3.1, §5.1); the quasistatic tip starts
 !> in the minimum it relaxes into from there.
 !>
-!> The reduced models (README: Reduced models (AFM)): the overdamped tip is
+!> The reduced models (docs/physics.md, reduced tip models): the overdamped tip is
 !> integrated like the full one (friction_afm_tip); the quasistatic tip is
 !> followed from sample to sample along its minimum of the total energy
 !> (friction_afm_quasistatic), and jumps to the next minimum where its own

@@ -1,5 +1,5 @@
 !> The friction-force map as a scene: the tip dragged over a surface line
-!> by line (README: The model).  Lines are dealt round-robin over the ranks;
+!> by line (docs/physics.md).  Lines are dealt round-robin over the ranks;
 !> the file is written together, each rank its own lines.
 module friction_afm_scene
    use mpi_f08
@@ -122,7 +122,7 @@ contains
          ! bad input, reported before any work.
          call new_potential(c, potential, error, self%surface%net, self%surface%cutoff)
          if (allocated(error)) return
-         ! A reduced tip model outside where it holds (README: Reduced models (AFM)):
+         ! A reduced tip model outside where it holds (docs/physics.md, reduced tip models):
          ! one note per reason.
          if (job%rank == 0) then
             warnings = afm_model_warnings(c, potential)

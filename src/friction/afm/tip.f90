@@ -7,7 +7,7 @@
 !> on the surface, and the absolute tolerance (Å) bounds the lateral force
 !> error directly: |δF| <= k |δu|.  Internal units (friction_kinds): Å, eV, s.
 !>
-!> Reduced models (README: Reduced models): `model_overdamped` drops the
+!> Reduced models (docs/physics.md, reduced tip models): `model_overdamped` drops the
 !> inertia, c_i r_i' = k_i (r_M,i - r_i) - dV/dr_i, state y = u only;
 !> `model_quasistatic` follows the equilibrium (friction_afm_scan) and uses
 !> the same first-order system, at a fixed support, only to relax the tip

@@ -1,6 +1,6 @@
-!> Where the reduced tip models hold (README: Reduced models (AFM)).  The
+!> Where the reduced tip models hold (docs/physics.md, reduced tip models).  The
 !> program warns, it does not refuse: a reduced model outside its limit
-!> still runs, and the README's table shows what it costs in accuracy.
+!> still runs, and docs/speed.md shows what it costs in accuracy.
 module friction_afm_validity
    use friction_kinds, only: wp, ev_per_angstrom_to_nn, deg_to_rad
    use friction_error, only: error_type
@@ -104,7 +104,7 @@ contains
    !> (nN), the friction the full model would add to.  The rule before the
    !> run compares the drag with the surface force, which can be far above
    !> the friction (HOPG at 400 Å/s: drag 0.96 % of the force, 3 % of the
-   !> friction; README: Reduced models (AFM)).
+   !> friction; docs/physics.md, reduced tip models).
    function quasistatic_friction_warning(config, friction) result(text)
       type(afm_config), intent(in) :: config
       real(wp), intent(in) :: friction

@@ -1,4 +1,4 @@
-!> What a user chooses about the chaos diagnostics (README: &analysis), in
+!> What a user chooses about the chaos diagnostics (docs/input.md, &analysis), in
 !> the units of the scene's time.  Scene-independent: a scene maps `series`
 !> to one of its variables and `section` to one of its sections.
 module friction_analysis_settings

@@ -1,5 +1,4 @@
-!> Settings of the brake scene as the namelist gives them (README: input
-!> reference, groups &brake, &brake_dimensional, &verify, &integrator), and
+!> Settings of the brake scene as the namelist gives them (docs/input.md, groups &brake, &brake_dimensional, &verify, &integrator), and
 !> the parameters of Eq. 10 they resolve to.
 module friction_brake_config
    use friction_kinds, only: wp, i8
@@ -70,7 +69,7 @@ module friction_brake_config
 contains
 
    !> The groups &integrator, &brake, &brake_dimensional, &verify and
-   !> &analysis (README: input reference).
+   !> &analysis (docs/input.md).
    subroutine visit(self, v)
       class(brake_config), intent(inout) :: self
       type(parameter_visitor), intent(inout) :: v

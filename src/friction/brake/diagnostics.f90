@@ -1,4 +1,4 @@
-!> The chaos diagnostics of a brake run (README: Girling brake, chaos):
+!> The chaos diagnostics of a brake run (docs/physics.md, chaos diagnostics):
 !> the spectrum of one variable over a window, the stroboscopic map and a
 !> section, and the maximum Lyapunov exponent from the equations (two runs
 !> through the same stick/slip logic, Benettin) and from the series

@@ -1,4 +1,4 @@
-!> The brake file (README: output reference, /brake).  Collective: every
+!> The brake file (docs/output.md, /brake).  Collective: every
 !> rank calls it with the same data (rank 0 computed it and broadcast it;
 !> the datasets are small), and rank 0 writes the values.
 module friction_brake_output
@@ -165,7 +165,7 @@ contains
 
    end subroutine write_brake_file
 
-   !> /brake/spectrum, /brake/poincare, /brake/lyapunov (README: output reference).
+   !> /brake/spectrum, /brake/poincare, /brake/lyapunov (docs/output.md).
    subroutine write_diagnostics(file, d)
       type(h5_file), intent(inout) :: file
       type(brake_diagnostics), intent(in) :: d

@@ -1,4 +1,4 @@
-!> The Girling brake as a scene (README: Girling brake): one trajectory.
+!> The Girling brake as a scene (docs/physics.md, the Girling brake): one trajectory.
 !> Rank 0 integrates it; with verify on, the check run goes to rank 1 when
 !> there is one (concurrently), else rank 0 runs it after the main run.  The
 !> results are broadcast (a few MB at most) so that every rank takes part in
@@ -162,7 +162,7 @@ contains
                   & .not. (d%max_difference(1) <= settings%check%max_difference)) then
                   write (line, '(a, es8.2, a, es8.2, a)') 'verify failed: the check run differs by ', &
                      & d%max_difference(1), ' m in x, more than check_limit = ', settings%check%max_difference, &
-                     & ' m (README: Girling brake, which steppers need verify)'
+                     & ' m (docs/speed.md, which steppers need verify)'
                   call fatal_error(error, trim(line), error_numerical)
                   return
                end if

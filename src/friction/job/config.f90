@@ -21,7 +21,7 @@ module friction_job_config
 
    !> &sweep: one or two numeric variables of the scene ('group.name'), each
    !> over a list, a linspace or a logspace; the points are the grid of the
-   !> two, the second varying fastest (README: Parameter sweeps).
+   !> two, the second varying fastest (docs/sweeps.md).
    type :: sweep_settings
       ! As the input gives them
       character(len=64) :: variables(2) = ''       !! 'group.name', e.g. 'brake.v_dr_prime'

@@ -146,7 +146,7 @@ contains
    end subroutine run_configured
 
    !> The scene of `files` as a SPICE netlist for ngspice (the paper's
-   !> network model, README: Network model) in `path`, its waveforms going to
+   !> network model, docs/netlist.md) in `path`, its waveforms going to
    !> the same name with .data; nothing is integrated.  Rank 0 writes; every
    !> rank returns the same error or none.  `summary` says what was written.
    subroutine write_netlist(files, path, force, comm, reporter, summary, error)

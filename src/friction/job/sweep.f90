@@ -1,4 +1,4 @@
-!> Parameter sweeps over the MPI ranks (README: Parameter sweeps).  Each
+!> Parameter sweeps over the MPI ranks (docs/sweeps.md).  Each
 !> point is a copy of the job's scene with the swept variables set in memory
 !> and checked by the scene's own checks; an invalid or failing point is
 !> recorded as failed with its reason and the sweep goes on.
@@ -193,7 +193,7 @@ contains
       call MPI_Allreduce(MPI_IN_PLACE, flag, 1, MPI_INTEGER, MPI_MAX, job%comm)
       interrupted = flag /= 0
 
-      ! Peak resident memory of every rank, for the benchmark (README: Parameter sweeps).
+      ! Peak resident memory of every rank, for the benchmark (docs/sweeps.md).
       allocate (memory(job%nranks))
       call MPI_Gather(peak_memory_kb(), 1, MPI_INTEGER, memory, 1, MPI_INTEGER, 0, job%comm)
       wall = MPI_Wtime() - job%t_start

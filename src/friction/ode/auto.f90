@@ -1,7 +1,7 @@
 !> method = 'auto': the GSL stepper that the work-precision charts show to be
 !> the fastest for a scene at the asked tolerance.
 !>
-!> The table and its evidence are in the README (Speed against accuracy):
+!> The table and its evidence are in docs/speed.md:
 !> scripts/work_precision measures every stepper on every scene over a
 !> ladder of tolerances against a far tighter reference, and for each rung
 !> finds the fastest stepper reaching the error that rung asks for

@@ -17,7 +17,7 @@ module friction_scene
 
    public :: scene, point_result
 
-   !> One named result of a sweep point (README: Parameter sweeps).
+   !> One named result of a sweep point (docs/sweeps.md).
    type :: point_result
       character(len=24) :: name = ''
       character(len=16) :: unit = ''
