@@ -11,6 +11,7 @@ module friction_ode_solver
    use friction_kinds, only: wp, i8
    use friction_error, only: error_type, fatal_error, error_numerical, error_input, error_internal
    use friction_ode_system, only: ode_system
+   use friction_strings, only: itoa, rtoa
    implicit none
    private
 
@@ -232,8 +233,19 @@ contains
       self%h_min = settings%h_min
       self%method = settings%method
       status = gsl_odeiv2_driver_set_nmax(self%driver, int(settings%max_steps, c_long))
-      if (settings%h_min > 0.0_wp) &
-         & status = gsl_odeiv2_driver_set_hmin(self%driver, real(settings%h_min, c_double))
+      if (status /= gsl_success) then
+         call fatal_error(error, 'GSL refused max_steps = '//itoa(settings%max_steps), error_input)
+         return
+      end if
+      if (settings%h_min > 0.0_wp) then
+         ! GSL refuses an h_min above the first step (and would go on without it).
+         status = gsl_odeiv2_driver_set_hmin(self%driver, real(settings%h_min, c_double))
+         if (status /= gsl_success) then
+            call fatal_error(error, 'h_min = '//rtoa(settings%h_min)//' is larger than the first step ' &
+               & //rtoa(h_start)//': set h_start >= h_min, or a smaller h_min', error_input)
+            return
+         end if
+      end if
       self%done = integrator_statistics()
    end subroutine init
 
