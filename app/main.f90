@@ -118,6 +118,10 @@ contains
             end if
             i = i + 1
             call get_command_argument(i, arg)
+            if (len_trim(arg) == 0) then
+               code = usage_error('option -o needs a file name, not an empty one')
+               return
+            end if
             opts%output = trim(arg)
          case ('--netlist')
             if (i == n) then
@@ -206,9 +210,12 @@ contains
       end select
    end function exit_code
 
+   !> Flush first: what the run said must reach stderr even if finalizing fails.
    subroutine finish(code)
       integer, intent(in) :: code
 
+      flush (error_unit)
+      flush (output_unit)
       call MPI_Finalize()
       flush (error_unit)
       flush (output_unit)

@@ -1,18 +1,18 @@
 !> Settings of a friction-force-map scene, in the units of the namelist
 !> (see docs/input.md), and the conversion to the internal model.
 module friction_afm_config
-   use friction_kinds, only: wp, pi, kg_to_internal, n_per_m_to_internal, ns_per_m_to_internal, &
+   use friction_kinds, only: wp, i8, pi, kg_to_internal, n_per_m_to_internal, ns_per_m_to_internal, &
       & deg_to_rad
    use friction_error, only: error_type, fatal_error, error_input
    use friction_ode_solver, only: solver_settings
    use friction_surface_potential, only: surface_potential
    use friction_surface_naf, only: new_naf_potential
    use friction_surface_hopg, only: new_hopg_potential
-   use friction_surface_net, only: crystal_net, graphite_net, square_net, read_xyz
+   use friction_surface_net, only: crystal_net, graphite_net, square_net, read_xyz, max_local_density, sort_order
    use friction_surface_lennard_jones, only: new_lj_potential, cutoff_for_tolerance
    use friction_kinds, only: ev_per_angstrom_to_nn
    use friction_afm_tip, only: afm_tip, model_inertial, model_overdamped, model_quasistatic
-   use friction_strings, only: itoa, rtoa, quoted
+   use friction_strings, only: itoa, rtoa, quoted, bytes_text
    use friction_files, only: file_exists
    use friction_parameters, only: configurable, parameter_visitor
    use friction_checks, only: config_checker
@@ -30,6 +30,8 @@ module friction_afm_config
    character(len=*), parameter :: tip_model_names(3) = [character(len=11) :: 'inertial', 'overdamped', &
       & 'quasistatic']
    integer, parameter :: max_species = 8, max_defects = 64
+   !> Quantities a trip records (friction_afm_scan's n_quantities), for sizes in messages.
+   integer, parameter :: n_trip_quantities = 9
 
    type, extends(configurable) :: afm_config
       ! &surface
@@ -171,6 +173,12 @@ contains
       call c%nonnegative('scan', 'lead_in', self%lead_in, 'angstrom')
       if (self%nx < 2) call c%reject('scan', 'nx', itoa(self%nx), 'must be >= 2 (sample points per line)')
       if (self%ny < 1) call c%reject('scan', 'ny', itoa(self%ny), 'must be >= 1 (lines)')
+      ! Sizes in 64 bits: a map's dataset holds nx * ny values, and one
+      ! collective MPI-IO write takes at most 2**31 - 1 of them.
+      if (int(self%nx, i8) * int(max(self%ny, 1), i8) > int(huge(1), i8)) call c%reject('scan', 'nx', &
+         & itoa(self%nx), 'with ny = '//itoa(self%ny)//' the map has '//itoa(int(self%nx, i8) * self%ny) &
+         & //' samples, more than 2147483647 per dataset (and '//bytes_text(8.0_wp * n_trip_quantities &
+         & * real(self%nx, wp) * self%ny)//' of memory for the trace alone)')
       call check_integrator(self%solver, c)
 
    contains
@@ -310,26 +318,50 @@ contains
       call net%remove_sites(vacant)
    end subroutine new_net
 
-   !> Atoms per Å² in the middle of a net: those within 8 Å of its centroid
-   !> (the whole bounding box for a small net).
+   !> Atoms per Å² for the cutoff's error bound (cutoff_for_tolerance): the
+   !> density within 8 Å of the net's middle (the median of the atoms'
+   !> positions, which a far stray atom does not move, unlike the centroid),
+   !> or the largest density over discs of 8 Å around its atoms if that is
+   !> larger, so that the bound holds for any net.  (The density of the
+   !> bounding box, used before for small nets, let one far atom shrink the
+   !> cutoff.)
    pure real(wp) function net_density(net) result(density)
       type(crystal_net), intent(in) :: net
       real(wp), parameter :: radius = 8.0_wp
-      real(wp) :: centre(2), extent(2)
-      integer :: inside, i
+      real(wp) :: centre(2)
+      integer :: inside, i, k, n
+      integer, allocatable :: order(:)
 
-      centre = sum(net%position(1:2, :), dim=2) / net%size()
+      n = net%size()
+      do k = 1, 2
+         order = sort_order(net%position(k, :))
+         centre(k) = 0.5_wp * (net%position(k, order((n + 1) / 2)) + net%position(k, order(n / 2 + 1)))
+      end do
       inside = 0
-      do i = 1, net%size()
+      do i = 1, n
          if (sum((net%position(1:2, i) - centre)**2) < radius**2) inside = inside + 1
       end do
-      extent = maxval(net%position(1:2, :), dim=2) - minval(net%position(1:2, :), dim=2)
-      if (inside >= 10) then
-         density = inside / (pi * radius**2)
-      else
-         density = net%size() / max(1.0_wp, product(extent + 1.0_wp))
-      end if
+      density = max(inside / (pi * radius**2), max_local_density(net, radius))
    end function net_density
+
+   !> The box (x_min, x_max, y_min, y_max, Å) of every support position of
+   !> the map, widened by `margin` (the cutoff and the tip's excursion from
+   !> its support): where the tip can reach atoms.
+   pure function scan_region(config, margin) result(box)
+      type(afm_config), intent(in) :: config
+      real(wp), intent(in) :: margin
+      real(wp) :: box(4)
+      real(wp) :: corner(2, 4), along(3), across(3)
+
+      along = config%scan_direction()
+      across = config%across_direction()
+      corner(:, 1) = [config%origin_x, config%origin_y] - config%lead_in * along(1:2)
+      corner(:, 2) = corner(:, 1) + (config%length + 2.0_wp * config%lead_in) * along(1:2)
+      corner(:, 3) = corner(:, 1) + config%width * across(1:2)
+      corner(:, 4) = corner(:, 2) + config%width * across(1:2)
+      box = [minval(corner(1, :)) - margin, maxval(corner(1, :)) + margin, &
+         & minval(corner(2, :)) - margin, maxval(corner(2, :)) + margin]
+   end function scan_region
 
    !> The surface potential the settings name; for a lattice sum also the
    !> net (for the output) and the cutoff used.
@@ -359,7 +391,8 @@ contains
          rc = config%cutoff
          if (rc <= 0.0_wp) rc = cutoff_for_tolerance(maxval(config%epsilon(1:ns) * config%sigma(1:ns)**6), &
             & 1.0_wp, net_density(atoms), config%cutoff_tolerance / ev_per_angstrom_to_nn)
-         allocate (potential, source=new_lj_potential(atoms, config%epsilon(1:ns), config%sigma(1:ns), rc))
+         allocate (potential, source=new_lj_potential(atoms, config%epsilon(1:ns), config%sigma(1:ns), rc, &
+            & scan_region(config, rc + 10.0_wp)))
          if (present(net)) net = atoms
          if (present(cutoff)) cutoff = rc
       case default

@@ -9,7 +9,7 @@ module friction_afm_netlist
    use friction_error, only: error_type, fatal_error, error_input
    use friction_netlist_spice, only: nl, tolerances, control_end, num
    use friction_afm_config, only: afm_config
-   use friction_afm_scan, only: support_across
+   use friction_afm_scan, only: line_offset
    implicit none
    private
 
@@ -26,7 +26,7 @@ contains
       character(len=:), allocatable, intent(out) :: text
       type(error_type), allocatable, intent(out) :: error
       character(len=:), allocatable :: gradient_x, gradient_y, surface
-      real(wp) :: along(3), start(3), offset(c%ny), sample_time, trip_time
+      real(wp) :: along(3), start(3), sample_time, trip_time
 
       select case (trim(c%potential))
       case ('naf')
@@ -55,9 +55,8 @@ contains
       end select
 
       along = c%scan_direction()
-      offset = support_across(c)
       ! Line 0 starts lead_in before its first sample, as the kernel's trace.
-      start = [c%origin_x, c%origin_y, 0.0_wp] + offset(1) * c%across_direction() - c%lead_in * along
+      start = [c%origin_x, c%origin_y, 0.0_wp] + line_offset(c, 0) * c%across_direction() - c%lead_in * along
       sample_time = c%length / real(c%nx - 1, wp) / c%velocity
       trip_time = (c%length + c%lead_in) / c%velocity
 

@@ -22,13 +22,15 @@ module friction_afm_scan
    use friction_afm_tip, only: afm_tip, model_inertial, model_quasistatic
    use friction_afm_quasistatic, only: newton_equilibrium, equilibrium_tangent
    use friction_surface_potential, only: surface_potential
-   use friction_strings, only: rtoa
+   use friction_surface_lennard_jones, only: lj_potential
+   use friction_strings, only: rtoa, itoa, bytes_text
+   use friction_files, only: available_memory
    implicit none
    private
 
    public :: afm_scanner, trip_record, quantity_names, quantity_units, n_quantities, quantity_count
    public :: q_fx, q_fy, q_f_along, q_f_across, q_tip_x, q_tip_y, q_fz, q_tip_z, q_jumps
-   public :: support_along, support_across, find_height
+   public :: support_along, support_across, find_height, support_at, line_offset
 
    integer, parameter :: n_quantities = 9
    integer, parameter :: q_fx = 1, q_fy = 2, q_f_along = 3, q_f_across = 4, q_tip_x = 5, q_tip_y = 6, &
@@ -82,26 +84,45 @@ contains
       quantity_count = merge(q_tip_z, q_tip_y, ndim == 3)
    end function quantity_count
 
+   !> Support position of sample i (0-based) along the line, Å.
+   pure real(wp) function support_at(config, i) result(s)
+      type(afm_config), intent(in) :: config
+      integer, intent(in) :: i
+
+      s = config%length * real(i, wp) / real(config%nx - 1, wp)
+   end function support_at
+
+   !> Offset of line j (0-based) across the scan, Å.
+   pure real(wp) function line_offset(config, j) result(t)
+      type(afm_config), intent(in) :: config
+      integer, intent(in) :: j
+
+      t = 0.0_wp
+      if (config%ny > 1) t = config%width * real(j, wp) / real(config%ny - 1, wp)
+   end function line_offset
+
    !> Support positions along the line, Å.
    pure function support_along(config) result(s)
       type(afm_config), intent(in) :: config
-      real(wp) :: s(config%nx)
+      real(wp), allocatable :: s(:)
       integer :: i
 
-      s = [(config%length * real(i, wp) / real(config%nx - 1, wp), i = 0, config%nx - 1)]
+      allocate (s(config%nx))
+      do i = 1, config%nx
+         s(i) = support_at(config, i - 1)
+      end do
    end function support_along
 
    !> Offsets of the lines across the scan, Å.
    pure function support_across(config) result(t)
       type(afm_config), intent(in) :: config
-      real(wp) :: t(config%ny)
+      real(wp), allocatable :: t(:)
       integer :: j
 
-      if (config%ny == 1) then
-         t = 0.0_wp
-      else
-         t = [(config%width * real(j, wp) / real(config%ny - 1, wp), j = 0, config%ny - 1)]
-      end if
+      allocate (t(config%ny))
+      do j = 1, config%ny
+         t(j) = line_offset(config, j - 1)
+      end do
    end function support_across
 
    subroutine init(self, config, potential, error)
@@ -122,6 +143,12 @@ contains
          call find_height(self%tip, [config%origin_x, config%origin_y, 0.0_wp], 0.0_wp, &
             & self%contact_height, error)
          if (allocated(error)) return
+         call check_above_net(self%tip, [config%origin_x, config%origin_y, self%contact_height], &
+            & 'the contact height found at the scan origin lies within the layer of atoms, not above it: ' &
+            & //'the net is too sparse for the tip (its atoms too far apart for their sigma, or a single atom ' &
+            & //'away from the origin), so the tip would fall through; use a denser net, a larger sigma, or ' &
+            & //'start the scan over the atoms', error)
+         if (allocated(error)) return
          self%support_height = self%contact_height + config%support_z
       end if
       ! First step: a small fraction of the fastest time scale in sight
@@ -136,7 +163,8 @@ contains
          end if
       end if
       self%h_start = config%solver%h_start
-      if (self%h_start <= 0.0_wp) self%h_start = 1.0e-3_wp * period
+      ! (An h_min above the automatic first step raises it, as for the brake.)
+      if (self%h_start <= 0.0_wp) self%h_start = max(1.0e-3_wp * period, config%solver%h_min)
       call self%solver%init(self%tip, config%solver, self%h_start, error)
    end subroutine init
 
@@ -147,7 +175,7 @@ contains
       logical, intent(in) :: forward
       type(trip_record), intent(inout) :: record
       type(error_type), allocatable, intent(out) :: error
-      real(wp) :: along(3), across(3), line_start(3), s(self%config%nx), offset(self%config%ny)
+      real(wp) :: along(3), across(3), line_start(3)
       real(wp) :: y(6), t, t_sample, s_start, force(3), tip_r(3), z_start
       integer(i8) :: now
       integer :: i, k, nx, nd, jumps
@@ -158,9 +186,7 @@ contains
          nd = tip%ndim
          along = c%scan_direction()
          across = c%across_direction()
-         s = support_along(c)
-         offset = support_across(c)
-         line_start = [c%origin_x, c%origin_y, 0.0_wp] + offset(j + 1) * across
+         line_start = [c%origin_x, c%origin_y, 0.0_wp] + line_offset(c, j) * across
          if (forward) then
             s_start = -c%lead_in
             tip%support_velocity = c%velocity * along
@@ -176,16 +202,23 @@ contains
             tip%support_start(3) = self%support_height
             call find_height(tip, tip%support_start, tip%spring(3), z_start, error)
             if (allocated(error)) return
+            call check_above_net(tip, [tip%support_start(1:2), z_start], 'at the start of line '//itoa(j) &
+               & //' the load presses the tip into the layer of atoms (support_z = '//rtoa(c%support_z) &
+               & //' Å from the contact height, kz = '//rtoa(c%kz)//' N/m): raise support_z', error)
+            if (allocated(error)) return
             y(3) = z_start - self%support_height
          end if
          t = 0.0_wp
          jumps = 0
          call self%solver%restart(self%h_start)
          if (tip%model == model_quasistatic) call self%relax(t, y(1:nd), error)
-         if (.not. allocated(record%values)) allocate (record%values(nx, n_quantities))
+         if (.not. allocated(record%values)) then
+            call allocate_trip(record, nx, error)
+            if (allocated(error)) return
+         end if
          do k = 1, nx
             i = merge(k, nx + 1 - k, forward)
-            t_sample = abs(s(i) - s_start) / c%velocity
+            t_sample = abs(support_at(c, i - 1) - s_start) / c%velocity
             if (allocated(error)) then
                continue
             else if (tip%model == model_quasistatic) then
@@ -207,6 +240,13 @@ contains
             end if
             force = tip%lateral_force(y) * ev_per_angstrom_to_nn
             tip_r = tip%tip_position(t, y)
+            if (nd == 3) then
+               call check_above_net(tip, tip_r, 'the tip passed into the layer of atoms at (' &
+                  & //rtoa(tip_r(1))//', '//rtoa(tip_r(2))//', '//rtoa(tip_r(3))//') Å (line '//itoa(j) &
+                  & //trim(merge(' trace  ', ' retrace', forward))//'): the load (support_z = '//rtoa(c%support_z) &
+                  & //' Å) is more than the layer holds; raise support_z', error)
+               if (allocated(error)) return
+            end if
             record%values(i, q_fx) = force(1)
             record%values(i, q_fy) = force(2)
             record%values(i, q_f_along) = dot_product(force, along)
@@ -220,6 +260,47 @@ contains
          end do
       end associate
    end subroutine run_trip
+
+   !> For a tip over a lattice sum: an error (bad input) when the tip at `r`
+   !> is not above the atoms under it, i.e. less than half the smallest σ
+   !> above the highest atom within 2 σ_max laterally.  A root of the force
+   !> balance in the plane of the atoms (a sparse net, tiny σ or a) or a
+   !> tip pushed through the layer is not a contact.
+   subroutine check_above_net(tip, r, reason, error)
+      type(afm_tip), intent(in) :: tip
+      real(wp), intent(in) :: r(3)
+      character(len=*), intent(in) :: reason
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: top, sigma_min
+
+      select type (p => tip%potential)
+      type is (lj_potential)
+         call p%highest_near(r(1:2), 2.0_wp * maxval(p%sigma), top, sigma_min)
+         if (top > -huge(1.0_wp) .and. .not. (r(3) > top + 0.5_wp * sigma_min)) &
+            & call fatal_error(error, reason, error_input)
+         if (top == -huge(1.0_wp) .and. r(3) < 0.5_wp * sigma_min + minval(p%position(3, :))) &
+            & call fatal_error(error, reason, error_input)
+      end select
+   end subroutine check_above_net
+
+   !> One trip's record of nx samples, or an error stating the memory it
+   !> needs when this machine has not that much available.
+   subroutine allocate_trip(record, nx, error)
+      type(trip_record), intent(inout) :: record
+      integer, intent(in) :: nx
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: needed, available
+      integer :: stat
+
+      needed = 8.0_wp * real(nx, wp) * n_quantities
+      available = available_memory()
+      stat = 0
+      if (.not. (available > 0.0_wp .and. needed > available)) allocate (record%values(nx, n_quantities), stat=stat)
+      if (stat /= 0 .or. (available > 0.0_wp .and. needed > available)) call fatal_error(error, &
+         & 'one scan line of '//itoa(nx)//' points needs '//bytes_text(needed)//' of memory, more than this ' &
+         & //'machine has available ('//bytes_text(max(available, 0.0_wp))//'): use fewer points (&scan nx)', &
+         & error_input)
+   end subroutine allocate_trip
 
    !> The height z at which the tip above (x, y) = at(1:2) is in equilibrium
    !> between the surface and a z spring of constant `spring` (eV/Å²) held

@@ -4,8 +4,9 @@
 module friction_afm_scene
    use mpi_f08
    use friction_kinds, only: wp, i8
-   use friction_error, only: error_type
-   use friction_strings, only: itoa
+   use friction_error, only: error_type, fatal_error, error_input
+   use friction_files, only: available_memory
+   use friction_strings, only: itoa, bytes_text
    use friction_version, only: version_string
    use friction_parameters, only: parameter_visitor
    use friction_checks, only: config_checker
@@ -138,12 +139,12 @@ contains
          call share_of(c%ny, job%nranks, job%rank, self%first, count)
          if (allocated(self%trace)) deallocate (self%trace)
          if (allocated(self%retrace)) deallocate (self%retrace)
-         allocate (self%trace(c%nx, count, n_quantities))
-         allocate (self%retrace(c%nx, merge(count, 0, c%retrace), n_quantities))
-         call scanner%init(c, potential, error)
+         ! The map's share of this rank, checked before it is allocated.
+         call allocate_share(error)
+         if (.not. allocated(error)) call scanner%init(c, potential, error)
          self%surface%contact_height = scanner%contact_height
          self%surface%support_height = scanner%support_height
-         self%three_d = scanner%tip%ndim == 3
+         if (allocated(scanner%tip)) self%three_d = scanner%tip%ndim == 3
          do j = 1, count
             if (allocated(error)) exit
             call scanner%run_trip(self%first + (j - 1) * job%nranks, .true., trip, error)
@@ -181,6 +182,31 @@ contains
       end associate
 
    contains
+
+      !> trace and retrace for this rank's lines, or an error stating the
+      !> memory they need when this machine has not that much available.
+      subroutine allocate_share(error)
+         type(error_type), allocatable, intent(out) :: error
+         real(wp) :: needed, available
+         integer :: stat
+
+         needed = 8.0_wp * real(self%ran%nx, wp) * real(count, wp) * n_quantities &
+            & * merge(2.0_wp, 1.0_wp, self%ran%retrace)
+         available = available_memory()
+         if (available > 0.0_wp .and. needed > available) then
+            call fatal_error(error, 'the map needs '//bytes_text(needed)//' of memory on each rank (' &
+               & //itoa(self%ran%nx)//' points x '//itoa(count)//' lines x '//itoa(n_quantities) &
+               & //' quantities x 8 bytes'//trim(merge(' x 2 trips', '          ', self%ran%retrace)) &
+               & //'), more than the '//bytes_text(available)//' this machine has available: use fewer ' &
+               & //'points (&scan nx, ny) or more ranks on more machines', error_input)
+            return
+         end if
+         allocate (self%trace(self%ran%nx, count, n_quantities), stat=stat)
+         if (stat == 0) allocate (self%retrace(self%ran%nx, merge(count, 0, self%ran%retrace), n_quantities), &
+            & stat=stat)
+         if (stat /= 0) call fatal_error(error, 'the map needs '//bytes_text(needed)//' of memory on each ' &
+            & //'rank, which could not be allocated: use fewer points (&scan nx, ny) or more ranks', error_input)
+      end subroutine allocate_share
 
       !> The quasistatic map's mean friction against the drag it leaves out.
       subroutine check_friction()

@@ -6,11 +6,11 @@ module friction_brake_config
    use friction_ode_solver, only: solver_settings
    use friction_brake_params, only: brake_parameters, brake_dimensional, derive_parameters
    use friction_analysis_settings, only: analysis_settings
-   use friction_strings, only: rtoa, quoted
+   use friction_strings, only: rtoa, quoted, bytes_text
    use friction_parameters, only: configurable, parameter_visitor
    use friction_checks, only: config_checker
    use friction_ode_solver, only: step_type_names, step_type_index
-   use friction_ode_settings, only: visit_integrator, check_integrator
+   use friction_ode_settings, only: visit_integrator, check_integrator, check_tolerance_bounds
    implicit none
    private
 
@@ -191,7 +191,9 @@ contains
       call c%positive('brake', 'stick_velocity', self%stick_velocity, 'm per unit τ')
       if (c%failed()) return
       if ((self%t_end - self%t_start) / self%dt_out > 1.0e7_wp) call c%reject('brake', 'dt_out', &
-         & rtoa(self%dt_out), 'gives more than 1e7 output points over [t_start, t_end]')
+         & rtoa(self%dt_out), 'gives more than 1e7 output points over [t_start, t_end] (' &
+         & //rtoa((self%t_end - self%t_start) / self%dt_out)//' points would need ' &
+         & //bytes_text(44.0_wp * (self%t_end - self%t_start) / self%dt_out)//' of memory for the trajectory alone)')
       associate (p => resolved%params)
          normal = p%normal_force(self%y0)
          if (.not. (normal > 0.0_wp)) call c%reject('brake', 'y0', rtoa(self%y0), &
@@ -203,6 +205,7 @@ contains
          & "unknown GSL step type (known: ''"//', '//quoted(step_type_names())//')')
       call c%nonnegative('verify', 'check_rtol', self%check%rtol, '0 for rtol / 1000')
       call c%nonnegative('verify', 'check_atol', self%check%atol, '0 for atol / 1000')
+      call check_tolerance_bounds(c, 'verify', 'check_rtol', 'check_atol', self%check%rtol, self%check%atol)
       call c%nonnegative('verify', 'check_limit', self%check%max_difference, 'm; 0 reports only')
       call self%analysis%validate(c, self%t_start, self%t_end, series_names)
    end subroutine validate

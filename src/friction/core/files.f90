@@ -1,12 +1,25 @@
 !> File-system operations Fortran lacks: atomic rename and removal through
-!> the C library, so output appears under its final name only when complete.
+!> the C library, so output appears under its final name only when complete,
+!> and publication that never replaces a file it should not (README:
+!> Reliability): without `replace` a file appears only if nothing is at its
+!> name at that very moment (a hard link, which fails if the name exists);
+!> with it, only a regular file is replaced, never a device, a directory or
+!> a symbolic link.
 module friction_files
-   use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char
+   use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char, c_double
    use friction_error, only: error_type, fatal_error, error_io, error_input
+   use friction_strings, only: itoa
    implicit none
    private
 
    public :: rename_file, remove_file, file_exists, process_id, write_text_file, open_for_reading
+   public :: path_kind, same_file, publish_file, truncate_file, output_problem, system_error_text, free_bytes
+   public :: available_memory
+   public :: kind_none, kind_regular, kind_directory, kind_link, kind_other, kind_unknown
+
+   !> What path_kind finds at a path.
+   integer, parameter :: kind_none = 0, kind_regular = 1, kind_directory = 2, kind_link = 3, kind_other = 4, &
+      & kind_unknown = -1
 
    interface
       function c_rename(from, to) result(stat) bind(c, name='rename')
@@ -20,6 +33,66 @@ module friction_files
          character(kind=c_char), intent(in) :: path(*)
          integer(c_int) :: stat
       end function c_remove
+
+      function c_path_kind(path, follow) result(kind) bind(c, name='friction_path_kind')
+         import :: c_int, c_char
+         character(kind=c_char), intent(in) :: path(*)
+         integer(c_int), value :: follow
+         integer(c_int) :: kind
+      end function c_path_kind
+
+      function c_same_file(a, b) result(same) bind(c, name='friction_same_file')
+         import :: c_int, c_char
+         character(kind=c_char), intent(in) :: a(*), b(*)
+         integer(c_int) :: same
+      end function c_same_file
+
+      function c_link(from, to) result(code) bind(c, name='friction_link')
+         import :: c_int, c_char
+         character(kind=c_char), intent(in) :: from(*), to(*)
+         integer(c_int) :: code
+      end function c_link
+
+      function c_rename_noreplace(from, to) result(code) bind(c, name='friction_rename_noreplace')
+         import :: c_int, c_char
+         character(kind=c_char), intent(in) :: from(*), to(*)
+         integer(c_int) :: code
+      end function c_rename_noreplace
+
+      function c_rename_errno(from, to) result(code) bind(c, name='friction_rename')
+         import :: c_int, c_char
+         character(kind=c_char), intent(in) :: from(*), to(*)
+         integer(c_int) :: code
+      end function c_rename_errno
+
+      function c_unlink(path) result(code) bind(c, name='friction_unlink')
+         import :: c_int, c_char
+         character(kind=c_char), intent(in) :: path(*)
+         integer(c_int) :: code
+      end function c_unlink
+
+      function c_truncate(path) result(code) bind(c, name='friction_truncate')
+         import :: c_int, c_char
+         character(kind=c_char), intent(in) :: path(*)
+         integer(c_int) :: code
+      end function c_truncate
+
+      function c_errno_exists() result(code) bind(c, name='friction_errno_exists')
+         import :: c_int
+         integer(c_int) :: code
+      end function c_errno_exists
+
+      function c_free_bytes(path) result(bytes) bind(c, name='friction_free_bytes')
+         import :: c_char, c_double
+         character(kind=c_char), intent(in) :: path(*)
+         real(c_double) :: bytes
+      end function c_free_bytes
+
+      subroutine c_error_text(code, buffer, size) bind(c, name='friction_error_text')
+         import :: c_int, c_char
+         integer(c_int), value :: code, size
+         character(kind=c_char), intent(out) :: buffer(*)
+      end subroutine c_error_text
 
       !> POSIX getpid (pid_t is an int on the platforms we build for).
       function c_getpid() result(pid) bind(c, name='getpid')
@@ -56,6 +129,142 @@ contains
       inquire (file=path, exist=file_exists)
    end function file_exists
 
+   !> What is at `path`: kind_none, kind_regular, kind_directory, kind_link,
+   !> kind_other (a device, pipe or socket) or kind_unknown.  A symbolic link
+   !> is reported as such unless `follow`.
+   integer function path_kind(path, follow)
+      character(len=*), intent(in) :: path
+      logical, intent(in), optional :: follow
+      integer(c_int) :: through
+
+      through = 0
+      if (present(follow)) through = merge(1, 0, follow)
+      path_kind = int(c_path_kind(path//c_null_char, through))
+   end function path_kind
+
+   !> Whether both paths name one existing file (links followed).
+   logical function same_file(a, b)
+      character(len=*), intent(in) :: a, b
+
+      same_file = c_same_file(a//c_null_char, b//c_null_char) /= 0
+   end function same_file
+
+   !> The C library's text for an errno value.
+   function system_error_text(code) result(text)
+      integer, intent(in) :: code
+      character(len=:), allocatable :: text
+      character(kind=c_char) :: buffer(200)
+      integer :: n
+
+      buffer = c_null_char
+      call c_error_text(int(code, c_int), buffer, int(size(buffer), c_int))
+      n = findloc(buffer, c_null_char, dim=1) - 1
+      if (n < 0) n = size(buffer)
+      allocate (character(len=n) :: text)
+      text = transfer(buffer(1:n), text)
+   end function system_error_text
+
+   !> Why `path` cannot be an output ('' when it can): a symbolic link (never
+   !> followed nor replaced), a directory, a device, pipe or socket, or a
+   !> regular file without `replace`.
+   function output_problem(path, replace) result(problem)
+      character(len=*), intent(in) :: path
+      logical, intent(in) :: replace
+      character(len=:), allocatable :: problem
+
+      problem = ''
+      select case (path_kind(path))
+      case (kind_link)
+         problem = 'is a symbolic link; friction neither follows nor replaces links, so name the file itself'
+      case (kind_directory)
+         problem = 'is a directory'
+      case (kind_other)
+         problem = 'is not a regular file (a device, pipe or socket); friction writes only regular files ' &
+            & //'and --force replaces only a regular file'
+      case (kind_regular)
+         if (.not. replace) problem = 'the output file exists; use --force to overwrite it'
+      end select
+   end function output_problem
+
+   !> Give the complete file `from` its final name `to`.  Without `replace`
+   !> the name is taken only if nothing holds it at that moment: a hard link
+   !> (link(2) fails if `to` exists), then `from` removed; where the file
+   !> system has no hard links, rename(2) with RENAME_NOREPLACE.  With
+   !> `replace`, `to` may be nothing or a regular file, replaced atomically by
+   !> rename(2).  On failure `from` is left in place (the caller decides).
+   subroutine publish_file(from, to, replace, error)
+      character(len=*), intent(in) :: from, to
+      logical, intent(in) :: replace
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: problem
+      integer :: code, eexist
+
+      eexist = int(c_errno_exists())
+      problem = output_problem(to, replace)
+      if (len(problem) > 0) then
+         call fatal_error(error, to//': '//problem, error_io)
+         return
+      end if
+      if (replace) then
+         code = c_rename_errno(from//c_null_char, to//c_null_char)
+         if (code /= 0) call fatal_error(error, 'cannot rename '//from//' to '//to//' (' &
+            & //system_error_text(code)//')', error_io)
+         return
+      end if
+      code = c_link(from//c_null_char, to//c_null_char)
+      if (code == 0) then
+         code = c_unlink(from//c_null_char)
+         return
+      end if
+      if (code /= eexist) code = c_rename_noreplace(from//c_null_char, to//c_null_char)
+      if (code == 0) return
+      if (code == eexist) then
+         call fatal_error(error, to//': the output file appeared while this run computed (another run?) and is ' &
+            & //'not overwritten; use --force to overwrite it', error_io)
+      else
+         call fatal_error(error, 'cannot give '//from//' the name '//to//' without the risk of replacing a file ' &
+            & //'(' //system_error_text(code)//')', error_io)
+      end if
+   end subroutine publish_file
+
+   !> Bytes that may still be written on the file system of `path` (or of
+   !> its directory); negative when unknown.
+   real(c_double) function free_bytes(path)
+      character(len=*), intent(in) :: path
+
+      free_bytes = c_free_bytes(path//c_null_char)
+   end function free_bytes
+
+   !> Memory this machine can still give a process without swapping, bytes
+   !> (MemAvailable of /proc/meminfo); negative when unknown.
+   real(c_double) function available_memory() result(bytes)
+      character(len=256) :: line
+      integer :: unit, stat
+      real(c_double) :: kb
+
+      bytes = -1.0_c_double
+      open (newunit=unit, file='/proc/meminfo', status='old', action='read', iostat=stat)
+      if (stat /= 0) return
+      do
+         read (unit, '(a)', iostat=stat) line
+         if (stat /= 0) exit
+         if (line(1:13) == 'MemAvailable:') then
+            read (line(14:), *, iostat=stat) kb
+            if (stat == 0) bytes = 1024.0_c_double * kb
+            exit
+         end if
+      end do
+      close (unit)
+   end function available_memory
+
+   !> Cut a file to no bytes, best effort (gives back a full disk's space).
+   subroutine truncate_file(path)
+      character(len=*), intent(in) :: path
+      integer(c_int) :: code
+
+      code = c_truncate(path//c_null_char)
+   end subroutine truncate_file
+
    !> Rename atomically (within one file system), replacing `to` if present.
    subroutine rename_file(from, to, error)
       character(len=*), intent(in) :: from, to
@@ -80,15 +289,20 @@ contains
 
 
    !> Write text to path, complete or not at all (a temporary name beside it,
-   !> renamed when written).
-   subroutine write_text_file(path, text, error)
+   !> published when written; see publish_file for `replace`, default true).
+   !> Every write is checked, the close too (a full disk shows there).
+   subroutine write_text_file(path, text, error, replace)
       character(len=*), intent(in) :: path, text
       type(error_type), allocatable, intent(out) :: error
+      logical, intent(in), optional :: replace
       character(len=:), allocatable :: temporary
       character(len=256) :: message
       integer :: unit, stat
+      logical :: may_replace
 
-      temporary = path//'.tmp'
+      may_replace = .true.
+      if (present(replace)) may_replace = replace
+      temporary = path//'.tmp-'//itoa(process_id())
       open (newunit=unit, file=temporary, status='replace', action='write', form='unformatted', &
          & access='stream', iostat=stat, iomsg=message)
       if (stat /= 0) then
@@ -96,13 +310,19 @@ contains
          return
       end if
       write (unit, iostat=stat, iomsg=message) text
+      if (stat == 0) flush (unit, iostat=stat, iomsg=message)
       if (stat /= 0) then
          close (unit, status='delete')
          call fatal_error(error, path//': writing failed ('//trim(message)//')', error_io)
          return
       end if
-      close (unit)
-      call rename_file(temporary, path, error)
+      close (unit, iostat=stat, iomsg=message)
+      if (stat /= 0) then
+         call remove_file(temporary)
+         call fatal_error(error, path//': writing failed ('//trim(message)//')', error_io)
+         return
+      end if
+      call publish_file(temporary, path, may_replace, error)
       if (allocated(error)) call remove_file(temporary)
    end subroutine write_text_file
 

@@ -208,6 +208,8 @@ contains
                self%problem = 'expected '//kind_text('r')
                return
             end if
+            self%problem = range_problem(self%text(from(k):to(k)), value(max(1, self%first) + k - 1))
+            if (len(self%problem) > 0) return
          end do
       end select
    end subroutine real_array
@@ -417,6 +419,16 @@ contains
             if (to(k) < from(k)) cycle
             if (.not. is_quoted(self%text(from(k):to(k)))) then
                self%problem = 'expected '//kind_text('c')
+               return
+            end if
+            if (.not. is_utf8(self%text(from(k) + 1:to(k) - 1))) then
+               self%problem = 'not UTF-8 text: the value goes into the output''s UTF-8 attributes'
+               return
+            end if
+            ! (A name of a choice (folded) that is too long is an unknown
+            ! choice, which its check reports with the choices.)
+            if (.not. folding .and. len(unquote(self%text(from(k):to(k)))) > len(value)) then
+               self%problem = 'longer than '//itoa(len(value))//' characters'
                return
             end if
             value(max(1, self%first) + k - 1) = unquote(self%text(from(k):to(k)))
@@ -754,6 +766,64 @@ contains
       end if
       if (max(1, first) + n - 1 > room) problem = 'more values than the '//itoa(room)//' elements'
    end subroutine value_items
+
+   !> Why a number read from `text` is not the number the text says ('' when
+   !> it is): a literal beyond the largest double (1e400 reads as Infinity)
+   !> or a non-zero one below the smallest (1e-400 reads as 0).  The value
+   !> text of a real never spells Inf or NaN (value_has_kind allows digits,
+   !> signs, '.', 'e' and 'd' only), so any non-finite value overflowed.
+   function range_problem(text, x) result(problem)
+      character(len=*), intent(in) :: text
+      real(wp), intent(in) :: x
+      character(len=:), allocatable :: problem
+      integer :: e
+
+      problem = ''
+      if (.not. (abs(x) <= huge(x))) then
+         problem = 'out of range: larger than the largest number, '//trim(shortest(huge(x)))
+         return
+      end if
+      if (x /= 0.0_wp) return
+      e = scan(lower(text), 'ed')
+      if (e == 0) e = len(text) + 1
+      if (verify(text(1:e - 1), '+-.0') /= 0) problem = 'out of range: a non-zero number below the smallest, ' &
+         & //trim(shortest(tiny(x)))
+   end function range_problem
+
+   !> Whether text is well-formed UTF-8 (ASCII included) without control
+   !> characters other than tab.
+   pure logical function is_utf8(text) result(ok)
+      character(len=*), intent(in) :: text
+      integer :: i, c, follow, k
+
+      ok = .false.
+      i = 1
+      do while (i <= len(text))
+         c = iachar(text(i:i))
+         if (c < 0) c = c + 256
+         if (c < 128) then
+            if (c < 32 .and. c /= 9) return
+            if (c == 127) return
+            follow = 0
+         else if (c >= 194 .and. c <= 223) then
+            follow = 1
+         else if (c >= 224 .and. c <= 239) then
+            follow = 2
+         else if (c >= 240 .and. c <= 244) then
+            follow = 3
+         else
+            return
+         end if
+         if (i + follow > len(text)) return
+         do k = 1, follow
+            c = iachar(text(i + k:i + k))
+            if (c < 0) c = c + 256
+            if (c < 128 .or. c > 191) return
+         end do
+         i = i + follow + 1
+      end do
+      ok = .true.
+   end function is_utf8
 
    !> What a kind code means, for messages.
    pure function kind_text(kind) result(text)

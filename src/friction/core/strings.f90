@@ -4,7 +4,7 @@ module friction_strings
    implicit none
    private
 
-   public :: itoa, rtoa, join, quoted, lower
+   public :: itoa, rtoa, join, quoted, lower, text_hash, bytes_text
 
    !> An integer as text, without blanks.
    interface itoa
@@ -81,5 +81,53 @@ contains
          if (i < size(words)) text = text//', '
       end do
    end function quoted
+
+   !> The 64-bit FNV-1a hash of a text as 16 hex digits: a fingerprint
+   !> (not a cryptographic hash) that tells whether two texts are the same,
+   !> e.g. a checkpoint's input and the run's.  Computed in two 32-bit halves
+   !> so no integer arithmetic overflows: h * p mod 2**64 with the prime
+   !> p = 2**40 + 435 is h * 435 + (h * 2**40 mod 2**64).
+   pure function text_hash(text) result(hex)
+      character(len=*), intent(in) :: text
+      character(len=16) :: hex
+      integer(i8), parameter :: mask32 = 4294967295_i8, mask24 = 16777215_i8
+      integer(i8) :: hi, lo, t
+      integer :: i
+
+      hi = 3421674724_i8   ! the offset basis cbf29ce4 84222325
+      lo = 2216829733_i8
+      do i = 1, len(text)
+         lo = ieor(lo, int(iachar(text(i:i)), i8))
+         t = lo * 435_i8                                        ! < 2**41
+         hi = iand(hi * 435_i8 + shiftr(t, 32) + shiftl(iand(lo, mask24), 8), mask32)
+         lo = iand(t, mask32)
+      end do
+      write (hex, '(z8.8, z8.8)') hi, lo
+      hex = lower(hex)
+   end function text_hash
+
+   !> A size in bytes as text for messages: '512 bytes', '3.2 MB', '288.0 GB'.
+   pure function bytes_text(bytes) result(text)
+      real(wp), intent(in) :: bytes
+      character(len=:), allocatable :: text
+      character(len=32) :: buffer
+      character(len=*), parameter :: units(4) = ['kB', 'MB', 'GB', 'TB']
+      real(wp) :: x
+      integer :: k
+
+      if (bytes < 1000.0_wp) then
+         write (buffer, '(i0, a)') nint(bytes), ' bytes'
+         text = trim(buffer)
+         return
+      end if
+      x = bytes
+      k = 0
+      do while (x >= 1000.0_wp .and. k < size(units))
+         x = x / 1000.0_wp
+         k = k + 1
+      end do
+      write (buffer, '(f0.1, 1x, a)') x, units(k)
+      text = trim(adjustl(buffer))
+   end function bytes_text
 
 end module friction_strings

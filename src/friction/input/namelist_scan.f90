@@ -164,23 +164,27 @@ contains
    end subroutine grow
 
    !> The file as one text with newlines, comments blanked, and the line of
-   !> every character.
+   !> every character.  Lines of any length (read in pieces without
+   !> advancing); a file that is not a regular one (a pipe) is read once, as
+   !> it comes.
    subroutine read_text(path, text, line_of, error)
       character(len=*), intent(in) :: path
       character(len=:), allocatable, intent(out) :: text
       integer, allocatable, intent(out) :: line_of(:)
       type(error_type), allocatable, intent(out) :: error
-      character(len=4096) :: buffer
+      character(len=:), allocatable :: buffer, whole
+      character(len=256) :: message
       character :: quote
-      integer :: unit, stat, line, i, n
+      integer :: unit, stat, line, i, n, used, filled
 
       call open_for_reading(path, unit, error)
       if (allocated(error)) return
-      text = ''
-      allocate (line_of(0))
+      allocate (character(len=4096) :: whole)
+      allocate (line_of(4096))
+      used = 0
       line = 0
       do
-         read (unit, '(a)', iostat=stat) buffer
+         call read_line(buffer, stat)
          if (stat /= 0) exit
          line = line + 1
          n = len_trim(buffer)
@@ -195,10 +199,64 @@ contains
                exit
             end if
          end do
-         text = text//buffer(1:n)//new_line('a')
-         line_of = [line_of, spread(line, 1, n + 1)]
+         call append(buffer(1:n)//new_line('a'), line)
       end do
       close (unit)
+      if (stat > 0) then
+         call fatal_error(error, path//':'//itoa(line + 1)//': cannot read the file ('//trim(message)//')', &
+            & error_input)
+         return
+      end if
+      text = whole(1:used)
+      line_of = line_of(1:used)
+
+   contains
+
+      !> One whole line, however long, without its end; stat < 0 at the end
+      !> of the file, > 0 on a read error.
+      subroutine read_line(got, stat)
+         character(len=:), allocatable, intent(out) :: got
+         integer, intent(out) :: stat
+         character(len=4096) :: piece
+         integer :: size_read
+
+         got = ''
+         do
+            read (unit, '(a)', advance='no', iostat=stat, iomsg=message, size=size_read) piece
+            got = got//piece(1:size_read)
+            if (is_iostat_eor(stat)) then
+               stat = 0
+               return
+            end if
+            if (stat /= 0) then
+               ! A last line without its newline still counts.
+               if (is_iostat_end(stat) .and. len(got) > 0) stat = 0
+               return
+            end if
+         end do
+      end subroutine read_line
+
+      !> Add characters of one line to the text.
+      subroutine append(more, line)
+         character(len=*), intent(in) :: more
+         integer, intent(in) :: line
+         character(len=:), allocatable :: grown
+         integer, allocatable :: lines(:)
+
+         filled = used + len(more)
+         if (filled > len(whole)) then
+            allocate (character(len=max(2 * len(whole), filled)) :: grown)
+            grown(1:used) = whole(1:used)
+            call move_alloc(grown, whole)
+            allocate (lines(len(whole)))
+            lines(1:used) = line_of(1:used)
+            call move_alloc(lines, line_of)
+         end if
+         whole(used + 1:filled) = more
+         line_of(used + 1:filled) = line
+         used = filled
+      end subroutine append
+
    end subroutine read_text
 
 end module friction_input_scan

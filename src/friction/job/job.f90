@@ -10,7 +10,8 @@ module friction_job
    use friction_job_config, only: job_config, read_input, check_job, job_text
    use friction_checks, only: config_checker
    use friction_version, only: version_string
-   use friction_files, only: file_exists, write_text_file
+   use friction_files, only: file_exists, write_text_file, output_problem, same_file, path_kind, kind_regular
+   use friction_strings, only: text_hash
    use friction_scene_report, only: job_reporter
    use friction_scene_context, only: job_context, agree_on_error, check_writable, default_output, temporary_name, &
       & publish
@@ -52,8 +53,14 @@ contains
          call fatal_error(error, 'no output file given', error_input)
          return
       end if
-      ! Every rank reads the input: an error in it is the same everywhere.
+
+      ! Every rank reads the input.  An error in a file is the same everywhere,
+      ! but not when a rank cannot read what another read (a pipe reaches
+      ! rank 0 only): the ranks agree on an error and on the text they read.
       call read_input(files, config, job%input_text, error)
+      call agree_on_error(job, error)
+      if (allocated(error)) return
+      call check_same_input(job, error)
       if (allocated(error)) return
       call run_configured(job, config, force, reporter, summary, error)
    end subroutine run_job
@@ -123,12 +130,10 @@ contains
       type(error_type), allocatable, intent(out) :: error
       character(len=:), allocatable :: temporary
 
-      if (file_exists(job%output) .and. .not. (force .or. (job%resume .and. config%sweep%enabled()))) then
-         call fatal_error(error, job%output//': the output file exists; use --force to overwrite it', error_input)
-         return
-      end if
+      job%replace = force .or. (job%resume .and. config%sweep%enabled())
       ! Find out now, not after the computation, whether the output can be written.
-      if (job%rank == 0) call check_writable(job%output, error)
+      if (job%rank == 0) call check_output(job, error)
+      if (job%rank == 0 .and. .not. allocated(error)) call check_writable(job%output, error)
       call agree_on_error(job, error)
       if (allocated(error)) return
 
@@ -145,6 +150,78 @@ contains
       summary = config%scene%summary(job)
    end subroutine run_configured
 
+   !> Every rank must have read the same input: compare the hash of each
+   !> rank's resolved input with rank 0's.  When they differ, name an input
+   !> that is not a regular file (a pipe, /dev/stdin), the usual cause.
+   subroutine check_same_input(job, error)
+      type(job_context), intent(in) :: job
+      type(error_type), allocatable, intent(out) :: error
+      character(len=16) :: hash
+      integer :: differs, k, culprit
+
+      hash = text_hash(job%input_text)
+      call MPI_Bcast(hash, 16, MPI_CHARACTER, 0, job%comm)
+      differs = merge(1, 0, hash /= text_hash(job%input_text))
+      call MPI_Allreduce(MPI_IN_PLACE, differs, 1, MPI_INTEGER, MPI_MAX, job%comm)
+      if (differs == 0) return
+      culprit = 0
+      do k = 1, size(job%files)
+         if (path_kind(trim(job%files(k)), follow=.true.) /= kind_regular) then
+            culprit = k
+            exit
+         end if
+      end do
+      if (culprit > 0) then
+         call fatal_error(error, trim(job%files(culprit))//': not a regular file (a pipe or a device?): on ' &
+            & //'more than one rank every rank reads the input itself, and they read different text; give ' &
+            & //'a regular file, or run on one rank', error_input)
+      else
+         call fatal_error(error, 'the ranks read different input (did a file change while it was read?)', &
+            & error_input)
+      end if
+   end subroutine check_same_input
+
+   !> The output must be writable without harm: not a link, device or
+   !> directory; an existing regular file only with `replace`; and never one
+   !> of the job's input files (a namelist file, or a file a namelist names
+   !> such as an XYZ net).
+   subroutine check_output(job, error)
+      type(job_context), intent(in) :: job
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: problem, named
+      integer :: k, from
+
+      problem = output_problem(job%output, job%replace)
+      if (len(problem) > 0) then
+         call fatal_error(error, job%output//': '//problem, error_input)
+         return
+      end if
+      do k = 1, size(job%files)
+         if (same_file(job%output, trim(job%files(k)))) then
+            call fatal_error(error, job%output//': the output is the input file '//trim(job%files(k)) &
+               & //'; name another output (-o FILE)', error_input)
+            return
+         end if
+      end do
+      ! Quoted values of the resolved input that name files.
+      from = 0
+      do
+         k = index(job%input_text(from + 1:), "'")
+         if (k == 0) exit
+         from = from + k
+         k = index(job%input_text(from + 1:), "'")
+         if (k == 0) exit
+         named = job%input_text(from + 1:from + k - 1)
+         from = from + k
+         if (len(named) == 0) cycle
+         if (same_file(job%output, named)) then
+            call fatal_error(error, job%output//': the output is the input file '//named &
+               & //'; name another output (-o FILE)', error_input)
+            return
+         end if
+      end do
+   end subroutine check_output
+
    !> The scene of `files` as a SPICE netlist for ngspice (the paper's
    !> network model, docs/netlist.md) in `path`, its waveforms going to
    !> the same name with .data; nothing is integrated.  Rank 0 writes; every
@@ -159,8 +236,8 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(job_context) :: job
       type(job_config) :: config
-      character(len=:), allocatable :: text, note, data_file
-      integer :: dot
+      character(len=:), allocatable :: text, note, data_file, problem
+      integer :: dot, k
 
       job%comm = comm
       call MPI_Comm_rank(comm, job%rank)
@@ -184,7 +261,15 @@ contains
          call fatal_error(error, path//': the netlist file exists; use --force to overwrite it', error_input)
          return
       end if
-      if (job%rank == 0) call write_text_file(path, text, error)
+      if (job%rank == 0) then
+         problem = output_problem(path, force)
+         if (len(problem) > 0) call fatal_error(error, path//': '//problem, error_input)
+         do k = 1, size(files)
+            if (.not. allocated(error) .and. same_file(path, trim(files(k)))) call fatal_error(error, &
+               & path//': the netlist is the input file '//trim(files(k))//'; name another file', error_input)
+         end do
+         if (.not. allocated(error)) call write_text_file(path, text, error, replace=force)
+      end if
       call agree_on_error(job, error)
       if (allocated(error)) return
       if (job%rank == 0 .and. len(note) > 0) call reporter%note('note: '//note)

@@ -21,7 +21,7 @@ module friction_job_sweep
    use mpi_f08
    use friction_kinds, only: wp, i8
    use friction_error, only: error_type, fatal_error, error_interrupted, error_input
-   use friction_strings, only: itoa
+   use friction_strings, only: itoa, text_hash
    use friction_version, only: version_string
    use friction_ode_solver, only: integrator_statistics
    use friction_parameters, only: set_parameter_number, split_name, parameter_info, list_parameters
@@ -33,7 +33,7 @@ module friction_job_sweep
    use friction_files, only: file_exists, rename_file, remove_file, process_id
    use friction_scene_report, only: job_reporter
    use friction_scene_context, only: job_context, temporary_name, publish, ranks_text, sum_to_root_real, &
-      & sum_to_root_integer
+      & sum_to_root_integer, agree_on_error
    implicit none
    private
 
@@ -45,6 +45,8 @@ module friction_job_sweep
    end type reason_text
 
    integer, parameter :: status_done = 1, status_failed = 2
+   !> The first word of a checkpoint (its format's version).
+   character(len=*), parameter :: checkpoint_magic = 'friction-checkpoint-2'
 
 contains
 
@@ -61,6 +63,9 @@ contains
       character(len=:), allocatable :: temporary, series_name, series_unit, reason
       type(point_result), allocatable :: names(:)
       type(reason_text), allocatable :: reasons(:)
+      type(error_type), allocatable :: checkpoint_error
+      character(len=:), allocatable :: input_hash, problem
+      integer :: unsaved
       real(wp), allocatable :: results(:, :), cost(:), maxima(:), point_maxima(:), flat(:)
       integer, allocatable :: status(:), counts(:), offsets(:), owner(:), computed_by_run(:)
       integer, allocatable :: memory(:)
@@ -78,6 +83,29 @@ contains
       names = config%scene%point_results()
       call config%scene%point_series(series_name, series_unit)
       n = size(config%sweep%values, 2)
+      input_hash = text_hash(job%input_text)
+      ! --resume: every checkpoint there is must be of this very input and
+      ! whole, or nothing is computed (README: Parameter sweeps).
+      if (job%resume) then
+         if (job%rank == 0) then
+            do i = 1, n
+               problem = checkpoint_problem(checkpoint_name(job, i), input_hash, config%sweep%values(:, i))
+               if (len(problem) > 0) then
+                  if (index(problem, 'another input') > 0 .or. index(problem, 'other values') > 0) then
+                     problem = problem//'; --resume reuses only the checkpoints of the same input: run with ' &
+                        & //'the input of the interrupted run, or remove '//job%output//'.point-*.ckpt to start afresh'
+                  else
+                     problem = problem//'; remove it, and --resume computes that point again'
+                  end if
+                  call fatal_error(error, problem, error_input)
+                  exit
+               end if
+            end do
+         end if
+         call agree_on_error(job, error)
+         if (allocated(error)) return
+      end if
+      unsaved = 0
       allocate (results(size(names), n), cost(n), source=0.0_wp)
       allocate (status(n), counts(n), owner(n), computed_by_run(n), source=0)
       allocate (reasons(n))
@@ -132,7 +160,7 @@ contains
          computed = computed + 1
          owner(i) = job%rank + 1
          if (job%resume) then
-            call load_point(checkpoint_name(job, i), config%sweep%values(:, i), status(i), results(:, i), &
+            call load_point(checkpoint_name(job, i), input_hash, config%sweep%values(:, i), status(i), results(:, i), &
                & cost(i), reason, point_maxima, loaded)
             if (loaded) then
                counts(i) = size(point_maxima)
@@ -157,13 +185,24 @@ contains
          counts(i) = size(point_maxima)
          maxima = [maxima, point_maxima]
          cost(i) = MPI_Wtime() - t0
-         call save_point(checkpoint_name(job, i), config%sweep%values(:, i), status(i), results(:, i), &
-            & cost(i), reasons(i)%text, point_maxima)
+         call save_point(checkpoint_name(job, i), input_hash, config%sweep%values(:, i), status(i), results(:, i), &
+            & cost(i), reasons(i)%text, point_maxima, problem)
+         if (len(problem) > 0) then
+            unsaved = unsaved + 1
+            if (.not. allocated(checkpoint_error)) call fatal_error(checkpoint_error, problem)
+         end if
          deallocate (point_maxima)
          if (allocated(point_error)) deallocate (point_error)
          if (job%rank == 0) call reporter%progress(real(i, wp), real(n, wp), 'points', .false.)
       end do
       if (dynamic) call MPI_Win_free(window)
+      ! Checkpoints that could not be written: the points are in memory and go
+      ! into the file, but an interrupted run would compute them again.
+      call MPI_Allreduce(MPI_IN_PLACE, unsaved, 1, MPI_INTEGER, MPI_SUM, job%comm)
+      call agree_on_error(job, checkpoint_error)
+      if (unsaved > 0 .and. job%rank == 0) call reporter%note('warning: '//itoa(unsaved) &
+         & //' checkpoint(s) could not be written, so --resume would compute those points again; first: ' &
+         & //checkpoint_error%message)
 
       ! Each point has exactly one owner; the others hold zeros, so a sum gathers it exactly.
       call MPI_Allreduce(MPI_IN_PLACE, counts, n, MPI_INTEGER, MPI_SUM, job%comm)
@@ -391,62 +430,212 @@ contains
 
    !> A finished point's results, written under a temporary name and renamed,
    !> so a checkpoint is whole or absent.  Reals with 17 significant digits
-   !> read back to the same double.
-   subroutine save_point(path, values, status, results, cost, reason, maxima)
-      character(len=*), intent(in) :: path, reason
+   !> read back to the same double.  The first line holds the hash of the
+   !> job's resolved input (`input_hash`), the last the number of lines
+   !> before it and a checksum of them (load_point checks both).  Every write
+   !> and the close are checked: a checkpoint that could not be written whole
+   !> (a full disk) is removed, never renamed into place, and `problem` says
+   !> why ('' when written).
+   subroutine save_point(path, input_hash, values, status, results, cost, reason, maxima, problem)
+      character(len=*), intent(in) :: path, input_hash, reason
       real(wp), intent(in) :: values(:), results(:), cost, maxima(:)
       integer, intent(in) :: status
+      character(len=:), allocatable, intent(out) :: problem
       type(error_type), allocatable :: save_error
-      integer :: unit, stat
+      character(len=:), allocatable :: text, one_line
+      character(len=256) :: message
+      integer :: unit, stat, k
 
-      open (newunit=unit, file=path//'.tmp', status='replace', action='write', iostat=stat)
-      if (stat /= 0) return   ! no checkpoint: the point is computed again on --resume
-      write (unit, '(*(es26.17e3))') values
-      write (unit, '(3(i0, 1x))') status, size(results), size(maxima)
-      write (unit, '(*(es26.17e3))') results, cost
-      write (unit, '(a)') trim(reason)
-      if (size(maxima) > 0) write (unit, '(es26.17e3)') maxima
-      close (unit)
+      ! The reason on one line.
+      one_line = trim(reason)
+      do k = 1, len(one_line)
+         if (one_line(k:k) == new_line('a') .or. one_line(k:k) == achar(13)) one_line(k:k) = ' '
+      end do
+      text = checkpoint_magic//' input '//input_hash//new_line('a')//real_line(values) &
+         & //itoa(status)//' '//itoa(size(results))//' '//itoa(size(maxima))//new_line('a') &
+         & //real_line([results, cost])//one_line//new_line('a')
+      do k = 1, size(maxima)
+         text = text//real_line(maxima(k:k))
+      end do
+      text = text//'end '//itoa(count_lines(text))//' '//text_hash(text)//new_line('a')
+      problem = ''
+      open (newunit=unit, file=path//'.tmp', status='replace', action='write', form='unformatted', &
+         & access='stream', iostat=stat, iomsg=message)
+      if (stat == 0) then
+         write (unit, iostat=stat, iomsg=message) text
+         if (stat == 0) flush (unit, iostat=stat, iomsg=message)
+         if (stat == 0) then
+            close (unit, iostat=stat, iomsg=message)
+         else
+            close (unit, iostat=k)
+         end if
+      end if
+      if (stat /= 0) then
+         problem = path//': the checkpoint could not be written ('//trim(message)//')'
+         call remove_file(path//'.tmp')
+         return
+      end if
       call rename_file(path//'.tmp', path, save_error)
+      if (allocated(save_error)) then
+         problem = save_error%message
+         call remove_file(path//'.tmp')
+      end if
    end subroutine save_point
 
-   !> A point's checkpoint, if there is a whole one for the same values.
-   subroutine load_point(path, values, status, results, cost, reason, maxima, loaded)
+   !> Numbers on one line, 17 significant digits.
+   function real_line(values) result(line)
+      real(wp), intent(in) :: values(:)
+      character(len=:), allocatable :: line
+      character(len=26) :: word
+      integer :: k
+
+      line = ''
+      do k = 1, size(values)
+         write (word, '(es26.17e3)') values(k)
+         line = line//word
+      end do
+      line = line//new_line('a')
+   end function real_line
+
+   pure integer function count_lines(text) result(n)
+      character(len=*), intent(in) :: text
+      integer :: k
+
+      n = 0
+      do k = 1, len(text)
+         if (text(k:k) == new_line('a')) n = n + 1
+      end do
+   end function count_lines
+
+   !> The whole text of a file ('' with ok false when it cannot be read).
+   subroutine read_whole(path, text, ok)
       character(len=*), intent(in) :: path
+      character(len=:), allocatable, intent(out) :: text
+      logical, intent(out) :: ok
+      integer :: unit, stat
+      integer(i8) :: bytes
+
+      text = ''
+      ok = .false.
+      open (newunit=unit, file=path, status='old', action='read', form='unformatted', access='stream', iostat=stat)
+      if (stat /= 0) return
+      inquire (unit=unit, size=bytes)
+      if (bytes < 0 .or. bytes > 100000000_i8) then
+         close (unit)
+         return
+      end if
+      deallocate (text)
+      allocate (character(len=int(bytes)) :: text)
+      stat = 0
+      if (bytes > 0) read (unit, iostat=stat) text
+      close (unit)
+      ok = stat == 0
+   end subroutine read_whole
+
+   !> Why the checkpoint at `path` cannot serve this run ('' when it can, or
+   !> when there is none): written for another input (its input hash is not
+   !> `input_hash`), for other values of the swept variables, or damaged
+   !> (not whole, or its checksum does not match).
+   function checkpoint_problem(path, input_hash, values) result(problem)
+      character(len=*), intent(in) :: path, input_hash
+      real(wp), intent(in) :: values(:)
+      character(len=:), allocatable :: problem
+      character(len=:), allocatable :: text, body, last
+      real(wp) :: saved(size(values))
+      integer :: cut, stat, n_lines, first_end
+      character(len=16) :: sum_text
+      logical :: ok
+
+      problem = ''
+      if (.not. file_exists(path)) return
+      call read_whole(path, text, ok)
+      if (.not. ok) then
+         problem = path//': the checkpoint cannot be read'
+         return
+      end if
+      ! The last line: 'end LINES CHECKSUM'.
+      cut = 0
+      if (len(text) > 1) cut = index(text(1:len(text) - 1), new_line('a'), back=.true.)
+      if (len(text) == 0 .or. text(len(text):len(text)) /= new_line('a') .or. cut == 0) then
+         problem = path//': the checkpoint is damaged (it does not end with its checksum line)'
+         return
+      end if
+      body = text(1:cut)
+      last = text(cut + 1:len(text) - 1)
+      n_lines = -1
+      sum_text = ''
+      if (last(1:min(4, len(last))) == 'end ') then
+         read (last(5:), *, iostat=stat) n_lines, sum_text
+         if (stat /= 0) n_lines = -1
+      end if
+      if (n_lines /= count_lines(body) .or. sum_text /= text_hash(body)) then
+         problem = path//': the checkpoint is damaged (its line count or checksum does not match its content)'
+         return
+      end if
+      first_end = index(body, new_line('a'))
+      if (body(1:first_end - 1) /= checkpoint_magic//' input '//input_hash) then
+         if (index(body(1:first_end - 1), checkpoint_magic//' input ') == 1) then
+            problem = path//': the checkpoint was written for another input (its resolved input, every ' &
+               & //'group and the sweep, differs from this run''s)'
+         else
+            problem = path//': not a checkpoint of this version of friction'
+         end if
+         return
+      end if
+      read (body(first_end + 1:), *, iostat=stat) saved
+      if (stat /= 0) then
+         problem = path//': the checkpoint is damaged (its values do not read)'
+      else if (.not. all(saved == values)) then
+         problem = path//': the checkpoint is for other values of the swept variables'
+      end if
+   end function checkpoint_problem
+
+   !> A point's checkpoint, if there is a whole one for the same input and
+   !> values (checkpoint_problem finds none).
+   subroutine load_point(path, input_hash, values, status, results, cost, reason, maxima, loaded)
+      character(len=*), intent(in) :: path, input_hash
       real(wp), intent(in) :: values(:)
       integer, intent(inout) :: status
       real(wp), intent(inout) :: results(:), cost
       character(len=:), allocatable, intent(out) :: reason
       real(wp), allocatable, intent(out) :: maxima(:)
       logical, intent(out) :: loaded
-      real(wp) :: saved_values(size(values)), numbers(size(results) + 1)
-      integer :: unit, stat, found(3)
-      character(len=4096) :: line
+      real(wp) :: numbers(size(results) + 1)
+      character(len=:), allocatable :: text
+      integer :: stat, found(3), k, at, next
+      logical :: ok
 
       loaded = .false.
       reason = ''
       if (.not. file_exists(path)) return
-      open (newunit=unit, file=path, status='old', action='read', iostat=stat)
+      if (len(checkpoint_problem(path, input_hash, values)) > 0) return
+      call read_whole(path, text, ok)
+      if (.not. ok) return
+      ! Lines: 1 header, 2 values, 3 counts, 4 results and cost, 5 reason, then maxima.
+      at = 1
+      do k = 1, 2
+         at = at + index(text(at:), new_line('a'))
+      end do
+      next = at + index(text(at:), new_line('a')) - 1
+      read (text(at:next - 1), *, iostat=stat) found
+      if (stat /= 0 .or. found(2) /= size(results) .or. found(3) < 0) return
+      at = next + 1
+      next = at + index(text(at:), new_line('a')) - 1
+      read (text(at:next - 1), *, iostat=stat) numbers
       if (stat /= 0) return
-      read (unit, *, iostat=stat) saved_values
-      if (stat == 0 .and. all(saved_values == values)) then
-         read (unit, *, iostat=stat) found
-         if (stat == 0 .and. found(2) /= size(results)) stat = 1
-         if (stat == 0) read (unit, *, iostat=stat) numbers
-         if (stat == 0) read (unit, '(a)', iostat=stat) line
-         if (stat == 0) reason = trim(line)
-         if (stat == 0) then
-            allocate (maxima(max(0, found(3))))
-            if (found(3) > 0) read (unit, *, iostat=stat) maxima
-         end if
-         if (stat == 0) then
-            status = found(1)
-            results = numbers(1:size(results))
-            cost = numbers(size(results) + 1)
-            loaded = .true.
-         end if
+      at = next + 1
+      next = at + index(text(at:), new_line('a')) - 1
+      reason = text(at:next - 1)
+      at = next + 1
+      allocate (maxima(found(3)))
+      if (found(3) > 0) then
+         read (text(at:), *, iostat=stat) maxima
+         if (stat /= 0) return
       end if
-      close (unit)
+      status = found(1)
+      results = numbers(1:size(results))
+      cost = numbers(size(results) + 1)
+      loaded = .true.
    end subroutine load_point
 
    !> This process's peak resident set (VmHWM of /proc/self/status) in kB;

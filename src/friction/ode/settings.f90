@@ -2,7 +2,7 @@
 !> scene (each scene keeps its own defaults), and their checks.
 module friction_ode_settings
    use friction_kinds, only: wp
-   use friction_strings, only: itoa, quoted
+   use friction_strings, only: itoa, quoted, rtoa
    use friction_parameters, only: parameter_visitor
    use friction_checks, only: config_checker
    use friction_ode_solver, only: solver_settings, step_type_names, step_type_index
@@ -10,7 +10,7 @@ module friction_ode_settings
    implicit none
    private
 
-   public :: visit_integrator, check_integrator
+   public :: visit_integrator, check_integrator, check_tolerance_bounds
 
 contains
 
@@ -41,10 +41,31 @@ contains
          & quoted([auto_name])//' to choose by scene and rtol)')
       call c%positive('integrator', 'rtol', s%rtol, 'relative tolerance')
       call c%positive('integrator', 'atol', s%atol, 'absolute tolerance, Å and Å/s')
+      call check_tolerance_bounds(c, 'integrator', 'rtol', 'atol', s%rtol, s%atol)
       call c%nonnegative('integrator', 'h_start', s%h_start, 's; 0 chooses automatically')
       call c%nonnegative('integrator', 'h_min', s%h_min, 's; 0 for no limit')
+      if (s%h_start > 0.0_wp .and. s%h_min > s%h_start) call c%reject('integrator', 'h_min', rtoa(s%h_min), &
+         & 'must not exceed h_start = '//rtoa(s%h_start)//' (the first step)')
       if (s%max_steps < 1) call c%reject('integrator', 'max_steps', itoa(s%max_steps), 'must be >= 1')
       call c%nonnegative('integrator', 'max_wall_time', s%max_wall_time, 's; 0 for no limit')
    end subroutine check_integrator
+
+   !> Upper bounds of the tolerances.  GSL accepts a step whose error estimate
+   !> is below atol + rtol |y|: with rtol >= 1 any step whose error is as
+   !> large as the state itself passes, and an atol of 1 is already a whole
+   !> Å (or m, m/τ: the brake's state is far smaller) on every component; a
+   !> larger one lets the stepper take steps of any size, and the run ends
+   !> with exit 0 and meaningless numbers (rtol = atol = 1e300 gave forces of
+   !> 1e181 nN).  So rtol < 1 and atol <= 1.
+   subroutine check_tolerance_bounds(c, group, rtol_name, atol_name, rtol, atol)
+      type(config_checker), intent(inout) :: c
+      character(len=*), intent(in) :: group, rtol_name, atol_name
+      real(wp), intent(in) :: rtol, atol
+
+      if (rtol >= 1.0_wp) call c%reject(group, rtol_name, rtoa(rtol), 'must be < 1: a relative tolerance of ' &
+         & //'100 % or more accepts any step')
+      if (atol > 1.0_wp) call c%reject(group, atol_name, rtoa(atol), 'must be <= 1: an absolute tolerance above ' &
+         & //'1 (Å, Å/s; the brake''s m, m/τ) accepts steps of any size')
+   end subroutine check_tolerance_bounds
 
 end module friction_ode_settings

@@ -15,6 +15,7 @@ module friction_ode_solver
    use friction_error, only: error_type, fatal_error, error_numerical, error_input, error_internal
    use friction_strings, only: rtoa
    use friction_ode_system, only: ode_system
+   use friction_strings, only: itoa, rtoa
    implicit none
    private
 

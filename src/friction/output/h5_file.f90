@@ -12,13 +12,29 @@
 !> is for one thread at a time, as friction_run_job says.)
 module friction_output_h5
    use, intrinsic :: iso_fortran_env, only: int64
-   use, intrinsic :: iso_c_binding, only: c_ptr, c_loc, c_funptr, c_int, c_int64_t, c_null_ptr, c_null_funptr
-   use mpi_f08, only: MPI_Comm, MPI_INFO_NULL, MPI_Comm_rank
+   use, intrinsic :: iso_c_binding, only: c_ptr, c_loc, c_funptr, c_int, c_int64_t, c_null_ptr, c_null_funptr, &
+      & c_size_t, c_double
+   use mpi_f08, only: MPI_Comm, MPI_INFO_NULL, MPI_Comm_rank, MPI_Allreduce, MPI_Barrier, MPI_IN_PLACE, &
+      & MPI_INTEGER, MPI_MAX
    use hdf5
    use friction_kinds, only: wp, i8
    use friction_error, only: error_type, fatal_error, error_io
+   use friction_files, only: truncate_file, free_bytes
+   use friction_strings, only: bytes_text
    implicit none
    private
+
+   interface
+      !> The metadata cache's current size (what a flush may still write).
+      function h5fget_mdc_size(file, max_size, min_clean_size, cur_size, cur_num_entries) result(status) &
+         & bind(c, name='H5Fget_mdc_size')
+         import :: hid_t, c_size_t, c_int
+         integer(hid_t), value :: file
+         integer(c_size_t), intent(out) :: max_size, min_clean_size, cur_size
+         integer(c_int), intent(out) :: cur_num_entries
+         integer(c_int) :: status
+      end function h5fget_mdc_size
+   end interface
 
    public :: h5_file
 
@@ -60,6 +76,7 @@ module friction_output_h5
       integer(hid_t) :: id = -1
       character(len=:), allocatable :: path
       integer :: rank = 0         !! this process in the communicator
+      type(MPI_Comm) :: comm      !! the file's communicator
       integer :: status = 0       !! first HDF5 failure, kept until checked
       character(len=:), allocatable :: failed_at
    contains
@@ -93,6 +110,7 @@ contains
 
       self%path = path
       self%status = 0
+      self%comm = comm
       call MPI_Comm_rank(comm, self%rank)
       ! The library never prints: failures come back through stat.
       call printing%silence()
@@ -230,7 +248,10 @@ contains
       call h5screate_simple_f(rank, dims(1:rank), filespace, stat)
       call h5dcreate_f(self%id, name, type, filespace, dset, stat)
       call self%check(stat, 'creating dataset '//name)
-      if (stat /= 0) return
+      if (stat /= 0) then
+         call h5sclose_f(filespace, stat)
+         return
+      end if
       if (n_total == 0) then   ! an empty dataset: nothing to write (and no buffer to point at)
          if (len_trim(units) > 0) call attribute_text(self, dset, 'units', units)
          call h5dclose_f(dset, stat)
@@ -238,7 +259,7 @@ contains
          return
       end if
       call h5screate_simple_f(rank, count(1:rank), memspace, stat)
-      if (product(held) > 0) then
+      if (int(held(1), i8) * held(2) > 0) then
          call h5sselect_hyperslab_f(filespace, H5S_SELECT_SET_F, offset(1:rank), count(1:rank), stat, &
             & stride=step(1:rank))
       else
@@ -284,7 +305,16 @@ contains
       call h5screate_simple_f(1, dims, filespace, stat)
       call h5dcreate_f(self%id, name, H5T_NATIVE_INTEGER, filespace, dset, stat)
       call self%check(stat, 'creating dataset '//name)
-      if (stat /= 0) return
+      if (stat /= 0) then
+         call h5sclose_f(filespace, stat)
+         return
+      end if
+      if (size(values) == 0) then   ! an empty dataset: nothing to write
+         call attribute_text(self, dset, 'units', units)
+         call h5dclose_f(dset, stat)
+         call h5sclose_f(filespace, stat)
+         return
+      end if
       call h5screate_simple_f(1, dims, memspace, stat)
       if (self%rank /= 0 .or. size(values) == 0) then
          call h5sselect_none_f(filespace, stat)
@@ -417,6 +447,7 @@ contains
 
       call printing%silence()
       if (self%id >= 0) then
+         call give_back_space(self)
          call h5fclose_f(self%id, stat)
          call self%check(stat, 'closing the file')
          self%id = -1
@@ -445,6 +476,40 @@ contains
       if (self%saved) status = h5e_set_auto2(default_error_stack, self%func, self%data)
       self%saved = .false.
    end subroutine printing_restore
+
+   !> Before closing (collective): closing writes the metadata HDF5 holds in
+   !> its cache, and an HDF5 file (1.10) whose close fails for a full disk
+   !> stays half open: its handle cannot be closed again and HDF5's clean-up
+   !> at MPI_Finalize crashes in H5F__close_cb.  So a close must not fail:
+   !> rank 0 first checks that the disk has room for the cached metadata
+   !> (with 1 MB to spare), and if it has not, or any rank failed to write,
+   !> the file is cut to no bytes, which gives back the space its data took,
+   !> so that closing succeeds and leaves no handle open.  (The failed file
+   !> is removed by its writer anyway.)  A flush is not tried instead: a
+   !> failed flush leaves the cache unable to close.
+   subroutine give_back_space(self)
+      class(h5_file), intent(inout) :: self
+      integer(c_size_t) :: max_size, min_clean, cached
+      integer(c_int) :: entries
+      integer :: failed
+      real(c_double) :: free
+
+      if (self%rank == 0 .and. self%status == 0) then
+         if (h5fget_mdc_size(self%id, max_size, min_clean, cached, entries) >= 0) then
+            free = free_bytes(self%path)
+            if (free >= 0.0_c_double .and. free < 1.25_c_double * real(cached, c_double) + 8192.0_c_double) &
+               & call self%check(1, 'writing the file: the disk is full ('//bytes_text(real(free, wp)) &
+               & //' free, closing needs up to '//bytes_text(1.25_wp * real(cached, wp) + 8192.0_wp)//')')
+         end if
+      end if
+      failed = merge(1, 0, self%status /= 0)
+      call MPI_Allreduce(MPI_IN_PLACE, failed, 1, MPI_INTEGER, MPI_MAX, self%comm)
+      if (failed == 0) return
+      call self%check(1, 'writing the file on another rank')
+      call MPI_Barrier(self%comm)
+      if (self%rank == 0) call truncate_file(self%path)
+      call MPI_Barrier(self%comm)
+   end subroutine give_back_space
 
    subroutine check(self, stat, what)
       class(h5_file), intent(inout) :: self

@@ -5,7 +5,7 @@ module friction_scene_context
    use friction_kinds, only: wp
    use friction_error, only: error_type, fatal_error, error_io
    use friction_strings, only: itoa
-   use friction_files, only: rename_file, remove_file, process_id
+   use friction_files, only: publish_file, remove_file, process_id
    implicit none
    private
 
@@ -22,6 +22,7 @@ module friction_scene_context
       character(len=:), allocatable :: input_text
       character(len=4096), allocatable :: files(:)
       logical :: resume = .false.
+      logical :: replace = .false.           !! the output may replace a regular file (--force, --resume)
       integer :: stop_after = 0              !! test hook: > 0 stops a sweep after that point
    end type job_context
 
@@ -77,26 +78,57 @@ contains
    end function temporary_name
 
    !> After the (collective or rank-0) write to `temporary`: on success on
-   !> every rank, rename it to the output; otherwise remove it.  Every rank
-   !> returns the same error or none.
+   !> every rank, give it the output's name (publish_file: without the job's
+   !> `replace` a file that appeared at that name meanwhile is never
+   !> overwritten; this run's file is then kept under its temporary name and
+   !> the error says so); otherwise remove it.  Every rank returns the same
+   !> error or none.
    subroutine publish(job, temporary, error)
       type(job_context), intent(in) :: job
       character(len=*), intent(in) :: temporary
       type(error_type), allocatable, intent(inout) :: error
       integer :: failed
+      logical :: keep
 
       failed = merge(1, 0, allocated(error))
       call MPI_Allreduce(MPI_IN_PLACE, failed, 1, MPI_INTEGER, MPI_MAX, job%comm)
       if (job%rank == 0) then
+         keep = .false.
          if (failed == 0) then
-            call rename_file(temporary, job%output, error)
+            call publish_file(temporary, job%output, job%replace, error)
+            if (allocated(error)) then
+               keep = index(error%message, 'appeared while this run computed') > 0
+               if (keep) error%message = error%message//'; this run''s file is kept as '//temporary
+            end if
          else if (.not. allocated(error)) then
             call fatal_error(error, temporary//': writing failed on another rank', error_io)
          end if
-         if (allocated(error)) call remove_file(temporary)
+         if (allocated(error) .and. .not. keep) then
+            call remove_file(temporary)
+            ! Name the output, not the temporary file that no longer exists.
+            if (index(error%message, temporary) > 0) error%message = replaced(error%message, temporary, job%output) &
+               & //' (nothing written: the partial file was removed)'
+         end if
       end if
       call agree_on_error(job, error)
    end subroutine publish
+
+   !> text with every `from` replaced by `to`.
+   function replaced(text, from, to) result(out)
+      character(len=*), intent(in) :: text, from, to
+      character(len=:), allocatable :: out
+      integer :: at, k
+
+      out = ''
+      k = 1
+      do
+         at = index(text(k:), from)
+         if (at == 0 .or. len(from) == 0) exit
+         out = out//text(k:k + at - 2)//to
+         k = k + at - 1 + len(from)
+      end do
+      out = out//text(k:)
+   end function replaced
 
    !> Create and remove a probe file beside the output.
    subroutine check_writable(path, error)

@@ -37,6 +37,7 @@ module friction_surface_lennard_jones
       procedure :: gradient
       procedure :: hessian
       procedure :: dimensions
+      procedure :: highest_near
       procedure, private :: cell_range
    end type lj_potential
 
@@ -66,28 +67,48 @@ contains
    end function cutoff_for_tolerance
 
    !> The potential of a net with per-species ε (eV), σ (Å) and cutoff r_c
-   !> (Å; 0 for the full sum).
-   function new_lj_potential(net, epsilon, sigma, cutoff) result(self)
+   !> (Å; 0 for the full sum).  The cell grid covers the atoms within
+   !> `region` (x_min, x_max, y_min, y_max, Å: where the tip can reach, the
+   !> cutoff included) or all atoms when absent; atoms outside the grid are
+   !> binned into its border cells, which a tip outside the grid visits, so
+   !> the sum is the same for any grid: a stray atom far away costs one atom,
+   !> not a grid reaching out to it.  The grid has at most max_cells cells
+   !> (larger cells when the region is larger).
+   function new_lj_potential(net, epsilon, sigma, cutoff, region) result(self)
       type(crystal_net), intent(in) :: net
       real(wp), intent(in) :: epsilon(:), sigma(:), cutoff
+      real(wp), intent(in), optional :: region(4)
       type(lj_potential) :: self
+      integer, parameter :: max_cells = 4194304
       integer, allocatable :: cell_of(:), fill(:)
-      real(wp) :: upper(2)
-      integer :: i, c, n
+      real(wp) :: upper(2), extent(2)
+      integer :: i, c, n, cells
 
       allocate (self%epsilon, source=epsilon)
       allocate (self%sigma, source=sigma)
       self%cutoff = cutoff
       n = net%size()
-      self%origin = minval(net%position(1:2, :), dim=2) - 1.0e-9_wp
-      upper = maxval(net%position(1:2, :), dim=2) + 1.0e-9_wp
+      self%origin = minval(net%position(1:2, :), dim=2)
+      upper = maxval(net%position(1:2, :), dim=2)
+      if (present(region)) then
+         self%origin = max(self%origin, [region(1), region(3)])
+         upper = min(upper, [region(2), region(4)])
+         upper = max(upper, self%origin)   ! no atom in the region: one row or column of cells
+      end if
+      self%origin = self%origin - 1.0e-9_wp
+      upper = upper + 1.0e-9_wp
+      extent = upper - self%origin
       if (cutoff > 0.0_wp) then
          self%cell = cutoff / cells_per_cutoff
+         do while ((extent(1) / self%cell + 1.0_wp) * (extent(2) / self%cell + 1.0_wp) > max_cells)
+            self%cell = 1.5_wp * self%cell
+         end do
       else
-         self%cell = max(upper(1) - self%origin(1), upper(2) - self%origin(2)) + 1.0_wp
+         self%cell = max(extent(1), extent(2)) + 1.0_wp
       end if
-      self%ncell = max(1, ceiling((upper - self%origin) / self%cell))
-      allocate (cell_of(n), fill(product(self%ncell) + 1))
+      self%ncell = max(1, min(max_cells, ceiling(min(extent / self%cell, real(max_cells, wp)))))
+      cells = self%ncell(1) * self%ncell(2)
+      allocate (cell_of(n), fill(cells + 1))
       do i = 1, n
          cell_of(i) = cell_index(self, net%position(1:2, i))
       end do
@@ -96,13 +117,13 @@ contains
       do i = 1, n
          fill(cell_of(i) + 1) = fill(cell_of(i) + 1) + 1
       end do
-      allocate (self%cell_start(product(self%ncell) + 1))
+      allocate (self%cell_start(cells + 1))
       self%cell_start(1) = 1
-      do c = 1, product(self%ncell)
+      do c = 1, cells
          self%cell_start(c + 1) = self%cell_start(c) + fill(c + 1)
       end do
       allocate (self%position(3, n), self%species(n))
-      fill(1:product(self%ncell)) = self%cell_start(1:product(self%ncell))
+      fill(1:cells) = self%cell_start(1:cells)
       do i = 1, n
          c = cell_of(i)
          self%position(:, fill(c)) = net%position(:, i)
@@ -111,13 +132,14 @@ contains
       end do
    end function new_lj_potential
 
-   !> The cell (1-based, x fastest) holding a point of the net.
+   !> The cell (1-based, x fastest) holding a point of the net; points
+   !> outside the grid go to its border cells.
    pure integer function cell_index(self, p) result(c)
       type(lj_potential), intent(in) :: self
       real(wp), intent(in) :: p(2)
       integer :: ij(2)
 
-      ij = min(self%ncell - 1, max(0, int((p - self%origin) / self%cell)))
+      ij = int(min(real(self%ncell - 1, wp), max(0.0_wp, (p - self%origin) / self%cell)))
       c = ij(1) + ij(2) * self%ncell(1) + 1
    end function cell_index
 
@@ -133,8 +155,11 @@ contains
          hi = self%ncell - 1
          return
       end if
-      lo = max(0, floor((r(1:2) - self%cutoff - self%origin) / self%cell))
-      hi = min(self%ncell - 1, floor((r(1:2) + self%cutoff - self%origin) / self%cell))
+      ! Clamped to the grid (in reals first: a tip far away must not overflow
+      ! an integer): a tip outside it visits the border cells, which hold
+      ! the atoms outside the grid.
+      lo = int(min(real(self%ncell - 1, wp), max(0.0_wp, (r(1:2) - self%cutoff - self%origin) / self%cell)))
+      hi = int(min(real(self%ncell - 1, wp), max(0.0_wp, (r(1:2) + self%cutoff - self%origin) / self%cell)))
    end subroutine cell_range
 
    pure function energy(self, r) result(v)
@@ -209,6 +234,29 @@ contains
          end do
       end do
    end subroutine sum_pairs
+
+   !> The height of the highest atom within lateral distance `radius` of
+   !> (x, y) = xy, and the smallest σ of the net's species; -huge when no
+   !> atom is that near.
+   pure subroutine highest_near(self, xy, radius, top, sigma_min)
+      class(lj_potential), intent(in) :: self
+      real(wp), intent(in) :: xy(2), radius
+      real(wp), intent(out) :: top, sigma_min
+      integer :: lo(2), hi(2), cx, cy, c, i
+
+      top = -huge(1.0_wp)
+      sigma_min = minval(self%sigma)
+      lo = int(min(real(self%ncell - 1, wp), max(0.0_wp, (xy - radius - self%origin) / self%cell)))
+      hi = int(min(real(self%ncell - 1, wp), max(0.0_wp, (xy + radius - self%origin) / self%cell)))
+      do cy = lo(2), hi(2)
+         do cx = lo(1), hi(1)
+            c = cx + cy * self%ncell(1) + 1
+            do i = self%cell_start(c), self%cell_start(c + 1) - 1
+               if (sum((self%position(1:2, i) - xy)**2) < radius**2) top = max(top, self%position(3, i))
+            end do
+         end do
+      end do
+   end subroutine highest_near
 
    pure function dimensions(self) result(n)
       class(lj_potential), intent(in) :: self

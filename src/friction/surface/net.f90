@@ -15,7 +15,8 @@ module friction_surface_net
    implicit none
    private
 
-   public :: crystal_net, graphite_net, square_net, read_xyz, write_xyz, vacancy_mark
+   public :: crystal_net, graphite_net, square_net, read_xyz, write_xyz, vacancy_mark, sort_order, max_local_density, &
+      & first_duplicate
 
    !> Species label that marks a vacant site in an XYZ file.
    character(len=*), parameter :: vacancy_mark = 'X'
@@ -147,6 +148,8 @@ contains
       real(wp), allocatable :: position(:, :)
       integer, allocatable :: species(:)
       logical, allocatable :: vacant(:)
+      integer, allocatable :: kept(:)
+      type(crystal_net) :: atoms
       integer :: unit, stat, n, i, k
 
       call open_for_reading(path, unit, error, error_io)
@@ -159,7 +162,13 @@ contains
          return
       end if
       read (unit, '(a)', iostat=stat) line   ! comment line
-      allocate (position(3, n), species(n), vacant(n))
+      allocate (position(3, n), species(n), vacant(n), stat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, path//':1: '//itoa(n)//' atoms announced: more than this machine can hold', &
+            & error_input)
+         close (unit)
+         return
+      end if
       do i = 1, n
          read (unit, '(a)', iostat=stat) line
          if (stat /= 0) then
@@ -201,8 +210,116 @@ contains
       close (unit)
       net%position = position
       net%species = max(species, 1)
+      ! Two atoms at one place (a copied line, a net written twice) make no
+      ! physical sample and multiply the cost: an error naming both lines.
+      kept = pack([(i, i = 1, n)], .not. vacant)
+      atoms%position = position(:, kept)
+      atoms%species = net%species(kept)
+      call first_duplicate(atoms, 1.0e-6_wp, i, k)
+      if (i > 0) then
+         call fatal_error(error, path//':'//itoa(kept(k) + 2)//': the atom is at the position of the atom on ' &
+            & //'line '//itoa(kept(i) + 2)//' (within 1e-6 Å); remove the duplicate', error_input)
+         return
+      end if
       call net%remove_sites(vacant)
    end subroutine read_xyz
+
+   !> The indices that put `values` in ascending order (a stable bottom-up
+   !> merge sort: n log n for nets of any size).
+   pure function sort_order(values) result(order)
+      real(wp), intent(in) :: values(:)
+      integer :: order(size(values))
+      integer :: scratch(size(values))
+      integer :: n, width, left, middle, right, i, j, k
+
+      n = size(values)
+      order = [(i, i = 1, n)]
+      width = 1
+      do while (width < n)
+         left = 1
+         do while (left <= n)
+            middle = min(left + width, n + 1)
+            right = min(left + 2 * width, n + 1)
+            i = left
+            j = middle
+            do k = left, right - 1
+               if (i < middle .and. (j >= right .or. values(order(min(i, n))) <= values(order(min(j, n))))) then
+                  scratch(k) = order(i)
+                  i = i + 1
+               else
+                  scratch(k) = order(j)
+                  j = j + 1
+               end if
+            end do
+            left = right
+         end do
+         order = scratch
+         width = 2 * width
+      end do
+   end function sort_order
+
+   !> The largest areal density, atoms/Å², of the net seen from above over
+   !> discs of `radius` (Å) centred on its atoms: an upper bound of the
+   !> density anywhere in it (however far its atoms spread), unlike the
+   !> density of its bounding box.
+   pure real(wp) function max_local_density(net, radius) result(density)
+      type(crystal_net), intent(in) :: net
+      real(wp), intent(in) :: radius
+      integer, allocatable :: order(:)
+      integer :: n, k, low, m, inside, best, i, j
+
+      n = net%size()
+      density = 0.0_wp
+      if (n == 0) return
+      order = sort_order(net%position(1, :))
+      best = 0
+      low = 1
+      do k = 1, n
+         i = order(k)
+         do while (net%position(1, order(low)) < net%position(1, i) - radius)
+            low = low + 1
+         end do
+         inside = 0
+         m = low
+         do while (m <= n)
+            j = order(m)
+            if (net%position(1, j) > net%position(1, i) + radius) exit
+            if (sum((net%position(1:2, j) - net%position(1:2, i))**2) < radius**2) inside = inside + 1
+            m = m + 1
+         end do
+         best = max(best, inside)
+      end do
+      density = best / (3.14159265358979323846_wp * radius**2)
+   end function max_local_density
+
+   !> The first pair of atoms (i < j, in the net's order) closer than
+   !> `distance` (Å) in 3D; 0, 0 when there is none.
+   pure subroutine first_duplicate(net, distance, first, second)
+      type(crystal_net), intent(in) :: net
+      real(wp), intent(in) :: distance
+      integer, intent(out) :: first, second
+      integer, allocatable :: order(:)
+      integer :: n, k, m, i, j
+
+      first = 0
+      second = 0
+      n = net%size()
+      if (n < 2) return
+      order = sort_order(net%position(1, :))
+      do k = 1, n - 1
+         i = order(k)
+         do m = k + 1, n
+            j = order(m)
+            if (net%position(1, j) - net%position(1, i) >= distance) exit
+            if (sum((net%position(:, j) - net%position(:, i))**2) < distance**2) then
+               if (first == 0 .or. min(i, j) < first .or. (min(i, j) == first .and. max(i, j) < second)) then
+                  first = min(i, j)
+                  second = max(i, j)
+               end if
+            end if
+         end do
+      end do
+   end subroutine first_duplicate
 
    !> Write a net as XYZ (positions to 1e-10 Å).
    subroutine write_xyz(path, net, species_names, comment, error)

@@ -1,0 +1,107 @@
+/* File-system calls Fortran lacks, for publishing output safely (core/files.f90):
+ * the type of what is at a path (without following a symbolic link), whether
+ * two paths are one file, a hard link that fails when the target exists, a
+ * rename that never replaces, removal, and truncation.  Each returns 0 or the
+ * errno of the failure, and friction_error_text says what an errno means. */
+#define _GNU_SOURCE
+#include <errno.h>
+#include <fcntl.h>
+#include <stdio.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/statvfs.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
+/* What is at path, the link itself when follow is 0: 0 nothing, 1 a regular
+ * file, 2 a directory, 3 a symbolic link, 4 anything else (a device, pipe or
+ * socket), -1 cannot tell (permission, a path too long, ...). */
+int friction_path_kind(const char *path, int follow)
+{
+    struct stat s;
+    int status = follow ? stat(path, &s) : lstat(path, &s);
+    if (status != 0) return (errno == ENOENT || errno == ENOTDIR) ? 0 : -1;
+    if (S_ISREG(s.st_mode)) return 1;
+    if (S_ISDIR(s.st_mode)) return 2;
+    if (S_ISLNK(s.st_mode)) return 3;
+    return 4;
+}
+
+/* 1 when both paths exist and are the same file (device and inode, links
+ * followed), else 0. */
+int friction_same_file(const char *a, const char *b)
+{
+    struct stat sa, sb;
+    if (stat(a, &sa) != 0 || stat(b, &sb) != 0) return 0;
+    return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+}
+
+/* A second name for an existing file; fails with EEXIST if `to` exists, so
+ * a file appears under `to` only if nothing was there at that moment. */
+int friction_link(const char *from, const char *to)
+{
+    return link(from, to) == 0 ? 0 : errno;
+}
+
+/* The errno value of an existing target (EEXIST). */
+int friction_errno_exists(void) { return EEXIST; }
+
+/* rename(2) that fails with EEXIST instead of replacing (Linux renameat2
+ * RENAME_NOREPLACE); EINVAL or ENOSYS where the file system or kernel lacks it. */
+int friction_rename_noreplace(const char *from, const char *to)
+{
+#ifdef SYS_renameat2
+    return syscall(SYS_renameat2, AT_FDCWD, from, AT_FDCWD, to, 1u /* RENAME_NOREPLACE */) == 0 ? 0 : errno;
+#else
+    (void)from;
+    (void)to;
+    return ENOSYS;
+#endif
+}
+
+/* rename(2), replacing `to`. */
+int friction_rename(const char *from, const char *to)
+{
+    return rename(from, to) == 0 ? 0 : errno;
+}
+
+int friction_unlink(const char *path)
+{
+    return unlink(path) == 0 ? 0 : errno;
+}
+
+/* Cut a file to no bytes: gives back the space of a file that could not be
+ * written whole (a full disk), so its writer can close it. */
+int friction_truncate(const char *path)
+{
+    return truncate(path, 0) == 0 ? 0 : errno;
+}
+
+/* Bytes an unprivileged writer may still write on the file system that
+ * holds path (or its directory, when path does not exist yet); -1 unknown. */
+double friction_free_bytes(const char *path)
+{
+    struct statvfs s;
+    if (statvfs(path, &s) != 0) {
+        char directory[4096];
+        const char *slash = strrchr(path, '/');
+        if (slash == NULL) {
+            snprintf(directory, sizeof directory, ".");
+        } else {
+            size_t n = (size_t)(slash - path);
+            if (n == 0) n = 1;
+            if (n >= sizeof directory) return -1.0;
+            memcpy(directory, path, n);
+            directory[n] = '\0';
+        }
+        if (statvfs(directory, &s) != 0) return -1.0;
+    }
+    return (double)s.f_bavail * (double)s.f_frsize;
+}
+
+/* The text of errno `code`, NUL-terminated in buffer (of `size` bytes). */
+void friction_error_text(int code, char *buffer, int size)
+{
+    if (size <= 0) return;
+    snprintf(buffer, (size_t)size, "%s", strerror(code));
+}
