@@ -1,6 +1,7 @@
 !> Text helpers: numbers and lists as text for messages, case folding.
 module friction_strings
    use friction_kinds, only: wp, i8
+   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
    implicit none
    private
 
@@ -115,6 +116,10 @@ contains
       real(wp) :: x
       integer :: k
 
+      if (.not. ieee_is_finite(bytes)) then
+         text = 'an unbounded size'
+         return
+      end if
       if (bytes < 1000.0_wp) then
          write (buffer, '(i0, a)') nint(bytes), ' bytes'
          text = trim(buffer)
@@ -126,7 +131,11 @@ contains
          x = x / 1000.0_wp
          k = k + 1
       end do
-      write (buffer, '(f0.1, 1x, a)') x, units(k)
+      if (x < 1.0e6_wp) then
+         write (buffer, '(f0.1, 1x, a)') x, units(k)
+      else   ! (beyond TB: an exponent, not hundreds of digits)
+         write (buffer, '(es10.3e3, 1x, a)') x, units(k)
+      end if
       text = trim(adjustl(buffer))
    end function bytes_text
 
