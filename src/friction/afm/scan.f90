@@ -241,10 +241,11 @@ contains
             force = tip%lateral_force(y) * ev_per_angstrom_to_nn
             tip_r = tip%tip_position(t, y)
             if (nd == 3) then
-               call check_above_net(tip, tip_r, 'the tip passed into the layer of atoms at (' &
+               call check_above_net(tip, tip_r, 'the tip went below the layer of atoms at (' &
                   & //rtoa(tip_r(1))//', '//rtoa(tip_r(2))//', '//rtoa(tip_r(3))//') Å (line '//itoa(j) &
-                  & //trim(merge(' trace  ', ' retrace', forward))//'): the load (support_z = '//rtoa(c%support_z) &
-                  & //' Å) is more than the layer holds; raise support_z', error)
+                  & //trim(merge(' trace  ', ' retrace', forward))//'): off the edge of the net, or pressed ' &
+                  & //'through it by the load (support_z = '//rtoa(c%support_z)//' Å); scan over the net, or ' &
+                  & //'raise support_z', error)
                if (allocated(error)) return
             end if
             record%values(i, q_fx) = force(1)
