@@ -23,7 +23,7 @@ module friction_afm_scan
    use friction_afm_quasistatic, only: newton_equilibrium, equilibrium_tangent
    use friction_surface_potential, only: surface_potential
    use friction_surface_lennard_jones, only: lj_potential
-   use friction_strings, only: rtoa, itoa, bytes_text
+   use friction_strings, only: rtoa, itoa, bytes_text, fixed_text
    use friction_files, only: available_memory
    implicit none
    private
@@ -233,8 +233,8 @@ contains
                   & //rtoa(c%solver%max_wall_time)//' s reached at t = '//rtoa(t)//' s', error_numerical)
             end if
             if (allocated(error)) then
-               write (where, '(a, i0, a, f0.4, a)') ' (line ', j, trim(merge(' trace  ', ' retrace', forward)) &
-                  & //', support at ', c%velocity * t, ' Å into the trip)'
+               write (where, '(a, i0, a)') ' (line ', j, trim(merge(' trace  ', ' retrace', forward)) &
+                  & //', support at '//fixed_text(c%velocity * t, 4)//' Å into the trip)'
                error%message = error%message//trim(where)
                return
             end if

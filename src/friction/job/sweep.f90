@@ -65,7 +65,7 @@ contains
       type(reason_text), allocatable :: reasons(:)
       type(error_type), allocatable :: checkpoint_error
       character(len=:), allocatable :: input_hash, problem
-      integer :: unsaved
+      integer :: unsaved, last_taken
       real(wp), allocatable :: results(:, :), cost(:), maxima(:), point_maxima(:), flat(:)
       integer, allocatable :: status(:), counts(:), offsets(:), owner(:), computed_by_run(:)
       integer, allocatable :: memory(:)
@@ -134,9 +134,12 @@ contains
       block_last = int(int(n, i8) * (job%rank + 1) / job%nranks)
       computed = 0
       interrupted = .false.
+      last_taken = 0
       do
          ! Between points: a stop request ends the sweep here, the point in hand done.
-         if (reporter%stop_requested()) then
+         ! (The test hook likewise, once this rank has done point stop_after:
+         ! with stop_after = n, a stop request after the last point.)
+         if (reporter%stop_requested() .or. (job%stop_after > 0 .and. last_taken >= job%stop_after)) then
             interrupted = .true.
             exit
          end if
@@ -153,6 +156,7 @@ contains
          end if
          i = next + 1
          if (i > n) exit
+         last_taken = i
          if (job%stop_after > 0 .and. i > job%stop_after) then
             interrupted = .true.   ! the test hook: as if a signal came after that point
             exit

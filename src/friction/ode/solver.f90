@@ -78,6 +78,9 @@ module friction_ode_solver
       character(len=8) :: time_name = 't', time_unit = ' s'
       !> counters of the finished restarts
       type(integrator_statistics) :: done
+      !> GSL's status of the last restart (its first step), reported by the next advance or step
+      integer(c_int) :: restart_status = 0
+      real(wp) :: restart_step = 0.0_wp
    contains
       procedure :: init
       procedure :: restart
@@ -260,7 +263,20 @@ contains
       self%box%rhs_evaluations = 0
       self%box%jacobian_evaluations = 0
       status = gsl_odeiv2_driver_reset_hstart(self%driver, real(h_start, c_double))
+      self%restart_status = status
+      self%restart_step = h_start
    end subroutine restart
+
+   !> An error when GSL refused the last restart's first step.
+   subroutine check_restart(self, error)
+      class(ode_solver), intent(inout) :: self
+      type(error_type), allocatable, intent(out) :: error
+
+      if (self%restart_status == gsl_success) return
+      call fatal_error(error, trim(self%method)//': GSL refused the first step '//rtoa(self%restart_step) &
+         & //trim(self%time_unit)//': '//gsl_message(self%restart_status), error_numerical)
+      self%restart_status = gsl_success
+   end subroutine check_restart
 
    !> Advance y from t to t1.  On failure t holds the time reached.
    subroutine advance(self, t, t1, y, error)
@@ -272,6 +288,8 @@ contains
       integer(c_int) :: status
       integer(c_long) :: steps, failed
 
+      call check_restart(self, error)
+      if (allocated(error)) return
       status = gsl_odeiv2_driver_apply(self%driver, t, t1, y)
       call friction_gsl_driver_counts(self%driver, steps, failed)
       if (status /= gsl_success) then
@@ -303,6 +321,8 @@ contains
       type(error_type), allocatable, intent(out) :: error
       integer(c_int) :: status
 
+      call check_restart(self, error)
+      if (allocated(error)) return
       status = friction_gsl_driver_step_once(self%driver, t, t1, y)
       if (status == gsl_ebadfunc) then
          call fatal_error(error, trim(self%method)//': the right-hand side became NaN or Inf at ' &
