@@ -23,7 +23,7 @@ module friction_afm_scan
    use friction_afm_quasistatic, only: newton_equilibrium, equilibrium_tangent
    use friction_surface_potential, only: surface_potential
    use friction_surface_lennard_jones, only: lj_potential
-   use friction_strings, only: rtoa, itoa, bytes_text
+   use friction_strings, only: rtoa, itoa, bytes_text, fixed_text
    use friction_files, only: available_memory
    implicit none
    private
@@ -233,18 +233,19 @@ contains
                   & //rtoa(c%solver%max_wall_time)//' s reached at t = '//rtoa(t)//' s', error_numerical)
             end if
             if (allocated(error)) then
-               write (where, '(a, i0, a, f0.4, a)') ' (line ', j, trim(merge(' trace  ', ' retrace', forward)) &
-                  & //', support at ', c%velocity * t, ' Å into the trip)'
+               write (where, '(a, i0, a)') ' (line ', j, trim(merge(' trace  ', ' retrace', forward)) &
+                  & //', support at '//fixed_text(c%velocity * t, 4)//' Å into the trip)'
                error%message = error%message//trim(where)
                return
             end if
             force = tip%lateral_force(y) * ev_per_angstrom_to_nn
             tip_r = tip%tip_position(t, y)
             if (nd == 3) then
-               call check_above_net(tip, tip_r, 'the tip passed into the layer of atoms at (' &
+               call check_above_net(tip, tip_r, 'the tip went below the layer of atoms at (' &
                   & //rtoa(tip_r(1))//', '//rtoa(tip_r(2))//', '//rtoa(tip_r(3))//') Å (line '//itoa(j) &
-                  & //trim(merge(' trace  ', ' retrace', forward))//'): the load (support_z = '//rtoa(c%support_z) &
-                  & //' Å) is more than the layer holds; raise support_z', error)
+                  & //trim(merge(' trace  ', ' retrace', forward))//'): off the edge of the net, or pressed ' &
+                  & //'through it by the load (support_z = '//rtoa(c%support_z)//' Å); scan over the net, or ' &
+                  & //'raise support_z', error)
                if (allocated(error)) return
             end if
             record%values(i, q_fx) = force(1)

@@ -8,7 +8,7 @@ module friction_afm_validity
    use friction_afm_tip, only: afm_tip
    use friction_afm_scan, only: find_height
    use friction_surface_potential, only: surface_potential
-   use friction_strings, only: rtoa, itoa
+   use friction_strings, only: rtoa, itoa, fixed_text
    implicit none
    private
 
@@ -172,12 +172,8 @@ contains
       real(wp), intent(in) :: value
       integer, intent(in) :: digits
       character(len=:), allocatable :: text
-      character(len=32) :: buffer, form
 
-      write (form, '(a, i0, a)') '(f0.', digits, ')'
-      write (buffer, form) value
-      text = trim(adjustl(buffer))
-      if (text(1:1) == '.') text = '0'//text
+      text = fixed_text(value, digits)
    end function fixed
 
 end module friction_afm_validity

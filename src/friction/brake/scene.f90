@@ -7,6 +7,7 @@
 module friction_brake_scene
    use mpi_f08
    use friction_kinds, only: wp, i8
+   use friction_strings, only: fixed_text
    use friction_error, only: error_type, fatal_error, error_numerical
    use friction_version, only: version_string
    use friction_parameters, only: parameter_visitor
@@ -212,8 +213,9 @@ contains
       character(len=12) :: seconds
 
       write (seconds, '(f12.3)') self%record%wall_time
-      write (line, '(a, i0, a, f0.1, a, i0, a)') ' model, ', self%main_run%n, ' points to τ = ', &
-         & self%ran%grid_time(self%main_run%n), ', ', self%main_run%events%n, ' events, '
+      write (line, '(a, i0, a)') ' model, ', self%main_run%n, ' points to τ = ' &
+         & //fixed_text(self%ran%grid_time(self%main_run%n), 1)
+      write (line, '(a, a, i0, a)') trim(line), ', ', self%main_run%events%n, ' events, '
       text = trim(self%ran%model)//trim(line)//' '//trim(adjustl(seconds))//' s '//ranks_text(job%nranks)
    end function brake_summary
 

@@ -6,7 +6,7 @@
 !> with it, only a regular file is replaced, never a device, a directory or
 !> a symbolic link.
 module friction_files
-   use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char, c_double
+   use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char, c_double, c_long
    use friction_error, only: error_type, fatal_error, error_io, error_input
    use friction_strings, only: itoa
    implicit none
@@ -14,8 +14,13 @@ module friction_files
 
    public :: rename_file, remove_file, file_exists, process_id, write_text_file, open_for_reading
    public :: path_kind, same_file, publish_file, truncate_file, output_problem, system_error_text, free_bytes
-   public :: available_memory
+   public :: available_memory, write_bytes, min_free_bytes
    public :: kind_none, kind_regular, kind_directory, kind_link, kind_other, kind_unknown
+
+   !> Free space, bytes, below which no output is written: an HDF5 file that
+   !> fails for a full disk can be closed (and so leave no handle open) only
+   !> when its metadata, tens of kB, still finds room.
+   real(c_double), parameter :: min_free_bytes = 1.0e6_c_double
 
    !> What path_kind finds at a path.
    integer, parameter :: kind_none = 0, kind_regular = 1, kind_directory = 2, kind_link = 3, kind_other = 4, &
@@ -87,6 +92,13 @@ module friction_files
          character(kind=c_char), intent(in) :: path(*)
          real(c_double) :: bytes
       end function c_free_bytes
+
+      function c_write_file(path, data, length) result(code) bind(c, name='friction_write_file')
+         import :: c_int, c_char, c_long
+         character(kind=c_char), intent(in) :: path(*), data(*)
+         integer(c_long), value :: length
+         integer(c_int) :: code
+      end function c_write_file
 
       subroutine c_error_text(code, buffer, size) bind(c, name='friction_error_text')
          import :: c_int, c_char
@@ -200,7 +212,9 @@ contains
       integer :: code, eexist
 
       eexist = int(c_errno_exists())
-      problem = output_problem(to, replace)
+      ! (Without `replace` an existing name of any kind makes link(2) fail.)
+      problem = ''
+      if (replace) problem = output_problem(to, replace)
       if (len(problem) > 0) then
          call fatal_error(error, to//': '//problem, error_io)
          return
@@ -288,38 +302,35 @@ contains
    end function process_id
 
 
+   !> Write text as the whole content of a new file at `path` (replacing a
+   !> file there), every step checked through the C library (gfortran's own
+   !> writes report success on a full disk); `problem` says what failed ('' on
+   !> success), and a file not written whole is removed.
+   subroutine write_bytes(path, text, problem)
+      character(len=*), intent(in) :: path, text
+      character(len=:), allocatable, intent(out) :: problem
+      integer :: code
+
+      code = int(c_write_file(path//c_null_char, text, int(len(text), c_long)))
+      problem = ''
+      if (code /= 0) problem = system_error_text(code)
+   end subroutine write_bytes
+
    !> Write text to path, complete or not at all (a temporary name beside it,
    !> published when written; see publish_file for `replace`, default true).
-   !> Every write is checked, the close too (a full disk shows there).
    subroutine write_text_file(path, text, error, replace)
       character(len=*), intent(in) :: path, text
       type(error_type), allocatable, intent(out) :: error
       logical, intent(in), optional :: replace
-      character(len=:), allocatable :: temporary
-      character(len=256) :: message
-      integer :: unit, stat
+      character(len=:), allocatable :: temporary, problem
       logical :: may_replace
 
       may_replace = .true.
       if (present(replace)) may_replace = replace
       temporary = path//'.tmp-'//itoa(process_id())
-      open (newunit=unit, file=temporary, status='replace', action='write', form='unformatted', &
-         & access='stream', iostat=stat, iomsg=message)
-      if (stat /= 0) then
-         call fatal_error(error, path//': cannot write the file here ('//trim(message)//')', error_io)
-         return
-      end if
-      write (unit, iostat=stat, iomsg=message) text
-      if (stat == 0) flush (unit, iostat=stat, iomsg=message)
-      if (stat /= 0) then
-         close (unit, status='delete')
-         call fatal_error(error, path//': writing failed ('//trim(message)//')', error_io)
-         return
-      end if
-      close (unit, iostat=stat, iomsg=message)
-      if (stat /= 0) then
-         call remove_file(temporary)
-         call fatal_error(error, path//': writing failed ('//trim(message)//')', error_io)
+      call write_bytes(temporary, text, problem)
+      if (len(problem) > 0) then
+         call fatal_error(error, path//': writing failed ('//problem//')', error_io)
          return
       end if
       call publish_file(temporary, path, may_replace, error)

@@ -99,6 +99,26 @@ double friction_free_bytes(const char *path)
     return (double)s.f_bavail * (double)s.f_frsize;
 }
 
+/* Write `length` bytes to a new file at path (replacing one there), every
+ * step checked: open, write, flush, fsync and close.  (gfortran's formatted
+ * and stream writes lose ENOSPC: its flush and close report success on a
+ * full disk, leaving an empty file.)  On failure the file is removed and
+ * the errno returned. */
+int friction_write_file(const char *path, const char *data, long length)
+{
+    int code = 0;
+    FILE *file = fopen(path, "wb");
+    if (file == NULL) return errno;
+    if (length > 0 && fwrite(data, 1, (size_t)length, file) != (size_t)length) code = errno;
+    if (code == 0 && fflush(file) != 0) code = errno;
+    if (code == 0 && fsync(fileno(file)) != 0 && errno != EINVAL && errno != EROFS) code = errno;
+    if (fclose(file) != 0 && code == 0) code = errno;
+    if (code == 0) return 0;
+    if (code == 0) code = EIO;
+    unlink(path);
+    return code;
+}
+
 /* The text of errno `code`, NUL-terminated in buffer (of `size` bytes). */
 void friction_error_text(int code, char *buffer, int size)
 {

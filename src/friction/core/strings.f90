@@ -5,7 +5,7 @@ module friction_strings
    implicit none
    private
 
-   public :: itoa, rtoa, join, quoted, lower, text_hash, bytes_text
+   public :: itoa, rtoa, join, quoted, lower, text_hash, bytes_text, fixed_text
 
    !> An integer as text, without blanks.
    interface itoa
@@ -51,6 +51,28 @@ contains
       write (buffer, '(1pg0.6)') x
       text = trim(adjustl(buffer))
    end function rtoa
+
+   !> A real with `digits` decimals and no padding ('0.25', '-3.1'); beyond
+   !> 1e15 in magnitude, or not finite, in scientific notation, so that any
+   !> value fits (an internal write that overflows its buffer aborts).
+   function fixed_text(x, digits) result(text)
+      real(wp), intent(in) :: x
+      integer, intent(in) :: digits
+      character(len=:), allocatable :: text
+      character(len=64) :: buffer, form
+
+      if (.not. (abs(x) < 1.0e15_wp)) then
+         write (buffer, '(es14.4e3)') x
+      else
+         write (form, '(a, i0, a)') '(f0.', max(0, min(digits, 30)), ')'
+         write (buffer, form) x
+      end if
+      text = trim(adjustl(buffer))
+      if (text(1:1) == '.') text = '0'//text
+      if (len(text) > 1) then
+         if (text(1:2) == '-.') text = '-0'//text(2:)
+      end if
+   end function fixed_text
 
    !> Words separated by a separator (', ' when absent), each with a prefix.
    pure function join(words, separator, prefix) result(text)
@@ -131,12 +153,7 @@ contains
          x = x / 1000.0_wp
          k = k + 1
       end do
-      if (x < 1.0e6_wp) then
-         write (buffer, '(f0.1, 1x, a)') x, units(k)
-      else   ! (beyond TB: an exponent, not hundreds of digits)
-         write (buffer, '(es10.3e3, 1x, a)') x, units(k)
-      end if
-      text = trim(adjustl(buffer))
+      text = fixed_text(x, 1)//' '//units(k)
    end function bytes_text
 
 end module friction_strings

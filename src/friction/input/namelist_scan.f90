@@ -188,6 +188,17 @@ contains
          if (stat /= 0) exit
          line = line + 1
          n = len_trim(buffer)
+         ! A namelist file is text: a control character (a NUL, the bytes of a
+         ! binary file given by mistake) is an error, not something to skip.
+         do i = 1, n
+            if (buffer(i:i) == achar(13)) buffer(i:i) = ' '   ! a CR of a CR LF line end
+            if (iachar(buffer(i:i)) < 32 .and. iachar(buffer(i:i)) /= 9 .and. iachar(buffer(i:i)) /= 12) then
+               close (unit)
+               call fatal_error(error, path//':'//itoa(line)//': control character (byte '// &
+                  & itoa(iachar(buffer(i:i)))//') in column '//itoa(i)//': not a namelist text file', error_input)
+               return
+            end if
+         end do
          quote = ' '
          do i = 1, n
             if (quote /= ' ') then

@@ -30,7 +30,7 @@ module friction_job_sweep
    use friction_job_config, only: job_config
    use friction_output_h5, only: h5_file
    use friction_output_summary, only: run_summary, write_run_attributes
-   use friction_files, only: file_exists, rename_file, remove_file, process_id
+   use friction_files, only: file_exists, rename_file, remove_file, process_id, write_bytes
    use friction_scene_report, only: job_reporter
    use friction_scene_context, only: job_context, temporary_name, publish, ranks_text, sum_to_root_real, &
       & sum_to_root_integer, agree_on_error
@@ -65,7 +65,7 @@ contains
       type(reason_text), allocatable :: reasons(:)
       type(error_type), allocatable :: checkpoint_error
       character(len=:), allocatable :: input_hash, problem
-      integer :: unsaved
+      integer :: unsaved, last_taken
       real(wp), allocatable :: results(:, :), cost(:), maxima(:), point_maxima(:), flat(:)
       integer, allocatable :: status(:), counts(:), offsets(:), owner(:), computed_by_run(:)
       integer, allocatable :: memory(:)
@@ -134,9 +134,12 @@ contains
       block_last = int(int(n, i8) * (job%rank + 1) / job%nranks)
       computed = 0
       interrupted = .false.
+      last_taken = 0
       do
          ! Between points: a stop request ends the sweep here, the point in hand done.
-         if (reporter%stop_requested()) then
+         ! (The test hook likewise, once this rank has done point stop_after:
+         ! with stop_after = n, a stop request after the last point.)
+         if (reporter%stop_requested() .or. (job%stop_after > 0 .and. last_taken >= job%stop_after)) then
             interrupted = .true.
             exit
          end if
@@ -153,6 +156,7 @@ contains
          end if
          i = next + 1
          if (i > n) exit
+         last_taken = i
          if (job%stop_after > 0 .and. i > job%stop_after) then
             interrupted = .true.   ! the test hook: as if a signal came after that point
             exit
@@ -230,6 +234,9 @@ contains
       call sum_to_root_integer(job, computed_by_run, n)
       flag = merge(1, 0, interrupted)
       call MPI_Allreduce(MPI_IN_PLACE, flag, 1, MPI_INTEGER, MPI_MAX, job%comm)
+      ! A stop request after the last point stopped nothing: the sweep is complete.
+      if (job%rank == 0 .and. flag /= 0 .and. all(status /= 0)) flag = 0
+      call MPI_Bcast(flag, 1, MPI_INTEGER, 0, job%comm)
       interrupted = flag /= 0
 
       ! Peak resident memory of every rank, for the benchmark (docs/sweeps.md).
@@ -443,8 +450,7 @@ contains
       character(len=:), allocatable, intent(out) :: problem
       type(error_type), allocatable :: save_error
       character(len=:), allocatable :: text, one_line
-      character(len=256) :: message
-      integer :: unit, stat, k
+      integer :: k
 
       ! The reason on one line.
       one_line = trim(reason)
@@ -458,21 +464,9 @@ contains
          text = text//real_line(maxima(k:k))
       end do
       text = text//'end '//itoa(count_lines(text))//' '//text_hash(text)//new_line('a')
-      problem = ''
-      open (newunit=unit, file=path//'.tmp', status='replace', action='write', form='unformatted', &
-         & access='stream', iostat=stat, iomsg=message)
-      if (stat == 0) then
-         write (unit, iostat=stat, iomsg=message) text
-         if (stat == 0) flush (unit, iostat=stat, iomsg=message)
-         if (stat == 0) then
-            close (unit, iostat=stat, iomsg=message)
-         else
-            close (unit, iostat=k)
-         end if
-      end if
-      if (stat /= 0) then
-         problem = path//': the checkpoint could not be written ('//trim(message)//')'
-         call remove_file(path//'.tmp')
+      call write_bytes(path//'.tmp', text, problem)
+      if (len(problem) > 0) then
+         problem = path//': the checkpoint could not be written ('//problem//')'
          return
       end if
       call rename_file(path//'.tmp', path, save_error)

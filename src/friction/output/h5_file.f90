@@ -15,11 +15,11 @@ module friction_output_h5
    use, intrinsic :: iso_c_binding, only: c_ptr, c_loc, c_funptr, c_int, c_int64_t, c_null_ptr, c_null_funptr, &
       & c_size_t, c_double
    use mpi_f08, only: MPI_Comm, MPI_INFO_NULL, MPI_Comm_rank, MPI_Allreduce, MPI_Barrier, MPI_IN_PLACE, &
-      & MPI_INTEGER, MPI_MAX
+      & MPI_INTEGER, MPI_MAX, MPI_Bcast, MPI_DOUBLE_PRECISION
    use hdf5
    use friction_kinds, only: wp, i8
    use friction_error, only: error_type, fatal_error, error_io
-   use friction_files, only: truncate_file, free_bytes
+   use friction_files, only: truncate_file, free_bytes, min_free_bytes
    use friction_strings, only: bytes_text
    implicit none
    private
@@ -28,8 +28,8 @@ module friction_output_h5
       !> The metadata cache's current size (what a flush may still write).
       function h5fget_mdc_size(file, max_size, min_clean_size, cur_size, cur_num_entries) result(status) &
          & bind(c, name='H5Fget_mdc_size')
-         import :: hid_t, c_size_t, c_int
-         integer(hid_t), value :: file
+         import :: c_int64_t, c_size_t, c_int
+         integer(c_int64_t), value :: file   !! an hid_t
          integer(c_size_t), intent(out) :: max_size, min_clean_size, cur_size
          integer(c_int), intent(out) :: cur_num_entries
          integer(c_int) :: status
@@ -94,6 +94,7 @@ module friction_output_h5
       procedure :: has_attribute
       procedure :: close
       procedure, private :: check
+      procedure, private :: agree
    end type h5_file
 
 contains
@@ -107,11 +108,22 @@ contains
       integer(hid_t) :: fapl
       integer :: stat
       type(error_printing) :: printing
+      real(c_double) :: free
 
       self%path = path
       self%status = 0
       self%comm = comm
       call MPI_Comm_rank(comm, self%rank)
+      ! Not on a (nearly) full disk: room to spare is what lets a failed
+      ! file be closed (give_back_space).
+      free = -1.0_c_double
+      if (self%rank == 0) free = free_bytes(path)
+      call MPI_Bcast(free, 1, MPI_DOUBLE_PRECISION, 0, comm)
+      if (free >= 0.0_c_double .and. free < min_free_bytes) then
+         call fatal_error(error, path//': the disk is full ('//bytes_text(real(free, wp))//' free; writing ' &
+            & //'the output needs at least '//bytes_text(real(min_free_bytes, wp))//' to spare)', error_io)
+         return
+      end if
       ! The library never prints: failures come back through stat.
       call printing%silence()
       call h5open_f(stat)
@@ -230,6 +242,7 @@ contains
       integer(hid_t) :: filespace, memspace, dset, xfer
       integer(hsize_t) :: dims(2), count(2), offset(2), step(2)
       integer :: stat, rank
+      logical :: created
 
       if (self%status /= 0) return
       if (one_d) then
@@ -247,8 +260,11 @@ contains
       end if
       call h5screate_simple_f(rank, dims(1:rank), filespace, stat)
       call h5dcreate_f(self%id, name, type, filespace, dset, stat)
+      created = stat == 0
+      call self%agree(stat)
       call self%check(stat, 'creating dataset '//name)
       if (stat /= 0) then
+         if (created) call h5dclose_f(dset, stat)
          call h5sclose_f(filespace, stat)
          return
       end if
@@ -271,6 +287,7 @@ contains
       call h5pset_dxpl_mpio_f(xfer, H5FD_MPIO_COLLECTIVE_F, stat)
       call h5dwrite_f(dset, type, buffer, stat, mem_space_id=memspace, file_space_id=filespace, &
          & xfer_prp=xfer)
+      call self%agree(stat)
       call self%check(stat, 'writing dataset '//name)
       call h5pclose_f(xfer, stat)
       call h5sclose_f(memspace, stat)
@@ -300,12 +317,16 @@ contains
       integer(hid_t) :: filespace, memspace, dset, xfer
       integer(hsize_t) :: dims(1)
       integer :: stat
+      logical :: created
 
       dims = [int(size(values), hsize_t)]
       call h5screate_simple_f(1, dims, filespace, stat)
       call h5dcreate_f(self%id, name, H5T_NATIVE_INTEGER, filespace, dset, stat)
+      created = stat == 0
+      call self%agree(stat)
       call self%check(stat, 'creating dataset '//name)
       if (stat /= 0) then
+         if (created) call h5dclose_f(dset, stat)
          call h5sclose_f(filespace, stat)
          return
       end if
@@ -324,6 +345,7 @@ contains
       call h5pset_dxpl_mpio_f(xfer, H5FD_MPIO_COLLECTIVE_F, stat)
       call h5dwrite_f(dset, H5T_NATIVE_INTEGER, values, dims, stat, &
          & mem_space_id=memspace, file_space_id=filespace, xfer_prp=xfer)
+      call self%agree(stat)
       call self%check(stat, 'writing dataset '//name)
       call h5pclose_f(xfer, stat)
       call h5sclose_f(memspace, stat)
@@ -510,6 +532,19 @@ contains
       if (self%rank == 0) call truncate_file(self%path)
       call MPI_Barrier(self%comm)
    end subroutine give_back_space
+
+   !> A collective write's status, the same on every rank: a write can fail
+   !> on one rank alone (a full disk), and a rank that then skipped the next
+   !> collective call would leave the others waiting in it.
+   subroutine agree(self, stat)
+      class(h5_file), intent(inout) :: self
+      integer, intent(inout) :: stat
+      integer :: failed
+
+      failed = merge(1, 0, stat /= 0)
+      call MPI_Allreduce(MPI_IN_PLACE, failed, 1, MPI_INTEGER, MPI_MAX, self%comm)
+      if (failed /= 0 .and. stat == 0) stat = -1
+   end subroutine agree
 
    subroutine check(self, stat, what)
       class(h5_file), intent(inout) :: self

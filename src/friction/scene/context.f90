@@ -4,8 +4,8 @@ module friction_scene_context
    use mpi_f08
    use friction_kinds, only: wp
    use friction_error, only: error_type, fatal_error, error_io
-   use friction_strings, only: itoa
-   use friction_files, only: publish_file, remove_file, process_id
+   use friction_strings, only: itoa, bytes_text
+   use friction_files, only: publish_file, remove_file, process_id, free_bytes, min_free_bytes
    implicit none
    private
 
@@ -137,6 +137,7 @@ contains
       character(len=:), allocatable :: probe
       character(len=256) :: message
       integer :: unit, stat
+      real(wp) :: free
 
       probe = path//'.tmp-'//itoa(process_id())
       open (newunit=unit, file=probe, status='new', action='write', iostat=stat, iomsg=message)
@@ -145,6 +146,10 @@ contains
          return
       end if
       close (unit, status='delete')
+      free = free_bytes(path)
+      if (free >= 0.0_wp .and. free < min_free_bytes) call fatal_error(error, path//': the disk is full (' &
+         & //bytes_text(free)//' free; writing the output needs at least '//bytes_text(min_free_bytes) &
+         & //' to spare)', error_io)
    end subroutine check_writable
 
    !> inputs/hopg.nml -> hopg.h5

@@ -4,6 +4,7 @@
 !> (app/) and the C API extend it.
 module friction_scene_report
    use friction_kinds, only: wp
+   use friction_strings, only: fixed_text
    implicit none
    private
 
@@ -35,7 +36,7 @@ contains
       character(len=80) :: buffer
 
       if (what == 'tau') then
-         write (buffer, '(a, f0.1, a, f0.1)') 'τ = ', done, ' of ', total
+         buffer = 'τ = '//fixed_text(done, 1)//' of '//fixed_text(total, 1)
       else
          write (buffer, '(i0, a, i0, a)') nint(done), ' of ', nint(total), ' '//what
          if (what == 'points') buffer = trim(buffer)//' started'

@@ -1,0 +1,581 @@
+#!/usr/bin/env python3
+"""A property-based fuzzing suite of the `friction` program (README:
+Reliability), with Hypothesis.  It generates namelists (valid ones with
+random physical values, and broken ones), XYZ nets with random defects, and
+output faults, runs the program on each and asserts the contract:
+
+  * the exit code is one of the documented ones, 0 2 3 4 5 6 (never a
+    signal, never another code);
+  * a failure says so in one clear message: exactly one line
+    `friction: error: ...` (usage errors: one `friction: ...` line);
+  * never a runtime abort: no "Fortran runtime error", "Error allocating",
+    backtrace or signal report on stderr;
+  * an existing file is never damaged: every file present before a run is
+    byte for byte the same after it, except an output replaced on purpose
+    (--force on a regular file);
+  * nothing is left behind: no temporary files (*.tmp*), no output after a
+    failure;
+  * an output holds no non-finite value (none of these inputs asks for one),
+    and its datasets have the shapes the input asks for.
+
+    fuzz_test.py --binary BIN --mpiexec MPIEXEC --inputs DIR --workdir DIR CLASS [--examples N] [--long]
+
+CLASS is one of the classes below, or `all`.  The ordinary suite runs each
+class with its fixed budget and a derandomized (fixed) seed; --long (or
+FRICTION_FUZZ_EXAMPLES=N) runs N examples per class with fresh random seeds:
+scripts/fuzz.  A summary line per class gives the cases tried and the exit
+codes seen.
+"""
+import argparse
+import collections
+import hashlib
+import math
+import os
+import shutil
+import stat
+import subprocess
+import sys
+import time
+
+import h5py
+import numpy as np
+from hypothesis import HealthCheck, example, given, settings, strategies as st
+
+ABORTS = ("Fortran runtime error", "Error allocating", "Backtrace", "Segmentation fault", "SIGSEGV",
+          "Error termination", "Program received signal", "HDF5-DIAG")
+DOCUMENTED = {0, 2, 3, 4, 5, 6}
+# Every generated run is bounded: a stiff or slow random case ends with exit 4.
+BOUNDS = "&integrator max_wall_time = 3.0, max_steps = 400000 /\n"
+SINGLETON = {"OMPI_MCA_ess_singleton_isolated": "1"}
+
+
+class Contract:
+    """Runs the program in a fresh directory and checks the contract."""
+
+    def __init__(self, args, name):
+        self.args = args
+        self.name = name
+        self.count = 0
+        self.codes = collections.Counter()
+        self.seconds = 0.0
+
+    def fresh(self):
+        self.count += 1
+        directory = os.path.join(self.args.workdir, f"{self.name}-{self.count}")
+        unmount_if_mounted(os.path.join(directory, "small"))
+        shutil.rmtree(directory, ignore_errors=True)
+        os.makedirs(directory)
+        return directory
+
+    def run(self, directory, arguments, ranks=None, stdin=None, replaced=(), output=None, shapes=None,
+            allowed=DOCUMENTED, timeout=120):
+        """Run `friction --quiet ARGUMENTS` in directory and check the
+        contract; `replaced` may change (the output with --force), `output`
+        is checked when the run succeeds; returns the completed process."""
+        before = snapshot(directory)
+        cmd = [self.args.binary, "--quiet", *arguments]
+        env = dict(os.environ)
+        if ranks is None:
+            env.update(SINGLETON)
+        else:
+            cmd = [self.args.mpiexec, "-n", str(ranks), *cmd]
+        start = time.monotonic()
+        try:
+            result = subprocess.run(cmd, cwd=directory, capture_output=True, env=env, timeout=timeout,
+                                    input=stdin)
+        except subprocess.TimeoutExpired:
+            raise AssertionError(f"{cmd}: no answer in {timeout} s (a hang)")
+        self.seconds += time.monotonic() - start
+        stderr = result.stderr.decode("utf-8", "replace")
+        code = result.returncode
+        self.codes[code] += 1
+        where = f"{' '.join(cmd)} in {directory}:\n{stderr}"
+        assert code >= 0, f"killed by signal {-code}: {where}"
+        assert code in DOCUMENTED, f"exit {code}, not a documented code: {where}"
+        assert code in allowed, f"exit {code}, expected one of {sorted(allowed)}: {where}"
+        for word in ABORTS:
+            assert word not in stderr, f"runtime abort ({word!r}): {where}"
+        if code not in (0, 6):
+            prefix = "friction:" if code == 2 else "friction: error:"
+            lines = [line for line in stderr.splitlines() if line.startswith(prefix)]
+            assert len(lines) == 1, f"expected one {prefix!r} message: {where}"
+        after = snapshot(directory)
+        for name, digest in before.items():
+            if name in replaced and code == 0:
+                continue
+            assert after.get(name) == digest, f"existing file {name} was damaged or removed: {where}"
+        left = [name for name in after if ".tmp" in name]
+        assert not left, f"temporary files left: {left}: {where}"
+        if output is not None:
+            path = os.path.join(directory, output)
+            if code == 0:
+                check_output(path, shapes, where)
+            elif output not in before:
+                assert not os.path.exists(path), f"a failed run left its output {output}: {where}"
+        return result
+
+    def summary(self):
+        codes = ", ".join(f"exit {code}: {n}" for code, n in sorted(self.codes.items()))
+        return f"{self.name}: {self.count} cases, {codes}; {self.seconds:.1f} s in the program"
+
+
+def snapshot(directory):
+    """Digest of every regular file under directory (links and other kinds
+    by what they are)."""
+    found = {}
+    for root, dirs, files in os.walk(directory):
+        for name in files + dirs:
+            full = os.path.join(root, name)
+            relative = os.path.relpath(full, directory)
+            mode = os.lstat(full).st_mode
+            if stat.S_ISLNK(mode):
+                found[relative] = "link:" + os.readlink(full)
+            elif stat.S_ISREG(mode):
+                with open(full, "rb") as handle:
+                    found[relative] = hashlib.sha256(handle.read()).hexdigest()
+            elif not stat.S_ISDIR(mode):
+                found[relative] = f"kind:{stat.S_IFMT(mode)}"
+    return found
+
+
+def check_output(path, shapes, where):
+    """Every number finite; the datasets the input asks for, with their shapes."""
+    assert os.path.isfile(path), f"exit 0 but no output {path}: {where}"
+    with h5py.File(path, "r") as handle:
+        datasets = []
+        handle.visititems(lambda name, item: datasets.append(name) if isinstance(item, h5py.Dataset) else None)
+        assert datasets, f"no datasets in {path}: {where}"
+        for name in datasets:
+            data = handle[name][()]
+            if np.issubdtype(np.asarray(data).dtype, np.floating):
+                assert np.all(np.isfinite(data)), f"/{name} has non-finite values: {where}"
+            # Not absurd either: a lateral force of 1e6 nN is no friction force
+            # (rtol = atol = 1e300 once gave 1e181 nN with exit 0).
+            if name.startswith("afm/") and name.split("/")[-1] in ("fx", "fy", "fz", "f_along", "f_across"):
+                assert np.all(np.abs(data) < 1e6), f"/{name} holds absurd forces (max {np.max(np.abs(data))}): {where}"
+        for name, shape in (shapes or {}).items():
+            assert name in handle, f"/{name} missing: {where}"
+            assert handle[name].shape == shape, f"/{name} has shape {handle[name].shape}, not {shape}: {where}"
+
+
+def unmount_if_mounted(directory):
+    if os.path.ismount(directory):
+        subprocess.run(["umount", directory], capture_output=True)
+
+
+def number(value):
+    """A real as namelist text that reads back to the same double."""
+    return repr(float(value))
+
+
+def log_uniform(low, high):
+    return st.floats(math.log10(low), math.log10(high)).map(lambda e: 10.0 ** e)
+
+
+# ---- class 1: valid maps with random physical values ----
+
+VALID_AFM = st.fixed_dictionaries({
+    "potential": st.sampled_from(["naf", "hopg"]),
+    "v0": st.floats(0.0, 2.0),
+    "kx": st.floats(0.5, 50.0), "ky": st.floats(0.5, 50.0),
+    "mass": log_uniform(1e-9, 1e-7),
+    "cx": log_uniform(1e-4, 1e-2), "cy": log_uniform(1e-4, 1e-2),
+    "velocity": log_uniform(10.0, 5000.0),
+    "angle": st.floats(-90.0, 90.0), "length": st.floats(0.5, 20.0), "width": st.floats(0.0, 10.0),
+    "lead_in": st.floats(0.0, 3.0),
+    "nx": st.integers(2, 24), "ny": st.integers(1, 3), "retrace": st.booleans(),
+    "model": st.sampled_from(["inertial", "overdamped", "quasistatic"]),
+    "method": st.sampled_from(["auto", "rkf45", "rk8pd", "rkck", "msbdf", "rk4imp"]),
+    "rtol": log_uniform(1e-8, 1e-2), "atol": log_uniform(1e-8, 1e-3),
+})
+
+
+def afm_text(p):
+    return (f"&surface potential = '{p['potential']}', v0 = {number(p['v0'])} /\n"
+            f"&tip model = '{p['model']}', mass = {number(p['mass'])}, kx = {number(p['kx'])}, "
+            f"ky = {number(p['ky'])}, cx = {number(p['cx'])}, cy = {number(p['cy'])} /\n"
+            f"&scan velocity = {number(p['velocity'])}, length = {number(p['length'])}, "
+            f"width = {number(p['width'])}, angle = {number(p['angle'])}, lead_in = {number(p['lead_in'])},\n"
+            f"  nx = {p['nx']}, ny = {p['ny']}, retrace = {'.true.' if p['retrace'] else '.false.'} /\n"
+            f"&integrator method = '{p['method']}', rtol = {number(p['rtol'])}, atol = {number(p['atol'])},"
+            f" max_wall_time = 3.0, max_steps = 400000 /\n")
+
+
+def afm_shapes(p):
+    shapes = {"afm/support_x": (p["nx"],), "afm/support_y": (p["ny"],), "afm/trace/fx": (p["ny"], p["nx"])}
+    if p["retrace"]:
+        shapes["afm/retrace/fx"] = (p["ny"], p["nx"])
+        shapes["afm/friction"] = (p["ny"],)
+    return shapes
+
+
+def valid_afm(contract, p):
+    directory = contract.fresh()
+    with open(os.path.join(directory, "run.nml"), "w") as handle:
+        handle.write(afm_text(p))
+    contract.run(directory, ["-o", "out.h5", os.path.join(contract.args.inputs, f"{p['potential']}.nml"),
+                             "run.nml"], output="out.h5", shapes=afm_shapes(p), allowed={0, 4})
+
+
+# ---- class 2: valid brake runs ----
+
+VALID_BRAKE = st.fixed_dictionaries({
+    "model": st.sampled_from(["switched", "regularized"]),
+    "mu": st.floats(0.05, 0.55), "mu_s": st.floats(0.56, 0.9),
+    "v_dr_prime": st.floats(-0.01, 0.0),
+    "t_end": st.floats(0.5, 60.0), "dt_out": st.floats(0.05, 1.0),
+    "x0": st.floats(-0.01, 0.01), "w0": st.floats(-0.01, 0.01),
+    "method": st.sampled_from(["auto", "rk8pd", "rkf45", "msbdf"]),
+})
+
+
+def valid_brake(contract, p):
+    directory = contract.fresh()
+    with open(os.path.join(directory, "run.nml"), "w") as handle:
+        handle.write(f"&brake model = '{p['model']}', mu = {number(p['mu'])}, mu_s = {number(p['mu_s'])},"
+                     f" v_dr_prime = {number(p['v_dr_prime'])}, t_start = 0.0, t_end = {number(p['t_end'])},"
+                     f" dt_out = {number(p['dt_out'])}, x0 = {number(p['x0'])}, w0 = {number(p['w0'])} /\n"
+                     "&analysis spectrum = .false., poincare = .false., lyapunov = .false., rosenstein = .false. /\n"
+                     f"&integrator method = '{p['method']}', max_wall_time = 3.0 /\n")
+    contract.run(directory, ["-o", "out.h5", os.path.join(contract.args.inputs, "brake.nml"), "run.nml"],
+                 output="out.h5", allowed={0, 4})
+
+
+# ---- class 3: broken values ----
+
+VARIABLES = [("tip", "mass", "r"), ("tip", "kx", "r"), ("tip", "cx", "r"), ("scan", "velocity", "r"),
+             ("scan", "length", "r"), ("scan", "angle", "r"), ("scan", "nx", "i"), ("scan", "ny", "i"),
+             ("surface", "v0", "r"), ("surface", "potential", "c"), ("integrator", "rtol", "r"),
+             ("integrator", "atol", "r"), ("integrator", "method", "c"), ("integrator", "h_min", "r"),
+             ("scan", "retrace", "l"), ("tip", "model", "c")]
+# Values every variable of the kind must refuse (exit 3).
+ALWAYS_BAD = {
+    "r": ["abc", "'1.0'", ".true.", "1e400", "-1e400", "1e-400", "nan", "inf", "1.0.0", "--1", "1e", "0x10",
+          "'unclosed", "1,2,3,4,5", "1.0d+999", "3*"],
+    "i": ["abc", "1.5", "1e3", "2147483648", "99999999999999999999", "'4'", "-", "4 5", ".false."],
+    "c": ["rkf45", "'nonesuch'", "'unclosed", "1.0", "'a' 'b'", "'\u00e9\udcff'"],
+    "l": ["maybe", "1", "'t'", "yes"],
+}
+# Values that may or may not be valid for the variable: any documented
+# outcome, but no abort and a finite output when it runs.
+MAYBE = ["0", "-1", "-0.5", "1e30", "1e-30", "", "2", "1e-12", "4.9e-324", "1.7976931348623157e308"]
+
+
+def broken_value(contract, case):
+    (group, name, kind), bad, value = case
+    directory = contract.fresh()
+    small = "&scan nx = 8, ny = 2 /\n" + BOUNDS
+    with open(os.path.join(directory, "small.nml"), "w") as handle:
+        handle.write(small)
+    text = f"&{group} {name} = {value} /\n"
+    with open(os.path.join(directory, "bad.nml"), "w", errors="surrogateescape") as handle:
+        handle.write(text)
+    result = contract.run(directory, ["-o", "out.h5", os.path.join(contract.args.inputs, "naf.nml"), "small.nml",
+                                      "bad.nml"], output="out.h5", allowed={3} if bad else {0, 3, 4}, timeout=180)
+    if result.returncode == 3:
+        stderr = result.stderr.decode("utf-8", "replace")
+        assert "bad.nml" in stderr or bad is False, f"the message does not name bad.nml: {stderr}"
+
+
+BROKEN_VALUES = st.sampled_from(VARIABLES).flatmap(
+    lambda variable: st.one_of(
+        st.tuples(st.just(variable), st.just(True), st.sampled_from(ALWAYS_BAD[variable[2]])),
+        st.tuples(st.just(variable), st.just(False), st.sampled_from(MAYBE))))
+
+
+# ---- class 4: broken structure: mutated files, garbage, long lines, missing groups ----
+
+BASE = ("&surface potential = 'naf', v0 = 1.0 /\n&tip mass = 1.0e-8, kx = 10.0, ky = 10.0 /\n"
+        "&scan nx = 8, ny = 2, velocity = 400.0 /\n")
+
+
+@st.composite
+def mutated(draw):
+    text = bytearray((BASE + BOUNDS).encode())
+    kind = draw(st.sampled_from(["delete", "insert", "replace", "truncate", "long-line", "garbage", "drop-group",
+                                 "duplicate-line", "no-newline"]))
+    if kind == "delete":
+        at = draw(st.integers(0, len(text) - 1))
+        del text[at:at + draw(st.integers(1, 5))]
+    elif kind == "insert":
+        at = draw(st.integers(0, len(text)))
+        text[at:at] = draw(st.binary(min_size=1, max_size=6))
+    elif kind == "replace":
+        at = draw(st.integers(0, len(text) - 1))
+        text[at] = draw(st.integers(0, 255))
+    elif kind == "truncate":
+        text = text[:draw(st.integers(0, len(text)))]
+    elif kind == "long-line":
+        at = draw(st.sampled_from([i for i, c in enumerate(text) if c == ord(",")]))
+        text[at + 1:at + 1] = b" " * draw(st.integers(1000, 200000))
+    elif kind == "garbage":
+        text = bytearray(draw(st.binary(min_size=0, max_size=3000)))
+    elif kind == "drop-group":
+        lines = bytes(text).split(b"\n")
+        del lines[draw(st.integers(0, len(lines) - 1))]
+        text = bytearray(b"\n".join(lines))
+    elif kind == "duplicate-line":
+        lines = bytes(text).split(b"\n")
+        k = draw(st.integers(0, len(lines) - 1))
+        lines.insert(k, lines[k])
+        text = bytearray(b"\n".join(lines))
+    else:
+        text = bytearray(bytes(text).rstrip(b"\n"))
+    return kind, bytes(text)
+
+
+def broken_structure(contract, case):
+    kind, text = case
+    directory = contract.fresh()
+    with open(os.path.join(directory, "run.nml"), "wb") as handle:
+        handle.write(text)
+    # The shipped NaF file first: what the mutated file leaves unset keeps its value.
+    contract.run(directory, ["-o", "out.h5", os.path.join(contract.args.inputs, "naf.nml"), "run.nml"],
+                 output="out.h5", allowed={0, 3, 4}, timeout=180)
+
+
+# ---- class 5: XYZ nets with random defects ----
+
+@st.composite
+def nets(draw):
+    side = draw(st.integers(1, 7))
+    a = draw(st.floats(0.3, 4.0))
+    jitter = draw(st.floats(0.0, 0.3))
+    atoms = []
+    for i in range(side):
+        for j in range(side):
+            dx, dy = draw(st.tuples(st.floats(-jitter, jitter), st.floats(-jitter, jitter)))
+            atoms.append(["C", (i - (side - 1) / 2) * a + dx, (j - (side - 1) / 2) * a + dy, 0.0])
+    defects = draw(st.lists(st.sampled_from(["duplicate", "far", "nan", "count-high", "count-low", "species",
+                                            "field", "vacancy", "raised", "none"]), max_size=3))
+    lines = [f"{s} {x!r} {y!r} {z!r}" for s, x, y, z in atoms]
+    count = len(lines)
+    for defect in defects:
+        if defect == "duplicate":
+            lines.append(lines[draw(st.integers(0, len(lines) - 1))])
+            count += 1
+        elif defect == "far":
+            lines.append(f"C {draw(st.sampled_from([1e5, -1e6, 3e7]))!r} {draw(st.floats(-1e6, 1e6))!r} 0.0")
+            count += 1
+        elif defect == "nan":
+            lines[draw(st.integers(0, len(lines) - 1))] = "C nan 0.0 0.0"
+        elif defect == "count-high":
+            count += draw(st.integers(1, 5))
+        elif defect == "count-low":
+            count = max(1, count - draw(st.integers(1, 3)))
+        elif defect == "species":
+            lines[draw(st.integers(0, len(lines) - 1))] = "Au 0.0 0.0 0.0"
+        elif defect == "field":
+            lines[draw(st.integers(0, len(lines) - 1))] = "C 1.0 two 0.0"
+        elif defect == "vacancy":
+            k = draw(st.integers(0, len(lines) - 1))
+            lines[k] = "X" + lines[k][1:]
+        elif defect == "raised":
+            lines.append(f"C 0.3 0.2 {draw(st.floats(0.5, 5.0))!r}")
+            count += 1
+    parameters = {
+        "sigma": draw(st.sampled_from([0.01, 0.5, 2.4945, 4.0])),
+        "support_z": draw(st.sampled_from([-6.0, -1.0, 0.0, -30.0, -1e6])),
+        "cutoff": draw(st.sampled_from([0.0, 0.0, 8.0, 1000.0])),
+    }
+    return f"{count}\nfuzzed net\n" + "\n".join(lines) + "\n", defects, parameters
+
+
+def xyz_net(contract, case):
+    text, defects, p = case
+    directory = contract.fresh()
+    with open(os.path.join(directory, "net.xyz"), "w") as handle:
+        handle.write(text)
+    cutoff = f", cutoff = {number(p['cutoff'])}" if p["cutoff"] > 0 else ""
+    if p["cutoff"] and p["cutoff"] < p["sigma"]:
+        cutoff = ""
+    with open(os.path.join(directory, "run.nml"), "w") as handle:
+        handle.write(f"&surface net = 'file', net_file = 'net.xyz', sigma = {number(p['sigma'])}{cutoff} /\n"
+                     f"&tip support_z = {number(p['support_z'])} /\n"
+                     "&scan nx = 6, ny = 2, length = 1.0, width = 1.0, origin_x = 0.1, origin_y = 0.1 /\n" + BOUNDS)
+    result = contract.run(directory, ["-o", "out.h5", os.path.join(contract.args.inputs, "graphite.nml"),
+                                      "run.nml"], output="out.h5", allowed={0, 3, 4}, timeout=180)
+    if result.returncode == 0:
+        with h5py.File(os.path.join(directory, "out.h5"), "r") as handle:
+            atoms = handle["surface/atoms"][()]
+            tip = np.concatenate([handle["afm/trace/tip_z"][()].ravel(), handle["afm/retrace/tip_z"][()].ravel()])
+            # The tip stays above the layer (never through it: README: Reliability).
+            assert np.all(tip > atoms[:, 2].min()), f"the tip went below the atoms: {directory}"
+            assert not any(d in defects for d in ("duplicate", "nan", "species", "field", "count-high")), \
+                f"a net with {defects} was accepted: {directory}"
+
+
+# ---- class 6: output faults ----
+
+FAULTS = ["existing", "existing-force", "symlink", "symlink-force", "dangling-symlink", "fifo", "directory",
+          "missing-directory", "input-as-output", "empty-name", "readonly", "full", "device", "two-ranks-full"]
+
+
+def output_fault(contract, case):
+    fault, nx, ny = case
+    directory = contract.fresh()
+    naf = os.path.join(contract.args.inputs, "naf.nml")
+    with open(os.path.join(directory, "small.nml"), "w") as handle:
+        handle.write(f"&scan nx = {nx}, ny = {ny} /\n" + BOUNDS)
+    shapes = {"afm/trace/fx": (ny, nx)}
+    run = contract.run
+    if fault in ("existing", "existing-force"):
+        with open(os.path.join(directory, "out.h5"), "w") as handle:
+            handle.write("someone's data")
+        force = ["-f"] if fault == "existing-force" else []
+        result = run(directory, [*force, "-o", "out.h5", naf, "small.nml"], output="out.h5", shapes=shapes,
+                     replaced={"out.h5"} if force else (), allowed={0} if force else {3})
+    elif fault in ("symlink", "symlink-force", "dangling-symlink"):
+        with open(os.path.join(directory, "target.h5"), "w") as handle:
+            handle.write("the target")
+        os.symlink("target.h5" if fault != "dangling-symlink" else "nowhere.h5", os.path.join(directory, "out.h5"))
+        force = ["-f"] if fault == "symlink-force" else []
+        run(directory, [*force, "-o", "out.h5", naf, "small.nml"], allowed={3})
+        assert not os.path.exists(os.path.join(directory, "nowhere.h5"))
+    elif fault in ("fifo", "device"):
+        target = os.path.join(directory, "out.h5")
+        if fault == "fifo":
+            os.mkfifo(target)
+        else:
+            try:
+                os.mknod(target, 0o666 | stat.S_IFCHR, os.makedev(1, 3))
+            except OSError:
+                os.mkfifo(target)
+        run(directory, ["-f", "-o", "out.h5", naf, "small.nml"], allowed={3}, timeout=60)
+    elif fault == "directory":
+        os.mkdir(os.path.join(directory, "out.h5"))
+        run(directory, ["-f", "-o", "out.h5", naf, "small.nml"], allowed={3})
+    elif fault == "missing-directory":
+        run(directory, ["-o", "no/such/out.h5", naf, "small.nml"], allowed={5})
+    elif fault == "input-as-output":
+        run(directory, ["-f", "-o", "small.nml", naf, "small.nml"], allowed={3})
+    elif fault == "empty-name":
+        run(directory, ["-o", "", naf, "small.nml"], allowed={2})
+    elif fault in ("readonly", "full", "two-ranks-full"):
+        small = os.path.join(directory, "small")
+        os.mkdir(small)
+        size = {"readonly": "1m", "full": "64k", "two-ranks-full": "3m"}[fault]
+        mounted = subprocess.run(["mount", "-t", "tmpfs", "-o", f"size={size}", "tmpfs", small],
+                                 capture_output=True).returncode == 0
+        if not mounted:   # (not root: the fault cannot be made here; an ordinary run instead)
+            run(directory, ["-o", "out.h5", naf, "small.nml"], output="out.h5", shapes=shapes, allowed={0, 4})
+            return
+        try:
+            with open(os.path.join(small, "existing.h5"), "w") as handle:
+                handle.write("keep")
+            if fault == "readonly":
+                subprocess.run(["mount", "-o", "remount,ro", small], check=True, capture_output=True)
+                allowed = {5}
+            else:
+                allowed = {0, 5}
+            with open(os.path.join(directory, "big.nml"), "w") as handle:
+                handle.write(f"&scan nx = {nx * 200}, ny = {ny * 4} /\n" + BOUNDS)
+            run(directory, ["-o", "small/out.h5", naf, "big.nml"], ranks=2 if fault == "two-ranks-full" else None,
+                output="small/out.h5", shapes={"afm/trace/fx": (ny * 4, nx * 200)}, allowed=allowed)
+        finally:
+            unmount_if_mounted(small)
+
+
+OUTPUT_FAULTS = st.tuples(st.sampled_from(FAULTS), st.integers(2, 20), st.integers(1, 3))
+
+
+# ---- the classes, their strategies and budgets (cases in the ordinary suite) ----
+
+CLASSES = {
+    "valid-afm": (VALID_AFM, valid_afm, 25),
+    "valid-brake": (VALID_BRAKE, valid_brake, 15),
+    "broken-values": (BROKEN_VALUES, broken_value, 30),
+    "broken-structure": (mutated(), broken_structure, 25),
+    "xyz-nets": (nets(), xyz_net, 15),
+    "output-faults": (OUTPUT_FAULTS, output_fault, 15),
+}
+
+
+def xyz_example(defect, sigma=2.4945, support_z=-6.0):
+    """A 4 x 4 net with one defect, as nets() makes it."""
+    atoms = [f"C {(i - 1.5) * 2.46!r} {(j - 1.5) * 2.46!r} 0.0" for i in range(4) for j in range(4)]
+    count = len(atoms)
+    if defect == "duplicate":
+        atoms.append(atoms[5])
+        count += 1
+    elif defect == "far":
+        atoms.append("C 1000000.0 -1000000.0 0.0")
+        count += 1
+    elif defect == "nan":
+        atoms[3] = "C nan 0.0 0.0"
+    elif defect == "count-high":
+        count += 2
+    elif defect == "species":
+        atoms[2] = "Au 0.0 0.0 0.0"
+    elif defect == "one":
+        atoms, count = ["C 3.0 3.0 0.0"], 1
+    parameters = {"sigma": sigma, "support_z": support_z, "cutoff": 0.0}
+    return (f"{count}\nexample\n" + "\n".join(atoms) + "\n", [defect], parameters)
+
+
+# Cases every run of the suite tries, before the generated ones: each
+# defect of issue 15 that the class covers, at least once.
+EXAMPLES = {
+    "broken-values": [(("tip", "mass", "r"), True, "1e400"), (("scan", "velocity", "r"), True, "-1e400"),
+                      (("surface", "v0", "r"), True, "1e-400"), (("tip", "kx", "r"), True, "1.0d+999"),
+                      (("scan", "nx", "i"), True, "2147483648"), (("integrator", "rtol", "r"), False, "1e300"),
+                      (("integrator", "atol", "r"), False, "1.7976931348623157e308"),
+                      (("integrator", "h_min", "r"), False, "1e-2"),
+                      (("surface", "potential", "c"), True, "'\u00e9\udcff'")],
+    "broken-structure": [("long-line", (BASE.replace("nx = 8,", "nx = 8," + " " * 5000) + BOUNDS).encode()),
+                         ("garbage", bytes(range(256)) * 4), ("no-newline", (BASE + BOUNDS).rstrip("\n").encode())],
+    "xyz-nets": [xyz_example(defect) for defect in ("duplicate", "far", "nan", "count-high", "species", "one")]
+                + [xyz_example("none", sigma=0.01), xyz_example("none", support_z=-1e6)],
+    "output-faults": [(fault, 4, 2) for fault in FAULTS],
+}
+
+
+def run_class(args, name, examples, derandomize):
+    strategy, check, _ = CLASSES[name]
+    contract = Contract(args, name)
+
+    def property_holds(case):
+        check(contract, case)
+
+    for case in reversed(EXAMPLES.get(name, [])):
+        property_holds = example(case)(property_holds)
+    property_holds = settings(max_examples=examples, derandomize=derandomize, deadline=None, database=None,
+                              suppress_health_check=list(HealthCheck), print_blob=True)(given(strategy)(property_holds))
+    property_holds()
+    return contract
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--binary", required=True)
+    parser.add_argument("--mpiexec", required=True)
+    parser.add_argument("--inputs", required=True)
+    parser.add_argument("--workdir", required=True)
+    parser.add_argument("--examples", type=int, default=None, help="cases per class (default: its budget)")
+    parser.add_argument("--long", action="store_true", help="a long run: fresh random seeds, 10x the budget")
+    parser.add_argument("classes", nargs="+", choices=sorted(CLASSES) + ["all"])
+    args = parser.parse_args()
+    args.binary = os.path.abspath(args.binary)
+    args.inputs = os.path.abspath(args.inputs)
+    names = sorted(CLASSES) if "all" in args.classes else args.classes
+    from_environment = os.environ.get("FRICTION_FUZZ_EXAMPLES")
+    long_run = args.long or bool(from_environment)
+    shutil.rmtree(args.workdir, ignore_errors=True)
+    os.makedirs(args.workdir)
+    start = time.monotonic()
+    total = 0
+    for name in names:
+        examples = args.examples or (int(from_environment) if from_environment else None) or \
+            CLASSES[name][2] * (10 if args.long else 1)
+        contract = run_class(args, name, examples, derandomize=not long_run)
+        total += contract.count
+        print(contract.summary())
+        if not long_run:
+            shutil.rmtree(args.workdir, ignore_errors=True)
+            os.makedirs(args.workdir)
+    print(f"fuzz: {total} cases in {len(names)} classes, {time.monotonic() - start:.1f} s; "
+          "crashes 0, contract violations 0")
+
+
+if __name__ == "__main__":
+    main()
