@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""A property-based fuzzing suite of the `friction` program (README:
-Reliability), with Hypothesis.  It generates namelists (valid ones with
+"""A property-based fuzzing suite of the `friction` program (docs/reliability.md),
+with Hypothesis.  It generates namelists (valid ones with
 random physical values, and broken ones), XYZ nets with random defects, and
 output faults, runs the program on each and asserts the contract:
 
@@ -399,7 +399,7 @@ def xyz_net(contract, case):
         with h5py.File(os.path.join(directory, "out.h5"), "r") as handle:
             atoms = handle["surface/atoms"][()]
             tip = np.concatenate([handle["afm/trace/tip_z"][()].ravel(), handle["afm/retrace/tip_z"][()].ravel()])
-            # The tip stays above the layer (never through it: README: Reliability).
+            # The tip stays above the layer (never through it: docs/reliability.md).
             assert np.all(tip > atoms[:, 2].min()), f"the tip went below the atoms: {directory}"
             assert not any(d in defects for d in ("duplicate", "nan", "species", "field", "count-high")), \
                 f"a net with {defects} was accepted: {directory}"

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Regression tests of issue 15 (README: Reliability): nothing crashes, nothing
+"""Regression tests of issue 15 (docs/reliability.md): nothing crashes, nothing
 is silently wrong, nothing is lost.  One case per CTest test:
 
     hardening_test.py --binary BIN --mpiexec MPIEXEC --inputs DIR --workdir DIR CASE
@@ -151,7 +151,7 @@ def case_force_own_input(args):
 
 def case_force_symlink(args):
     """A symbolic link at the output path is neither followed nor replaced,
-    with or without --force (README: Reliability); a dangling one neither."""
+    with or without --force (docs/reliability.md); a dangling one neither."""
     write(args, "small.nml", SMALL)
     write(args, "target.h5", "precious")
     os.symlink("target.h5", path(args, "link.h5"))

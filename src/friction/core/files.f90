@@ -1,7 +1,7 @@
 !> File-system operations Fortran lacks: atomic rename and removal through
 !> the C library, so output appears under its final name only when complete,
-!> and publication that never replaces a file it should not (README:
-!> Reliability): without `replace` a file appears only if nothing is at its
+!> and publication that never replaces a file it should not
+!> (docs/reliability.md): without `replace` a file appears only if nothing is at its
 !> name at that very moment (a hard link, which fails if the name exists);
 !> with it, only a regular file is replaced, never a device, a directory or
 !> a symbolic link.

@@ -55,7 +55,7 @@ contains
    !> A real with `digits` decimals and no padding ('0.25', '-3.1'); beyond
    !> 1e15 in magnitude, or not finite, in scientific notation, so that any
    !> value fits (an internal write that overflows its buffer aborts).
-   function fixed_text(x, digits) result(text)
+   pure function fixed_text(x, digits) result(text)
       real(wp), intent(in) :: x
       integer, intent(in) :: digits
       character(len=:), allocatable :: text
