@@ -223,9 +223,20 @@ def _variable_attrs(array):
     return attrs
 
 
-def _xarray_coords(coords, dims):
-    return {name: (coord.dims, coord.values, _variable_attrs(coord)) for name, coord in coords.items()
-            if set(coord.dims) <= set(dims)}
+def _xarray_name(name, coord, all_dims):
+    """A coordinate that runs along another dimension than the one it is named
+    after (a sweep's maxima: "brake.v_dr_prime" along "maximum") is renamed
+    "<its dimension>_<name>" ("maximum_brake.v_dr_prime"): in xarray a name is
+    either a dimension's coordinate or not."""
+    if name in all_dims and coord.dims != (name,):
+        return f"{coord.dims[0]}_{name}"
+    return name
+
+
+def _xarray_coords(coords, dims, all_dims=None):
+    all_dims = set(dims) | set(all_dims or ())
+    return {_xarray_name(name, coord, all_dims): (coord.dims, coord.values, _variable_attrs(coord))
+            for name, coord in coords.items() if set(coord.dims) <= set(dims)}
 
 
 class Dataset(Mapping):
@@ -276,12 +287,14 @@ class Dataset(Mapping):
         """Every dataset as a variable of one xarray.Dataset (named by its path),
         with its dimensions, coordinates and units; the root's attributes as the
         dataset's, a group's as "group/name" (NAME_units beside NAME, as in the
-        file)."""
+        file).  A sweep's maxima have their swept values as the coordinate
+        "maximum_<variable>"."""
         xr = _xarray()
         variables, coords = {}, {}
+        all_dims = {dim for array in self._arrays.values() for dim in array.dims}
         for name, array in self._arrays.items():
             variables[name] = (array.dims, array.values, _variable_attrs(array))
-            coords.update(_xarray_coords(array.coords, array.dims))
+            coords.update(_xarray_coords(array.coords, array.dims, all_dims))
         for name in coords:
             variables.pop(name, None)
         attrs = self.attrs.flat()

@@ -135,8 +135,15 @@ def test_to_xarray(naf_map, brake_sweep):
     assert ds.attrs["wall_time_units"] == "s" and ds.attrs["afm/angle_units"] == "degree"
     one = data["afm/friction"].to_xarray()
     assert one.dims == ("support_y",) and one.attrs["units"] == "nN"
-    sweep = friction.load(brake_sweep).to_xarray()
-    assert sweep["sweep/maxima"].coords["brake.v_dr_prime"].dims == ("maximum",)
+    sweep = friction.load(brake_sweep)
+    values, _ = raw(brake_sweep, "sweep/values")
+    counts, _ = raw(brake_sweep, "sweep/maxima_count")
+    converted = sweep.to_xarray()
+    assert np.array_equal(converted["brake.v_dr_prime"].values, values)
+    assert converted["sweep/lyapunov"].dims == ("brake.v_dr_prime",)
+    along = converted["sweep/maxima"].coords["maximum_brake.v_dr_prime"]
+    assert along.dims == ("maximum",) and np.array_equal(along.values, np.repeat(values, counts))
+    assert sweep["sweep/maxima"].to_xarray().coords["brake.v_dr_prime"].dims == ("maximum",)
 
 
 def test_to_xarray_without_xarray(naf_map, monkeypatch):
