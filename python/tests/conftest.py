@@ -19,6 +19,9 @@ sys.path.insert(0, str(ROOT / "python"))  # the package under test, before any i
 import helpers  # noqa: E402
 
 helpers.raise_on_failure()
+# friction.run initialises MPI in this process: Open MPI must be allowed to run as root here too.
+for _name, _value in helpers.MPI_ENV.items():
+    os.environ.setdefault(_name, _value)
 
 INPUTS = ROOT / "inputs"
 DATA = ROOT / "tests" / "data"
