@@ -21,92 +21,29 @@ Examples:
 
 Exit codes: 0 done, 1 a PNG could not be written, 2 bad command line or
 bad input file (missing, not a brake run, window outside the run).
+
+A command line over friction.plot.brake_phase and friction.plot.brake_x
+(python/friction/plot.py).
 """
 
 import argparse
 import sys
 from pathlib import Path
 
-import matplotlib
+# The package beside the scripts: python/ in the repository, share/friction/python when installed.
+_PACKAGE = Path(__file__).resolve().parent.parent / "python"
+if _PACKAGE.is_dir():
+    sys.path.insert(0, str(_PACKAGE))
 
-matplotlib.use("Agg")  # headless: no display needed
+import friction  # noqa: E402
+import friction.plot  # noqa: E402
 
-from friction_output import InputError, open_output, text  # noqa: E402
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-
-def read_run(path):
-    """Read the trajectory, events and parameters of a brake file into a dict."""
-    with open_output(path, "brake", "brake") as f:
-        brake = f["brake"]
-        run = {name: brake[name][()] for name in ("t", "x", "v", "y", "w", "stick")}
-        run["model"] = text(brake.attrs["model"])
-        run["v_dr"] = float(brake.attrs["v_dr_prime"])
-        run["method"] = text(f.attrs.get("method", b"?"))
-        events = brake["events"]
-        run["event_t"] = events["t"][()]
-        run["event_kind"] = events["kind"][()]
-    n = run["t"].size
-    for name in ("x", "v", "y", "w", "stick"):
-        if run[name].shape != (n,):
-            raise InputError(f"/brake/{name} has shape {run[name].shape}, expected ({n},)")
-    if n < 2:
-        raise InputError("the run has fewer than two output points")
-    return run
-
-
-def _describe(run):
-    return f"{run['model']} model ({run['method']}), $v'_{{dr}}$ = {run['v_dr']:g} m"
-
-
-def plot_phase(run, window, out, dpi):
-    """Phase plane (x, x') over the window; stick points in their own colour."""
-    t0, t1 = window
-    inside = (run["t"] >= t0) & (run["t"] <= t1)
-    x, v, stick = run["x"][inside], run["v"][inside], run["stick"][inside] == 1
-    fig, ax = plt.subplots(figsize=(8, 5.6), layout="constrained")
-    ax.plot(x, v, "-", color="tab:blue", linewidth=0.6, label="slip and stick (trajectory)")
-    if stick.any():
-        ax.plot(x[stick], v[stick], ".", color="tab:red", markersize=2.5,
-                label=f"stick: x' = v'$_{{dr}}$ ({stick.mean():.1%} of the points)")
-    ax.axhline(run["v_dr"], color="0.4", linestyle="--", linewidth=0.8,
-               label=f"belt velocity v'$_{{dr}}$ = {run['v_dr']:g}")
-    ax.set_xlabel("x, block displacement (m)")
-    ax.set_ylabel("x', block velocity (m per unit τ)")
-    ax.set_title(f"Phase plane, τ ∈ [{t0:g}, {t1:g}] (paper Fig. 12)\n{_describe(run)}")
-    ax.legend(loc="best", fontsize="small")
-    fig.savefig(out, dpi=dpi)
-    plt.close(fig)
-
-
-def plot_x(run, window, out, dpi):
-    """x(τ): the whole run above, the last 30 τ of the window below, where
-    stick shows as straight stretches of slope v'_dr."""
-    t, x, stick = run["t"], run["x"], run["stick"] == 1
-    fig, (whole, zoom) = plt.subplots(2, 1, figsize=(11, 7), layout="constrained")
-    zoom_from = max(window[0], window[1] - 30.0)
-    for ax, (t0, t1) in ((whole, (t[0], t[-1])), (zoom, (zoom_from, window[1]))):
-        inside = (t >= t0) & (t <= t1)
-        ax.plot(t[inside], x[inside], "-", color="tab:blue", linewidth=0.6, label="x(τ)")
-        part = inside & stick
-        if part.any():
-            ax.plot(t[part], x[part], ".", color="tab:red", markersize=1.5 if ax is whole else 3,
-                    label="stick")
-        ax.set_xlim(t0, t1)
-        ax.set_ylabel("x, block displacement (m)")
-    zoom.set_xlabel("τ = t √(k1/m)")
-    whole.legend(loc="upper right", fontsize="small")
-    n_events = run["event_t"].size
-    whole.set_title(f"Block displacement, {_describe(run)}\n{n_events} stick/slip events, "
-                    f"{stick.mean():.1%} of the points in stick; below: τ ∈ [{zoom_from:g}, {window[1]:g}]")
-    fig.savefig(out, dpi=dpi)
-    plt.close(fig)
+PROG = "plot_brake.py"
 
 
 def parse_args(argv):
     parser = argparse.ArgumentParser(
-        prog="plot_brake.py",
+        prog=PROG,
         description=__doc__,
         formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("file", type=Path, help="friction output file (HDF5, scene 'brake')")
@@ -126,29 +63,25 @@ def parse_args(argv):
 
 def main(argv=None):
     args = parse_args(argv)
-    prog = "plot_brake.py"
     try:
-        run = read_run(args.file)
-        t0, t1 = args.window
-        inside = np.count_nonzero((run["t"] >= t0) & (run["t"] <= t1))
-        if inside < 2:
-            raise InputError(f"--window {t0:g} {t1:g} is outside the run "
-                             f"(τ from {run['t'][0]:g} to {run['t'][-1]:g})")
-    except InputError as err:
-        print(f"{prog}: {args.file}: {err}", file=sys.stderr)
+        data = friction.load(args.file, scene="brake")
+        figures = {"phase": friction.plot.brake_phase(data, args.window),
+                   "x": friction.plot.brake_x(data, args.window)}
+    except friction.FileError as err:
+        print(f"{PROG}: {args.file}: {err}", file=sys.stderr)
+        return 2
+    except ValueError as err:  # the window: the plots name it "window T0 T1"
+        print(f"{PROG}: {args.file}: --{err}", file=sys.stderr)
         return 2
 
-    stem = args.file.stem
-    phase = args.output_dir / f"{stem}_phase.png"
-    xplot = args.output_dir / f"{stem}_x.png"
     try:
         args.output_dir.mkdir(parents=True, exist_ok=True)
-        plot_phase(run, args.window, phase, args.dpi)
-        print(f"wrote {phase}")
-        plot_x(run, args.window, xplot, args.dpi)
-        print(f"wrote {xplot}")
+        for name, figure in figures.items():
+            out = args.output_dir / f"{args.file.stem}_{name}.png"
+            figure.savefig(out, dpi=args.dpi)
+            print(f"wrote {out}")
     except OSError as err:
-        print(f"{prog}: cannot write into {args.output_dir}: {err}", file=sys.stderr)
+        print(f"{PROG}: cannot write into {args.output_dir}: {err}", file=sys.stderr)
         return 1
     return 0
 

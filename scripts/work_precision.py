@@ -90,14 +90,13 @@ from pathlib import Path
 try:
     import h5py
     import numpy as np
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    from matplotlib.colors import ListedColormap
 except ImportError as exc:  # pragma: no cover - environment problem
     sys.exit(f"work_precision: {exc}; run scripts/install-deps")
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+# The charts are drawn by the package (python/friction/plot.py) from the files written here.
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "python"))
+import friction.plot  # noqa: E402
 import benchmark_afm  # noqa: E402  (the AFM runner: env, snapshot, attributes)
 import benchmark_brake  # noqa: E402  (the brake runner: namelist, compute_time, x(t))
 import ngspice_compare  # noqa: E402  (the paper's network model in ngspice, as a peer)
@@ -432,36 +431,6 @@ def auto_evidence(res) -> list:
     return out
 
 
-STYLE = {"rk2": ("tab:gray", "o"), "rk4": ("tab:brown", "s"), "rkf45": ("tab:blue", "o"),
-         "rkck": ("tab:cyan", "^"), "rk8pd": ("tab:red", "D"), "rk1imp": ("tab:olive", "v"),
-         "rk2imp": ("tab:pink", "<"), "rk4imp": ("tab:green", ">"), "bsimp": ("tab:purple", "p"),
-         "msadams": ("gold", "h"), "msbdf": ("tab:orange", "*"), "switched": ("k", "x")}
-
-
-def plot_scene(res, extras, path: Path) -> None:
-    scene = res["scene"]
-    fig, ax = plt.subplots(figsize=(7.5, 5.2))
-    for method, pts in res["rows"].items():
-        ok = [p for p in pts if p.status == "ok"]
-        if not ok:
-            continue
-        color, marker = STYLE.get(method, ("k", "."))
-        ax.loglog([p.error for p in ok], [p.time for p in ok], marker=marker, color=color,
-                  label=method, lw=1.2, ms=5)
-    for ex in extras:
-        ax.loglog(ex["error"], ex["cpu_time"], "k--", marker="+", label=ex["label"])
-    ax.axvline(res["check"], color="0.6", ls=":", lw=1)
-    ax.text(res["check"], ax.get_ylim()[1], " reference\n self-check", va="top", fontsize=7, color="0.4")
-    ax.set_xlabel(f"error: max |{'x' if scene.kind == 'brake' else 'F'} - reference| ({scene.unit})")
-    ax.set_ylabel("CPU time (s, median)")
-    ax.set_title(f"{scene.title}\n{scene.quantity}; {scene.what}", fontsize=9)
-    ax.grid(True, which="major", alpha=0.3)
-    ax.legend(fontsize=7, ncol=2, loc="best")
-    fig.tight_layout()
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
-
-
 def write_scene(f: h5py.File, res, extras) -> None:
     scene = res["scene"]
     g = f.create_group(scene.name)
@@ -610,33 +579,6 @@ def write_failure_maps(path: Path, maps, methods, meta) -> None:
                 g[d].attrs["axes"] = f"methods x {mp['parameter']}"
 
 
-def plot_failure_maps(path: Path, maps, methods) -> None:
-    colors = ["#dddddd", "#4daf4a", "#ffd92f", "#e41a1c", "#984ea3"]  # none, ok, slow, failed, wrong
-    cmap = ListedColormap(colors)
-    fig, axes = plt.subplots(1, len(maps), figsize=(5.5 * len(maps), 0.42 * len(methods) + 2.2))
-    axes = np.atleast_1d(axes)
-    for ax, mp in zip(axes, maps):
-        cat = np.array([c["codes"] for c in mp["columns"]]).T
-        ax.imshow(cat + 1, cmap=cmap, vmin=0, vmax=4, aspect="auto")
-        ax.set_yticks(range(len(methods)), methods, fontsize=8)
-        ax.set_xticks(range(len(mp["columns"])), [c["label"] for c in mp["columns"]], fontsize=7,
-                      rotation=30)
-        for j, c in enumerate(mp["columns"]):
-            for i, p in enumerate(c["points"]):
-                txt = {"capped": "cap", "killed": "kill"}.get(p.status, "")
-                if p.status in ("ok", "wrong") and math.isfinite(p.time):
-                    txt = f"{p.time * 1e3:.0f}" if p.time >= 0.01 else f"{p.time * 1e3:.1f}"
-                ax.text(j, i, txt, ha="center", va="center", fontsize=6)
-        ax.set_title(mp["title"], fontsize=8)
-    handles = [plt.Rectangle((0, 0), 1, 1, color=colors[i + 1]) for i in range(4)]
-    fig.legend(handles, ["ok", "slow (>10x best, or time cap)", "fails with an error",
-                         "silently wrong (>100x asked)"], loc="lower center", ncol=4, fontsize=8)
-    fig.text(0.01, 0.01, "numbers: CPU time in ms", fontsize=7)
-    fig.tight_layout(rect=(0, 0.07, 1, 1))
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
-
-
 # --------------------------------------------------------------------------
 
 
@@ -666,20 +608,12 @@ def replot(path: Path, out: Path, extras: dict) -> int:
     --extra series (and any already in the file) are added to the file and
     drawn.  The measured data are not changed."""
     scenes = make_scenes(False)
+    replotted = []
     with h5py.File(path, "r+") as f:
         for name in f:
             if name not in scenes:
                 continue
             g = f[name]
-            rows = {}
-            for method in g:
-                if method == "extra":
-                    continue
-                m = g[method]
-                status = [v.decode() if isinstance(v, bytes) else str(v) for v in m["status"][()]]
-                rows[method] = [Point(method, float(r), float(a), st, error=float(e), time=float(t))
-                                for r, a, st, e, t in zip(m["tolerance"][()], m["atol"][()], status,
-                                                          m["error"][()], m["cpu_time"][()])]
             for ex in extras.get(name, []):
                 e = g.require_group("extra")
                 if ex["label"] in e:
@@ -687,12 +621,17 @@ def replot(path: Path, out: Path, extras: dict) -> int:
                 s = e.create_group(ex["label"])
                 s.create_dataset("error", data=np.asarray(ex["error"], dtype=float))
                 s.create_dataset("cpu_time", data=np.asarray(ex["cpu_time"], dtype=float))
-            series = [{"label": label, "error": g["extra"][label]["error"][()],
-                       "cpu_time": g["extra"][label]["cpu_time"][()]} for label in g.get("extra", {})]
-            res = {"scene": scenes[name], "rows": rows, "check": float(g.attrs["reference_check"])}
-            plot_scene(res, series, out / f"work_precision_{name}.png")
-            log(f"replotted {name} ({len(series)} extra series)")
+            replotted.append((name, len(g.get("extra", {}))))
+    data = friction.load(path)
+    for name, count in replotted:
+        save(friction.plot.work_precision(data, name), out / f"work_precision_{name}.png")
+        log(f"replotted {name} ({count} extra series)")
     return 0
+
+
+def save(figure, path: Path) -> None:
+    """The charts' resolution: 90 dpi."""
+    figure.savefig(path, dpi=90)
 
 
 def summary_table(results) -> str:
@@ -809,11 +748,13 @@ def main(argv=None) -> int:
         f.attrs["methods"] = ",".join(methods)
         for res in results:
             write_scene(f, res, extras.get(res["scene"].name, []))
+    charts = friction.load(args.out / "work_precision.h5")
     for res in results:
-        plot_scene(res, extras.get(res["scene"].name, []), args.out / f"work_precision_{res['scene'].name}.png")
+        name = res["scene"].name
+        save(friction.plot.work_precision(charts, name), args.out / f"work_precision_{name}.png")
     if maps:
         write_failure_maps(args.out / "failure_map.h5", maps, methods, meta)
-        plot_failure_maps(args.out / "failure_map.png", maps, methods)
+        save(friction.plot.failure_map(args.out / "failure_map.h5"), args.out / "failure_map.png")
 
     print("# Speed against accuracy\n")
     for res in results:

@@ -14,15 +14,17 @@ against the named stepper (friction_compute of a configuration handle for
 naf and hopg, one line each, and for both brake models).
 """
 import argparse
-import os
 import re
 import shutil
-import subprocess
 import sys
 from pathlib import Path
 
 import h5py
 import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import helpers  # noqa: E402
+from helpers import fail  # noqa: E402
 
 # (scene, input file, override, rtol, the table's stepper)
 AFM_SMALL = "&scan nx = 8, ny = 2, length = 4.0, width = 2.0 /\n"
@@ -44,20 +46,11 @@ TABLE = [
 ]
 
 
-def fail(message):
-    print("FAIL: " + message)
-    sys.exit(1)
-
-
 def run(binary, inputs, workdir, name, override):
-    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
     nml = workdir / f"{name}.nml"
     nml.write_text(override)
     out = workdir / f"{name}.h5"
-    result = subprocess.run([binary, "--quiet", "--force", "-o", str(out), str(inputs), str(nml)],
-                            capture_output=True, text=True, env=env)
-    if result.returncode != 0:
-        fail(f"{name}: exit code {result.returncode}: {result.stderr}")
+    helpers.run([binary, "--quiet", "--force", "-o", out, inputs, nml])
     return out
 
 
@@ -110,13 +103,11 @@ def main():
         print(f"{scene} rtol {rtol:g}: auto -> {expected}, {len(a_data)} datasets identical")
 
     if args.library:
-        os.environ["FRICTION_LIBRARY"] = args.library
-        sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "scripts"))
-        import friction_capi as fc
+        friction = helpers.friction_package(args.library)
 
         def computed(scene, values, method):
             """friction_compute of the scene with the values and the method, every array."""
-            with fc.Config(scene, values=dict(values, **{"integrator.method": method})) as cfg:
+            with friction.Config(scene, values=dict(values, **{"integrator.method": method})) as cfg:
                 return cfg.compute()
 
         for scene, _, _, rtol, expected in TABLE:

@@ -5,7 +5,7 @@
 
 Each case is a scene's input files (inputs/naf.nml, ...) and assignments over
 them.  The program reads the input files and the assignments written as a
-namelist file, bad.nml; the C API (scripts/friction_capi.py over the
+namelist file, bad.nml; the C API (the friction package's Config over the
 library) reads the same input files with friction_config_read and sets each
 assignment with friction_config_set, then runs friction_config_check.  The
 outcomes must be identical: both accept, or both refuse with the same
@@ -48,6 +48,8 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 import cli_test  # noqa: E402  (BAD_INPUTS, BAD_BRAKE_INPUTS)
+import helpers  # noqa: E402
+from helpers import fail  # noqa: E402
 
 # Listed cases that are not about a value (see the docstring).
 NOT_VALUES = {"unclosed-group", "missing-file", "no-arguments", "unknown-option", "unwritable-output",
@@ -66,11 +68,6 @@ CONTEXTS = [
     ("dimensional-regularized", "brake", DIMENSIONAL, [("brake", "model", "'regularized'")]),
 ]
 PROGRAM_PREFIX = re.compile(r"^friction: error: (bad\.nml:\d+: )?")
-
-
-def fail(message):
-    print("FAIL: " + message)
-    sys.exit(1)
 
 
 def assignments(text):
@@ -100,10 +97,7 @@ def namelist(pairs):
 class Checker:
     def __init__(self, args):
         self.args = args
-        os.environ["FRICTION_LIBRARY"] = args.library
-        sys.path.insert(0, str(HERE.parent / "scripts"))
-        import friction_capi
-        self.fc = friction_capi
+        self.fc = helpers.friction_package(args.library)
         self.runs = 0
 
     def capi(self, scene, base, pairs):
@@ -125,7 +119,7 @@ class Checker:
         os.makedirs(workdir, exist_ok=True)
         with open(os.path.join(workdir, "bad.nml"), "w") as f:
             f.write(namelist(pairs))
-        env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+        env = helpers.mpi_env()
         result = subprocess.run([self.args.binary, "-q", "-f", "--netlist", "out.cir"]
                                 + [os.path.join(self.args.inputs, path) for path in base] + ["bad.nml"],
                                 cwd=workdir, capture_output=True, text=True, env=env, timeout=300)

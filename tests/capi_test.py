@@ -23,11 +23,14 @@ Both run the same kernel: every number must be equal, to the last bit.
 import argparse
 import os
 import shutil
-import subprocess
 import sys
 
 import h5py
 import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import helpers  # noqa: E402
+from helpers import fail  # noqa: E402
 
 NAF = ("naf.nml", "&scan nx = 16, ny = 3, angle = 10.0, origin_x = 0.7, origin_y = 0.3, retrace = .true. /\n")
 HOPG_QUASISTATIC = ("hopg.nml", "&tip model = 'quasistatic' /\n&scan nx = 24, ny = 2, width = 1.0 /\n")
@@ -38,17 +41,9 @@ BRAKE = ("brake.nml", "&brake t_end = 40.0, dt_out = 0.5 /\n"
 TIMINGS = {"wall_time", "compute_time", "check_compute_time", "created"}
 
 
-def fail(message):
-    print("FAIL: " + message)
-    sys.exit(1)
-
-
 def run(command, cwd):
-    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
-    result = subprocess.run(command, cwd=cwd, capture_output=True, text=True, env=env)
-    if result.returncode != 0:
-        fail(f"{' '.join(command)} exited with {result.returncode}: {result.stderr}")
-    return result.stdout
+    """The command's standard output; fail() unless it exits 0."""
+    return helpers.run(command, cwd).stdout
 
 
 def inputs(args, scene, name):

@@ -23,6 +23,10 @@ import time
 import h5py
 import numpy as np
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import helpers  # noqa: E402
+from helpers import fail  # noqa: E402
+
 SMALL = "&scan nx = 24, ny = 7 /\n"
 
 # name: (override text, expected exit code, words the message must contain)
@@ -130,20 +134,8 @@ def namelist_text(handle):
     return handle.attrs["input"].decode().replace(" ", "").upper().replace("'", '"')
 
 
-def fail(message):
-    print("FAILED: " + message)
-    sys.exit(1)
-
-
 def run(args, cmd, expect=0, extra_env=None):
-    env = dict(os.environ)
-    env.update(extra_env or {})
-    result = subprocess.run(cmd, cwd=args.workdir, capture_output=True, text=True, env=env,
-                            timeout=600)
-    if expect is not None and result.returncode != expect:
-        fail(f"{' '.join(cmd)} exited {result.returncode}, expected {expect}\n"
-             f"stdout: {result.stdout}\nstderr: {result.stderr}")
-    return result
+    return helpers.run(cmd, cwd=args.workdir, expect=expect, extra_env=extra_env)
 
 
 def friction(args, *rest, ranks=None, expect=0, extra_env=None):

@@ -28,31 +28,18 @@ floor).  No timings are asserted.
 import argparse
 import os
 import shutil
-import subprocess
 import sys
 from pathlib import Path
 
 import numpy as np
 
-
-def fail(message):
-    print("FAILED: " + message)
-    sys.exit(1)
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import helpers  # noqa: E402
+from helpers import fail, require  # noqa: E402
 
 
 def run(command, cwd, expect=0):
-    result = subprocess.run([str(c) for c in command], cwd=cwd, capture_output=True, text=True)
-    print("$ " + " ".join(map(str, command)))
-    print(result.stdout + result.stderr)
-    if expect is not None and result.returncode != expect:
-        fail(f"exit code {result.returncode}, expected {expect}")
-    return result
-
-
-def require(condition, message):
-    if not condition:
-        fail(message)
-    print("ok: " + message)
+    return helpers.run(command, cwd, expect, echo=True)
 
 
 def agreement(args, work, inputs, extra, bound, unit):

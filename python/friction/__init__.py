@@ -1,0 +1,45 @@
+"""friction: dry friction from the atomic scale (AFM friction maps over NaF,
+HOPG, graphite) to the machine scale (the Girling brake), in Python.
+
+    import friction
+
+    path = friction.run("inputs/naf.nml", output="naf.h5", force=True)   # the program's job, with progress
+    data = friction.load(path)                      # labelled arrays with units
+    fig = friction.plot.afm_maps(data)              # the maps as a matplotlib Figure
+
+    cfg = friction.Config("afm", files=["inputs/naf.nml"], values={"scan.nx": 64})
+    x, fx, fy = cfg.afm_line(0)                     # one line, numpy arrays, no file
+    maps = cfg.compute()                            # the whole map: {"trace/fx": (ny, nx), ...}
+    run = friction.brake(values={"brake.t_end": 300.0})   # {"t": ..., "x": ..., "events/t": ...}
+
+The computations go through the C API of the shared library libfriction
+(found as friction._capi.find_library says: FRICTION_LIBRARY, the
+installation, a build tree, the system's loader), loaded on first use:
+importing the package, load() and the plots need no library.
+Reference: docs/python.md.
+"""
+from . import _capi
+from ._capi import FrictionError, LibraryNotFoundError, api_version, library_path
+from ._data import Array, Attributes, Dataset, FileError, load
+from ._run import Config, Line, afm_line, brake, compute, run
+from ._version import __version__
+
+__all__ = ["__version__", "library_version", "api_version", "library_path", "FrictionError",
+           "LibraryNotFoundError", "FileError", "Config", "Line", "run", "compute", "afm_line", "brake", "load",
+           "Dataset", "Array", "Attributes", "plot", "fit"]
+
+
+def library_version():
+    """The version of the loaded library (friction_version() of the C API);
+    __version__ is the package's, and the two agree for a matched install."""
+    return _capi.version()
+
+
+def __getattr__(name):
+    # friction.plot and friction.fit on first use: matplotlib only when plotting.
+    if name in ("plot", "fit"):
+        import importlib
+        module = importlib.import_module(f".{name}", __name__)
+        globals()[name] = module
+        return module
+    raise AttributeError(f"module 'friction' has no attribute {name!r}")

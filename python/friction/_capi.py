@@ -1,0 +1,441 @@
+"""ctypes binding of the friction C API (include/friction.h, API version 2).
+
+The low layer of the package: the library's functions with their C
+signatures, the error handle, configurations and results as Python objects.
+`friction.Config` and `friction.run` build on it; import it directly only
+for what they leave out.
+
+    from friction import _capi
+
+    with _capi.Config("afm", files=["inputs/naf.nml"]) as cfg:
+        cfg.set("tip.kx", 5.0)                  # numbers, True/False, text, lists
+        cfg.set("scan.nx", 64)
+        cfg.set("surface.potential", "hopg")    # text is quoted for you; set_text takes namelist text
+        fx, fy = cfg.afm_line(0)                # line 0 of the map, trace (forward=False: retrace)
+        maps = cfg.compute()                    # dict of numpy arrays: maps["trace/fx"] is (ny, nx)
+
+    run = _capi.Config("brake", values={"brake.t_end": 100.0}).compute()   # run["t"], run["x"], ...
+    _capi.run_job(["inputs/naf.nml"], "naf.h5", force=True,
+                  report=lambda message, fraction: print(message))  # the program's job, no MPI launcher
+
+A configuration has its scene's defaults and the variables of the namelist
+input, by "group.variable" ("tip.kx", "surface.sigma(2)"), in its units
+(README: Input reference).  Every value is checked by the scene's own checks,
+as the program checks its input; a call the library refuses raises
+FrictionError with the library's status and message.  A Config is freed with
+close(), at the end of a `with` block, or when it is collected.  ctypes
+releases the GIL during each call, so different Config objects compute at
+once in different threads; one Config must not be used by two threads at
+once.
+
+The library is loaded on first use (importing the package needs no library),
+from the first of (find_library):
+  1. the file named by the environment variable FRICTION_LIBRARY (and only it);
+  2. the library of the installation the package was installed into by
+     `cmake --install` (PREFIX/share/friction/python/friction ->
+     PREFIX/lib/libfriction.so.0, recorded in friction/_installed.py);
+  3. build/libfriction.so.0 of a build tree: the package's folder and each
+     folder above it are searched for build/ (python/friction in the
+     repository -> the repository's build/);
+  4. the system's loader (LD_LIBRARY_PATH, ldconfig's cache): libfriction.so.0.
+A library of another C API version is refused.
+"""
+import ctypes
+import ctypes.util
+import numbers
+import os
+import threading
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["FrictionError", "LibraryNotFoundError", "Config", "library", "library_path", "find_library",
+           "library_candidates", "version", "api_version", "run_job", "API_VERSION", "SONAME"]
+
+API_VERSION = 2   # the C API this module is written for (FRICTION_API_VERSION)
+SONAME = "libfriction.so.0"
+
+# void report(const char *message, double fraction, void *user)
+_REPORT = ctypes.CFUNCTYPE(None, ctypes.c_char_p, ctypes.c_double, ctypes.c_void_p)
+FORCE, RESUME, INIT_MPI = 1, 2, 4
+# Statuses (friction.h)
+OK, ERROR_INPUT, ERROR_NUMERICAL, ERROR_IO, ERROR_INTERNAL, INTERRUPTED = 0, 1, 2, 3, 4, 5
+
+
+class FrictionError(RuntimeError):
+    """A call the library refused or could not finish; .status is its code
+    (1 input, 2 numerical, 3 I/O, 4 internal, 5 a job's sweep interrupted),
+    .message the library's message."""
+
+    def __init__(self, status, message):
+        super().__init__(f"{message} (status {status})")
+        self.status = status
+        self.message = message
+
+
+class LibraryNotFoundError(OSError):
+    """No libfriction could be loaded; the message lists where the package looked."""
+
+
+_PACKAGE_DIR = Path(__file__).resolve().parent
+
+
+def _installed_candidates(package_dir):
+    """The library of the installation `cmake --install` put the package in, if it did."""
+    record = package_dir / "_installed.py"
+    if not record.is_file():
+        return []
+    namespace = {}
+    exec(compile(record.read_text(), str(record), "exec"), namespace)  # our own generated file
+    found = []
+    if namespace.get("LIBRARY_RELATIVE"):
+        found.append(("the installation beside the package", str((package_dir / namespace["LIBRARY_RELATIVE"]))))
+    if namespace.get("LIBRARY_ABSOLUTE"):
+        found.append(("the installation the package was installed from", namespace["LIBRARY_ABSOLUTE"]))
+    return found
+
+
+def library_candidates(environ=None, package_dir=None):
+    """Where the library is looked for, in order: a list of (what, path).
+
+    The last entry, ("the system's loader", SONAME), has no folder: the
+    dynamic loader's own search."""
+    environ = os.environ if environ is None else environ
+    package_dir = Path(package_dir or _PACKAGE_DIR).resolve()
+    if environ.get("FRICTION_LIBRARY"):
+        return [("FRICTION_LIBRARY", environ["FRICTION_LIBRARY"])]
+    found = _installed_candidates(package_dir)
+    for folder in (package_dir, *package_dir.parents):
+        found.append(("a build tree", str(folder / "build" / SONAME)))
+    found.append(("the system's loader", SONAME))
+    return found
+
+
+def find_library(environ=None, package_dir=None):
+    """The path (or, for the system's loader, the name) of the library to load;
+    LibraryNotFoundError with every place tried."""
+    tried = []
+    for what, path in library_candidates(environ, package_dir):
+        if what == "the system's loader":
+            try:
+                ctypes.CDLL(path)
+                return path
+            except OSError:
+                pass
+            located = ctypes.util.find_library("friction")
+            if located:
+                return located
+            tried.append(f"{what}: {path} (LD_LIBRARY_PATH, ldconfig)")
+        elif os.path.isfile(path):
+            return path
+        else:
+            tried.append(f"{what}: {path}")
+    raise LibraryNotFoundError(
+        "libfriction not found; set FRICTION_LIBRARY to the library (for example build/libfriction.so.0 "
+        "after scripts/build) or install friction with `cmake --install`. Looked in:\n  " + "\n  ".join(tried))
+
+
+def _signatures(lib):
+    c_int, c_size_t, c_char_p, c_void_p, c_double = (ctypes.c_int, ctypes.c_size_t, ctypes.c_char_p,
+                                                     ctypes.c_void_p, ctypes.c_double)
+    size_p = ctypes.POINTER(c_size_t)
+    signatures = {
+        "friction_version": (c_int, [c_char_p, c_size_t]),
+        "friction_api_version": (c_int, []),
+        "friction_error_new": (c_void_p, []),
+        "friction_error_free": (None, [c_void_p]),
+        "friction_error_status": (c_int, [c_void_p]),
+        "friction_error_message": (c_int, [c_void_p, c_char_p, c_size_t]),
+        "friction_config_new": (c_void_p, [c_char_p, c_void_p]),
+        "friction_config_free": (None, [c_void_p]),
+        "friction_config_read": (c_int, [c_void_p, c_char_p, c_void_p]),
+        "friction_config_set": (c_int, [c_void_p, c_char_p, c_char_p, c_void_p]),
+        "friction_config_set_real": (c_int, [c_void_p, c_char_p, c_double, c_void_p]),
+        "friction_config_get": (c_int, [c_void_p, c_char_p, c_char_p, c_size_t, c_void_p]),
+        "friction_config_text": (c_int, [c_void_p, c_char_p, c_size_t, size_p]),
+        "friction_config_names": (c_int, [c_void_p, c_char_p, c_size_t, size_p]),
+        "friction_config_check": (c_int, [c_void_p, c_void_p]),
+        "friction_afm_line": (c_int, [c_void_p, c_int, c_int, c_void_p, c_void_p, c_size_t, c_void_p]),
+        "friction_compute": (c_void_p, [c_void_p, c_void_p]),
+        "friction_result_get": (c_int, [c_void_p, c_char_p, c_void_p, c_size_t, size_p, c_void_p]),
+        "friction_result_shape": (c_int, [c_void_p, c_char_p, ctypes.POINTER(c_size_t * 2), c_void_p]),
+        "friction_result_names": (c_int, [c_void_p, c_char_p, c_size_t]),
+        "friction_result_free": (None, [c_void_p]),
+        "friction_run_job": (c_int, [ctypes.POINTER(c_char_p), c_int, c_char_p, c_int, _REPORT, c_void_p,
+                                     c_void_p]),
+        "friction_run_config": (c_int, [c_void_p, c_char_p, c_int, _REPORT, c_void_p, c_void_p]),
+    }
+    for name, (restype, argtypes) in signatures.items():
+        function = getattr(lib, name)
+        function.restype = restype
+        function.argtypes = argtypes
+
+
+def _open(path):
+    lib = ctypes.CDLL(path)
+    if not hasattr(lib, "friction_api_version"):
+        raise LibraryNotFoundError(f"{path}: a libfriction of API version 1; this package needs API version "
+                                   f"{API_VERSION}")
+    lib.friction_api_version.restype = ctypes.c_int
+    if lib.friction_api_version() != API_VERSION:
+        raise LibraryNotFoundError(f"{path}: libfriction of API version {lib.friction_api_version()}; this "
+                                   f"package needs {API_VERSION}")
+    _signatures(lib)
+    return lib
+
+
+_loaded = None
+_loaded_path = None
+_lock = threading.Lock()
+
+
+def library():
+    """The loaded library (ctypes.CDLL), loaded on the first call (find_library)."""
+    global _loaded, _loaded_path
+    if _loaded is None:
+        with _lock:
+            if _loaded is None:
+                path = find_library()
+                _loaded = _open(path)
+                _loaded_path = path
+    return _loaded
+
+
+def library_path():
+    """The file the library was loaded from (loading it if need be)."""
+    library()
+    if os.path.sep in _loaded_path:
+        return os.path.realpath(_loaded_path)
+
+    # Loaded by name through the system's loader: ask the loader for the file.
+    class DlInfo(ctypes.Structure):
+        _fields_ = [("dli_fname", ctypes.c_char_p), ("dli_fbase", ctypes.c_void_p),
+                    ("dli_sname", ctypes.c_char_p), ("dli_saddr", ctypes.c_void_p)]
+
+    dladdr = ctypes.CDLL(None).dladdr
+    dladdr.argtypes = [ctypes.c_void_p, ctypes.POINTER(DlInfo)]
+    record = DlInfo()
+    if dladdr(ctypes.cast(library().friction_version, ctypes.c_void_p), ctypes.byref(record)) and record.dli_fname:
+        return os.path.realpath(record.dli_fname.decode())
+    return _loaded_path
+
+
+def version():
+    """The library's version string ("major.minor.patch")."""
+    buf = ctypes.create_string_buffer(64)
+    library().friction_version(buf, len(buf))
+    return buf.value.decode()
+
+
+def api_version():
+    """The library's C API version (FRICTION_API_VERSION)."""
+    return library().friction_api_version()
+
+
+class _ErrorHandle:
+    """A friction_error for one call; check() turns a failure into FrictionError."""
+
+    def __enter__(self):
+        self.lib = library()
+        self.handle = self.lib.friction_error_new()
+        if not self.handle:
+            raise MemoryError("friction_error_new")
+        return self
+
+    def __exit__(self, *exc):
+        self.lib.friction_error_free(self.handle)
+
+    def check(self, status):
+        if status != 0:
+            buf = ctypes.create_string_buffer(4096)
+            self.lib.friction_error_message(self.handle, buf, len(buf))
+            raise FrictionError(status, buf.value.decode(errors="replace"))
+
+    def status(self):
+        return self.lib.friction_error_status(self.handle)
+
+
+def _call(function, *args):
+    """Call with a fresh error handle as the last argument; raise FrictionError on failure."""
+    with _ErrorHandle() as err:
+        err.check(function(*args, err.handle))
+
+
+def _quote(text):
+    return "'" + str(text).replace("'", "''") + "'"
+
+
+def _item(value):
+    if isinstance(value, (bool, np.bool_)):
+        return ".true." if value else ".false."
+    if isinstance(value, numbers.Integral):
+        return str(int(value))
+    if isinstance(value, numbers.Real):
+        return repr(float(value))
+    return _quote(value)
+
+
+def _callback(report):
+    if report is None:
+        return _REPORT()
+    return _REPORT(lambda message, fraction, user: report(message.decode(errors="replace"), fraction))
+
+
+class Config:
+    """A configuration of scene "afm" or "brake" (friction.h: friction_config).
+
+    files: namelist files read in order over the defaults (read());
+    values: {"group.variable": value} set after them (set())."""
+
+    def __init__(self, scene="afm", files=(), values=None):
+        self._lib = library()
+        self._handle = None
+        with _ErrorHandle() as err:
+            handle = self._lib.friction_config_new(scene.encode(), err.handle)
+            if not handle:
+                err.check(err.status())
+        self._handle = handle
+        self.scene = scene
+        if isinstance(files, (str, os.PathLike)):
+            files = [files]
+        for path in files:
+            self.read(path)
+        for name, value in (values or {}).items():
+            self.set(name, value)
+
+    # ---- lifetime ----
+    def close(self):
+        """Free the configuration (also at the end of a `with` block, or when collected)."""
+        if self._handle:
+            self._lib.friction_config_free(self._handle)
+            self._handle = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def __del__(self):
+        if getattr(self, "_handle", None):
+            self.close()
+
+    @property
+    def handle(self):
+        if not self._handle:
+            raise ValueError("the configuration is closed")
+        return self._handle
+
+    # ---- values ----
+    def read(self, path):
+        """Apply a namelist file over the current values (all or nothing)."""
+        _call(self._lib.friction_config_read, self.handle, os.fsencode(os.fspath(path)))
+        return self
+
+    def set(self, name, value):
+        """Set "group.variable" (or "group.variable(k)"): a number, True/False, a
+        text (quoted for you), or a list of them."""
+        if isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_)):
+            _call(self._lib.friction_config_set_real, self.handle, name.encode(), float(value))
+        elif isinstance(value, (list, tuple, np.ndarray)):
+            self.set_text(name, ", ".join(_item(v) for v in value))
+        else:
+            self.set_text(name, _item(value))
+        return self
+
+    def set_text(self, name, text):
+        """Set a variable from namelist value text ("5.0", "'hopg'", ".true.", "3*0.0")."""
+        _call(self._lib.friction_config_set, self.handle, name.encode(), text.encode())
+        return self
+
+    def get(self, name):
+        """A variable's value as namelist text ("10.0", "'naf'", ".true.", "2*0.0")."""
+        buf = ctypes.create_string_buffer(1 << 16)
+        _call(self._lib.friction_config_get, self.handle, name.encode(), buf, len(buf))
+        return buf.value.decode()
+
+    def _text(self, function):
+        needed = ctypes.c_size_t(0)
+        if function(self.handle, None, 0, ctypes.byref(needed)) != 0:
+            raise FrictionError(ERROR_INPUT, f"{function.__name__}: the size query failed")
+        buf = ctypes.create_string_buffer(needed.value)
+        if function(self.handle, buf, len(buf), None) != 0:
+            raise FrictionError(ERROR_INPUT, f"{function.__name__}: the text did not fit")
+        return buf.value.decode()
+
+    def text(self):
+        """The whole configuration as namelist text (read() reads it back)."""
+        return self._text(self._lib.friction_config_text)
+
+    def names(self):
+        """Every variable: a list of (name, kind, elements, unit), kind "real",
+        "integer", "logical" or "text"."""
+        rows = []
+        for line in self._text(self._lib.friction_config_names).splitlines():
+            name, kind, size, unit = line.split("\t")
+            rows.append((name, kind, int(size), unit))
+        return rows
+
+    def check(self):
+        """The scene's checks; FrictionError with the first value refused."""
+        _call(self._lib.friction_config_check, self.handle)
+        return self
+
+    # ---- computations on this process ----
+    def afm_line(self, line=0, forward=True):
+        """Line `line` (0-based) of the map, trace or retrace: fx, fy (nN) at scan.nx points."""
+        nx = int(self.get("scan.nx")) if self.scene == "afm" else 1
+        fx, fy = np.zeros(nx), np.zeros(nx)
+        _call(self._lib.friction_afm_line, self.handle, int(line), int(bool(forward)),
+              fx.ctypes.data_as(ctypes.c_void_p), fy.ctypes.data_as(ctypes.c_void_p), nx)
+        return fx, fy
+
+    def compute(self):
+        """The whole scene on this process: a dict of numpy arrays, maps (ny, nx),
+        series 1-D (friction.h: friction_compute)."""
+        with _ErrorHandle() as err:
+            result = self._lib.friction_compute(self.handle, err.handle)
+            if not result:
+                err.check(err.status())
+            try:
+                return _result_arrays(self._lib, result, err)
+            finally:
+                self._lib.friction_result_free(result)
+
+    def run(self, output, force=False, resume=False, report=None, init_mpi=True):
+        """The configuration's job to the HDF5 file `output` (friction.h: friction_run_config);
+        `report(message, fraction)` as for run_job."""
+        flags = (FORCE if force else 0) | (RESUME if resume else 0) | (INIT_MPI if init_mpi else 0)
+        callback = _callback(report)
+        _call(self._lib.friction_run_config, self.handle, os.fsencode(os.fspath(output)), flags, callback, None)
+
+
+def _result_arrays(lib, result, err):
+    buf = ctypes.create_string_buffer(1 << 16)
+    if lib.friction_result_names(result, buf, len(buf)) != 0:
+        raise FrictionError(ERROR_INPUT, "friction_result_names: the names did not fit")
+    arrays = {}
+    for name in buf.value.decode().split("\n"):
+        shape = (ctypes.c_size_t * 2)()
+        err.check(lib.friction_result_shape(result, name.encode(), ctypes.byref(shape), err.handle))
+        rows, columns = shape[0], shape[1]
+        values = np.zeros(rows * columns)
+        err.check(lib.friction_result_get(result, name.encode(), values.ctypes.data_as(ctypes.c_void_p),
+                                          values.size, None, err.handle))
+        arrays[name] = values.reshape(rows, columns) if columns > 1 else values
+    return arrays
+
+
+def run_job(files, output, force=False, resume=False, report=None, init_mpi=True):
+    """Run a namelist job as the program does (friction.h: friction_run_job): read
+    `files` in order, compute, write `output`.  `report(message, fraction)` if
+    given receives progress (fraction in [0, 1]) and notes (fraction -1).
+    init_mpi: in a process that has not initialised MPI the library does
+    (MPI_THREAD_FUNNELED, for the rest of the process) and the job runs on this
+    process alone; False refuses instead.  An interrupted sweep raises
+    FrictionError with status 5."""
+    paths = [os.fsencode(os.fspath(path)) for path in files]
+    array = (ctypes.c_char_p * max(1, len(paths)))(*paths)
+    flags = (FORCE if force else 0) | (RESUME if resume else 0) | (INIT_MPI if init_mpi else 0)
+    callback = _callback(report)
+    _call(library().friction_run_job, array, len(paths), os.fsencode(os.fspath(output)), flags, callback, None)

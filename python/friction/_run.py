@@ -1,0 +1,282 @@
+"""Jobs and computations: run(), Config, afm_line(), brake(), compute().
+
+The library's job runs the program's whole computation (every group: &analysis,
+&verify, &sweep) on this process and writes the program's HDF5 file; the
+computations return numpy arrays without a file.
+"""
+import os
+import re
+import sys
+import time
+from collections import namedtuple
+from pathlib import Path
+
+import numpy as np
+
+from . import _capi
+
+__all__ = ["Config", "run", "afm_line", "brake", "compute", "Line"]
+
+Line = namedtuple("Line", "x fx fy")
+Line.__doc__ = """One scan line: support positions x along the scan (angstrom) and the
+lateral force fx, fy along the lattice axes (nN) there."""
+
+
+class _TextProgress:
+    """Progress as plain lines on a stream: at most one every `interval`
+    seconds, the last one always; notes at once."""
+
+    def __init__(self, label, stream=None, interval=2.0):
+        self.label, self.stream, self.interval = label, stream or sys.stderr, interval
+        self.last = -float("inf")
+
+    def __call__(self, message, fraction):
+        if fraction < 0:
+            print(f"{self.label}: {message}", file=self.stream, flush=True)
+            return
+        now = time.monotonic()
+        if now - self.last >= self.interval or fraction >= 1.0:
+            self.last = now
+            print(f"{self.label}: {message} ({100 * fraction:.0f} %)", file=self.stream, flush=True)
+
+    def close(self):
+        pass
+
+
+class _TqdmProgress:
+    """Progress as a tqdm bar in percent, the library's message beside it; notes above it."""
+
+    def __init__(self, tqdm, label):
+        self.tqdm = tqdm
+        self.bar = tqdm(total=100, desc=label, unit="%", bar_format="{l_bar}{bar}| [{elapsed}<{remaining}{postfix}]")
+
+    def __call__(self, message, fraction):
+        if fraction < 0:
+            self.tqdm.write(message)
+            return
+        self.bar.set_postfix_str(message, refresh=False)
+        self.bar.update(round(100 * fraction, 2) - self.bar.n)
+
+    def close(self):
+        self.bar.close()
+
+
+def _progress(progress, label):
+    """The reporter for run()'s `progress`: None, a callable, or a bar (tqdm or text)."""
+    if progress is None or progress is False:
+        return None
+    if callable(progress):
+        return progress
+    if progress is not True:
+        raise TypeError(f"progress must be True, False or a callable (message, fraction), not {progress!r}")
+    try:
+        from tqdm.auto import tqdm
+    except ImportError:
+        return _TextProgress(label)
+    return _TqdmProgress(tqdm, label)
+
+
+class _Guarded:
+    """A report callback that keeps the first exception the user's callback
+    raised (ctypes would print and drop it) to raise after the job."""
+
+    def __init__(self, report):
+        self.report, self.error = report, None
+
+    def __call__(self, message, fraction):
+        if self.error is None:
+            try:
+                self.report(message, fraction)
+            except BaseException as err:  # noqa: B902 - re-raised after the job
+                self.error = err
+
+
+def _job(start, progress, label):
+    reporter = _progress(progress, label)
+    guarded = _Guarded(reporter) if reporter is not None else None
+    try:
+        start(guarded)
+    finally:
+        if hasattr(reporter, "close"):
+            reporter.close()
+    if guarded is not None and guarded.error is not None:
+        raise guarded.error
+
+
+def _files(files):
+    if isinstance(files, (str, os.PathLike)):
+        return [Path(files)]
+    return [Path(f) for f in files]
+
+
+def run(files, output=None, force=False, resume=False, progress=True):
+    """Run a job as the program does: read the namelist files in order (a
+    later file overrides earlier values variable by variable), compute the
+    scene or sweep they describe on this process, write the HDF5 file.
+
+    files     a namelist file or a list of them
+    output    the HDF5 file (default: the first file's name with .h5, in the
+              current directory, as the program's)
+    force     overwrite an existing output (otherwise FrictionError)
+    resume    a sweep reuses the checkpoints of an interrupted run
+    progress  True: a tqdm bar where tqdm is installed, else a line on
+              stderr every 2 s; False: nothing; a callable: called with
+              (message, fraction), fraction in [0, 1] for progress ("12 of 64
+              lines") and -1 for notes (a verify result)
+    Returns the output's Path.  Raises FrictionError for bad input (the
+    program's message, with file and line), a failed integration or an
+    unwritable file (nothing is written then), and with status 5 for a
+    sweep interrupted by a signal (its file holds the points done).
+
+    MPI: in a process without MPI the library initialises it once
+    (MPI_THREAD_FUNNELED) and the job runs on this process alone; under
+    `mpirun -n N python ...` with mpi4py initialising MPI first, the job is
+    collective over every rank, as the program's."""
+    paths = _files(files)
+    if not paths:
+        raise ValueError("run() needs at least one namelist file")
+    output = Path(output) if output is not None else Path.cwd() / (paths[0].stem + ".h5")
+    _job(lambda report: _capi.run_job(paths, output, force=force, resume=resume, report=report),
+         progress, output.name)
+    return output
+
+
+_LOGICAL = {".true.": True, ".false.": False, "t": True, "f": False, ".t.": True, ".f.": False}
+
+
+def _parse_item(item, kind):
+    item = item.strip()
+    if kind == "text":
+        if len(item) >= 2 and item[0] == item[-1] and item[0] in "'\"":
+            return item[1:-1].replace(item[0] * 2, item[0])
+        return item
+    if kind == "logical":
+        return _LOGICAL[item.lower()]
+    if kind == "integer":
+        return int(item)
+    return float(item.lower().replace("d", "e"))
+
+
+def _split_items(text):
+    """Namelist value items, commas outside quotes, "n*value" repeats expanded."""
+    items, current, quote = [], "", None
+    for ch in text:
+        if quote:
+            current += ch
+            if ch == quote:
+                quote = None
+        elif ch in "'\"":
+            quote = ch
+            current += ch
+        elif ch == ",":
+            items.append(current)
+            current = ""
+        else:
+            current += ch
+    items.append(current)
+    expanded = []
+    for item in (i.strip() for i in items):
+        repeat = re.fullmatch(r"(\d+)\*(.*)", item)
+        if repeat and not item.startswith(("'", '"')):
+            expanded += [repeat.group(2)] * int(repeat.group(1))
+        elif item:
+            expanded.append(item)
+    return expanded
+
+
+class Config(_capi.Config):
+    """A scene's configuration: its defaults, namelist files read over them
+    and values set by name, checked by the program's own checks.
+
+        cfg = friction.Config("afm", files=["inputs/naf.nml"], values={"scan.ny": 4})
+        cfg.set("tip.kx", 5.0).set("surface.potential", "hopg")
+        cfg["scan.nx"] = 64                  # the same as set()
+        cfg["scan.nx"]                       # 64: the value as Python (value())
+        cfg.get("scan.nx")                   # '64': namelist text
+        line = cfg.afm_line(0)               # Line(x, fx, fy) of the map's line 0, trace
+        maps = cfg.compute()                 # {"trace/fx": (ny, nx) array, ..., "support_x": ...}
+        cfg.run("naf.h5", force=True)        # the job with every group, to a file
+
+    scene: "afm" (a friction-force map) or "brake" (the Girling brake);
+    files: namelist files read in order; values: {"group.variable": value}
+    set after them.  Units are those of the namelist input."""
+
+    def __init__(self, scene="afm", files=(), values=None):
+        super().__init__(scene, files, values)
+
+    def kinds(self):
+        """{name: (kind, elements, unit)} of every variable."""
+        return {name: (kind, size, unit) for name, kind, size, unit in self.names()}
+
+    def value(self, name):
+        """A variable's value as Python: float, int, bool, str, or a list of
+        them for an array variable ("surface.sigma")."""
+        base = re.sub(r"\(\d+\)$", "", name)
+        kinds = self.kinds()
+        if base not in kinds:
+            self.get(name)   # the library's message for an unknown name
+        kind, size, _ = kinds[base]
+        items = [_parse_item(item, kind) for item in _split_items(self.get(name))]
+        if size == 1 or base != name:
+            return items[0] if items else None
+        return items
+
+    def unit(self, name):
+        """The unit of "group.variable" ('N/m', 'angstrom', '' for none)."""
+        return self.kinds()[re.sub(r"\(\d+\)$", "", name)][2]
+
+    def __getitem__(self, name):
+        return self.value(name)
+
+    def __setitem__(self, name, value):
+        self.set(name, value)
+
+    def support_x(self):
+        """The support positions along a scan line (angstrom), as /afm/support_x."""
+        nx, length = int(self.value("scan.nx")), float(self.value("scan.length"))
+        return length * np.arange(nx, dtype=float) / float(nx - 1)
+
+    def afm_line(self, line=0, forward=True):
+        """Line `line` (0-based) of the map, trace (forward) or retrace: a Line
+        (x, fx, fy), exactly the file's line of /afm/trace (/afm/retrace)."""
+        fx, fy = super().afm_line(line, forward)
+        return Line(self.support_x(), fx, fy)
+
+    def run(self, output, force=False, resume=False, progress=True):
+        """The configuration's job (every group: &analysis, &verify, &sweep) to
+        the HDF5 file `output`, whose `input` attribute is text(); arguments
+        and MPI as friction.run().  Returns the output's Path."""
+        output = Path(output)
+        _job(lambda report: _capi.Config.run(self, output, force=force, resume=resume, report=report),
+             progress, output.name)
+        return output
+
+    def __repr__(self):
+        state = "closed" if not self._handle else f"{len(self.names())} variables"
+        return f"<friction.Config {self.scene}: {state}>"
+
+
+def compute(scene, files=(), values=None):
+    """The scene's computation on this process, without a file: a dict of
+    numpy arrays named as in the program's file ("trace/fx" (ny, nx), ...,
+    "support_x"; "t", "x", ..., "events/t").  &analysis, &verify and &sweep
+    are for jobs (run())."""
+    with Config(scene, files, values) as cfg:
+        return cfg.compute()
+
+
+def afm_line(files=(), values=None, line=0, forward=True):
+    """One line of a friction-force map: Line(x, fx, fy), numpy arrays.
+
+        x, fx, fy = friction.afm_line("inputs/naf.nml", {"scan.nx": 64})"""
+    with Config("afm", files, values) as cfg:
+        return cfg.afm_line(line, forward)
+
+
+def brake(files=(), values=None):
+    """A Girling brake run: a dict of numpy arrays, the trajectory "t", "x",
+    "v", "y", "w", "stick" on the output grid and the events "events/t",
+    "events/kind", "events/x", ... (as /brake of the program's file).
+
+        run = friction.brake(values={"brake.t_end": 300.0})"""
+    return compute("brake", files, values)

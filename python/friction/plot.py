@@ -1,0 +1,846 @@
+"""The project's pictures as functions: each takes a file's data (a Dataset
+from friction.load, or a file name) and returns a matplotlib Figure.
+
+    data = friction.load("naf.h5")
+    fig = friction.plot.afm_maps(data)          # Fx and Fy maps (the paper's Fig. 7b/8b)
+    fig.savefig("naf_maps.png", dpi=150)
+
+AFM maps:     afm_maps, friction_loop
+lattice sums: graphite_net (Fig. 9a), stacked_lines (Fig. 9b)
+brake:        brake_phase (Fig. 12), brake_x, brake_spectrum (Fig. 13),
+              poincare (Fig. 14), lyapunov
+sweeps:       sweep (every chart of a sweep file), bifurcation, sweep_lyapunov,
+              sweep_friction
+speed:        work_precision, failure_map (files of scripts/work_precision)
+
+The figures are matplotlib.figure.Figure objects outside pyplot: nothing is
+shown or kept open behind the caller's back, and no display is needed.  In a
+notebook a figure shows as a cell's value.  A file that is not what a
+function draws raises friction.FileError, as the scripts report it.
+"""
+import io
+import math
+import warnings
+
+import numpy as np
+from matplotlib import colormaps
+from matplotlib.cm import ScalarMappable
+from matplotlib.collections import LineCollection
+from matplotlib.colors import ListedColormap, Normalize
+from matplotlib.figure import Figure as _Figure
+from matplotlib.patches import Polygon, Rectangle
+
+from ._data import FileError, load, reading, require
+
+__all__ = ["afm_maps", "friction_loop", "graphite_net", "stacked_lines", "brake_phase", "brake_x",
+           "brake_spectrum", "poincare", "lyapunov", "sweep", "bifurcation", "sweep_lyapunov",
+           "sweep_friction", "work_precision", "failure_map", "Figure"]
+
+
+class Figure(_Figure):
+    """A matplotlib Figure that shows itself as a PNG in a notebook."""
+
+    def _repr_png_(self):
+        buffer = io.BytesIO()
+        self.savefig(buffer, format="png")
+        return buffer.getvalue()
+
+
+def _figure(**kwargs):
+    return Figure(**kwargs)
+
+
+POTENTIAL_LABELS = {"naf": "NaF(001)", "hopg": "HOPG", "lj": "Lennard-Jones lattice sum"}
+
+
+def _describe_scan(potential, angle):
+    name = POTENTIAL_LABELS.get(potential, potential)
+    return f"{name}, scan angle {angle:g}°"
+
+
+# --------------------------------------------------------------------------
+# AFM maps
+# --------------------------------------------------------------------------
+
+
+def _scan(data):
+    """The map, its axes and the line friction of an AFM file, checked."""
+    data = require(data, "afm", "force-map")
+    with reading("force-map"):
+        afm = data.group_attrs["afm"]
+        scan = {"potential": str(afm["potential"]), "angle": float(afm["angle"]),
+                "x": data["afm/support_x"].values, "y": data["afm/support_y"].values,
+                "friction": data["afm/friction"].values if "afm/friction" in data else None}
+        for trip in ("trace", "retrace"):
+            if f"afm/{trip}/fx" in data:
+                scan[trip] = {q: data[f"afm/{trip}/{q}"].values for q in ("fx", "fy", "f_along")}
+    if "trace" not in scan:
+        raise FileError("no /afm/trace group")
+    shape = (scan["y"].size, scan["x"].size)
+    for trip in ("trace", "retrace"):
+        for name, values in scan.get(trip, {}).items():
+            if values.shape != shape:
+                raise FileError(f"/afm/{trip}/{name} has shape {values.shape}, expected (ny, nx) = {shape}")
+    return scan
+
+
+def _pixel_extent(x, y):
+    """imshow extent with pixel centres on the support positions (Å)."""
+    dx = (x[-1] - x[0]) / (x.size - 1) if x.size > 1 else 1.0
+    dy = (y[-1] - y[0]) / (y.size - 1) if y.size > 1 else dx
+    return [x[0] - dx / 2, x[-1] + dx / 2, y[0] - dy / 2, y[-1] + dy / 2]
+
+
+def afm_maps(data, trip="trace", cmap="RdBu_r"):
+    """Fx and Fy maps side by side over the scanned area (the paper's Fig. 7b/8b):
+    the support position along the scan against the line offset across it
+    (Å); colour scale symmetric about 0 nN.  trip: 'trace' or 'retrace'."""
+    scan = _scan(data)
+    if trip not in scan:
+        raise FileError(f"no /afm/{trip}: the run had retrace off")
+    extent = _pixel_extent(scan["x"], scan["y"])
+    fig = _figure(figsize=(11, 4.8), layout="constrained")
+    axes = fig.subplots(1, 2)
+    for ax, key, label in zip(axes, ("fx", "fy"), ("$F_x$", "$F_y$")):
+        values = scan[trip][key]
+        finite = np.abs(values[np.isfinite(values)])
+        limit = float(finite.max()) if finite.size and finite.max() > 0 else 1.0
+        image = ax.imshow(values, origin="lower", extent=extent, aspect="equal",
+                          interpolation="nearest", cmap=cmap, vmin=-limit, vmax=limit)
+        ax.set_title(f"{label} (lattice {key[1]} axis)")
+        ax.set_xlabel("support position along the scan (Å)")
+        ax.set_ylabel("line offset across the scan (Å)")
+        fig.colorbar(image, ax=ax, shrink=0.9, label=f"{label} (nN)")
+    fig.suptitle(f"Lateral force maps, {trip}: {_describe_scan(scan['potential'], scan['angle'])}")
+    return fig
+
+
+def friction_loop(data, line=None):
+    """Trace and retrace f_along of one line against the support position:
+    the friction loop, with the line's friction (/afm/friction) in the title.
+    line: 0 .. ny-1 (default: the middle line, ny // 2)."""
+    scan = _scan(data)
+    if "retrace" not in scan or scan["friction"] is None:
+        raise FileError("no /afm/retrace: the run had retrace off (no friction loop)")
+    ny = scan["y"].size
+    line = ny // 2 if line is None else int(line)
+    if not 0 <= line < ny:
+        raise ValueError(f"line {line} out of range: the file has lines 0 .. {ny - 1}")
+    x = scan["x"]
+    trace = scan["trace"]["f_along"][line]
+    retrace = scan["retrace"]["f_along"][line]
+    friction = scan["friction"][line]
+    fig = _figure(figsize=(8, 4.8), layout="constrained")
+    ax = fig.subplots()
+    ax.fill_between(x, retrace, trace, color="0.88", label="loop")
+    ax.plot(x, trace, "-", color="tab:red", label="trace (→)")
+    ax.plot(x, retrace, "-", color="tab:blue", label="retrace (←)")
+    ax.axhline(0.0, color="0.5", linewidth=0.6)
+    ax.set_xlabel("support position along the scan (Å)")
+    ax.set_ylabel("$F_\\parallel$, force along the scan (nN)")
+    ax.set_xlim(x[0], x[-1])
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small")
+    ax.set_title(f"Friction loop, line {line} (offset {scan['y'][line]:.3g} Å), "
+                 f"{_describe_scan(scan['potential'], scan['angle'])}\nfriction = {friction:.4g} nN")
+    return fig
+
+
+# --------------------------------------------------------------------------
+# Lattice sums (graphite): the net and stacked lines
+# --------------------------------------------------------------------------
+
+COMPONENTS = {
+    "fx": ("$F_x$", "force along the lattice x axis"),
+    "fy": ("$F_y$", "force along the lattice y axis"),
+    "fz": ("$F_z$", "vertical force"),
+    "f_along": ("$F_\\parallel$", "force along the scan"),
+    "f_across": ("$F_\\perp$", "force across the scan"),
+}
+BOND_FACTOR = 1.2  # bonds: pairs closer than this x the nearest-neighbour distance
+NN_SAMPLE = 400  # atoms whose nearest neighbour sets the nearest-neighbour distance
+
+
+def _lattice(data):
+    """The scan, the tip path and the net of a lattice-sum file, checked."""
+    data = require(data, "afm", "force-map")
+    if "surface/atoms" not in data:
+        raise FileError("not a lattice-sum scene: no /surface/atoms (for NaF/HOPG maps use plot_afm.py)")
+    with reading("force-map"):
+        afm = data.group_attrs["afm"]
+        surface = data.group_attrs.get("surface", {})
+        lattice = {
+            "potential": str(afm.get("potential", "?")),
+            "angle": float(afm["angle"]),
+            "origin": np.array([float(afm["origin_x"]), float(afm["origin_y"])]),
+            "x": np.asarray(data["afm/support_x"].values, dtype=float),
+            "y": np.asarray(data["afm/support_y"].values, dtype=float),
+            "atoms": np.asarray(data["surface/atoms"].values, dtype=float),
+            "species": (np.asarray(data["surface/species"].values, dtype=int)
+                        if "surface/species" in data else None),
+            "species_names": [s.strip() for s in str(surface.get("species_names", "")).split(",")],
+            "cutoff": float(surface["cutoff"]) if "cutoff" in surface else None,
+            "trips": {},
+        }
+        for trip in ("trace", "retrace"):
+            quantities = {q: np.asarray(data[f"afm/{trip}/{q}"].values, dtype=float)
+                          for q in (*COMPONENTS, "tip_x", "tip_y") if f"afm/{trip}/{q}" in data}
+            if quantities:
+                lattice["trips"][trip] = quantities
+
+    atoms = lattice["atoms"]
+    if atoms.ndim != 2 or atoms.shape[1] not in (2, 3) or atoms.shape[0] < 1:
+        raise FileError(f"/surface/atoms has shape {atoms.shape}, expected (natoms, 3)")
+    if not np.all(np.isfinite(atoms)):
+        raise FileError("/surface/atoms holds non-finite positions")
+    names = [n for n in lattice["species_names"] if n] or ["atom"]
+    lattice["species_names"] = names
+    species = lattice["species"]
+    if species is None:
+        lattice["species"] = np.ones(atoms.shape[0], dtype=int)
+    elif species.shape != (atoms.shape[0],):
+        raise FileError(f"/surface/species has shape {species.shape}, expected (natoms,) = ({atoms.shape[0]},)")
+    elif species.size and (species.min() < 1 or species.max() > len(names)):
+        raise FileError(f"/surface/species holds indices {species.min()} .. {species.max()}, "
+                        f"but species_names lists {len(names)}")
+    if lattice["x"].ndim != 1 or lattice["y"].ndim != 1 or lattice["x"].size < 1 or lattice["y"].size < 1:
+        raise FileError("/afm/support_x and /afm/support_y must be nonempty 1-D arrays")
+    if "trace" not in lattice["trips"]:
+        raise FileError("no /afm/trace group")
+    shape = (lattice["y"].size, lattice["x"].size)
+    for trip, values in lattice["trips"].items():
+        for name, array in values.items():
+            if array.shape != shape:
+                raise FileError(f"/afm/{trip}/{name} has shape {array.shape}, expected (ny, nx) = {shape}")
+    return lattice
+
+
+def scan_axes(angle_deg):
+    """Unit vectors along (u) and across (n) the scan in the lattice frame."""
+    t = np.radians(angle_deg)
+    return np.array([np.cos(t), np.sin(t)]), np.array([-np.sin(t), np.cos(t)])
+
+
+def scan_region(lattice):
+    """Corners of the area covered by the support: origin, +L u, +L u + W n, +W n."""
+    u, n = scan_axes(lattice["angle"])
+    x0, x1 = lattice["x"].min(), lattice["x"].max()
+    y0, y1 = lattice["y"].min(), lattice["y"].max()
+    o = lattice["origin"]
+    return np.array([o + x0 * u + y0 * n, o + x1 * u + y0 * n, o + x1 * u + y1 * n, o + x0 * u + y1 * n])
+
+
+def nearest_neighbour_distance(xyz):
+    """Typical nearest-neighbour distance: the median over (a sample of) the atoms.
+
+    A median rather than the minimum, so one misplaced atom does not shrink
+    the bonds of the whole net.  None for a single atom or coincident atoms.
+    """
+    count = xyz.shape[0]
+    if count < 2:
+        return None
+    sample = xyz[np.unique(np.linspace(0, count - 1, min(count, NN_SAMPLE)).astype(int))]
+    nearest = np.empty(sample.shape[0])
+    for k, p in enumerate(sample):
+        d2 = np.sum((xyz - p) ** 2, axis=1)
+        d2 = d2[d2 > 1e-12]  # itself (and exact duplicates)
+        nearest[k] = np.sqrt(d2.min()) if d2.size else np.inf
+    d = float(np.median(nearest))
+    return d if np.isfinite(d) and d > 0 else None
+
+
+def bonds(xyz, cutoff):
+    """Index pairs (i, j), i < j, of atoms closer than cutoff: a cell list in x, y."""
+    count = xyz.shape[0]
+    if count < 2 or not cutoff or cutoff <= 0:
+        return np.empty((0, 2), dtype=int)
+    cell = np.floor((xyz[:, :2] - xyz[:, :2].min(axis=0)) / cutoff).astype(np.int64)
+    stride = int(cell[:, 1].max()) + 3
+    key = (cell[:, 0] + 1) * stride + (cell[:, 1] + 1)
+    order = np.argsort(key, kind="stable")
+    sorted_key = key[order]
+    pairs = []
+    # Half the 3 x 3 neighbourhood (plus the cell itself): each pair once.
+    for dx, dy in ((0, 0), (1, -1), (1, 0), (1, 1), (0, 1)):
+        target = key + dx * stride + dy
+        lo = np.searchsorted(sorted_key, target, side="left")
+        hi = np.searchsorted(sorted_key, target, side="right")
+        counts = hi - lo
+        total = int(counts.sum())
+        if total == 0:
+            continue
+        i = np.repeat(np.arange(count), counts)
+        start = np.repeat(lo - np.concatenate(([0], np.cumsum(counts)[:-1])), counts)
+        j = order[start + np.arange(total)]
+        keep = np.sum((xyz[i] - xyz[j]) ** 2, axis=1) < cutoff ** 2
+        if (dx, dy) == (0, 0):
+            keep &= i < j
+        pairs.append(np.column_stack((i[keep], j[keep])))
+    return np.concatenate(pairs) if pairs else np.empty((0, 2), dtype=int)
+
+
+def graphite_net(data, margin=5.0, whole=False, tip_line=0):
+    """The crystal net of a lattice-sum map (the paper's Fig. 9a): atoms by
+    species, bonds (pairs closer than 1.2 x the nearest-neighbour distance),
+    the scan region and the tip's path on trace line `tip_line` (None: no
+    path); zoomed to the scan region plus `margin` Å, or the whole net."""
+    lattice = _lattice(data)
+    xyz = lattice["atoms"]
+    species = lattice["species"]
+    names = lattice["species_names"]
+    region = scan_region(lattice)
+    ny = lattice["y"].size
+    if tip_line is not None and not 0 <= tip_line < ny:
+        raise ValueError(f"tip line {tip_line} out of range: the file has lines 0 .. {ny - 1}")
+    tip = None
+    if tip_line is not None:
+        trace = lattice["trips"]["trace"]
+        if "tip_x" in trace and "tip_y" in trace:
+            tip = np.column_stack((trace["tip_x"][tip_line], trace["tip_y"][tip_line]))
+
+    if whole:
+        lo = np.minimum(xyz[:, :2].min(axis=0), region.min(axis=0))
+        hi = np.maximum(xyz[:, :2].max(axis=0), region.max(axis=0))
+        pad = 0.03 * float(max(hi - lo)) + 1.0
+        lo, hi = lo - pad, hi + pad
+    else:
+        shown = region
+        if tip is not None:
+            shown = np.vstack((region, tip[np.all(np.isfinite(tip), axis=1)]))
+        lo, hi = shown.min(axis=0) - margin, shown.max(axis=0) + margin
+
+    d_nn = nearest_neighbour_distance(xyz)
+    bond_cut = BOND_FACTOR * d_nn if d_nn else None
+    # Only the atoms in view (and a bond length around it) are drawn.
+    reach = bond_cut or 0.0
+    visible = np.all((xyz[:, :2] >= lo - reach) & (xyz[:, :2] <= hi + reach), axis=1)
+    pts, spc = xyz[visible], species[visible]
+
+    width, height = hi - lo
+    aspect = float(np.clip(height / width if width > 0 else 1.0, 0.3, 2.0))
+    fig = _figure(figsize=(7.0, 6.2 * aspect + 1.4), layout="constrained")
+    ax = fig.subplots()
+    pairs = bonds(pts, bond_cut)
+    if pairs.size:
+        segments = np.stack((pts[pairs[:, 0], :2], pts[pairs[:, 1], :2]), axis=1)
+        ax.add_collection(LineCollection(segments, colors="0.55", linewidths=0.6, zorder=1))
+    marker = float(np.clip(3000.0 / max(pts.shape[0], 1), 1.0, 30.0))
+    colours = colormaps["tab10"]
+    for k, name in enumerate(names, start=1):
+        mine = spc == k
+        count = int(np.sum(species == k))
+        if count == 0:
+            continue
+        ax.scatter(pts[mine, 0], pts[mine, 1], s=marker, color=colours((k - 1) % 10),
+                   edgecolors="none", zorder=2, label=f"{name} ({count} atoms)")
+
+    ax.add_patch(Polygon(region, closed=True, fill=False, edgecolor="tab:red",
+                         linewidth=1.6, zorder=3, label="scan region (support)"))
+    u, _ = scan_axes(lattice["angle"])
+    arrow = 0.25 * (lattice["x"].max() - lattice["x"].min()) or 1.0
+    o = region[0]
+    ax.annotate("", xy=o + arrow * u, xytext=o, zorder=4,
+                arrowprops=dict(arrowstyle="-|>", color="tab:red", linewidth=1.6))
+    if tip is not None:
+        ax.plot(tip[:, 0], tip[:, 1], "-", color="black", linewidth=1.0, zorder=4,
+                label=f"tip path, trace line {tip_line}")
+        ax.plot(tip[0, 0], tip[0, 1], "o", color="black", markersize=3, zorder=4)
+
+    ax.set_xlim(lo[0], hi[0])
+    ax.set_ylim(lo[1], hi[1])
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (Å)")
+    ax.set_ylabel("y (Å)")
+    note = f"{xyz.shape[0]} atoms"
+    if d_nn:
+        note += f", nearest neighbours {d_nn:.3f} Å"
+    if lattice["cutoff"]:
+        note += f", cutoff {lattice['cutoff']:.3g} Å"
+    ax.set_title(f"Crystal net and scan region: {_describe_scan(lattice['potential'], lattice['angle'])}\n{note}",
+                 fontsize="medium")
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.08), ncols=3, fontsize="small",
+              markerscale=max(1.0, 4.0 / np.sqrt(marker)), frameon=False)
+    return fig
+
+
+def stacked_lines(data, trip="trace", component="fx", offset=None):
+    """The scan lines stacked as in the paper's Fig. 9b: one force component
+    against the support position, line j shifted up by j x offset nN
+    (default: 1.2 x the largest peak-to-peak of the lines), labelled with its
+    offset across the scan.  The offset used is the figure's attribute
+    `line_offset`."""
+    lattice = _lattice(data)
+    if trip not in lattice["trips"]:
+        raise FileError(f"no /afm/{trip}: the run had retrace off")
+    if component not in lattice["trips"][trip]:
+        raise FileError(f"no /afm/{trip}/{component} in the file")
+    x, y = lattice["x"], lattice["y"]
+    values = lattice["trips"][trip][component]
+    ny = y.size
+    if offset is None:
+        with warnings.catch_warnings():  # all-NaN lines: no peak-to-peak, no warning
+            warnings.simplefilter("ignore", RuntimeWarning)
+            ptp = np.nanmax(values, axis=1) - np.nanmin(values, axis=1)
+        ptp = ptp[np.isfinite(ptp)]
+        offset = 1.2 * float(ptp.max()) if ptp.size and ptp.max() > 0 else 1.0
+    symbol, meaning = COMPONENTS[component]
+
+    fig = _figure(figsize=(8, min(4.0 + 0.35 * ny, 12.0)), layout="constrained")
+    ax = fig.subplots()
+    cmap = colormaps["viridis"]
+    span = (y.max() - y.min()) or 1.0
+    norm = Normalize(y.min(), y.min() + span)
+    step = max(1, int(np.ceil(ny / 30)))  # at most ~30 labels
+    for j in range(ny):
+        base = j * offset
+        colour = cmap(norm(y[j]))
+        ax.axhline(base, color="0.85", linewidth=0.5, zorder=1)
+        ax.plot(x, values[j] + base, "-", color=colour, linewidth=1.0, zorder=2)
+        if j % step == 0 or j == ny - 1:
+            ax.annotate(f"{y[j]:.2f} Å", xy=(1.0, base), xycoords=("axes fraction", "data"),
+                        xytext=(4, 0), textcoords="offset points", va="center",
+                        fontsize="x-small", color=colour)
+    if x.size > 1:
+        ax.set_xlim(x.min(), x.max())
+    direction = "→" if trip == "trace" else "←"
+    ax.set_xlabel(f"support position along the scan (Å), {trip} {direction}")
+    ax.set_ylabel(f"{symbol} (nN), line j shifted up by j × {offset:.3g} nN")
+    ax.set_ylim(-offset, (ny - 1) * offset + offset)
+    sm = ScalarMappable(norm=norm, cmap=cmap)
+    bar = fig.colorbar(sm, ax=ax, shrink=0.5, aspect=15, pad=0.09)
+    bar.set_label("line offset across the scan (Å)", fontsize="small")
+    ax.set_title(f"{symbol}, {meaning}, {ny} scan lines, {trip}: "
+                 f"{_describe_scan(lattice['potential'], lattice['angle'])}", fontsize="medium")
+    fig.line_offset = offset
+    return fig
+
+
+# --------------------------------------------------------------------------
+# The brake
+# --------------------------------------------------------------------------
+
+
+def _brake_run(data):
+    """The trajectory, events and parameters of a brake file, checked."""
+    data = require(data, "brake", "brake")
+    with reading("brake"):
+        run = {name: data[f"brake/{name}"].values for name in ("t", "x", "v", "y", "w", "stick")}
+        brake = data.group_attrs["brake"]
+        run["model"] = str(brake["model"])
+        run["v_dr"] = float(brake["v_dr_prime"])
+        run["method"] = str(data.attrs.get("method", "?"))
+        run["event_t"] = data["brake/events/t"].values
+        run["event_kind"] = data["brake/events/kind"].values
+    n = run["t"].size
+    for name in ("x", "v", "y", "w", "stick"):
+        if run[name].shape != (n,):
+            raise FileError(f"/brake/{name} has shape {run[name].shape}, expected ({n},)")
+    if n < 2:
+        raise FileError("the run has fewer than two output points")
+    return run
+
+
+def _describe_brake(run):
+    return f"{run['model']} model ({run['method']}), $v'_{{dr}}$ = {run['v_dr']:g} m"
+
+
+def _window(run, window):
+    t0, t1 = window
+    if not t0 < t1:
+        raise ValueError("the window (t0, t1) needs t0 < t1")
+    if np.count_nonzero((run["t"] >= t0) & (run["t"] <= t1)) < 2:
+        raise ValueError(f"window {t0:g} {t1:g} is outside the run (τ from {run['t'][0]:g} to {run['t'][-1]:g})")
+    return t0, t1
+
+
+def brake_phase(data, window=(100.0, 1000.0)):
+    """The phase plane (x, x') over the time window (the paper's Fig. 12,
+    tau in [100, 1000]); stick points in their own colour, the belt velocity
+    dashed."""
+    run = _brake_run(data)
+    t0, t1 = _window(run, window)
+    inside = (run["t"] >= t0) & (run["t"] <= t1)
+    x, v, stick = run["x"][inside], run["v"][inside], run["stick"][inside] == 1
+    fig = _figure(figsize=(8, 5.6), layout="constrained")
+    ax = fig.subplots()
+    ax.plot(x, v, "-", color="tab:blue", linewidth=0.6, label="slip and stick (trajectory)")
+    if stick.any():
+        ax.plot(x[stick], v[stick], ".", color="tab:red", markersize=2.5,
+                label=f"stick: x' = v'$_{{dr}}$ ({stick.mean():.1%} of the points)")
+    ax.axhline(run["v_dr"], color="0.4", linestyle="--", linewidth=0.8,
+               label=f"belt velocity v'$_{{dr}}$ = {run['v_dr']:g}")
+    ax.set_xlabel("x, block displacement (m)")
+    ax.set_ylabel("x', block velocity (m per unit τ)")
+    ax.set_title(f"Phase plane, τ ∈ [{t0:g}, {t1:g}] (paper Fig. 12)\n{_describe_brake(run)}")
+    ax.legend(loc="best", fontsize="small")
+    return fig
+
+
+def brake_x(data, window=(100.0, 1000.0)):
+    """x(tau): the whole run above, the last 30 tau of the window below, where
+    stick shows as straight stretches of slope v'_dr."""
+    run = _brake_run(data)
+    window = _window(run, window)
+    t, x, stick = run["t"], run["x"], run["stick"] == 1
+    fig = _figure(figsize=(11, 7), layout="constrained")
+    whole, zoom = fig.subplots(2, 1)
+    zoom_from = max(window[0], window[1] - 30.0)
+    for ax, (t0, t1) in ((whole, (t[0], t[-1])), (zoom, (zoom_from, window[1]))):
+        inside = (t >= t0) & (t <= t1)
+        ax.plot(t[inside], x[inside], "-", color="tab:blue", linewidth=0.6, label="x(τ)")
+        part = inside & stick
+        if part.any():
+            ax.plot(t[part], x[part], ".", color="tab:red", markersize=1.5 if ax is whole else 3, label="stick")
+        ax.set_xlim(t0, t1)
+        ax.set_ylabel("x, block displacement (m)")
+    zoom.set_xlabel("τ = t √(k1/m)")
+    whole.legend(loc="upper right", fontsize="small")
+    n_events = run["event_t"].size
+    whole.set_title(f"Block displacement, {_describe_brake(run)}\n{n_events} stick/slip events, "
+                    f"{stick.mean():.1%} of the points in stick; below: τ ∈ [{zoom_from:g}, {window[1]:g}]")
+    return fig
+
+
+def _diagnostics(data):
+    """The /brake/spectrum, /brake/poincare and /brake/lyapunov groups present."""
+    data = require(data, "brake", "brake")
+    d = {}
+    with reading("brake"):
+        brake = data.group_attrs["brake"]
+        d["model"] = str(brake["model"])
+        d["v_dr"] = float(brake["v_dr_prime"])
+        groups = data.group_attrs
+        if "brake/spectrum" in groups:
+            s = groups["brake/spectrum"]
+            d["spectrum"] = {"frequency": data["brake/spectrum/frequency"].values,
+                             "amplitude": data["brake/spectrum/amplitude"].values,
+                             "series": str(s["series"]), "window": str(s["window"]),
+                             **{k: float(s[k]) for k in ("peak_frequency", "resolution", "window_start",
+                                                         "window_end")}}
+        if "brake/poincare" in groups:
+            p = groups["brake/poincare"]
+            d["poincare"] = {name.rsplit("/", 1)[1]: data[name].values for name in data
+                             if name.startswith("brake/poincare/")}
+            d["poincare"]["period"] = float(p["strobe_period"])
+            d["poincare"]["section"] = str(p["section"])
+        if "brake/lyapunov" in groups:
+            d["lyapunov"] = {name.rsplit("/", 1)[1]: data[name].values for name in data
+                             if name.startswith("brake/lyapunov/")}
+            d["lyapunov"]["attrs"] = groups["brake/lyapunov"]
+    if not any(k in d for k in ("spectrum", "poincare", "lyapunov")):
+        raise FileError("no chaos diagnostics in the file (run friction with an &analysis group)")
+    return d
+
+
+def _need(d, part):
+    if part not in d:
+        raise FileError(f"no /brake/{part} in the file (run friction with &analysis {part} = .true.)")
+    return d[part]
+
+
+def brake_spectrum(data):
+    """The amplitude spectrum of the analysed variable over its window (the
+    paper's Fig. 13), with the peak frequency and the bin width."""
+    d = _diagnostics(data)
+    s = _need(d, "spectrum")
+    fig = _figure(figsize=(8, 5), layout="constrained")
+    ax = fig.subplots()
+    ax.semilogy(s["frequency"], np.maximum(s["amplitude"], 1e-300), "-", linewidth=0.8)
+    ax.axvline(s["peak_frequency"], color="tab:red", linestyle="--", linewidth=0.8,
+               label=f"peak {s['peak_frequency']:.6f} ± {s['resolution'] / 2:.6f} (bin {s['resolution']:.6f})")
+    ax.axvline(0.143433, color="0.5", linestyle=":", linewidth=0.8, label="paper: 0.143433")
+    ax.set_xlim(0, min(1.0, s["frequency"][-1]))
+    ax.set_xlabel("frequency (cycles per unit τ)")
+    ax.set_ylabel(f"amplitude of {s['series']}")
+    ax.set_title(f"Spectrum of {s['series']}, τ ∈ [{s['window_start']:g}, {s['window_end']:g}], "
+                 f"{s['window']} window (paper Fig. 13)\n{d['model']} model")
+    ax.legend(fontsize="small")
+    return fig
+
+
+def poincare(data):
+    """The stroboscopic map (x, x') at the strobe period (the paper's Fig. 14),
+    beside the true section (x, y)."""
+    d = _diagnostics(data)
+    p = _need(d, "poincare")
+    fig = _figure(figsize=(12, 5), layout="constrained")
+    strobe, section = fig.subplots(1, 2)
+    strobe.plot(p["strobe_x"], p["strobe_v"], ".", markersize=3)
+    strobe.set_title(f"Stroboscopic map, period {p['period']:.6g} τ (paper Fig. 14)\n{p['strobe_t'].size} points")
+    # On the stick-to-slip section x' = v'_dr: (x, y) shows what changes.
+    section.plot(p["section_x"], p["section_y"], ".", markersize=3, color="tab:green")
+    section.set_title(f"Section: {p['section']} (x, y)\n{p['section_t'].size} points")
+    section.set_ylabel("y, crank arm tip displacement (m)")
+    strobe.set_ylabel("x', block velocity (m per unit τ)")
+    for ax in (strobe, section):
+        ax.set_xlabel("x, block displacement (m)")
+    return fig
+
+
+def lyapunov(data):
+    """The running Benettin estimate (from the equations) and the Rosenstein
+    divergence curve with its fit range and slope (from the series)."""
+    d = _diagnostics(data)
+    g = _need(d, "lyapunov")
+    a = g["attrs"]
+    fig = _figure(figsize=(12, 5), layout="constrained")
+    flow, series = fig.subplots(1, 2)
+    if "benettin_estimate" in g:
+        flow.plot(g["benettin_time"], g["benettin_estimate"], "-", linewidth=0.8)
+        flow.axhline(0, color="0.5", linewidth=0.6)
+        flow.set_title(f"Benettin running estimate: {float(a['benettin_exponent']):.3g} per τ\n"
+                       f"renormalised every {float(a['benettin_renormalise']):g} τ, "
+                       f"d0 = {float(a['benettin_d0']):g}, transient {float(a['benettin_transient']):g} τ")
+        flow.set_xlabel("measuring time (τ)")
+        flow.set_ylabel("λ estimate (1/τ)")
+    else:
+        flow.set_axis_off()
+    if "rosenstein_divergence" in g:
+        t, curve = g["rosenstein_time"], g["rosenstein_divergence"]
+        k0, k1 = int(a["rosenstein_fit_start"]), int(a["rosenstein_fit_end"])
+        lam = float(a["rosenstein_exponent"])
+        series.plot(t, curve, "-", linewidth=0.8, label="mean ln divergence")
+        series.plot(t[k0:k1 + 1], curve[k0] + lam * (t[k0:k1 + 1] - t[k0]), "--", color="tab:red",
+                    label=f"fit: λ = {lam:.3g} per τ ({float(a['rosenstein_log2_per_sample']):.3g} log2/sample)")
+        series.set_title(f"Rosenstein: m = {int(a['rosenstein_dimension'])}, delay {int(a['rosenstein_delay'])}, "
+                         f"Theiler {int(a['rosenstein_theiler'])} samples of "
+                         f"{float(a['rosenstein_sample_spacing']):g} τ")
+        series.set_xlabel("time after the pairing (τ)")
+        series.set_ylabel("⟨ln distance⟩")
+        series.legend(fontsize="small")
+    else:
+        series.set_axis_off()
+    return fig
+
+
+# --------------------------------------------------------------------------
+# Sweeps
+# --------------------------------------------------------------------------
+
+
+def _sweep(data):
+    """The per-point datasets of /sweep (flat, in the order of the points), checked."""
+    data = require(data, "sweep", "sweep")
+    with reading("sweep"):
+        s = {"scene": str(data.attrs.get("sweep_scene", "brake")), "variable": str(data.attrs["sweep_variable"])}
+        keys = ["values", "status"]
+        if s["scene"] == "brake":
+            keys += ["maxima", "maxima_offset", "maxima_count", "lyapunov", "stick_fraction"]
+        else:
+            keys += ["mean_friction", "max_force"]
+        missing = [key for key in keys if f"sweep/{key}" not in data]
+        if missing:
+            raise FileError("/sweep lacks " + ", ".join(missing))
+        s.update({key: np.ravel(data[f"sweep/{key}"].values) for key in keys})
+        if "sweep_variable2" in data.attrs:
+            s["variable2"] = str(data.attrs["sweep_variable2"])
+            s["values2"] = np.ravel(data["sweep/values2"].values)
+    n = s["values"].size
+    if any(s[key].size != n for key in keys if key != "maxima"):
+        raise FileError("per-point datasets of different lengths")
+    if s["scene"] == "brake" and s["maxima_count"].sum() != s["maxima"].size:
+        raise FileError("maxima_count does not add up to the maxima")
+    return s
+
+
+def _series(s):
+    """(label, mask) per value of the second variable; one series without."""
+    if "values2" not in s:
+        return [(None, np.ones(s["values"].size, bool))]
+    return [(f"{s['variable2']} = {value:g}", s["values2"] == value) for value in np.unique(s["values2"])]
+
+
+def _mark_failed(ax, s):
+    failed = s["status"] == 2
+    for k, value in enumerate(np.unique(s["values"][failed])):
+        ax.axvline(value, color="r", lw=0.8, alpha=0.5, label="failed" if k == 0 else None)
+
+
+def _log_scale(values):
+    """A log axis for positive values spread over more than a decade."""
+    values = values[np.isfinite(values)]
+    return values.size > 1 and values.min() > 0 and values.max() / values.min() > 10
+
+
+def _brake_sweep(data):
+    s = _sweep(data)
+    if s["scene"] != "brake":
+        raise FileError("not a brake sweep (sweep_scene = 'afm': use sweep_friction)")
+    return s
+
+
+def bifurcation(data):
+    """A brake sweep's bifurcation diagram: the local maxima of x after the
+    transient against the swept parameter; failed points as red lines."""
+    s = _brake_sweep(data)
+    fig = _figure(figsize=(7, 4.5))
+    ax = fig.subplots()
+    for k, (label, mask) in enumerate(_series(s)):
+        counts = np.where(mask, s["maxima_count"], 0)
+        keep = np.repeat(mask, s["maxima_count"])
+        parameter = np.repeat(s["values"], counts)
+        ax.plot(parameter, s["maxima"][keep], ",", color="k" if label is None else f"C{k}", alpha=0.6)
+        if label is not None:
+            ax.plot([], [], "o", color=f"C{k}", label=label)
+    _mark_failed(ax, s)
+    ax.set_xlabel(s["variable"])
+    ax.set_ylabel("local maxima of x after the transient (m)")
+    ax.set_title("bifurcation diagram")
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend()
+    fig.tight_layout()
+    return fig
+
+
+def sweep_lyapunov(data):
+    """A brake sweep's Benettin exponent and stick fraction against the parameter."""
+    s = _brake_sweep(data)
+    done = s["status"] == 1
+    fig = _figure(figsize=(7, 6))
+    top, bottom = fig.subplots(2, 1, sharex=True)
+    top.axhline(0.0, color="0.6", lw=0.8)
+    for k, (label, mask) in enumerate(_series(s)):
+        keep = done & mask
+        top.plot(s["values"][keep], s["lyapunov"][keep], "o-", ms=3, color=f"C{k}", label=label)
+        bottom.plot(s["values"][keep], s["stick_fraction"][keep], "o-", ms=3, color=f"C{k}")
+    top.set_ylabel("Benettin exponent (1/τ)")
+    bottom.set_ylabel("stick fraction")
+    bottom.set_xlabel(s["variable"])
+    if "values2" in s:
+        top.legend(fontsize="small")
+    fig.tight_layout()
+    return fig
+
+
+def sweep_friction(data):
+    """An AFM sweep's mean friction and maximum lateral force against the
+    parameter, a line per value of a second variable."""
+    s = _sweep(data)
+    if s["scene"] != "afm":
+        raise FileError("not an AFM sweep (sweep_scene = 'brake': use bifurcation, sweep_lyapunov)")
+    done = s["status"] == 1
+    fig = _figure(figsize=(7, 6.5))
+    top, bottom = fig.subplots(2, 1, sharex=True)
+    for k, (label, mask) in enumerate(_series(s)):
+        keep = done & mask
+        top.plot(s["values"][keep], s["mean_friction"][keep], "o-", ms=3, color=f"C{k}", label=label)
+        bottom.plot(s["values"][keep], s["max_force"][keep], "o-", ms=3, color=f"C{k}")
+    for ax in (top, bottom):
+        _mark_failed(ax, s)
+    if _log_scale(s["values"]):
+        bottom.set_xscale("log")
+    if _log_scale(s["mean_friction"][done]):
+        top.set_yscale("log")
+    top.set_ylabel("mean friction (nN)")
+    top.set_title("half the width of the friction loop, over the map")
+    bottom.set_ylabel("maximum lateral force (nN)")
+    bottom.set_xlabel(s["variable"])
+    if top.get_legend_handles_labels()[0]:
+        top.legend(fontsize="small")
+    fig.tight_layout()
+    return fig
+
+
+def sweep(data):
+    """Every chart of a sweep file: {"bifurcation": Figure, "lyapunov": Figure}
+    for a brake sweep, {"friction": Figure} for an AFM sweep."""
+    data = require(data, "sweep", "sweep")
+    s = _sweep(data)
+    if s["scene"] == "brake":
+        return {"bifurcation": bifurcation(data), "lyapunov": sweep_lyapunov(data)}
+    return {"friction": sweep_friction(data)}
+
+
+# --------------------------------------------------------------------------
+# Speed against accuracy (files of scripts/work_precision)
+# --------------------------------------------------------------------------
+
+STYLE = {"rk2": ("tab:gray", "o"), "rk4": ("tab:brown", "s"), "rkf45": ("tab:blue", "o"),
+         "rkck": ("tab:cyan", "^"), "rk8pd": ("tab:red", "D"), "rk1imp": ("tab:olive", "v"),
+         "rk2imp": ("tab:pink", "<"), "rk4imp": ("tab:green", ">"), "bsimp": ("tab:purple", "p"),
+         "msadams": ("gold", "h"), "msbdf": ("tab:orange", "*"), "switched": ("k", "x")}
+
+
+def work_precision(data, scene):
+    """The work-precision chart of one scene of a work_precision.h5: error
+    against CPU time, log-log, a line per method (its 'ok' points), the
+    series measured elsewhere dashed, the reference's own check dotted."""
+    data = load(data)
+    if scene not in data.group_attrs:
+        known = sorted(g for g in data.group_attrs if "/" not in g)
+        raise FileError(f"no scene {scene!r} in the file (scenes: {', '.join(known)})")
+    with reading("work-precision"):
+        attrs = data.group_attrs[scene]
+        methods = sorted({name.split("/")[1] for name in data
+                          if name.startswith(f"{scene}/") and name.count("/") == 2 and name.split("/")[1] != "extra"},
+                         key=lambda m: list(STYLE).index(m) if m in STYLE else len(STYLE))
+        check = float(attrs["reference_check"])
+        unit = str(attrs["unit"])
+        fig = _figure(figsize=(7.5, 5.2))
+        ax = fig.subplots()
+        for method in methods:
+            status = np.asarray(data[f"{scene}/{method}/status"].values)
+            ok = status == "ok"
+            if not ok.any():
+                continue
+            color, marker = STYLE.get(method, ("k", "."))
+            ax.loglog(data[f"{scene}/{method}/error"].values[ok], data[f"{scene}/{method}/cpu_time"].values[ok],
+                      marker=marker, color=color, label=method, lw=1.2, ms=5)
+        extras = sorted({name.split("/")[2] for name in data if name.startswith(f"{scene}/extra/")})
+        for label in extras:
+            ax.loglog(data[f"{scene}/extra/{label}/error"].values, data[f"{scene}/extra/{label}/cpu_time"].values,
+                      "k--", marker="+", label=label)
+        ax.axvline(check, color="0.6", ls=":", lw=1)
+        ax.text(check, ax.get_ylim()[1], " reference\n self-check", va="top", fontsize=7, color="0.4")
+        quantity = "x" if scene.startswith("brake") else "F"
+        ax.set_xlabel(f"error: max |{quantity} - reference| ({unit})")
+        ax.set_ylabel("CPU time (s, median)")
+        ax.set_title(f"{attrs['title']}\n{attrs['quantity']}; {attrs['run']}", fontsize=9)
+        ax.grid(True, which="major", alpha=0.3)
+        ax.legend(fontsize=7, ncol=2, loc="best")
+        fig.tight_layout()
+    return fig
+
+
+FAILURE_COLOURS = ["#dddddd", "#4daf4a", "#ffd92f", "#e41a1c", "#984ea3"]  # none, ok, slow, failed, wrong
+PARAMETER_LABELS = {"epsilon_prime": lambda v: f"ε' = {v:.0e}", "damping_ratio": lambda v: f"ζ = {v:g}"}
+
+
+def failure_map(data):
+    """The failure maps of a failure_map.h5: every method against each
+    setting of a parameter, ok, slow, failed or silently wrong, with the CPU
+    time in ms."""
+    data = load(data)
+    maps = [g for g in data.group_attrs if "/" not in g]
+    if not maps:
+        raise FileError("no failure maps in the file")
+    with reading("failure-map"):
+        first = maps[0]
+        methods = list(data[f"{first}/methods"].values)
+        fig = _figure(figsize=(5.5 * len(maps), 0.42 * len(methods) + 2.2))
+        axes = np.atleast_1d(fig.subplots(1, len(maps)))
+        cmap = ListedColormap(FAILURE_COLOURS)
+        for ax, name in zip(axes, maps):
+            attrs = data.group_attrs[name]
+            parameter = next(p for p in PARAMETER_LABELS if f"{name}/{p}" in data)
+            values = data[f"{name}/{parameter}"].values
+            labels = [PARAMETER_LABELS[parameter](v) for v in values]
+            category = np.asarray(data[f"{name}/category"].values, dtype=int)
+            status = data[f"{name}/status"].values
+            cpu = data[f"{name}/cpu_time"].values
+            ax.imshow(category + 1, cmap=cmap, vmin=0, vmax=4, aspect="auto")
+            ax.set_yticks(range(len(methods)), methods, fontsize=8)
+            ax.set_xticks(range(len(labels)), labels, fontsize=7, rotation=30)
+            for j in range(len(labels)):
+                for i in range(len(methods)):
+                    st = status[i, j]
+                    txt = {"capped": "cap", "killed": "kill"}.get(st, "")
+                    if st in ("ok", "wrong") and math.isfinite(cpu[i, j]):
+                        txt = f"{cpu[i, j] * 1e3:.0f}" if cpu[i, j] >= 0.01 else f"{cpu[i, j] * 1e3:.1f}"
+                    ax.text(j, i, txt, ha="center", va="center", fontsize=6)
+            ax.set_title(attrs["title"], fontsize=8)
+        handles = [Rectangle((0, 0), 1, 1, color=FAILURE_COLOURS[i + 1]) for i in range(4)]
+        fig.legend(handles, ["ok", "slow (>10x best, or time cap)", "fails with an error",
+                             "silently wrong (>100x asked)"], loc="lower center", ncol=4, fontsize=8)
+        fig.text(0.01, 0.01, "numbers: CPU time in ms", fontsize=7)
+        fig.tight_layout(rect=(0, 0.07, 1, 1))
+    return fig

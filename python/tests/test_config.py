@@ -1,0 +1,121 @@
+"""Configurations and computations: the program's numbers to the last bit,
+values as Python, the program's checks and messages."""
+import h5py
+import numpy as np
+import pytest
+
+import helpers
+from conftest import DATA, INPUTS
+
+NAF = [INPUTS / "naf.nml", DATA / "small.nml"]
+
+
+def file_datasets(path, group):
+    found = {}
+    with h5py.File(path) as f:
+        f[group].visititems(lambda name, item: found.__setitem__(name, item[()])
+                            if isinstance(item, h5py.Dataset) else None)
+    return found
+
+
+def test_compute_is_the_programs_map_to_the_last_bit(friction, naf_map):
+    with friction.Config("afm", files=NAF) as cfg:
+        computed = cfg.compute()
+    program = file_datasets(naf_map, "afm")
+    assert sorted(computed) == sorted(program)
+    for name, values in program.items():
+        assert computed[name].shape == values.shape, name
+        assert np.array_equal(computed[name], values), name
+
+
+def test_afm_line_is_the_files_line_to_the_last_bit(friction, naf_map):
+    with h5py.File(naf_map) as f:
+        support_x = f["afm/support_x"][()]
+        trace, retrace = f["afm/trace/fx"][()], f["afm/retrace/fy"][()]
+    with friction.Config("afm", files=NAF) as cfg:
+        for j in (0, 3, 9):
+            x, fx, _ = cfg.afm_line(j)
+            assert np.array_equal(x, support_x)
+            assert np.array_equal(fx, trace[j])
+            _, _, fy = cfg.afm_line(j, forward=False)
+            assert np.array_equal(fy, retrace[j])
+    line = friction.afm_line(NAF, line=3)
+    assert isinstance(line, friction.Line) and np.array_equal(line.fx, trace[3])
+
+
+def test_brake_is_the_programs_run_to_the_last_bit(friction, files):
+    override = ("&brake t_end = 40.0, dt_out = 0.5 /\n"
+                "&analysis spectrum = .false., poincare = .false., lyapunov = .false., rosenstein = .false. /\n")
+    path = files("brake_40", [INPUTS / "brake.nml"], override)
+    run = friction.brake([INPUTS / "brake.nml", path.parent / "brake_40_override.nml"])
+    program = file_datasets(path, "brake")
+    trajectory = {k: v for k, v in program.items() if k.count("/") == 0 or k.startswith("events/")}
+    assert set(trajectory) == set(run)
+    for name, values in trajectory.items():
+        assert np.array_equal(run[name], values), name
+    assert run["t"][0] == 0.0 and run["t"][-1] == 40.0 and run["t"].size == 81
+
+
+def test_values_as_python(friction):
+    with friction.Config("afm", files=[INPUTS / "naf.nml"]) as cfg:
+        assert cfg["scan.nx"] == 128 and isinstance(cfg["scan.nx"], int)
+        assert cfg["surface.potential"] == "naf"
+        assert cfg["scan.retrace"] is True
+        assert cfg["tip.mass"] == 1e-8
+        assert cfg.unit("tip.mass") == "kg" and cfg.unit("tip.kx") == "N/m"
+        cfg["scan.nx"] = 64
+        cfg.set("surface.potential", "hopg").set("scan.retrace", False).set("tip.kx", 2.5)
+        assert (cfg.get("scan.nx"), cfg["surface.potential"], cfg["scan.retrace"], cfg["tip.kx"]) == \
+            ("64", "hopg", False, 2.5)
+        sigma = cfg["surface.sigma"]
+        assert isinstance(sigma, list) and len(sigma) == cfg.kinds()["surface.sigma"][1]
+        cfg.set("surface.sigma", [1.5, 2.5])
+        assert cfg["surface.sigma"][:3] == [1.5, 2.5, sigma[2]]
+        assert cfg["surface.sigma(2)"] == 2.5
+        assert len(cfg.support_x()) == 64 and cfg.support_x()[-1] == cfg["scan.length"]
+
+
+def test_text_reads_back(friction, tmp_path):
+    with friction.Config("afm", files=[INPUTS / "hopg.nml"], values={"tip.kx": 3.25}) as cfg:
+        text = cfg.text()
+    (tmp_path / "echo.nml").write_text(text)
+    with friction.Config("afm", files=[tmp_path / "echo.nml"]) as again:
+        assert again.text() == text and again["tip.kx"] == 3.25
+
+
+def test_refusals_carry_the_programs_messages(friction, tmp_path):
+    with friction.Config("afm") as cfg:
+        cfg.set("tip.mass", -1.0e-8)
+        with pytest.raises(friction.FrictionError) as caught:
+            cfg.check()
+        assert caught.value.status == 1
+        assert caught.value.message == "&tip: mass = -1.000000E-8: must be > 0 (kg)"
+        with pytest.raises(friction.FrictionError, match="nx = 'many': expected an integer"):
+            cfg.set("scan.nx", "many")
+        with pytest.raises(friction.FrictionError, match="nosuch"):
+            cfg.get("tip.nosuch")
+    bad = tmp_path / "bad.nml"
+    bad.write_text("&tip\n mass = -1.0e-8\n/\n")
+    with friction.Config("afm", files=[bad]) as cfg:
+        with pytest.raises(friction.FrictionError, match=r"bad\.nml:2: &tip: mass = -1\.000000E-8: must be > 0 \(kg\)"):
+            cfg.check()
+    with pytest.raises(friction.FrictionError, match="unknown scene|scene"):
+        friction.Config("boat")
+
+
+def test_the_program_refuses_with_the_same_words(friction, program, tmp_path):
+    bad = tmp_path / "bad.nml"
+    bad.write_text("&tip mass = -1.0e-8 /\n")
+    result = helpers.run([program, "-q", "-o", tmp_path / "x.h5", INPUTS / "naf.nml", bad], expect=3)
+    with friction.Config("afm", files=[INPUTS / "naf.nml", bad]) as cfg:
+        with pytest.raises(friction.FrictionError) as caught:
+            cfg.check()
+    assert f"friction: error: {caught.value.message}" in result.stderr
+
+
+def test_a_closed_configuration(friction):
+    cfg = friction.Config("brake")
+    cfg.close()
+    with pytest.raises(ValueError, match="closed"):
+        cfg.get("brake.mu")
+    assert "closed" in repr(cfg)
