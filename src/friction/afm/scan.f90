@@ -14,12 +14,27 @@
 !> followed from sample to sample along its minimum of the total energy
 !> (friction_afm_quasistatic), and jumps to the next minimum where its own
 !> disappears (see follow).
+!>
+!> At a temperature (&thermal temperature > 0; README: Friction at a
+!> temperature) a trip is integrated with the Langevin tip
+!> (friction_afm_langevin: BAOAB, or Leimkuhler–Matthews without inertia) at
+!> a fixed step, the largest not above the chosen one that divides the
+!> sample interval (and the lead-in) into whole steps, so that samples fall
+!> on steps.  The tip starts at the support with a velocity drawn from the
+!> bath's Maxwell–Boltzmann distribution; the noise is the random stream of
+!> (seed, line, trip, realization), trip 0 the trace and 1 the retrace, so
+!> a trip's samples depend on nothing else (not on the ranks).  run_line
+!> gives a line's trips over all realizations: the mean of every sample,
+!> its standard error, and the friction with its standard error.
 module friction_afm_scan
    use friction_kinds, only: wp, i8, pi, ev_per_angstrom_to_nn
    use friction_error, only: error_type, fatal_error, error_input, error_numerical
    use friction_ode_solver, only: ode_solver, integrator_statistics
-   use friction_afm_config, only: afm_config, new_tip
+   use friction_afm_config, only: afm_config, new_tip, surface_curvature
    use friction_afm_tip, only: afm_tip, model_inertial, model_quasistatic
+   use friction_afm_thermal, only: welford_add, welford_sem
+   use friction_afm_langevin, only: langevin_integrator, langevin_state, langevin_time_step
+   use friction_random, only: random_stream
    use friction_afm_quasistatic, only: newton_equilibrium, equilibrium_tangent
    use friction_surface_potential, only: surface_potential
    use friction_strings, only: rtoa
@@ -28,7 +43,7 @@ module friction_afm_scan
 
    public :: afm_scanner, trip_record, quantity_names, quantity_units, n_quantities, quantity_count
    public :: q_fx, q_fy, q_f_along, q_f_across, q_tip_x, q_tip_y, q_fz, q_tip_z, q_jumps
-   public :: support_along, support_across, find_height
+   public :: support_along, support_across, find_height, line_record
 
    integer, parameter :: n_quantities = 9
    integer, parameter :: q_fx = 1, q_fy = 2, q_f_along = 3, q_f_across = 4, q_tip_x = 5, q_tip_y = 6, &
@@ -56,6 +71,17 @@ module friction_afm_scan
       real(wp), allocatable :: values(:, :)
    end type trip_record
 
+   !> One line over all realizations (run_line): per trip the mean of every
+   !> sample, values(i, q) as trip_record's, and its standard error over the
+   !> realizations (NaN for one realization; 0 at T = 0, where there is one
+   !> deterministic trip); the line's friction (half the difference of the
+   !> mean force along on trace and retrace) and its standard error.
+   type :: line_record
+      real(wp), allocatable :: trace(:, :), retrace(:, :)
+      real(wp), allocatable :: trace_sem(:, :), retrace_sem(:, :)
+      real(wp) :: friction = 0.0_wp, friction_sem = 0.0_wp
+   end type line_record
+
    !> Integrates trips of one scene; owns one tip model and its solver.
    type :: afm_scanner
       type(afm_config) :: config
@@ -65,9 +91,20 @@ module friction_afm_scan
       integer(i8) :: clock_start = 0, clock_rate = 1   !! wall clock at init, for max_wall_time
       real(wp) :: contact_height = 0.0_wp   !! z0: free tip's equilibrium height at the origin, Å (3D)
       real(wp) :: support_height = 0.0_wp   !! z_M = z0 + support_z, Å (3D)
+      ! At a temperature (config%thermal)
+      logical :: thermal = .false.
+      type(langevin_integrator) :: langevin        !! the step between samples
+      type(langevin_integrator) :: lead_langevin   !! the step of the lead-in
+      integer :: sample_steps = 0                  !! Langevin steps between two samples
+      integer :: lead_steps = 0                    !! Langevin steps of the lead-in
+      integer(i8) :: langevin_steps = 0, force_evaluations = 0
+      type(random_stream) :: stream
    contains
       procedure :: init
       procedure :: run_trip
+      procedure :: run_thermal_trip
+      procedure :: run_line
+      procedure :: time_step
       procedure :: statistics
       procedure, private :: follow
       procedure, private :: relax
@@ -138,7 +175,192 @@ contains
       self%h_start = config%solver%h_start
       if (self%h_start <= 0.0_wp) self%h_start = 1.0e-3_wp * period
       call self%solver%init(self%tip, config%solver, self%h_start, error)
+      if (allocated(error)) return
+      self%thermal = config%thermal%enabled()
+      if (self%thermal) call init_thermal()
+
+   contains
+
+      !> The Langevin steps: the largest not above the chosen one (the
+      !> input's time_step, or langevin_time_step's default) that divide the
+      !> sample interval and the lead-in into whole steps.
+      subroutine init_thermal()
+         real(wp) :: curvature, dt, limit, lead_time
+
+         curvature = surface_curvature(config, potential)
+         call langevin_time_step(self%tip, curvature, dt, limit, error)
+         if (allocated(error)) return
+         if (config%thermal%time_step > 0.0_wp) dt = config%thermal%time_step
+         if (max(sample_time, config%lead_in / config%velocity) / dt > 1.0e9_wp) then
+            call fatal_error(error, 'Langevin: a step of '//rtoa(dt)//' s makes more than 1e9 steps between ' &
+               & //'two samples', error_input)
+            return
+         end if
+         self%sample_steps = max(1, ceiling(sample_time / dt))
+         call self%langevin%init(self%tip, config%thermal%temperature, sample_time / self%sample_steps, error, &
+            & curvature=curvature)
+         if (allocated(error)) return
+         lead_time = config%lead_in / config%velocity
+         self%lead_steps = 0
+         if (lead_time > 0.0_wp) then
+            self%lead_steps = max(1, ceiling(lead_time / dt))
+            call self%lead_langevin%init(self%tip, config%thermal%temperature, lead_time / self%lead_steps, &
+               & error, curvature=curvature)
+         end if
+      end subroutine init_thermal
+
    end subroutine init
+
+   !> The Langevin step between samples, s (0 at T = 0).
+   pure real(wp) function time_step(self)
+      class(afm_scanner), intent(in) :: self
+
+      time_step = 0.0_wp
+      if (self%thermal) time_step = self%langevin%dt
+   end function time_step
+
+   !> Line j (0-based) over all realizations: its trace, and its retrace
+   !> when the configuration scans back or `with_retrace` asks for it
+   !> (line_record).  At T = 0 the deterministic trips (run_trip), standard
+   !> errors 0.
+   subroutine run_line(self, j, line, error, with_retrace)
+      class(afm_scanner), intent(inout) :: self
+      integer, intent(in) :: j
+      type(line_record), intent(inout) :: line
+      type(error_type), allocatable, intent(out) :: error
+      logical, intent(in), optional :: with_retrace
+      type(trip_record) :: trace, retrace
+      real(wp) :: friction, m2
+      integer :: r, nx, n
+      logical :: back
+
+      nx = self%config%nx
+      back = self%config%retrace
+      if (present(with_retrace)) back = with_retrace
+      if (.not. self%thermal) then
+         call self%run_trip(j, .true., trace, error)
+         if (allocated(error)) return
+         line%trace = trace%values
+         line%trace_sem = 0.0_wp * trace%values
+         if (back) then
+            call self%run_trip(j, .false., retrace, error)
+            if (allocated(error)) return
+            line%retrace = retrace%values
+            line%retrace_sem = 0.0_wp * retrace%values
+            line%friction = 0.5_wp * (sum(trace%values(:, q_f_along)) - sum(retrace%values(:, q_f_along))) / nx
+            line%friction_sem = 0.0_wp
+         end if
+         return
+      end if
+      n = self%config%thermal%realizations
+      if (allocated(line%trace)) deallocate (line%trace, line%trace_sem)
+      if (allocated(line%retrace)) deallocate (line%retrace, line%retrace_sem)
+      allocate (line%trace(nx, n_quantities), line%trace_sem(nx, n_quantities))
+      if (back) allocate (line%retrace(nx, n_quantities), line%retrace_sem(nx, n_quantities))
+      line%friction = 0.0_wp
+      m2 = 0.0_wp
+      do r = 1, n
+         call self%run_thermal_trip(j, .true., r - 1, trace, error)
+         if (allocated(error)) return
+         ! (the sums of squares go in the _sem arrays until the end)
+         call welford_add(line%trace, line%trace_sem, trace%values, r)
+         if (.not. back) cycle
+         call self%run_thermal_trip(j, .false., r - 1, retrace, error)
+         if (allocated(error)) return
+         call welford_add(line%retrace, line%retrace_sem, retrace%values, r)
+         friction = 0.5_wp * (sum(trace%values(:, q_f_along)) - sum(retrace%values(:, q_f_along))) / nx
+         call welford_add(line%friction, m2, friction, r)
+      end do
+      line%trace_sem = welford_sem(line%trace_sem, n)
+      if (back) then
+         line%retrace_sem = welford_sem(line%retrace_sem, n)
+         line%friction_sem = welford_sem(m2, n)
+      end if
+   end subroutine run_line
+
+   !> One Langevin trip along line j (0-based), trace when forward, with the
+   !> noise of realization (0-based): samples as run_trip's.
+   subroutine run_thermal_trip(self, j, forward, realization, record, error)
+      class(afm_scanner), intent(inout) :: self
+      integer, intent(in) :: j, realization
+      logical, intent(in) :: forward
+      type(trip_record), intent(inout) :: record
+      type(error_type), allocatable, intent(out) :: error
+      type(langevin_state) :: state
+      real(wp) :: along(3), across(3), line_start(3), offset(self%config%ny), s_start, force(3), tip_r(3), t
+      real(wp) :: u0(3)
+      integer(i8) :: now
+      integer :: i, k, nx
+      character(len=128) :: where
+
+      associate (c => self%config, tip => self%tip)
+         nx = c%nx
+         along = c%scan_direction()
+         across = c%across_direction()
+         offset = support_across(c)
+         line_start = [c%origin_x, c%origin_y, 0.0_wp] + offset(j + 1) * across
+         if (forward) then
+            s_start = -c%lead_in
+            tip%support_velocity = c%velocity * along
+         else
+            s_start = c%length + c%lead_in
+            tip%support_velocity = -c%velocity * along
+         end if
+         tip%support_start = line_start + s_start * along
+         if (.not. allocated(record%values)) allocate (record%values(nx, n_quantities))
+         call self%stream%init(c%thermal%seed, j, merge(0, 1, forward), realization, error)
+         if (allocated(error)) return
+         ! At the support, with a thermal velocity (inertial tip).
+         u0 = 0.0_wp
+         t = 0.0_wp
+         if (self%lead_steps > 0) then
+            call self%lead_langevin%start(self%stream, 0.0_wp, u0, state)
+            call self%lead_langevin%advance(tip, self%stream, state, self%lead_steps, error)
+            self%langevin_steps = self%langevin_steps + self%lead_steps
+            self%force_evaluations = self%force_evaluations + self%lead_steps + 1
+            ! on with the samples' step from the end of the lead-in
+            state%t0 = c%lead_in / c%velocity
+            state%steps = 0
+         else
+            call self%langevin%start(self%stream, 0.0_wp, u0, state)
+         end if
+         do k = 1, nx
+            i = merge(k, nx + 1 - k, forward)
+            if (k > 1 .and. .not. allocated(error)) then
+               call self%langevin%advance(tip, self%stream, state, self%sample_steps, error)
+               self%langevin_steps = self%langevin_steps + self%sample_steps
+               self%force_evaluations = self%force_evaluations + self%sample_steps + 1
+            end if
+            t = self%langevin%time_of(state)
+            if (.not. allocated(error) .and. c%solver%max_wall_time > 0.0_wp) then
+               call system_clock(now)
+               if (real(now - self%clock_start, wp) / self%clock_rate > c%solver%max_wall_time) &
+                  & call fatal_error(error, 'Langevin: max_wall_time = '//rtoa(c%solver%max_wall_time) &
+                  & //' s reached at t = '//rtoa(t)//' s', error_numerical)
+            end if
+            if (allocated(error)) then
+               write (where, '(a, i0, a, i0, a, f0.4, a)') ' (line ', j, &
+                  & trim(merge(' trace  ', ' retrace', forward))//', realization ', realization, &
+                  & ', support at ', c%velocity * t, ' Å into the trip)'
+               error%message = error%message//trim(where)
+               call self%stream%free()
+               return
+            end if
+            force = tip%lateral_force(state%u) * ev_per_angstrom_to_nn
+            tip_r = tip%tip_position(t, state%u)
+            record%values(i, q_fx) = force(1)
+            record%values(i, q_fy) = force(2)
+            record%values(i, q_f_along) = dot_product(force, along)
+            record%values(i, q_f_across) = dot_product(force, across)
+            record%values(i, q_tip_x) = tip_r(1)
+            record%values(i, q_tip_y) = tip_r(2)
+            record%values(i, q_fz) = force(3)
+            record%values(i, q_tip_z) = tip_r(3)
+            record%values(i, q_jumps) = 0.0_wp
+         end do
+         call self%stream%free()
+      end associate
+   end subroutine run_thermal_trip
 
    !> One trip along line j (0-based): trace when forward, else retrace.
    subroutine run_trip(self, j, forward, record, error)
@@ -386,12 +608,17 @@ contains
       end associate
    end subroutine relax
 
-   !> Integrator counters of all trips so far.
+   !> Integrator counters of all trips so far (at T > 0 the Langevin steps
+   !> and force evaluations).
    function statistics(self) result(stats)
       class(afm_scanner), intent(in) :: self
       type(integrator_statistics) :: stats
 
       stats = self%solver%statistics()
+      if (self%thermal) then
+         stats%steps = stats%steps + self%langevin_steps
+         stats%rhs_evaluations = stats%rhs_evaluations + self%force_evaluations
+      end if
    end function statistics
 
 end module friction_afm_scan

@@ -17,8 +17,8 @@ module friction_afm_scene
    use friction_scene_report, only: job_reporter
    use friction_scene_context, only: job_context, agree_on_error, ranks_text, share_of
    use friction_afm_config, only: afm_config, new_potential, species_count
-   use friction_afm_scan, only: afm_scanner, trip_record, n_quantities, q_fx, q_fy, q_f_along
-   use friction_afm_output, only: write_afm_file, afm_surface_record
+   use friction_afm_scan, only: afm_scanner, line_record, n_quantities, q_fx, q_fy, q_f_along
+   use friction_afm_output, only: write_afm_file, afm_surface_record, afm_thermal_record
    use friction_afm_validity, only: afm_model_warnings, quasistatic_friction_warning
    use friction_afm_netlist, only: afm_netlist
    implicit none
@@ -31,6 +31,12 @@ module friction_afm_scene
       ! The run's results on this rank
       type(afm_config), private :: ran           !! the settings that ran
       real(wp), allocatable, private :: trace(:, :, :), retrace(:, :, :)
+      !> At a temperature: standard errors over the realizations of the
+      !> samples and of each line's friction.
+      real(wp), allocatable, private :: trace_sem(:, :, :), retrace_sem(:, :, :)
+      real(wp), allocatable, private :: friction_sem(:)
+      real(wp), private :: time_step = 0.0_wp   !! the Langevin step, s
+      character(len=:), allocatable, private :: scheme
       type(afm_surface_record), private :: surface
       type(run_summary), private :: record
       integer, private :: first = 0
@@ -65,6 +71,9 @@ contains
       character(len=32), allocatable, intent(out) :: names(:)
 
       names = [character(len=32) :: 'surface', 'tip', 'scan', 'integrator']
+      ! &thermal only at a temperature: at T = 0 its other variables do
+      ! nothing, and the echo is the deterministic program's.
+      if (self%config%thermal%enabled()) names = [character(len=32) :: names, 'thermal']
    end subroutine afm_groups
 
    subroutine afm_visit(self, v)
@@ -91,6 +100,7 @@ contains
       if (c%solver%method == auto_name) c%solver%method = auto_method('afm', c%potential, c%solver%rtol)
    end function resolved
 
+   !> The stepper that runs; at a temperature the Langevin scheme.
    function afm_method(self) result(name)
       class(afm_scene), intent(in) :: self
       character(len=:), allocatable :: name
@@ -98,7 +108,20 @@ contains
 
       c = self%resolved()
       name = trim(c%solver%method)
+      if (c%thermal%enabled()) name = thermal_scheme(c)
    end function afm_method
+
+   !> The Langevin scheme of the tip model.
+   function thermal_scheme(c) result(name)
+      type(afm_config), intent(in) :: c
+      character(len=:), allocatable :: name
+
+      if (c%model == 'overdamped') then
+         name = 'leimkuhler-matthews'
+      else
+         name = 'baoab'
+      end if
+   end function thermal_scheme
 
    !> Compute this rank's lines of the map.
    subroutine afm_run(self, job, reporter, error)
@@ -108,7 +131,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(afm_scanner), target :: scanner
       class(surface_potential), allocatable :: potential
-      type(trip_record) :: trip
+      type(line_record) :: line
       type(integrator_statistics) :: stats
       integer(i8) :: counts(4)
       integer :: count, j
@@ -141,18 +164,29 @@ contains
          allocate (self%trace(c%nx, count, n_quantities))
          allocate (self%retrace(c%nx, merge(count, 0, c%retrace), n_quantities))
          call scanner%init(c, potential, error)
+         if (allocated(self%trace_sem)) deallocate (self%trace_sem)
+         if (allocated(self%retrace_sem)) deallocate (self%retrace_sem)
+         if (allocated(self%friction_sem)) deallocate (self%friction_sem)
+         if (scanner%thermal) then
+            allocate (self%trace_sem(c%nx, count, n_quantities))
+            allocate (self%retrace_sem(c%nx, merge(count, 0, c%retrace), n_quantities))
+            allocate (self%friction_sem(count))
+            self%time_step = scanner%time_step()
+            self%scheme = thermal_scheme(c)
+         end if
          self%surface%contact_height = scanner%contact_height
          self%surface%support_height = scanner%support_height
          self%three_d = scanner%tip%ndim == 3
          do j = 1, count
             if (allocated(error)) exit
-            call scanner%run_trip(self%first + (j - 1) * job%nranks, .true., trip, error)
+            call scanner%run_line(self%first + (j - 1) * job%nranks, line, error)
             if (allocated(error)) exit
-            self%trace(:, j, :) = trip%values
-            if (c%retrace) then
-               call scanner%run_trip(self%first + (j - 1) * job%nranks, .false., trip, error)
-               if (allocated(error)) exit
-               self%retrace(:, j, :) = trip%values
+            self%trace(:, j, :) = line%trace
+            if (c%retrace) self%retrace(:, j, :) = line%retrace
+            if (scanner%thermal) then
+               self%trace_sem(:, j, :) = line%trace_sem
+               if (c%retrace) self%retrace_sem(:, j, :) = line%retrace_sem
+               self%friction_sem(j) = line%friction_sem
             end if
             ! Rank 0's share is as large as any other and spread over the whole
             ! map, so its fraction done is the map's fraction done.
@@ -207,9 +241,20 @@ contains
       character(len=*), intent(in) :: path
       type(job_context), intent(in) :: job
       type(error_type), allocatable, intent(out) :: error
+      type(afm_thermal_record) :: thermal
 
       self%record%version = version_string
-      if (self%three_d) then
+      if (allocated(self%trace_sem)) then
+         ! (Component by component: gfortran's structure constructor mishandles
+         ! deferred-length components.)
+         thermal%trace_sem = self%trace_sem
+         thermal%retrace_sem = self%retrace_sem
+         thermal%friction_sem = self%friction_sem
+         thermal%time_step = self%time_step
+         thermal%scheme = self%scheme
+         call write_afm_file(path, job%comm, self%ran, self%first, job%nranks, self%trace, self%retrace, &
+            & self%record, error, thermal=thermal)
+      else if (self%three_d) then
          call write_afm_file(path, job%comm, self%ran, self%first, job%nranks, self%trace, self%retrace, &
             & self%record, error, self%surface)
       else
@@ -262,6 +307,8 @@ contains
       type(error_type), allocatable, intent(out) :: error
 
       note = ''
+      if (self%config%thermal%enabled()) note = 'the netlist is the deterministic tip: &thermal ' &
+         & //'temperature > 0 adds thermal noise, which it does not model'
       call afm_netlist(self%resolved(), data_file, version, text, error)
    end subroutine afm_netlist_text
 
@@ -269,14 +316,15 @@ contains
    !> parameter scan charts: the mean friction (half the width of the
    !> friction loop, the mean of (trace - retrace) f_along / 2 over the map;
    !> the mean trace f_along without retrace) and the maximum lateral force
-   !> |(fx, fy)| over all samples, both nN.  Holds one trip at a time.
+   !> |(fx, fy)| over all samples, both nN; at a temperature both of the
+   !> samples' means over the realizations.  Holds one line at a time.
    subroutine afm_friction(c, mean_friction, max_force, error)
       type(afm_config), intent(in) :: c
       real(wp), intent(out) :: mean_friction, max_force
       type(error_type), allocatable, intent(out) :: error
       type(afm_scanner), target :: scanner
       class(surface_potential), allocatable :: potential
-      type(trip_record) :: trip
+      type(line_record) :: line
       real(wp) :: total
       integer :: j
 
@@ -288,15 +336,13 @@ contains
       if (allocated(error)) return
       total = 0.0_wp
       do j = 0, c%ny - 1
-         call scanner%run_trip(j, .true., trip, error)
+         call scanner%run_line(j, line, error)
          if (allocated(error)) return
-         total = total + sum(trip%values(:, q_f_along))
-         max_force = max(max_force, maxval(hypot(trip%values(:, q_fx), trip%values(:, q_fy))))
+         total = total + sum(line%trace(:, q_f_along))
+         max_force = max(max_force, maxval(hypot(line%trace(:, q_fx), line%trace(:, q_fy))))
          if (c%retrace) then
-            call scanner%run_trip(j, .false., trip, error)
-            if (allocated(error)) return
-            total = total - sum(trip%values(:, q_f_along))
-            max_force = max(max_force, maxval(hypot(trip%values(:, q_fx), trip%values(:, q_fy))))
+            total = total - sum(line%retrace(:, q_f_along))
+            max_force = max(max_force, maxval(hypot(line%retrace(:, q_fx), line%retrace(:, q_fy))))
          end if
       end do
       mean_friction = total / (real(c%nx, wp) * c%ny * merge(2, 1, c%retrace))
