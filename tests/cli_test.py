@@ -543,9 +543,10 @@ def thermal_friction(path):
 
 def case_thermal_ranks(args):
     """At 300 K (3 realizations, a lead-in): the documented datasets, the
-    mean and its standard error of every sample and line, the same file bit
-    for bit on 1, 2 and 3 ranks and from the echoed input; another seed
-    gives other samples and a consistent mean friction."""
+    mean and its standard error of every sample and line, the slips in
+    order (mostly forward, with the force along the support's motion), the
+    same file bit for bit on 1, 2 and 3 ranks and from the echoed input;
+    another seed gives other samples and a consistent mean friction."""
     naf = os.path.join(args.inputs, "naf.nml")
     small = write(args, "thermal.nml", THERMAL_SMALL)
     files = {}
@@ -598,6 +599,26 @@ def case_thermal_ranks(args):
                                    - f["afm/retrace/f_along"][()].mean(axis=1))
         if np.max(np.abs(friction_expected - f["afm/friction"][()])) > 1e-12:
             fail("/afm/friction is not half the trace-retrace difference of the mean force")
+        # The slips of every line, realization and trip, in that order.
+        slips = {name: f[f"afm/slips/{name}"][()] for name in
+                 ("line", "realization", "trip", "support", "force", "jump", "jump_across")}
+        if len({len(v) for v in slips.values()}) != 1 or len(slips["line"]) < 5 * 3 * 2 * 3:
+            fail(f"/afm/slips: {len(slips['line'])} slips, expected a few per trip on 20 Å of NaF")
+        for name, unit in (("support", "angstrom"), ("force", "nN"), ("jump", "angstrom"),
+                           ("jump_across", "angstrom")):
+            if f[f"afm/slips/{name}"].attrs["units"].decode() != unit:
+                fail(f"/afm/slips/{name} is not in {unit}")
+        order = slips["line"] * 6 + slips["realization"] * 2 + slips["trip"]
+        if np.any(np.diff(order) < 0) or slips["line"].max() > 4 or slips["realization"].max() > 2:
+            fail("/afm/slips is not ordered by line, realization and trip")
+        if np.any(np.hypot(slips["jump"], slips["jump_across"]) < 0.5) \
+                or np.any((slips["support"] < 0) | (slips["support"] > 20)):
+            fail("a slip with a jump below 0.5 Å or outside the line")
+        trace = slips["trip"] == 0
+        forward = slips["jump"] > 0
+        if np.mean(forward) < 0.8 or np.mean(slips["force"][trace & forward] > 0) < 0.9 \
+                or np.mean(slips["force"][~trace & forward] < 0) < 0.9:
+            fail("slips are not mostly forward, pulled by the force along the support's motion")
         echoed = f.attrs["input"].decode()
     friction(args, "-o", "echo.h5", write(args, "echo.nml", echoed))
     again = comparable(os.path.join(args.workdir, "echo.h5"))
@@ -624,7 +645,8 @@ def case_thermal_equipartition(args):
     standard errors, from the scatter over the 24 independent lines, the
     variance's below 1 %.  Both schemes are exact for k<δu²> at any stable
     step; BAOAB's drag is low by (γh)²/12 = 2e-4, far below the statistics.
-    A 2 Å lead-in starts every sample in equilibrium."""
+    A 2 Å lead-in starts every sample in equilibrium.  A flat surface has
+    no slips."""
     k, c, v = 10.0, 1.0e-3, 400.0            # N/m, N s/m, Å/s
     kt = 1.380649e-23 * 300.0                 # J
     variance = k * kt * 1e18                  # (N/m)(J) = N², in nN²
@@ -648,6 +670,8 @@ def case_thermal_equipartition(args):
                     fail(f"{model} {axis}: standard error {se} of k<du^2>/kT above 1 %")
                 if abs(ratio - 1.0) > 3 * se:
                     fail(f"{model} {axis}: k<du^2>/kT = {ratio} +- {se}, not 1 within 3 SE")
+            if len(f["afm/slips/line"]) != 0:
+                fail(f"{model}: slips on a flat surface")
             lines = f["afm/friction"][()]
             mean, se = lines.mean(), lines.std(ddof=1) / np.sqrt(len(lines))
             print(f"{model}: friction = {mean:.5f} +- {se:.5f} nN, drag c v = {drag:.5f} nN")

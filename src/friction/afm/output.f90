@@ -36,6 +36,9 @@ module friction_afm_output
       real(wp), allocatable :: friction_sem(:)
       real(wp) :: time_step = 0.0_wp
       character(len=:), allocatable :: scheme
+      !> every rank's slips, the same on every rank: line, realization,
+      !> trip, support (Å), force (nN), jump along and across (Å) for each
+      real(wp), allocatable :: slips(:, :)
    end type afm_thermal_record
 
 
@@ -60,7 +63,9 @@ contains
    !> over the realizations, and `thermal` holds their standard errors: each
    !> dataset NAME gets NAME_sem beside it, /afm/friction (the mean) gets
    !> /afm/friction_sem, and /afm the attributes temperature, seed,
-   !> realizations, time_step (the Langevin step used) and scheme.
+   !> realizations, time_step (the Langevin step used) and scheme; and the
+   !> slips, /afm/slips/line, realization, trip, support, force, jump,
+   !> jump_across.
    subroutine write_afm_file(path, comm, config, first, stride, trace, retrace, summary, error, surface, thermal)
       character(len=*), intent(in) :: path
       type(MPI_Comm), intent(in) :: comm
@@ -125,6 +130,16 @@ contains
             & config%ny, first, stride, 'nN')
          if (present(thermal)) call file%write_vector_block('/afm/friction_sem', thermal%friction_sem, &
             & config%ny, first, stride, 'nN')
+      end if
+      if (present(thermal)) then
+         call file%create_group('/afm/slips')
+         call file%write_integer_vector('/afm/slips/line', nint(thermal%slips(1, :)))
+         call file%write_integer_vector('/afm/slips/realization', nint(thermal%slips(2, :)))
+         call file%write_integer_vector('/afm/slips/trip', nint(thermal%slips(3, :)))
+         call file%write_vector('/afm/slips/support', thermal%slips(4, :), 'angstrom')
+         call file%write_vector('/afm/slips/force', thermal%slips(5, :), 'nN')
+         call file%write_vector('/afm/slips/jump', thermal%slips(6, :), 'angstrom')
+         call file%write_vector('/afm/slips/jump_across', thermal%slips(7, :), 'angstrom')
       end if
       call file%close(error)
 

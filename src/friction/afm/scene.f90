@@ -17,7 +17,7 @@ module friction_afm_scene
    use friction_scene_report, only: job_reporter
    use friction_scene_context, only: job_context, agree_on_error, ranks_text, share_of
    use friction_afm_config, only: afm_config, new_potential, species_count
-   use friction_afm_scan, only: afm_scanner, line_record, n_quantities, q_fx, q_fy, q_f_along
+   use friction_afm_scan, only: afm_scanner, line_record, slip_list, n_quantities, q_fx, q_fy, q_f_along
    use friction_afm_output, only: write_afm_file, afm_surface_record, afm_thermal_record
    use friction_afm_validity, only: afm_model_warnings, quasistatic_friction_warning
    use friction_afm_netlist, only: afm_netlist
@@ -25,6 +25,9 @@ module friction_afm_scene
    private
 
    public :: afm_scene, afm_friction
+
+   !> A slip's items: line, realization, trip, support, force, jump, jump_across.
+   integer, parameter :: n_slip_items = 7
 
    type, extends(scene) :: afm_scene
       type(afm_config) :: config                 !! as the input gives it ('auto' unresolved)
@@ -35,6 +38,10 @@ module friction_afm_scene
       !> samples and of each line's friction.
       real(wp), allocatable, private :: trace_sem(:, :, :), retrace_sem(:, :, :)
       real(wp), allocatable, private :: friction_sem(:)
+      !> The map's slips (all ranks', ordered by line, realization, trip and
+      !> time): line, realization, trip, support (Å), force (nN), jump along
+      !> and across (Å).
+      real(wp), allocatable, private :: slips(:, :)
       real(wp), private :: time_step = 0.0_wp   !! the Langevin step, s
       character(len=:), allocatable, private :: scheme
       type(afm_surface_record), private :: surface
@@ -133,6 +140,7 @@ contains
       class(surface_potential), allocatable :: potential
       type(line_record) :: line
       type(integrator_statistics) :: stats
+      real(wp), allocatable :: local_slips(:, :)
       integer(i8) :: counts(4)
       integer :: count, j
       real(wp) :: wall
@@ -167,6 +175,8 @@ contains
          if (allocated(self%trace_sem)) deallocate (self%trace_sem)
          if (allocated(self%retrace_sem)) deallocate (self%retrace_sem)
          if (allocated(self%friction_sem)) deallocate (self%friction_sem)
+         if (allocated(self%slips)) deallocate (self%slips)
+         allocate (local_slips(n_slip_items, 0))
          if (scanner%thermal) then
             allocate (self%trace_sem(c%nx, count, n_quantities))
             allocate (self%retrace_sem(c%nx, merge(count, 0, c%retrace), n_quantities))
@@ -187,6 +197,7 @@ contains
                self%trace_sem(:, j, :) = line%trace_sem
                if (c%retrace) self%retrace_sem(:, j, :) = line%retrace_sem
                self%friction_sem(j) = line%friction_sem
+               call keep_slips(self%first + (j - 1) * job%nranks, line%slips)
             end if
             ! Rank 0's share is as large as any other and spread over the whole
             ! map, so its fraction done is the map's fraction done.
@@ -199,6 +210,7 @@ contains
          call agree_on_error(job, error)
          if (allocated(error)) return
          if (c%model == 'quasistatic') call check_friction()
+         if (scanner%thermal) call gather_slips()
 
          stats = scanner%statistics()
          counts = [stats%steps, stats%failed_steps, stats%rhs_evaluations, stats%jacobian_evaluations]
@@ -215,6 +227,52 @@ contains
       end associate
 
    contains
+
+      !> A line's slips onto this rank's list.
+      subroutine keep_slips(global_line, slips)
+         integer, intent(in) :: global_line
+         type(slip_list), intent(in) :: slips
+         real(wp), allocatable :: more(:, :)
+         integer :: k, n
+
+         n = size(local_slips, 2)
+         allocate (more(n_slip_items, n + slips%n))
+         more(:, 1:n) = local_slips
+         do k = 1, slips%n
+            more(:, n + k) = [real(global_line, wp), real(slips%realization(k), wp), real(slips%trip(k), wp), &
+               & slips%support(k), slips%force(k), slips%jump(k), slips%jump_across(k)]
+         end do
+         call move_alloc(more, local_slips)
+      end subroutine keep_slips
+
+      !> Every rank's slips on every rank, in the order of the lines (each
+      !> rank's list is in its lines' order; the lines are dealt round-robin).
+      subroutine gather_slips()
+         integer :: counts(job%nranks), displacements(job%nranks), cursor(job%nranks), n, r, line, k, at
+         real(wp), allocatable :: everything(:, :)
+
+         n = size(local_slips, 2)
+         call MPI_Allgather(n, 1, MPI_INTEGER, counts, 1, MPI_INTEGER, job%comm)
+         displacements(1) = 0
+         do r = 2, job%nranks
+            displacements(r) = displacements(r - 1) + counts(r - 1)
+         end do
+         allocate (everything(n_slip_items, sum(counts)))
+         call MPI_Allgatherv(local_slips, n_slip_items * n, MPI_DOUBLE_PRECISION, everything, &
+            & n_slip_items * counts, n_slip_items * displacements, MPI_DOUBLE_PRECISION, job%comm)
+         allocate (self%slips(n_slip_items, sum(counts)))
+         cursor = displacements
+         at = 0
+         do line = 0, self%ran%ny - 1
+            r = mod(line, job%nranks) + 1
+            do k = cursor(r) + 1, displacements(r) + counts(r)
+               if (nint(everything(1, k)) /= line) exit
+               at = at + 1
+               self%slips(:, at) = everything(:, k)
+               cursor(r) = k
+            end do
+         end do
+      end subroutine gather_slips
 
       !> The quasistatic map's mean friction against the drag it leaves out.
       subroutine check_friction()
@@ -252,6 +310,7 @@ contains
          thermal%friction_sem = self%friction_sem
          thermal%time_step = self%time_step
          thermal%scheme = self%scheme
+         thermal%slips = self%slips
          call write_afm_file(path, job%comm, self%ran, self%first, job%nranks, self%trace, self%retrace, &
             & self%record, error, thermal=thermal)
       else if (self%three_d) then
