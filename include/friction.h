@@ -143,8 +143,10 @@ int friction_config_check(const friction_config *cfg, friction_error *err);
  * trace (forward != 0) or retrace (still stored by position), the lateral
  * force fx[i], fy[i] (nN) at the nx = scan.nx support positions of the
  * line, exactly as the program's file holds line `line` of /afm/trace
- * (/afm/retrace).  Every tip model, surface and potential.  n is the length
- * of fx and fy: n < scan.nx is FRICTION_ERROR_INPUT and nothing is written. */
+ * (/afm/retrace).  Every tip model, surface and potential; at a temperature
+ * (&thermal temperature > 0) the mean over the realizations, as the file
+ * holds it.  n is the length of fx and fy: n < scan.nx is
+ * FRICTION_ERROR_INPUT and nothing is written. */
 int friction_afm_line(const friction_config *cfg, int line, int forward, double *fx, double *fy, size_t n,
                       friction_error *err);
 
@@ -155,7 +157,9 @@ int friction_afm_line(const friction_config *cfg, int line, int forward, double 
  *          "trace/tip_x", "trace/tip_y" as (ny, nx) maps (also "trace/fz",
  *          "trace/tip_z" for a tip moving in z, "trace/jumps" for the
  *          quasistatic model); the same under "retrace/" and "friction"
- *          (ny, nN) when scan.retrace.
+ *          (ny, nN) when scan.retrace.  At a temperature the means over the
+ *          realizations, with their standard errors beside them as in the
+ *          file: "trace/fx_sem", ..., "friction_sem".
  *   brake: as /brake: "t", "x", "v", "y", "w", "stick" (1 stick, 0 slip) on
  *          the output grid; the events "events/t", "events/kind", "events/x",
  *          "events/v", "events/y", "events/w".  (&analysis and &verify are

@@ -4,7 +4,7 @@
     cli_test.py --binary BIN --mpiexec MPIEXEC --inputs DIR --workdir DIR CASE
 
 Cases: datasets-naf, datasets-hopg, ranks, override, force, numerical-failure, models,
-quasistatic-failure,
+quasistatic-failure, thermal-zero, thermal-ranks, thermal-equipartition,
 and bad-<name> for each bad input in BAD_INPUTS; for the brake scene
 brake-run, brake-ranks, brake-dimensional, brake-verify, brake-failure, brake-analysis and
 bad-brake-<name> for each bad input in BAD_BRAKE_INPUTS; for sweeps sweep-ranks,
@@ -79,6 +79,19 @@ BAD_INPUTS = {
                               ["bad.nml:3", "&tip", "cy", "> 0", "overdamped"]),
     "overdamped-no-damping-z": ("&surface potential = 'lj' /\n&tip model = 'overdamped', cz = 0.0 /\n", 3,
                                 ["bad.nml:2", "&tip", "cz", "overdamped"]),
+    # The microscope at a temperature (README: Friction at a temperature).
+    "thermal-negative-temperature": ("&thermal temperature = -1.0 /\n", 3,
+                                     ["bad.nml:1", "&thermal", "temperature = -1", ">= 0"]),
+    "thermal-undamped-axis": ("&thermal temperature = 300.0 /\n&tip\n  cy = 0.0\n/\n", 3,
+                              ["bad.nml:3", "&tip", "cy", "> 0", "temperature = 300", "heat bath"]),
+    "thermal-realizations": ("&thermal\n  temperature = 300.0\n  realizations = 0\n/\n", 3,
+                             ["bad.nml:3", "&thermal", "realizations = 0", ">= 1"]),
+    "thermal-step-above-limit": ("&thermal temperature = 300.0, time_step = 1.0e-4 /\n", 3,
+                                 ["bad.nml:1", "&thermal", "time_step", "stability limit"]),
+    "thermal-unknown-model": ("&thermal temperature = 300.0, model = 'metropolis' /\n", 3,
+                              ["bad.nml:1", "&thermal", "model", "metropolis", "langevin"]),
+    "thermal-quasistatic": ("&tip model = 'quasistatic' /\n&thermal temperature = 300.0 /\n", 3,
+                            ["bad.nml:1", "&tip", "model", "quasistatic", "thermal"]),
 }
 
 DOCUMENTED = ["fx", "fy", "f_along", "f_across", "tip_x", "tip_y"]
@@ -474,6 +487,189 @@ def case_wall_time(args):
             fail(f"message lacks {word!r}: {result.stderr}")
     if leftovers(args):
         fail(f"a stopped run left files: {leftovers(args)}")
+
+
+THERMAL_SMALL = ("&scan nx = 24, ny = 5, lead_in = 1.0 /\n"
+                 "&thermal temperature = 300.0, realizations = 3, seed = 7 /\n")
+
+
+def case_thermal_zero(args):
+    """temperature = 0 is the deterministic program bit for bit, whatever
+    the other &thermal variables say: every dataset and attribute (the
+    echoed input too) equals the run without &thermal; and 1 mK is close to
+    it."""
+    naf = os.path.join(args.inputs, "naf.nml")
+    small = write(args, "small.nml", SMALL)
+    zero = write(args, "zero.nml", "&thermal temperature = 0.0, seed = 99, realizations = 5, time_step = 1e-7 /\n")
+    friction(args, "-o", "plain.h5", naf, small)
+    friction(args, "-o", "zero.h5", naf, small, zero)
+    a, b = comparable(os.path.join(args.workdir, "plain.h5")), comparable(os.path.join(args.workdir, "zero.h5"))
+    if a.keys() != b.keys():
+        fail(f"T = 0 wrote other objects: {set(a) ^ set(b)}")
+    for key, value in a.items():
+        if not np.array_equal(np.asarray(value), np.asarray(b[key])):
+            fail(f"{key} differs at temperature = 0")
+    # A small temperature converges to it: at 1 mK the fluctuations are
+    # sqrt(k k_B T) = 4e-4 nN, and what is left is the two integrators'
+    # difference (BAOAB at its fixed step against rkf45 at rtol 1e-3),
+    # measured at most 1.5e-4 nN on the lines' friction and 6e-3 nN on a
+    # sample (in mid-slip, where the force changes fastest).
+    cold = write(args, "cold.nml", "&thermal temperature = 1.0e-3, realizations = 2 /\n")
+    friction(args, "-o", "cold.h5", naf, small, cold)
+    with h5py.File(os.path.join(args.workdir, "plain.h5"), "r") as f, \
+            h5py.File(os.path.join(args.workdir, "cold.h5"), "r") as g:
+        lines = np.max(np.abs(f["afm/friction"][()] - g["afm/friction"][()]))
+        samples = max(np.max(np.abs(f[f"afm/{trip}/{q}"][()] - g[f"afm/{trip}/{q}"][()]))
+                      for trip in ("trace", "retrace") for q in ("fx", "fy"))
+        print(f"1 mK against T = 0: friction within {lines:.2e} nN, samples within {samples:.2e} nN")
+        if lines > 1e-3 or samples > 0.05:
+            fail(f"1 mK is not close to T = 0: friction {lines} nN, samples {samples} nN apart")
+
+
+def thermal_friction(path):
+    """The map's mean friction over its lines and its standard error (from
+    the lines' standard errors: the lines are independent)."""
+    with h5py.File(path, "r") as f:
+        lines, sems = f["afm/friction"][()], f["afm/friction_sem"][()]
+    return lines.mean(), np.sqrt(np.sum(sems ** 2)) / len(lines)
+
+
+def case_thermal_ranks(args):
+    """At 300 K (3 realizations, a lead-in): the documented datasets, the
+    mean and its standard error of every sample and line, the slips in
+    order (mostly forward, with the force along the support's motion), the
+    same file bit for bit on 1, 2 and 3 ranks and from the echoed input;
+    another seed gives other samples and a consistent mean friction."""
+    naf = os.path.join(args.inputs, "naf.nml")
+    small = write(args, "thermal.nml", THERMAL_SMALL)
+    files = {}
+    for n in (1, 2, 3):
+        friction(args, "-o", f"t_{n}.h5", naf, small, ranks=n)
+        files[n] = comparable(os.path.join(args.workdir, f"t_{n}.h5"))
+    for n in (2, 3):
+        if files[1].keys() != files[n].keys():
+            fail(f"1 and {n} ranks wrote different objects: {set(files[1]) ^ set(files[n])}")
+        for key, value in files[1].items():
+            if not np.array_equal(np.asarray(value), np.asarray(files[n][key])):
+                fail(f"{key} differs between 1 and {n} ranks")
+    path = os.path.join(args.workdir, "t_1.h5")
+    with h5py.File(path, "r") as f:
+        if f.attrs["method"].decode() != "baoab":
+            fail(f"root method = {f.attrs['method']!r}, expected 'baoab'")
+        if f.attrs["integrator_steps"] <= 0:
+            fail("no Langevin steps counted")
+        attrs = f["afm"].attrs
+        for name, value, unit in (("temperature", 300.0, "K"), ("time_step", None, "s")):
+            if name not in attrs or attrs[name + "_units"].decode() != unit:
+                fail(f"/afm attribute {name} with units {unit} missing")
+            if value is not None and attrs[name] != value:
+                fail(f"/afm attribute {name} = {attrs[name]}, expected {value}")
+        if attrs["seed"] != 7 or attrs["realizations"] != 3 or attrs["scheme"].decode() != "baoab":
+            fail(f"/afm seed, realizations, scheme: {attrs['seed']}, {attrs['realizations']}, {attrs['scheme']}")
+        # the step divides the sample interval (20 Å / 23 at 400 Å/s)
+        steps = 20.0 / 23 / 400.0 / attrs["time_step"]
+        if abs(steps - round(steps)) > 1e-6:
+            fail(f"the Langevin step does not divide the sample interval: {steps} steps")
+        text = namelist_text(f)
+        if "&THERMAL" not in text or "TEMPERATURE=300.0" not in text:
+            fail("the echoed input lacks &thermal:\n" + text)
+        expect = {"afm/friction": (5,), "afm/friction_sem": (5,)}
+        for trip in ("trace", "retrace"):
+            for name in DOCUMENTED:
+                expect[f"afm/{trip}/{name}"] = (5, 24)
+                expect[f"afm/{trip}/{name}_sem"] = (5, 24)
+        for name, shape in expect.items():
+            if name not in f or f[name].shape != shape:
+                fail(f"/{name} missing or not of shape {shape}")
+            if "units" not in f[name].attrs:
+                fail(f"/{name} has no units attribute")
+            if not np.all(np.isfinite(f[name][()])):
+                fail(f"/{name} has non-finite values")
+        for trip in ("trace", "retrace"):
+            if not np.all(f[f"afm/{trip}/fx_sem"][()] > 0):
+                fail(f"/afm/{trip}/fx_sem is not positive everywhere (a lead-in thermalizes the first sample)")
+        friction_expected = 0.5 * (f["afm/trace/f_along"][()].mean(axis=1)
+                                   - f["afm/retrace/f_along"][()].mean(axis=1))
+        if np.max(np.abs(friction_expected - f["afm/friction"][()])) > 1e-12:
+            fail("/afm/friction is not half the trace-retrace difference of the mean force")
+        # The slips of every line, realization and trip, in that order.
+        slips = {name: f[f"afm/slips/{name}"][()] for name in
+                 ("line", "realization", "trip", "support", "force", "jump", "jump_across")}
+        if len({len(v) for v in slips.values()}) != 1 or len(slips["line"]) < 5 * 3 * 2 * 3:
+            fail(f"/afm/slips: {len(slips['line'])} slips, expected a few per trip on 20 Å of NaF")
+        for name, unit in (("support", "angstrom"), ("force", "nN"), ("jump", "angstrom"),
+                           ("jump_across", "angstrom")):
+            if f[f"afm/slips/{name}"].attrs["units"].decode() != unit:
+                fail(f"/afm/slips/{name} is not in {unit}")
+        order = slips["line"] * 6 + slips["realization"] * 2 + slips["trip"]
+        if np.any(np.diff(order) < 0) or slips["line"].max() > 4 or slips["realization"].max() > 2:
+            fail("/afm/slips is not ordered by line, realization and trip")
+        if np.any(np.hypot(slips["jump"], slips["jump_across"]) < 0.5) \
+                or np.any((slips["support"] < 0) | (slips["support"] > 20)):
+            fail("a slip with a jump below 0.5 Å or outside the line")
+        trace = slips["trip"] == 0
+        forward = slips["jump"] > 0
+        if np.mean(forward) < 0.8 or np.mean(slips["force"][trace & forward] > 0) < 0.9 \
+                or np.mean(slips["force"][~trace & forward] < 0) < 0.9:
+            fail("slips are not mostly forward, pulled by the force along the support's motion")
+        echoed = f.attrs["input"].decode()
+    friction(args, "-o", "echo.h5", write(args, "echo.nml", echoed))
+    again = comparable(os.path.join(args.workdir, "echo.h5"))
+    for key, value in files[1].items():
+        if not np.array_equal(np.asarray(value), np.asarray(again[key])):
+            fail(f"{key} differs when run from the echoed input")
+    other = write(args, "seed.nml", "&thermal seed = 8 /\n")
+    friction(args, "-o", "seed8.h5", naf, small, other)
+    with h5py.File(os.path.join(args.workdir, "seed8.h5"), "r") as f:
+        if np.array_equal(f["afm/trace/fx"][()], files[1]["afm/trace/fx"]):
+            fail("seeds 7 and 8 gave the same samples")
+    (m7, s7), (m8, s8) = thermal_friction(path), thermal_friction(os.path.join(args.workdir, "seed8.h5"))
+    print(f"mean friction: seed 7 {m7:.4f} +- {s7:.4f} nN, seed 8 {m8:.4f} +- {s8:.4f} nN")
+    if abs(m7 - m8) > 3 * np.hypot(s7, s8):
+        fail(f"seeds 7 and 8: mean friction {m7} +- {s7} and {m8} +- {s8} nN differ by more than 3 SE")
+
+
+def case_thermal_equipartition(args):
+    """On a flat surface (V0 = 0) at 300 K with the support at 400 Å/s, for
+    the inertial tip (BAOAB) and the overdamped one (Leimkuhler–Matthews),
+    through the whole program on 2 ranks: per axis the variance of the
+    spring force over the realizations (realizations × sem²) is k k_B T
+    (k<δu²> = k_B T), and the mean friction is the drag c v; each within 3
+    standard errors, from the scatter over the 24 independent lines, the
+    variance's below 1 %.  Both schemes are exact for k<δu²> at any stable
+    step; BAOAB's drag is low by (γh)²/12 = 2e-4, far below the statistics.
+    A 2 Å lead-in starts every sample in equilibrium.  A flat surface has
+    no slips."""
+    k, c, v = 10.0, 1.0e-3, 400.0            # N/m, N s/m, Å/s
+    kt = 1.380649e-23 * 300.0                 # J
+    variance = k * kt * 1e18                  # (N/m)(J) = N², in nN²
+    drag = c * v * 1e-10 * 1e9                # nN
+    naf = os.path.join(args.inputs, "naf.nml")
+    for model in ("inertial", "overdamped"):
+        text = ("&surface v0 = 0.0 /\n"
+                f"&tip model = '{model}' /\n"
+                "&scan nx = 64, ny = 24, lead_in = 2.0 /\n"
+                "&thermal temperature = 300.0, realizations = 16, seed = 11 /\n")
+        out = f"flat_{model}.h5"
+        friction(args, "-o", out, naf, write(args, f"flat_{model}.nml", text), ranks=2)
+        with h5py.File(os.path.join(args.workdir, out), "r") as f:
+            n = f["afm"].attrs["realizations"]
+            for axis in ("fx", "fy"):
+                per_line = np.concatenate([n * f[f"afm/{trip}/{axis}_sem"][()] ** 2
+                                           for trip in ("trace", "retrace")], axis=1).mean(axis=1)
+                ratio, se = per_line.mean() / variance, per_line.std(ddof=1) / np.sqrt(len(per_line)) / variance
+                print(f"{model} {axis}: k<du^2>/kT = {ratio:.4f} +- {se:.4f}")
+                if se > 0.01:
+                    fail(f"{model} {axis}: standard error {se} of k<du^2>/kT above 1 %")
+                if abs(ratio - 1.0) > 3 * se:
+                    fail(f"{model} {axis}: k<du^2>/kT = {ratio} +- {se}, not 1 within 3 SE")
+            if len(f["afm/slips/line"]) != 0:
+                fail(f"{model}: slips on a flat surface")
+            lines = f["afm/friction"][()]
+            mean, se = lines.mean(), lines.std(ddof=1) / np.sqrt(len(lines))
+            print(f"{model}: friction = {mean:.5f} +- {se:.5f} nN, drag c v = {drag:.5f} nN")
+            if abs(mean - drag) > 3 * se:
+                fail(f"{model}: mean friction {mean} +- {se} nN is not the drag c v = {drag} nN within 3 SE")
 
 
 def case_bad(args, name):
@@ -996,7 +1192,8 @@ def main():
          "numerical-failure": case_numerical_failure, "wall-time": case_wall_time,
          "graphite": case_graphite, "models": case_models, "quasistatic-failure": case_quasistatic_failure,
          "graphite-ranks": case_graphite_ranks, "graphite-defects": case_graphite_defects,
-         "input-roundtrip": case_input_roundtrip}[args.case](args)
+         "input-roundtrip": case_input_roundtrip, "thermal-zero": case_thermal_zero,
+         "thermal-ranks": case_thermal_ranks, "thermal-equipartition": case_thermal_equipartition}[args.case](args)
     print("1 passed, 0 failed")
 
 

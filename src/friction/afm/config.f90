@@ -17,11 +17,13 @@ module friction_afm_config
    use friction_parameters, only: configurable, parameter_visitor
    use friction_checks, only: config_checker
    use friction_ode_settings, only: visit_integrator, check_integrator
+   use friction_afm_thermal, only: thermal_settings
+   use friction_afm_langevin, only: langevin_time_step, largest_curvature
    implicit none
    private
 
    public :: afm_config, potential_names, net_names, tip_model_names, new_potential, new_tip, net_sites, max_species, &
-      & max_defects, species_count
+      & max_defects, species_count, surface_curvature, thermal_step_limit
 
    character(len=*), parameter :: potential_names(3) = [character(len=4) :: 'naf', 'hopg', 'lj']
    character(len=*), parameter :: net_names(3) = [character(len=8) :: 'graphite', 'square', 'file']
@@ -78,6 +80,8 @@ module friction_afm_config
       logical :: retrace = .true.      !! scan every line back as well
       ! &integrator
       type(solver_settings) :: solver
+      ! &thermal
+      type(thermal_settings) :: thermal
    contains
       procedure :: visit
       procedure :: validate
@@ -87,7 +91,7 @@ module friction_afm_config
 
 contains
 
-   !> The groups &surface, &tip, &scan and &integrator (docs/input.md).
+   !> The groups &surface, &tip, &scan, &integrator and &thermal (docs/input.md).
    subroutine visit(self, v)
       class(afm_config), intent(inout) :: self
       type(parameter_visitor), intent(inout) :: v
@@ -135,6 +139,7 @@ contains
       call v%item('retrace', self%retrace)
       call v%end_group()
       call visit_integrator(self%solver, v, 's')
+      call self%thermal%visit(v)
    end subroutine visit
 
    !> Every value of the map's groups, or the first bad one to `c`.
@@ -180,8 +185,40 @@ contains
          & //' samples, more than 2147483647 per dataset (and '//bytes_text(8.0_wp * n_trip_quantities &
          & * real(self%nx, wp) * self%ny)//' of memory for the trace alone)')
       call check_integrator(self%solver, c)
+      call self%thermal%validate(c)
+      if (.not. c%failed() .and. self%thermal%enabled()) call check_thermal()
 
    contains
+
+      !> At T > 0: a tip model with thermal motion, a heat bath on every
+      !> moving axis, a surface the thermal scan supports, and a step below
+      !> the Langevin integrator's stability limit.
+      subroutine check_thermal()
+         real(wp) :: limit
+         character(len=:), allocatable :: at
+
+         at = ' at &thermal temperature = '//rtoa(self%thermal%temperature)//' K'
+         if (self%model == 'quasistatic') then
+            call c%reject('tip', 'model', "'quasistatic'", 'has no thermal motion'//at//": use 'inertial' " &
+               & //"or 'overdamped' (the thermal reduced model is not available yet)")
+            return
+         end if
+         if (self%potential == 'lj') then
+            call c%reject('thermal', 'temperature', rtoa(self%thermal%temperature), "is not available yet for " &
+               & //"potential = 'lj' (the lattice-sum surface): use 'naf' or 'hopg', or temperature = 0")
+            return
+         end if
+         ! Fluctuation-dissipation: the bath that heats an axis is its damper.
+         if (.not. (self%cx > 0.0_wp)) call c%reject('tip', 'cx', rtoa(self%cx), 'must be > 0 (N s/m)'//at// &
+            & ': the heat bath acts through the damper (fluctuation-dissipation), an undamped axis has none')
+         if (.not. (self%cy > 0.0_wp)) call c%reject('tip', 'cy', rtoa(self%cy), 'must be > 0 (N s/m)'//at// &
+            & ': the heat bath acts through the damper (fluctuation-dissipation), an undamped axis has none')
+         if (c%failed() .or. self%thermal%time_step == 0.0_wp) return
+         limit = thermal_step_limit(self)
+         if (limit > 0.0_wp .and. self%thermal%time_step >= limit) call c%reject('thermal', 'time_step', &
+            & rtoa(self%thermal%time_step), 'is at or above the stability limit '//rtoa(limit)//' s of the ' &
+            & //'Langevin integrator (2/omega_max inertial, 2 c/k_max overdamped; 0 chooses a step)')
+      end subroutine check_thermal
 
       !> The overdamped model divides by the damping of every moving direction.
       subroutine require_damped(name, value)
@@ -399,6 +436,44 @@ contains
          call fatal_error(error, "unknown potential '"//trim(config%potential)//"'", error_input)
       end select
    end subroutine new_potential
+
+   !> The largest curvature of the surface (eV/Å², >= 0) over one lattice
+   !> cell, the Langevin step's scale (friction_afm_langevin): NaF over
+   !> ax × ay, HOPG over the rectangular cell a × a√3, on 32² points; 0 for
+   !> other surfaces.
+   function surface_curvature(config, potential) result(curvature)
+      type(afm_config), intent(in) :: config
+      class(surface_potential), intent(in) :: potential
+      real(wp) :: curvature
+
+      select case (trim(config%potential))
+      case ('naf')
+         curvature = largest_curvature(potential, [0.0_wp, 0.0_wp], [config%ax, config%ay], 32)
+      case ('hopg')
+         curvature = largest_curvature(potential, [0.0_wp, 0.0_wp], [config%a, sqrt(3.0_wp) * config%a], 32)
+      case default
+         curvature = 0.0_wp
+      end select
+   end function surface_curvature
+
+   !> The stability limit of the Langevin step for the settings' tip and
+   !> surface, s (0 when it cannot be told: a surface or tip that does not
+   !> build).
+   function thermal_step_limit(config) result(limit)
+      type(afm_config), intent(in) :: config
+      real(wp) :: limit
+      class(surface_potential), allocatable :: potential
+      type(afm_tip) :: tip
+      type(error_type), allocatable :: error
+      real(wp) :: dt
+
+      limit = 0.0_wp
+      call new_potential(config, potential, error)
+      if (allocated(error)) return
+      call new_tip(config, potential, tip)
+      call langevin_time_step(tip, surface_curvature(config, potential), dt, limit, error)
+      if (allocated(error)) limit = 0.0_wp
+   end function thermal_step_limit
 
    !> The tip model in internal units around a potential; the support path
    !> is set per trip.  The quasistatic model uses the damping only to relax

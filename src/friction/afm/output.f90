@@ -16,7 +16,7 @@ module friction_afm_output
    implicit none
    private
 
-   public :: write_afm_file, line_friction, afm_surface_record
+   public :: write_afm_file, line_friction, afm_surface_record, afm_thermal_record
 
    !> The sample of a lattice-sum scene, for pictures that overlay it.
    type :: afm_surface_record
@@ -26,6 +26,20 @@ module friction_afm_output
       real(wp) :: contact_height = 0.0_wp   !! Å
       real(wp) :: support_height = 0.0_wp   !! Å
    end type afm_surface_record
+
+   !> A map at a temperature (README: Friction at a temperature): this
+   !> rank's standard errors over the realizations, of every sample
+   !> (trace_sem(:, j, q) beside trace(:, j, q)) and of every line's
+   !> friction; the Langevin step and scheme.
+   type :: afm_thermal_record
+      real(wp), allocatable :: trace_sem(:, :, :), retrace_sem(:, :, :)
+      real(wp), allocatable :: friction_sem(:)
+      real(wp) :: time_step = 0.0_wp
+      character(len=:), allocatable :: scheme
+      !> every rank's slips, the same on every rank: line, realization,
+      !> trip, support (Å), force (nN), jump along and across (Å) for each
+      real(wp), allocatable :: slips(:, :)
+   end type afm_thermal_record
 
 
 contains
@@ -45,8 +59,14 @@ contains
 
    !> Write the scan.  trace(:, j, q) holds quantity q of local line j, which
    !> is line first + (j - 1) * stride of the map (0-based); retrace likewise
-   !> when config%retrace.
-   subroutine write_afm_file(path, comm, config, first, stride, trace, retrace, summary, error, surface)
+   !> when config%retrace.  At a temperature trace and retrace are the means
+   !> over the realizations, and `thermal` holds their standard errors: each
+   !> dataset NAME gets NAME_sem beside it, /afm/friction (the mean) gets
+   !> /afm/friction_sem, and /afm the attributes temperature, seed,
+   !> realizations, time_step (the Langevin step used) and scheme; and the
+   !> slips, /afm/slips/line, realization, trip, support, force, jump,
+   !> jump_across.
+   subroutine write_afm_file(path, comm, config, first, stride, trace, retrace, summary, error, surface, thermal)
       character(len=*), intent(in) :: path
       type(MPI_Comm), intent(in) :: comm
       type(afm_config), intent(in) :: config
@@ -56,6 +76,8 @@ contains
       type(error_type), allocatable, intent(out) :: error
       !> present for a tip moving in 3D over a crystal net
       type(afm_surface_record), intent(in), optional :: surface
+      !> present at a temperature
+      type(afm_thermal_record), intent(in), optional :: thermal
       type(h5_file) :: file
       type(error_type), allocatable :: close_error
       type(afm_config) :: copy
@@ -66,7 +88,11 @@ contains
          call file%close(close_error)
          return
       end if
-      call write_run_attributes(file, 'afm', trim(config%solver%method), summary)
+      if (present(thermal)) then
+         call write_run_attributes(file, 'afm', thermal%scheme, summary)
+      else
+         call write_run_attributes(file, 'afm', trim(config%solver%method), summary)
+      end if
 
       call file%create_group('/afm')
       call file%write_attribute_text('/afm', 'potential', trim(config%potential))
@@ -86,29 +112,58 @@ contains
          call file%write_attribute_text('/surface', 'species_names', join(surface%species_names))
          call file%write_attribute_real('/surface', 'cutoff', surface%cutoff, 'angstrom')
       end if
+      if (present(thermal)) then
+         call file%write_attribute_real('/afm', 'temperature', config%thermal%temperature, 'K')
+         call file%write_attribute_integer('/afm', 'seed', config%thermal%seed)
+         call file%write_attribute_integer('/afm', 'realizations', int(config%thermal%realizations, i8))
+         call file%write_attribute_real('/afm', 'time_step', thermal%time_step, 's')
+         call file%write_attribute_text('/afm', 'scheme', thermal%scheme)
+      end if
       copy = config
       call write_parameter_attributes(file, '/afm', copy, [character(len=8) :: 'surface', 'tip', 'scan'])
       call write_trips('/afm/trace', trace)
+      if (present(thermal)) call write_trips('/afm/trace', thermal%trace_sem, '_sem')
       if (config%retrace) then
          call write_trips('/afm/retrace', retrace)
+         if (present(thermal)) call write_trips('/afm/retrace', thermal%retrace_sem, '_sem')
          call file%write_vector_block('/afm/friction', line_friction(trace, retrace), &
             & config%ny, first, stride, 'nN')
+         if (present(thermal)) call file%write_vector_block('/afm/friction_sem', thermal%friction_sem, &
+            & config%ny, first, stride, 'nN')
+      end if
+      if (present(thermal)) then
+         call file%create_group('/afm/slips')
+         call file%write_integer_vector('/afm/slips/line', nint(thermal%slips(1, :)))
+         call file%write_integer_vector('/afm/slips/realization', nint(thermal%slips(2, :)))
+         call file%write_integer_vector('/afm/slips/trip', nint(thermal%slips(3, :)))
+         call file%write_vector('/afm/slips/support', thermal%slips(4, :), 'angstrom')
+         call file%write_vector('/afm/slips/force', thermal%slips(5, :), 'nN')
+         call file%write_vector('/afm/slips/jump', thermal%slips(6, :), 'angstrom')
+         call file%write_vector('/afm/slips/jump_across', thermal%slips(7, :), 'angstrom')
       end if
       call file%close(error)
 
    contains
 
-      subroutine write_trips(group, values)
+      !> The datasets of a trip's quantities, their names + suffix ('_sem').
+      subroutine write_trips(group, values, suffix)
          character(len=*), intent(in) :: group
          real(wp), intent(in) :: values(:, :, :)
+         character(len=*), intent(in), optional :: suffix
+         character(len=:), allocatable :: tail
 
-         call file%create_group(group)
+         tail = ''
+         if (present(suffix)) then
+            tail = suffix
+         else
+            call file%create_group(group)
+         end if
          do q = 1, nq
-            call file%write_line_block(group//'/'//trim(quantity_names(q)), values(:, :, q), &
+            call file%write_line_block(group//'/'//trim(quantity_names(q))//tail, values(:, :, q), &
                & config%ny, first, stride, trim(quantity_units(q)))
          end do
-         if (config%model == 'quasistatic') call file%write_line_block(group//'/'//trim(quantity_names(q_jumps)), &
-            & values(:, :, q_jumps), config%ny, first, stride, trim(quantity_units(q_jumps)))
+         if (config%model == 'quasistatic') call file%write_line_block(group//'/'//trim(quantity_names(q_jumps)) &
+            & //tail, values(:, :, q_jumps), config%ny, first, stride, trim(quantity_units(q_jumps)))
       end subroutine write_trips
 
    end subroutine write_afm_file

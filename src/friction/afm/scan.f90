@@ -14,12 +14,38 @@
 !> followed from sample to sample along its minimum of the total energy
 !> (friction_afm_quasistatic), and jumps to the next minimum where its own
 !> disappears (see follow).
+!>
+!> At a temperature (&thermal temperature > 0; README: Friction at a
+!> temperature) a trip is integrated with the Langevin tip
+!> (friction_afm_langevin: BAOAB, or Leimkuhler–Matthews without inertia) at
+!> a fixed step, the largest not above the chosen one that divides the
+!> sample interval (and the lead-in) into whole steps, so that samples fall
+!> on steps.  The tip starts at the support with a velocity drawn from the
+!> bath's Maxwell–Boltzmann distribution; the noise is the random stream of
+!> (seed, line, trip, realization), trip 0 the trace and 1 the retrace, so
+!> a trip's samples depend on nothing else (not on the ranks).  run_line
+!> gives a line's trips over all realizations: the mean of every sample,
+!> its standard error, and the friction with its standard error.
+!>
+!> Slips at a temperature (see check_slips): every check_distance of
+!> support travel (and at every sample) the tip's state is quenched, by
+!> Newton's method on the total energy (friction_afm_kramers'
+!> find_minimum), into the minimum whose basin it is in; a slip is a change
+!> of that minimum by more than slip_distance.  Recorded: where the support
+!> was and the force along the scan at the last check before the slip, and
+!> the jump of the minimum along the support's motion (negative for a slip
+!> back) and across the scan.  The checks split the Langevin steps into calls, which leaves the
+!> trajectory bit for bit as it is.
 module friction_afm_scan
    use friction_kinds, only: wp, i8, pi, ev_per_angstrom_to_nn
    use friction_error, only: error_type, fatal_error, error_input, error_numerical
    use friction_ode_solver, only: ode_solver, integrator_statistics
-   use friction_afm_config, only: afm_config, new_tip
+   use friction_afm_config, only: afm_config, new_tip, surface_curvature
    use friction_afm_tip, only: afm_tip, model_inertial, model_quasistatic
+   use friction_afm_thermal, only: welford_add, welford_sem
+   use friction_afm_langevin, only: langevin_integrator, langevin_state, langevin_time_step
+   use friction_afm_kramers, only: find_minimum
+   use friction_random, only: random_stream
    use friction_afm_quasistatic, only: newton_equilibrium, equilibrium_tangent
    use friction_surface_potential, only: surface_potential
    use friction_surface_lennard_jones, only: lj_potential
@@ -30,7 +56,7 @@ module friction_afm_scan
 
    public :: afm_scanner, trip_record, quantity_names, quantity_units, n_quantities, quantity_count
    public :: q_fx, q_fy, q_f_along, q_f_across, q_tip_x, q_tip_y, q_fz, q_tip_z, q_jumps
-   public :: support_along, support_across, find_height, support_at, line_offset
+   public :: support_along, support_across, find_height, support_at, line_offset, line_record, slip_list
 
    integer, parameter :: n_quantities = 9
    integer, parameter :: q_fx = 1, q_fy = 2, q_f_along = 3, q_f_across = 4, q_tip_x = 5, q_tip_y = 6, &
@@ -52,11 +78,45 @@ module friction_afm_scan
    !> it; relaxation stretches (of 10 relaxation times) before giving up.
    real(wp), parameter :: fold_resolution = 1.0e-9_wp, jump_push = 0.05_wp, landing_distance = 0.05_wp
    integer, parameter :: max_stretches = 100000
+   !> Slips at a temperature (see check_slips): the support travel between
+   !> two quenches, Å (in a stick the force then changes by the stick slope
+   !> times 0.05 Å, ~0.04 nN on NaF, below its thermal spread sqrt(k k_B T)
+   !> = 0.2 nN at 300 K; the quenches, ~3 µs each, then add about 10 % to
+   !> the inertial tip's cost and 40 % to the overdamped one's on NaF at
+   !> 400 Å/s); the jump of
+   !> the quenched minimum that is a slip, Å (below any well spacing of NaF
+   !> or HOPG, above any drift of a minimum between two checks).
+   real(wp), parameter :: check_distance = 0.05_wp, slip_distance = 0.5_wp
 
    !> One trip's samples: values(i, q) for sample i and quantity q (output units).
    type :: trip_record
       real(wp), allocatable :: values(:, :)
    end type trip_record
+
+   !> One line over all realizations (run_line): per trip the mean of every
+   !> sample, values(i, q) as trip_record's, and its standard error over the
+   !> realizations (NaN for one realization; 0 at T = 0, where there is one
+   !> deterministic trip); the line's friction (half the difference of the
+   !> mean force along on trace and retrace) and its standard error.
+   !> Slips in the order they happened: realization (0-based), trip (0
+   !> trace, 1 retrace), support position along the line (Å, as
+   !> support_along), force along the scan before the slip (nN), jump of
+   !> the minimum along the support's motion and across the scan (Å).
+   type :: slip_list
+      integer :: n = 0
+      integer, allocatable :: realization(:), trip(:)
+      real(wp), allocatable :: support(:), force(:), jump(:), jump_across(:)
+   contains
+      procedure :: clear => slips_clear
+      procedure :: add => slips_add
+   end type slip_list
+
+   type :: line_record
+      real(wp), allocatable :: trace(:, :), retrace(:, :)
+      real(wp), allocatable :: trace_sem(:, :), retrace_sem(:, :)
+      real(wp) :: friction = 0.0_wp, friction_sem = 0.0_wp
+      type(slip_list) :: slips   !! at a temperature
+   end type line_record
 
    !> Integrates trips of one scene; owns one tip model and its solver.
    type :: afm_scanner
@@ -67,9 +127,21 @@ module friction_afm_scan
       integer(i8) :: clock_start = 0, clock_rate = 1   !! wall clock at init, for max_wall_time
       real(wp) :: contact_height = 0.0_wp   !! z0: free tip's equilibrium height at the origin, Å (3D)
       real(wp) :: support_height = 0.0_wp   !! z_M = z0 + support_z, Å (3D)
+      ! At a temperature (config%thermal)
+      logical :: thermal = .false.
+      type(langevin_integrator) :: langevin        !! the step between samples
+      type(langevin_integrator) :: lead_langevin   !! the step of the lead-in
+      integer :: sample_steps = 0                  !! Langevin steps between two samples
+      integer :: lead_steps = 0                    !! Langevin steps of the lead-in
+      integer :: check_steps = 0                   !! Langevin steps between two slip checks
+      integer(i8) :: langevin_steps = 0, force_evaluations = 0
+      type(random_stream) :: stream
    contains
       procedure :: init
       procedure :: run_trip
+      procedure :: run_thermal_trip
+      procedure :: run_line
+      procedure :: time_step
       procedure :: statistics
       procedure, private :: follow
       procedure, private :: relax
@@ -166,7 +238,294 @@ contains
       ! (An h_min above the automatic first step raises it, as for the brake.)
       if (self%h_start <= 0.0_wp) self%h_start = max(1.0e-3_wp * period, config%solver%h_min)
       call self%solver%init(self%tip, config%solver, self%h_start, error)
+      if (allocated(error)) return
+      self%thermal = config%thermal%enabled()
+      if (self%thermal) call init_thermal()
+
+   contains
+
+      !> The Langevin steps: the largest not above the chosen one (the
+      !> input's time_step, or langevin_time_step's default) that divide the
+      !> sample interval and the lead-in into whole steps.
+      subroutine init_thermal()
+         real(wp) :: curvature, dt, limit, lead_time
+
+         curvature = surface_curvature(config, potential)
+         call langevin_time_step(self%tip, curvature, dt, limit, error)
+         if (allocated(error)) return
+         if (config%thermal%time_step > 0.0_wp) dt = config%thermal%time_step
+         if (max(sample_time, config%lead_in / config%velocity) / dt > 1.0e9_wp) then
+            call fatal_error(error, 'Langevin: a step of '//rtoa(dt)//' s makes more than 1e9 steps between ' &
+               & //'two samples', error_input)
+            return
+         end if
+         self%sample_steps = max(1, ceiling(sample_time / dt))
+         call self%langevin%init(self%tip, config%thermal%temperature, sample_time / self%sample_steps, error, &
+            & curvature=curvature)
+         if (allocated(error)) return
+         self%check_steps = max(1, min(self%sample_steps, &
+            & int(check_distance / (config%velocity * self%langevin%dt))))
+         lead_time = config%lead_in / config%velocity
+         self%lead_steps = 0
+         if (lead_time > 0.0_wp) then
+            self%lead_steps = max(1, ceiling(lead_time / dt))
+            call self%lead_langevin%init(self%tip, config%thermal%temperature, lead_time / self%lead_steps, &
+               & error, curvature=curvature)
+         end if
+      end subroutine init_thermal
+
    end subroutine init
+
+   !> The Langevin step between samples, s (0 at T = 0).
+   pure real(wp) function time_step(self)
+      class(afm_scanner), intent(in) :: self
+
+      time_step = 0.0_wp
+      if (self%thermal) time_step = self%langevin%dt
+   end function time_step
+
+   !> Line j (0-based) over all realizations: its trace, and its retrace
+   !> when the configuration scans back or `with_retrace` asks for it
+   !> (line_record).  At T = 0 the deterministic trips (run_trip), standard
+   !> errors 0.
+   subroutine run_line(self, j, line, error, with_retrace)
+      class(afm_scanner), intent(inout) :: self
+      integer, intent(in) :: j
+      type(line_record), intent(inout) :: line
+      type(error_type), allocatable, intent(out) :: error
+      logical, intent(in), optional :: with_retrace
+      type(trip_record) :: trace, retrace
+      real(wp) :: friction, m2
+      integer :: r, nx, n
+      logical :: back
+
+      nx = self%config%nx
+      back = self%config%retrace
+      if (present(with_retrace)) back = with_retrace
+      if (.not. self%thermal) then
+         call self%run_trip(j, .true., trace, error)
+         if (allocated(error)) return
+         line%trace = trace%values
+         line%trace_sem = 0.0_wp * trace%values
+         if (back) then
+            call self%run_trip(j, .false., retrace, error)
+            if (allocated(error)) return
+            line%retrace = retrace%values
+            line%retrace_sem = 0.0_wp * retrace%values
+            line%friction = 0.5_wp * (sum(trace%values(:, q_f_along)) - sum(retrace%values(:, q_f_along))) / nx
+            line%friction_sem = 0.0_wp
+         end if
+         return
+      end if
+      n = self%config%thermal%realizations
+      if (allocated(line%trace)) deallocate (line%trace, line%trace_sem)
+      if (allocated(line%retrace)) deallocate (line%retrace, line%retrace_sem)
+      allocate (line%trace(nx, n_quantities), line%trace_sem(nx, n_quantities))
+      if (back) allocate (line%retrace(nx, n_quantities), line%retrace_sem(nx, n_quantities))
+      line%friction = 0.0_wp
+      m2 = 0.0_wp
+      call line%slips%clear()
+      do r = 1, n
+         call self%run_thermal_trip(j, .true., r - 1, trace, error, line%slips)
+         if (allocated(error)) return
+         ! (the sums of squares go in the _sem arrays until the end)
+         call welford_add(line%trace, line%trace_sem, trace%values, r)
+         if (.not. back) cycle
+         call self%run_thermal_trip(j, .false., r - 1, retrace, error, line%slips)
+         if (allocated(error)) return
+         call welford_add(line%retrace, line%retrace_sem, retrace%values, r)
+         friction = 0.5_wp * (sum(trace%values(:, q_f_along)) - sum(retrace%values(:, q_f_along))) / nx
+         call welford_add(line%friction, m2, friction, r)
+      end do
+      line%trace_sem = welford_sem(line%trace_sem, n)
+      if (back) then
+         line%retrace_sem = welford_sem(line%retrace_sem, n)
+         line%friction_sem = welford_sem(m2, n)
+      end if
+   end subroutine run_line
+
+   !> One Langevin trip along line j (0-based), trace when forward, with the
+   !> noise of realization (0-based): samples as run_trip's; the slips
+   !> between the first and the last sample appended to `slips` when given.
+   subroutine run_thermal_trip(self, j, forward, realization, record, error, slips)
+      class(afm_scanner), intent(inout) :: self
+      integer, intent(in) :: j, realization
+      logical, intent(in) :: forward
+      type(trip_record), intent(inout) :: record
+      type(error_type), allocatable, intent(out) :: error
+      type(slip_list), intent(inout), optional :: slips
+      type(langevin_state) :: state
+      real(wp) :: along(3), across(3), line_start(3), offset(self%config%ny), s_start, force(3), tip_r(3), t
+      real(wp) :: u0(3), minimum(3), last_support, last_force, motion(3)
+      integer(i8) :: now
+      integer :: i, k, nx, nd, done, n
+      logical :: in_well
+      character(len=128) :: where
+
+      associate (c => self%config, tip => self%tip)
+         nx = c%nx
+         along = c%scan_direction()
+         across = c%across_direction()
+         offset = support_across(c)
+         line_start = [c%origin_x, c%origin_y, 0.0_wp] + offset(j + 1) * across
+         if (forward) then
+            s_start = -c%lead_in
+            tip%support_velocity = c%velocity * along
+         else
+            s_start = c%length + c%lead_in
+            tip%support_velocity = -c%velocity * along
+         end if
+         tip%support_start = line_start + s_start * along
+         if (.not. allocated(record%values)) allocate (record%values(nx, n_quantities))
+         call self%stream%init(c%thermal%seed, j, merge(0, 1, forward), realization, error)
+         if (allocated(error)) return
+         ! At the support, with a thermal velocity (inertial tip).
+         u0 = 0.0_wp
+         t = 0.0_wp
+         if (self%lead_steps > 0) then
+            call self%lead_langevin%start(self%stream, 0.0_wp, u0, state)
+            call self%lead_langevin%advance(tip, self%stream, state, self%lead_steps, error)
+            self%langevin_steps = self%langevin_steps + self%lead_steps
+            self%force_evaluations = self%force_evaluations + self%lead_steps + 1
+            ! on with the samples' step from the end of the lead-in
+            state%t0 = c%lead_in / c%velocity
+            state%steps = 0
+         else
+            call self%langevin%start(self%stream, 0.0_wp, u0, state)
+         end if
+         nd = tip%ndim
+         motion = tip%support_velocity / c%velocity
+         in_well = .false.
+         do k = 1, nx
+            i = merge(k, nx + 1 - k, forward)
+            if (k > 1 .and. .not. allocated(error)) then
+               if (present(slips)) then
+                  ! In stretches of check_steps, each followed by a check.
+                  done = 0
+                  do while (done < self%sample_steps .and. .not. allocated(error))
+                     n = min(self%check_steps, self%sample_steps - done)
+                     call self%langevin%advance(tip, self%stream, state, n, error)
+                     self%force_evaluations = self%force_evaluations + n + 1
+                     done = done + n
+                     if (.not. allocated(error)) call check_slips()
+                  end do
+               else
+                  call self%langevin%advance(tip, self%stream, state, self%sample_steps, error)
+                  self%force_evaluations = self%force_evaluations + self%sample_steps + 1
+               end if
+               self%langevin_steps = self%langevin_steps + self%sample_steps
+            else if (k == 1 .and. present(slips)) then
+               call check_slips()
+            end if
+            t = self%langevin%time_of(state)
+            if (.not. allocated(error) .and. c%solver%max_wall_time > 0.0_wp) then
+               call system_clock(now)
+               if (real(now - self%clock_start, wp) / self%clock_rate > c%solver%max_wall_time) &
+                  & call fatal_error(error, 'Langevin: max_wall_time = '//rtoa(c%solver%max_wall_time) &
+                  & //' s reached at t = '//rtoa(t)//' s', error_numerical)
+            end if
+            if (allocated(error)) then
+               write (where, '(a, i0, a, i0, a, f0.4, a)') ' (line ', j, &
+                  & trim(merge(' trace  ', ' retrace', forward))//', realization ', realization, &
+                  & ', support at ', c%velocity * t, ' Å into the trip)'
+               error%message = error%message//trim(where)
+               call self%stream%free()
+               return
+            end if
+            force = tip%lateral_force(state%u) * ev_per_angstrom_to_nn
+            tip_r = tip%tip_position(t, state%u)
+            record%values(i, q_fx) = force(1)
+            record%values(i, q_fy) = force(2)
+            record%values(i, q_f_along) = dot_product(force, along)
+            record%values(i, q_f_across) = dot_product(force, across)
+            record%values(i, q_tip_x) = tip_r(1)
+            record%values(i, q_tip_y) = tip_r(2)
+            record%values(i, q_fz) = force(3)
+            record%values(i, q_tip_z) = tip_r(3)
+            record%values(i, q_jumps) = 0.0_wp
+         end do
+         call self%stream%free()
+      end associate
+
+   contains
+
+      !> Quench the state into its minimum; a slip when the minimum moved by
+      !> more than slip_distance since the last check.  (A quench that does
+      !> not converge leaves the check out.)
+      subroutine check_slips()
+         type(error_type), allocatable :: quench_error
+         real(wp) :: u_min(3), here(3), support_now, force_now, tn
+
+         associate (c => self%config, tip => self%tip)
+            tn = self%langevin%time_of(state)
+            u_min = 0.0_wp
+            call find_minimum(tip, tn, state%u(1:nd), u_min(1:nd), quench_error)
+            if (allocated(quench_error)) return
+            here = tip%support(tn)
+            here(1:nd) = here(1:nd) + u_min(1:nd)
+            support_now = merge(s_start + c%velocity * tn, s_start - c%velocity * tn, forward)
+            force_now = -dot_product(tip%spring(1:nd) * state%u(1:nd), along(1:nd)) * ev_per_angstrom_to_nn
+            if (in_well) then
+               if (norm2(here(1:nd) - minimum(1:nd)) > slip_distance) call slips%add(realization, &
+                  & merge(0, 1, forward), last_support, last_force, dot_product(here - minimum, motion), &
+                  & dot_product(here - minimum, across))
+            end if
+            minimum = here
+            last_support = support_now
+            last_force = force_now
+            in_well = .true.
+         end associate
+      end subroutine check_slips
+
+   end subroutine run_thermal_trip
+
+   subroutine slips_clear(self)
+      class(slip_list), intent(inout) :: self
+
+      self%n = 0
+   end subroutine slips_clear
+
+   subroutine slips_add(self, realization, trip, support, force, jump, jump_across)
+      class(slip_list), intent(inout) :: self
+      integer, intent(in) :: realization, trip
+      real(wp), intent(in) :: support, force, jump, jump_across
+      integer, allocatable :: ints(:)
+      real(wp), allocatable :: reals(:)
+      integer :: room
+
+      if (.not. allocated(self%realization)) then
+         allocate (self%realization(16), self%trip(16), self%support(16), self%force(16), self%jump(16), &
+            & self%jump_across(16))
+      end if
+      room = size(self%realization)
+      if (self%n == room) then
+         allocate (ints(2 * room))
+         ints(1:room) = self%realization
+         call move_alloc(ints, self%realization)
+         allocate (ints(2 * room))
+         ints(1:room) = self%trip
+         call move_alloc(ints, self%trip)
+         allocate (reals(2 * room))
+         reals(1:room) = self%support
+         call move_alloc(reals, self%support)
+         allocate (reals(2 * room))
+         reals(1:room) = self%force
+         call move_alloc(reals, self%force)
+         allocate (reals(2 * room))
+         reals(1:room) = self%jump
+         call move_alloc(reals, self%jump)
+         allocate (reals(2 * room))
+         reals(1:room) = self%jump_across
+         call move_alloc(reals, self%jump_across)
+      end if
+      self%n = self%n + 1
+      self%realization(self%n) = realization
+      self%trip(self%n) = trip
+      self%support(self%n) = support
+      self%force(self%n) = force
+      self%jump(self%n) = jump
+      self%jump_across(self%n) = jump_across
+   end subroutine slips_add
 
    !> One trip along line j (0-based): trace when forward, else retrace.
    subroutine run_trip(self, j, forward, record, error)
@@ -468,12 +827,17 @@ contains
       end associate
    end subroutine relax
 
-   !> Integrator counters of all trips so far.
+   !> Integrator counters of all trips so far (at T > 0 the Langevin steps
+   !> and force evaluations).
    function statistics(self) result(stats)
       class(afm_scanner), intent(in) :: self
       type(integrator_statistics) :: stats
 
       stats = self%solver%statistics()
+      if (self%thermal) then
+         stats%steps = stats%steps + self%langevin_steps
+         stats%rhs_evaluations = stats%rhs_evaluations + self%force_evaluations
+      end if
    end function statistics
 
 end module friction_afm_scan

@@ -18,8 +18,8 @@ module friction_afm_scene
    use friction_scene_report, only: job_reporter
    use friction_scene_context, only: job_context, agree_on_error, ranks_text, share_of
    use friction_afm_config, only: afm_config, new_potential, species_count
-   use friction_afm_scan, only: afm_scanner, trip_record, n_quantities, q_fx, q_fy, q_f_along
-   use friction_afm_output, only: write_afm_file, afm_surface_record
+   use friction_afm_scan, only: afm_scanner, line_record, slip_list, n_quantities, q_fx, q_fy, q_f_along
+   use friction_afm_output, only: write_afm_file, afm_surface_record, afm_thermal_record
    use friction_afm_validity, only: afm_model_warnings, quasistatic_friction_warning
    use friction_afm_netlist, only: afm_netlist
    implicit none
@@ -27,11 +27,24 @@ module friction_afm_scene
 
    public :: afm_scene, afm_friction
 
+   !> A slip's items: line, realization, trip, support, force, jump, jump_across.
+   integer, parameter :: n_slip_items = 7
+
    type, extends(scene) :: afm_scene
       type(afm_config) :: config                 !! as the input gives it ('auto' unresolved)
       ! The run's results on this rank
       type(afm_config), private :: ran           !! the settings that ran
       real(wp), allocatable, private :: trace(:, :, :), retrace(:, :, :)
+      !> At a temperature: standard errors over the realizations of the
+      !> samples and of each line's friction.
+      real(wp), allocatable, private :: trace_sem(:, :, :), retrace_sem(:, :, :)
+      real(wp), allocatable, private :: friction_sem(:)
+      !> The map's slips (all ranks', ordered by line, realization, trip and
+      !> time): line, realization, trip, support (Å), force (nN), jump along
+      !> and across (Å).
+      real(wp), allocatable, private :: slips(:, :)
+      real(wp), private :: time_step = 0.0_wp   !! the Langevin step, s
+      character(len=:), allocatable, private :: scheme
       type(afm_surface_record), private :: surface
       type(run_summary), private :: record
       integer, private :: first = 0
@@ -66,6 +79,9 @@ contains
       character(len=32), allocatable, intent(out) :: names(:)
 
       names = [character(len=32) :: 'surface', 'tip', 'scan', 'integrator']
+      ! &thermal only at a temperature: at T = 0 its other variables do
+      ! nothing, and the echo is the deterministic program's.
+      if (self%config%thermal%enabled()) names = [character(len=32) :: names, 'thermal']
    end subroutine afm_groups
 
    subroutine afm_visit(self, v)
@@ -92,6 +108,7 @@ contains
       if (c%solver%method == auto_name) c%solver%method = auto_method('afm', c%potential, c%solver%rtol)
    end function resolved
 
+   !> The stepper that runs; at a temperature the Langevin scheme.
    function afm_method(self) result(name)
       class(afm_scene), intent(in) :: self
       character(len=:), allocatable :: name
@@ -99,7 +116,20 @@ contains
 
       c = self%resolved()
       name = trim(c%solver%method)
+      if (c%thermal%enabled()) name = thermal_scheme(c)
    end function afm_method
+
+   !> The Langevin scheme of the tip model.
+   function thermal_scheme(c) result(name)
+      type(afm_config), intent(in) :: c
+      character(len=:), allocatable :: name
+
+      if (c%model == 'overdamped') then
+         name = 'leimkuhler-matthews'
+      else
+         name = 'baoab'
+      end if
+   end function thermal_scheme
 
    !> Compute this rank's lines of the map.
    subroutine afm_run(self, job, reporter, error)
@@ -109,8 +139,9 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(afm_scanner), target :: scanner
       class(surface_potential), allocatable :: potential
-      type(trip_record) :: trip
+      type(line_record) :: line
       type(integrator_statistics) :: stats
+      real(wp), allocatable :: local_slips(:, :)
       integer(i8) :: counts(4)
       integer :: count, j
       real(wp) :: wall
@@ -142,18 +173,32 @@ contains
          ! The map's share of this rank, checked before it is allocated.
          call allocate_share(error)
          if (.not. allocated(error)) call scanner%init(c, potential, error)
+          if (allocated(self%trace_sem)) deallocate (self%trace_sem)
+          if (allocated(self%retrace_sem)) deallocate (self%retrace_sem)
+          if (allocated(self%friction_sem)) deallocate (self%friction_sem)
+          if (allocated(self%slips)) deallocate (self%slips)
+          allocate (local_slips(n_slip_items, 0))
+          if (.not. allocated(error) .and. scanner%thermal) then
+             allocate (self%trace_sem(c%nx, count, n_quantities))
+             allocate (self%retrace_sem(c%nx, merge(count, 0, c%retrace), n_quantities))
+             allocate (self%friction_sem(count))
+             self%time_step = scanner%time_step()
+             self%scheme = thermal_scheme(c)
+          end if
          self%surface%contact_height = scanner%contact_height
          self%surface%support_height = scanner%support_height
          if (allocated(scanner%tip)) self%three_d = scanner%tip%ndim == 3
          do j = 1, count
             if (allocated(error)) exit
-            call scanner%run_trip(self%first + (j - 1) * job%nranks, .true., trip, error)
+            call scanner%run_line(self%first + (j - 1) * job%nranks, line, error)
             if (allocated(error)) exit
-            self%trace(:, j, :) = trip%values
-            if (c%retrace) then
-               call scanner%run_trip(self%first + (j - 1) * job%nranks, .false., trip, error)
-               if (allocated(error)) exit
-               self%retrace(:, j, :) = trip%values
+            self%trace(:, j, :) = line%trace
+            if (c%retrace) self%retrace(:, j, :) = line%retrace
+            if (scanner%thermal) then
+               self%trace_sem(:, j, :) = line%trace_sem
+               if (c%retrace) self%retrace_sem(:, j, :) = line%retrace_sem
+               self%friction_sem(j) = line%friction_sem
+               call keep_slips(self%first + (j - 1) * job%nranks, line%slips)
             end if
             ! Rank 0's share is as large as any other and spread over the whole
             ! map, so its fraction done is the map's fraction done.
@@ -166,6 +211,7 @@ contains
          call agree_on_error(job, error)
          if (allocated(error)) return
          if (c%model == 'quasistatic') call check_friction()
+         if (scanner%thermal) call gather_slips()
 
          stats = scanner%statistics()
          counts = [stats%steps, stats%failed_steps, stats%rhs_evaluations, stats%jacobian_evaluations]
@@ -208,6 +254,52 @@ contains
             & //'rank, which could not be allocated: use fewer points (&scan nx, ny) or more ranks', error_input)
       end subroutine allocate_share
 
+      !> A line's slips onto this rank's list.
+      subroutine keep_slips(global_line, slips)
+         integer, intent(in) :: global_line
+         type(slip_list), intent(in) :: slips
+         real(wp), allocatable :: more(:, :)
+         integer :: k, n
+
+         n = size(local_slips, 2)
+         allocate (more(n_slip_items, n + slips%n))
+         more(:, 1:n) = local_slips
+         do k = 1, slips%n
+            more(:, n + k) = [real(global_line, wp), real(slips%realization(k), wp), real(slips%trip(k), wp), &
+               & slips%support(k), slips%force(k), slips%jump(k), slips%jump_across(k)]
+         end do
+         call move_alloc(more, local_slips)
+      end subroutine keep_slips
+
+      !> Every rank's slips on every rank, in the order of the lines (each
+      !> rank's list is in its lines' order; the lines are dealt round-robin).
+      subroutine gather_slips()
+         integer :: counts(job%nranks), displacements(job%nranks), cursor(job%nranks), n, r, line, k, at
+         real(wp), allocatable :: everything(:, :)
+
+         n = size(local_slips, 2)
+         call MPI_Allgather(n, 1, MPI_INTEGER, counts, 1, MPI_INTEGER, job%comm)
+         displacements(1) = 0
+         do r = 2, job%nranks
+            displacements(r) = displacements(r - 1) + counts(r - 1)
+         end do
+         allocate (everything(n_slip_items, sum(counts)))
+         call MPI_Allgatherv(local_slips, n_slip_items * n, MPI_DOUBLE_PRECISION, everything, &
+            & n_slip_items * counts, n_slip_items * displacements, MPI_DOUBLE_PRECISION, job%comm)
+         allocate (self%slips(n_slip_items, sum(counts)))
+         cursor = displacements
+         at = 0
+         do line = 0, self%ran%ny - 1
+            r = mod(line, job%nranks) + 1
+            do k = cursor(r) + 1, displacements(r) + counts(r)
+               if (nint(everything(1, k)) /= line) exit
+               at = at + 1
+               self%slips(:, at) = everything(:, k)
+               cursor(r) = k
+            end do
+         end do
+      end subroutine gather_slips
+
       !> The quasistatic map's mean friction against the drag it leaves out.
       subroutine check_friction()
          real(wp) :: sums(2)
@@ -233,9 +325,21 @@ contains
       character(len=*), intent(in) :: path
       type(job_context), intent(in) :: job
       type(error_type), allocatable, intent(out) :: error
+      type(afm_thermal_record) :: thermal
 
       self%record%version = version_string
-      if (self%three_d) then
+      if (allocated(self%trace_sem)) then
+         ! (Component by component: gfortran's structure constructor mishandles
+         ! deferred-length components.)
+         thermal%trace_sem = self%trace_sem
+         thermal%retrace_sem = self%retrace_sem
+         thermal%friction_sem = self%friction_sem
+         thermal%time_step = self%time_step
+         thermal%scheme = self%scheme
+         thermal%slips = self%slips
+         call write_afm_file(path, job%comm, self%ran, self%first, job%nranks, self%trace, self%retrace, &
+            & self%record, error, thermal=thermal)
+      else if (self%three_d) then
          call write_afm_file(path, job%comm, self%ran, self%first, job%nranks, self%trace, self%retrace, &
             & self%record, error, self%surface)
       else
@@ -288,6 +392,8 @@ contains
       type(error_type), allocatable, intent(out) :: error
 
       note = ''
+      if (self%config%thermal%enabled()) note = 'the netlist is the deterministic tip: &thermal ' &
+         & //'temperature > 0 adds thermal noise, which it does not model'
       call afm_netlist(self%resolved(), data_file, version, text, error)
    end subroutine afm_netlist_text
 
@@ -295,14 +401,15 @@ contains
    !> parameter scan charts: the mean friction (half the width of the
    !> friction loop, the mean of (trace - retrace) f_along / 2 over the map;
    !> the mean trace f_along without retrace) and the maximum lateral force
-   !> |(fx, fy)| over all samples, both nN.  Holds one trip at a time.
+   !> |(fx, fy)| over all samples, both nN; at a temperature both of the
+   !> samples' means over the realizations.  Holds one line at a time.
    subroutine afm_friction(c, mean_friction, max_force, error)
       type(afm_config), intent(in) :: c
       real(wp), intent(out) :: mean_friction, max_force
       type(error_type), allocatable, intent(out) :: error
       type(afm_scanner), target :: scanner
       class(surface_potential), allocatable :: potential
-      type(trip_record) :: trip
+      type(line_record) :: line
       real(wp) :: total
       integer :: j
 
@@ -314,15 +421,13 @@ contains
       if (allocated(error)) return
       total = 0.0_wp
       do j = 0, c%ny - 1
-         call scanner%run_trip(j, .true., trip, error)
+         call scanner%run_line(j, line, error)
          if (allocated(error)) return
-         total = total + sum(trip%values(:, q_f_along))
-         max_force = max(max_force, maxval(hypot(trip%values(:, q_fx), trip%values(:, q_fy))))
+         total = total + sum(line%trace(:, q_f_along))
+         max_force = max(max_force, maxval(hypot(line%trace(:, q_fx), line%trace(:, q_fy))))
          if (c%retrace) then
-            call scanner%run_trip(j, .false., trip, error)
-            if (allocated(error)) return
-            total = total - sum(trip%values(:, q_f_along))
-            max_force = max(max_force, maxval(hypot(trip%values(:, q_fx), trip%values(:, q_fy))))
+            total = total - sum(line%retrace(:, q_f_along))
+            max_force = max(max_force, maxval(hypot(line%retrace(:, q_fx), line%retrace(:, q_fy))))
          end if
       end do
       mean_friction = total / (real(c%nx, wp) * c%ny * merge(2, 1, c%retrace))

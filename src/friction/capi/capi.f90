@@ -27,8 +27,8 @@ module friction_capi
    use friction_input_reader, only: namelist_source, scan_files, apply_files
    use friction_surface_potential, only: surface_potential
    use friction_afm_config, only: afm_config, new_potential
-   use friction_afm_scan, only: afm_scanner, trip_record, quantity_names, quantity_count, q_fx, q_fy, q_jumps, &
-      & support_along, support_across
+   use friction_afm_scan, only: afm_scanner, trip_record, line_record, quantity_names, quantity_count, q_fx, q_fy, &
+      & q_jumps, support_along, support_across
    use friction_afm_output, only: line_friction
    use friction_afm_scene, only: afm_scene
    use friction_brake_config, only: brake_config
@@ -692,6 +692,7 @@ contains
       class(surface_potential), allocatable :: potential
       type(afm_scanner), target :: scanner
       type(trip_record) :: trip
+      type(line_record) :: mean
       real(c_double), pointer :: out(:)
 
       if (.not. config_of(cfg, config, error)) then
@@ -727,7 +728,22 @@ contains
       end if
       call new_potential(c, potential, error)
       if (.not. allocated(error)) call scanner%init(c, potential, error)
-      if (.not. allocated(error)) call scanner%run_trip(int(line), forward /= 0, trip, error)
+      if (allocated(error)) then
+         continue
+      else if (scanner%thermal) then
+         ! At a temperature: the mean over the realizations (of whole lines:
+         ! a trip's noise is its own, whatever else is computed).
+         call scanner%run_line(int(line), mean, error, with_retrace=forward == 0)
+         if (.not. allocated(error)) then
+            if (forward /= 0) then
+               trip%values = mean%trace
+            else
+               trip%values = mean%retrace
+            end if
+         end if
+      else
+         call scanner%run_trip(int(line), forward /= 0, trip, error)
+      end if
       if (.not. allocated(error)) then
          call c_f_pointer(fx, out, [c%nx])
          out = trip%values(:, q_fx)
@@ -799,15 +815,17 @@ contains
    end subroutine add_item
 
    !> The whole map on this process: every line's trace (and retrace), as
-   !> the program's file holds them under /afm.
+   !> the program's file holds them under /afm; at a temperature the means
+   !> over the realizations, and NAME_sem beside every NAME.
    subroutine compute_afm(c, result, error)
       type(afm_config), intent(in) :: c
       type(capi_result), intent(inout) :: result
       type(error_type), allocatable, intent(out) :: error
       class(surface_potential), allocatable :: potential
       type(afm_scanner), target :: scanner
-      type(trip_record) :: trip
-      real(wp), allocatable :: trace(:, :, :), retrace(:, :, :)
+      type(line_record) :: line
+      real(wp), allocatable :: trace(:, :, :), retrace(:, :, :), trace_sem(:, :, :), retrace_sem(:, :, :)
+      real(wp), allocatable :: friction_sem(:)
       integer :: j, q
 
       call new_potential(c, potential, error)
@@ -817,36 +835,43 @@ contains
       ! (line j's samples are trace(:, j, q): row-major (ny, nx) as it lies)
       allocate (trace(c%nx, c%ny, size(quantity_names)), retrace(c%nx, merge(c%ny, 0, c%retrace), &
          & size(quantity_names)))
+      allocate (trace_sem, mold=trace)
+      allocate (retrace_sem, mold=retrace)
+      allocate (friction_sem(c%ny))
       do j = 1, c%ny
-         call scanner%run_trip(j - 1, .true., trip, error)
+         call scanner%run_line(j - 1, line, error)
          if (allocated(error)) return
-         trace(:, j, :) = trip%values
+         trace(:, j, :) = line%trace
+         trace_sem(:, j, :) = line%trace_sem
          if (c%retrace) then
-            call scanner%run_trip(j - 1, .false., trip, error)
-            if (allocated(error)) return
-            retrace(:, j, :) = trip%values
+            retrace(:, j, :) = line%retrace
+            retrace_sem(:, j, :) = line%retrace_sem
+            friction_sem(j) = line%friction_sem
          end if
       end do
       call add_item(result, 'support_x', c%nx, 1, support_along(c))
       call add_item(result, 'support_y', c%ny, 1, support_across(c))
-      call add_trips('trace', trace)
+      call add_trips('trace', trace, '')
+      if (scanner%thermal) call add_trips('trace', trace_sem, '_sem')
       if (c%retrace) then
-         call add_trips('retrace', retrace)
+         call add_trips('retrace', retrace, '')
+         if (scanner%thermal) call add_trips('retrace', retrace_sem, '_sem')
          call add_item(result, 'friction', c%ny, 1, line_friction(trace, retrace))
+         if (scanner%thermal) call add_item(result, 'friction_sem', c%ny, 1, friction_sem)
       end if
 
    contains
 
-      subroutine add_trips(trip_name, values)
-         character(len=*), intent(in) :: trip_name
+      subroutine add_trips(trip_name, values, suffix)
+         character(len=*), intent(in) :: trip_name, suffix
          real(wp), intent(in) :: values(:, :, :)
 
          do q = 1, quantity_count(scanner%tip%ndim)
-            call add_item(result, trip_name//'/'//trim(quantity_names(q)), c%ny, c%nx, &
+            call add_item(result, trip_name//'/'//trim(quantity_names(q))//suffix, c%ny, c%nx, &
                & reshape(values(:, :, q), [c%nx * c%ny]))
          end do
-         if (c%model == 'quasistatic') call add_item(result, trip_name//'/'//trim(quantity_names(q_jumps)), &
-            & c%ny, c%nx, reshape(values(:, :, q_jumps), [c%nx * c%ny]))
+         if (c%model == 'quasistatic') call add_item(result, trip_name//'/'//trim(quantity_names(q_jumps)) &
+            & //suffix, c%ny, c%nx, reshape(values(:, :, q_jumps), [c%nx * c%ny]))
       end subroutine add_trips
 
    end subroutine compute_afm
