@@ -95,6 +95,7 @@ module friction_output_h5
       procedure :: close
       procedure, private :: check
       procedure, private :: agree
+      procedure, private :: create_dataset
    end type h5_file
 
 contains
@@ -242,7 +243,6 @@ contains
       integer(hid_t) :: filespace, memspace, dset, xfer
       integer(hsize_t) :: dims(2), count(2), offset(2), step(2)
       integer :: stat, rank
-      logical :: created
 
       if (self%status /= 0) return
       if (one_d) then
@@ -259,15 +259,7 @@ contains
          step = [1_hsize_t, int(stride, hsize_t)]
       end if
       call h5screate_simple_f(rank, dims(1:rank), filespace, stat)
-      call h5dcreate_f(self%id, name, type, filespace, dset, stat)
-      created = stat == 0
-      call self%agree(stat)
-      call self%check(stat, 'creating dataset '//name)
-      if (stat /= 0) then
-         if (created) call h5dclose_f(dset, stat)
-         call h5sclose_f(filespace, stat)
-         return
-      end if
+      if (.not. self%create_dataset(name, type, filespace, dset)) return
       if (n_total == 0) then   ! an empty dataset: nothing to write (and no buffer to point at)
          if (len_trim(units) > 0) call attribute_text(self, dset, 'units', units)
          call h5dclose_f(dset, stat)
@@ -317,19 +309,10 @@ contains
       integer(hid_t) :: filespace, memspace, dset, xfer
       integer(hsize_t) :: dims(1)
       integer :: stat
-      logical :: created
 
       dims = [int(size(values), hsize_t)]
       call h5screate_simple_f(1, dims, filespace, stat)
-      call h5dcreate_f(self%id, name, H5T_NATIVE_INTEGER, filespace, dset, stat)
-      created = stat == 0
-      call self%agree(stat)
-      call self%check(stat, 'creating dataset '//name)
-      if (stat /= 0) then
-         if (created) call h5dclose_f(dset, stat)
-         call h5sclose_f(filespace, stat)
-         return
-      end if
+      if (.not. self%create_dataset(name, H5T_NATIVE_INTEGER, filespace, dset)) return
       if (size(values) == 0) then   ! an empty dataset: nothing to write
          call attribute_text(self, dset, 'units', units)
          call h5dclose_f(dset, stat)
@@ -532,6 +515,26 @@ contains
       if (self%rank == 0) call truncate_file(self%path)
       call MPI_Barrier(self%comm)
    end subroutine give_back_space
+
+   !> Create a dataset on every rank, or none: on a failure anywhere the
+   !> dataset (where created) and `filespace` are closed, and false returned.
+   logical function create_dataset(self, name, type, filespace, dset) result(ok)
+      class(h5_file), intent(inout) :: self
+      character(len=*), intent(in) :: name
+      integer(hid_t), intent(in) :: type, filespace
+      integer(hid_t), intent(out) :: dset
+      integer :: stat
+      logical :: created
+
+      call h5dcreate_f(self%id, name, type, filespace, dset, stat)
+      created = stat == 0
+      call self%agree(stat)
+      call self%check(stat, 'creating dataset '//name)
+      ok = stat == 0
+      if (ok) return
+      if (created) call h5dclose_f(dset, stat)
+      call h5sclose_f(filespace, stat)
+   end function create_dataset
 
    !> A collective write's status, the same on every rank: a write can fail
    !> on one rank alone (a full disk), and a rank that then skipped the next
