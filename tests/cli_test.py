@@ -912,9 +912,12 @@ BAD_SWEEP_INPUTS = {
                        ["&sweep", "sweep_count2", "100 x 11", "1024"]),
     "spacing": ("&sweep sweep_variable = 'brake.mu', sweep_spacing = 'geometric' /\n",
                 ["bad.nml:1", "&sweep", "sweep_spacing", "'log'"]),
-    "log-negative": ("&sweep sweep_variable = 'brake.v_dr_prime', sweep_spacing = 'log',\n"
-                     " sweep_from = -0.004, sweep_to = -0.001, sweep_count = 3 /\n",
-                     ["bad.nml:2", "&sweep", "sweep_from", "> 0"]),
+    "log-mixed-sign": ("&sweep sweep_variable = 'brake.v_dr_prime', sweep_spacing = 'log',\n"
+                       " sweep_from = -0.004, sweep_to = 0.001, sweep_count = 3 /\n",
+                       ["bad.nml:2", "&sweep", "sweep_to", "sign of sweep_from"]),
+    "log-zero": ("&sweep sweep_variable = 'brake.v_dr_prime', sweep_spacing = 'log',\n"
+                 " sweep_from = 0.0, sweep_to = 0.001, sweep_count = 3 /\n",
+                 ["bad.nml:2", "&sweep", "sweep_from", "must not be 0"]),
     "count": ("&sweep sweep_variable = 'brake.mu', sweep_spacing = 'linear', sweep_count = 0 /\n",
               ["bad.nml:1", "&sweep", "sweep_count"]),
     "no-values": ("&sweep sweep_variable = 'brake.mu' /\n", ["&sweep", "sweep_values", "at least one"]),
@@ -926,7 +929,7 @@ BAD_SWEEP_INPUTS = {
 def sweep_results(path):
     with h5py.File(path, "r") as handle:
         return {key: handle["sweep"][key][()] for key in SWEEP_PER_POINT}, \
-            handle["sweep/status"].attrs["reason"].decode().split("\n")
+            [r.decode().rstrip() for r in handle["sweep/reason"][()]]
 
 
 def case_sweep_ranks(args):
@@ -1069,6 +1072,31 @@ def case_sweep_failure(args):
         fail(f"status {results['status']}, expected [1, 2, 1]")
     if "max_wall_time" not in reasons[1]:
         fail(f"the failed point's reason lacks max_wall_time: {reasons[1]!r}")
+    # A 32 x 24 grid of which every point fails (mu above mu_s): each reason
+    # is kept (768 of ~190 characters: more than an attribute's 64 kB), and
+    # the exit is 4, not 0, with the file written.
+    grid = write(args, "grid.nml", "&sweep sweep_variable = 'brake.mu', sweep_spacing = 'linear', sweep_from = 0.6,"
+                 " sweep_to = 0.9, sweep_count = 32,\n sweep_variable2 = 'brake.xi', sweep_spacing2 = 'linear',"
+                 " sweep_from2 = 0.1, sweep_to2 = 0.5, sweep_count2 = 24 /\n")
+    done = friction(args, "-o", "grid.h5", brake, small, grid, ranks=2, expect=4)
+    if "every one of the 768 sweep points failed" not in done.stderr:
+        fail(f"no message that every point failed: {done.stderr}")
+    results, reasons = sweep_results(os.path.join(args.workdir, "grid.h5"))
+    if list(set(results["status"])) != [2] or len(reasons) != 768:
+        fail(f"statuses {set(results['status'])} and {len(reasons)} reasons, expected 2 and 768")
+    if not all("mu" in r and "mu_s" in r for r in reasons):
+        fail("a failed point of the grid lacks its reason")
+    # A logarithmic range below zero (a belt that runs backwards): the values
+    # are -(geometric progression), 0.004 -> 0.001 through sqrt(0.004 * 0.001).
+    backwards = write(args, "backwards.nml", "&sweep sweep_variable = 'brake.v_dr_prime', sweep_spacing = 'log',"
+                      " sweep_from = -0.004, sweep_to = -0.001, sweep_count = 3 /\n")
+    friction(args, "-o", "backwards.h5", brake, small, backwards)
+    with h5py.File(os.path.join(args.workdir, "backwards.h5"), "r") as handle:
+        values = handle["sweep/values"][()]
+        status = handle["sweep/status"][()]
+    # 4 ulp: one exp and one log of the ends
+    if not np.allclose(values, [-0.004, -0.002, -0.001], rtol=1e-15 * 4, atol=0) or list(status) != [1, 1, 1]:
+        fail(f"log range below zero: values {values}, status {status}")
 
 
 def case_sweep_resume(args):

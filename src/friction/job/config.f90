@@ -276,11 +276,16 @@ contains
                end if
                call c%finite('sweep', 'sweep_from'//suffix, s%from(a))
                call c%finite('sweep', 'sweep_to'//suffix, s%to(a))
-               if (s%spacings(a) == 'log') then
-                  if (.not. (s%from(a) > 0.0_wp)) call c%reject('sweep', 'sweep_from'//suffix, rtoa(s%from(a)), &
-                     & "must be > 0 for sweep_spacing"//suffix//" = 'log'")
-                  if (.not. (s%to(a) > 0.0_wp)) call c%reject('sweep', 'sweep_to'//suffix, rtoa(s%to(a)), &
-                     & "must be > 0 for sweep_spacing"//suffix//" = 'log'")
+               ! A logarithmic range keeps one sign: both ends above zero, or
+               ! both below (a belt that runs backwards: v_dr_prime < 0).
+               if (s%spacings(a) == 'log' .and. .not. c%failed()) then
+                  if (s%from(a) == 0.0_wp) then
+                     call c%reject('sweep', 'sweep_from'//suffix, rtoa(s%from(a)), &
+                        & "must not be 0 for sweep_spacing"//suffix//" = 'log'")
+                  else if (.not. (s%to(a) * sign(1.0_wp, s%from(a)) > 0.0_wp)) then
+                     call c%reject('sweep', 'sweep_to'//suffix, rtoa(s%to(a)), "must be nonzero and of the sign " &
+                        & //"of sweep_from"//suffix//" = "//rtoa(s%from(a))//" for sweep_spacing"//suffix//" = 'log'")
+                  end if
                end if
                if (c%failed()) return
                n = s%count(a)
@@ -291,7 +296,8 @@ contains
                      else if (s%spacings(a) == 'linear') then
                         axis(k) = from + (to - from) * (k - 1) / (count - 1)
                      else
-                        axis(k) = exp(log(from) + (log(to) - log(from)) * (k - 1) / (count - 1))
+                        axis(k) = sign(exp(log(abs(from)) + (log(abs(to)) - log(abs(from))) * (k - 1) &
+                           & / (count - 1)), from)
                      end if
                   end do
                   ! An integer variable takes whole values: a spaced range is rounded

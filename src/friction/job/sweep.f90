@@ -20,7 +20,7 @@ module friction_job_sweep
    use, intrinsic :: iso_c_binding, only: c_ptr, c_f_pointer
    use mpi_f08
    use friction_kinds, only: wp, i8
-   use friction_error, only: error_type, fatal_error, error_interrupted, error_input
+   use friction_error, only: error_type, fatal_error, error_interrupted, error_input, error_numerical
    use friction_strings, only: itoa, text_hash
    use friction_version, only: version_string
    use friction_ode_solver, only: integrator_statistics
@@ -66,6 +66,7 @@ contains
       type(error_type), allocatable :: checkpoint_error
       character(len=:), allocatable :: input_hash, problem
       integer :: unsaved, last_taken
+      logical :: all_failed
       real(wp), allocatable :: results(:, :), cost(:), maxima(:), point_maxima(:), flat(:)
       integer, allocatable :: status(:), counts(:), offsets(:), owner(:), computed_by_run(:)
       integer, allocatable :: memory(:)
@@ -271,6 +272,18 @@ contains
             call remove_file(checkpoint_name(job, i))
          end do
       end if
+      ! A sweep of which no point succeeded has no result to show: the file
+      ! holds every point's reason, and the exit says it failed (rank 0 holds
+      ! the reasons; its message is the one every rank returns).
+      all_failed = n > 0 .and. count(status == status_failed) == n   ! (rank 0 holds the statuses)
+      call MPI_Bcast(all_failed, 1, MPI_LOGICAL, 0, job%comm)
+      if (all_failed) then
+         reason = ''
+         if (job%rank == 0 .and. allocated(reasons(1)%text)) reason = ': point 1: '//reasons(1)%text
+         call fatal_error(error, 'every one of the '//itoa(n)//' sweep points failed; the file holds each ' &
+            & //'point''s reason (/sweep/reason)'//reason, error_numerical)
+         call agree_on_error(job, error)
+      end if
    end subroutine run_sweep_job
 
    !> Point i: a copy of the scene with the swept variables set in memory,
@@ -365,13 +378,17 @@ contains
       logical, intent(in) :: interrupted
       type(error_type), allocatable, intent(out) :: error
       type(h5_file) :: file
-      character(len=:), allocatable :: text, name
-      integer :: i, k
+      character(len=:), allocatable :: name, lines(:)
+      integer :: i, k, longest
 
-      text = ''
+      longest = 1
       do i = 1, size(status)
-         if (allocated(reasons(i)%text)) text = text//reasons(i)%text
-         text = text//new_line('a')
+         if (allocated(reasons(i)%text)) longest = max(longest, len(reasons(i)%text))
+      end do
+      allocate (character(len=longest) :: lines(size(status)))
+      do i = 1, size(status)
+         lines(i) = ''
+         if (allocated(reasons(i)%text)) lines(i) = reasons(i)%text
       end do
       call file%create(path, MPI_COMM_SELF, error)
       if (allocated(error)) return
@@ -404,7 +421,8 @@ contains
       end if
       call file%write_integer_vector('/sweep/status', status)
       call file%write_attribute_text('/sweep/status', 'meaning', '0 pending, 1 done, 2 failed')
-      call file%write_attribute_text('/sweep/status', 'reason', text)
+      call file%write_text_vector('/sweep/reason', lines)
+      call file%write_attribute_text('/sweep/reason', 'meaning', 'a failed point''s error message (empty otherwise)')
       call file%write_vector('/sweep/compute_time', cost, 's')
       call file%write_integer_vector('/sweep/computed_by_this_run', computed_by_run)
       call file%write_integer_vector('/sweep/peak_memory_per_rank', memory)

@@ -88,6 +88,7 @@ module friction_output_h5
       procedure :: write_vector_block
       procedure :: write_line_block
       procedure :: write_vector_integer
+      procedure :: write_text_vector
       procedure :: write_attribute_text
       procedure :: write_attribute_real
       procedure :: write_attribute_integer
@@ -336,6 +337,48 @@ contains
       call attribute_text(self, dset, 'units', units)
       call h5dclose_f(dset, stat)
    end subroutine write_vector_integer_silently
+
+   !> A 1-D dataset of fixed-length UTF-8 texts (rank 0's are written; the
+   !> call is collective).  Texts of any number and length: an attribute
+   !> would stop at HDF5's 64 kB limit on attributes.
+   subroutine write_text_vector(self, name, texts)
+      class(h5_file), intent(inout) :: self
+      character(len=*), intent(in) :: name
+      character(len=*), intent(in) :: texts(:)
+      integer(hid_t) :: filespace, memspace, dset, xfer, type
+      integer(hsize_t) :: dims(1)
+      integer :: stat
+      type(error_printing) :: printing
+
+      if (self%status /= 0) return
+      call printing%silence()
+      dims = [int(size(texts), hsize_t)]
+      call h5tcopy_f(H5T_FORTRAN_S1, type, stat)
+      call h5tset_size_f(type, int(max(1, len(texts)), size_t), stat)
+      call h5tset_cset_f(type, H5T_CSET_UTF8_F, stat)
+      call h5screate_simple_f(1, dims, filespace, stat)
+      if (self%create_dataset(name, type, filespace, dset)) then
+         if (size(texts) > 0) then
+            call h5screate_simple_f(1, dims, memspace, stat)
+            if (self%rank /= 0) then
+               call h5sselect_none_f(filespace, stat)
+               call h5sselect_none_f(memspace, stat)
+            end if
+            call h5pcreate_f(H5P_DATASET_XFER_F, xfer, stat)
+            call h5pset_dxpl_mpio_f(xfer, H5FD_MPIO_COLLECTIVE_F, stat)
+            call h5dwrite_f(dset, type, texts, dims, stat, mem_space_id=memspace, file_space_id=filespace, &
+               & xfer_prp=xfer)
+            call self%agree(stat)
+            call self%check(stat, 'writing dataset '//name)
+            call h5pclose_f(xfer, stat)
+            call h5sclose_f(memspace, stat)
+         end if
+         call h5sclose_f(filespace, stat)
+         call h5dclose_f(dset, stat)
+      end if
+      call h5tclose_f(type, stat)
+      call printing%restore()
+   end subroutine write_text_vector
 
    !> A text attribute on the object at path object ('/' for the root).
    subroutine write_attribute_text(self, object, name, text)
