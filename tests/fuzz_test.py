@@ -29,6 +29,7 @@ codes seen.
 import argparse
 import collections
 import hashlib
+import json
 import math
 import os
 import shutil
@@ -479,6 +480,79 @@ def output_fault(contract, case):
 OUTPUT_FAULTS = st.tuples(st.sampled_from(FAULTS), st.integers(2, 20), st.integers(1, 3))
 
 
+# ---- class 7: the C API in a host process: values by name, a line into short arrays ----
+
+CAPI_NAMES = ["tip.nonesuch", "nogroup.mass", "", "tip.", ".mass", "tip.mass(2)", "scan.nx(0)", "brake.mu",
+              "surface.lattice(99)", "tip" + "." * 300, "tip.mass\udcff"]
+CAPI_STATUSES = {0, 1, 2, 3, 4}   # friction.h: OK, ERROR_INPUT, ERROR_NUMERICAL, ERROR_IO, ERROR_INTERNAL
+
+
+@st.composite
+def capi_cases(draw):
+    """1 to 3 values set by name (a known variable with a value it must
+    refuse or may take, or a name that does not exist), then one line into
+    arrays of nx + change elements (change < 0: too short)."""
+    sets = []
+    for _ in range(draw(st.integers(1, 3))):
+        if draw(st.integers(0, 4)) == 0:
+            sets.append((draw(st.sampled_from(CAPI_NAMES)), "1.0", "unknown"))
+        else:
+            (group, name, kind), bad, value = draw(BROKEN_VALUES)
+            sets.append((f"{group}.{name}", value, "bad" if bad else "maybe"))
+    return {"sets": sets, "line_length_change": draw(st.sampled_from([0, 0, -1, -7, 5]))}
+
+
+def capi_values(contract, case):
+    directory = contract.fresh()
+    files = [os.path.join(contract.args.inputs, "naf.nml"), os.path.join(directory, "small.nml")]
+    with open(files[1], "w") as handle:
+        handle.write("&scan nx = 8, ny = 2 /\n" + BOUNDS)
+    job = {"scene": "afm", "files": files, "sets": [[name, value] for name, value, _ in case["sets"]],
+           "line_length_change": case["line_length_change"]}
+    env = dict(os.environ, FRICTION_LIBRARY=contract.args.library)
+    cmd = [sys.executable, os.path.join(os.path.dirname(os.path.abspath(__file__)), "fuzz_capi_host.py"),
+           os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "python")]
+    start = time.monotonic()
+    try:
+        result = subprocess.run(cmd, input=json.dumps(job, ensure_ascii=True).encode(), capture_output=True,
+                                env=env, cwd=directory, timeout=180)
+    except subprocess.TimeoutExpired:
+        raise AssertionError(f"C API case {job}: no answer in 180 s (a hang)")
+    contract.seconds += time.monotonic() - start
+    stderr = result.stderr.decode("utf-8", "replace")
+    where = f"C API case {job}:\n{stderr}"
+    contract.codes[result.returncode] += 1
+    assert result.returncode >= 0, f"the host was killed by signal {-result.returncode}: {where}"
+    assert result.returncode == 0, f"the host ended with {result.returncode}: {where}"
+    for word in ABORTS:
+        assert word not in stderr, f"runtime abort ({word!r}): {where}"
+    report = json.loads(result.stdout)
+    last = {name: k for k, (name, _, _) in enumerate(case["sets"])}
+    for k, ((name, value, kind), (status, message)) in enumerate(zip(case["sets"], report["sets"])):
+        assert status in CAPI_STATUSES, f"set {name} = {value!r}: status {status}: {where}"
+        if kind == "unknown":
+            assert status == 1, f"set of the unknown name {name!r} was not refused (status {status}): {where}"
+        if kind == "bad" and status == 0 and last[name] == k:
+            # Refused by the checks when not by the set: a value the text
+            # reads as (an unknown method, say) but the scene cannot take.
+            assert report["check"][0] == 1, f"set {name} = {value!r} was taken and passed the checks: {where}"
+            message = report["check"][1]
+            status = 1
+        if status != 0:
+            assert message.strip(), f"set {name} = {value!r}: refused without a message: {where}"
+            if kind == "bad" and last[name] == k and len(case["sets"]) == 1:
+                assert name.split(".")[1] in message, f"the message does not name {name}: {message}"
+    for stage in ("check", "line", "compute"):
+        if report[stage] is not None:
+            assert report[stage][0] in CAPI_STATUSES, f"{stage}: status {report[stage][0]}: {where}"
+            if report[stage][0] != 0:
+                assert report[stage][1].strip(), f"{stage}: refused without a message: {where}"
+    assert report["guard_intact"], f"friction_afm_line wrote past the {report.get('line_n')} elements given: {where}"
+    if report["line"] is not None and report["line_n"] < report["nx"]:
+        assert report["line"][0] == 1, f"arrays of {report['line_n']} for nx = {report['nx']} accepted: {where}"
+    assert report["finite"], f"a computed array holds non-finite values: {where}"
+
+
 # ---- the classes, their strategies and budgets (cases in the ordinary suite) ----
 
 CLASSES = {
@@ -488,6 +562,7 @@ CLASSES = {
     "broken-structure": (mutated(), broken_structure, 25),
     "xyz-nets": (nets(), xyz_net, 15),
     "output-faults": (OUTPUT_FAULTS, output_fault, 15),
+    "capi-values": (capi_cases(), capi_values, 15),
 }
 
 
@@ -527,6 +602,9 @@ EXAMPLES = {
     "xyz-nets": [xyz_example(defect) for defect in ("duplicate", "far", "nan", "count-high", "species", "one")]
                 + [xyz_example("none", sigma=0.01), xyz_example("none", support_z=-1e6)],
     "output-faults": [(fault, 4, 2) for fault in FAULTS],
+    "capi-values": [{"sets": [("tip.mass", "1e400", "bad")], "line_length_change": -1},
+                    {"sets": [("surface.potential", "'\u00e9\udcff'", "bad")], "line_length_change": 0},
+                    {"sets": [("tip.nonesuch", "1.0", "unknown")], "line_length_change": -7}],
 }
 
 
@@ -550,6 +628,7 @@ def main():
     parser.add_argument("--binary", required=True)
     parser.add_argument("--mpiexec", required=True)
     parser.add_argument("--inputs", required=True)
+    parser.add_argument("--library", default=None, help="libfriction, for the C API class")
     parser.add_argument("--workdir", required=True)
     parser.add_argument("--examples", type=int, default=None, help="cases per class (default: its budget)")
     parser.add_argument("--long", action="store_true", help="a long run: fresh random seeds, 10x the budget")
@@ -557,6 +636,10 @@ def main():
     args = parser.parse_args()
     args.binary = os.path.abspath(args.binary)
     args.inputs = os.path.abspath(args.inputs)
+    if "capi-values" in args.classes or "all" in args.classes:
+        if not args.library:
+            parser.error("the class capi-values needs --library")
+        args.library = os.path.abspath(args.library)
     names = sorted(CLASSES) if "all" in args.classes else args.classes
     from_environment = os.environ.get("FRICTION_FUZZ_EXAMPLES")
     long_run = args.long or bool(from_environment)
