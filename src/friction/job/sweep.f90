@@ -22,6 +22,7 @@ module friction_job_sweep
    use friction_kinds, only: wp, i8
    use friction_error, only: error_type, fatal_error, error_interrupted, error_input, error_numerical
    use friction_strings, only: itoa, text_hash
+   use friction_output_checkpoint, only: save_checkpoint, checkpoint_body, real_line, next_line
    use friction_version, only: version_string
    use friction_ode_solver, only: integrator_statistics
    use friction_parameters, only: set_parameter_number, split_name, parameter_info, list_parameters
@@ -30,7 +31,7 @@ module friction_job_sweep
    use friction_job_config, only: job_config
    use friction_output_h5, only: h5_file
    use friction_output_summary, only: run_summary, write_run_attributes
-   use friction_files, only: file_exists, rename_file, remove_file, process_id, write_bytes
+   use friction_files, only: remove_file
    use friction_scene_report, only: job_reporter
    use friction_scene_context, only: job_context, temporary_name, publish, ranks_text, sum_to_root_real, &
       & sum_to_root_integer, agree_on_error
@@ -45,8 +46,6 @@ module friction_job_sweep
    end type reason_text
 
    integer, parameter :: status_done = 1, status_failed = 2
-   !> The first word of a checkpoint (its format's version).
-   character(len=*), parameter :: checkpoint_magic = 'friction-checkpoint-2'
 
 contains
 
@@ -453,20 +452,14 @@ contains
 
    end subroutine write_sweep_file
 
-   !> A finished point's results, written under a temporary name and renamed,
-   !> so a checkpoint is whole or absent.  Reals with 17 significant digits
-   !> read back to the same double.  The first line holds the hash of the
-   !> job's resolved input (`input_hash`), the last the number of lines
-   !> before it and a checksum of them (load_point checks both).  Every write
-   !> and the close are checked: a checkpoint that could not be written whole
-   !> (a full disk) is removed, never renamed into place, and `problem` says
-   !> why ('' when written).
+   !> A finished point's checkpoint (output/checkpoint.f90): its swept
+   !> values, status, results, cost, reason and maxima.  `problem` says why
+   !> it could not be written ('' when written).
    subroutine save_point(path, input_hash, values, status, results, cost, reason, maxima, problem)
       character(len=*), intent(in) :: path, input_hash, reason
       real(wp), intent(in) :: values(:), results(:), cost, maxima(:)
       integer, intent(in) :: status
       character(len=:), allocatable, intent(out) :: problem
-      type(error_type), allocatable :: save_error
       character(len=:), allocatable :: text, one_line
       integer :: k
 
@@ -475,126 +468,28 @@ contains
       do k = 1, len(one_line)
          if (one_line(k:k) == new_line('a') .or. one_line(k:k) == achar(13)) one_line(k:k) = ' '
       end do
-      text = checkpoint_magic//' input '//input_hash//new_line('a')//real_line(values) &
-         & //itoa(status)//' '//itoa(size(results))//' '//itoa(size(maxima))//new_line('a') &
+      text = real_line(values)//itoa(status)//' '//itoa(size(results))//' '//itoa(size(maxima))//new_line('a') &
          & //real_line([results, cost])//one_line//new_line('a')
       do k = 1, size(maxima)
          text = text//real_line(maxima(k:k))
       end do
-      text = text//'end '//itoa(count_lines(text))//' '//text_hash(text)//new_line('a')
-      call write_bytes(path//'.tmp', text, problem)
-      if (len(problem) > 0) then
-         problem = path//': the checkpoint could not be written ('//problem//')'
-         return
-      end if
-      call rename_file(path//'.tmp', path, save_error)
-      if (allocated(save_error)) then
-         problem = save_error%message
-         call remove_file(path//'.tmp')
-      end if
+      call save_checkpoint(path, input_hash, text, problem)
    end subroutine save_point
 
-   !> Numbers on one line, 17 significant digits.
-   function real_line(values) result(line)
-      real(wp), intent(in) :: values(:)
-      character(len=:), allocatable :: line
-      character(len=26) :: word
-      integer :: k
-
-      line = ''
-      do k = 1, size(values)
-         write (word, '(es26.17e3)') values(k)
-         line = line//word
-      end do
-      line = line//new_line('a')
-   end function real_line
-
-   pure integer function count_lines(text) result(n)
-      character(len=*), intent(in) :: text
-      integer :: k
-
-      n = 0
-      do k = 1, len(text)
-         if (text(k:k) == new_line('a')) n = n + 1
-      end do
-   end function count_lines
-
-   !> The whole text of a file ('' with ok false when it cannot be read).
-   subroutine read_whole(path, text, ok)
-      character(len=*), intent(in) :: path
-      character(len=:), allocatable, intent(out) :: text
-      logical, intent(out) :: ok
-      integer :: unit, stat
-      integer(i8) :: bytes
-
-      text = ''
-      ok = .false.
-      open (newunit=unit, file=path, status='old', action='read', form='unformatted', access='stream', iostat=stat)
-      if (stat /= 0) return
-      inquire (unit=unit, size=bytes)
-      if (bytes < 0 .or. bytes > 100000000_i8) then
-         close (unit)
-         return
-      end if
-      deallocate (text)
-      allocate (character(len=int(bytes)) :: text)
-      stat = 0
-      if (bytes > 0) read (unit, iostat=stat) text
-      close (unit)
-      ok = stat == 0
-   end subroutine read_whole
-
    !> Why the checkpoint at `path` cannot serve this run ('' when it can, or
-   !> when there is none): written for another input (its input hash is not
-   !> `input_hash`), for other values of the swept variables, or damaged
-   !> (not whole, or its checksum does not match).
+   !> when there is none): written for another input, damaged, or for other
+   !> values of the swept variables.
    function checkpoint_problem(path, input_hash, values) result(problem)
       character(len=*), intent(in) :: path, input_hash
       real(wp), intent(in) :: values(:)
       character(len=:), allocatable :: problem
-      character(len=:), allocatable :: text, body, last
+      character(len=:), allocatable :: body
       real(wp) :: saved(size(values))
-      integer :: cut, stat, n_lines, first_end
-      character(len=16) :: sum_text
-      logical :: ok
+      integer :: stat
 
-      problem = ''
-      if (.not. file_exists(path)) return
-      call read_whole(path, text, ok)
-      if (.not. ok) then
-         problem = path//': the checkpoint cannot be read'
-         return
-      end if
-      ! The last line: 'end LINES CHECKSUM'.
-      cut = 0
-      if (len(text) > 1) cut = index(text(1:len(text) - 1), new_line('a'), back=.true.)
-      if (len(text) == 0 .or. text(len(text):len(text)) /= new_line('a') .or. cut == 0) then
-         problem = path//': the checkpoint is damaged (it does not end with its checksum line)'
-         return
-      end if
-      body = text(1:cut)
-      last = text(cut + 1:len(text) - 1)
-      n_lines = -1
-      sum_text = ''
-      if (last(1:min(4, len(last))) == 'end ') then
-         read (last(5:), *, iostat=stat) n_lines, sum_text
-         if (stat /= 0) n_lines = -1
-      end if
-      if (n_lines /= count_lines(body) .or. sum_text /= text_hash(body)) then
-         problem = path//': the checkpoint is damaged (its line count or checksum does not match its content)'
-         return
-      end if
-      first_end = index(body, new_line('a'))
-      if (body(1:first_end - 1) /= checkpoint_magic//' input '//input_hash) then
-         if (index(body(1:first_end - 1), checkpoint_magic//' input ') == 1) then
-            problem = path//': the checkpoint was written for another input (its resolved input, every ' &
-               & //'group and the sweep, differs from this run''s)'
-         else
-            problem = path//': not a checkpoint of this version of friction'
-         end if
-         return
-      end if
-      read (body(first_end + 1:), *, iostat=stat) saved
+      call checkpoint_body(path, input_hash, body, problem)
+      if (len(problem) > 0 .or. .not. allocated(body)) return
+      read (body, *, iostat=stat) saved
       if (stat /= 0) then
          problem = path//': the checkpoint is damaged (its values do not read)'
       else if (.not. all(saved == values)) then
@@ -613,35 +508,27 @@ contains
       real(wp), allocatable, intent(out) :: maxima(:)
       logical, intent(out) :: loaded
       real(wp) :: numbers(size(results) + 1)
-      character(len=:), allocatable :: text
-      integer :: stat, found(3), k, at, next
-      logical :: ok
+      character(len=:), allocatable :: body, problem, line
+      integer :: stat, found(3), at
 
       loaded = .false.
       reason = ''
-      if (.not. file_exists(path)) return
       if (len(checkpoint_problem(path, input_hash, values)) > 0) return
-      call read_whole(path, text, ok)
-      if (.not. ok) return
-      ! Lines: 1 header, 2 values, 3 counts, 4 results and cost, 5 reason, then maxima.
+      call checkpoint_body(path, input_hash, body, problem)
+      if (.not. allocated(body)) return
+      ! Lines: values, counts, results and cost, reason, then maxima.
       at = 1
-      do k = 1, 2
-         at = at + index(text(at:), new_line('a'))
-      end do
-      next = at + index(text(at:), new_line('a')) - 1
-      read (text(at:next - 1), *, iostat=stat) found
+      line = next_line(body, at)   ! (the values, checked above)
+      line = next_line(body, at)
+      read (line, *, iostat=stat) found
       if (stat /= 0 .or. found(2) /= size(results) .or. found(3) < 0) return
-      at = next + 1
-      next = at + index(text(at:), new_line('a')) - 1
-      read (text(at:next - 1), *, iostat=stat) numbers
+      line = next_line(body, at)
+      read (line, *, iostat=stat) numbers
       if (stat /= 0) return
-      at = next + 1
-      next = at + index(text(at:), new_line('a')) - 1
-      reason = text(at:next - 1)
-      at = next + 1
+      reason = next_line(body, at)
       allocate (maxima(found(3)))
       if (found(3) > 0) then
-         read (text(at:), *, iostat=stat) maxima
+         read (body(at:), *, iostat=stat) maxima
          if (stat /= 0) return
       end if
       status = found(1)
