@@ -182,8 +182,9 @@ contains
          & '                     in the current directory)', &
          & '  -f, --force        overwrite an existing output file', &
          & '  -q, --quiet        no progress or summary on stderr', &
-         & '      --resume       sweeps: reuse the points an interrupted run completed', &
-         & '                     (its checkpoints beside the output); overwrites the output', &
+         & '      --resume       reuse the sweep points or map lines an interrupted run', &
+         & '                     completed (its checkpoints beside the output); a sweep''s', &
+         & '                     output is overwritten', &
          & '      --netlist FILE write the scene as a SPICE netlist for ngspice (the paper''s', &
          & '                     network model) and exit without integrating: the brake', &
          & '                     (arctan law), or line 0 (trace) of a NaF or HOPG map;', &
@@ -192,7 +193,8 @@ contains
          & '  -V, --version      the version', &
          & '', &
          & 'exit codes: 0 done, 2 usage, 3 bad input, 4 integration failed, 5 output failed,', &
-         & '            6 sweep interrupted (file written with the points done; --resume)'
+         & '            6 interrupted (a sweep''s file written with the points done, a map''s', &
+         & '            lines done checkpointed; --resume)'
    end subroutine print_help
 
    integer function exit_code(error)

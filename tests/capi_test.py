@@ -30,7 +30,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import helpers  # noqa: E402
-from helpers import fail  # noqa: E402
+from helpers import fail, file_contents  # noqa: E402
 
 NAF = ("naf.nml", "&scan nx = 16, ny = 3, angle = 10.0, origin_x = 0.7, origin_y = 0.3, retrace = .true. /\n")
 HOPG_QUASISTATIC = ("hopg.nml", "&tip model = 'quasistatic' /\n&scan nx = 24, ny = 2, width = 1.0 /\n")
@@ -38,7 +38,6 @@ GRAPHITE = ("graphite.nml", "&scan nx = 4, ny = 2, length = 1.0, width = 0.5 /\n
 BRAKE = ("brake.nml", "&brake t_end = 40.0, dt_out = 0.5 /\n"
          "&analysis spectrum = .false., poincare = .false., lyapunov = .false., rosenstein = .false. /\n")
 # Attributes that measure the run rather than compute it.
-TIMINGS = {"wall_time", "compute_time", "check_compute_time", "created"}
 
 
 def run(command, cwd):
@@ -108,25 +107,6 @@ def compare_scene(args, scene_name, scene, group):
         fail(f"{scene_name}: {lines} lines printed")
     print(f"{scene_name}: friction_compute equals the file's {len(program)} datasets"
           + (f", friction_afm_line its {lines // 2} line trips" if lines else "") + ", to the last bit")
-
-
-def file_contents(path):
-    """Every dataset and attribute of an HDF5 file, by name."""
-    contents = {}
-
-    def visit(name, item):
-        if isinstance(item, h5py.Dataset):
-            contents[name] = item[()]
-        for key, value in item.attrs.items():
-            if key not in TIMINGS:
-                contents[f"{name}@{key}"] = value
-
-    with h5py.File(path, "r") as f:
-        for key, value in f.attrs.items():
-            if key not in TIMINGS:
-                contents[f"/@{key}"] = value
-        f.visititems(visit)
-    return contents
 
 
 def compare_jobs(args):

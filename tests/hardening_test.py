@@ -20,6 +20,9 @@ import time
 import h5py
 import numpy as np
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from helpers import file_contents  # noqa: E402
+
 SMALL = "&scan nx = 16, ny = 4 /\n"
 NO_DIAGNOSTICS = "&analysis spectrum = .false., poincare = .false., lyapunov = .false., rosenstein = .false. /\n"
 SWEEP = ("&brake mu = 0.5, mu_s = 0.59, t_end = 300.0, dt_out = 0.1 /\n"
@@ -386,6 +389,94 @@ def case_resume_damaged(args):
     with h5py.File(path(args, "part.h5"), "r") as handle:
         if list(handle["sweep/computed_by_this_run"][()]) != [0, 1, 1, 1, 1]:
             fail(f"computed {handle['sweep/computed_by_this_run'][()]}")
+
+
+# ---- defect 11: a long map survives a time limit ----
+
+MAP = "&scan nx = 24, ny = 7, checkpoint_interval = 0.0 /\n"
+THERMAL_MAP = ("&scan nx = 16, ny = 5, checkpoint_interval = 0.0 /\n"
+               "&thermal temperature = 300.0, realizations = 2, seed = 3 /\n")
+
+
+def map_resumed(args, name, text, ranks):
+    """An uninterrupted map, then the same map stopped after 2 lines of each
+    rank (exit 6, no file, a checkpoint per line done) and resumed: the
+    resumed file equals the uninterrupted one in every dataset and every
+    attribute but the timings (the integrator's counts included), and the
+    checkpoints are gone."""
+    write(args, f"{name}.nml", text)
+    files = [inputs(args, "naf.nml"), f"{name}.nml"]
+    friction(args, "-o", f"{name}_whole.h5", *files, ranks=ranks)
+    result = friction(args, "-o", f"{name}.h5", *files, ranks=ranks, expect=6,
+                      env={"FRICTION_TEST_STOP_AFTER": "2"})
+    contains(result, "map interrupted", "--resume")
+    if os.path.exists(path(args, f"{name}.h5")):
+        fail("an interrupted map wrote its output")
+    checkpoints = sorted(f for f in listing(args.workdir) if f.startswith(f"{name}.h5.line-"))
+    if len(checkpoints) != 2 * ranks:
+        fail(f"{len(checkpoints)} line checkpoints after 2 lines on each of {ranks} ranks: {checkpoints}")
+    friction(args, "--resume", "-o", f"{name}.h5", *files, ranks=ranks)
+    whole, resumed = file_contents(path(args, f"{name}_whole.h5")), file_contents(path(args, f"{name}.h5"))
+    if sorted(whole) != sorted(resumed):
+        fail(f"{name}: the resumed file holds {sorted(set(whole) ^ set(resumed))} the other does not")
+    for key in whole:
+        if not np.array_equal(np.asarray(whole[key]), np.asarray(resumed[key]), equal_nan=np.asarray(whole[key]).dtype.kind == "f"):
+            fail(f"{name}: {key} differs between the uninterrupted and the resumed map")
+    left = [f for f in listing(args.workdir) if ".ckpt" in f]
+    if left:
+        fail(f"checkpoints left after the map completed: {left}")
+    return files
+
+
+def case_map_resume(args):
+    """A NaF map on 2 ranks, and the same at 300 K with 2 realizations (the
+    standard errors and the slips in the checkpoints), resume to the
+    uninterrupted file; a checkpoint of another input or a damaged one is
+    refused (exit 3, naming it)."""
+    files = map_resumed(args, "map", MAP, 2)
+    map_resumed(args, "warm", THERMAL_MAP, 2)
+    os.remove(path(args, "map.h5"))
+    friction(args, "-o", "map.h5", *files, expect=6, env={"FRICTION_TEST_STOP_AFTER": "1"})
+    write(args, "v0.nml", "&surface v0 = 1.1 /\n")
+    result = friction(args, "--resume", "-o", "map.h5", *files, "v0.nml", expect=3)
+    contains(result, "map.h5.line-1.ckpt", "another input")
+    name = path(args, "map.h5.line-1.ckpt")
+    text = open(name).read()
+    write(args, "map.h5.line-1.ckpt", text[:len(text) - 40])
+    result = friction(args, "--resume", "-o", "map.h5", *files, expect=3)
+    contains(result, "map.h5.line-1.ckpt", "damaged")
+    os.remove(name)
+    friction(args, "--resume", "-o", "map.h5", *files)
+
+
+def case_map_signal(args):
+    """SIGTERM during a map that checkpoints every line: exit 6, no output,
+    the lines done kept; --resume completes it to the uninterrupted file."""
+    write(args, "long.nml", "&scan nx = 64, ny = 400, checkpoint_interval = 0.0 /\n")
+    files = [inputs(args, "naf.nml"), "long.nml"]
+    process = subprocess.Popen([args.binary, "--quiet", "-o", "cut.h5", *files], cwd=args.workdir,
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and not any(".ckpt" in f for f in listing(args.workdir)):
+        time.sleep(0.05)
+    process.send_signal(signal.SIGTERM)
+    _, stderr = process.communicate(timeout=120)
+    if process.returncode == 0:
+        raise Skip("the map finished before the signal (a fast machine)")
+    if process.returncode != 6 or "map interrupted" not in stderr:
+        fail(f"SIGTERM during a map: exit {process.returncode}: {stderr}")
+    if os.path.exists(path(args, "cut.h5")):
+        fail("an interrupted map wrote its output")
+    kept = [f for f in listing(args.workdir) if f.startswith("cut.h5.line-")]
+    if not kept:
+        fail("no line kept")
+    friction(args, "--resume", "-o", "cut.h5", *files)
+    friction(args, "-o", "whole.h5", *files)
+    whole, resumed = file_contents(path(args, "whole.h5")), file_contents(path(args, "cut.h5"))
+    differing = [key for key in whole if not np.array_equal(np.asarray(whole[key]), np.asarray(resumed.get(key)))]
+    if differing:
+        fail(f"the resumed map differs from the uninterrupted one in {differing}")
+    print(f"{len(kept)} of 400 lines kept at the signal; the resumed map equals the uninterrupted one")
 
 
 def case_sweep_signal_last(args):

@@ -3,7 +3,7 @@
 package of this repository.
 
     sys.path.insert(0, str(Path(__file__).resolve().parent))   # tests/
-    from helpers import fail, mpi_env, run, friction_package
+    from helpers import fail, mpi_env, run, friction_package, file_contents
 
 The standalone test programs (cli_test.py, capi_test.py, ...) report a
 failure with fail(), which prints "FAILED: ..." and exits 1; pytest tests
@@ -90,3 +90,30 @@ def friction_package(library=None):
         sys.path.insert(0, str(PACKAGE))
     import friction
     return friction
+
+
+# Attributes that differ between two runs of the same input.
+TIMINGS = {"wall_time", "compute_time", "check_compute_time", "created"}
+
+
+def file_contents(path, ignore=TIMINGS):
+    """Every dataset and attribute of an HDF5 file by name ("group/name",
+    "group/name@attribute"), but the attributes in `ignore` (the timings):
+    two files that hold the same results compare equal as dicts of arrays."""
+    import h5py
+
+    contents = {}
+
+    def visit(name, item):
+        if isinstance(item, h5py.Dataset):
+            contents[name] = item[()]
+        for key, value in item.attrs.items():
+            if key not in ignore:
+                contents[f"{name}@{key}"] = value
+
+    with h5py.File(path, "r") as f:
+        for key, value in f.attrs.items():
+            if key not in ignore:
+                contents[f"/@{key}"] = value
+        f.visititems(visit)
+    return contents

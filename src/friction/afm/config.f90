@@ -75,6 +75,9 @@ module friction_afm_config
       real(wp) :: origin_x = 0.0_wp    !! first point of the first line, Å (lattice frame)
       real(wp) :: origin_y = 0.0_wp
       real(wp) :: lead_in = 0.0_wp     !! support travel before the first sample, Å
+      !> wall time between checkpoints of finished lines, s (0: every line);
+      !> a map shorter than this writes none
+      real(wp) :: checkpoint_interval = 60.0_wp
       integer :: nx = 128              !! sample points per line
       integer :: ny = 128              !! lines
       logical :: retrace = .true.      !! scan every line back as well
@@ -137,6 +140,7 @@ contains
       call v%item('nx', self%nx)
       call v%item('ny', self%ny)
       call v%item('retrace', self%retrace)
+      call v%item('checkpoint_interval', self%checkpoint_interval, 's')
       call v%end_group()
       call visit_integrator(self%solver, v, 's')
       call self%thermal%visit(v)
@@ -176,6 +180,7 @@ contains
       call c%finite('scan', 'origin_x', self%origin_x)
       call c%finite('scan', 'origin_y', self%origin_y)
       call c%nonnegative('scan', 'lead_in', self%lead_in, 'angstrom')
+      call c%nonnegative('scan', 'checkpoint_interval', self%checkpoint_interval, 's')
       if (self%nx < 2) call c%reject('scan', 'nx', itoa(self%nx), 'must be >= 2 (sample points per line)')
       if (self%ny < 1) call c%reject('scan', 'ny', itoa(self%ny), 'must be >= 1 (lines)')
       ! Sizes in 64 bits: a map's dataset holds nx * ny values, and one

@@ -4,9 +4,9 @@
 module friction_afm_scene
    use mpi_f08
    use friction_kinds, only: wp, i8
-   use friction_error, only: error_type, fatal_error, error_input
-   use friction_files, only: available_memory
-   use friction_strings, only: itoa, bytes_text
+   use friction_error, only: error_type, fatal_error, error_input, error_interrupted
+   use friction_files, only: available_memory, remove_file
+   use friction_strings, only: itoa, bytes_text, text_hash
    use friction_version, only: version_string
    use friction_parameters, only: parameter_visitor
    use friction_checks, only: config_checker
@@ -22,6 +22,7 @@ module friction_afm_scene
    use friction_afm_output, only: write_afm_file, afm_surface_record, afm_thermal_record
    use friction_afm_validity, only: afm_model_warnings, quasistatic_friction_warning
    use friction_afm_netlist, only: afm_netlist
+   use friction_afm_line_checkpoint, only: line_checkpoint_name, save_line, load_line
    implicit none
    private
 
@@ -143,8 +144,12 @@ contains
       type(integrator_statistics) :: stats
       real(wp), allocatable :: local_slips(:, :)
       integer(i8) :: counts(4)
-      integer :: count, j
-      real(wp) :: wall
+      integer :: count, j, computed, saved, flag
+      real(wp) :: wall, last_saved
+      real(wp), allocatable :: line_counts(:, :)
+      character(len=:), allocatable :: input_hash, problem
+      logical :: interrupted
+      logical, allocatable :: loaded(:)
       character(len=:), allocatable :: warnings
       integer :: start, end
 
@@ -188,33 +193,66 @@ contains
          self%surface%contact_height = scanner%contact_height
          self%surface%support_height = scanner%support_height
          if (allocated(scanner%tip)) self%three_d = scanner%tip%ndim == 3
+         ! Finished lines go to checkpoints beside the output (every
+         ! checkpoint_interval of wall time, and when stopped) for --resume.
+         input_hash = text_hash(job%input_text)
+         allocate (line_counts(4, count), source=0.0_wp)
+         allocate (loaded(count), source=.false.)
+         computed = 0
+         saved = 0
+         last_saved = MPI_Wtime()
+         interrupted = .false.
          do j = 1, count
             if (allocated(error)) exit
-            call scanner%run_line(self%first + (j - 1) * job%nranks, line, error)
+            ! Between lines: a stop request (or the test hook, after that many
+            ! lines of this rank computed) ends the map here.
+            if (reporter%stop_requested() .or. (job%stop_after > 0 .and. computed >= job%stop_after)) then
+               interrupted = .true.
+               exit
+            end if
+            if (job%resume) call resume_line(j, error)
             if (allocated(error)) exit
-            self%trace(:, j, :) = line%trace
-            if (c%retrace) self%retrace(:, j, :) = line%retrace
-            if (scanner%thermal) then
-               self%trace_sem(:, j, :) = line%trace_sem
-               if (c%retrace) self%retrace_sem(:, j, :) = line%retrace_sem
-               self%friction_sem(j) = line%friction_sem
-               call keep_slips(self%first + (j - 1) * job%nranks, line%slips)
+            if (.not. loaded(j)) then
+               counts = scanner_counts()
+               call scanner%run_line(self%first + (j - 1) * job%nranks, line, error)
+               if (allocated(error)) exit
+               line_counts(:, j) = real(scanner_counts() - counts, wp)
+               computed = computed + 1
+               self%trace(:, j, :) = line%trace
+               if (c%retrace) self%retrace(:, j, :) = line%retrace
+               if (scanner%thermal) then
+                  self%trace_sem(:, j, :) = line%trace_sem
+                  if (c%retrace) self%retrace_sem(:, j, :) = line%retrace_sem
+                  self%friction_sem(j) = line%friction_sem
+                  call keep_slips(self%first + (j - 1) * job%nranks, line%slips)
+               end if
+               if (MPI_Wtime() - last_saved >= c%checkpoint_interval) call save_lines(j, error)
             end if
             ! Rank 0's share is as large as any other and spread over the whole
             ! map, so its fraction done is the map's fraction done.
             if (job%rank == 0) call reporter%progress(real(lines_done(j), wp), real(c%ny, wp), 'lines', .false.)
          end do
-         if (job%rank == 0 .and. .not. allocated(error)) &
+         if (interrupted .and. .not. allocated(error)) call save_lines(j - 1, error)
+         if (job%rank == 0 .and. .not. allocated(error) .and. .not. interrupted) &
             & call reporter%progress(real(lines_done(count), wp), real(c%ny, wp), 'lines', .true.)
 
          ! A failure on any rank stops all of them here, before anything is written.
          call agree_on_error(job, error)
          if (allocated(error)) return
+         flag = merge(1, 0, interrupted)
+         call MPI_Allreduce(MPI_IN_PLACE, flag, 1, MPI_INTEGER, MPI_MAX, job%comm)
+         if (flag /= 0) then
+            call fatal_error(error, 'map interrupted: no file written; the lines done are checkpointed beside ' &
+               & //'the output ('//line_checkpoint_name(job%output, 0)//' ...): run again with --resume to ' &
+               & //'compute only the others', error_interrupted)
+            return
+         end if
          if (c%model == 'quasistatic') call check_friction()
          if (scanner%thermal) call gather_slips()
 
-         stats = scanner%statistics()
-         counts = [stats%steps, stats%failed_steps, stats%rhs_evaluations, stats%jacobian_evaluations]
+         ! The counts of every line, computed now or loaded: a resumed map
+         ! records what an uninterrupted one does.
+         counts = nint(sum(line_counts, dim=2), i8)
          call MPI_Allreduce(MPI_IN_PLACE, counts, 4, MPI_INTEGER8, MPI_SUM, job%comm)
          stats = integrator_statistics(counts(1), counts(2), counts(3), counts(4))
          wall = MPI_Wtime() - job%t_start
@@ -225,9 +263,93 @@ contains
          self%record%nranks = job%nranks
          self%record%wall_time = wall
          self%record%stats = stats
+         ! Complete: the checkpoints have served.
+         do j = 1, count
+            call remove_file(line_checkpoint_name(job%output, self%first + (j - 1) * job%nranks))
+         end do
       end associate
 
    contains
+
+      !> The scanner's integrator counts so far.
+      function scanner_counts() result(now)
+         integer(i8) :: now(4)
+         type(integrator_statistics) :: so_far
+
+         so_far = scanner%statistics()
+         now = [so_far%steps, so_far%failed_steps, so_far%rhs_evaluations, so_far%jacobian_evaluations]
+      end function scanner_counts
+
+      !> Line j of this rank from its checkpoint, when there is one for this
+      !> input (then loaded(j)); one that exists but cannot serve is an error.
+      subroutine resume_line(j, error)
+         integer, intent(in) :: j
+         type(error_type), allocatable, intent(out) :: error
+         real(wp), allocatable :: slips(:, :), trace(:, :), retrace(:, :), trace_sem(:, :), retrace_sem(:, :)
+         real(wp) :: friction_sem
+         integer :: g
+
+         g = self%first + (j - 1) * job%nranks
+         call line_arrays(j, trace, retrace, trace_sem, retrace_sem)
+         call load_line(line_checkpoint_name(job%output, g), input_hash, g, trace, retrace, trace_sem, &
+            & retrace_sem, friction_sem, slips, line_counts(:, j), loaded(j), problem)
+         if (len(problem) > 0) then
+            call fatal_error(error, problem//'; --resume reuses only the checkpoints of the same input: remove ' &
+               & //'it, or run without --resume', error_input)
+            return
+         end if
+         if (.not. loaded(j)) return
+         self%trace(:, j, :) = trace
+         if (self%ran%retrace) self%retrace(:, j, :) = retrace
+         if (scanner%thermal) then
+            self%trace_sem(:, j, :) = trace_sem
+            if (self%ran%retrace) self%retrace_sem(:, j, :) = retrace_sem
+            self%friction_sem(j) = friction_sem
+            local_slips = reshape([local_slips, slips], [n_slip_items, size(local_slips, 2) + size(slips, 2)])
+         end if
+      end subroutine resume_line
+
+      !> Checkpoints of this rank's lines after `saved` up to `last` that
+      !> were computed in this run.
+      subroutine save_lines(last, error)
+         integer, intent(in) :: last
+         type(error_type), allocatable, intent(out) :: error
+         real(wp), allocatable :: trace(:, :), retrace(:, :), trace_sem(:, :), retrace_sem(:, :)
+         real(wp) :: friction_sem
+         integer :: j, g, k
+
+         do j = saved + 1, last
+            if (loaded(j)) cycle
+            g = self%first + (j - 1) * job%nranks
+            call line_arrays(j, trace, retrace, trace_sem, retrace_sem)
+            friction_sem = 0.0_wp
+            if (scanner%thermal) friction_sem = self%friction_sem(j)
+            call save_line(line_checkpoint_name(job%output, g), input_hash, g, trace, retrace, trace_sem, &
+               & retrace_sem, friction_sem, local_slips(:, pack([(k, k=1, size(local_slips, 2))], &
+               & nint(local_slips(1, :)) == g)), line_counts(:, j), problem)
+            if (len(problem) > 0) then
+               call fatal_error(error, problem)
+               return
+            end if
+         end do
+         saved = max(saved, last)
+         last_saved = MPI_Wtime()
+      end subroutine save_lines
+
+      !> Line j's samples as save_line and load_line take them: (nx,
+      !> quantities) each, of no rows for what the map does not have.
+      subroutine line_arrays(j, trace, retrace, trace_sem, retrace_sem)
+         integer, intent(in) :: j
+         real(wp), allocatable, intent(out) :: trace(:, :), retrace(:, :), trace_sem(:, :), retrace_sem(:, :)
+         logical :: thermal
+
+         thermal = scanner%thermal
+         trace = self%trace(:, j, :)
+         allocate (retrace(0, 0), trace_sem(0, 0), retrace_sem(0, 0))
+         if (self%ran%retrace) retrace = self%retrace(:, j, :)
+         if (thermal) trace_sem = self%trace_sem(:, j, :)
+         if (thermal .and. self%ran%retrace) retrace_sem = self%retrace_sem(:, j, :)
+      end subroutine line_arrays
 
       !> trace and retrace for this rank's lines, or an error stating the
       !> memory they need when this machine has not that much available.
