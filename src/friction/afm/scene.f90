@@ -4,6 +4,7 @@
 module friction_afm_scene
    use mpi_f08
    use friction_kinds, only: wp, i8
+   use friction_clock, only: wall_seconds
    use friction_error, only: error_type, fatal_error, error_input
    use friction_files, only: available_memory
    use friction_strings, only: itoa, bytes_text
@@ -215,10 +216,12 @@ contains
 
          stats = scanner%statistics()
          counts = [stats%steps, stats%failed_steps, stats%rhs_evaluations, stats%jacobian_evaluations]
-         call MPI_Allreduce(MPI_IN_PLACE, counts, 4, MPI_INTEGER8, MPI_SUM, job%comm)
+         wall = wall_seconds() - job%t_start
+         if (job%parallel()) then
+            call MPI_Allreduce(MPI_IN_PLACE, counts, 4, MPI_INTEGER8, MPI_SUM, job%comm)
+            call MPI_Allreduce(MPI_IN_PLACE, wall, 1, MPI_DOUBLE_PRECISION, MPI_MAX, job%comm)
+         end if
          stats = integrator_statistics(counts(1), counts(2), counts(3), counts(4))
-         wall = MPI_Wtime() - job%t_start
-         call MPI_Allreduce(MPI_IN_PLACE, wall, 1, MPI_DOUBLE_PRECISION, MPI_MAX, job%comm)
          ! (Component by component: gfortran's structure constructor mis-sizes a
          ! deferred-length component copied from another derived type's.)
          self%record%input_text = job%input_text
@@ -278,6 +281,10 @@ contains
          real(wp), allocatable :: everything(:, :)
 
          n = size(local_slips, 2)
+         if (.not. job%parallel()) then
+            call move_alloc(local_slips, self%slips)
+            return
+         end if
          call MPI_Allgather(n, 1, MPI_INTEGER, counts, 1, MPI_INTEGER, job%comm)
          displacements(1) = 0
          do r = 2, job%nranks
@@ -307,7 +314,7 @@ contains
 
          sums = [sum(self%trace(:, :, q_f_along)), real(size(self%trace(:, :, q_f_along)), wp)]
          if (self%ran%retrace) sums(1) = 0.5_wp * (sums(1) - sum(self%retrace(:, :, q_f_along)))
-         call MPI_Allreduce(MPI_IN_PLACE, sums, 2, MPI_DOUBLE_PRECISION, MPI_SUM, job%comm)
+         if (job%parallel()) call MPI_Allreduce(MPI_IN_PLACE, sums, 2, MPI_DOUBLE_PRECISION, MPI_SUM, job%comm)
          warning = quasistatic_friction_warning(self%ran, sums(1) / max(1.0_wp, sums(2)))
          if (job%rank == 0 .and. len(warning) > 0) call reporter%note('warning: '//warning)
       end subroutine check_friction

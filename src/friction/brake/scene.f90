@@ -7,6 +7,7 @@
 module friction_brake_scene
    use mpi_f08
    use friction_kinds, only: wp, i8
+   use friction_clock, only: wall_seconds
    use friction_strings, only: fixed_text
    use friction_error, only: error_type, fatal_error, error_numerical
    use friction_version, only: version_string
@@ -181,8 +182,8 @@ contains
             if (allocated(error)) return
          end if
 
-         wall = MPI_Wtime() - job%t_start
-         call MPI_Allreduce(MPI_IN_PLACE, wall, 1, MPI_DOUBLE_PRECISION, MPI_MAX, job%comm)
+         wall = wall_seconds() - job%t_start
+         if (job%parallel()) call MPI_Allreduce(MPI_IN_PLACE, wall, 1, MPI_DOUBLE_PRECISION, MPI_MAX, job%comm)
          record%input_text = job%input_text
          record%version = version_string
          record%nranks = job%nranks
@@ -318,6 +319,11 @@ contains
          counts = [stats%steps, stats%failed_steps, stats%rhs_evaluations, stats%jacobian_evaluations]
          times = [run%compute_time, run%stick_time()]
          n_events = run%events%n
+         if (.not. job%parallel()) then   ! serial: root is this process, which holds the run
+            compute_time = times(1)
+            stick_time = times(2)
+            return
+         end if
       else
          call run%trajectory%allocate_points(n)
          run%n = n
