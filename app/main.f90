@@ -233,6 +233,8 @@ contains
          & 'trajectory; inputs/brake.nml; groups &brake &brake_dimensional &verify &analysis).', &
          & 'With a &sweep group: a parameter sweep of either scene over the MPI ranks, one or two', &
          & 'variables (inputs/brake_sweep.nml, inputs/afm_sweep.nml; docs/sweeps.md).', &
+         & 'Without mpirun (or srun) the run is serial and does not start MPI; FRICTION_MPI=1', &
+         & 'starts it anyway (docs/cli.md).', &
          & '', &
          & 'Input files are namelist files read in order; a later file overrides', &
          & 'earlier values variable by variable.  Groups: &job &surface &tip &scan', &
