@@ -4,7 +4,6 @@
 module friction_afm_scene
    use mpi_f08
    use friction_kinds, only: wp, i8
-   use friction_clock, only: wall_seconds
    use friction_error, only: error_type, fatal_error, error_input
    use friction_files, only: available_memory
    use friction_strings, only: itoa, bytes_text
@@ -17,7 +16,7 @@ module friction_afm_scene
    use friction_output_summary, only: run_summary
    use friction_scene, only: scene, point_result
    use friction_scene_report, only: job_reporter
-   use friction_scene_context, only: job_context, agree_on_error, ranks_text, share_of
+   use friction_scene_context, only: job_context, agree_on_error, ranks_text, share_of, job_wall_time
    use friction_afm_config, only: afm_config, new_potential, species_count
    use friction_afm_scan, only: afm_scanner, line_record, slip_list, n_quantities, q_fx, q_fy, q_f_along
    use friction_afm_output, only: write_afm_file, afm_surface_record, afm_thermal_record
@@ -216,11 +215,8 @@ contains
 
          stats = scanner%statistics()
          counts = [stats%steps, stats%failed_steps, stats%rhs_evaluations, stats%jacobian_evaluations]
-         wall = wall_seconds() - job%t_start
-         if (job%parallel()) then
-            call MPI_Allreduce(MPI_IN_PLACE, counts, 4, MPI_INTEGER8, MPI_SUM, job%comm)
-            call MPI_Allreduce(MPI_IN_PLACE, wall, 1, MPI_DOUBLE_PRECISION, MPI_MAX, job%comm)
-         end if
+         if (job%parallel()) call MPI_Allreduce(MPI_IN_PLACE, counts, 4, MPI_INTEGER8, MPI_SUM, job%comm)
+         wall = job_wall_time(job)
          stats = integrator_statistics(counts(1), counts(2), counts(3), counts(4))
          ! (Component by component: gfortran's structure constructor mis-sizes a
          ! deferred-length component copied from another derived type's.)

@@ -7,7 +7,6 @@
 module friction_brake_scene
    use mpi_f08
    use friction_kinds, only: wp, i8
-   use friction_clock, only: wall_seconds
    use friction_strings, only: fixed_text
    use friction_error, only: error_type, fatal_error, error_numerical
    use friction_version, only: version_string
@@ -17,7 +16,7 @@ module friction_brake_scene
    use friction_ode_auto, only: auto_name, auto_method
    use friction_scene, only: scene, point_result
    use friction_scene_report, only: job_reporter
-   use friction_scene_context, only: job_context, agree_on_error, ranks_text
+   use friction_scene_context, only: job_context, agree_on_error, ranks_text, job_wall_time
    use friction_brake_config, only: brake_config, model_switched
    use friction_brake_simulate, only: brake_run, compare_runs
    use friction_brake_output, only: brake_run_summary, brake_check_summary, write_brake_file
@@ -182,8 +181,7 @@ contains
             if (allocated(error)) return
          end if
 
-         wall = wall_seconds() - job%t_start
-         if (job%parallel()) call MPI_Allreduce(MPI_IN_PLACE, wall, 1, MPI_DOUBLE_PRECISION, MPI_MAX, job%comm)
+         wall = job_wall_time(job)
          record%input_text = job%input_text
          record%version = version_string
          record%nranks = job%nranks

@@ -34,7 +34,7 @@ module friction_job_sweep
    use friction_files, only: file_exists, rename_file, remove_file, process_id, write_bytes
    use friction_scene_report, only: job_reporter
    use friction_scene_context, only: job_context, temporary_name, publish, ranks_text, sum_to_root_real, &
-      & sum_to_root_integer, agree_on_error
+      & sum_to_root_integer, agree_on_error, job_wall_time
    implicit none
    private
 
@@ -242,10 +242,9 @@ contains
 
       ! Peak resident memory of every rank, for the benchmark (docs/sweeps.md).
       allocate (memory(job%nranks))
-      wall = wall_seconds() - job%t_start
+      wall = job_wall_time(job)
       if (job%parallel()) then
          call MPI_Gather(peak_memory_kb(), 1, MPI_INTEGER, memory, 1, MPI_INTEGER, 0, job%comm)
-         call MPI_Allreduce(MPI_IN_PLACE, wall, 1, MPI_DOUBLE_PRECISION, MPI_MAX, job%comm)
       else
          memory(1) = peak_memory_kb()
       end if

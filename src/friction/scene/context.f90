@@ -6,6 +6,7 @@
 module friction_scene_context
    use mpi_f08
    use friction_kinds, only: wp
+   use friction_clock, only: wall_seconds
    use friction_error, only: error_type, fatal_error, error_io
    use friction_strings, only: itoa, bytes_text
    use friction_files, only: publish_file, remove_file, process_id, free_bytes, min_free_bytes
@@ -13,7 +14,7 @@ module friction_scene_context
    private
 
    public :: job_context, agree_on_error, temporary_name, publish, check_writable, default_output, &
-      & ranks_text, sum_to_root_real, sum_to_root_integer, share_of
+      & ranks_text, sum_to_root_real, sum_to_root_integer, share_of, job_wall_time
 
    !> One job's run: where it runs, since when, what it read and writes.
    type :: job_context
@@ -39,6 +40,16 @@ contains
 
       parallel = .not. (self%comm == MPI_COMM_NULL)
    end function parallel
+
+   !> Seconds since the job started (job%t_start), the longest of any rank:
+   !> a run's wall_time.  Collective.
+   function job_wall_time(job) result(wall)
+      type(job_context), intent(in) :: job
+      real(wp) :: wall
+
+      wall = wall_seconds() - job%t_start
+      if (job%parallel()) call MPI_Allreduce(MPI_IN_PLACE, wall, 1, MPI_DOUBLE_PRECISION, MPI_MAX, job%comm)
+   end function job_wall_time
 
    !> A rank's share of n items, dealt round-robin: items first, first +
    !> nranks, ... (0-based), count of them.  Neighbouring lines cost alike
