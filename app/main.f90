@@ -7,6 +7,11 @@
 !> library's run_job (src/friction/job/); this program parses the command
 !> line, shows the job's progress and notes on stderr, and turns its error
 !> into a message and an exit code.
+!>
+!> MPI is started only for a job launched by an MPI launcher (mpirun, srun,
+!> mpiexec: see launched()) or with FRICTION_MPI=1; any other run is serial,
+!> through the same job code, without MPI_Init and its start-up time.
+!> --help, --version, --netlist and usage errors never start MPI.
 program friction_main
    use, intrinsic :: iso_c_binding, only: c_int
    use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
@@ -14,6 +19,7 @@ program friction_main
    use friction_error, only: error_type, error_input, error_io, error_interrupted
    use friction_version, only: version_string
    use friction_job, only: run_job, write_netlist, default_output
+   use friction_clock, only: wall_seconds
    use friction_app_terminal, only: terminal_reporter
    implicit none
 
@@ -41,20 +47,31 @@ program friction_main
    type(error_type), allocatable :: error
    character(len=:), allocatable :: summary
    integer :: rank, code
+   logical :: mpi_started = .false.
+   type(MPI_Comm) :: comm
 
-   call MPI_Init()
-   reporter%t_start = MPI_Wtime()
-   call MPI_Comm_rank(MPI_COMM_WORLD, rank)
+   reporter%t_start = wall_seconds()
+   ! Until MPI starts (if it does), the launcher's rank says who prints.
+   rank = launcher_rank()
 
    code = parse_arguments(opts)
    if (code >= 0) call finish(code)
    reporter%quiet = opts%quiet
+   comm = MPI_COMM_NULL
    if (allocated(opts%netlist)) then
-      call write_netlist(opts%files, opts%netlist, opts%force, MPI_COMM_WORLD, reporter, summary, error)
+      ! One process writes the netlist, without MPI: the others of a launch have nothing to do.
+      if (rank /= 0) call finish(0)
+      call write_netlist(opts%files, opts%netlist, opts%force, comm, reporter, summary, error)
       opts%output = opts%netlist
    else
+      if (launched() .or. forced_mpi()) then
+         call MPI_Init()
+         mpi_started = .true.
+         comm = MPI_COMM_WORLD
+         call MPI_Comm_rank(comm, rank)
+      end if
       if (.not. allocated(opts%output)) opts%output = default_output(opts%files(1))
-      call run_job(opts%files, opts%output, opts%force, opts%resume, MPI_COMM_WORLD, reporter, summary, error, &
+      call run_job(opts%files, opts%output, opts%force, opts%resume, comm, reporter, summary, error, &
          & stop_after=test_stop_after())
    end if
    ! An interrupted sweep has written its file: say what it holds, then why it stopped.
@@ -74,6 +91,50 @@ program friction_main
    call finish(0)
 
 contains
+
+   !> Whether an MPI launcher started this process: Open MPI's mpirun
+   !> (OMPI_COMM_WORLD_SIZE, OMPI_UNIVERSE_SIZE), any PMIx launcher (PMIX_RANK:
+   !> Open MPI 5, srun --mpi=pmix), or a PMI one (PMI_RANK, PMI_SIZE: MPICH's
+   !> mpiexec, srun --mpi=pmi2).  Without one, a run is serial.
+   logical function launched()
+      character(len=*), parameter :: names(5) = [character(len=20) :: 'OMPI_COMM_WORLD_SIZE', &
+         & 'OMPI_UNIVERSE_SIZE', 'PMIX_RANK', 'PMI_RANK', 'PMI_SIZE']
+      integer :: k, length, stat
+
+      launched = .false.
+      do k = 1, size(names)
+         call get_environment_variable(trim(names(k)), length=length, status=stat)
+         if (stat == 0) launched = .true.
+      end do
+   end function launched
+
+   !> FRICTION_MPI=1: start MPI even without a launcher (a singleton run,
+   !> as `mpirun -n 1` would; docs/cli.md).
+   logical function forced_mpi()
+      character(len=8) :: text
+      integer :: stat
+
+      call get_environment_variable('FRICTION_MPI', text, status=stat)
+      forced_mpi = stat == 0 .and. trim(text) == '1'
+   end function forced_mpi
+
+   !> This process's rank as its launcher set it (0 without a launcher), so
+   !> that under mpirun only rank 0 prints help, version and usage errors.
+   integer function launcher_rank() result(r)
+      character(len=*), parameter :: names(4) = [character(len=21) :: 'OMPI_COMM_WORLD_RANK', 'PMIX_RANK', &
+         & 'PMI_RANK', 'SLURM_PROCID']
+      character(len=32) :: text
+      integer :: k, length, stat
+
+      r = 0
+      do k = 1, size(names)
+         call get_environment_variable(trim(names(k)), text, length, stat)
+         if (stat /= 0 .or. length == 0) cycle
+         read (text, *, iostat=stat) r
+         if (stat /= 0) r = 0
+         return
+      end do
+   end function launcher_rank
 
    !> The test suite's hook for an interrupted sweep (docs/testing.md):
    !> FRICTION_TEST_STOP_AFTER=N stops a sweep after point N as SIGTERM
@@ -172,6 +233,8 @@ contains
          & 'trajectory; inputs/brake.nml; groups &brake &brake_dimensional &verify &analysis).', &
          & 'With a &sweep group: a parameter sweep of either scene over the MPI ranks, one or two', &
          & 'variables (inputs/brake_sweep.nml, inputs/afm_sweep.nml; docs/sweeps.md).', &
+         & 'Without mpirun (or srun) the run is serial and does not start MPI; FRICTION_MPI=1', &
+         & 'starts it anyway (docs/cli.md).', &
          & '', &
          & 'Input files are namelist files read in order; a later file overrides', &
          & 'earlier values variable by variable.  Groups: &job &surface &tip &scan', &
@@ -218,7 +281,7 @@ contains
 
       flush (error_unit)
       flush (output_unit)
-      call MPI_Finalize()
+      if (mpi_started) call MPI_Finalize()
       flush (error_unit)
       flush (output_unit)
       call c_exit(int(code, c_int))

@@ -3,7 +3,7 @@
 module friction_app_terminal
    use, intrinsic :: iso_c_binding, only: c_int
    use, intrinsic :: iso_fortran_env, only: error_unit
-   use mpi_f08, only: MPI_Wtime
+   use friction_clock, only: wall_seconds
    use friction_kinds, only: wp
    use friction_job, only: job_reporter
    use friction_scene_report, only: progress_text
@@ -55,7 +55,7 @@ contains
       character(len=12) :: seconds(2)
 
       if (self%quiet) return
-      now = MPI_Wtime()
+      now = wall_seconds()
       tty = friction_stderr_is_terminal() /= 0
       interval = 0.5_wp
       if (.not. tty) interval = max(2.0_wp, 0.1_wp * (now - self%t_start))

@@ -26,8 +26,8 @@
  * its own handles (configuration, result, error).  A handle must not be used
  * by two threads at once.  The only state shared between calls is a
  * mutex-guarded count of the threads inside GSL, so that the host's GSL
- * handler is back when the last of them returns.  The job functions use MPI
- * and must be called from one thread at a time.
+ * handler is back when the last of them returns.  The job functions may use
+ * MPI and must be called from one thread at a time.
  *
  * Units are those of the namelist input (docs/input.md).
  */
@@ -209,7 +209,10 @@ typedef void (*friction_report_fn)(const char *message, double fraction, void *u
  *     library initialises MPI (MPI_THREAD_FUNNELED), runs the job on this
  *     process alone and leaves MPI initialised for the process's exit (MPI
  *     cannot be initialised twice: the caller must not call MPI_Init later);
- *   - otherwise FRICTION_ERROR_INPUT: call MPI_Init first or pass the flag.
+ *   - MPI is not initialised and the flag is not given: the job runs
+ *     serially on this process without any MPI call (MPI stays
+ *     uninitialised); its file is the one a 1-rank MPI run writes;
+ *   - after MPI_Finalize: FRICTION_ERROR_INPUT.
  * Returns FRICTION_OK, an error code, or FRICTION_INTERRUPTED. */
 int friction_run_job(const char *const *files, int nfiles, const char *output, int flags,
                      friction_report_fn report, void *user, friction_error *err);

@@ -115,6 +115,7 @@ def compare_jobs(args):
         run([args.binary, "-q", "-o", "cli.h5", "--force"] + files, args.workdir)
         cli = file_contents(os.path.join(args.workdir, "cli.h5"))
         for way, command in [("friction_run_job", [args.capi, "job", "capi.h5"] + files),
+                             ("friction_run_job without MPI", [args.capi, "serial-job", "capi.h5"] + files),
                              ("friction_run_config", [args.capi, "config-job", scene_kind, "capi.h5"] + files)]:
             run(command, args.workdir)
             capi = file_contents(os.path.join(args.workdir, "capi.h5"))

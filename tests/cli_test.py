@@ -8,7 +8,8 @@ quasistatic-failure, thermal-zero, thermal-ranks, thermal-equipartition,
 and bad-<name> for each bad input in BAD_INPUTS; for the brake scene
 brake-run, brake-ranks, brake-dimensional, brake-verify, brake-failure, brake-analysis and
 bad-brake-<name> for each bad input in BAD_BRAKE_INPUTS; for sweeps sweep-ranks,
-sweep-failure, sweep-resume, sweep-signal and bad-sweep-<name> for each bad input in BAD_SWEEP_INPUTS.  Each asserts on exit codes,
+sweep-failure, sweep-resume, sweep-signal and bad-sweep-<name> for each bad input in BAD_SWEEP_INPUTS;
+serial-files and serial-no-mpi for runs without a launcher (no MPI).  Each asserts on exit codes,
 messages and file contents (read with h5py); none asserts on timings.
 """
 import argparse
@@ -1190,6 +1191,99 @@ def case_bad_brake(args, name):
         fail(f"bad input left files: {leftovers(args)}")
 
 
+# ---- serial runs (no launcher: no MPI) against `mpirun -n 1` ----
+
+# The variables by which an MPI launcher tells a process it was launched
+# (app/main.f90, launched()); removed so that a run of the program is serial.
+LAUNCHER_VARIABLES = ("OMPI_COMM_WORLD_SIZE", "OMPI_UNIVERSE_SIZE", "PMIX_RANK", "PMI_RANK", "PMI_SIZE",
+                      "FRICTION_MPI")
+# Objects that record how the run went rather than what it computed, besides
+# the root's wall_time that comparable() leaves out: seconds measured (the
+# brake's and its check's compute_time, each sweep point's) and a sweep's
+# peak memory per rank.
+RUN_DEPENDENT = ("brake@compute_time", "brake/verify@compute_time", "sweep/compute_time",
+                 "sweep/peak_memory_per_rank")
+
+
+def serial_env():
+    """This process's environment without any launcher's variables."""
+    return {name: value for name, value in helpers.mpi_env().items() if name not in LAUNCHER_VARIABLES}
+
+
+def case_serial_files(args):
+    """A run without mpirun is serial (no MPI_Init, HDF5's default driver) and
+    writes the same file as `mpirun -n 1`: every dataset and attribute equal,
+    bit for bit, except those in RUN_DEPENDENT.  For an AFM map, a thermal
+    map (its slips gathered), a brake run with diagnostics and verification,
+    and a sweep."""
+    brake = os.path.join(args.inputs, "brake.nml")
+    naf = os.path.join(args.inputs, "naf.nml")
+    verify = write(args, "verify.nml", "&verify check = .true., check_method = 'rk4imp' /\n")
+    cases = {"afm": [naf, write(args, "small.nml", SMALL)],
+             "thermal": [naf, write(args, "thermal.nml", THERMAL_SMALL)],
+             "brake": [brake, write(args, "analysis.nml", BRAKE_ANALYSIS), verify],
+             "sweep": [brake, write(args, "sweep.nml", SWEEP_SMALL)]}
+    for label, files in cases.items():
+        serial, launched = f"{label}_serial.h5", f"{label}_mpirun.h5"
+        helpers.run([args.binary, "--quiet", "-o", serial, *files], cwd=args.workdir, env=serial_env())
+        friction(args, "-o", launched, *files, ranks=1)
+        a, b = (comparable(os.path.join(args.workdir, name)) for name in (serial, launched))
+        if a.keys() != b.keys():
+            fail(f"{label}: serial and mpirun -n 1 wrote different objects: {set(a) ^ set(b)}")
+        compared = 0
+        for key in a:
+            if key in RUN_DEPENDENT:
+                continue
+            compared += 1
+            if not np.array_equal(np.asarray(a[key]), np.asarray(b[key])):
+                fail(f"{label}: {key} differs between the serial run and mpirun -n 1")
+        with h5py.File(os.path.join(args.workdir, serial), "r") as f:
+            if f.attrs["nranks"] != 1:
+                fail(f"{serial}: nranks = {f.attrs['nranks']}")
+        print(f"ok: {label}: {compared} datasets and attributes identical")
+
+
+def case_serial_no_mpi(args):
+    """--version, --help, usage errors, --netlist, bad input and a serial run
+    never call MPI_Init: with Open MPI told to use a point-to-point layer that
+    does not exist, MPI_Init aborts (checked first: FRICTION_MPI=1 starts MPI
+    and the run fails), yet these all do what they should."""
+    broken = dict(serial_env(), OMPI_MCA_pml="no-such-pml")
+    brake = os.path.join(args.inputs, "brake.nml")
+    short = write(args, "short.nml", BRAKE_SHORT)
+
+    def program(*rest, expect, forced=False):
+        env = dict(broken, FRICTION_MPI="1") if forced else broken
+        return helpers.run([args.binary, *rest], cwd=args.workdir, expect=expect, env=env)
+
+    # The control: MPI started with this environment fails.
+    result = program("--quiet", "-o", "forced.h5", brake, short, expect=None, forced=True)
+    if result.returncode == 0 or os.path.exists(os.path.join(args.workdir, "forced.h5")):
+        fail("FRICTION_MPI=1 with a missing pml ran: the test cannot tell whether MPI starts "
+             f"(exit {result.returncode})\n{result.stderr}")
+    # Never MPI, even when asked for it:
+    if program("--version", expect=0, forced=True).stdout.split()[0] != "friction":
+        fail("--version printed no version")
+    if "usage:" not in program("--help", expect=0, forced=True).stdout:
+        fail("--help printed no usage")
+    if "unknown option" not in program("--no-such-option", brake, expect=2, forced=True).stderr:
+        fail("no usage error for an unknown option")
+    program("--quiet", "--netlist", "brake.cir", brake, expect=0, forced=True)
+    if not os.path.exists(os.path.join(args.workdir, "brake.cir")):
+        fail("--netlist wrote no netlist")
+    # A run without a launcher is serial: bad input and a whole run.
+    bad = write(args, "bad.nml", "&brake xi = 0.0 /\n")
+    message = program("--quiet", "-o", "bad.h5", brake, bad, expect=3).stderr
+    if "bad.nml:1" not in message or "xi" not in message:
+        fail("bad input: no message naming the file, line and variable: " + message)
+    program("--quiet", "-o", "serial.h5", brake, short, expect=0)
+    with h5py.File(os.path.join(args.workdir, "serial.h5"), "r") as f:
+        if f.attrs["nranks"] != 1 or f["brake/x"].size != 1001:
+            fail(f"serial.h5: nranks {f.attrs['nranks']}, {f['brake/x'].size} samples (expected 1 and 1001)")
+    if leftovers(args) != ["brake.cir", "serial.h5"]:
+        fail(f"unexpected files: {leftovers(args)}")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--binary", required=True)
@@ -1222,7 +1316,8 @@ def main():
          "graphite": case_graphite, "models": case_models, "quasistatic-failure": case_quasistatic_failure,
          "graphite-ranks": case_graphite_ranks, "graphite-defects": case_graphite_defects,
          "input-roundtrip": case_input_roundtrip, "thermal-zero": case_thermal_zero,
-         "thermal-ranks": case_thermal_ranks, "thermal-equipartition": case_thermal_equipartition}[args.case](args)
+         "thermal-ranks": case_thermal_ranks, "thermal-equipartition": case_thermal_equipartition,
+         "serial-files": case_serial_files, "serial-no-mpi": case_serial_no_mpi}[args.case](args)
     print("1 passed, 0 failed")
 
 

@@ -9,14 +9,16 @@
  *                               friction_afm_line of every line: prints every array
  *   test_capi brake FILE...     friction_config_read(FILE...), friction_compute: prints
  *   test_capi job OUT FILE...   friction_run_job(FILE..., OUT); progress reports checked
+ *   test_capi serial-job OUT FILE...   the same without FRICTION_JOB_INIT_MPI: a serial
+ *                               job, after which MPI is still not initialised
  *   test_capi config-job SCENE OUT FILE...   the same through friction_config_new(SCENE),
  *                               friction_config_read and friction_run_config
  *
  * The printing modes write each array as "# name rows columns" and its values,
  * one per line (%.17g, which reads back to the same double); capi_test.py
  * compares them and the job files with the program's output.  No mode but
- * the job modes initialises MPI: `checks` tests that the jobs refuse to run
- * without it.
+ * the job modes initialises MPI: `checks` tests that a job without MPI and
+ * without FRICTION_JOB_INIT_MPI runs serially and leaves MPI alone.
  */
 #include <friction.h>
 
@@ -25,6 +27,16 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+/* From the MPI library the friction library links (callable before MPI_Init):
+ * whether a job initialised MPI. */
+extern int MPI_Initialized(int *flag);
+
+static int mpi_initialized(void) {
+  int flag = 0;
+  MPI_Initialized(&flag);
+  return flag;
+}
 
 static int failures = 0;
 
@@ -436,16 +448,20 @@ static void check_jobs(friction_error *err) {
   expect_input_error(friction_run_job(none, 1, "out.h5", 0, NULL, NULL, err), err, "files[0]",
                      "run_job files[0] NULL");
   expect_input_error(friction_run_job(missing, 1, "out.h5", 8, NULL, NULL, err), err, "flags", "run_job flags");
-  /* this process has not initialised MPI: no job without the caller's consent */
+  /* this process has not initialised MPI and does not ask for it: the jobs run
+   * serially (here up to their input errors) and leave MPI uninitialised */
   expect_input_error(friction_run_job(missing, 1, "out.h5", FRICTION_JOB_FORCE, NULL, NULL, err), err,
-                     "MPI is not initialised: call MPI_Init", "run_job without MPI");
-  CHECK(strstr(last_message, "FRICTION_JOB_INIT_MPI") != NULL, "message '%s'", last_message);
+                     "no-such-dir/missing.nml", "serial run_job of a missing file");
+  CHECK(!mpi_initialized(), "a serial run_job initialised MPI");
   friction_config *cfg = friction_config_new("brake", err);
-  expect_input_error(friction_run_config(cfg, "out.h5", 0, NULL, NULL, err), err, "MPI is not initialised",
-                     "run_config without MPI");
+  friction_config_set(cfg, "brake.xi", "0.0", err);
+  expect_input_error(friction_run_config(cfg, "out.h5", 0, NULL, NULL, err), err, "&brake: xi = 0.00000: must be > 0",
+                     "serial run_config of a bad configuration");
+  CHECK(!mpi_initialized(), "a serial run_config initialised MPI");
   /* with the flag the library initialises MPI (for the rest of this process) */
   expect_input_error(friction_run_job(missing, 1, "out.h5", FRICTION_JOB_INIT_MPI, NULL, NULL, err), err,
                      "no-such-dir/missing.nml", "run_job missing file");
+  CHECK(mpi_initialized(), "FRICTION_JOB_INIT_MPI did not initialise MPI");
   /* ... after which no flag is needed; a bad configuration is refused by its checks */
   expect_input_error(friction_run_job(missing, 1, "out.h5", 0, NULL, NULL, err), err, "missing.nml",
                      "run_job with MPI initialised");
@@ -622,10 +638,10 @@ static void count_report(const char *message, double fraction, void *user) {
 /* friction_run_job (or, with a scene, friction_config_read +
  * friction_run_config) on the files argv[1..] writing argv[0]; the library
  * initialises MPI.  The progress must reach 1 without going backwards. */
-static int run_job(int argc, char **argv, const char *scene) {
+static int run_job(int argc, char **argv, const char *scene, int init_mpi) {
   struct reports seen = {0, 0, 0.0, 0};
   friction_error *err = friction_error_new();
-  int status, flags = FRICTION_JOB_FORCE | FRICTION_JOB_INIT_MPI;
+  int status, flags = FRICTION_JOB_FORCE | (init_mpi ? FRICTION_JOB_INIT_MPI : 0);
   if (argc < 2) return 2;
   if (scene != NULL) {
     friction_config *cfg = read_config(scene, argc - 1, argv + 1, err);
@@ -639,6 +655,7 @@ static int run_job(int argc, char **argv, const char *scene) {
   CHECK(seen.progress > 0, "no progress reported");
   CHECK(seen.backwards == 0, "progress went backwards %d times", seen.backwards);
   CHECK(seen.last_fraction == 1.0, "progress ended at %g, not 1", seen.last_fraction);
+  CHECK(mpi_initialized() == init_mpi, "after the job MPI is %sinitialised", mpi_initialized() ? "" : "not ");
   fprintf(stderr, "job: %d progress reports, %d notes\n", seen.progress, seen.notes);
   friction_error_free(err);
   return failures != 0;
@@ -649,9 +666,10 @@ int main(int argc, char **argv) {
   if (strcmp(mode, "checks") == 0) return checks();
   if (strcmp(mode, "threads") == 0) return threads();
   if (strcmp(mode, "afm") == 0 || strcmp(mode, "brake") == 0) return print_scene(mode, argc - 2, argv + 2);
-  if (strcmp(mode, "job") == 0) return run_job(argc - 2, argv + 2, NULL);
-  if (strcmp(mode, "config-job") == 0 && argc > 2) return run_job(argc - 3, argv + 3, argv[2]);
+  if (strcmp(mode, "job") == 0) return run_job(argc - 2, argv + 2, NULL, 1);
+  if (strcmp(mode, "serial-job") == 0) return run_job(argc - 2, argv + 2, NULL, 0);
+  if (strcmp(mode, "config-job") == 0 && argc > 2) return run_job(argc - 3, argv + 3, argv[2], 1);
   fprintf(stderr, "usage: test_capi checks|threads|afm FILE...|brake FILE...|job OUT FILE...|"
-                  "config-job SCENE OUT FILE...\n");
+                  "serial-job OUT FILE...|config-job SCENE OUT FILE...\n");
   return 2;
 }

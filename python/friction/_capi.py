@@ -402,7 +402,7 @@ class Config:
             finally:
                 self._lib.friction_result_free(result)
 
-    def run(self, output, force=False, resume=False, report=None, init_mpi=True):
+    def run(self, output, force=False, resume=False, report=None, init_mpi=False):
         """The configuration's job to the HDF5 file `output` (friction.h: friction_run_config);
         `report(message, fraction)` as for run_job."""
         flags = (FORCE if force else 0) | (RESUME if resume else 0) | (INIT_MPI if init_mpi else 0)
@@ -426,13 +426,13 @@ def _result_arrays(lib, result, err):
     return arrays
 
 
-def run_job(files, output, force=False, resume=False, report=None, init_mpi=True):
+def run_job(files, output, force=False, resume=False, report=None, init_mpi=False):
     """Run a namelist job as the program does (friction.h: friction_run_job): read
     `files` in order, compute, write `output`.  `report(message, fraction)` if
     given receives progress (fraction in [0, 1]) and notes (fraction -1).
-    init_mpi: in a process that has not initialised MPI the library does
-    (MPI_THREAD_FUNNELED, for the rest of the process) and the job runs on this
-    process alone; False refuses instead.  An interrupted sweep raises
+    init_mpi: in a process that has not initialised MPI the job runs serially on
+    this process without MPI; True has the library initialise MPI first
+    (MPI_THREAD_FUNNELED, for the rest of the process) and run it there.  An interrupted sweep raises
     FrictionError with status 5."""
     paths = [os.fsencode(os.fspath(path)) for path in files]
     array = (ctypes.c_char_p * max(1, len(paths)))(*paths)

@@ -128,8 +128,8 @@ def run(files, output=None, force=False, resume=False, progress=True):
     unwritable file (nothing is written then), and with status 5 for a
     sweep interrupted by a signal (its file holds the points done).
 
-    MPI: in a process without MPI the library initialises it once
-    (MPI_THREAD_FUNNELED) and the job runs on this process alone; under
+    MPI: in a process without MPI the job runs serially on this process,
+    without starting MPI (the same file as `mpirun -n 1`); under
     `mpirun -n N python ...` with mpi4py initialising MPI first, the job is
     collective over every rank, as the program's."""
     paths = _files(files)

@@ -10,13 +10,14 @@ module friction_afm_scene
    use friction_version, only: version_string
    use friction_parameters, only: parameter_visitor
    use friction_checks, only: config_checker
+   use friction_clock, only: wall_seconds
    use friction_ode_solver, only: integrator_statistics
    use friction_ode_auto, only: auto_name, auto_method
    use friction_surface_potential, only: surface_potential
    use friction_output_summary, only: run_summary
    use friction_scene, only: scene, point_result
    use friction_scene_report, only: job_reporter
-   use friction_scene_context, only: job_context, agree_on_error, ranks_text, share_of
+   use friction_scene_context, only: job_context, agree_on_error, ranks_text, share_of, job_wall_time
    use friction_afm_config, only: afm_config, new_potential, species_count
    use friction_afm_scan, only: afm_scanner, line_record, slip_list, n_quantities, q_fx, q_fy, q_f_along
    use friction_afm_output, only: write_afm_file, afm_surface_record, afm_thermal_record
@@ -200,7 +201,7 @@ contains
          allocate (loaded(count), source=.false.)
          computed = 0
          saved = 0
-         last_saved = MPI_Wtime()
+         last_saved = wall_seconds()
          interrupted = .false.
          do j = 1, count
             if (allocated(error)) exit
@@ -226,7 +227,7 @@ contains
                   self%friction_sem(j) = line%friction_sem
                   call keep_slips(self%first + (j - 1) * job%nranks, line%slips)
                end if
-               if (MPI_Wtime() - last_saved >= c%checkpoint_interval) call save_lines(j, error)
+               if (wall_seconds() - last_saved >= c%checkpoint_interval) call save_lines(j, error)
             end if
             ! Rank 0's share is as large as any other and spread over the whole
             ! map, so its fraction done is the map's fraction done.
@@ -240,7 +241,7 @@ contains
          call agree_on_error(job, error)
          if (allocated(error)) return
          flag = merge(1, 0, interrupted)
-         call MPI_Allreduce(MPI_IN_PLACE, flag, 1, MPI_INTEGER, MPI_MAX, job%comm)
+         if (job%parallel()) call MPI_Allreduce(MPI_IN_PLACE, flag, 1, MPI_INTEGER, MPI_MAX, job%comm)
          if (flag /= 0) then
             call fatal_error(error, 'map interrupted: no file written; the lines done are checkpointed beside ' &
                & //'the output ('//line_checkpoint_name(job%output, 0)//' ...): run again with --resume to ' &
@@ -253,10 +254,9 @@ contains
          ! The counts of every line, computed now or loaded: a resumed map
          ! records what an uninterrupted one does.
          counts = nint(sum(line_counts, dim=2), i8)
-         call MPI_Allreduce(MPI_IN_PLACE, counts, 4, MPI_INTEGER8, MPI_SUM, job%comm)
+         if (job%parallel()) call MPI_Allreduce(MPI_IN_PLACE, counts, 4, MPI_INTEGER8, MPI_SUM, job%comm)
+         wall = job_wall_time(job)
          stats = integrator_statistics(counts(1), counts(2), counts(3), counts(4))
-         wall = MPI_Wtime() - job%t_start
-         call MPI_Allreduce(MPI_IN_PLACE, wall, 1, MPI_DOUBLE_PRECISION, MPI_MAX, job%comm)
          ! (Component by component: gfortran's structure constructor mis-sizes a
          ! deferred-length component copied from another derived type's.)
          self%record%input_text = job%input_text
@@ -333,7 +333,7 @@ contains
             end if
          end do
          saved = max(saved, last)
-         last_saved = MPI_Wtime()
+         last_saved = wall_seconds()
       end subroutine save_lines
 
       !> Line j's samples as save_line and load_line take them: (nx,
@@ -400,6 +400,10 @@ contains
          real(wp), allocatable :: everything(:, :)
 
          n = size(local_slips, 2)
+         if (.not. job%parallel()) then
+            call move_alloc(local_slips, self%slips)
+            return
+         end if
          call MPI_Allgather(n, 1, MPI_INTEGER, counts, 1, MPI_INTEGER, job%comm)
          displacements(1) = 0
          do r = 2, job%nranks
@@ -429,7 +433,7 @@ contains
 
          sums = [sum(self%trace(:, :, q_f_along)), real(size(self%trace(:, :, q_f_along)), wp)]
          if (self%ran%retrace) sums(1) = 0.5_wp * (sums(1) - sum(self%retrace(:, :, q_f_along)))
-         call MPI_Allreduce(MPI_IN_PLACE, sums, 2, MPI_DOUBLE_PRECISION, MPI_SUM, job%comm)
+         if (job%parallel()) call MPI_Allreduce(MPI_IN_PLACE, sums, 2, MPI_DOUBLE_PRECISION, MPI_SUM, job%comm)
          warning = quasistatic_friction_warning(self%ran, sums(1) / max(1.0_wp, sums(2)))
          if (job%rank == 0 .and. len(warning) > 0) call reporter%note('warning: '//warning)
       end subroutine check_friction

@@ -16,7 +16,7 @@ module friction_brake_scene
    use friction_ode_auto, only: auto_name, auto_method
    use friction_scene, only: scene, point_result
    use friction_scene_report, only: job_reporter
-   use friction_scene_context, only: job_context, agree_on_error, ranks_text
+   use friction_scene_context, only: job_context, agree_on_error, ranks_text, job_wall_time
    use friction_brake_config, only: brake_config, model_switched
    use friction_brake_simulate, only: brake_run, compare_runs
    use friction_brake_output, only: brake_run_summary, brake_check_summary, write_brake_file
@@ -181,8 +181,7 @@ contains
             if (allocated(error)) return
          end if
 
-         wall = MPI_Wtime() - job%t_start
-         call MPI_Allreduce(MPI_IN_PLACE, wall, 1, MPI_DOUBLE_PRECISION, MPI_MAX, job%comm)
+         wall = job_wall_time(job)
          record%input_text = job%input_text
          record%version = version_string
          record%nranks = job%nranks
@@ -318,6 +317,11 @@ contains
          counts = [stats%steps, stats%failed_steps, stats%rhs_evaluations, stats%jacobian_evaluations]
          times = [run%compute_time, run%stick_time()]
          n_events = run%events%n
+         if (.not. job%parallel()) then   ! serial: root is this process, which holds the run
+            compute_time = times(1)
+            stick_time = times(2)
+            return
+         end if
       else
          call run%trajectory%allocate_points(n)
          run%n = n

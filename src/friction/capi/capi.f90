@@ -16,7 +16,8 @@
 module friction_capi
    use, intrinsic :: iso_c_binding, only: c_ptr, c_char, c_int, c_double, c_size_t, c_null_char, c_null_ptr, &
       & c_associated, c_f_pointer, c_loc, c_funptr, c_f_procpointer
-   use mpi_f08, only: MPI_Initialized, MPI_Finalized, MPI_Init_thread, MPI_THREAD_FUNNELED, MPI_COMM_WORLD
+   use mpi_f08, only: MPI_Comm, MPI_Initialized, MPI_Finalized, MPI_Init_thread, MPI_THREAD_FUNNELED, &
+      & MPI_COMM_WORLD, MPI_COMM_NULL
    use friction_kinds, only: wp
    use friction_error, only: error_type, fatal_error, error_input
    use friction_strings, only: itoa, rtoa, join, quoted
@@ -1035,14 +1036,18 @@ contains
 
    ! ---- jobs ----
 
-   !> The flags' checks and MPI: initialised by the caller, or here when the
-   !> caller passes FRICTION_JOB_INIT_MPI.
-   subroutine prepare_job(flags, error)
+   !> The flags' checks and the job's communicator: MPI_COMM_WORLD when the
+   !> caller initialised MPI, or when it passes FRICTION_JOB_INIT_MPI (MPI is
+   !> initialised here); otherwise MPI_COMM_NULL, a serial job on this process
+   !> that makes no MPI call.
+   subroutine prepare_job(flags, comm, error)
       integer(c_int), intent(in) :: flags
+      type(MPI_Comm), intent(out) :: comm
       type(error_type), allocatable, intent(inout) :: error
       logical :: ready, finished
       integer :: provided, ierror
 
+      comm = MPI_COMM_NULL
       if (allocated(error)) return
       if (iand(flags, not(job_force + job_resume + job_init_mpi)) /= 0) then
          call fatal_error(error, 'flags = '//itoa(int(flags))//': unknown bits (known: FRICTION_JOB_FORCE, ' &
@@ -1056,15 +1061,15 @@ contains
          return
       end if
       call MPI_Initialized(ready)
-      if (ready) return
-      if (iand(flags, job_init_mpi) == 0) then
-         call fatal_error(error, 'MPI is not initialised: call MPI_Init (or MPI_Init_thread) first, or pass ' &
-            & //'FRICTION_JOB_INIT_MPI to let the library initialise it (MPI_THREAD_FUNNELED, left for the ' &
-            & //"process's exit)", error_input)
-         return
+      if (.not. ready) then
+         if (iand(flags, job_init_mpi) == 0) return   ! serial, without MPI
+         call MPI_Init_thread(MPI_THREAD_FUNNELED, provided, ierror)
+         if (ierror /= 0) then
+            call fatal_error(error, 'MPI_Init_thread failed (error '//itoa(ierror)//')', error_input)
+            return
+         end if
       end if
-      call MPI_Init_thread(MPI_THREAD_FUNNELED, provided, ierror)
-      if (ierror /= 0) call fatal_error(error, 'MPI_Init_thread failed (error '//itoa(ierror)//')', error_input)
+      comm = MPI_COMM_WORLD
    end subroutine prepare_job
 
    !> int friction_run_job(const char *const *files, int nfiles, const char *output, int flags,
@@ -1079,6 +1084,7 @@ contains
       character(len=4096), allocatable :: paths(:)
       character(len=:), allocatable :: summary, path
       type(callback_reporter) :: reporter
+      type(MPI_Comm) :: comm
       integer :: k
 
       allocate (paths(0))
@@ -1106,7 +1112,7 @@ contains
             paths(k) = path
          end do
       end if
-      call prepare_job(flags, error)
+      call prepare_job(flags, comm, error)
       if (allocated(error)) then
          status = report(handle, error)
          return
@@ -1114,7 +1120,7 @@ contains
       reporter%user = user
       if (c_associated(report_fn)) call c_f_procpointer(report_fn, reporter%call)
       call run_job(paths, c_string(output), iand(flags, job_force) /= 0, iand(flags, job_resume) /= 0, &
-         & MPI_COMM_WORLD, reporter, summary, error)
+         & comm, reporter, summary, error)
       status = report(handle, error)
    end function friction_run_job
 
@@ -1129,11 +1135,12 @@ contains
       type(error_type), allocatable :: error
       character(len=:), allocatable :: summary
       type(callback_reporter) :: reporter
+      type(MPI_Comm) :: comm
 
       if (config_of(cfg, config, error)) then
          if (.not. c_associated(output)) call fatal_error(error, 'output is a null pointer', error_input)
       end if
-      call prepare_job(flags, error)
+      call prepare_job(flags, comm, error)
       if (allocated(error)) then
          status = report(handle, error)
          return
@@ -1141,7 +1148,7 @@ contains
       reporter%user = user
       if (c_associated(report_fn)) call c_f_procpointer(report_fn, reporter%call)
       call run_job_config(config%job, c_string(output), iand(flags, job_force) /= 0, iand(flags, job_resume) /= 0, &
-         & MPI_COMM_WORLD, reporter, summary, error, config%origins)
+         & comm, reporter, summary, error, config%origins)
       status = report(handle, error)
    end function friction_run_config
 

@@ -6,6 +6,7 @@
 module friction_job
    use mpi_f08
    use friction_kinds, only: wp
+   use friction_clock, only: wall_seconds
    use friction_error, only: error_type, fatal_error, error_input
    use friction_job_config, only: job_config, read_input, check_job, job_text
    use friction_checks, only: config_checker
@@ -111,13 +112,24 @@ contains
       logical, intent(in) :: resume
       type(job_context), intent(out) :: job
 
-      job%t_start = MPI_Wtime()
-      job%comm = comm
-      call MPI_Comm_rank(comm, job%rank)
-      call MPI_Comm_size(comm, job%nranks)
+      job%t_start = wall_seconds()
+      call set_comm(comm, job)
       job%output = output
       job%resume = resume
    end subroutine start_job
+
+   !> The job's communicator, rank and size; MPI_COMM_NULL: serial, MPI not started.
+   subroutine set_comm(comm, job)
+      type(MPI_Comm), intent(in) :: comm
+      type(job_context), intent(inout) :: job
+
+      job%comm = comm
+      job%rank = 0
+      job%nranks = 1
+      if (.not. job%parallel()) return
+      call MPI_Comm_rank(comm, job%rank)
+      call MPI_Comm_size(comm, job%nranks)
+   end subroutine set_comm
 
    !> The common body of run_job and run_job_config: a checked
    !> configuration, its echo in job%input_text, run and written.
@@ -159,6 +171,7 @@ contains
       character(len=16) :: hash
       integer :: differs, k, culprit
 
+      if (.not. job%parallel()) return
       hash = text_hash(job%input_text)
       call MPI_Bcast(hash, 16, MPI_CHARACTER, 0, job%comm)
       differs = merge(1, 0, hash /= text_hash(job%input_text))
@@ -239,9 +252,7 @@ contains
       character(len=:), allocatable :: text, note, data_file, problem
       integer :: dot, k
 
-      job%comm = comm
-      call MPI_Comm_rank(comm, job%rank)
-      call MPI_Comm_size(comm, job%nranks)
+      call set_comm(comm, job)
       call read_input(files, config, job%input_text, error)
       if (allocated(error)) return
       dot = index(path, '.', back=.true.)

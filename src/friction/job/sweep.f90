@@ -20,6 +20,7 @@ module friction_job_sweep
    use, intrinsic :: iso_c_binding, only: c_ptr, c_f_pointer
    use mpi_f08
    use friction_kinds, only: wp, i8
+   use friction_clock, only: wall_seconds
    use friction_error, only: error_type, fatal_error, error_interrupted, error_input, error_numerical
    use friction_strings, only: itoa, text_hash
    use friction_output_checkpoint, only: save_checkpoint, checkpoint_body, real_line, next_line
@@ -34,7 +35,7 @@ module friction_job_sweep
    use friction_files, only: remove_file
    use friction_scene_report, only: job_reporter
    use friction_scene_context, only: job_context, temporary_name, publish, ranks_text, sum_to_root_real, &
-      & sum_to_root_integer, agree_on_error
+      & sum_to_root_integer, agree_on_error, job_wall_time
    implicit none
    private
 
@@ -174,7 +175,7 @@ contains
             end if
          end if
          computed_by_run(i) = 1
-         t0 = MPI_Wtime()
+         t0 = wall_seconds()
          call run_point(config, i, results(:, i), point_maxima, point_error)
          if (allocated(point_error)) then
             status(i) = status_failed
@@ -188,7 +189,7 @@ contains
          end if
          counts(i) = size(point_maxima)
          maxima = [maxima, point_maxima]
-         cost(i) = MPI_Wtime() - t0
+         cost(i) = wall_seconds() - t0
          call save_point(checkpoint_name(job, i), input_hash, config%sweep%values(:, i), status(i), results(:, i), &
             & cost(i), reasons(i)%text, point_maxima, problem)
          if (len(problem) > 0) then
@@ -202,14 +203,14 @@ contains
       if (dynamic) call MPI_Win_free(window)
       ! Checkpoints that could not be written: the points are in memory and go
       ! into the file, but an interrupted run would compute them again.
-      call MPI_Allreduce(MPI_IN_PLACE, unsaved, 1, MPI_INTEGER, MPI_SUM, job%comm)
+      if (job%parallel()) call MPI_Allreduce(MPI_IN_PLACE, unsaved, 1, MPI_INTEGER, MPI_SUM, job%comm)
       call agree_on_error(job, checkpoint_error)
       if (unsaved > 0 .and. job%rank == 0) call reporter%note('warning: '//itoa(unsaved) &
          & //' checkpoint(s) could not be written, so --resume would compute those points again; first: ' &
          & //checkpoint_error%message)
 
       ! Each point has exactly one owner; the others hold zeros, so a sum gathers it exactly.
-      call MPI_Allreduce(MPI_IN_PLACE, counts, n, MPI_INTEGER, MPI_SUM, job%comm)
+      if (job%parallel()) call MPI_Allreduce(MPI_IN_PLACE, counts, n, MPI_INTEGER, MPI_SUM, job%comm)
       allocate (offsets(n))
       total = 0
       do i = 1, n
@@ -233,17 +234,20 @@ contains
       call sum_to_root_integer(job, owner, n)
       call sum_to_root_integer(job, computed_by_run, n)
       flag = merge(1, 0, interrupted)
-      call MPI_Allreduce(MPI_IN_PLACE, flag, 1, MPI_INTEGER, MPI_MAX, job%comm)
+      if (job%parallel()) call MPI_Allreduce(MPI_IN_PLACE, flag, 1, MPI_INTEGER, MPI_MAX, job%comm)
       ! A stop request after the last point stopped nothing: the sweep is complete.
       if (job%rank == 0 .and. flag /= 0 .and. all(status /= 0)) flag = 0
-      call MPI_Bcast(flag, 1, MPI_INTEGER, 0, job%comm)
+      if (job%parallel()) call MPI_Bcast(flag, 1, MPI_INTEGER, 0, job%comm)
       interrupted = flag /= 0
 
       ! Peak resident memory of every rank, for the benchmark (docs/sweeps.md).
       allocate (memory(job%nranks))
-      call MPI_Gather(peak_memory_kb(), 1, MPI_INTEGER, memory, 1, MPI_INTEGER, 0, job%comm)
-      wall = MPI_Wtime() - job%t_start
-      call MPI_Allreduce(MPI_IN_PLACE, wall, 1, MPI_DOUBLE_PRECISION, MPI_MAX, job%comm)
+      wall = job_wall_time(job)
+      if (job%parallel()) then
+         call MPI_Gather(peak_memory_kb(), 1, MPI_INTEGER, memory, 1, MPI_INTEGER, 0, job%comm)
+      else
+         memory(1) = peak_memory_kb()
+      end if
       ! (Component by component: gfortran's structure constructor mis-sizes a
       ! deferred-length component copied from another derived type's.)
       record%input_text = job%input_text
@@ -253,7 +257,8 @@ contains
       record%stats = integrator_statistics(0, 0, 0, 0)
       temporary = temporary_name(job)
       if (job%rank == 0) call write_sweep_file(temporary, config, record, names, series_name, series_unit, &
-         & results, flat, offsets, counts, status, reasons, cost, computed_by_run, memory, interrupted, error)
+         & results, flat, offsets, counts, status, reasons, cost, computed_by_run, memory, interrupted, &
+         & job%parallel(), error)
       call publish(job, temporary, error)
       if (allocated(error)) return
       write (seconds, '(f12.2)') wall
@@ -275,7 +280,7 @@ contains
       ! holds every point's reason, and the exit says it failed (rank 0 holds
       ! the reasons; its message is the one every rank returns).
       all_failed = n > 0 .and. count(status == status_failed) == n   ! (rank 0 holds the statuses)
-      call MPI_Bcast(all_failed, 1, MPI_LOGICAL, 0, job%comm)
+      if (job%parallel()) call MPI_Bcast(all_failed, 1, MPI_LOGICAL, 0, job%comm)
       if (all_failed) then
          reason = ''
          if (job%rank == 0 .and. allocated(reasons(1)%text)) reason = ': point 1: '//reasons(1)%text
@@ -329,6 +334,7 @@ contains
       character(len=:), allocatable :: mine, all
       integer :: i, r, at, total
 
+      if (.not. job%parallel()) return   ! serial: this process holds every reason
       allocate (lengths(size(owner)), source=0)
       mine = ''
       do i = 1, size(owner)
@@ -365,7 +371,7 @@ contains
 
    !> The sweep file, written by rank 0 alone.
    subroutine write_sweep_file(path, config, record, names, series_name, series_unit, results, flat, offsets, &
-      & counts, status, reasons, cost, computed_by_run, memory, interrupted, error)
+      & counts, status, reasons, cost, computed_by_run, memory, interrupted, parallel, error)
       character(len=*), intent(in) :: path
       type(job_config), intent(in) :: config
       type(run_summary), intent(in) :: record
@@ -375,6 +381,7 @@ contains
       integer, intent(in) :: offsets(:), counts(:), status(:), computed_by_run(:), memory(:)
       type(reason_text), intent(in) :: reasons(:)
       logical, intent(in) :: interrupted
+      logical, intent(in) :: parallel   !! on MPI (rank 0 writes through MPI_COMM_SELF), else serial
       type(error_type), allocatable, intent(out) :: error
       type(h5_file) :: file
       character(len=:), allocatable :: name, lines(:)
@@ -389,7 +396,7 @@ contains
          lines(i) = ''
          if (allocated(reasons(i)%text)) lines(i) = reasons(i)%text
       end do
-      call file%create(path, MPI_COMM_SELF, error)
+      call file%create(path, merge(MPI_COMM_SELF, MPI_COMM_NULL, parallel), error)
       if (allocated(error)) return
       call write_run_attributes(file, 'sweep', config%scene%method(), record)
       call file%write_attribute_text('/', 'sweep_scene', trim(config%scene_name))

@@ -15,7 +15,7 @@ module friction_output_h5
    use, intrinsic :: iso_c_binding, only: c_ptr, c_loc, c_funptr, c_int, c_int64_t, c_null_ptr, c_null_funptr, &
       & c_size_t, c_double
    use mpi_f08, only: MPI_Comm, MPI_INFO_NULL, MPI_Comm_rank, MPI_Allreduce, MPI_Barrier, MPI_IN_PLACE, &
-      & MPI_INTEGER, MPI_MAX, MPI_Bcast, MPI_DOUBLE_PRECISION
+      & MPI_INTEGER, MPI_MAX, MPI_Bcast, MPI_DOUBLE_PRECISION, MPI_COMM_NULL, operator(==)
    use hdf5
    use friction_kinds, only: wp, i8
    use friction_error, only: error_type, fatal_error, error_io
@@ -77,6 +77,7 @@ module friction_output_h5
       character(len=:), allocatable :: path
       integer :: rank = 0         !! this process in the communicator
       type(MPI_Comm) :: comm      !! the file's communicator
+      logical :: parallel = .true. !! written through MPI-IO (.false.: serial, MPI not started; sec2 driver)
       integer :: status = 0       !! first HDF5 failure, kept until checked
       character(len=:), allocatable :: failed_at
    contains
@@ -101,7 +102,9 @@ module friction_output_h5
 
 contains
 
-   !> Create (truncate) a file for parallel writing on communicator comm.
+   !> Create (truncate) a file for parallel writing on communicator comm;
+   !> comm = MPI_COMM_NULL: a serial run without MPI, written by this process
+   !> alone with HDF5's default (sec2) driver (the mpio driver needs MPI_Init).
    subroutine create(self, path, comm, error)
       class(h5_file), intent(inout) :: self
       character(len=*), intent(in) :: path
@@ -115,12 +118,14 @@ contains
       self%path = path
       self%status = 0
       self%comm = comm
-      call MPI_Comm_rank(comm, self%rank)
+      self%parallel = .not. (comm == MPI_COMM_NULL)
+      self%rank = 0
+      if (self%parallel) call MPI_Comm_rank(comm, self%rank)
       ! Not on a (nearly) full disk: room to spare is what lets a failed
       ! file be closed (give_back_space).
       free = -1.0_c_double
       if (self%rank == 0) free = free_bytes(path)
-      call MPI_Bcast(free, 1, MPI_DOUBLE_PRECISION, 0, comm)
+      if (self%parallel) call MPI_Bcast(free, 1, MPI_DOUBLE_PRECISION, 0, comm)
       if (free >= 0.0_c_double .and. free < min_free_bytes) then
          call fatal_error(error, path//': the disk is full ('//bytes_text(real(free, wp))//' free; writing ' &
             & //'the output needs at least '//bytes_text(real(min_free_bytes, wp))//' to spare)', error_io)
@@ -132,8 +137,10 @@ contains
       call self%check(stat, 'initialising HDF5')
       call h5pcreate_f(H5P_FILE_ACCESS_F, fapl, stat)
       call self%check(stat, 'creating the file access list')
-      call h5pset_fapl_mpio_f(fapl, comm%MPI_VAL, MPI_INFO_NULL%MPI_VAL, stat)
-      call self%check(stat, 'selecting the MPI-IO driver')
+      if (self%parallel) then
+         call h5pset_fapl_mpio_f(fapl, comm%MPI_VAL, MPI_INFO_NULL%MPI_VAL, stat)
+         call self%check(stat, 'selecting the MPI-IO driver')
+      end if
       call h5fcreate_f(path, H5F_ACC_TRUNC_F, self%id, stat, access_prp=fapl)
       call self%check(stat, 'creating the file')
       call h5pclose_f(fapl, stat)
@@ -277,7 +284,7 @@ contains
          call h5sselect_none_f(memspace, stat)
       end if
       call h5pcreate_f(H5P_DATASET_XFER_F, xfer, stat)
-      call h5pset_dxpl_mpio_f(xfer, H5FD_MPIO_COLLECTIVE_F, stat)
+      if (self%parallel) call h5pset_dxpl_mpio_f(xfer, H5FD_MPIO_COLLECTIVE_F, stat)
       call h5dwrite_f(dset, type, buffer, stat, mem_space_id=memspace, file_space_id=filespace, &
          & xfer_prp=xfer)
       call self%agree(stat)
@@ -326,7 +333,7 @@ contains
          call h5sselect_none_f(memspace, stat)
       end if
       call h5pcreate_f(H5P_DATASET_XFER_F, xfer, stat)
-      call h5pset_dxpl_mpio_f(xfer, H5FD_MPIO_COLLECTIVE_F, stat)
+      if (self%parallel) call h5pset_dxpl_mpio_f(xfer, H5FD_MPIO_COLLECTIVE_F, stat)
       call h5dwrite_f(dset, H5T_NATIVE_INTEGER, values, dims, stat, &
          & mem_space_id=memspace, file_space_id=filespace, xfer_prp=xfer)
       call self%agree(stat)
@@ -551,12 +558,12 @@ contains
          end if
       end if
       failed = merge(1, 0, self%status /= 0)
-      call MPI_Allreduce(MPI_IN_PLACE, failed, 1, MPI_INTEGER, MPI_MAX, self%comm)
+      if (self%parallel) call MPI_Allreduce(MPI_IN_PLACE, failed, 1, MPI_INTEGER, MPI_MAX, self%comm)
       if (failed == 0) return
       call self%check(1, 'writing the file on another rank')
-      call MPI_Barrier(self%comm)
+      if (self%parallel) call MPI_Barrier(self%comm)
       if (self%rank == 0) call truncate_file(self%path)
-      call MPI_Barrier(self%comm)
+      if (self%parallel) call MPI_Barrier(self%comm)
    end subroutine give_back_space
 
    !> Create a dataset on every rank, or none: on a failure anywhere the
@@ -588,7 +595,7 @@ contains
       integer :: failed
 
       failed = merge(1, 0, stat /= 0)
-      call MPI_Allreduce(MPI_IN_PLACE, failed, 1, MPI_INTEGER, MPI_MAX, self%comm)
+      if (self%parallel) call MPI_Allreduce(MPI_IN_PLACE, failed, 1, MPI_INTEGER, MPI_MAX, self%comm)
       if (failed /= 0 .and. stat == 0) stat = -1
    end subroutine agree
 

@@ -1,8 +1,12 @@
 !> What every job shares: its communicator and clock, the output's
 !> temporary name and publication, and one error agreed on by all ranks.
+!> A job whose communicator is MPI_COMM_NULL is serial: one process, MPI
+!> not started (a run without a launcher); every helper here then does on
+!> its own what the MPI one does on one rank, so the job code is the same.
 module friction_scene_context
    use mpi_f08
    use friction_kinds, only: wp
+   use friction_clock, only: wall_seconds
    use friction_error, only: error_type, fatal_error, error_io
    use friction_strings, only: itoa, bytes_text
    use friction_files, only: publish_file, remove_file, process_id, free_bytes, min_free_bytes
@@ -10,11 +14,11 @@ module friction_scene_context
    private
 
    public :: job_context, agree_on_error, temporary_name, publish, check_writable, default_output, &
-      & ranks_text, sum_to_root_real, sum_to_root_integer, share_of
+      & ranks_text, sum_to_root_real, sum_to_root_integer, share_of, job_wall_time
 
    !> One job's run: where it runs, since when, what it read and writes.
    type :: job_context
-      type(MPI_Comm) :: comm
+      type(MPI_Comm) :: comm = MPI_COMM_NULL  !! MPI_COMM_NULL: serial, without MPI
       integer :: rank = 0
       integer :: nranks = 1
       real(wp) :: t_start = 0.0_wp            !! MPI_Wtime at the start of the job
@@ -24,9 +28,28 @@ module friction_scene_context
       logical :: resume = .false.
       logical :: replace = .false.           !! the output may replace a regular file (--force, --resume)
       integer :: stop_after = 0              !! test hook: > 0 stops a sweep after that point
+   contains
+      procedure :: parallel
    end type job_context
 
 contains
+
+   !> Whether the job runs on MPI (false: serial, no MPI call may be made).
+   logical function parallel(self)
+      class(job_context), intent(in) :: self
+
+      parallel = .not. (self%comm == MPI_COMM_NULL)
+   end function parallel
+
+   !> Seconds since the job started (job%t_start), the longest of any rank:
+   !> a run's wall_time.  Collective.
+   function job_wall_time(job) result(wall)
+      type(job_context), intent(in) :: job
+      real(wp) :: wall
+
+      wall = wall_seconds() - job%t_start
+      if (job%parallel()) call MPI_Allreduce(MPI_IN_PLACE, wall, 1, MPI_DOUBLE_PRECISION, MPI_MAX, job%comm)
+   end function job_wall_time
 
    !> A rank's share of n items, dealt round-robin: items first, first +
    !> nranks, ... (0-based), count of them.  Neighbouring lines cost alike
@@ -51,6 +74,7 @@ contains
       integer :: failed, header(2)
       character(len=:), allocatable :: message
 
+      if (.not. job%parallel()) return
       failed = merge(job%rank, job%nranks, allocated(error))
       call MPI_Allreduce(MPI_IN_PLACE, failed, 1, MPI_INTEGER, MPI_MIN, job%comm)
       if (failed == job%nranks) return
@@ -73,7 +97,7 @@ contains
       integer :: pid
 
       pid = process_id()
-      call MPI_Bcast(pid, 1, MPI_INTEGER, 0, job%comm)
+      if (job%parallel()) call MPI_Bcast(pid, 1, MPI_INTEGER, 0, job%comm)
       name = job%output//'.tmp-'//itoa(pid)
    end function temporary_name
 
@@ -91,7 +115,7 @@ contains
       logical :: keep
 
       failed = merge(1, 0, allocated(error))
-      call MPI_Allreduce(MPI_IN_PLACE, failed, 1, MPI_INTEGER, MPI_MAX, job%comm)
+      if (job%parallel()) call MPI_Allreduce(MPI_IN_PLACE, failed, 1, MPI_INTEGER, MPI_MAX, job%comm)
       if (job%rank == 0) then
          keep = .false.
          if (failed == 0) then
@@ -178,6 +202,7 @@ contains
       type(job_context), intent(in) :: job
       real(wp), intent(inout) :: values(:)
 
+      if (.not. job%parallel()) return
       if (job%rank == 0) then
          call MPI_Reduce(MPI_IN_PLACE, values, size(values), MPI_DOUBLE_PRECISION, MPI_SUM, 0, job%comm)
       else
@@ -191,6 +216,7 @@ contains
       integer, intent(inout) :: values(*)
       integer, intent(in) :: count
 
+      if (.not. job%parallel()) return
       if (job%rank == 0) then
          call MPI_Reduce(MPI_IN_PLACE, values, count, MPI_INTEGER, MPI_SUM, 0, job%comm)
       else
