@@ -372,7 +372,7 @@ contains
                call h5sselect_none_f(memspace, stat)
             end if
             call h5pcreate_f(H5P_DATASET_XFER_F, xfer, stat)
-            call h5pset_dxpl_mpio_f(xfer, H5FD_MPIO_COLLECTIVE_F, stat)
+            if (self%parallel) call h5pset_dxpl_mpio_f(xfer, H5FD_MPIO_COLLECTIVE_F, stat)
             call h5dwrite_f(dset, type, texts, dims, stat, mem_space_id=memspace, file_space_id=filespace, &
                & xfer_prp=xfer)
             call self%agree(stat)
