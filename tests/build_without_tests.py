@@ -10,7 +10,7 @@ system's PATH except the test tools (ngspice, gnuplot, h5dump), builds it,
 and checks: the build succeeds; `friction --version` runs; and the CMake
 cache has no entry for a test tool (ngspice, gnuplot, h5dump, pFUnit,
 Python), i.e. configuration did not even look for one.  It compiles the
-library once (a minute or two on two cores: label `slow`).
+library once (about 20 s on two cores: label `slow`).
 """
 import argparse
 import os
