@@ -218,6 +218,7 @@ contains
 
    contains
 
+      !> The C API's words for a group outside the job's scene.
       function not_part(group) result(text)
          character(len=*), intent(in) :: group
          character(len=:), allocatable :: text
