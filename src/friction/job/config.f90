@@ -194,7 +194,7 @@ contains
          associate (s => sources(f))
             if (s%override) then
                if (any(own == s%mentions(1)%group)) cycle
-               call fatal_error(error, s%path//': '//not_part(s%mentions(1)%group), error_input)
+               call fatal_error(error, s%path//': '//not_part(s%mentions(1)%group, own), error_input)
                return
             end if
             do k = 1, size(s%groups)
@@ -205,7 +205,7 @@ contains
                   theirs = ''
                   if (len(owners) > 0) theirs = ' (a group of scene '//owners//')'
                   if (present(notes)) notes = [character(len=1024) :: notes, 'warning: '//where// &
-                     & not_part(s%groups(k))//'; ignored'//theirs]
+                     & not_part(s%groups(k), own)//'; ignored'//theirs]
                else
                   call fatal_error(error, where//'group &'//trim(s%groups(k))//' belongs to scene '//owners// &
                      & ", but no &job scene is given and the default scene is '"//trim(config%scene_name)// &
@@ -218,9 +218,10 @@ contains
 
    contains
 
-      !> The C API's words for a group outside the job's scene.
-      function not_part(group) result(text)
+      !> The C API's words for a group outside the job's scene (`own`: its groups).
+      function not_part(group, own) result(text)
          character(len=*), intent(in) :: group
+         character(len=*), intent(in) :: own(:)
          character(len=:), allocatable :: text
 
          text = 'group &'//trim(group)//" is not part of scene '"//trim(config%scene_name)//"' (its groups: " &
