@@ -35,7 +35,7 @@ module friction_capi
    use friction_brake_simulate, only: brake_run
    use friction_brake_scene, only: brake_scene
    use friction_job_factory, only: scene_names, new_scene
-   use friction_job_config, only: job_config, check_job, job_text, all_parameters, parameter_groups
+   use friction_job_config, only: job_config, check_job, job_text, all_parameters, parameter_groups, not_in_scene
    use friction_job, only: run_job, run_job_config, job_reporter
    use friction_scene_report, only: progress_text
    implicit none
@@ -319,15 +319,6 @@ contains
       end if
    end function config_of
 
-   !> The groups of a configuration (&job, its scene's, &sweep), as a
-   !> message lists them.
-   function own_groups(job) result(text)
-      type(job_config), intent(inout) :: job
-      character(len=:), allocatable :: text
-
-      text = join(parameter_groups(list_parameters(job)), ' ', '&')
-   end function own_groups
-
    !> A name 'group.variable' or 'group.variable(k)' for set and get, in
    !> `job` (the handle's copy): its group, variable, element (0 for none)
    !> and the variable's description.  The messages are the namelist
@@ -348,8 +339,7 @@ contains
       if (allocated(error)) return
       mine = list_parameters(job)
       if (.not. any(mine%group == group)) then
-         call fatal_error(error, 'group &'//group//" is not part of scene '"//trim(job%scene_name) &
-            & //"' (its groups: "//own_groups(job)//')', error_input)
+         call fatal_error(error, not_in_scene(job, group), error_input)
          return
       end if
       do k = 1, size(mine)
@@ -610,8 +600,7 @@ contains
                end if
             end if
             if (.not. any(mine%group == m%group)) then
-               call fatal_error(error, where//'group &'//trim(m%group)//" is not part of scene '" &
-                  & //trim(config%job%scene_name)//"' (its groups: "//own_groups(work)//')', error_input)
+               call fatal_error(error, where//not_in_scene(work, m%group), error_input)
                exit
             end if
          end associate

@@ -15,7 +15,7 @@ module friction_job_config
    private
 
    public :: job_config, sweep_settings, read_input, check_job, max_sweep_values, all_parameters, job_text, &
-      & parameter_groups
+      & parameter_groups, not_in_scene
 
    integer, parameter :: max_sweep_values = 1024
 
@@ -194,7 +194,7 @@ contains
          associate (s => sources(f))
             if (s%override) then
                if (any(own == s%mentions(1)%group)) cycle
-               call fatal_error(error, s%path//': '//not_part(s%mentions(1)%group, own), error_input)
+               call fatal_error(error, s%path//': '//not_in_scene(config, s%mentions(1)%group), error_input)
                return
             end if
             do k = 1, size(s%groups)
@@ -205,7 +205,7 @@ contains
                   theirs = ''
                   if (len(owners) > 0) theirs = ' (a group of scene '//owners//')'
                   if (present(notes)) notes = [character(len=1024) :: notes, 'warning: '//where// &
-                     & not_part(s%groups(k), own)//'; ignored'//theirs]
+                     & not_in_scene(config, s%groups(k))//'; ignored'//theirs]
                else
                   call fatal_error(error, where//'group &'//trim(s%groups(k))//' belongs to scene '//owners// &
                      & ", but no &job scene is given and the default scene is '"//trim(config%scene_name)// &
@@ -215,20 +215,18 @@ contains
             end do
          end associate
       end do
-
-   contains
-
-      !> The C API's words for a group outside the job's scene (`own`: its groups).
-      function not_part(group, own) result(text)
-         character(len=*), intent(in) :: group
-         character(len=*), intent(in) :: own(:)
-         character(len=:), allocatable :: text
-
-         text = 'group &'//trim(group)//" is not part of scene '"//trim(config%scene_name)//"' (its groups: " &
-            & //join(own, ' ', '&')//')'
-      end function not_part
-
    end subroutine check_other_scenes
+
+   !> What is wrong with a group outside the job's scene (the program's and
+   !> the C API's words).
+   function not_in_scene(config, group) result(text)
+      type(job_config), intent(inout) :: config
+      character(len=*), intent(in) :: group
+      character(len=:), allocatable :: text
+
+      text = 'group &'//trim(group)//" is not part of scene '"//trim(config%scene_name)//"' (its groups: " &
+         & //join(parameter_groups(list_parameters(config)), ' ', '&')//')'
+   end function not_in_scene
 
    !> The scenes whose jobs have `group`, quoted ('brake'; '' if none).
    function scenes_with(group) result(text)
