@@ -18,7 +18,7 @@ program friction_main
    use mpi_f08
    use friction_error, only: error_type, error_input, error_io, error_interrupted
    use friction_version, only: version_string
-   use friction_job, only: run_job, write_netlist, default_output
+   use friction_job, only: run_job, write_netlist, resolve_input, default_output
    use friction_clock, only: wall_seconds
    use friction_app_terminal, only: terminal_reporter
    implicit none
@@ -39,13 +39,15 @@ program friction_main
       logical :: force = .false.
       logical :: quiet = .false.
       logical :: resume = .false.
+      logical :: print_input = .false.           !! --print-input: print the resolved input, run nothing
       character(len=4096), allocatable :: files(:)
+      character(len=4096), allocatable :: sets(:)  !! --set group.variable=value, in order
    end type options
 
    type(options) :: opts
    type(terminal_reporter) :: reporter
    type(error_type), allocatable :: error
-   character(len=:), allocatable :: summary
+   character(len=:), allocatable :: summary, text
    integer :: rank, code
    logical :: mpi_started = .false.
    type(MPI_Comm) :: comm
@@ -58,10 +60,16 @@ program friction_main
    if (code >= 0) call finish(code)
    reporter%quiet = opts%quiet
    comm = MPI_COMM_NULL
-   if (allocated(opts%netlist)) then
+   if (opts%print_input) then
+      ! One process prints the resolved input, without MPI.
+      if (rank /= 0) call finish(0)
+      call resolve_input(opts%files, comm, reporter, text, error, opts%sets)
+      if (.not. allocated(error)) write (output_unit, '(a)', advance='no') text
+      opts%output = ''
+   else if (allocated(opts%netlist)) then
       ! One process writes the netlist, without MPI: the others of a launch have nothing to do.
       if (rank /= 0) call finish(0)
-      call write_netlist(opts%files, opts%netlist, opts%force, comm, reporter, summary, error)
+      call write_netlist(opts%files, opts%netlist, opts%force, comm, reporter, summary, error, opts%sets)
       opts%output = opts%netlist
    else
       if (launched() .or. forced_mpi()) then
@@ -72,7 +80,7 @@ program friction_main
       end if
       if (.not. allocated(opts%output)) opts%output = default_output(opts%files(1))
       call run_job(opts%files, opts%output, opts%force, opts%resume, comm, reporter, summary, error, &
-         & stop_after=test_stop_after())
+         & stop_after=test_stop_after(), overrides=opts%sets)
    end if
    ! An interrupted sweep has written its file: say what it holds, then why it stopped.
    if (rank == 0 .and. .not. opts%quiet .and. allocated(summary)) &
@@ -157,7 +165,7 @@ contains
       integer :: i, n
 
       code = -1
-      allocate (opts%files(0))
+      allocate (opts%files(0), opts%sets(0))
       n = command_argument_count()
       i = 0
       do while (i < n)
@@ -197,6 +205,21 @@ contains
                return
             end if
             opts%netlist = trim(arg)
+         case ('--set')
+            if (i == n) then
+               code = usage_error('option --set needs group.variable=value')
+               return
+            end if
+            i = i + 1
+            call get_command_argument(i, arg)
+            if (index(arg, '=') == 0) then
+               code = usage_error('option --set needs group.variable=value (e.g. --set tip.kx=12.5), not "' &
+                  & //trim(arg)//'"')
+               return
+            end if
+            opts%sets = [character(len=4096) :: opts%sets, arg]
+         case ('--print-input')
+            opts%print_input = .true.
          case ('-f', '--force')
             opts%force = .true.
          case ('-q', '--quiet')
@@ -212,6 +235,8 @@ contains
          end select
       end do
       if (size(opts%files) == 0) code = usage_error('no input file given')
+      if (code < 0 .and. opts%print_input .and. (allocated(opts%output) .or. allocated(opts%netlist) .or. &
+         & opts%resume)) code = usage_error('--print-input writes nothing: it takes no -o, --netlist or --resume')
    end function parse_arguments
 
    integer function usage_error(message) result(code)
@@ -237,14 +262,23 @@ contains
          & 'starts it anyway (docs/cli.md).', &
          & '', &
          & 'Input files are namelist files read in order; a later file overrides', &
-         & 'earlier values variable by variable.  Groups: &job &surface &tip &scan', &
-         & '&integrator (see docs/input.md).', &
+         & 'earlier values variable by variable, and --set values override the files.', &
+         & 'Groups: &job &surface &tip &scan &integrator &thermal (see docs/input.md).', &
+         & 'A group of another scene is ignored with a warning when &job names the scene,', &
+         & 'and is an error when the scene is the default (afm): &job is missing.', &
          & '', &
          & 'options:', &
          & '  -o, --output FILE  output file (default: first input''s name with .h5,', &
          & '                     in the current directory)', &
          & '  -f, --force        overwrite an existing output file', &
          & '  -q, --quiet        no progress or summary on stderr', &
+         & '      --set GROUP.VARIABLE=VALUE', &
+         & '                     set one variable after the files (repeatable, in order;', &
+         & '                     checked as a file''s: e.g. --set tip.kx=12.5,', &
+         & '                     --set "integrator.method=''rk8pd''", --set surface.sigma(2)=3.4)', &
+         & '      --print-input  print the resolved input (files and --set applied,', &
+         & '                     defaults filled) as a namelist that reads back to the', &
+         & '                     same run, and exit without computing or writing', &
          & '      --resume       reuse the sweep points or map lines an interrupted run', &
          & '                     completed (its checkpoints beside the output); a sweep''s', &
          & '                     output is overwritten', &

@@ -3,7 +3,8 @@
 
     cli_test.py --binary BIN --mpiexec MPIEXEC --inputs DIR --workdir DIR CASE
 
-Cases: datasets-naf, datasets-hopg, ranks, override, force, numerical-failure, models,
+Cases: datasets-naf, datasets-hopg, input-roundtrip, set, other-scene-group, ranks, override, force,
+numerical-failure, models,
 quasistatic-failure, thermal-zero, thermal-ranks, thermal-equipartition,
 and bad-<name> for each bad input in BAD_INPUTS; for the brake scene
 brake-run, brake-ranks, brake-dimensional, brake-verify, brake-failure, brake-analysis and
@@ -73,6 +74,18 @@ BAD_INPUTS = {
     "xyz-species": ("&surface potential = 'lj', net = 'file', net_file = 'net.xyz' /\n", 3,
                     ["net.xyz:3", "unknown species 'Au'"]),
     "unknown-option": (None, 2, ["--frobnicate"]),
+    # --set group.variable=value: checked as a file's line; the override is its "file".
+    "set-unknown-group": (None, 3, ["--set scans.nx=9", "unknown namelist group &scans", "&scan"]),
+    "set-unknown-variable": (None, 3, ["--set scan.nox=9", "&scan", "unknown variable 'nox'", "nx"]),
+    "set-bad-value": (None, 3, ["--set scan.nx=many", "&scan", "nx = many", "integer"]),
+    "set-bad-range": (None, 3, ["--set tip.mass=-1e-8", "&tip", "mass", "> 0"]),
+    "set-other-scene": (None, 3, ["--set brake.mu=0.2", "&brake", "not part of scene 'afm'"]),
+    "set-missing-equals": (None, 2, ["--set", "scan.nx", "group.variable=value", "usage"]),
+    "set-missing-argument": (None, 2, ["--set", "group.variable=value", "usage"]),
+    # A group of another scene where the input names no scene: the default
+    # AFM map is not what was meant (docs/cli.md, Groups of another scene).
+    "no-job-brake-group": ("&brake\n  mu = 0.2\n/\n", 3,
+                           ["bad.nml:1", "&brake", "scene 'brake'", "no &job scene", "'afm'"]),
     # The reduced tip models (docs/physics.md, Reduced tip models).
     "tip-model-unknown": ("&tip model = 'massless' /\n", 3,
                           ["bad.nml:1", "&tip", "model", "massless", "quasistatic"]),
@@ -172,11 +185,32 @@ def leftovers(args):
     return sorted(f for f in os.listdir(args.workdir) if not f.endswith(".nml"))
 
 
+TIMING = ("compute_time", "peak_memory_per_rank", "wall_time")   # how long it took, not what it computed
+
+
+def same_run(args, first, second, label):
+    """fail() unless two output files hold the same datasets and attributes
+    (bit for bit), timings and the created stamp aside."""
+    a, b = (comparable(os.path.join(args.workdir, name)) for name in (first, second))
+    a, b = ({key: value for key, value in items.items() if not any(t in key for t in TIMING)} for items in (a, b))
+    if a.keys() != b.keys():
+        fail(f"{label}: {first} and {second} hold different objects: {sorted(set(a) ^ set(b))}")
+    if not any(not key.startswith("@") and "@" not in key for key in a):
+        fail(f"{label}: no datasets")
+    for key, value in a.items():
+        if not np.array_equal(np.asarray(value), np.asarray(b[key]),
+                              equal_nan=np.asarray(value).dtype.kind == "f"):
+            fail(f"{label}: {key} differs between {first} and {second}")
+
+
 def case_input_roundtrip(args):
     """The root `input` attribute is a namelist that reads back to the same
-    run: for every scene (a NaF map, a graphite map with its net file, the
-    brake, a sweep) the file written from the echoed input alone has the same
-    datasets bit for bit and echoes the same text again."""
+    run, and --print-input prints that text without running or writing
+    anything: for every scene (a NaF map, a graphite map with its net file,
+    the brake, a sweep) the printed text is the file's attribute, and the
+    file written from the printed text alone has the same datasets and
+    attributes bit for bit (timings and the created stamp aside) and echoes
+    the same text again."""
     runs = {
         "naf": [os.path.join(args.inputs, "naf.nml"), write(args, "naf_small.nml", SMALL)],
         "graphite": [os.path.join(args.inputs, "graphite.nml"),
@@ -187,25 +221,66 @@ def case_input_roundtrip(args):
     }
     for label, files in runs.items():
         first, second = f"{label}_1.h5", f"{label}_2.h5"
+        before = leftovers(args)
+        printed = friction(args, "--print-input", *files).stdout
+        if leftovers(args) != before:
+            fail(f"{label}: --print-input wrote {sorted(set(leftovers(args)) - set(before))}")
         friction(args, "-o", first, *files)
         with h5py.File(os.path.join(args.workdir, first), "r") as f:
             echoed = f.attrs["input"].decode()
-        again = write(args, f"{label}_echo.nml", echoed)
+        if printed != echoed:
+            fail(f"{label}: --print-input printed\n{printed}\n--- but the file echoes\n{echoed}")
+        again = write(args, f"{label}_echo.nml", printed)
         friction(args, "-o", second, again)
-        with h5py.File(os.path.join(args.workdir, first), "r") as a, \
-                h5py.File(os.path.join(args.workdir, second), "r") as b:
+        with h5py.File(os.path.join(args.workdir, second), "r") as b:
             if b.attrs["input"].decode() != echoed:
                 fail(f"{label}: the echo of the echo differs:\n{echoed}\n---\n{b.attrs['input'].decode()}")
-            names = []
-            a.visit(lambda name: names.append(name) if isinstance(a[name], h5py.Dataset) else None)
-            if not names:
-                fail(f"{label}: no datasets")
-            for name in names:
-                if name.endswith("compute_time") or name.endswith("peak_memory_per_rank"):
-                    continue
-                if name not in b or not np.array_equal(a[name][()], b[name][()],
-                                                       equal_nan=a[name].dtype.kind == "f"):
-                    fail(f"{label}: /{name} differs when run from the echoed input")
+        same_run(args, first, second, label)
+
+
+def case_set(args):
+    """--set group.variable=value is an override file of one line: a run with
+    --set scan.nx=24 --set scan.ny=7 writes the file a run with the override
+    file SMALL writes (bit for bit, timings aside); --set applies after the
+    files and in order (the last one wins), takes an element surface.sigma(2)
+    and a quoted text; --print-input shows the values."""
+    naf = os.path.join(args.inputs, "naf.nml")
+    friction(args, "-o", "file.h5", naf, write(args, "small.nml", SMALL))
+    friction(args, "-o", "set.h5", "--set", "scan.nx=3", "--set", "scan.ny=7", naf,
+             write(args, "nx.nml", "&scan nx = 5 /\n"), "--set", "scan.nx=24")
+    same_run(args, "file.h5", "set.h5", "--set against an override file")
+    printed = friction(args, "--print-input", naf, "--set", "surface.sigma(2)=3.5",
+                       "--set", "integrator.method='rk8pd'", "--set", "tip.kx = 12.5").stdout
+    text = printed.replace(" ", "")
+    for wanted in ["sigma=2.4945,3.5,6*0.0", "method='rk8pd'", "kx=12.5"]:
+        if wanted not in text:
+            fail(f"{wanted} not in the printed input:\n{printed}")
+    if leftovers(args) != ["file.h5", "set.h5"]:
+        fail(f"unexpected files: {leftovers(args)}")
+
+
+def case_other_scene_group(args):
+    """A group of another scene in a file whose input names its scene (&job)
+    is ignored with a warning on stderr naming the file, line, group and the
+    scene it belongs to; the run goes on and writes the file a run without
+    that group writes."""
+    naf = os.path.join(args.inputs, "naf.nml")
+    small = write(args, "small.nml", SMALL)
+    extra = write(args, "extra.nml", "&scan nx = 24 /\n&brake\n  mu = 0.2\n/\n")
+    friction(args, "-o", "plain.h5", naf, small)
+    result = friction(args, "-o", "extra.h5", naf, small, extra)
+    warnings = [line for line in result.stderr.splitlines() if "warning" in line]
+    if len(warnings) != 1:
+        fail(f"expected one warning, got: {result.stderr!r}")
+    for word in ["extra.nml:2", "&brake", "not part of scene 'afm'", "scene 'brake'", "ignored"]:
+        if word not in warnings[0]:
+            fail(f"warning lacks {word!r}: {warnings[0]!r}")
+    same_run(args, "plain.h5", "extra.h5", "a group of another scene")
+    # The brake's own input with an AFM group: the same, the other way round.
+    result = friction(args, "--print-input", os.path.join(args.inputs, "brake.nml"),
+                      write(args, "tip.nml", "&tip kx = 3.0 /\n"))
+    if "tip.nml:1" not in result.stderr or "&tip" not in result.stderr or "scene 'afm'" not in result.stderr:
+        fail(f"no warning about &tip in a brake job: {result.stderr!r}")
 
 
 def case_datasets(args, scene):
@@ -685,6 +760,14 @@ def case_bad(args, name):
         cmd = ["--frobnicate", naf]
     elif name == "unwritable-output":
         cmd = ["-o", "no-such-dir/out.h5", naf]
+    elif name.startswith("set-"):
+        override = {"set-unknown-group": ["scans.nx=9"], "set-unknown-variable": ["scan.nox=9"],
+                    "set-bad-value": ["scan.nx=many"], "set-bad-range": ["tip.mass=-1e-8"],
+                    "set-other-scene": ["brake.mu=0.2"], "set-missing-equals": ["scan.nx"],
+                    "set-missing-argument": []}[name]
+        cmd = [naf, "--set", *override]
+    elif name == "no-job-brake-group":
+        cmd = [write(args, "bad.nml", text)]
     else:
         cmd = [naf, write(args, "bad.nml", text)]
     xyz = {"xyz-count": "3\nnet\nC 0 0 0\n",
@@ -1316,8 +1399,9 @@ def main():
          "graphite": case_graphite, "models": case_models, "quasistatic-failure": case_quasistatic_failure,
          "graphite-ranks": case_graphite_ranks, "graphite-defects": case_graphite_defects,
          "input-roundtrip": case_input_roundtrip, "thermal-zero": case_thermal_zero,
-         "thermal-ranks": case_thermal_ranks, "thermal-equipartition": case_thermal_equipartition,
-         "serial-files": case_serial_files, "serial-no-mpi": case_serial_no_mpi}[args.case](args)
+          "set": case_set, "other-scene-group": case_other_scene_group,
+          "thermal-ranks": case_thermal_ranks, "thermal-equipartition": case_thermal_equipartition,
+          "serial-files": case_serial_files, "serial-no-mpi": case_serial_no_mpi}[args.case](args)
     print("1 passed, 0 failed")
 
 

@@ -30,12 +30,7 @@ set(_fg_check ${Python3_EXECUTABLE} "${_fg_tests}/check_png.py" --newer-than "${
 set(_fg_expect ${Python3_EXECUTABLE} "${_fg_tests}/expect_exit.py")
 set(_fg_plot ${Python3_EXECUTABLE} "${_fg_scripts}/plot_graphite.py")
 
-execute_process(COMMAND ${Python3_EXECUTABLE} -c "import h5py, matplotlib, numpy"
-                RESULT_VARIABLE _fg_py_modules OUTPUT_QUIET ERROR_QUIET)
-if(NOT _fg_py_modules EQUAL 0)
-  message(FATAL_ERROR "The tests need h5py, matplotlib and numpy in ${Python3_EXECUTABLE}: "
-                      "run scripts/install-deps (python3 -m pip install h5py matplotlib numpy)")
-endif()
+# (h5py, matplotlib, numpy: checked by cmake/FrictionTestTools.cmake.)
 
 # ---- fixtures: the maps the plotting tests read ----
 # Graphite: 3 lines x 24 points, trace only, 150-atom flake; about a second.

@@ -7,10 +7,7 @@
 # Included from tests/CMakeLists.txt (after find_package(Python3)).  ngspice is
 # required, not optional: scripts/install-deps installs it, and a skipped
 # comparison could hide a broken network model.
-find_program(FRICTION_NGSPICE_EXECUTABLE ngspice DOC "ngspice, for the netlist tests")
-if(NOT FRICTION_NGSPICE_EXECUTABLE)
-  message(FATAL_ERROR "The netlist tests need ngspice: run scripts/install-deps (Debian package ngspice)")
-endif()
+# (FRICTION_NGSPICE_EXECUTABLE: found, or configuration stopped, by cmake/FrictionTestTools.cmake.)
 
 foreach(case brake naf switched bad-graphite bad-no-name bad-switched-mu bad-exists compare bad-compare)
   add_test(NAME netlist-${case}

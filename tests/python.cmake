@@ -9,12 +9,7 @@
 #                      whole, and the PNGs it writes are complete images
 # Included from tests/CMakeLists.txt after scripts.cmake (h5py, matplotlib, numpy checked).
 
-execute_process(COMMAND ${Python3_EXECUTABLE} -c "import pytest"
-                RESULT_VARIABLE _fp_pytest OUTPUT_QUIET ERROR_QUIET)
-if(NOT _fp_pytest EQUAL 0)
-  message(FATAL_ERROR "The tests need pytest in ${Python3_EXECUTABLE}: "
-                      "run scripts/install-deps (python3 -m pip install pytest)")
-endif()
+# (pytest: checked by cmake/FrictionTestTools.cmake.)
 
 set(_fp_work "${CMAKE_CURRENT_BINARY_DIR}/python")
 file(MAKE_DIRECTORY "${_fp_work}")

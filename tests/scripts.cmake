@@ -26,22 +26,9 @@ set(_fs_plot ${Python3_EXECUTABLE} "${_fs_scripts}/plot_afm.py")
 set(_fs_gnuplot sh "${_fs_scripts}/afm_maps_gnuplot.sh")
 
 # What the plotting routes need besides Python itself.
-execute_process(COMMAND ${Python3_EXECUTABLE} -c "import h5py, matplotlib, numpy"
-                RESULT_VARIABLE _fs_py_modules OUTPUT_QUIET ERROR_QUIET)
+# (Found, or configuration stopped naming what is missing, by cmake/FrictionTestTools.cmake.)
 set(_fs_no_python_modules OFF)
-if(NOT _fs_py_modules EQUAL 0)
-  message(FATAL_ERROR "The tests need h5py, matplotlib and numpy in ${Python3_EXECUTABLE}: "
-                      "run scripts/install-deps (python3 -m pip install h5py matplotlib numpy)")
-  set(_fs_no_python_modules ON)
-endif()
-find_program(FRICTION_GNUPLOT_EXECUTABLE gnuplot DOC "gnuplot, for the scripts tests")
-find_program(FRICTION_H5DUMP_EXECUTABLE h5dump DOC "h5dump (hdf5-tools), for the scripts tests")
 set(_fs_no_gnuplot OFF)
-if(NOT FRICTION_GNUPLOT_EXECUTABLE OR NOT FRICTION_H5DUMP_EXECUTABLE)
-  message(FATAL_ERROR "The tests need gnuplot and h5dump: "
-                      "sudo apt-get install gnuplot-nox hdf5-tools (or run scripts/install-deps)")
-  set(_fs_no_gnuplot ON)
-endif()
 set(_fs_gnuplot_env "GNUPLOT=${FRICTION_GNUPLOT_EXECUTABLE}" "H5DUMP=${FRICTION_H5DUMP_EXECUTABLE}")
 
 # The map every plotting test reads: 40 x 10 samples, trace and retrace.

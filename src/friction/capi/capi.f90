@@ -23,9 +23,9 @@ module friction_capi
    use friction_strings, only: itoa, rtoa, join, quoted
    use friction_version, only: version_string
    use friction_parameters, only: parameter_info, list_parameters, set_parameter, set_parameter_number, &
-      & get_parameter, kind_text, value_has_kind, split_name
+      & get_parameter, kind_text, value_has_kind
    use friction_checks, only: config_checker
-   use friction_input_reader, only: namelist_source, scan_files, apply_files
+   use friction_input_reader, only: namelist_source, scan_files, apply_files, parse_variable_name
    use friction_surface_potential, only: surface_potential
    use friction_afm_config, only: afm_config, new_potential
    use friction_afm_scan, only: afm_scanner, trip_record, line_record, quantity_names, quantity_count, q_fx, q_fy, &
@@ -36,7 +36,7 @@ module friction_capi
    use friction_brake_simulate, only: brake_run
    use friction_brake_scene, only: brake_scene
    use friction_job_factory, only: scene_names, new_scene
-   use friction_job_config, only: job_config, check_job, job_text, all_parameters, parameter_groups
+   use friction_job_config, only: job_config, check_job, job_text, all_parameters, parameter_groups, not_in_scene
    use friction_job, only: run_job, run_job_config, job_reporter
    use friction_scene_report, only: progress_text
    implicit none
@@ -320,15 +320,6 @@ contains
       end if
    end function config_of
 
-   !> The groups of a configuration (&job, its scene's, &sweep), as a
-   !> message lists them.
-   function own_groups(job) result(text)
-      type(job_config), intent(inout) :: job
-      character(len=:), allocatable :: text
-
-      text = join(parameter_groups(list_parameters(job)), ' ', '&')
-   end function own_groups
-
    !> A name 'group.variable' or 'group.variable(k)' for set and get, in
    !> `job` (the handle's copy): its group, variable, element (0 for none)
    !> and the variable's description.  The messages are the namelist
@@ -342,40 +333,14 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(parameter_info), allocatable :: universe(:), mine(:)
       character(len=32), allocatable :: known(:)
-      integer :: paren, stat, k
+      integer :: k
 
-      first = 0
-      call split_name(full, group, name)
-      if (index(full, '.') == 0 .or. len(group) == 0 .or. len(name) == 0) then
-         call fatal_error(error, "name '"//full//"': give a variable as 'group.variable', e.g. 'tip.kx' or " &
-            & //"'surface.sigma(2)'", error_input)
-         return
-      end if
-      paren = index(name, '(')
-      if (paren > 0) then
-         stat = 1
-         if (name(len(name):) == ')' .and. paren < len(name) - 1) then
-            if (verify(name(paren + 1:len(name) - 1), '0123456789') == 0) &
-               & read (name(paren + 1:len(name) - 1), *, iostat=stat) first
-         end if
-         if (stat /= 0 .or. first < 1) then
-            call fatal_error(error, "name '"//full//"': the element is a whole number >= 1 in parentheses, " &
-               & //"e.g. 'surface.sigma(2)'", error_input)
-            return
-         end if
-         name = name(1:paren - 1)
-      end if
       universe = all_parameters()
-      known = parameter_groups(universe)
-      if (.not. any(known == group)) then
-         call fatal_error(error, 'unknown namelist group &'//group//' (known: '//join(known, ' ', '&')//')', &
-            & error_input)
-         return
-      end if
+      call parse_variable_name(full, parameter_groups(universe), group, name, first, error)
+      if (allocated(error)) return
       mine = list_parameters(job)
       if (.not. any(mine%group == group)) then
-         call fatal_error(error, 'group &'//group//" is not part of scene '"//trim(job%scene_name) &
-            & //"' (its groups: "//own_groups(job)//')', error_input)
+         call fatal_error(error, not_in_scene(job, group), error_input)
          return
       end if
       do k = 1, size(mine)
@@ -636,8 +601,7 @@ contains
                end if
             end if
             if (.not. any(mine%group == m%group)) then
-               call fatal_error(error, where//'group &'//trim(m%group)//" is not part of scene '" &
-                  & //trim(config%job%scene_name)//"' (its groups: "//own_groups(work)//')', error_input)
+               call fatal_error(error, where//not_in_scene(work, m%group), error_input)
                exit
             end if
          end associate

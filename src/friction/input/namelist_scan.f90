@@ -33,20 +33,26 @@ contains
 
    !> The groups and assignments of a namelist file.  Groups outside
    !> `known_groups`, a group given twice and a group not closed are errors
-   !> naming the line.
-   subroutine scan_namelist_file(path, known_groups, mentions, error)
+   !> naming the line.  `groups` and `group_lines`, if given, are the groups
+   !> the file opens (empty ones too) and the line of each.
+   subroutine scan_namelist_file(path, known_groups, mentions, error, groups, group_lines)
       character(len=*), intent(in) :: path
       character(len=*), intent(in) :: known_groups(:)
       type(mention), allocatable, intent(out) :: mentions(:)
       type(error_type), allocatable, intent(out) :: error
+      character(len=32), allocatable, intent(out), optional :: groups(:)
+      integer, allocatable, intent(out), optional :: group_lines(:)
       character(len=:), allocatable :: text, group
       integer, allocatable :: line_of(:)
       character(len=32), allocatable :: seen(:)
+      integer, allocatable :: seen_lines(:)
       character :: quote
       integer :: i, j, k, n, value_from, first, stat
       logical :: in_group, open_mention
 
-      allocate (mentions(0), seen(0))
+      allocate (mentions(0), seen(0), seen_lines(0))
+      if (present(groups)) allocate (groups(0))
+      if (present(group_lines)) allocate (group_lines(0))
       call read_text(path, text, line_of, error)
       if (allocated(error)) return
       n = len(text)
@@ -84,6 +90,7 @@ contains
                   return
                end if
                seen = [character(len=32) :: seen, group]
+               seen_lines = [seen_lines, line_of(i)]
                in_group = .true.
                i = j
                cycle
@@ -130,7 +137,10 @@ contains
       end do
       if (in_group) then
          call fatal_error(error, path//': group &'//group//" is not closed with '/'", error_input)
+         return
       end if
+      if (present(groups)) groups = seen
+      if (present(group_lines)) group_lines = seen_lines
 
    contains
 

@@ -16,12 +16,19 @@ module friction_input_reader
    implicit none
    private
 
-   public :: namelist_source, scan_files, last_text, apply_files
+   public :: namelist_source, scan_files, last_text, apply_files, parse_variable_name, override_source, &
+      & source_place
 
-   !> The assignments of one file.
+   !> The assignments of one file, or of one command-line override
+   !> `--set group.variable=value` (its "file" is '--set group.variable=value',
+   !> its one mention has no line, and relative file names in its value are
+   !> relative to the working directory).
    type :: namelist_source
       character(len=:), allocatable :: path
       type(mention), allocatable :: mentions(:)
+      logical :: override = .false.
+      character(len=32), allocatable :: groups(:)   !! the groups the file opens (empty ones too)
+      integer, allocatable :: group_lines(:)        !! and the line of each
    end type namelist_source
 
 contains
@@ -38,10 +45,91 @@ contains
       allocate (sources(size(paths)))
       do k = 1, size(paths)
          sources(k)%path = trim(paths(k))
-         call scan_namelist_file(sources(k)%path, known_groups, sources(k)%mentions, error)
+         call scan_namelist_file(sources(k)%path, known_groups, sources(k)%mentions, error, sources(k)%groups, &
+            & sources(k)%group_lines)
          if (allocated(error)) return
       end do
    end subroutine scan_files
+
+   !> Where a source's line is, for messages: 'file:line', or the override
+   !> itself ('--set group.variable=value').
+   function source_place(source, line) result(place)
+      type(namelist_source), intent(in) :: source
+      integer, intent(in) :: line
+      character(len=:), allocatable :: place
+
+      place = source%path
+      if (.not. source%override) place = place//':'//itoa(line)
+   end function source_place
+
+   !> A variable's name 'group.variable' or 'group.variable(k)' (the C API's
+   !> names, and --set's): its group (one of `known_groups`), variable and
+   !> element (0 for none).  Whether the variable exists is the reader's
+   !> check (apply_files), or the caller's.
+   subroutine parse_variable_name(full, known_groups, group, name, first, error)
+      character(len=*), intent(in) :: full
+      character(len=*), intent(in) :: known_groups(:)
+      character(len=:), allocatable, intent(out) :: group, name
+      integer, intent(out) :: first
+      type(error_type), allocatable, intent(out) :: error
+      integer :: paren, stat
+
+      first = 0
+      call split_name(full, group, name)
+      if (index(full, '.') == 0 .or. len(group) == 0 .or. len(name) == 0) then
+         call fatal_error(error, "name '"//full//"': give a variable as 'group.variable', e.g. 'tip.kx' or " &
+            & //"'surface.sigma(2)'", error_input)
+         return
+      end if
+      paren = index(name, '(')
+      if (paren > 0) then
+         stat = 1
+         if (name(len(name):) == ')' .and. paren < len(name) - 1) then
+            if (verify(name(paren + 1:len(name) - 1), '0123456789') == 0) &
+               & read (name(paren + 1:len(name) - 1), *, iostat=stat) first
+         end if
+         if (stat /= 0 .or. first < 1) then
+            call fatal_error(error, "name '"//full//"': the element is a whole number >= 1 in parentheses, " &
+               & //"e.g. 'surface.sigma(2)'", error_input)
+            return
+         end if
+         name = name(1:paren - 1)
+      end if
+      if (.not. any(known_groups == group)) then
+         call fatal_error(error, 'unknown namelist group &'//group//' (known: '//join(known_groups, ' ', '&')//')', &
+            & error_input)
+         return
+      end if
+   end subroutine parse_variable_name
+
+   !> The source of one command-line override 'group.variable=value' (the
+   !> text after --set); an error names '--set' and the override as its file.
+   subroutine override_source(text, known_groups, source, error)
+      character(len=*), intent(in) :: text
+      character(len=*), intent(in) :: known_groups(:)
+      type(namelist_source), intent(out) :: source
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: group, name
+      integer :: equals, first
+
+      source%path = '--set '//trim(text)
+      source%override = .true.
+      allocate (source%mentions(1), source%groups(0), source%group_lines(0))
+      equals = index(text, '=')
+      if (equals == 0) then
+         call fatal_error(error, source%path//": give 'group.variable=value', e.g. 'tip.kx=12.5'", error_input)
+         return
+      end if
+      call parse_variable_name(trim(adjustl(text(1:equals - 1))), known_groups, group, name, first, error)
+      if (allocated(error)) then
+         error%message = source%path//': '//error%message
+         return
+      end if
+      source%mentions(1)%group = group
+      source%mentions(1)%name = name
+      source%mentions(1)%first = first
+      source%mentions(1)%value = trim(adjustl(text(equals + 1:)))
+   end subroutine override_source
 
    !> The value text the files last give group.name ('' if none).
    function last_text(sources, group, name) result(text)
@@ -78,14 +166,18 @@ contains
       do f = 1, size(sources)
          ! Relative file names in a file are relative to its directory, made
          ! absolute so that the echoed input reads back from anywhere.
-         slash = index(sources(f)%path, '/', back=.true.)
-         base = sources(f)%path(1:slash)
-         if (sources(f)%path(1:1) /= '/') base = working_directory()//base
+         if (sources(f)%override) then
+            base = working_directory()
+         else
+            slash = index(sources(f)%path, '/', back=.true.)
+            base = sources(f)%path(1:slash)
+            if (sources(f)%path(1:1) /= '/') base = working_directory()//base
+         end if
          ! Names and kinds first, for the whole file: nothing is set from a file
          ! with a bad assignment.
          do k = 1, size(sources(f)%mentions)
             associate (m => sources(f)%mentions(k))
-               where = sources(f)%path//':'//itoa(m%line)//': &'//trim(m%group)//': '
+               where = source_place(sources(f), m%line)//': &'//trim(m%group)//': '
                u = find(m%group, m%name)
                if (u == 0) then
                   known = pack(universe%name, universe%group == m%group)
@@ -103,7 +195,7 @@ contains
          do k = 1, size(sources(f)%mentions)
             associate (m => sources(f)%mentions(k))
                if (.not. any(mine%group == m%group)) cycle   ! another scene's group
-               where = sources(f)%path//':'//itoa(m%line)
+               where = source_place(sources(f), m%line)
                call set_parameter(target, trim(m%group), trim(m%name), m%value, m%first, base, problem)
                if (len(problem) > 0) then
                   shown = trim(m%name)

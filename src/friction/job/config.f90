@@ -8,14 +8,14 @@ module friction_job_config
    use friction_parameters, only: configurable, parameter_visitor, parameter_info, list_parameters, &
       & parameters_text, split_name
    use friction_checks, only: config_checker
-   use friction_input_reader, only: namelist_source, scan_files, apply_files
+   use friction_input_reader, only: namelist_source, scan_files, apply_files, override_source, source_place, last_text
    use friction_scene, only: scene
    use friction_job_factory, only: scene_names, new_scene
    implicit none
    private
 
    public :: job_config, sweep_settings, read_input, check_job, max_sweep_values, all_parameters, job_text, &
-      & parameter_groups
+      & parameter_groups, not_in_scene
 
    integer, parameter :: max_sweep_values = 1024
 
@@ -119,22 +119,39 @@ contains
       end do
    end function parameter_groups
 
-   !> Read and check the files in order into config; input_text is the
-   !> resolved input as namelist text that reads back to the same run.
-   subroutine read_input(paths, config, input_text, error)
+   !> Read and check the files in order, then the command-line `overrides`
+   !> ('group.variable=value', each read as a file of one assignment), into
+   !> config; input_text is the resolved input as namelist text that reads
+   !> back to the same run.  A file's group of another scene is ignored with
+   !> a warning in `notes` if the input names the scene (&job scene), and is
+   !> an error if the scene is the default one: the input then most likely
+   !> forgot its &job (docs/cli.md, Groups of another scene).
+   subroutine read_input(paths, config, input_text, error, overrides, notes)
       character(len=*), intent(in) :: paths(:)
       type(job_config), intent(out) :: config
       character(len=:), allocatable, intent(out) :: input_text
       type(error_type), allocatable, intent(out) :: error
-      type(namelist_source), allocatable :: sources(:)
+      character(len=*), intent(in), optional :: overrides(:)
+      character(len=1024), allocatable, intent(out), optional :: notes(:)
+      type(namelist_source), allocatable :: sources(:), files(:)
       type(parameter_info), allocatable :: universe(:)
       type(config_checker) :: checker
       character(len=32), allocatable :: groups(:)
+      integer :: k, n_over
 
+      if (present(notes)) allocate (notes(0))
       universe = all_parameters()
       groups = parameter_groups(universe)
-      call scan_files(paths, groups, sources, error)
+      call scan_files(paths, groups, files, error)
       if (allocated(error)) return
+      n_over = 0
+      if (present(overrides)) n_over = size(overrides)
+      allocate (sources(size(files) + n_over))
+      sources(1:size(files)) = files
+      do k = 1, n_over
+         call override_source(overrides(k), groups, sources(size(files) + k), error)
+         if (allocated(error)) return
+      end do
       ! &job and &sweep first (every assignment of every file is checked here),
       ! then the scene they name.
       call apply_files(sources, universe, config, checker, error)
@@ -146,6 +163,8 @@ contains
          call move_alloc(checker%error, error)
          return
       end if
+      call check_other_scenes(config, sources, len(last_text(sources, 'job', 'scene')) > 0, error, notes)
+      if (allocated(error)) return
       call apply_files(sources, universe, config, checker, error)
       if (allocated(error)) return
       call check_job(config, checker)
@@ -155,6 +174,77 @@ contains
       end if
       input_text = job_text(config)
    end subroutine read_input
+
+   !> Groups of the sources that are not part of the job's scene: in an
+   !> override (--set), an error with the C API's message; in a file, a
+   !> warning in `notes` when `explicit` (the input names its scene), else an
+   !> error naming the scene the group belongs to.
+   subroutine check_other_scenes(config, sources, explicit, error, notes)
+      type(job_config), intent(inout) :: config
+      type(namelist_source), intent(in) :: sources(:)
+      logical, intent(in) :: explicit
+      type(error_type), allocatable, intent(out) :: error
+      character(len=1024), allocatable, intent(inout), optional :: notes(:)
+      character(len=32), allocatable :: own(:)
+      character(len=:), allocatable :: where, owners, theirs
+      integer :: f, k
+
+      own = parameter_groups(list_parameters(config))
+      do f = 1, size(sources)
+         associate (s => sources(f))
+            if (s%override) then
+               if (any(own == s%mentions(1)%group)) cycle
+               call fatal_error(error, s%path//': '//not_in_scene(config, s%mentions(1)%group), error_input)
+               return
+            end if
+            do k = 1, size(s%groups)
+               if (any(own == s%groups(k))) cycle
+               where = source_place(s, s%group_lines(k))//': '
+               owners = scenes_with(s%groups(k))
+               if (explicit) then
+                  theirs = ''
+                  if (len(owners) > 0) theirs = ' (a group of scene '//owners//')'
+                  if (present(notes)) notes = [character(len=1024) :: notes, 'warning: '//where// &
+                     & not_in_scene(config, s%groups(k))//'; ignored'//theirs]
+               else
+                  call fatal_error(error, where//'group &'//trim(s%groups(k))//' belongs to scene '//owners// &
+                     & ", but no &job scene is given and the default scene is '"//trim(config%scene_name)// &
+                     & "': add &job scene = "//owners//' / (or remove the group)', error_input)
+                  return
+               end if
+            end do
+         end associate
+      end do
+   end subroutine check_other_scenes
+
+   !> What is wrong with a group outside the job's scene (the program's and
+   !> the C API's words).
+   function not_in_scene(config, group) result(text)
+      type(job_config), intent(inout) :: config
+      character(len=*), intent(in) :: group
+      character(len=:), allocatable :: text
+
+      text = 'group &'//trim(group)//" is not part of scene '"//trim(config%scene_name)//"' (its groups: " &
+         & //join(parameter_groups(list_parameters(config)), ' ', '&')//')'
+   end function not_in_scene
+
+   !> The scenes whose jobs have `group`, quoted ('brake'; '' if none).
+   function scenes_with(group) result(text)
+      character(len=*), intent(in) :: group
+      character(len=:), allocatable :: text
+      type(job_config) :: probe
+      integer :: k
+
+      text = ''
+      do k = 1, size(scene_names)
+         call new_scene(scene_names(k), probe%scene)
+         if (any(parameter_groups(list_parameters(probe)) == group)) then
+            if (len(text) > 0) text = text//' or '
+            text = text//"'"//trim(scene_names(k))//"'"
+         end if
+         deallocate (probe%scene)
+      end do
+   end function scenes_with
 
    !> The groups the job reads as namelist text.
    function job_text(config) result(text)

@@ -20,7 +20,7 @@ module friction_job
    implicit none
    private
 
-   public :: run_job, run_job_config, write_netlist, job_reporter, default_output
+   public :: run_job, run_job_config, write_netlist, resolve_input, job_reporter, default_output
 
 contains
 
@@ -29,12 +29,14 @@ contains
    !> temporary name, renamed when complete).  An existing output is an error
    !> unless `force`, or `resume` for a sweep (which reuses the checkpoints an
    !> interrupted run left beside it).  `summary` says what was written.
-   subroutine run_job(files, output, force, resume, comm, reporter, summary, error, stop_after)
+   !> `overrides` ('group.variable=value') apply after the files, in order.
+   subroutine run_job(files, output, force, resume, comm, reporter, summary, error, stop_after, overrides)
       character(len=*), intent(in) :: files(:)
       character(len=*), intent(in) :: output
       logical, intent(in) :: force, resume
       !> A test hook: > 0 stops a sweep after that point as a stop request would.
       integer, intent(in), optional :: stop_after
+      character(len=*), intent(in), optional :: overrides(:)
       type(MPI_Comm), intent(in) :: comm
       class(job_reporter), intent(inout) :: reporter
       character(len=:), allocatable, intent(out) :: summary
@@ -58,8 +60,7 @@ contains
       ! Every rank reads the input.  An error in a file is the same everywhere,
       ! but not when a rank cannot read what another read (a pipe reaches
       ! rank 0 only): the ranks agree on an error and on the text they read.
-      call read_input(files, config, job%input_text, error)
-      call agree_on_error(job, error)
+      call read_job_input(job, files, overrides, reporter, config, error)
       if (allocated(error)) return
       call check_same_input(job, error)
       if (allocated(error)) return
@@ -104,6 +105,48 @@ contains
       job%input_text = job_text(work)
       call run_configured(job, work, force, reporter, summary, error)
    end subroutine run_job_config
+
+   !> The resolved input of `files` and `overrides` (all applied, defaults
+   !> filled, checked) as the namelist text a run echoes into its output,
+   !> which reads back to the same run; nothing is computed or written.
+   !> Collective over `comm`; warnings go to the reporter.
+   subroutine resolve_input(files, comm, reporter, text, error, overrides)
+      character(len=*), intent(in) :: files(:)
+      type(MPI_Comm), intent(in) :: comm
+      class(job_reporter), intent(inout) :: reporter
+      character(len=:), allocatable, intent(out) :: text
+      type(error_type), allocatable, intent(out) :: error
+      character(len=*), intent(in), optional :: overrides(:)
+      type(job_context) :: job
+      type(job_config) :: config
+
+      call set_comm(comm, job)
+      call read_job_input(job, files, overrides, reporter, config, error)
+      if (allocated(error)) return
+      text = job%input_text
+   end subroutine resolve_input
+
+   !> Read the input into `config` and `job%input_text` on every rank, the
+   !> ranks agreeing on an error; rank 0 passes the reader's warnings on.
+   subroutine read_job_input(job, files, overrides, reporter, config, error)
+      type(job_context), intent(inout) :: job
+      character(len=*), intent(in) :: files(:)
+      character(len=*), intent(in), optional :: overrides(:)
+      class(job_reporter), intent(inout) :: reporter
+      type(job_config), intent(out) :: config
+      type(error_type), allocatable, intent(out) :: error
+      character(len=1024), allocatable :: notes(:)
+      integer :: k
+
+      call read_input(files, config, job%input_text, error, overrides, notes)
+      call agree_on_error(job, error)
+      if (allocated(error)) return
+      if (job%rank == 0) then
+         do k = 1, size(notes)
+            call reporter%note(trim(notes(k)))
+         end do
+      end if
+   end subroutine read_job_input
 
    !> A job's context on `comm`, its clock started.
    subroutine start_job(comm, output, resume, job)
@@ -239,8 +282,9 @@ contains
    !> network model, docs/netlist.md) in `path`, its waveforms going to
    !> the same name with .data; nothing is integrated.  Rank 0 writes; every
    !> rank returns the same error or none.  `summary` says what was written.
-   subroutine write_netlist(files, path, force, comm, reporter, summary, error)
+   subroutine write_netlist(files, path, force, comm, reporter, summary, error, overrides)
       character(len=*), intent(in) :: files(:)
+      character(len=*), intent(in), optional :: overrides(:)
       character(len=*), intent(in) :: path
       logical, intent(in) :: force
       type(MPI_Comm), intent(in) :: comm
@@ -253,7 +297,7 @@ contains
       integer :: dot, k
 
       call set_comm(comm, job)
-      call read_input(files, config, job%input_text, error)
+      call read_job_input(job, files, overrides, reporter, config, error)
       if (allocated(error)) return
       dot = index(path, '.', back=.true.)
       if (dot > index(path, '/', back=.true.) + 1) then
