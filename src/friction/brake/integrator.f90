@@ -9,6 +9,7 @@ module friction_brake_integrator
    use friction_ode_events, only: event_locator
    use friction_brake_config, only: brake_config
    use friction_brake_record, only: brake_event_table
+   use friction_analysis_lyapunov_spectrum, only: pack_tangent
    implicit none
    private
 
@@ -19,6 +20,11 @@ module friction_brake_integrator
       real(wp) :: y(4) = 0.0_wp             !! state there: x, x', y, y'
       real(wp) :: stick_time = -1.0_wp      !! time spent in stick, when the model tracks it exactly; else < 0
       type(event_locator) :: locator
+      !> Set before start: integrate the tangent matrix phi beside the state
+      !> (the Lyapunov spectrum, docs/physics.md); phi = I at the start.
+      logical :: tangent = .false.
+      real(wp) :: phi(4, 4) = 0.0_wp
+      integer :: lost = 0                   !! directions mapped to 0 (stick) since reset_tangent
    contains
       !> Start at (t0, y0) with the settings of `config`; the event table is cleared.
       procedure(start_interface), deferred :: start
@@ -27,6 +33,7 @@ module friction_brake_integrator
       !> Whether the block sticks to the belt now.
       procedure(sticking_interface), deferred :: is_sticking
       procedure :: statistics
+      procedure :: reset_tangent
    end type brake_integrator
 
    abstract interface
@@ -62,5 +69,17 @@ contains
 
       stats = self%locator%statistics()
    end function statistics
+
+   !> Replace the tangent matrix (after a QR step) and forget lost directions.
+   subroutine reset_tangent(self, phi)
+      class(brake_integrator), intent(inout) :: self
+      real(wp), intent(in) :: phi(4, 4)
+
+      self%phi = phi
+      self%lost = 0
+      ! The stepper's copies of the state are stale: start it again here (in
+      ! stick harmless: a slip restarts it anyway), at the step it had reached.
+      call self%locator%restart(self%t, pack_tangent(self%y, self%phi), 0.0_wp)
+   end subroutine reset_tangent
 
 end module friction_brake_integrator
