@@ -23,7 +23,7 @@ module friction_analysis_lyapunov_spectrum
    private
 
    public :: tangent_system, tangent_settings, spectrum_accumulator, tangent_spectrum, kaplan_yorke
-   public :: orthonormalise, pack_tangent, unpack_tangent
+   public :: orthonormalise, pack_tangent, unpack_tangent, generic_frame
 
    !> The orbit and its tangent matrix as one system (events: those of the base).
    type, extends(event_system) :: tangent_system
@@ -207,6 +207,25 @@ contains
       end do
    end subroutine orthonormalise
 
+   !> A fixed orthonormal frame in general position (the QR of I + the Hilbert
+   !> matrix) to start the tangent vectors from: no vector along a coordinate
+   !> axis, so a direction a nonsmooth flow maps to zero (the brake's velocity
+   !> in stick) is not one of the first n - lost and shows up in the last column.
+   pure function generic_frame(n) result(q)
+      integer, intent(in) :: n
+      real(wp) :: q(n, n)
+      real(wp) :: r(n)
+      integer :: i, j
+
+      do j = 1, n
+         do i = 1, n
+            q(i, j) = 1.0_wp / real(i + j - 1, wp)
+         end do
+         q(j, j) = q(j, j) + 1.0_wp
+      end do
+      call orthonormalise(q, r, 0)
+   end function generic_frame
+
    pure subroutine accumulator_start(self, n, capacity)
       class(spectrum_accumulator), intent(inout) :: self
       integer, intent(in) :: n, capacity
@@ -293,7 +312,7 @@ contains
    end function kaplan_yorke
 
    !> The spectrum of a smooth system from y0 at t0: the orbit alone over the
-   !> transient, then orbit and tangent from Φ = I.
+   !> transient, then orbit and tangent from the generic frame.
    subroutine tangent_spectrum(system, solver, y0, t0, settings, result, error)
       class(ode_system), intent(in) :: system
       type(solver_settings), intent(in) :: solver
@@ -304,7 +323,7 @@ contains
       type(tangent_system), target :: extended
       type(ode_solver) :: orbit, tangent
       real(wp) :: t, y(size(y0)), phi(size(y0), size(y0)), z(size(y0) * (size(y0) + 1)), h
-      integer :: n, i, k, intervals
+      integer :: n, k, intervals
 
       if (.not. (settings%renormalise > 0.0_wp .and. settings%duration >= settings%renormalise &
          & .and. settings%transient >= 0.0_wp)) then
@@ -325,10 +344,7 @@ contains
          call orbit%destroy()
          if (allocated(error)) return
       end if
-      phi = 0.0_wp
-      do i = 1, n
-         phi(i, i) = 1.0_wp
-      end do
+      phi = generic_frame(n)
       call tangent%init(extended, solver, h, error)
       if (allocated(error)) return
       intervals = nint(settings%duration / settings%renormalise)

@@ -14,7 +14,8 @@ module friction_brake_diagnostics
    use friction_analysis_spectrum, only: spectrum_settings, spectrum_result, amplitude_spectrum
    use friction_analysis_poincare, only: stroboscopic_map, upward_section
    use friction_analysis_lyapunov_flow, only: benettin_settings, benettin_accumulator
-   use friction_analysis_lyapunov_spectrum, only: tangent_settings, spectrum_accumulator, kaplan_yorke
+   use friction_analysis_lyapunov_spectrum, only: tangent_settings, spectrum_accumulator, kaplan_yorke, &
+      & generic_frame
    use friction_analysis_lyapunov_series, only: rosenstein_settings, rosenstein_result, rosenstein_exponent
    implicit none
    private
@@ -220,7 +221,7 @@ contains
       class(brake_integrator), allocatable, target :: run
       type(brake_event_table) :: events
       real(wp) :: phi(4, 4), t0
-      integer :: k, intervals, i
+      integer :: k, intervals
 
       if (.not. (settings%renormalise > 0.0_wp .and. settings%duration >= settings%renormalise &
          & .and. settings%transient >= 0.0_wp)) then
@@ -232,10 +233,7 @@ contains
       run%tangent = .true.
       call run%start(config, config%t_start, initial_state(config), events, error)
       if (allocated(error)) return
-      phi = 0.0_wp
-      do i = 1, 4
-         phi(i, i) = 1.0_wp
-      end do
+      phi = generic_frame(4)
       t0 = config%t_start + settings%transient
       ! The transient in renormalisation intervals too, so that Φ stays bounded.
       do while (run%t < t0)
