@@ -25,6 +25,9 @@ module friction_analysis_lyapunov_spectrum
    public :: tangent_system, tangent_settings, spectrum_accumulator, tangent_spectrum, kaplan_yorke
    public :: orthonormalise, pack_tangent, unpack_tangent, generic_frame
 
+   !> Largest base system: n + n² must fit the GSL bridge's 20 (ode/solver.f90).
+   integer, parameter :: max_base = 4
+
    !> The orbit and its tangent matrix as one system (events: those of the base).
    type, extends(event_system) :: tangent_system
       class(ode_system), allocatable :: base
@@ -67,20 +70,29 @@ contains
       n = n + n * n
    end function tangent_dimension
 
-   !> (f(y), J(y) Φ).
+   !> (f(y), J(y) Φ), Φ by columns (no temporaries: this is the hot loop).
    pure subroutine tangent_rhs(self, t, y, dydt)
       class(tangent_system), intent(in) :: self
       real(wp), intent(in) :: t
       real(wp), intent(in) :: y(:)
       real(wp), intent(out) :: dydt(:)
-      real(wp), allocatable :: dfdy(:, :), dfdt(:)
-      integer :: n
+      real(wp) :: dfdy(max_base, max_base), dfdt(max_base)
+      integer :: n, i, j, k, c
 
       n = self%base%dimension()
-      allocate (dfdy(n, n), dfdt(n))
       call self%base%rhs(t, y(1:n), dydt(1:n))
-      call self%base%jacobian(t, y(1:n), dfdy, dfdt)
-      dydt(n + 1:n + n * n) = reshape(matmul(dfdy, reshape(y(n + 1:n + n * n), [n, n])), [n * n])
+      call self%base%jacobian(t, y(1:n), dfdy(1:n, 1:n), dfdt(1:n))
+      do j = 1, n
+         c = n + (j - 1) * n
+         do i = 1, n
+            dydt(c + i) = 0.0_wp
+         end do
+         do k = 1, n
+            do i = 1, n
+               dydt(c + i) = dydt(c + i) + dfdy(i, k) * y(c + k)
+            end do
+         end do
+      end do
    end subroutine tangent_rhs
 
    !> Jacobian of (f, J Φ) for the implicit steppers: J on the diagonal
