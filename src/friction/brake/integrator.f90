@@ -9,7 +9,7 @@ module friction_brake_integrator
    use friction_ode_events, only: event_locator
    use friction_brake_config, only: brake_config
    use friction_brake_record, only: brake_event_table
-   use friction_analysis_lyapunov_spectrum, only: pack_tangent
+   use friction_analysis_lyapunov_spectrum, only: pack_tangent, unpack_tangent
    implicit none
    private
 
@@ -34,6 +34,9 @@ module friction_brake_integrator
       procedure(sticking_interface), deferred :: is_sticking
       procedure :: statistics
       procedure :: reset_tangent
+      procedure :: start_tangent
+      procedure :: locator_advance
+      procedure :: locator_restart
    end type brake_integrator
 
    abstract interface
@@ -70,6 +73,46 @@ contains
       stats = self%locator%statistics()
    end function statistics
 
+   !> Φ = I at the start of a run with the tangent.
+   subroutine start_tangent(self)
+      class(brake_integrator), intent(inout) :: self
+      integer :: i
+
+      self%phi = 0.0_wp
+      do i = 1, 4
+         self%phi(i, i) = 1.0_wp
+      end do
+      self%lost = 0
+   end subroutine start_tangent
+
+   !> The locator's advance of (t, y), with Φ beside y when the tangent is on.
+   subroutine locator_advance(self, t_target, error)
+      class(brake_integrator), intent(inout) :: self
+      real(wp), intent(in) :: t_target
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: z(20)
+
+      if (self%tangent) then
+         z = pack_tangent(self%y, self%phi)
+         call self%locator%advance(self%t, t_target, z, error)
+         call unpack_tangent(z, self%y, self%phi)
+      else
+         call self%locator%advance(self%t, t_target, self%y, error)
+      end if
+   end subroutine locator_advance
+
+   !> The locator's restart at (t, y), with Φ when the tangent is on.
+   subroutine locator_restart(self, h_start)
+      class(brake_integrator), intent(inout) :: self
+      real(wp), intent(in) :: h_start
+
+      if (self%tangent) then
+         call self%locator%restart(self%t, pack_tangent(self%y, self%phi), h_start)
+      else
+         call self%locator%restart(self%t, self%y, h_start)
+      end if
+   end subroutine locator_restart
+
    !> Replace the tangent matrix (after a QR step) and forget lost directions.
    subroutine reset_tangent(self, phi)
       class(brake_integrator), intent(inout) :: self
@@ -79,7 +122,7 @@ contains
       self%lost = 0
       ! The stepper's copies of the state are stale: start it again here (in
       ! stick harmless: a slip restarts it anyway), at the step it had reached.
-      call self%locator%restart(self%t, pack_tangent(self%y, self%phi), 0.0_wp)
+      call self%locator_restart(0.0_wp)
    end subroutine reset_tangent
 
 end module friction_brake_integrator

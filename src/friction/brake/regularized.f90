@@ -23,7 +23,7 @@ module friction_brake_regularized
    use friction_brake_config, only: brake_config
    use friction_brake_integrator, only: brake_integrator
    use friction_brake_record, only: brake_event_table, event_stick_to_slip, event_slip_to_stick
-   use friction_analysis_lyapunov_spectrum, only: tangent_system, pack_tangent, unpack_tangent
+   use friction_analysis_lyapunov_spectrum, only: tangent_system
    implicit none
    private
 
@@ -197,14 +197,8 @@ contains
       if (allocated(error)) return
       self%t = t0
       self%y = y0
-      if (self%tangent) then
-         self%phi = reshape([1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 1.0_wp, 0.0_wp, 0.0_wp, &
-            & 0.0_wp, 0.0_wp, 1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 1.0_wp], [4, 4])
-         self%lost = 0
-         call self%locator%restart(t0, pack_tangent(y0, self%phi), h_start)
-      else
-         call self%locator%restart(t0, y0, h_start)
-      end if
+      if (self%tangent) call self%start_tangent()
+      call self%locator_restart(h_start)
       call events%clear()
    end subroutine integrator_init
 
@@ -217,16 +211,7 @@ contains
       integer :: i
 
       do while (self%t < t_target)
-         if (self%tangent) then
-            block
-               real(wp) :: z(20)
-               z = pack_tangent(self%y, self%phi)
-               call self%locator%advance(self%t, t_target, z, error)
-               call unpack_tangent(z, self%y, self%phi)
-            end block
-         else
-            call self%locator%advance(self%t, t_target, self%y, error)
-         end if
+         call self%locator_advance(t_target, error)
          if (allocated(error)) then
             error%message = error%message//' (regularized model'
             if (.not. is_implicit_step_type(self%method)) error%message = error%message &

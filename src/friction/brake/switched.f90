@@ -26,7 +26,7 @@ module friction_brake_switched
    use friction_brake_config, only: brake_config
    use friction_brake_integrator, only: brake_integrator
    use friction_brake_stick, only: stick_motion, stick_end_lift_off, stick_end_force_positive, stick_tangent
-   use friction_analysis_lyapunov_spectrum, only: tangent_system, pack_tangent, unpack_tangent
+   use friction_analysis_lyapunov_spectrum, only: tangent_system
    use friction_brake_record, only: brake_event_table, event_stick_to_slip, event_slip_to_stick, &
       & event_slip_reversal
    implicit none
@@ -176,9 +176,7 @@ contains
          allocate (self%slip_tangent%base, source=self%slip)
          call self%locator%init(self%slip_tangent, settings, [event_falling, event_falling], [.true., .true.], &
             & event_tolerance, self%h_start, error, time_name='τ', time_unit='')
-         self%phi = reshape([1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 1.0_wp, 0.0_wp, 0.0_wp, &
-            & 0.0_wp, 0.0_wp, 1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 1.0_wp], [4, 4])
-         self%lost = 0
+         call self%start_tangent()
       else
          call self%locator%init(self%slip, settings, [event_falling, event_falling], [.true., .true.], &
             & event_tolerance, self%h_start, error, time_name='τ', time_unit='')
@@ -234,16 +232,7 @@ contains
             call start_slip(self, -1.0_wp)
             call events%add(self%t, event_stick_to_slip, self%y)
          else
-            if (self%tangent) then
-               block
-                  real(wp) :: z(20)
-                  z = pack_tangent(self%y, self%phi)
-                  call self%locator%advance(self%t, t_target, z, error)
-                  call unpack_tangent(z, self%y, self%phi)
-               end block
-            else
-               call self%locator%advance(self%t, t_target, self%y, error)
-            end if
+            call self%locator_advance(t_target, error)
             if (allocated(error)) then
                error%message = error%message//' (switched model, in slip)'
                return
@@ -299,10 +288,8 @@ contains
          type is (brake_slip)
             b%direction = s
          end select
-         call self%locator%restart(self%t, pack_tangent(self%y, self%phi), h_start)
-      else
-         call self%locator%restart(self%t, self%y, h_start)
       end if
+      call self%locator_restart(h_start)
    end subroutine start_slip_in
 
    !> The right-hand side of slip in direction s at the current state.
