@@ -81,7 +81,8 @@ DEFAULT_BINARY = ROOT / "build" / "friction"
 # law without the chaos diagnostics.
 COMMON = ("&scan ny = 1, retrace = .false. /\n"
           "&brake model = 'regularized' /\n"
-          "&analysis spectrum = .false., poincare = .false., lyapunov = .false., rosenstein = .false. /\n"
+          "&analysis spectrum = .false., poincare = .false., lyapunov = .false., rosenstein = .false.,"
+          " lyapunov_spectrum = .false. /\n"
           "&verify check = .false. /\n")
 
 

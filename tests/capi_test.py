@@ -36,7 +36,8 @@ NAF = ("naf.nml", "&scan nx = 16, ny = 3, angle = 10.0, origin_x = 0.7, origin_y
 HOPG_QUASISTATIC = ("hopg.nml", "&tip model = 'quasistatic' /\n&scan nx = 24, ny = 2, width = 1.0 /\n")
 GRAPHITE = ("graphite.nml", "&scan nx = 4, ny = 2, length = 1.0, width = 0.5 /\n")
 BRAKE = ("brake.nml", "&brake t_end = 40.0, dt_out = 0.5 /\n"
-         "&analysis spectrum = .false., poincare = .false., lyapunov = .false., rosenstein = .false. /\n")
+         "&analysis spectrum = .false., poincare = .false., lyapunov = .false., rosenstein = .false.,"
+         " lyapunov_spectrum = .false. /\n")
 # Attributes that measure the run rather than compute it.
 
 

@@ -113,11 +113,12 @@ DOCUMENTED = ["fx", "fy", "f_along", "f_across", "tip_x", "tip_y"]
 # The brake scene (inputs/brake.nml) on a short span for the tests.
 # (The chaos diagnostics of inputs/brake.nml are off here: the brake-analysis case tests them.)
 BRAKE_SHORT = ("&brake t_end = 100.0, dt_out = 0.1 /\n"
-               "&analysis spectrum = .false., poincare = .false., lyapunov = .false., rosenstein = .false. /\n")
+               "&analysis spectrum = .false., poincare = .false., lyapunov = .false., rosenstein = .false.,"
+               " lyapunov_spectrum = .false. /\n")
 # The chaos diagnostics on a short span (brake-analysis).
 BRAKE_ANALYSIS = ("&brake t_end = 400.0, dt_out = 0.1 /\n"
                   "&analysis window_start = 50.0, window_end = 400.0, lyapunov_transient = 50.0,"
-                  " rosenstein_stride = 2 /\n")
+                  " lyapunov_spectrum_transient = 50.0, rosenstein_stride = 2 /\n")
 
 # Bad brake input: (override text on inputs/brake.nml, exit code, words of the message).
 BAD_BRAKE_INPUTS = {
@@ -152,6 +153,20 @@ BAD_BRAKE_INPUTS = {
                                  ["bad.nml:1", "&analysis", "window_end", "after window_start"]),
     "analysis-zero-renormalise": ("&analysis lyapunov_renormalise = 0.0 /\n", 3,
                                   ["bad.nml:1", "&analysis", "lyapunov_renormalise", "> 0"]),
+    "analysis-spectrum-not-logical": ("&analysis lyapunov_spectrum = 3.5 /\n", 3,
+                                      ["bad.nml:1", "&analysis", "lyapunov_spectrum", "logical"]),
+    "analysis-spectrum-negative-transient": ("&analysis lyapunov_spectrum_transient = -1.0 /\n", 3,
+                                             ["bad.nml:1", "&analysis", "lyapunov_spectrum_transient", ">= 0"]),
+    "analysis-spectrum-transient-past-end": ("&analysis lyapunov_spectrum = .true.,\n"
+                                             " lyapunov_spectrum_transient = 5000.0 /\n", 3,
+                                             ["bad.nml:2", "&analysis", "lyapunov_spectrum_transient", "t_end"]),
+    "analysis-spectrum-negative-duration": ("&analysis lyapunov_spectrum_duration = -5.0 /\n", 3,
+                                            ["bad.nml:1", "&analysis", "lyapunov_spectrum_duration", ">= 0"]),
+    "analysis-spectrum-short-duration": ("&analysis lyapunov_spectrum_duration = 0.5 /\n", 3,
+                                         ["bad.nml:1", "&analysis", "lyapunov_spectrum_duration",
+                                          "lyapunov_spectrum_renormalise"]),
+    "analysis-spectrum-zero-renormalise": ("&analysis lyapunov_spectrum_renormalise = 0.0 /\n", 3,
+                                           ["bad.nml:1", "&analysis", "lyapunov_spectrum_renormalise", "> 0"]),
 }
 
 
@@ -914,6 +929,36 @@ def case_brake_analysis(args):
             fail("log2-per-sample conversion")
         if f["brake/lyapunov/rosenstein_divergence"].size != 151:
             fail("divergence curve length")
+        # The whole spectrum (inputs/brake.nml switches it on): 4 exponents,
+        # largest first, the last -inf (the velocity forgotten in stick), one
+        # running estimate per interval over 400 - 50 tau.
+        exponents = f["brake/lyapunov/exponents"][()]
+        history = f["brake/lyapunov/exponents_history"][()]
+        if exponents.size != 4 or not np.all(np.diff(exponents[:3]) <= 0) or exponents[3] != -np.inf:
+            fail(f"exponents {exponents}")
+        if history.shape != (350, 4) or f["brake/lyapunov/exponents_time"].size != 350:
+            fail(f"exponents_history shape {history.shape}")
+        if sorted(history[-1]) != sorted(exponents):
+            fail("the last running estimate is not the spectrum")
+        if lyap["spectrum_renormalise"] != 1.0 or lyap["spectrum_transient_units"] != b"tau" \
+                or lyap["spectrum_lost_directions"] != 1 or "kaplan_yorke_dimension" not in lyap:
+            fail("spectrum settings not recorded")
+        if f["brake/lyapunov/exponents"].attrs["units"] != b"1/tau":
+            fail("exponents units")
+    # With the spectrum off the file is the same apart from the spectrum's
+    # objects and the echo of the input.
+    off = write(args, "off.nml", "&analysis lyapunov_spectrum = .false. /\n")
+    friction(args, "-o", "off.h5", brake, short, off)
+    without = comparable(os.path.join(args.workdir, "off.h5"))
+    spectrum_keys = {k for k in a if k.startswith("brake/lyapunov/exponents")
+                     or k.startswith("brake/lyapunov@spectrum_") or k.startswith("brake/lyapunov@kaplan_yorke")}
+    if set(a) - spectrum_keys != set(without):
+        fail(f"objects differ with the spectrum off: {sorted(set(a) ^ set(without))}")
+    for key, value in without.items():
+        if key.endswith("compute_time") or key == "@input":
+            continue
+        if not np.array_equal(np.asarray(value), np.asarray(a[key])):
+            fail(f"{key} differs with the spectrum off")
 
 
 def case_brake_dimensional(args):

@@ -9,7 +9,7 @@ module test_systems
    use friction_ode_events, only: event_system
    implicit none
    private
-   public :: lorenz, oscillator, decay, step_types_with_cases
+   public :: lorenz, oscillator, decay, hopf, step_types_with_cases
 
    !> The GSL step types that test_steppers.pf and test_events.pf have cases
    !> for, one each (and so one CTest test each).  Their guard cases require
@@ -27,6 +27,17 @@ module test_systems
       procedure :: rhs => lorenz_rhs
       procedure :: jacobian => lorenz_jacobian
    end type lorenz
+
+   !> Hopf normal form x' = a x - ω y - x r², y' = ω x + a y - y r²: the
+   !> limit cycle r = √a of period 2π/ω with exponents exactly 0 (along the
+   !> orbit) and -2a (radial: r' = a r - r³ has slope a - 3a there).
+   type, extends(ode_system) :: hopf
+      real(wp) :: a = 1.0_wp, omega = 6.283185307179586_wp
+   contains
+      procedure :: dimension => hopf_dimension
+      procedure :: rhs => hopf_rhs
+      procedure :: jacobian => hopf_jacobian
+   end type hopf
 
    !> x'' = -ω² x: every orbit periodic, exponent 0.  Event function: x'
    !> (upward zero at the minimum of x), for a located section.
@@ -129,5 +140,32 @@ contains
       dfdy(1, 1) = -self%rate
       dfdt = 0.0_wp
    end subroutine decay_jacobian
+
+   pure function hopf_dimension(self) result(n)
+      class(hopf), intent(in) :: self
+      integer :: n
+      n = 2
+   end function hopf_dimension
+
+   pure subroutine hopf_rhs(self, t, y, dydt)
+      class(hopf), intent(in) :: self
+      real(wp), intent(in) :: t, y(:)
+      real(wp), intent(out) :: dydt(:)
+      real(wp) :: r2
+      r2 = y(1)**2 + y(2)**2
+      dydt(1) = self%a * y(1) - self%omega * y(2) - y(1) * r2
+      dydt(2) = self%omega * y(1) + self%a * y(2) - y(2) * r2
+   end subroutine hopf_rhs
+
+   pure subroutine hopf_jacobian(self, t, y, dfdy, dfdt)
+      class(hopf), intent(in) :: self
+      real(wp), intent(in) :: t, y(:)
+      real(wp), intent(out) :: dfdy(:, :), dfdt(:)
+      real(wp) :: r2
+      r2 = y(1)**2 + y(2)**2
+      dfdy(1, :) = [self%a - r2 - 2.0_wp * y(1)**2, -self%omega - 2.0_wp * y(1) * y(2)]
+      dfdy(2, :) = [self%omega - 2.0_wp * y(1) * y(2), self%a - r2 - 2.0_wp * y(2)**2]
+      dfdt = 0.0_wp
+   end subroutine hopf_jacobian
 
 end module test_systems

@@ -34,6 +34,11 @@ module friction_analysis_settings
       real(wp) :: lyapunov_duration = 0.0_wp       !! 0: to the end of the run
       real(wp) :: lyapunov_renormalise = 1.0_wp
       real(wp) :: lyapunov_d0 = 1.0e-8_wp
+      ! The whole spectrum from the tangent equations (QR)
+      logical :: lyapunov_spectrum = .false.
+      real(wp) :: lyapunov_spectrum_transient = 100.0_wp    !! from the start of the run
+      real(wp) :: lyapunov_spectrum_duration = 0.0_wp       !! 0: to the end of the run
+      real(wp) :: lyapunov_spectrum_renormalise = 1.0_wp    !! between QR factorisations
       ! ... and from the series (Rosenstein); lengths in samples of the strided series
       logical :: rosenstein = .false.
       integer :: rosenstein_stride = 4
@@ -73,6 +78,10 @@ contains
       call v%item('lyapunov_duration', self%lyapunov_duration, time_unit)
       call v%item('lyapunov_renormalise', self%lyapunov_renormalise, time_unit)
       call v%item('lyapunov_d0', self%lyapunov_d0)
+      call v%item('lyapunov_spectrum', self%lyapunov_spectrum)
+      call v%item('lyapunov_spectrum_transient', self%lyapunov_spectrum_transient, time_unit)
+      call v%item('lyapunov_spectrum_duration', self%lyapunov_spectrum_duration, time_unit)
+      call v%item('lyapunov_spectrum_renormalise', self%lyapunov_spectrum_renormalise, time_unit)
       call v%item('rosenstein', self%rosenstein)
       call v%item('rosenstein_stride', self%rosenstein_stride, 'samples')
       call v%item('rosenstein_dimension', self%rosenstein_dimension)
@@ -114,6 +123,19 @@ contains
          & .not. (t_end - t_start - self%lyapunov_transient >= self%lyapunov_renormalise)) &
          & call c%reject('analysis', 'lyapunov_transient', rtoa(self%lyapunov_transient), &
          & 'leaves less than one renormalisation interval before t_end')
+      call c%nonnegative('analysis', 'lyapunov_spectrum_transient', self%lyapunov_spectrum_transient, 'τ')
+      call c%nonnegative('analysis', 'lyapunov_spectrum_duration', self%lyapunov_spectrum_duration, &
+         & 'τ; 0 for the rest of the run')
+      call c%positive('analysis', 'lyapunov_spectrum_renormalise', self%lyapunov_spectrum_renormalise, 'τ')
+      if (self%lyapunov_spectrum .and. self%lyapunov_spectrum_duration == 0.0_wp .and. &
+         & .not. (t_end - t_start - self%lyapunov_spectrum_transient >= self%lyapunov_spectrum_renormalise)) &
+         & call c%reject('analysis', 'lyapunov_spectrum_transient', rtoa(self%lyapunov_spectrum_transient), &
+         & 'leaves less than one renormalisation interval before t_end')
+      if (self%lyapunov_spectrum .and. self%lyapunov_spectrum_duration > 0.0_wp .and. &
+         & self%lyapunov_spectrum_duration < self%lyapunov_spectrum_renormalise) &
+         & call c%reject('analysis', 'lyapunov_spectrum_duration', rtoa(self%lyapunov_spectrum_duration), &
+         & 'shorter than one renormalisation interval, lyapunov_spectrum_renormalise = ' &
+         & //rtoa(self%lyapunov_spectrum_renormalise))
       if (self%rosenstein_stride < 1) call c%reject('analysis', 'rosenstein_stride', &
          & itoa(self%rosenstein_stride), 'must be >= 1')
       if (self%rosenstein_dimension < 1) call c%reject('analysis', 'rosenstein_dimension', &

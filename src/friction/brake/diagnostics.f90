@@ -14,11 +14,13 @@ module friction_brake_diagnostics
    use friction_analysis_spectrum, only: spectrum_settings, spectrum_result, amplitude_spectrum
    use friction_analysis_poincare, only: stroboscopic_map, upward_section
    use friction_analysis_lyapunov_flow, only: benettin_settings, benettin_accumulator
+   use friction_analysis_lyapunov_spectrum, only: tangent_settings, spectrum_accumulator, kaplan_yorke, &
+      & generic_frame
    use friction_analysis_lyapunov_series, only: rosenstein_settings, rosenstein_result, rosenstein_exponent
    implicit none
    private
 
-   public :: brake_diagnostics, diagnose_brake, brake_benettin, series_names
+   public :: brake_diagnostics, diagnose_brake, brake_benettin, brake_lyapunov_spectrum, series_names
 
 
    type :: brake_diagnostics
@@ -29,6 +31,10 @@ module friction_brake_diagnostics
       real(wp), allocatable :: section_t(:), section_points(:, :)   !! (4, n)
       type(benettin_settings) :: benettin
       type(benettin_accumulator) :: flow
+      type(tangent_settings) :: tangent
+      type(spectrum_accumulator) :: qr                !! the whole spectrum (tangent equations, QR)
+      real(wp), allocatable :: exponents(:)          !! largest first; -inf for directions lost in stick
+      real(wp) :: kaplan_yorke = 0.0_wp
       type(rosenstein_result) :: series
       real(wp) :: series_dt = 0.0_wp   !! sample spacing of the strided series
    end type brake_diagnostics
@@ -115,6 +121,17 @@ contains
             call brake_benettin(config, result%benettin, result%flow, error)
             if (allocated(error)) return
          end if
+         if (a%lyapunov_spectrum) then
+            result%tangent%transient = a%lyapunov_spectrum_transient
+            result%tangent%duration = a%lyapunov_spectrum_duration
+            if (result%tangent%duration == 0.0_wp) &
+               & result%tangent%duration = config%t_end - config%t_start - a%lyapunov_spectrum_transient
+            result%tangent%renormalise = a%lyapunov_spectrum_renormalise
+            call brake_lyapunov_spectrum(config, result%tangent, result%qr, error)
+            if (allocated(error)) return
+            result%exponents = result%qr%exponents()
+            result%kaplan_yorke = kaplan_yorke(result%exponents)
+         end if
          if (a%rosenstein) then
             result%series_dt = config%dt_out * a%rosenstein_stride
             call rosenstein_exponent(window_series(1::a%rosenstein_stride), result%series_dt, &
@@ -191,5 +208,51 @@ contains
       end subroutine advance
 
    end subroutine brake_benettin
+
+   !> The whole spectrum of the brake: one run of either model with its
+   !> tangent matrix (the switched model applies the saltation matrices at
+   !> its events and the stick flow, which forgets the block's velocity);
+   !> after the transient, a QR step every renormalisation interval.
+   subroutine brake_lyapunov_spectrum(config, settings, result, error)
+      type(brake_config), intent(in) :: config
+      type(tangent_settings), intent(in) :: settings
+      type(spectrum_accumulator), intent(out) :: result
+      type(error_type), allocatable, intent(out) :: error
+      class(brake_integrator), allocatable, target :: run
+      type(brake_event_table) :: events
+      real(wp) :: phi(4, 4), t0
+      integer :: k, intervals
+
+      if (.not. (settings%renormalise > 0.0_wp .and. settings%duration >= settings%renormalise &
+         & .and. settings%transient >= 0.0_wp)) then
+         call fatal_error(error, '&analysis: the Lyapunov spectrum needs lyapunov_spectrum_renormalise > 0, ' &
+            & //'a duration of at least one interval after lyapunov_spectrum_transient', error_input)
+         return
+      end if
+      call new_brake_integrator(config%model, run)
+      run%tangent = .true.
+      call run%start(config, config%t_start, initial_state(config), events, error)
+      if (allocated(error)) return
+      phi = generic_frame(4)
+      t0 = config%t_start + settings%transient
+      ! The transient in renormalisation intervals too, so that Φ stays bounded.
+      do while (run%t < t0)
+         call run%advance_to(min(run%t + settings%renormalise, t0), events, error)
+         if (allocated(error)) return
+         call events%clear()
+         call run%reset_tangent(phi)
+      end do
+      intervals = int(settings%duration / settings%renormalise + 1.0e-9_wp)
+      call result%start(4, intervals)
+      do k = 1, intervals
+         call run%advance_to(t0 + k * settings%renormalise, events, error)
+         if (allocated(error)) return
+         ! Long runs: keep the event table from growing without bound.
+         call events%clear()
+         phi = run%phi
+         call result%renormalise(phi, settings%renormalise, run%lost)
+         call run%reset_tangent(phi)
+      end do
+   end subroutine brake_lyapunov_spectrum
 
 end module friction_brake_diagnostics

@@ -9,6 +9,7 @@ module friction_brake_integrator
    use friction_ode_events, only: event_locator
    use friction_brake_config, only: brake_config
    use friction_brake_record, only: brake_event_table
+   use friction_analysis_lyapunov_spectrum, only: pack_tangent, unpack_tangent
    implicit none
    private
 
@@ -19,6 +20,11 @@ module friction_brake_integrator
       real(wp) :: y(4) = 0.0_wp             !! state there: x, x', y, y'
       real(wp) :: stick_time = -1.0_wp      !! time spent in stick, when the model tracks it exactly; else < 0
       type(event_locator) :: locator
+      !> Set before start: integrate the tangent matrix phi beside the state
+      !> (the Lyapunov spectrum, docs/physics.md); phi = I at the start.
+      logical :: tangent = .false.
+      real(wp) :: phi(4, 4) = 0.0_wp
+      integer :: lost = 0                   !! directions mapped to 0 (stick) since reset_tangent
    contains
       !> Start at (t0, y0) with the settings of `config`; the event table is cleared.
       procedure(start_interface), deferred :: start
@@ -27,6 +33,10 @@ module friction_brake_integrator
       !> Whether the block sticks to the belt now.
       procedure(sticking_interface), deferred :: is_sticking
       procedure :: statistics
+      procedure :: reset_tangent
+      procedure :: start_tangent
+      procedure :: locator_advance
+      procedure :: locator_restart
    end type brake_integrator
 
    abstract interface
@@ -62,5 +72,57 @@ contains
 
       stats = self%locator%statistics()
    end function statistics
+
+   !> Φ = I at the start of a run with the tangent.
+   subroutine start_tangent(self)
+      class(brake_integrator), intent(inout) :: self
+      integer :: i
+
+      self%phi = 0.0_wp
+      do i = 1, 4
+         self%phi(i, i) = 1.0_wp
+      end do
+      self%lost = 0
+   end subroutine start_tangent
+
+   !> The locator's advance of (t, y), with Φ beside y when the tangent is on.
+   subroutine locator_advance(self, t_target, error)
+      class(brake_integrator), intent(inout) :: self
+      real(wp), intent(in) :: t_target
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: z(20)
+
+      if (self%tangent) then
+         z = pack_tangent(self%y, self%phi)
+         call self%locator%advance(self%t, t_target, z, error)
+         call unpack_tangent(z, self%y, self%phi)
+      else
+         call self%locator%advance(self%t, t_target, self%y, error)
+      end if
+   end subroutine locator_advance
+
+   !> The locator's restart at (t, y), with Φ when the tangent is on.
+   subroutine locator_restart(self, h_start)
+      class(brake_integrator), intent(inout) :: self
+      real(wp), intent(in) :: h_start
+
+      if (self%tangent) then
+         call self%locator%restart(self%t, pack_tangent(self%y, self%phi), h_start)
+      else
+         call self%locator%restart(self%t, self%y, h_start)
+      end if
+   end subroutine locator_restart
+
+   !> Replace the tangent matrix (after a QR step) and forget lost directions.
+   subroutine reset_tangent(self, phi)
+      class(brake_integrator), intent(inout) :: self
+      real(wp), intent(in) :: phi(4, 4)
+
+      self%phi = phi
+      self%lost = 0
+      ! The stepper's copies of the state are stale: start it again here (in
+      ! stick harmless: a slip restarts it anyway), at the step it had reached.
+      call self%locator_restart(0.0_wp)
+   end subroutine reset_tangent
 
 end module friction_brake_integrator

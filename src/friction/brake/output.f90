@@ -204,7 +204,17 @@ contains
                call file%write_vector('/brake/poincare/section_'//names(k), d%section_points(k, :), trim(units(k)))
             end do
          end if
-         if (a%lyapunov .or. a%rosenstein) call file%create_group('/brake/lyapunov')
+         if (a%lyapunov .or. a%rosenstein .or. a%lyapunov_spectrum) call file%create_group('/brake/lyapunov')
+         if (a%lyapunov_spectrum) then
+            call file%write_vector('/brake/lyapunov/exponents', d%exponents, '1/tau')
+            call file%write_vector('/brake/lyapunov/exponents_time', d%qr%time(1:d%qr%count), 'tau')
+            call file%write_matrix('/brake/lyapunov/exponents_history', d%qr%history(:, 1:d%qr%count), '1/tau')
+            call file%write_attribute_real('/brake/lyapunov', 'kaplan_yorke_dimension', d%kaplan_yorke, '1')
+            call file%write_attribute_integer('/brake/lyapunov', 'spectrum_lost_directions', int(d%qr%lost, i8))
+            call file%write_attribute_real('/brake/lyapunov', 'spectrum_transient', d%tangent%transient, 'tau')
+            call file%write_attribute_real('/brake/lyapunov', 'spectrum_duration', d%tangent%duration, 'tau')
+            call file%write_attribute_real('/brake/lyapunov', 'spectrum_renormalise', d%tangent%renormalise, 'tau')
+         end if
          if (a%lyapunov) then
             call file%write_attribute_real('/brake/lyapunov', 'benettin_exponent', d%flow%current(), '1/tau')
             call file%write_attribute_real('/brake/lyapunov', 'benettin_transient', d%benettin%transient, 'tau')

@@ -23,6 +23,7 @@ module friction_brake_regularized
    use friction_brake_config, only: brake_config
    use friction_brake_integrator, only: brake_integrator
    use friction_brake_record, only: brake_event_table, event_stick_to_slip, event_slip_to_stick
+   use friction_analysis_lyapunov_spectrum, only: tangent_system
    implicit none
    private
 
@@ -44,6 +45,7 @@ module friction_brake_regularized
    !> when |v_rel| enters and leaves the creep band as events.
    type, extends(brake_integrator) :: regularized_integrator
       type(brake_regularized), allocatable :: system
+      type(tangent_system), allocatable :: extended   !! with its tangent (when tangent)
       character(len=16) :: method = ''
    contains
       procedure :: init => integrator_init
@@ -182,12 +184,21 @@ contains
       h_start = settings%h_start
       if (.not. (h_start > 0.0_wp)) h_start = min(1.0e-3_wp, &
          & 0.1_wp / max(1.0_wp, abs(regularized_friction_slope(p, p%normal_force(y0(3)), 0.0_wp))))
-      call self%locator%init(self%system, settings, [event_falling, event_either, event_either], &
-         & [.true., .false., .false.], event_tolerance, h_start, error, time_name='τ', time_unit='')
+      if (self%tangent) then
+         if (allocated(self%extended)) deallocate (self%extended)
+         allocate (self%extended)
+         allocate (self%extended%base, source=self%system)
+         call self%locator%init(self%extended, settings, [event_falling, event_either, event_either], &
+            & [.true., .false., .false.], event_tolerance, h_start, error, time_name='τ', time_unit='')
+      else
+         call self%locator%init(self%system, settings, [event_falling, event_either, event_either], &
+            & [.true., .false., .false.], event_tolerance, h_start, error, time_name='τ', time_unit='')
+      end if
       if (allocated(error)) return
       self%t = t0
       self%y = y0
-      call self%locator%restart(t0, y0, h_start)
+      if (self%tangent) call self%start_tangent()
+      call self%locator_restart(h_start)
       call events%clear()
    end subroutine integrator_init
 
@@ -200,7 +211,7 @@ contains
       integer :: i
 
       do while (self%t < t_target)
-         call self%locator%advance(self%t, t_target, self%y, error)
+         call self%locator_advance(t_target, error)
          if (allocated(error)) then
             error%message = error%message//' (regularized model'
             if (.not. is_implicit_step_type(self%method)) error%message = error%message &

@@ -174,7 +174,7 @@ contains
          ! Benettin, of the settings): every rank computes the same numbers, so
          ! the file does not depend on the number of ranks.
          associate (a => settings%analysis)
-            self%analysing = a%spectrum .or. a%poincare .or. a%lyapunov .or. a%rosenstein
+            self%analysing = a%spectrum .or. a%poincare .or. a%lyapunov .or. a%rosenstein .or. a%lyapunov_spectrum
          end associate
          if (self%analysing) then
             call diagnose_brake(settings, main_run%trajectory, main_run%events, self%diagnostics, error)
@@ -250,6 +250,8 @@ contains
 
       results = 0.0_wp
       point = self%resolved()
+      ! A sweep point reports no spectrum: skip its cost.
+      point%analysis%lyapunov_spectrum = .false.
       call integrate_brake(run, point, silent, error)
       if (allocated(error)) return
       associate (a => point%analysis)

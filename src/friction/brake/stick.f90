@@ -25,7 +25,7 @@ module friction_brake_stick
    implicit none
    private
 
-   public :: stick_motion, stick_end_force_positive, stick_end_force_negative, stick_end_lift_off
+   public :: stick_tangent, stick_motion, stick_end_force_positive, stick_end_force_negative, stick_end_lift_off
 
    !> Which limit ended the stick.
    integer, parameter :: stick_end_force_positive = 1  !! 2x - y reached +μs N'
@@ -75,6 +75,29 @@ contains
       y(3) = y(1) / self%p%kappa + self%a * c + self%b * s
       y(4) = self%p%v_dr / self%p%kappa + self%omega * (self%b * c - self%a * s)
    end function state_at
+
+   !> The derivative of the stick flow over a time u: the state after u with
+   !> respect to the state before, (x, y, w) by the closed form above and
+   !> the velocity pinned to the belt (its row and column 0).  It depends on
+   !> u only, so pieces of one stick compose.
+   pure function stick_tangent(p, u) result(m)
+      type(brake_parameters), intent(in) :: p
+      real(wp), intent(in) :: u
+      real(wp) :: m(4, 4)
+      real(wp) :: omega, c, s
+
+      omega = sqrt(p%kappa / p%xi)
+      c = cos(omega * u)
+      s = sin(omega * u)
+      m = 0.0_wp
+      m(1, 1) = 1.0_wp
+      m(3, 1) = (1.0_wp - c) / p%kappa
+      m(3, 3) = c
+      m(3, 4) = s / omega
+      m(4, 1) = omega * s / p%kappa
+      m(4, 3) = -omega * s
+      m(4, 4) = c
+   end function stick_tangent
 
    !> h_k at time t, and its time derivative.
    pure subroutine limit_value(self, k, t, h, dh)

@@ -25,7 +25,8 @@ module friction_brake_switched
    use friction_brake_params, only: brake_parameters
    use friction_brake_config, only: brake_config
    use friction_brake_integrator, only: brake_integrator
-   use friction_brake_stick, only: stick_motion, stick_end_lift_off
+   use friction_brake_stick, only: stick_motion, stick_end_lift_off, stick_end_force_positive, stick_tangent
+   use friction_analysis_lyapunov_spectrum, only: tangent_system
    use friction_brake_record, only: brake_event_table, event_stick_to_slip, event_slip_to_stick, &
       & event_slip_reversal
    implicit none
@@ -49,6 +50,7 @@ module friction_brake_switched
    type, extends(brake_integrator) :: switched_integrator
       type(brake_parameters) :: p
       type(brake_slip), allocatable :: slip
+      type(tangent_system), allocatable :: slip_tangent   !! slip with its tangent (when tangent)
       type(stick_motion) :: stick
       logical :: sticking = .true.
       real(wp) :: h_start = 0.0_wp
@@ -168,8 +170,17 @@ contains
       self%slip%params = p
       self%h_start = settings%h_start
       if (.not. (self%h_start > 0.0_wp)) self%h_start = 1.0e-3_wp
-      call self%locator%init(self%slip, settings, [event_falling, event_falling], [.true., .true.], &
-         & event_tolerance, self%h_start, error, time_name='τ', time_unit='')
+      if (self%tangent) then
+         if (allocated(self%slip_tangent)) deallocate (self%slip_tangent)
+         allocate (self%slip_tangent)
+         allocate (self%slip_tangent%base, source=self%slip)
+         call self%locator%init(self%slip_tangent, settings, [event_falling, event_falling], [.true., .true.], &
+            & event_tolerance, self%h_start, error, time_name='τ', time_unit='')
+         call self%start_tangent()
+      else
+         call self%locator%init(self%slip, settings, [event_falling, event_falling], [.true., .true.], &
+            & event_tolerance, self%h_start, error, time_name='τ', time_unit='')
+      end if
       if (allocated(error)) return
       self%t = t0
       self%y = y0
@@ -204,6 +215,10 @@ contains
             call self%stick%find_end(self%t, t_target, found, t_end, which)
             if (.not. found) t_end = t_target
             self%stick_time = self%stick_time + (t_end - self%t)
+            if (self%tangent) then
+               self%phi = matmul(stick_tangent(self%p, t_end - self%t), self%phi)
+               self%lost = 1
+            end if
             self%y = self%stick%state_at(t_end)
             self%t = t_end
             if (.not. found) cycle
@@ -213,10 +228,11 @@ contains
                return
             end if
             self%sticking = .false.
+            if (self%tangent) call stick_exit_saltation(self, which)
             call start_slip(self, -1.0_wp)
             call events%add(self%t, event_stick_to_slip, self%y)
          else
-            call self%locator%advance(self%t, t_target, self%y, error)
+            call self%locator_advance(t_target, error)
             if (allocated(error)) then
                error%message = error%message//' (switched model, in slip)'
                return
@@ -227,10 +243,17 @@ contains
                if (abs(self%p%elastic_force(self%y(1), self%y(3))) <= &
                   & self%p%mu_s * self%p%normal_force(self%y(3))) then
                   self%sticking = .true.
+                  if (self%tangent) then
+                     call saltation(self%phi, slip_field(self, self%slip%direction), stick_field(self), &
+                        & [0.0_wp, self%slip%direction, 0.0_wp, 0.0_wp])
+                     self%lost = 1
+                  end if
                   self%y(2) = self%p%v_dr   ! exact: the event left v_rel within the tolerance of 0
                   call self%stick%start(self%p, self%t, self%y)
                   call events%add(self%t, event_slip_to_stick, self%y)
                else
+                  if (self%tangent) call saltation(self%phi, slip_field(self, self%slip%direction), &
+                     & slip_field(self, -self%slip%direction), [0.0_wp, self%slip%direction, 0.0_wp, 0.0_wp])
                   call start_slip(self, -1.0_wp)
                   call events%add(self%t, event_slip_reversal, self%y)
                end if
@@ -260,7 +283,65 @@ contains
       real(wp), intent(in) :: s, h_start
 
       self%slip%direction = s
-      call self%locator%restart(self%t, self%y, h_start)
+      if (self%tangent) then
+         select type (b => self%slip_tangent%base)
+         type is (brake_slip)
+            b%direction = s
+         end select
+      end if
+      call self%locator_restart(h_start)
    end subroutine start_slip_in
+
+   !> The right-hand side of slip in direction s at the current state.
+   function slip_field(self, s) result(f)
+      class(switched_integrator), intent(in) :: self
+      real(wp), intent(in) :: s
+      real(wp) :: f(4)
+      type(brake_slip) :: slip
+
+      slip%params = self%p
+      slip%direction = s
+      call slip%rhs(self%t, self%y, f)
+   end function slip_field
+
+   !> The right-hand side of stick (the block's velocity pinned to the belt).
+   pure function stick_field(self) result(f)
+      class(switched_integrator), intent(in) :: self
+      real(wp) :: f(4)
+
+      f = [self%p%v_dr, 0.0_wp, self%y(4), (self%y(1) - self%p%kappa * self%y(3)) / self%p%xi]
+   end function stick_field
+
+   !> Tangent vectors across a switching surface h = 0 with normal n = ∇h,
+   !> crossed from the field f⁻ into f⁺ (docs/physics.md, the saltation
+   !> matrix): Φ ← (I + (f⁺ - f⁻) nᵀ / (nᵀ f⁻)) Φ.  A grazing crossing
+   !> (nᵀ f⁻ = 0, measure zero) leaves Φ as it is.
+   pure subroutine saltation(phi, f_minus, f_plus, normal)
+      real(wp), intent(inout) :: phi(4, 4)
+      real(wp), intent(in) :: f_minus(4), f_plus(4), normal(4)
+      real(wp) :: rate, row(4)
+      integer :: i
+
+      rate = dot_product(normal, f_minus)
+      if (rate == 0.0_wp) return
+      row = matmul(normal, phi) / rate
+      do i = 1, 4
+         phi(i, :) = phi(i, :) + (f_plus(i) - f_minus(i)) * row
+      end do
+   end subroutine saltation
+
+   !> Leaving stick where the limit `which` was reached: h = μs N' ∓ (2x - y)
+   !> with normal ∇h, into slip in the direction the unbalanced force drives.
+   subroutine stick_exit_saltation(self, which)
+      class(switched_integrator), intent(inout) :: self
+      integer, intent(in) :: which
+      real(wp) :: sigma, normal(4), s
+
+      ! h = μs N' - σ (2x - y): σ = +1 at the positive limit, -1 at the negative.
+      sigma = merge(1.0_wp, -1.0_wp, which == stick_end_force_positive)
+      normal = [-2.0_wp * sigma, 0.0_wp, self%p%mu_s * (1.0_wp - self%p%kappa) + sigma, 0.0_wp]
+      s = -sigma
+      call saltation(self%phi, stick_field(self), slip_field(self, s), normal)
+   end subroutine stick_exit_saltation
 
 end module friction_brake_switched

@@ -55,8 +55,9 @@ module friction_ode_events
    !> Directions of a crossing: g goes from - to + (rising), + to - (falling).
    integer, parameter :: event_rising = 1, event_falling = -1, event_either = 0
 
-   !> Largest state dimension the locator keeps copies of.
-   integer, parameter :: max_state = 8
+   !> Largest state dimension the locator keeps copies of: a state of 4
+   !> with its 4 x 4 tangent matrix (the Lyapunov spectrum of the brake).
+   integer, parameter :: max_state = 20
 
    !> An ODE system with event functions.
    type, abstract, extends(ode_system) :: event_system

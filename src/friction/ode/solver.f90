@@ -25,7 +25,8 @@ module friction_ode_solver
    !> Room for a step type name (as solver_settings%method).
    integer, parameter :: step_type_name_length = 16
 
-   integer, parameter :: max_dimension = 8
+   !> Largest system: a state of 4 with its 4 x 4 tangent matrix (the Lyapunov spectrum).
+   integer, parameter :: max_dimension = 20
 
    !> GSL status codes used here (gsl_errno.h).
    integer(c_int), parameter :: gsl_success = 0, gsl_enomem = 8, gsl_ebadfunc = 9
