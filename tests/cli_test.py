@@ -4,7 +4,7 @@
     cli_test.py --binary BIN --mpiexec MPIEXEC --inputs DIR --workdir DIR CASE
 
 Cases: datasets-naf, datasets-hopg, ranks, override, force, numerical-failure, models,
-quasistatic-failure, thermal-zero, thermal-ranks, thermal-equipartition,
+quasistatic-failure, thermal-zero, thermal-ranks, thermal-equipartition, thermal-kramers,
 and bad-<name> for each bad input in BAD_INPUTS; for the brake scene
 brake-run, brake-ranks, brake-dimensional, brake-verify, brake-failure, brake-analysis and
 bad-brake-<name> for each bad input in BAD_BRAKE_INPUTS; for sweeps sweep-ranks,
@@ -92,6 +92,10 @@ BAD_INPUTS = {
                               ["bad.nml:1", "&thermal", "model", "metropolis", "langevin"]),
     "thermal-quasistatic": ("&tip model = 'quasistatic' /\n&thermal temperature = 300.0 /\n", 3,
                             ["bad.nml:1", "&tip", "model", "quasistatic", "thermal"]),
+    "thermal-kramers-time-step": ("&thermal\n  temperature = 300.0\n  model = 'kramers'\n  time_step = 1e-7\n/\n", 3,
+                                  ["bad.nml:4", "&thermal", "time_step", "kramers", "leave it 0"]),
+    "thermal-kramers-weak-damping": ("&tip\n  cx = 1.0e-5\n/\n&thermal temperature = 300.0, model = 'kramers' /\n", 3,
+                                     ["bad.nml:2", "&tip", "cx", "energy diffusion", "langevin"]),
 }
 
 DOCUMENTED = ["fx", "fy", "f_along", "f_across", "tip_x", "tip_y"]
@@ -672,6 +676,66 @@ def case_thermal_equipartition(args):
                 fail(f"{model}: mean friction {mean} +- {se} nN is not the drag c v = {drag} nN within 3 SE")
 
 
+def case_thermal_kramers(args):
+    """The thermal reduced model (&thermal model = 'kramers') against the
+    Langevin tip where both hold, through the whole program on 2 ranks.
+
+    Why these parameters: on NaF with inputs/naf.nml's tip at 300 K the
+    escape rate's prefactor is ~1e3 /s, so the reduced model's jumps come
+    at barriers well above its 3 k_B T floor only below ~5 Å/s (above, its
+    friction stops growing with v: the jumps are at the floor), while the
+    Langevin tip costs ~1e6 steps per Å there.  At 3 Å/s the jumps are
+    thermal (the friction is 10 % below its value at 10 Å/s) and two
+    9.24 Å lines (two lattice periods, off the row by 0.5 Å, 1 Å lead-in)
+    of 8 realizations take the Langevin tip ~30 s on 2 ranks.  Asserted:
+    the mean friction over the lines agrees within two combined standard
+    errors (each from the lines' standard errors over their realizations:
+    the realizations are independent); the file is the same bit for bit
+    on 1 and 2 ranks; the scheme is 'kramers-kmc' with no time step; and
+    the reduced model's slips are forward, pulled by the force along the
+    support's motion.  (The slip counts are not compared: the Langevin
+    run finds slips by quenching every 0.05 Å, which merges two jumps in
+    quick succession into one; measured 128 against the model's 144.)
+    Measured: kramers 0.4192 +- 0.0084 nN, langevin 0.4015 +- 0.0099 nN
+    (1.4 combined SE apart); at 2 Å/s with 12 realizations 0.395 +- 0.008
+    and 0.397 +- 0.008 nN."""
+    naf = os.path.join(args.inputs, "naf.nml")
+    results = {}
+    for model in ("kramers", "langevin"):
+        text = ("&scan velocity = 3.0, length = 9.24, nx = 12, ny = 2, width = 1.0, origin_y = 0.5, lead_in = 1.0 /\n"
+                f"&thermal temperature = 300.0, realizations = 8, seed = 5, model = '{model}' /\n")
+        friction(args, "-o", f"{model}.h5", naf, write(args, f"{model}.nml", text), ranks=2)
+        path = os.path.join(args.workdir, f"{model}.h5")
+        with h5py.File(path, "r") as f:
+            slips = {name: f[f"afm/slips/{name}"][()] for name in ("trip", "force", "jump")}
+            scheme = f["afm"].attrs["scheme"].decode()
+            step = f["afm"].attrs["time_step"]
+        results[model] = thermal_friction(path), slips, scheme, step
+    (mk, sk), slips_k, scheme, step = results["kramers"]
+    (ml, sl), slips_l, _, _ = results["langevin"]
+    print(f"mean friction at 3 A/s: kramers {mk:.4f} +- {sk:.4f} nN, langevin {ml:.4f} +- {sl:.4f} nN; "
+          f"slips {len(slips_k['jump'])} and {len(slips_l['jump'])}")
+    if scheme != "kramers-kmc" or step != 0.0:
+        fail(f"/afm scheme {scheme!r} and time_step {step}, expected 'kramers-kmc' and 0")
+    if abs(mk - ml) > 2 * np.hypot(sk, sl):
+        fail(f"kramers {mk} +- {sk} nN and langevin {ml} +- {sl} nN differ by more than 2 combined SE")
+    trace = slips_k["trip"] == 0
+    if np.any(slips_k["jump"] <= 0.5) or np.any(slips_k["force"][trace] <= 0) or np.any(slips_k["force"][~trace] >= 0):
+        fail("kramers slips are not all forward, pulled by the force along the support's motion")
+    text = ("&scan velocity = 3.0, length = 9.24, nx = 12, ny = 3, width = 1.0, origin_y = 0.5, lead_in = 1.0 /\n"
+            "&thermal temperature = 300.0, realizations = 2, seed = 5, model = 'kramers' /\n")
+    small = write(args, "ranks.nml", text)
+    files = {}
+    for n in (1, 2):
+        friction(args, "-o", f"k_{n}.h5", naf, small, ranks=n)
+        files[n] = comparable(os.path.join(args.workdir, f"k_{n}.h5"))
+    if files[1].keys() != files[2].keys():
+        fail(f"1 and 2 ranks wrote different objects: {set(files[1]) ^ set(files[2])}")
+    for key, value in files[1].items():
+        if not np.array_equal(np.asarray(value), np.asarray(files[2][key])):
+            fail(f"{key} differs between 1 and 2 ranks")
+
+
 def case_bad(args, name):
     text, code, words = BAD_INPUTS[name]
     naf = os.path.join(args.inputs, "naf.nml")
@@ -1193,7 +1257,8 @@ def main():
          "graphite": case_graphite, "models": case_models, "quasistatic-failure": case_quasistatic_failure,
          "graphite-ranks": case_graphite_ranks, "graphite-defects": case_graphite_defects,
          "input-roundtrip": case_input_roundtrip, "thermal-zero": case_thermal_zero,
-         "thermal-ranks": case_thermal_ranks, "thermal-equipartition": case_thermal_equipartition}[args.case](args)
+         "thermal-ranks": case_thermal_ranks, "thermal-equipartition": case_thermal_equipartition,
+         "thermal-kramers": case_thermal_kramers}[args.case](args)
     print("1 passed, 0 failed")
 
 
