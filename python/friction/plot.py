@@ -12,6 +12,7 @@ brake:        brake_phase (Fig. 12), brake_x, brake_spectrum (Fig. 13),
 sweeps:       sweep (every chart of a sweep file), bifurcation, sweep_lyapunov,
               sweep_friction
 speed:        work_precision, failure_map (files of scripts/work_precision)
+thermal:      friction_velocity (rows of scripts/thermal_velocity.py), sang_fit
 
 The figures are matplotlib.figure.Figure objects outside pyplot: nothing is
 shown or kept open behind the caller's back, and no display is needed.  In a
@@ -34,7 +35,7 @@ from ._data import FileError, load, reading, require
 
 __all__ = ["afm_maps", "friction_loop", "graphite_net", "stacked_lines", "brake_phase", "brake_x",
            "brake_spectrum", "poincare", "lyapunov", "sweep", "bifurcation", "sweep_lyapunov",
-           "sweep_friction", "work_precision", "failure_map", "Figure"]
+           "sweep_friction", "work_precision", "failure_map", "friction_velocity", "sang_fit", "Figure"]
 
 
 class Figure(_Figure):
@@ -843,4 +844,55 @@ def failure_map(data):
                              "silently wrong (>100x asked)"], loc="lower center", ncol=4, fontsize=8)
         fig.text(0.01, 0.01, "numbers: CPU time in ms", fontsize=7)
         fig.tight_layout(rect=(0, 0.07, 1, 1))
+    return fig
+
+
+def sang_fit(velocity, friction, sem):
+    """Sang, Dubé and Grant's law F = F_c - B [ln(v_c/v)]^(2/3) (PRL 87,
+    174301, 2001) fitted by weighted least squares: linear in F_c and B for
+    each v_c, v_c on a grid.  Returns (F_c, B, v_c), v_c in the units of
+    velocity."""
+    lv = np.log(np.asarray(velocity, float))
+    f = np.asarray(friction, float)
+    w = 1.0 / np.asarray(sem, float) ** 2
+    best = None
+    for lnvc in lv.max() + np.geomspace(0.01, 60.0, 4000):
+        x = (lnvc - lv) ** (2.0 / 3.0)
+        a = np.vstack([np.ones_like(x), -x]).T
+        coef = np.linalg.solve(a.T @ (w[:, None] * a), a.T @ (w * f))
+        chi = float(np.sum(w * (f - a @ coef) ** 2))
+        if best is None or chi < best[0]:
+            best = (chi, coef[0], coef[1], math.exp(lnvc))
+    return best[1], best[2], best[3]
+
+
+def friction_velocity(rows):
+    """The mean friction against the support velocity with error bars (one
+    standard error), a series per model ('kramers', 'langevin'), and
+    Sang et al.'s law fitted through the reduced model's points below
+    3 Å/s (where its jumps are thermal).  rows: dicts with model, velocity
+    (Å/s), friction and sem (nN), as scripts/thermal_velocity.py gives."""
+    fig = _figure(figsize=(6.4, 4.4))
+    ax = fig.add_subplot()
+    styles = {"kramers": ("o", "tab:blue", "reduced model (Kramers KMC)"),
+              "langevin": ("s", "tab:red", "Langevin tip")}
+    for model, (marker, colour, label) in styles.items():
+        pts = sorted((r["velocity"], r["friction"], r["sem"]) for r in rows if r["model"] == model)
+        if not pts:
+            continue
+        v, f, e = map(np.array, zip(*pts))
+        ax.errorbar(v, f, yerr=e, marker=marker, color=colour, linestyle="none", capsize=3, label=label)
+    slow = sorted((r["velocity"], r["friction"], r["sem"]) for r in rows
+                  if r["model"] == "kramers" and r["velocity"] < 3.0)
+    if len(slow) >= 3:
+        v, f, e = map(np.array, zip(*slow))
+        fc, b, vc = sang_fit(v, f, e)
+        grid = np.geomspace(v.min(), min(vc, 10 * v.max()) * 0.999, 200)
+        ax.plot(grid, fc - b * np.log(vc / grid) ** (2.0 / 3.0), color="tab:blue", linewidth=1,
+                label=f"Sang et al.: $F_c$ = {fc:.3f} nN, $v_c$ = {vc:.3g} Å/s")
+    ax.set_xscale("log")
+    ax.set_xlabel("support velocity (Å/s)")
+    ax.set_ylabel("mean friction (nN)")
+    ax.set_title("NaF, 300 K: friction against velocity")
+    ax.legend(fontsize="small")
     return fig

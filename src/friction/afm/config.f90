@@ -205,7 +205,7 @@ contains
          at = ' at &thermal temperature = '//rtoa(self%thermal%temperature)//' K'
          if (self%model == 'quasistatic') then
             call c%reject('tip', 'model', "'quasistatic'", 'has no thermal motion'//at//": use 'inertial' " &
-               & //"or 'overdamped' (the thermal reduced model is not available yet)")
+               & //"or 'overdamped' (with &thermal model = 'kramers' they choose the escape rate's prefactor)")
             return
          end if
          if (self%potential == 'lj') then
@@ -218,12 +218,35 @@ contains
             & ': the heat bath acts through the damper (fluctuation-dissipation), an undamped axis has none')
          if (.not. (self%cy > 0.0_wp)) call c%reject('tip', 'cy', rtoa(self%cy), 'must be > 0 (N s/m)'//at// &
             & ': the heat bath acts through the damper (fluctuation-dissipation), an undamped axis has none')
+         if (.not. c%failed() .and. self%thermal%model == 'kramers') call check_kramers()
          if (c%failed() .or. self%thermal%time_step == 0.0_wp) return
          limit = thermal_step_limit(self)
          if (limit > 0.0_wp .and. self%thermal%time_step >= limit) call c%reject('thermal', 'time_step', &
             & rtoa(self%thermal%time_step), 'is at or above the stability limit '//rtoa(limit)//' s of the ' &
             & //'Langevin integrator (2/omega_max inertial, 2 c/k_max overdamped; 0 chooses a step)')
       end subroutine check_thermal
+
+      !> model = 'kramers' with the inertial tip: Kramers' rate in the
+      !> spatial-diffusion regime needs the damping not weak.  Below
+      !> gamma = c/m ~ omega k_B T/Delta E the escape is limited by energy
+      !> diffusion (Mel'nikov-Meshkov) and the rate is too high; the model
+      !> jumps deterministically below 3 k_B T, so gamma >= omega/3 (omega
+      !> = sqrt(k/m) of either lateral spring) keeps every rate it uses in
+      !> the regime it holds in.
+      subroutine check_kramers()
+         real(wp) :: omega
+
+         if (self%model /= 'inertial') return
+         omega = sqrt(max(self%kx, self%ky) / self%mass)
+         if (self%cx / self%mass < omega / 3.0_wp) call c%reject('tip', 'cx', rtoa(self%cx), 'is too weak ' &
+            & //"a damping for &thermal model = 'kramers' (c/m = "//rtoa(self%cx / self%mass)//' /s below ' &
+            & //'omega/3 = '//rtoa(omega / 3.0_wp)//" /s: escape is then limited by energy diffusion, where " &
+            & //"Kramers' rate does not hold); use model = 'langevin'")
+         if (self%cy / self%mass < omega / 3.0_wp) call c%reject('tip', 'cy', rtoa(self%cy), 'is too weak ' &
+            & //"a damping for &thermal model = 'kramers' (c/m = "//rtoa(self%cy / self%mass)//' /s below ' &
+            & //'omega/3 = '//rtoa(omega / 3.0_wp)//" /s: escape is then limited by energy diffusion, where " &
+            & //"Kramers' rate does not hold); use model = 'langevin'")
+      end subroutine check_kramers
 
       !> The overdamped model divides by the damping of every moving direction.
       subroutine require_damped(name, value)

@@ -43,8 +43,9 @@ module friction_afm_scan
    use friction_afm_config, only: afm_config, new_tip, surface_curvature
    use friction_afm_tip, only: afm_tip, model_inertial, model_quasistatic
    use friction_afm_thermal, only: welford_add, welford_sem
-   use friction_afm_langevin, only: langevin_integrator, langevin_state, langevin_time_step
-   use friction_afm_kramers, only: find_minimum
+   use friction_afm_langevin, only: langevin_integrator, langevin_state, langevin_time_step, boltzmann
+   use friction_afm_kramers, only: find_minimum, hazard_path, hazard_start, hazard_advance, jump_landing, &
+      & hazard_running, hazard_low_barrier
    use friction_random, only: random_stream
    use friction_afm_quasistatic, only: newton_equilibrium, equilibrium_tangent
    use friction_surface_potential, only: surface_potential
@@ -87,6 +88,16 @@ module friction_afm_scan
    !> the quenched minimum that is a slip, Å (below any well spacing of NaF
    !> or HOPG, above any drift of a minimum between two checks).
    real(wp), parameter :: check_distance = 0.05_wp, slip_distance = 0.5_wp
+   !> The thermal reduced model (see run_kramers_trip): the exits searched
+   !> from a minimum (along the support's motion and against it, each also
+   !> turned by ±exit_angle, rad: 40°, between the motion and the diagonal
+   !> saddles of a square lattice); the support travel between two searches, Å (a tenth of
+   !> NaF's shortest well spacing); the barrier, in k_B T, below which an
+   !> exit fires at once (Kramers' rate holds for barriers of several
+   !> k_B T, its corrections O(k_B T/ΔE)).
+   integer, parameter :: n_exits = 6
+   real(wp), parameter :: exit_angle = 40.0_wp * pi / 180.0_wp, search_distance = 0.1_wp
+   real(wp), parameter :: barrier_floor = 3.0_wp
 
    !> One trip's samples: values(i, q) for sample i and quantity q (output units).
    type :: trip_record
@@ -129,21 +140,25 @@ module friction_afm_scan
       real(wp) :: support_height = 0.0_wp   !! z_M = z0 + support_z, Å (3D)
       ! At a temperature (config%thermal)
       logical :: thermal = .false.
+      logical :: kramers = .false.                 !! &thermal model = 'kramers' (no Langevin steps)
       type(langevin_integrator) :: langevin        !! the step between samples
       type(langevin_integrator) :: lead_langevin   !! the step of the lead-in
       integer :: sample_steps = 0                  !! Langevin steps between two samples
       integer :: lead_steps = 0                    !! Langevin steps of the lead-in
       integer :: check_steps = 0                   !! Langevin steps between two slip checks
       integer(i8) :: langevin_steps = 0, force_evaluations = 0
+      integer(i8) :: hazard_steps = 0              !! model = 'kramers': steps along the KMC paths
       type(random_stream) :: stream
    contains
       procedure :: init
       procedure :: run_trip
       procedure :: run_thermal_trip
+      procedure :: run_kramers_trip
       procedure :: run_line
       procedure :: time_step
       procedure :: statistics
       procedure, private :: follow
+      procedure, private :: start_thermal_trip
       procedure, private :: relax
    end type afm_scanner
 
@@ -240,7 +255,8 @@ contains
       call self%solver%init(self%tip, config%solver, self%h_start, error)
       if (allocated(error)) return
       self%thermal = config%thermal%enabled()
-      if (self%thermal) call init_thermal()
+      self%kramers = self%thermal .and. config%thermal%model == 'kramers'
+      if (self%thermal .and. .not. self%kramers) call init_thermal()
 
    contains
 
@@ -355,30 +371,21 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(slip_list), intent(inout), optional :: slips
       type(langevin_state) :: state
-      real(wp) :: along(3), across(3), line_start(3), offset(self%config%ny), s_start, force(3), tip_r(3), t
+      real(wp) :: along(3), across(3), s_start, force(3), tip_r(3), t
       real(wp) :: u0(3), minimum(3), last_support, last_force, motion(3)
       integer(i8) :: now
       integer :: i, k, nx, nd, done, n
       logical :: in_well
       character(len=128) :: where
 
+      if (self%kramers) then
+         call self%run_kramers_trip(j, forward, realization, record, error, slips)
+         return
+      end if
+      call self%start_thermal_trip(j, forward, realization, record, along, across, s_start, error)
+      if (allocated(error)) return
       associate (c => self%config, tip => self%tip)
          nx = c%nx
-         along = c%scan_direction()
-         across = c%across_direction()
-         offset = support_across(c)
-         line_start = [c%origin_x, c%origin_y, 0.0_wp] + offset(j + 1) * across
-         if (forward) then
-            s_start = -c%lead_in
-            tip%support_velocity = c%velocity * along
-         else
-            s_start = c%length + c%lead_in
-            tip%support_velocity = -c%velocity * along
-         end if
-         tip%support_start = line_start + s_start * along
-         if (.not. allocated(record%values)) allocate (record%values(nx, n_quantities))
-         call self%stream%init(c%thermal%seed, j, merge(0, 1, forward), realization, error)
-         if (allocated(error)) return
          ! At the support, with a thermal velocity (inertial tip).
          u0 = 0.0_wp
          t = 0.0_wp
@@ -478,6 +485,260 @@ contains
       end subroutine check_slips
 
    end subroutine run_thermal_trip
+
+   !> What a trip at a temperature starts with: the support at the start of
+   !> line j (0-based), moving forward (trace) or back, the trip's record,
+   !> and the random stream of (seed, line, trip, realization).
+   subroutine start_thermal_trip(self, j, forward, realization, record, along, across, s_start, error)
+      class(afm_scanner), intent(inout) :: self
+      integer, intent(in) :: j, realization
+      logical, intent(in) :: forward
+      type(trip_record), intent(inout) :: record
+      real(wp), intent(out) :: along(3), across(3), s_start
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: line_start(3), offset(self%config%ny)
+
+      associate (c => self%config, tip => self%tip)
+         along = c%scan_direction()
+         across = c%across_direction()
+         offset = support_across(c)
+         line_start = [c%origin_x, c%origin_y, 0.0_wp] + offset(j + 1) * across
+         if (forward) then
+            s_start = -c%lead_in
+            tip%support_velocity = c%velocity * along
+         else
+            s_start = c%length + c%lead_in
+            tip%support_velocity = -c%velocity * along
+         end if
+         tip%support_start = line_start + s_start * along
+         if (.not. allocated(record%values)) allocate (record%values(c%nx, n_quantities))
+         call self%stream%init(c%thermal%seed, j, merge(0, 1, forward), realization, error)
+      end associate
+   end subroutine start_thermal_trip
+
+   !> One trip of the thermal reduced model (&thermal model = 'kramers')
+   !> along line j (0-based), trace when forward, with the random stream of
+   !> realization (0-based); samples and slips as run_thermal_trip's.
+   !>
+   !> The tip sits in a minimum of its total energy E (surface and springs)
+   !> and leaves it over one of the first-order saddles ahead (see
+   !> start_exits), each at its Kramers–Langer rate r_s(t), whose prefactor
+   !> is the tip model's: Kramers' moderate-to-strong friction rate for the
+   !> inertial tip, Smoluchowski's for the overdamped one.  As the support
+   !> moves the barriers fall and the rates grow.  Every exit has its own
+   !> clock: it fires when its ∫ r_s dt reaches an exponential variate of
+   !> its own (hazard_advance); the first to fire is the jump (competing
+   !> independent clocks: the total rate is Σ r_s, and an exit is taken
+   !> with probability r_s/Σ r_s).  An exit also fires, at once, where its
+   !> barrier has fallen below barrier_floor k_B T or the minimum has
+   !> vanished at a fold: there the rate formula stops holding, and escape
+   !> takes of the order of the inverse attempt frequency, during which a
+   !> slow support does not move.  The tip lands in the minimum past the
+   !> saddle (jump_landing).  Jumps back, over the saddles behind, are
+   !> exits like the others.
+   !>
+   !> The exits are searched after every jump.  Where no saddle is found
+   !> (the search gives up on barriers of ~1 eV on NaF, e^-40 at 300 K) the
+   !> minimum is followed for search_distance of support travel with no
+   !> jump and searched again, with new variates (exponential clocks have
+   !> no memory, so a new start is exact); if the minimum vanished
+   !> meanwhile, the tip's descent into the next one is the jump, as in the
+   !> quasistatic model.  A saddle lost while its
+   !> barrier is still high (it merges with another stationary point)
+   !> starts a new search there.  A sample records the tip in its minimum:
+   !> the force -k u_min is the mean over the well's thermal spread up to
+   !> O(k_B T) anharmonic terms.  Slips: every jump, with the support where
+   !> it happened, the force before it and the move of the minimum.
+   subroutine run_kramers_trip(self, j, forward, realization, record, error, slips)
+      class(afm_scanner), intent(inout) :: self
+      integer, intent(in) :: j, realization
+      logical, intent(in) :: forward
+      type(trip_record), intent(inout) :: record
+      type(error_type), allocatable, intent(out) :: error
+      type(slip_list), intent(inout), optional :: slips
+      !> Searches allowed between two samples before the trip is reported
+      !> as stuck.
+      integer, parameter :: max_searches = 100000
+      type(hazard_path) :: paths(n_exits)
+      real(wp) :: along(3), across(3), s_start, force(3), tip_r(3), t_sample, targets(n_exits), motion(3)
+      real(wp) :: u_cur(3), u_next(3), t_cur, t_end, temperature, t_event, t_first
+      logical :: active(n_exits), need_search
+      integer(i8) :: now
+      integer :: i, k, nx, nd, status, searches, p, first
+
+      call self%start_thermal_trip(j, forward, realization, record, along, across, s_start, error)
+      if (allocated(error)) return
+      associate (c => self%config, tip => self%tip)
+         nx = c%nx
+         nd = tip%ndim
+         temperature = c%thermal%temperature
+         motion = tip%support_velocity / c%velocity
+         ! From the support, into the minimum it relaxes to.
+         u_cur = 0.0_wp
+         u_next = 0.0_wp
+         t_cur = 0.0_wp
+         call find_minimum(tip, t_cur, u_next(1:nd), u_cur(1:nd), error)
+         need_search = .true.
+         do k = 1, nx
+            i = merge(k, nx + 1 - k, forward)
+            t_sample = abs(support_at(c, i - 1) - s_start) / c%velocity
+            searches = 0
+            do while (.not. allocated(error))
+               if (.not. (t_cur < t_sample)) exit
+               if (need_search) then
+                  searches = searches + 1
+                  if (searches > max_searches) then
+                     call fatal_error(error, 'kramers: more than '//itoa(max_searches)//' searches for exits ' &
+                        & //'between two samples at t = '//rtoa(t_cur)//' s', error_numerical)
+                     exit
+                  end if
+                  call start_exits()
+                  need_search = .not. any(active)
+                  if (need_search) then
+                     t_end = min(t_sample, t_cur + search_distance / c%velocity)
+                     if (t_sample - t_end <= 1.0e-9_wp * (t_end - t_cur)) t_end = t_sample
+                     call follow_minimum()
+                     cycle
+                  end if
+               end if
+               ! Every clock on to the sample or to the first event so far.
+               t_first = t_sample
+               first = 0
+               do p = 1, n_exits
+                  if (.not. active(p)) cycle
+                  call hazard_advance(tip, paths(p), t_first, targets(p), status, t_event, error, &
+                     & barrier_floor=barrier_floor)
+                  self%hazard_steps = self%hazard_steps + paths(p)%steps
+                  paths(p)%steps = 0
+                  if (allocated(error)) exit
+                  if (status == hazard_running) cycle
+                  first = p
+                  t_first = t_event
+                  ! A saddle lost, not overcome: a new search from there.
+                  if (status == hazard_low_barrier .and. paths(p)%barrier > 1.001_wp * barrier_floor &
+                     & * boltzmann * temperature) first = -p
+               end do
+               if (allocated(error)) exit
+               if (first > 0) then
+                  call jump(paths(first), t_first)
+                  need_search = .true.
+               else if (first < 0) then
+                  t_cur = paths(-first)%t
+                  u_cur = paths(-first)%u_min
+                  need_search = .true.
+               else
+                  t_cur = t_sample
+                  u_cur = paths(findloc(active, .true., 1))%u_min
+               end if
+            end do
+            if (.not. allocated(error) .and. c%solver%max_wall_time > 0.0_wp) then
+               call system_clock(now)
+               if (real(now - self%clock_start, wp) / self%clock_rate > c%solver%max_wall_time) &
+                  & call fatal_error(error, 'kramers: max_wall_time = '//rtoa(c%solver%max_wall_time) &
+                  & //' s reached at t = '//rtoa(t_cur)//' s', error_numerical)
+            end if
+            if (allocated(error)) then
+               error%message = error%message//' (line '//itoa(j)//trim(merge(' trace  ', ' retrace', forward)) &
+                  & //', realization '//itoa(realization)//', support at '//fixed_text(c%velocity * t_cur, 4) &
+                  & //' Å into the trip)'
+               call self%stream%free()
+               return
+            end if
+            force = tip%lateral_force(u_cur) * ev_per_angstrom_to_nn
+            tip_r = tip%tip_position(t_sample, u_cur)
+            record%values(i, q_fx) = force(1)
+            record%values(i, q_fy) = force(2)
+            record%values(i, q_f_along) = dot_product(force, along)
+            record%values(i, q_f_across) = dot_product(force, across)
+            record%values(i, q_tip_x) = tip_r(1)
+            record%values(i, q_tip_y) = tip_r(2)
+            record%values(i, q_fz) = force(3)
+            record%values(i, q_tip_z) = tip_r(3)
+            record%values(i, q_jumps) = 0.0_wp
+         end do
+         call self%stream%free()
+      end associate
+
+   contains
+
+      !> The exits from the minimum u_cur at support time t_cur: the saddles
+      !> found from it along the support's motion and against it, each also
+      !> turned by ±exit_angle in the scan plane (on a line of symmetry the
+      !> saddle ahead is a pair, and the search along the motion alone stops
+      !> on the ridge between them; off it the pair's barriers differ),
+      !> without repeats; each with its clock's variate, drawn in order.
+      !> The exits behind are the back jumps, which bring the mean force to
+      !> zero as v -> 0 (detailed balance between neighbouring wells).
+      subroutine start_exits()
+         type(error_type), allocatable :: search_error
+         real(wp) :: d(3), normal(3)
+         integer :: q, m, found
+
+         associate (tip => self%tip)
+            active = .false.
+            found = 0
+            normal = [-motion(2), motion(1), 0.0_wp]
+            do q = 1, n_exits
+               ! Ahead (1-3) and behind (4-6).
+               d = merge(1.0_wp, -1.0_wp, q <= 3) * motion
+               if (mod(q, 3) == 2) d = d + tan(exit_angle) * normal
+               if (mod(q, 3) == 0) d = d - tan(exit_angle) * normal
+               call hazard_start(tip, temperature, t_cur, u_cur(1:nd), paths(found + 1), search_error, &
+                  & direction=d(1:nd))
+               if (allocated(search_error)) then
+                  deallocate (search_error)
+                  cycle
+               end if
+               if (any([(norm2(paths(m)%u_saddle(1:nd) - paths(found + 1)%u_saddle(1:nd)) <= &
+                  & landing_distance, m = 1, found)])) cycle
+               found = found + 1
+               active(found) = .true.
+            end do
+            do q = 1, found
+               targets(q) = self%stream%exponential()
+            end do
+         end associate
+      end subroutine start_exits
+
+      !> No exit found: the minimum followed from t_cur to t_end; a jump if
+      !> it vanished meanwhile (the descent lands elsewhere).
+      subroutine follow_minimum()
+         associate (tip => self%tip)
+            call find_minimum(tip, t_end, u_cur(1:nd), u_next(1:nd), error)
+            if (allocated(error)) return
+            if (norm2(u_next(1:nd) - u_cur(1:nd)) > slip_distance) call add_slip(t_end, u_cur, u_next)
+            u_cur = u_next
+            t_cur = t_end
+         end associate
+      end subroutine follow_minimum
+
+      !> The jump at support time te from the path's minimum over its saddle.
+      subroutine jump(path, te)
+         type(hazard_path), intent(in) :: path
+         real(wp), intent(in) :: te
+
+         call jump_landing(self%tip, te, path%u_min(1:nd), path%u_saddle(1:nd), u_next(1:nd), error)
+         if (allocated(error)) return
+         call add_slip(te, path%u_min, u_next)
+         u_cur = u_next
+         t_cur = te
+      end subroutine jump
+
+      !> A slip at support time te from the minimum `before` to `after`.
+      subroutine add_slip(te, before, after)
+         real(wp), intent(in) :: te, before(3), after(3)
+         real(wp) :: support_now, force_now
+
+         if (.not. present(slips)) return
+         associate (c => self%config, tip => self%tip)
+            support_now = merge(s_start + c%velocity * te, s_start - c%velocity * te, forward)
+            force_now = -dot_product(tip%spring(1:nd) * before(1:nd), along(1:nd)) * ev_per_angstrom_to_nn
+            call slips%add(realization, merge(0, 1, forward), support_now, force_now, &
+               & dot_product(after - before, motion), dot_product(after - before, across))
+         end associate
+      end subroutine add_slip
+
+   end subroutine run_kramers_trip
 
    subroutine slips_clear(self)
       class(slip_list), intent(inout) :: self
@@ -835,7 +1096,7 @@ contains
 
       stats = self%solver%statistics()
       if (self%thermal) then
-         stats%steps = stats%steps + self%langevin_steps
+         stats%steps = stats%steps + self%langevin_steps + self%hazard_steps
          stats%rhs_evaluations = stats%rhs_evaluations + self%force_evaluations
       end if
    end function statistics

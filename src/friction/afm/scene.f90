@@ -121,12 +121,15 @@ contains
       if (c%thermal%enabled()) name = thermal_scheme(c)
    end function afm_method
 
-   !> The Langevin scheme of the tip model.
+   !> The thermal scheme: the Langevin scheme of the tip model, or the
+   !> kinetic Monte Carlo of the thermal reduced model.
    function thermal_scheme(c) result(name)
       type(afm_config), intent(in) :: c
       character(len=:), allocatable :: name
 
-      if (c%model == 'overdamped') then
+      if (c%thermal%model == 'kramers') then
+         name = 'kramers-kmc'
+      else if (c%model == 'overdamped') then
          name = 'leimkuhler-matthews'
       else
          name = 'baoab'

@@ -1,11 +1,14 @@
 !> &thermal: the microscope at a temperature (README: Friction at a
 !> temperature).  At temperature = 0 (the default) the program is the
 !> deterministic one, bit for bit, and the other variables are not used.
-!> At T > 0 every trip of the support is integrated with the Langevin tip
-!> (friction_afm_langevin) at a fixed step, `realizations` times with
+!> At T > 0 every trip of the support is run `realizations` times with
 !> independent noise, each from the random stream of its (seed, line,
-!> trip, realization) (friction_random); the output is the mean of every
-!> sample over the realizations with its standard error.
+!> trip, realization) (friction_random), by model = 'langevin' (the
+!> Langevin tip, friction_afm_langevin, at a fixed step) or 'kramers' (the
+!> thermal reduced model: the tip in a minimum of its energy, jumping over
+!> the saddle ahead at Kramers–Langer rates by kinetic Monte Carlo,
+!> friction_afm_kramers and friction_afm_scan); the output is the mean of
+!> every sample over the realizations with its standard error.
 !>
 !> This module holds the group's variables and the checks that need no
 !> other group; the checks against the tip and the surface (an undamped
@@ -16,7 +19,7 @@
 module friction_afm_thermal
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
    use friction_kinds, only: wp, i8
-   use friction_strings, only: itoa, quoted
+   use friction_strings, only: itoa, rtoa, quoted
    use friction_parameters, only: configurable, parameter_visitor
    use friction_checks, only: config_checker
    implicit none
@@ -24,8 +27,8 @@ module friction_afm_thermal
 
    public :: thermal_settings, thermal_model_names, welford_add, welford_sem
 
-   !> &thermal model: the Langevin tip; the thermal reduced model (Kramers
-   !> rates and kinetic Monte Carlo, friction_afm_kramers) is to come.
+   !> &thermal model: the Langevin tip, or the thermal reduced model (Kramers
+   !> rates and kinetic Monte Carlo, friction_afm_kramers).
    character(len=*), parameter :: thermal_model_names(2) = [character(len=8) :: 'langevin', 'kramers']
 
    type, extends(configurable) :: thermal_settings
@@ -55,7 +58,7 @@ contains
       call v%end_group()
    end subroutine visit
 
-   !> T > 0: the Langevin tip runs.
+   !> T > 0: the thermal model runs.
    pure logical function enabled(self)
       class(thermal_settings), intent(in) :: self
 
@@ -74,9 +77,9 @@ contains
       if (.not. any(thermal_model_names == self%model)) then
          call c%reject('thermal', 'model', "'"//trim(self%model)//"'", 'unknown thermal model (known: ' &
             & //quoted(thermal_model_names)//')')
-      else if (self%model == 'kramers' .and. self%enabled()) then
-         call c%reject('thermal', 'model', "'kramers'", "the thermal reduced model is not available yet " &
-            & //"(use 'langevin')")
+      else if (self%model == 'kramers' .and. self%enabled() .and. self%time_step /= 0.0_wp) then
+         call c%reject('thermal', 'time_step', rtoa(self%time_step), "is not used by model = 'kramers' " &
+            & //"(it takes no time steps: the jumps are drawn from the escape rate); leave it 0")
       end if
       call c%finite('thermal', 'time_step', self%time_step)
       call c%nonnegative('thermal', 'time_step', self%time_step, 's; 0 chooses it')
