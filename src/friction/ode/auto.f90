@@ -28,10 +28,13 @@ module friction_ode_auto
    !> The method name that asks for the choice.
    character(len=*), parameter :: auto_name = 'auto'
 
-   !> Stiffness S from which the implicit stiff_method is chosen.  On the NaF
-   !> map (128 samples a line) the two cost the same at S = 120 and bsimp is
-   !> 2 times faster at S = 390, 6 times at 1200 (docs/speed.md, Stiff tips).
-   real(wp), parameter :: stiff_threshold = 200.0_wp
+   !> Stiffness S from which the implicit stiff_method is chosen.  Measured on
+   !> NaF and HOPG lines of 128 samples (docs/speed.md, Stiff tips): below
+   !> S = 100 the explicit pairs are 2 to 5 times faster at equal error; from
+   !> 120 to 460 either may win by up to 2 times, depending on how much of
+   !> the cost is the slips (accuracy) rather than the sticks (stability);
+   !> from 1200 on bsimp wins by 6 times and more.  Hence the switch at 1000.
+   real(wp), parameter :: stiff_threshold = 1000.0_wp
 
    !> The stepper of stiff scenes: the Bader-Deuflhard extrapolation with the
    !> analytic Jacobian; the fastest of GSL's implicit steppers at equal error
