@@ -19,12 +19,16 @@ Measures and prints (this is not a test; nothing fails on a missed target):
 * The stiff tips of method = 'auto' (docs/speed.md, Stiff tips): the same
   map with 16 lines and the damping --stiff-damping (N s/m), 'auto' (which
   picks bsimp there) against rkck, rk8pd and CVODE at equal error.
+* With --crossover, instead of all that: the crossover of the rule, tips of
+  growing stiffness S (NaF and HOPG, 4 lines of 128 samples), the fastest
+  explicit stepper (rkck, rk8pd) against bsimp at equal error, and the
+  stepper 'auto' picks.
 
 The CVODE program is compiled here with $CC (default cc) against SUNDIALS
 (Debian: libsundials-dev); without it the CVODE rows are skipped with a
 note.  Usage (normally through scripts/benchmark_stiff, which builds first):
 
-    python3 scripts/benchmark_stiff.py [--repeats N] [--binary PATH] [--quick]
+    python3 scripts/benchmark_stiff.py [--repeats N] [--binary PATH] [--quick] [--crossover]
                                        [--levels E1,E2] [--stiff-damping C] [--json FILE]
 """
 
@@ -50,6 +54,19 @@ except ImportError as exc:  # pragma: no cover - environment problem
 
 ROOT = Path(__file__).resolve().parent.parent
 NAF = ROOT / "inputs" / "naf.nml"
+HOPG = ROOT / "inputs" / "hopg.nml"
+# (label, input, tip/scan overrides): the paper's tips, then stiffer ones.
+CROSSOVER = [
+    ("NaF, paper", NAF, ""),
+    ("HOPG, paper", HOPG, ""),
+    ("NaF, c = 3e-3", NAF, "&tip cx = 3e-3, cy = 3e-3 /\n"),
+    ("NaF, c = 1e-2", NAF, "&tip cx = 1e-2, cy = 1e-2 /\n"),
+    ("HOPG, c = 1e-2", HOPG, "&tip cx = 1e-2, cy = 1e-2 /\n"),
+    ("NaF, m = 1e-9", NAF, "&tip mass = 1e-9 /\n"),
+    ("NaF, 40 Å/s", NAF, "velocity = 40.0"),
+    ("NaF, c = 3e-2", NAF, "&tip cx = 3e-2, cy = 3e-2 /\n"),
+    ("NaF, c = 1e-1", NAF, "&tip cx = 1e-1, cy = 1e-1 /\n"),
+]
 PEER_SOURCE = ROOT / "scripts" / "cvode_naf.c"
 TARGET_PROCESS_S = 0.3
 FORCES = ("afm/trace/fx", "afm/trace/fy", "afm/retrace/fx", "afm/retrace/fy")
@@ -85,7 +102,8 @@ class Bench:
         self.count = 0
 
     # ---------------------------------------------------------- the program
-    def friction(self, method: str, rtol: float, atol: float, extra: str = "", repeats: int | None = None):
+    def friction(self, method: str, rtol: float, atol: float, extra: str = "", repeats: int | None = None,
+                 base: Path = NAF):
         """Median over repeats of (compute, process wall, process CPU); forces; attributes."""
         self.count += 1
         nml = self.workdir / f"o{self.count}.nml"
@@ -93,7 +111,7 @@ class Bench:
         out = self.workdir / f"o{self.count}.h5"
         computes, walls, cpus = [], [], []
         for _ in range(repeats or self.repeats):
-            result, wall, cpu = run_process([str(self.binary), "-q", "-f", "-o", str(out), str(NAF), str(nml)])
+            result, wall, cpu = run_process([str(self.binary), "-q", "-f", "-o", str(out), str(base), str(nml)])
             if result.returncode != 0:
                 raise RuntimeError(f"friction {method} {rtol:g}: {result.stderr.strip()}")
             with h5py.File(out, "r") as f:
@@ -196,6 +214,41 @@ def compare(title: str, series: dict, levels: list[float], summary: list) -> Non
         summary.append({"case": title, "level": level, "best": best[0], "program": mine, "cvode": peer})
 
 
+def crossover(bench: Bench, levels: list[float]) -> list[dict]:
+    """The explicit pairs against bsimp on tips of growing stiffness."""
+    print("| tip | auto picks | error level | fastest explicit | its time | bsimp's time | explicit / bsimp |")
+    print("|---|---|---|---|---|---|---|")
+    rows = []
+    for label, base, override in CROSSOVER:
+        scan = f", {override}" if override.startswith("velocity") else ""
+        tip = "" if scan else override
+        extra = f"&scan ny = 4{scan} /\n{tip}"
+        log(f"crossover: {label}")
+        ref = bench.friction("rk8pd", 1e-12, 1e-12, extra, repeats=1, base=base)[1]
+        picked = bench.friction("auto", 1e-3, 1e-3, extra, repeats=1, base=base)[0]["ran"]
+        series = {}
+        for method in ("rkck", "rk8pd", "bsimp"):
+            series[method] = []
+            for rtol in (1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8):
+                cost, forces = bench.friction(method, rtol, rtol, extra, base=base)
+                error = float(np.abs(forces - ref).max())
+                series[method].append({"error": error, "compute": cost["compute"]})
+                if error < min(levels) / 10 or cost["compute"] > 5.0:
+                    break
+        for level in levels:
+            explicit = [(m, cost_at(series[m], level, "compute")) for m in ("rkck", "rk8pd")]
+            explicit = [e for e in explicit if e[1] is not None]
+            implicit = cost_at(series["bsimp"], level, "compute")
+            best = min(explicit, key=lambda e: e[1]) if explicit else None
+            ratio = f"{best[1] / implicit:.2f}" if best and implicit else "-"
+            print(f"| {label} | {picked} | {level:.0e} | {best[0] if best else '-'} | "
+                  f"{best[1] * 1e3:.1f} ms | " if best else f"| {label} | {picked} | {level:.0e} | - | - | ", end="")
+            print(f"{implicit * 1e3:.1f} ms | {ratio} |" if implicit else "not reached | - |")
+            rows.append({"tip": label, "auto": picked, "level": level, "explicit": best,
+                         "bsimp": implicit})
+    return rows
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--binary", type=Path, default=ROOT / "build" / "friction")
@@ -203,6 +256,7 @@ def main(argv=None) -> int:
     p.add_argument("--quick", action="store_true", help="8 lines, short ladders, 1 repeat")
     p.add_argument("--levels", default="1e-4,1e-7", help="force error levels, nN")
     p.add_argument("--stiff-damping", type=float, default=3.0e-2, help="N s/m for the stiff tip")
+    p.add_argument("--crossover", action="store_true", help="only the crossover table of the rule")
     p.add_argument("--json", type=Path)
     args = p.parse_args(argv)
     if not args.binary.exists():
@@ -213,6 +267,11 @@ def main(argv=None) -> int:
     record = {"levels": levels, "summary": []}
     with tempfile.TemporaryDirectory(prefix="benchmark_stiff_") as scratch:
         bench = Bench(args.binary.resolve(), Path(scratch), repeats)
+        if args.crossover:
+            record["crossover"] = crossover(bench, levels)
+            if args.json:
+                args.json.write_text(json.dumps(record, indent=1, default=float))
+            return 0
         why = bench.build_peer()
         if why:
             log(why)
