@@ -252,11 +252,6 @@ def make_scenes(quick: bool) -> dict:
                         "NaF, 8 lines, trace + retrace", "inputs/naf.nml, ny = 8, nx = 64"),
         "hopg": AfmScene("hopg", ("hopg.nml",), "&scan nx = 64, ny = 8 /", afm_tols, 1e-12,
                          "HOPG, 8 lines at 7°, trace + retrace", "inputs/hopg.nml, ny = 8, nx = 64"),
-        # A stiff tip (damping 30 times the paper's: S = 1181, docs/speed.md,
-        # Stiff tips), where method = 'auto' picks bsimp.
-        "naf_stiff": AfmScene("naf_stiff", ("naf.nml",), "&scan nx = 64, ny = 8 /\n&tip cx = 3e-2, cy = 3e-2 /",
-                              afm_tols, 1e-12, "NaF, 8 lines, stiff tip (c = 3e-2 N s/m), trace + retrace",
-                              "inputs/naf.nml, ny = 8, nx = 64, cx = cy = 3e-2"),
         # the failure map's NaF case: the first line alone
         "naf_line": AfmScene("naf_line", ("naf.nml",), "&scan nx = 64, ny = 1 /", afm_tols, 1e-12,
                              "NaF, one line, trace + retrace", "inputs/naf.nml, ny = 1, nx = 64"),
