@@ -28,6 +28,7 @@ from helpers import fail  # noqa: E402
 
 # (scene, input file, override, rtol, the table's stepper)
 AFM_SMALL = "&scan nx = 8, ny = 2, length = 4.0, width = 2.0 /\n"
+STIFF_TIP = "&tip cx = 3e-2, cy = 3e-2 /\n"
 LJ_SMALL = "&scan nx = 4, ny = 1, length = 1.0 /\n"
 BRAKE_SHORT = ("&brake model = '{model}', t_end = 40.0, dt_out = 0.5 /\n"
                "&analysis spectrum = .false., poincare = .false., lyapunov = .false., rosenstein = .false.,"
@@ -38,6 +39,15 @@ TABLE = [
     ("naf", "naf.nml", AFM_SMALL, 1e-9, "rk8pd"),
     ("hopg", "hopg.nml", AFM_SMALL, 1e-4, "rkck"),
     ("hopg", "hopg.nml", AFM_SMALL, 1e-8, "rk8pd"),
+    # Stiff tips (docs/speed.md, Stiff tips): S = rate x sample interval.  The
+    # small scan's sample interval is 4/7 Å / 400 Å/s = 1.43 ms; damping
+    # 3e-2 N s/m gives a decay rate of 3.0e6 /s (NaF) and 3.0e6 /s (HOPG),
+    # S = 4300: bsimp at any rtol.  The paper's NaF tip (rate 1.17e5 /s)
+    # scanned at 4 Å/s has S = 1.17e5 x 0.143 s = 16700: bsimp too.
+    ("naf_stiff", "naf.nml", AFM_SMALL + STIFF_TIP, 1e-3, "bsimp"),
+    ("naf_stiff", "naf.nml", AFM_SMALL + STIFF_TIP, 1e-9, "bsimp"),
+    ("hopg_stiff", "hopg.nml", AFM_SMALL + STIFF_TIP, 1e-4, "bsimp"),
+    ("naf_slow", "naf.nml", AFM_SMALL.replace(" /", ", velocity = 4.0 /"), 1e-5, "bsimp"),
     ("graphite", "graphite.nml", LJ_SMALL, 1e-4, "rk8pd"),
     ("brake_regularized", "brake.nml", BRAKE_SHORT.format(model="regularized"), 1e-3, "rk2"),
     ("brake_regularized", "brake.nml", BRAKE_SHORT.format(model="regularized"), 1e-5, "rk4imp"),
@@ -112,10 +122,13 @@ def main():
                 return cfg.compute()
 
         for scene, _, _, rtol, expected in TABLE:
-            if scene in ("naf", "hopg"):
-                values = {"surface.potential": scene, "scan.nx": 32, "scan.ny": 1, "integrator.rtol": rtol,
+            if scene in ("naf", "hopg", "naf_stiff", "hopg_stiff"):
+                potential = scene.split("_")[0]
+                values = {"surface.potential": potential, "scan.nx": 32, "scan.ny": 1, "integrator.rtol": rtol,
                           "integrator.atol": rtol}
-                if scene == "hopg":
+                if scene.endswith("_stiff"):
+                    values.update({"tip.cx": 3e-2, "tip.cy": 3e-2})
+                if potential == "hopg":
                     values.update({"surface.v0": 0.5, "tip.kx": 25.0, "tip.ky": 25.0, "scan.angle": 7.0})
                 kind = "afm"
             elif scene.startswith("brake_"):

@@ -19,11 +19,12 @@ module friction_afm_config
    use friction_ode_settings, only: visit_integrator, check_integrator
    use friction_afm_thermal, only: thermal_settings
    use friction_afm_langevin, only: langevin_time_step, largest_curvature
+   use friction_ode_auto, only: oscillator_rate
    implicit none
    private
 
    public :: afm_config, potential_names, net_names, tip_model_names, new_potential, new_tip, net_sites, max_species, &
-      & max_defects, species_count, surface_curvature, thermal_step_limit
+      & max_defects, species_count, surface_curvature, thermal_step_limit, tip_stiffness
 
    character(len=*), parameter :: potential_names(3) = [character(len=4) :: 'naf', 'hopg', 'lj']
    character(len=*), parameter :: net_names(3) = [character(len=8) :: 'graphite', 'square', 'file']
@@ -502,6 +503,39 @@ contains
       call langevin_time_step(tip, surface_curvature(config, potential), dt, limit, error)
       if (allocated(error)) limit = 0.0_wp
    end function thermal_step_limit
+
+   !> The stiffness S of the scan for method = 'auto' (friction_ode_auto):
+   !> the largest decay rate of the tip linearised anywhere on the surface
+   !> times the time between two samples.  Per direction the rate is that of
+   !> the damped oscillator whose spring k_i is softened or stiffened by the
+   !> surface's largest curvature (either sign: the tip also crosses
+   !> maxima); the quasistatic model, which takes no steps of the motion,
+   !> and the Lennard-Jones sums, whose curvature is not bounded here, give
+   !> 0 (not known).
+   function tip_stiffness(config) result(stiffness)
+      type(afm_config), intent(in) :: config
+      real(wp) :: stiffness
+      class(surface_potential), allocatable :: potential
+      type(afm_tip) :: tip
+      type(error_type), allocatable :: error
+      real(wp) :: curvature, rate, sample_time
+      integer :: i
+
+      stiffness = 0.0_wp
+      if (config%model == 'quasistatic' .or. config%potential == 'lj') return
+      if (config%nx < 2 .or. .not. config%velocity > 0.0_wp) return
+      call new_potential(config, potential, error)
+      if (allocated(error)) return
+      call new_tip(config, potential, tip)
+      curvature = surface_curvature(config, potential)
+      rate = 0.0_wp
+      do i = 1, tip%ndim
+         rate = max(rate, oscillator_rate(merge(tip%mass, 0.0_wp, tip%model == model_inertial), &
+            & tip%damping(i), tip%spring(i) - curvature, tip%spring(i) + curvature))
+      end do
+      sample_time = config%length / real(config%nx - 1, wp) / config%velocity
+      stiffness = rate * sample_time
+   end function tip_stiffness
 
    !> The tip model in internal units around a potential; the support path
    !> is set per trip.  The quasistatic model uses the damping only to relax

@@ -18,7 +18,7 @@ module friction_afm_scene
    use friction_scene, only: scene, point_result
    use friction_scene_report, only: job_reporter
    use friction_scene_context, only: job_context, agree_on_error, ranks_text, share_of, job_wall_time
-   use friction_afm_config, only: afm_config, new_potential, species_count
+   use friction_afm_config, only: afm_config, new_potential, species_count, tip_stiffness
    use friction_afm_scan, only: afm_scanner, line_record, slip_list, n_quantities, q_fx, q_fy, q_f_along
    use friction_afm_output, only: write_afm_file, afm_surface_record, afm_thermal_record
    use friction_afm_validity, only: afm_model_warnings, quasistatic_friction_warning
@@ -101,13 +101,15 @@ contains
    end subroutine afm_check
 
    !> The settings that run: method = 'auto' becomes the stepper the
-   !> work-precision charts show fastest for the potential at this rtol.
+   !> work-precision charts show fastest for the potential at this rtol, or
+   !> the implicit one where the tip is stiff (tip_stiffness).
    function resolved(self) result(c)
       class(afm_scene), intent(in) :: self
       type(afm_config) :: c
 
       c = self%config
-      if (c%solver%method == auto_name) c%solver%method = auto_method('afm', c%potential, c%solver%rtol)
+      if (c%solver%method == auto_name) c%solver%method = auto_method('afm', c%potential, c%solver%rtol, &
+         & tip_stiffness(c))
    end function resolved
 
    !> The stepper that runs; at a temperature the Langevin scheme.

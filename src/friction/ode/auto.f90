@@ -8,26 +8,59 @@
 !> (atol + rtol times the scale of the measured quantity).  The bands below
 !> are those findings; a scene not measured falls back on the stepper of the
 !> nearest measured scene.
+!>
+!> A stiff scene comes first: where the explicit steppers would be bound by
+!> stability rather than accuracy, an implicit one is chosen whatever the
+!> table says.  The caller measures that as the stiffness
+!>   S = (largest decay rate of the linearised system) x (output interval),
+!> which is about three times the number of steps an explicit pair must take
+!> between two outputs however loose the tolerance (its stability interval
+!> on the negative real axis is about 3), while an implicit stepper can
+!> step from output to output.  The crossover S = stiff_threshold is
+!> measured (docs/speed.md, Stiff tips).
 module friction_ode_auto
    use friction_kinds, only: wp
    implicit none
    private
 
-   public :: auto_name, auto_method
+   public :: auto_name, auto_method, stiff_threshold, stiff_method, oscillator_rate
 
    !> The method name that asks for the choice.
    character(len=*), parameter :: auto_name = 'auto'
+
+   !> Stiffness S from which the implicit stiff_method is chosen.  Measured on
+   !> NaF and HOPG lines of 128 samples (docs/speed.md, Stiff tips): below
+   !> S = 100 the explicit pairs are 2 to 5 times faster at equal error; from
+   !> 120 to 460 either may win by up to 2 times, depending on how much of
+   !> the cost is the slips (accuracy) rather than the sticks (stability);
+   !> from 1200 on bsimp wins by 6 times and more.  Hence the switch at 1000.
+   real(wp), parameter :: stiff_threshold = 1000.0_wp
+
+   !> The stepper of stiff scenes: the Bader-Deuflhard extrapolation with the
+   !> analytic Jacobian; the fastest of GSL's implicit steppers at equal error
+   !> on the stiff tips measured (msbdf, rk4imp and rk2imp are slower or less
+   !> accurate than asked).
+   character(len=*), parameter :: stiff_method = 'bsimp'
 
 contains
 
    !> The stepper for a scene ('afm' or 'brake'), its model (for the AFM the
    !> potential: 'naf', 'hopg', 'lj'; for the brake 'regularized' or
-   !> 'switched') and the asked relative tolerance.  Always a known step type.
-   pure function auto_method(scene, model, rtol) result(method)
+   !> 'switched'), the asked relative tolerance and, where the caller can
+   !> tell, the stiffness S (see above; absent or 0: not known, the table
+   !> alone decides).  Always a known step type.
+   pure function auto_method(scene, model, rtol, stiffness) result(method)
       character(len=*), intent(in) :: scene, model
       real(wp), intent(in) :: rtol
+      real(wp), intent(in), optional :: stiffness
       character(len=16) :: method
 
+      if (present(stiffness)) then
+         if (stiffness >= stiff_threshold) then
+            method = stiff_method
+            return
+         end if
+      end if
       select case (trim(scene))
       case ('brake')
          select case (trim(model))
@@ -58,5 +91,37 @@ contains
          end select
       end select
    end function auto_method
+
+   !> The largest decay rate |lambda| (1/time) of a damped oscillator
+   !> m x'' + c x' + k x = 0 whose stiffness k may be anywhere in
+   !> [k_low, k_high] (a spring plus a surface curvature of either sign):
+   !> the roots of m lambda**2 + c lambda + k = 0.  Over that range the
+   !> largest |lambda| is at an end: the fast real root grows as k falls,
+   !> the modulus sqrt(k/m) of complex roots as k rises.  Without inertia
+   !> (m = 0) the rate is k/c; 0 when neither m nor c is positive.
+   pure real(wp) function oscillator_rate(m, c, k_low, k_high) result(rate)
+      real(wp), intent(in) :: m, c, k_low, k_high
+
+      if (m > 0.0_wp) then
+         rate = max(root_modulus(k_low), root_modulus(k_high))
+      else if (c > 0.0_wp) then
+         rate = max(abs(k_low), abs(k_high)) / c
+      else
+         rate = 0.0_wp
+      end if
+   contains
+      pure real(wp) function root_modulus(k)
+         real(wp), intent(in) :: k
+         real(wp) :: half, discriminant
+
+         half = 0.5_wp * c / m
+         discriminant = half**2 - k / m
+         if (discriminant >= 0.0_wp) then
+            root_modulus = abs(half) + sqrt(discriminant)
+         else
+            root_modulus = sqrt(k / m)
+         end if
+      end function root_modulus
+   end function oscillator_rate
 
 end module friction_ode_auto
