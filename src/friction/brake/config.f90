@@ -208,6 +208,8 @@ contains
       call check_tolerance_bounds(c, 'verify', 'check_rtol', 'check_atol', self%check%rtol, self%check%atol)
       call c%nonnegative('verify', 'check_limit', self%check%max_difference, 'm; 0 reports only')
       call self%analysis%validate(c, self%t_start, self%t_end, series_names)
+      if (self%analysis%orbit .and. self%model /= model_switched) call c%reject('analysis', 'orbit', '.true.', &
+         & "needs model = 'switched': the section is its located stick-to-slip events")
    end subroutine validate
 
    !> With units = 'dimensional', derive params from the §6.2 data

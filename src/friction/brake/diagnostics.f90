@@ -17,6 +17,8 @@ module friction_brake_diagnostics
    use friction_analysis_lyapunov_spectrum, only: tangent_settings, spectrum_accumulator, kaplan_yorke, &
       & generic_frame
    use friction_analysis_lyapunov_series, only: rosenstein_settings, rosenstein_result, rosenstein_exponent
+   use friction_analysis_periodic_orbit, only: orbit_settings
+   use friction_brake_orbit, only: brake_orbit, brake_periodic_orbit
    implicit none
    private
 
@@ -37,6 +39,7 @@ module friction_brake_diagnostics
       real(wp) :: kaplan_yorke = 0.0_wp
       type(rosenstein_result) :: series
       real(wp) :: series_dt = 0.0_wp   !! sample spacing of the strided series
+      type(brake_orbit) :: orbit       !! the periodic orbit through the section (Newton)
    end type brake_diagnostics
 
 contains
@@ -131,6 +134,13 @@ contains
             if (allocated(error)) return
             result%exponents = result%qr%exponents()
             result%kaplan_yorke = kaplan_yorke(result%exponents)
+         end if
+         if (a%orbit) then
+            ! Not finding one is a result (orbit%found), not an error.
+            call brake_periodic_orbit(config, events, a%orbit_transient, &
+               & orbit_settings(tolerance=a%orbit_tolerance, max_iterations=a%orbit_max_iterations), &
+               & result%orbit, error)
+            if (allocated(error)) return
          end if
          if (a%rosenstein) then
             result%series_dt = config%dt_out * a%rosenstein_stride

@@ -174,7 +174,8 @@ contains
          ! Benettin, of the settings): every rank computes the same numbers, so
          ! the file does not depend on the number of ranks.
          associate (a => settings%analysis)
-            self%analysing = a%spectrum .or. a%poincare .or. a%lyapunov .or. a%rosenstein .or. a%lyapunov_spectrum
+            self%analysing = a%spectrum .or. a%poincare .or. a%lyapunov .or. a%rosenstein .or. a%lyapunov_spectrum &
+               & .or. a%orbit
          end associate
          if (self%analysing) then
             call diagnose_brake(settings, main_run%trajectory, main_run%events, self%diagnostics, error)
