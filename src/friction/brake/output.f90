@@ -224,6 +224,7 @@ contains
             call file%write_vector('/brake/lyapunov/benettin_time', d%flow%time(1:d%flow%n), '1')
             call file%write_vector('/brake/lyapunov/benettin_estimate', d%flow%estimate(1:d%flow%n), '1/tau')
          end if
+         if (a%orbit) call write_orbit(file, d)
          if (a%rosenstein) then
             call file%write_attribute_real('/brake/lyapunov', 'rosenstein_exponent', d%series%exponent, '1/tau')
             ! OpenTSTool's largelyap unit: log2 per sample of the series.
@@ -245,5 +246,38 @@ contains
          end if
       end associate
    end subroutine write_diagnostics
+
+   !> /brake/orbit (docs/output.md): the periodic orbit through the
+   !> stick-to-slip section, or found = 0 and the reason.
+   subroutine write_orbit(file, d)
+      type(h5_file), intent(inout) :: file
+      type(brake_diagnostics), intent(in) :: d
+      character(len=*), parameter :: group = '/brake/orbit'
+      real(wp) :: parts(2, 4)
+
+      associate (a => d%settings, o => d%orbit)
+         call file%create_group(group)
+         call file%write_attribute_integer(group, 'found', merge(1_i8, 0_i8, o%orbit%found))
+         if (.not. o%orbit%found) call file%write_attribute_text(group, 'reason', o%orbit%reason)
+         call file%write_attribute_text(group, 'section', 'stick_to_slip')
+         call file%write_attribute_integer(group, 'static_limit', int(nint(o%limit), i8))
+         call file%write_attribute_real(group, 'guess_time', o%guess_time, 'tau')
+         call file%write_attribute_real(group, 'transient', a%orbit_transient, 'tau')
+         call file%write_attribute_real(group, 'tolerance', a%orbit_tolerance, 'm')
+         call file%write_attribute_integer(group, 'iterations', int(o%orbit%iterations, i8))
+         call file%write_attribute_real(group, 'residual', o%orbit%residual, 'm')
+         ! The fixed point, or Newton's last iterate when none was found.
+         call file%write_vector(group//'/point', o%state, 'm, m per unit tau, m, m per unit tau')
+         call file%write_attribute_text(group//'/point', 'names', 'x, v, y, w')
+         if (.not. o%orbit%found) return
+         call file%write_attribute_real(group, 'period', o%orbit%period, 'tau')
+         call file%write_matrix(group//'/section_jacobian', o%orbit%jacobian, '1')
+         parts(1, :) = real(o%multipliers)
+         parts(2, :) = aimag(o%multipliers)
+         call file%write_matrix(group//'/floquet_multipliers', parts, '1')
+         call file%write_attribute_text(group//'/floquet_multipliers', 'columns', 'real, imag')
+         call file%write_vector(group//'/floquet_exponents', o%exponents, '1/tau')
+      end associate
+   end subroutine write_orbit
 
 end module friction_brake_output
