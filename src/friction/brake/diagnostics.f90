@@ -18,7 +18,7 @@ module friction_brake_diagnostics
       & generic_frame
    use friction_analysis_lyapunov_series, only: rosenstein_settings, rosenstein_result, rosenstein_exponent
    use friction_analysis_periodic_orbit, only: orbit_settings
-   use friction_brake_orbit, only: brake_orbit, brake_periodic_orbit
+   use friction_brake_orbit, only: brake_orbit, brake_periodic_orbit, orbit_branch, follow_branch
    implicit none
    private
 
@@ -40,6 +40,7 @@ module friction_brake_diagnostics
       type(rosenstein_result) :: series
       real(wp) :: series_dt = 0.0_wp   !! sample spacing of the strided series
       type(brake_orbit) :: orbit       !! the periodic orbit through the section (Newton)
+      type(orbit_branch) :: branch     !! ... followed along the continuation line
    end type brake_diagnostics
 
 contains
@@ -141,6 +142,12 @@ contains
                & orbit_settings(tolerance=a%orbit_tolerance, max_iterations=a%orbit_max_iterations), &
                & result%orbit, error)
             if (allocated(error)) return
+            if (len_trim(a%continuation) > 0) then
+               call follow_branch(config, result%orbit, a%continuation_end, a%continuation_points, &
+                  & a%orbit_transient, orbit_settings(tolerance=a%orbit_tolerance, &
+                  & max_iterations=a%orbit_max_iterations), result%branch, error)
+               if (allocated(error)) return
+            end if
          end if
          if (a%rosenstein) then
             result%series_dt = config%dt_out * a%rosenstein_stride
