@@ -153,8 +153,6 @@ contains
          & 'shorter than one renormalisation interval, lyapunov_spectrum_renormalise = ' &
          & //rtoa(self%lyapunov_spectrum_renormalise))
       call c%nonnegative('analysis', 'orbit_transient', self%orbit_transient, 'τ')
-      if (self%orbit .and. .not. (self%orbit_transient < t_end - t_start)) call c%reject('analysis', &
-         & 'orbit_transient', rtoa(self%orbit_transient), 'leaves no time for a section point before t_end')
       call c%positive('analysis', 'orbit_tolerance', self%orbit_tolerance, 'm and m per unit time')
       if (self%orbit_max_iterations < 1) call c%reject('analysis', 'orbit_max_iterations', &
          & itoa(self%orbit_max_iterations), 'must be >= 1')

@@ -211,9 +211,12 @@ contains
       call check_tolerance_bounds(c, 'verify', 'check_rtol', 'check_atol', self%check%rtol, self%check%atol)
       call c%nonnegative('verify', 'check_limit', self%check%max_difference, 'm; 0 reports only')
       call self%analysis%validate(c, self%t_start, self%t_end, series_names)
-      if (self%analysis%orbit .and. self%model /= model_switched) call c%reject('analysis', 'orbit', '.true.', &
-         & "needs model = 'switched': the section is its located stick-to-slip events")
       if (c%failed() .or. len_trim(self%analysis%continuation) == 0) return
+      if (self%model /= model_switched) then
+         call c%reject('analysis', 'continuation', "'"//trim(self%analysis%continuation)//"'", &
+            & "follows the orbit on the located stick-to-slip section: needs model = 'switched'")
+         return
+      end if
       if (.not. any(continuation_names == self%analysis%continuation)) then
          call c%reject('analysis', 'continuation', "'"//trim(self%analysis%continuation)//"'", &
             & 'not a variable of &brake the orbit can follow (known: '//quoted(continuation_names)//')')

@@ -136,7 +136,9 @@ contains
             result%exponents = result%qr%exponents()
             result%kaplan_yorke = kaplan_yorke(result%exponents)
          end if
-         if (a%orbit) then
+         if (a%orbit .and. config%model /= model_switched) then
+            result%orbit%orbit%reason = "the section is the switched model's located slip onsets: model = 'switched'"
+         else if (a%orbit) then
             ! Not finding one is a result (orbit%found), not an error.
             call brake_periodic_orbit(config, events, a%orbit_transient, &
                & orbit_settings(tolerance=a%orbit_tolerance, max_iterations=a%orbit_max_iterations), &
