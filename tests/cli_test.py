@@ -118,7 +118,7 @@ DOCUMENTED = ["fx", "fy", "f_along", "f_across", "tip_x", "tip_y"]
 # (The chaos diagnostics of inputs/brake.nml are off here: the brake-analysis case tests them.)
 BRAKE_SHORT = ("&brake t_end = 100.0, dt_out = 0.1 /\n"
                "&analysis spectrum = .false., poincare = .false., lyapunov = .false., rosenstein = .false.,"
-               " lyapunov_spectrum = .false. /\n")
+               " lyapunov_spectrum = .false., orbit = .false. /\n")
 # The chaos diagnostics on a short span (brake-analysis).
 BRAKE_ANALYSIS = ("&brake t_end = 400.0, dt_out = 0.1 /\n"
                   "&analysis window_start = 50.0, window_end = 400.0, lyapunov_transient = 50.0,"
