@@ -8,6 +8,9 @@ brake sweep:
                           the swept parameter (a bifurcation diagram)
   <stem>_lyapunov.png     the Benettin exponent and the stick fraction
                           against the parameter
+  <stem>_atlas.png        with a second variable: maps of the exponent and
+                          the stick fraction over the grid (then only this
+                          one when the second variable has more than 8 values)
 
 and for an AFM sweep:
 

@@ -1009,7 +1009,7 @@ def case_brake_run(args):
     t = d["t"]
     if t.shape != (1001,) or abs(t[0]) > 0 or abs(t[-1] - 100.0) > 1e-9:
         fail(f"grid: {t.shape}, {t[0]} .. {t[-1]}")
-    for key, unit in [("x", b"m"), ("t", b"1")]:
+    for key, unit in [("x", b"m"), ("t", b"tau")]:
         if d["units"][key] != unit:
             fail(f"/brake/{key} units {d['units'][key]}")
     a = d["attrs"]

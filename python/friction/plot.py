@@ -810,6 +810,77 @@ def sweep_lyapunov(data):
     return fig
 
 
+def _grid_axis(values, name):
+    """(coordinates, label, log) of one axis of a 2-D sweep: a geometric
+    axis of negative values (belt velocities) is drawn as its magnitude on
+    a log scale."""
+    if values.size > 2 and np.all(values < 0):
+        ratio = values[1:] / values[:-1]
+        if np.allclose(ratio, ratio[0], rtol=1e-6) and not np.isclose(ratio[0], 1.0):
+            return -values, f"−{name}", True
+    if values.size > 2 and np.all(values > 0):
+        ratio = values[1:] / values[:-1]
+        if np.allclose(ratio, ratio[0], rtol=1e-6) and not np.isclose(ratio[0], 1.0):
+            return values, name, True
+    return values, name, False
+
+
+def _edges(centres, log):
+    """Cell edges around grid centres (geometric means on a log axis)."""
+    c = np.log(centres) if log else centres
+    if c.size == 1:
+        e = np.array([c[0] - 0.5, c[0] + 0.5])
+    else:
+        inner = 0.5 * (c[1:] + c[:-1])
+        e = np.concatenate([[2 * c[0] - inner[0]], inner, [2 * c[-1] - inner[-1]]])
+    return np.exp(e) if log else e
+
+
+def atlas(data):
+    """A two-variable brake sweep as maps: the Benettin exponent (chaos where
+    it is positive) and the stick fraction over the grid; failed or pending
+    points are grey."""
+    s = _brake_sweep(data)
+    if "values2" not in s:
+        raise FileError("an atlas needs a sweep over two variables (sweep_variable2)")
+    n1 = np.unique(s["values"]).size
+    n2 = np.unique(s["values2"]).size
+    if n1 * n2 != s["values"].size:
+        raise FileError("the sweep's points do not form a grid")
+    # The second variable varies fastest (docs/sweeps.md).
+    v1 = s["values"].reshape(n1, n2)[:, 0]
+    v2 = s["values2"].reshape(n1, n2)[0, :]
+    x, xlabel, xlog = _grid_axis(v2, s["variable2"])
+    y, ylabel, ylog = _grid_axis(v1, s["variable"])
+    done = (s["status"] == 1).reshape(n1, n2)
+    fig = _figure(figsize=(7, 8.5))
+    top, bottom = fig.subplots(2, 1, sharex=True)
+    exponent = np.where(done, s["lyapunov"].reshape(n1, n2), np.nan)
+    finite = exponent[np.isfinite(exponent)]
+    bound = max(float(np.max(np.abs(finite))) if finite.size else 1.0, 1e-12)
+    cmap = colormaps["RdBu_r"].copy()
+    cmap.set_bad("0.7")
+    image = top.pcolormesh(_edges(x, xlog), _edges(y, ylog), np.ma.masked_invalid(exponent), cmap=cmap,
+                           vmin=-bound, vmax=bound, shading="flat")
+    fig.colorbar(image, ax=top, label="Benettin exponent (1/τ)")
+    top.set_title("largest Lyapunov exponent: chaos where red")
+    stick = np.where(done, s["stick_fraction"].reshape(n1, n2), np.nan)
+    grey = colormaps["viridis"].copy()
+    grey.set_bad("0.7")
+    image = bottom.pcolormesh(_edges(x, xlog), _edges(y, ylog), np.ma.masked_invalid(stick), cmap=grey,
+                              vmin=0.0, vmax=1.0, shading="flat")
+    fig.colorbar(image, ax=bottom, label="stick fraction")
+    for ax in (top, bottom):
+        ax.set_ylabel(ylabel)
+        if ylog:
+            ax.set_yscale("log")
+        if xlog:
+            ax.set_xscale("log")
+    bottom.set_xlabel(xlabel)
+    fig.tight_layout()
+    return fig
+
+
 def sweep_friction(data):
     """An AFM sweep's mean friction and maximum lateral force against the
     parameter, a line per value of a second variable."""
@@ -841,11 +912,18 @@ def sweep_friction(data):
 
 def sweep(data):
     """Every chart of a sweep file: {"bifurcation": Figure, "lyapunov": Figure}
-    for a brake sweep, {"friction": Figure} for an AFM sweep."""
+    for a brake sweep, and "atlas" (maps) when it has a second variable (only
+    the maps when that has more than 8 values: a line each would not read);
+    {"friction": Figure} for an AFM sweep."""
     data = require(data, "sweep", "sweep")
     s = _sweep(data)
     if s["scene"] == "brake":
-        return {"bifurcation": bifurcation(data), "lyapunov": sweep_lyapunov(data)}
+        if "values2" not in s:
+            return {"bifurcation": bifurcation(data), "lyapunov": sweep_lyapunov(data)}
+        figures = {"atlas": atlas(data)}
+        if np.unique(s["values2"]).size <= 8:
+            figures.update({"bifurcation": bifurcation(data), "lyapunov": sweep_lyapunov(data)})
+        return figures
     return {"friction": sweep_friction(data)}
 
 

@@ -89,6 +89,15 @@ def brake_sweep(files):
 
 
 @pytest.fixture(scope="session")
+def brake_atlas(files):
+    """A brake sweep over a 3 x 4 grid of mu and a log-spaced (negative) v'_dr."""
+    return files("brake_atlas_small", [INPUTS / "brake_sweep.nml", DATA / "sweep_small.nml"],
+                 "&sweep sweep_variable = 'brake.mu', sweep_spacing = 'linear', sweep_from = 0.3, sweep_to = 0.5,"
+                 " sweep_count = 3, sweep_variable2 = 'brake.v_dr_prime', sweep_spacing2 = 'log',"
+                 " sweep_from2 = -0.004, sweep_to2 = -0.0005, sweep_count2 = 4 /\n")
+
+
+@pytest.fixture(scope="session")
 def afm_sweep(files):
     """An AFM sweep over a 5 x 2 grid of V0 and the velocity (tests/data/afm_sweep_small.nml)."""
     return files("afm_sweep_small", [INPUTS / "afm_sweep.nml", DATA / "afm_sweep_small.nml"])

@@ -137,6 +137,26 @@ def test_sweep_pictures(brake_sweep, afm_sweep, tmp_path):
     saved(afm["friction"], tmp_path / "afm_sweep.png")
 
 
+def test_atlas(brake_atlas, brake_sweep, tmp_path):
+    figures = friction.plot.sweep(brake_atlas)
+    # 4 values of the second variable: the maps and the lines.
+    assert set(figures) == {"atlas", "bifurcation", "lyapunov"}
+    top, bottom = figures["atlas"].axes[:2]
+    data = friction.load(brake_atlas)
+    # The second variable varies fastest: row i is mu_i, column j the j-th belt speed.
+    wanted = data["sweep/lyapunov"].values.reshape(3, 4)
+    assert np.array_equal(np.asarray(top.collections[0].get_array()).reshape(3, 4), wanted)
+    stick = data["sweep/stick_fraction"].values.reshape(3, 4)
+    assert np.array_equal(np.asarray(bottom.collections[0].get_array()).reshape(3, 4), stick)
+    # Negative log-spaced belt speeds are drawn as magnitudes on a log axis.
+    assert bottom.get_xscale() == "log" and bottom.get_xlabel() == "−brake.v_dr_prime"
+    assert top.get_yscale() == "linear" and top.get_ylabel() == "brake.mu"
+    assert np.allclose(sorted(bottom.get_xlim()), [0.0005 / 2 ** 0.5, 0.004 * 2 ** 0.5], rtol=1e-9)
+    saved(figures["atlas"], tmp_path / "atlas.png")
+    with pytest.raises(friction.FileError, match="needs a sweep over two variables"):
+        friction.plot.atlas(brake_sweep)
+
+
 def test_work_precision_charts(tmp_path):
     data = friction.load(ROOT / "docs" / "work_precision.h5")
     fig = friction.plot.work_precision(data, "naf")

@@ -97,7 +97,7 @@ contains
          call write_parameter_attributes(file, '/brake', copy, [character(len=17) :: 'brake'])
       end if
 
-      call file%write_vector('/brake/t', trajectory%t, '1')
+      call file%write_vector('/brake/t', trajectory%t, 'tau')
       call file%write_vector('/brake/x', trajectory%x, 'm')
       call file%write_vector('/brake/v', trajectory%v, 'm per unit tau')
       call file%write_vector('/brake/y', trajectory%y, 'm')
@@ -198,8 +198,8 @@ contains
             call file%write_attribute_real('/brake/poincare', 'strobe_start', a%strobe_start, 'tau')
             call file%write_attribute_real('/brake/poincare', 'strobe_end', a%strobe_end, 'tau')
             call file%write_attribute_text('/brake/poincare', 'section', trim(a%section))
-            call file%write_vector('/brake/poincare/strobe_t', d%strobe_t, '1')
-            call file%write_vector('/brake/poincare/section_t', d%section_t, '1')
+            call file%write_vector('/brake/poincare/strobe_t', d%strobe_t, 'tau')
+            call file%write_vector('/brake/poincare/section_t', d%section_t, 'tau')
             do k = 1, 4
                call file%write_vector('/brake/poincare/strobe_'//names(k), d%strobe_points(k, :), trim(units(k)))
                call file%write_vector('/brake/poincare/section_'//names(k), d%section_points(k, :), trim(units(k)))
@@ -222,7 +222,7 @@ contains
             call file%write_attribute_real('/brake/lyapunov', 'benettin_duration', d%benettin%duration, 'tau')
             call file%write_attribute_real('/brake/lyapunov', 'benettin_renormalise', d%benettin%renormalise, 'tau')
             call file%write_attribute_real('/brake/lyapunov', 'benettin_d0', d%benettin%d0)
-            call file%write_vector('/brake/lyapunov/benettin_time', d%flow%time(1:d%flow%n), '1')
+            call file%write_vector('/brake/lyapunov/benettin_time', d%flow%time(1:d%flow%n), 'tau')
             call file%write_vector('/brake/lyapunov/benettin_estimate', d%flow%estimate(1:d%flow%n), '1/tau')
          end if
          if (a%orbit) call write_orbit(file, d)

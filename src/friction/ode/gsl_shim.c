@@ -190,23 +190,42 @@ const char *friction_gsl_error_reason(void)
 /* ---- the driver ---- */
 
 /* A driver for system sys with step type index (1-based), first step
- * hstart (non-zero) and the y_new error control; *driver is NULL
- * unless GSL_SUCCESS is returned. */
+ * hstart (non-zero) and the y_new error control on the first `controlled`
+ * components (all of them when controlled >= the dimension); *driver is
+ * NULL unless GSL_SUCCESS is returned.  The others are given an absolute
+ * scale so large that their error never limits the step: GSL's scaled
+ * control with a_y = 1, a_dydt = 0 and scale 1 is the y_new control. */
 int friction_gsl_driver_new(gsl_odeiv2_driver **driver, const gsl_odeiv2_system *sys, int index,
-                            double hstart, double epsabs, double epsrel)
+                            double hstart, double epsabs, double epsrel, int controlled)
 {
     gsl_odeiv2_driver *d;
+    gsl_odeiv2_control *c = NULL;
+    double *scale;
+    size_t i, n = sys->dimension;
     int status;
 
     *driver = NULL;
     if (index < 1 || index > step_type_count) return GSL_EINVAL;
+    if (controlled < 1) return GSL_EINVAL;
     /* GSL's own check of hstart (non-zero) comes after its allocations and
      * leaks them. */
     if (!(hstart > 0.0 || hstart < 0.0)) return GSL_EINVAL;
     quiet_begin();
     d = gsl_odeiv2_driver_alloc_y_new(sys, *step_types[index - 1].type, hstart, epsabs, epsrel);
+    if (d != NULL && (size_t)controlled < n && (scale = malloc(n * sizeof *scale)) != NULL) {
+        for (i = 0; i < n; i++) scale[i] = i < (size_t)controlled ? 1.0 : 1.0e200;
+        /* (GSL copies the scales.) */
+        c = gsl_odeiv2_control_scaled_new(epsabs, epsrel, 1.0, 0.0, scale, n);
+        free(scale);
+        if (c != NULL) {
+            gsl_odeiv2_control_free(d->c);
+            d->c = c;
+            gsl_odeiv2_control_set_driver(c, d);
+        }
+    }
     status = quiet_end(GSL_SUCCESS);
     if (d == NULL) return status != GSL_SUCCESS ? status : GSL_ENOMEM;
+    if (status == GSL_SUCCESS && (size_t)controlled < n && c == NULL) status = GSL_ENOMEM;
     if (status != GSL_SUCCESS) {
         quiet_begin();
         gsl_odeiv2_driver_free(d);

@@ -126,13 +126,14 @@ module friction_ode_solver
          integer(c_int) :: uses
       end function friction_gsl_step_type_uses_jacobian
 
-      function friction_gsl_driver_new(driver, sys, index, hstart, epsabs, epsrel) &
+      function friction_gsl_driver_new(driver, sys, index, hstart, epsabs, epsrel, controlled) &
          & result(status) bind(c, name='friction_gsl_driver_new')
          import :: c_ptr, c_int, c_double
          type(c_ptr), intent(out) :: driver
          type(c_ptr), value :: sys
          integer(c_int), value :: index
          real(c_double), value :: hstart, epsabs, epsrel
+         integer(c_int), value :: controlled
          integer(c_int) :: status
       end function friction_gsl_driver_new
 
@@ -263,7 +264,8 @@ contains
       self%sys%dimension = int(self%box%n, c_size_t)
       self%sys%params = c_loc(self%box)
       status = friction_gsl_driver_new(self%driver, c_loc(self%sys), int(index, c_int), &
-         & real(h_start, c_double), real(settings%atol, c_double), real(settings%rtol, c_double))
+         & real(h_start, c_double), real(settings%atol, c_double), real(settings%rtol, c_double), &
+         & int(model%controlled_dimension(), c_int))
       if (status /= gsl_success) then
          if (status == gsl_enomem) then
             call fatal_error(error, 'GSL could not allocate a driver for '//trim(settings%method), &

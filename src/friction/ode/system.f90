@@ -14,6 +14,7 @@ module friction_ode_system
       procedure(dimension_interface), deferred :: dimension
       procedure(rhs_interface), deferred :: rhs
       procedure(jacobian_interface), deferred :: jacobian
+      procedure :: controlled_dimension
    end type ode_system
 
    abstract interface
@@ -43,5 +44,17 @@ module friction_ode_system
          real(wp), intent(out) :: dfdt(:)
       end subroutine jacobian_interface
    end interface
+
+contains
+
+   !> The leading components the step-size control measures (all of them
+   !> unless a system says otherwise: a trajectory with its tangent vectors
+   !> lets the trajectory alone set the steps).
+   pure function controlled_dimension(self) result(n)
+      class(ode_system), intent(in) :: self
+      integer :: n
+
+      n = self%dimension()
+   end function controlled_dimension
 
 end module friction_ode_system
