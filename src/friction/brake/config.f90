@@ -234,8 +234,13 @@ contains
          type(config_checker) :: inner
          end_point = continuation_config(self, self%analysis%continuation_end)
          call end_point%validate(inner)
-         if (inner%failed()) call c%reject('analysis', 'continuation_end', rtoa(self%analysis%continuation_end), &
-            & 'the end of the line is not a valid brake: '//inner%error%message)
+         if (inner%failed()) then
+            ! The inner checker knows no file: drop its '(default): ' origin.
+            associate (message => inner%error%message, origin => index(inner%error%message, '(default): '))
+               call c%reject('analysis', 'continuation_end', rtoa(self%analysis%continuation_end), &
+                  & 'the end of the line is not a valid brake: '//message(merge(origin + 11, 1, origin == 1):))
+            end associate
+         end if
       end block
    end subroutine validate
 
