@@ -99,7 +99,7 @@ class Friction:
             f"max_steps = 200000000, max_wall_time = {self.max_wall!r} /\n"
             # The integration alone is measured: no chaos diagnostics.
             "&analysis spectrum = .false., poincare = .false., lyapunov = .false., rosenstein = .false.,"
-            " lyapunov_spectrum = .false. /\n")
+            " lyapunov_spectrum = .false., orbit = .false. /\n")
         try:
             proc = subprocess.run([str(self.binary), "--quiet", "--force", "-o", str(out), str(INPUT), str(nml)],
                                   capture_output=True, text=True, cwd=self.workdir,

@@ -31,9 +31,9 @@ import h5py
 ROOT = Path(__file__).resolve().parent.parent
 
 OFF = ("&analysis spectrum = .false., poincare = .false., lyapunov = .false., rosenstein = .false.,"
-       " lyapunov_spectrum = .false. /\n")
+       " lyapunov_spectrum = .false., orbit = .false. /\n")
 ON = ("&analysis spectrum = .false., poincare = .false., lyapunov = .false., rosenstein = .false.,"
-      " lyapunov_spectrum = .true. /\n")
+      " lyapunov_spectrum = .true., orbit = .false. /\n")
 CASES = {"paper case (period 1)": "", "chaotic (mu = 0.35, v'_dr = -2e-4)": "mu = 0.35, v_dr_prime = -2.0e-4, "}
 
 

@@ -82,7 +82,7 @@ DEFAULT_BINARY = ROOT / "build" / "friction"
 COMMON = ("&scan ny = 1, retrace = .false. /\n"
           "&brake model = 'regularized' /\n"
           "&analysis spectrum = .false., poincare = .false., lyapunov = .false., rosenstein = .false.,"
-          " lyapunov_spectrum = .false. /\n"
+          " lyapunov_spectrum = .false., orbit = .false. /\n"
           "&verify check = .false. /\n")
 
 

@@ -13,6 +13,12 @@ current directory, like `friction` itself) the PNGs of what the file holds:
   <stem>_lyapunov.png  the running Benettin estimate (from the equations)
                        and the Rosenstein divergence curve with its fit range
                        and slope (from the series)
+  <stem>_floquet.png   the periodic orbit's Floquet multipliers and the
+                       unit circle (&analysis orbit)
+  <stem>_bifurcation.png  along a continuation line: the attractor's slip
+                       onsets, the followed orbit (stable solid, unstable
+                       dashed), the detected bifurcations annotated, and the
+                       largest |multiplier| (&analysis continuation)
 
 Frequencies in cycles per unit tau, exponents in 1/tau (natural log).
 
@@ -23,8 +29,9 @@ Examples:
 Exit codes: 0 done, 1 a PNG could not be written, 2 bad command line or
 bad input file (missing, not a brake run, no diagnostics in it).
 
-A command line over friction.plot.brake_spectrum, friction.plot.poincare and
-friction.plot.lyapunov (python/friction/plot.py).
+A command line over friction.plot.brake_spectrum, friction.plot.poincare,
+friction.plot.lyapunov, friction.plot.floquet and friction.plot.orbit_branch
+(python/friction/plot.py).
 """
 
 import argparse
@@ -40,8 +47,12 @@ import friction  # noqa: E402
 import friction.plot  # noqa: E402
 
 PROG = "plot_chaos.py"
-PLOTS = (("spectrum", friction.plot.brake_spectrum), ("poincare", friction.plot.poincare),
-         ("lyapunov", friction.plot.lyapunov))
+# (PNG name, the group it needs, the function drawing it)
+PLOTS = (("spectrum", "brake/spectrum", friction.plot.brake_spectrum),
+         ("poincare", "brake/poincare", friction.plot.poincare),
+         ("lyapunov", "brake/lyapunov", friction.plot.lyapunov),
+         ("floquet", "brake/orbit", friction.plot.floquet),
+         ("bifurcation", "brake/orbit/branch", friction.plot.orbit_branch))
 
 
 def parse_args(argv):
@@ -63,7 +74,7 @@ def main(argv=None):
     args = parse_args(argv)
     try:
         data = friction.load(args.file, scene="brake")
-        present = [(name, draw) for name, draw in PLOTS if f"brake/{name}" in data.group_attrs]
+        present = [(name, draw) for name, group, draw in PLOTS if group in data.group_attrs]
         if not present:
             raise friction.FileError("no chaos diagnostics in the file (run friction with an &analysis group)")
         figures = {name: draw(data) for name, draw in present}

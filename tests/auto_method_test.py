@@ -32,7 +32,7 @@ STIFF_TIP = "&tip cx = 3e-2, cy = 3e-2 /\n"
 LJ_SMALL = "&scan nx = 4, ny = 1, length = 1.0 /\n"
 BRAKE_SHORT = ("&brake model = '{model}', t_end = 40.0, dt_out = 0.5 /\n"
                "&analysis spectrum = .false., poincare = .false., lyapunov = .false., rosenstein = .false.,"
-               " lyapunov_spectrum = .false. /\n")
+               " lyapunov_spectrum = .false., orbit = .false. /\n")
 TABLE = [
     ("naf", "naf.nml", AFM_SMALL, 1e-3, "rkck"),
     ("naf", "naf.nml", AFM_SMALL, 1e-7, "rkck"),

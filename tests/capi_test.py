@@ -37,7 +37,7 @@ HOPG_QUASISTATIC = ("hopg.nml", "&tip model = 'quasistatic' /\n&scan nx = 24, ny
 GRAPHITE = ("graphite.nml", "&scan nx = 4, ny = 2, length = 1.0, width = 0.5 /\n")
 BRAKE = ("brake.nml", "&brake t_end = 40.0, dt_out = 0.5 /\n"
          "&analysis spectrum = .false., poincare = .false., lyapunov = .false., rosenstein = .false.,"
-         " lyapunov_spectrum = .false. /\n")
+         " lyapunov_spectrum = .false., orbit = .false. /\n")
 # Attributes that measure the run rather than compute it.
 
 

@@ -118,7 +118,7 @@ DOCUMENTED = ["fx", "fy", "f_along", "f_across", "tip_x", "tip_y"]
 # (The chaos diagnostics of inputs/brake.nml are off here: the brake-analysis case tests them.)
 BRAKE_SHORT = ("&brake t_end = 100.0, dt_out = 0.1 /\n"
                "&analysis spectrum = .false., poincare = .false., lyapunov = .false., rosenstein = .false.,"
-               " lyapunov_spectrum = .false. /\n")
+               " lyapunov_spectrum = .false., orbit = .false. /\n")
 # The chaos diagnostics on a short span (brake-analysis).
 BRAKE_ANALYSIS = ("&brake t_end = 400.0, dt_out = 0.1 /\n"
                   "&analysis window_start = 50.0, window_end = 400.0, lyapunov_transient = 50.0,"
@@ -171,6 +171,30 @@ BAD_BRAKE_INPUTS = {
                                           "lyapunov_spectrum_renormalise"]),
     "analysis-spectrum-zero-renormalise": ("&analysis lyapunov_spectrum_renormalise = 0.0 /\n", 3,
                                            ["bad.nml:1", "&analysis", "lyapunov_spectrum_renormalise", "> 0"]),
+    "analysis-orbit-not-logical": ("&analysis orbit = 2.5 /\n", 3, ["bad.nml:1", "&analysis", "orbit", "logical"]),
+    "analysis-orbit-negative-transient": ("&analysis\n orbit_transient = -1.0 /\n", 3,
+                                          ["bad.nml:2", "&analysis", "orbit_transient", ">= 0"]),
+    "analysis-orbit-zero-tolerance": ("&analysis orbit_tolerance = 0.0 /\n", 3,
+                                      ["bad.nml:1", "&analysis", "orbit_tolerance", "> 0"]),
+    "analysis-orbit-zero-iterations": ("&analysis orbit_max_iterations = 0 /\n", 3,
+                                       ["bad.nml:1", "&analysis", "orbit_max_iterations", ">= 1"]),
+    "analysis-continuation-unknown": ("&analysis continuation = 'v_belt' /\n", 3,
+                                      ["bad.nml:1", "&analysis", "continuation", "v_belt", "v_dr_prime"]),
+    "analysis-continuation-without-orbit": ("&analysis orbit = .false.,\n continuation = 'mu',"
+                                            " continuation_end = 0.5 /\n", 3,
+                                            ["bad.nml:2", "&analysis", "continuation", "orbit = .true."]),
+    "analysis-continuation-one-point": ("&analysis continuation_points = 1 /\n", 3,
+                                        ["bad.nml:1", "&analysis", "continuation_points", ">= 2"]),
+    "analysis-continuation-end-invalid": ("&analysis continuation = 'mu'\n continuation_end = 0.7 /\n", 3,
+                                          ["bad.nml:2", "&analysis", "continuation_end", "mu_s"]),
+    "analysis-continuation-end-not-number": ("&analysis continuation_end = 'far' /\n", 3,
+                                             ["bad.nml:1", "&analysis", "continuation_end", "number"]),
+    "analysis-continuation-regularized": ("&brake model = 'regularized' /\n"
+                                          "&analysis continuation = 'mu', continuation_end = 0.5 /\n", 3,
+                                          ["bad.nml:2", "&analysis", "continuation", "switched"]),
+    "analysis-continuation-dimensional": ("&brake units = 'dimensional' /\n"
+                                          "&analysis continuation = 'xi', continuation_end = 0.5 /\n", 3,
+                                          ["bad.nml:2", "&analysis", "continuation", "dimensional"]),
 }
 
 
@@ -1043,6 +1067,70 @@ def case_brake_ranks(args):
                 fail(f"{key} differs between 1 and {other} ranks")
 
 
+# The periodic orbit and its continuation on a short span (brake-orbit): μ
+# from 0.54 to 0.50 at v'_dr = -2e-4 in 5 points crosses a period doubling
+# near 0.5265 (tests/test_orbit.pf).
+BRAKE_ORBIT = ("&brake mu = 0.54, v_dr_prime = -2.0e-4, t_end = 400.0, dt_out = 0.1 /\n"
+               "&analysis spectrum = .false., poincare = .false., lyapunov = .false., rosenstein = .false.,"
+               " lyapunov_spectrum = .false., orbit_transient = 200.0,"
+               " continuation = 'mu', continuation_end = 0.50, continuation_points = 5 /\n")
+
+
+def case_brake_orbit(args):
+    """/brake/orbit and its branch: datasets and units, the stick's multiplier
+    0 with exponent -inf, |mu| = exp(exponent T), the detected period doubling,
+    the same file on 1, 2 and 3 ranks; no slip onset: found = 0, exit 0."""
+    short = write(args, "orbit.nml", BRAKE_ORBIT)
+    brake = os.path.join(args.inputs, "brake.nml")
+    files = {}
+    for n in (1, 2, 3):
+        friction(args, "-o", f"o{n}.h5", brake, short, ranks=n)
+        files[n] = comparable(os.path.join(args.workdir, f"o{n}.h5"))
+    for n in (2, 3):
+        if files[1].keys() != files[n].keys():
+            fail(f"1 and {n} ranks wrote different objects")
+        for key, value in files[1].items():
+            if key.endswith("compute_time"):
+                continue
+            mine, theirs = np.asarray(value), np.asarray(files[n][key])
+            if not np.array_equal(mine, theirs, equal_nan=mine.dtype.kind == "f"):
+                fail(f"{key} differs between 1 and {n} ranks")
+    with h5py.File(os.path.join(args.workdir, "o1.h5"), "r") as f:
+        o = f["brake/orbit"]
+        if o.attrs["found"] != 1 or o.attrs["period_units"] != b"tau" or "reason" in o.attrs:
+            fail(f"orbit attributes {dict(o.attrs)}")
+        mu = o["floquet_multipliers"][()]
+        lam = o["floquet_exponents"][()]
+        if mu.shape != (4, 2) or o["floquet_multipliers"].attrs["columns"] != b"real, imag":
+            fail(f"multipliers {mu}")
+        if tuple(mu[0]) != (1.0, 0.0) or tuple(mu[3]) != (0.0, 0.0) or lam[3] != -np.inf or lam[0] != 0.0:
+            fail(f"trivial and stick multipliers {mu}, exponents {lam}")
+        modulus = np.hypot(mu[1:3, 0], mu[1:3, 1])
+        if np.max(np.abs(modulus - np.exp(lam[1:3] * o.attrs["period"]))) > 1e-12:
+            fail("exponents are not ln|mu| / period")
+        if o["point"][1] != -2.0e-4 or o["point"].attrs["names"] != b"x, v, y, w":
+            fail("the point is not a slip onset (v = v_dr)")
+        if list(o["events_per_period"][()]) != [1, 1, 0]:
+            fail(f"events per period {o['events_per_period'][()]}")
+        b = f["brake/orbit/branch"]
+        if b.attrs["variable"] != b"mu" or list(b["parameter"][()]) != [0.54, 0.53, 0.52, 0.51, 0.50]:
+            fail(f"branch parameter {b['parameter'][()]}")
+        if not np.all(b["found"][()] == 1) or b["floquet_multipliers_real"].shape != (5, 4):
+            fail("branch")
+        kinds = f["brake/orbit/bifurcations/kind"][()]
+        at = f["brake/orbit/bifurcations/parameter"][()]
+        if list(kinds) != [1] or not 0.52 < at[0] < 0.53:
+            fail(f"bifurcations {kinds} at {at}")
+        if b["section_x"].size != b["section_parameter"].size or b["section_x"].size == 0:
+            fail("the attractor's slip onsets")
+    never = write(args, "never.nml", "&brake mu = 0.0, mu_s = 0.0, x0 = 0.004 /\n&analysis continuation = '' /\n")
+    friction(args, "-o", "never.h5", brake, short, never)
+    with h5py.File(os.path.join(args.workdir, "never.h5"), "r") as f:
+        o = f["brake/orbit"]
+        if o.attrs["found"] != 0 or b"no slip onset" not in o.attrs["reason"] or "floquet_multipliers" in o:
+            fail(f"not found: {dict(o.attrs)}")
+
+
 def case_brake_analysis(args):
     """The chaos diagnostics: /brake/spectrum, /brake/poincare, /brake/lyapunov
     with their settings and units, the same on 1 and 2 ranks."""
@@ -1174,7 +1262,8 @@ SWEEP_SMALL = ("&brake mu = 0.5, mu_s = 0.59, t_end = 300.0, dt_out = 0.1 /\n"
                "&sweep sweep_variable = 'brake.v_dr_prime', sweep_spacing = 'linear',"
                " sweep_from = -0.004, sweep_to = -0.001, sweep_count = 7 /\n")
 SWEEP_PER_POINT = ["values", "maxima", "maxima_offset", "maxima_count", "peak_frequency", "lyapunov",
-                   "stick_fraction", "events", "status"]
+                   "stick_fraction", "events", "status", "orbit_found", "orbit_period", "orbit_max_multiplier",
+                   "orbit_critical_real", "orbit_critical_imag"]
 
 # Bad &sweep input: (override text, words of the message).
 BAD_SWEEP_INPUTS = {
@@ -1590,7 +1679,8 @@ def main():
     elif args.case.startswith("brake-"):
         {"brake-run": case_brake_run, "brake-ranks": case_brake_ranks,
          "brake-dimensional": case_brake_dimensional, "brake-verify": case_brake_verify,
-         "brake-failure": case_brake_failure, "brake-analysis": case_brake_analysis}[args.case](args)
+         "brake-failure": case_brake_failure, "brake-analysis": case_brake_analysis,
+         "brake-orbit": case_brake_orbit}[args.case](args)
     else:
         {"ranks": case_ranks, "override": case_override, "force": case_force,
          "numerical-failure": case_numerical_failure, "wall-time": case_wall_time,

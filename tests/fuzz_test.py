@@ -237,7 +237,7 @@ def valid_brake(contract, p):
                      f" v_dr_prime = {number(p['v_dr_prime'])}, t_start = 0.0, t_end = {number(p['t_end'])},"
                      f" dt_out = {number(p['dt_out'])}, x0 = {number(p['x0'])}, w0 = {number(p['w0'])} /\n"
                      "&analysis spectrum = .false., poincare = .false., lyapunov = .false., rosenstein = .false.,"
-                     " lyapunov_spectrum = .false. /\n"
+                     " lyapunov_spectrum = .false., orbit = .false. /\n"
                      f"&integrator method = '{p['method']}', max_wall_time = 3.0 /\n")
     contract.run(directory, ["-o", "out.h5", os.path.join(contract.args.inputs, "brake.nml"), "run.nml"],
                  output="out.h5", allowed={0, 4})

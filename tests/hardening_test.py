@@ -25,7 +25,7 @@ from helpers import file_contents  # noqa: E402
 
 SMALL = "&scan nx = 16, ny = 4 /\n"
 NO_DIAGNOSTICS = ("&analysis spectrum = .false., poincare = .false., lyapunov = .false., rosenstein = .false.,"
-                  " lyapunov_spectrum = .false. /\n")
+                  " lyapunov_spectrum = .false., orbit = .false. /\n")
 SWEEP = ("&brake mu = 0.5, mu_s = 0.59, t_end = 300.0, dt_out = 0.1 /\n"
          "&analysis window_start = 50.0, window_end = 300.0, lyapunov_transient = 50.0,"
          " poincare = .false., rosenstein = .false. /\n"

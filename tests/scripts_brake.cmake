@@ -62,9 +62,29 @@ set_tests_properties(scripts.plot_chaos.run PROPERTIES
   FIXTURES_REQUIRED scripts_brake_run FIXTURES_SETUP scripts_plot_chaos)
 add_test(NAME scripts.plot_chaos.png
   COMMAND ${_fb_check} "${_fb_work}/chaos/brake_short_spectrum.png"
-          "${_fb_work}/chaos/brake_short_poincare.png" "${_fb_work}/chaos/brake_short_lyapunov.png")
+          "${_fb_work}/chaos/brake_short_poincare.png" "${_fb_work}/chaos/brake_short_lyapunov.png"
+          "${_fb_work}/chaos/brake_short_floquet.png")
 set_tests_properties(scripts.plot_chaos.png PROPERTIES
   FIXTURES_REQUIRED "scripts_brake_run;scripts_plot_chaos")
+# The orbit followed along mu (inputs/brake_continuation.nml, shortened):
+# the bifurcation diagram.
+set(_fc_branch "${_fb_work}/brake_continuation_short.h5")
+add_test(NAME scripts.plot_chaos.continuation_run
+  COMMAND $<TARGET_FILE:friction_app> --quiet --force -o "${_fc_branch}" "${_fs_inputs}/brake.nml"
+          "${_fs_inputs}/brake_continuation.nml" "${_fs_tests}/data/brake_continuation_short.nml"
+  WORKING_DIRECTORY "${_fb_work}")
+set_tests_properties(scripts.plot_chaos.continuation_run PROPERTIES FIXTURES_SETUP scripts_continuation_run)
+add_test(NAME scripts.plot_chaos.bifurcation
+  COMMAND ${_fc_plot} "${_fc_branch}" -o "${_fb_work}/branch"
+  WORKING_DIRECTORY "${_fb_work}")
+set_tests_properties(scripts.plot_chaos.bifurcation PROPERTIES
+  FIXTURES_REQUIRED scripts_continuation_run FIXTURES_SETUP scripts_plot_bifurcation)
+add_test(NAME scripts.plot_chaos.bifurcation_png
+  COMMAND ${Python3_EXECUTABLE} "${_fs_tests}/check_png.py" --newer-than "${_fc_branch}"
+          "${_fb_work}/branch/brake_continuation_short_bifurcation.png"
+          "${_fb_work}/branch/brake_continuation_short_floquet.png")
+set_tests_properties(scripts.plot_chaos.bifurcation_png PROPERTIES
+  FIXTURES_REQUIRED "scripts_continuation_run;scripts_plot_bifurcation")
 add_test(NAME scripts.plot_chaos.help COMMAND ${_fc_plot} --help)
 set_tests_properties(scripts.plot_chaos.help PROPERTIES
   PASS_REGULAR_EXPRESSION "usage: plot_chaos.py.*--output-dir")
@@ -80,6 +100,7 @@ set_tests_properties(scripts.plot_chaos.not_a_brake_file PROPERTIES
   FIXTURES_REQUIRED scripts_small_map)
 
 set(_fb_all scripts.plot_chaos.run scripts.plot_chaos.png scripts.plot_chaos.help
+  scripts.plot_chaos.continuation_run scripts.plot_chaos.bifurcation scripts.plot_chaos.bifurcation_png
   scripts.plot_chaos.missing_file scripts.plot_chaos.not_a_brake_file
   scripts.brake_run scripts.plot_brake.run scripts.plot_brake.png scripts.plot_brake.help
   scripts.plot_brake.missing_file scripts.plot_brake.not_a_brake_file scripts.plot_brake.window_outside)

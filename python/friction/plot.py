@@ -8,7 +8,7 @@ from friction.load, or a file name) and returns a matplotlib Figure.
 AFM maps:     afm_maps, friction_loop
 lattice sums: graphite_net (Fig. 9a), stacked_lines (Fig. 9b)
 brake:        brake_phase (Fig. 12), brake_x, brake_spectrum (Fig. 13),
-              poincare (Fig. 14), lyapunov
+              poincare (Fig. 14), lyapunov, floquet, orbit_branch
 sweeps:       sweep (every chart of a sweep file), bifurcation, sweep_lyapunov,
               sweep_friction
 speed:        work_precision, failure_map (files of scripts/work_precision)
@@ -34,7 +34,7 @@ from matplotlib.patches import Polygon, Rectangle
 from ._data import FileError, load, reading, require
 
 __all__ = ["afm_maps", "friction_loop", "graphite_net", "stacked_lines", "brake_phase", "brake_x",
-           "brake_spectrum", "poincare", "lyapunov", "sweep", "bifurcation", "sweep_lyapunov",
+           "brake_spectrum", "poincare", "lyapunov", "floquet", "orbit_branch", "sweep", "bifurcation", "sweep_lyapunov",
            "sweep_friction", "work_precision", "failure_map", "friction_velocity", "sang_fit", "Figure"]
 
 
@@ -610,6 +610,104 @@ def lyapunov(data):
         series.legend(fontsize="small")
     else:
         series.set_axis_off()
+    return fig
+
+
+def _orbit(data):
+    """The /brake/orbit group: attributes and datasets (branch ones under 'branch/')."""
+    data = require(data, "brake", "brake")
+    with reading("brake"):
+        if "brake/orbit" not in data.group_attrs:
+            raise FileError("no /brake/orbit in the file (run friction with &analysis orbit = .true.)")
+        o = {name[len("brake/orbit/"):]: data[name].values for name in data if name.startswith("brake/orbit/")}
+        o["attrs"] = data.group_attrs["brake/orbit"]
+        if "brake/orbit/branch" in data.group_attrs:
+            o["variable"] = str(data.group_attrs["brake/orbit/branch"]["variable"])
+            names = str(data.group_attrs["brake/orbit/bifurcations"]["kind_names"])
+            o["kind_names"] = {int(code): name.strip() for code, name in
+                               (item.split("=") for item in names.split(","))}
+    return o
+
+
+def floquet(data):
+    """The periodic orbit's Floquet multipliers in the complex plane with the
+    unit circle (the stick's exact 0 and the trivial 1 included)."""
+    o = _orbit(data)
+    a = o["attrs"]
+    fig = _figure(figsize=(5.5, 5.5), layout="constrained")
+    ax = fig.subplots()
+    angle = np.linspace(0, 2 * np.pi, 361)
+    ax.plot(np.cos(angle), np.sin(angle), color="0.5", linewidth=0.8, label="unit circle")
+    if int(a["found"]) == 1:
+        mu = o["floquet_multipliers"]
+        ax.plot(mu[:, 0], mu[:, 1], "o", color="tab:red", label="multipliers")
+        title = (f"period {float(a['period']):.6g} τ, {int(a['iterations'])} Newton steps, "
+                 f"residual {float(a['residual']):.1e}")
+        reach = max(1.2, 1.1 * np.max(np.hypot(mu[:, 0], mu[:, 1])))
+    else:
+        title = f"no orbit: {a['reason']}"
+        reach = 1.2
+    ax.set_xlim(-reach, reach)
+    ax.set_ylim(-reach, reach)
+    ax.set_aspect("equal")
+    ax.set_xlabel("Re μ")
+    ax.set_ylabel("Im μ")
+    ax.set_title(f"Floquet multipliers of the periodic orbit\n{title}", fontsize="medium")
+    ax.legend(fontsize="small")
+    return fig
+
+
+def orbit_branch(data):
+    """The bifurcation diagram along a continuation line: the attractor's x at
+    its slip onsets (dots), the followed orbit's slip onset x (solid where
+    stable, dashed where unstable), the detected bifurcations; below, the
+    largest |μ| of the section map against 1."""
+    o = _orbit(data)
+    if "branch/parameter" not in o:
+        raise FileError("no /brake/orbit/branch in the file (run friction with &analysis continuation)")
+    p = o["branch/parameter"]
+    found = o["branch/found"] == 1
+    x = o["branch/point"][:, 0]
+    modulus = o["branch/max_modulus"]
+    fig = _figure(figsize=(8, 7), layout="constrained")
+    top, bottom = fig.subplots(2, 1, sharex=True, height_ratios=[2, 1])
+    top.plot(o["branch/section_parameter"], o["branch/section_x"], ".", markersize=1.5, color="0.4",
+             label="attractor: x at slip onsets")
+    kinds = np.asarray(o.get("bifurcations/kind", []), dtype=int)
+    where = np.asarray(o.get("bifurcations/parameter", []), dtype=float)
+    jumps = where[kinds == 4]
+    # One segment per pair of neighbours with orbits on one branch (no
+    # discontinuity between them): solid if stable at both ends.
+    for k in range(1, p.size):
+        if not (found[k - 1] and found[k]) or np.any((jumps - p[k - 1]) * (jumps - p[k]) < 0):
+            continue
+        stable = modulus[k - 1] < 1 and modulus[k] < 1
+        style = {"linestyle": "-" if stable else "--", "color": "tab:blue" if stable else "tab:orange"}
+        top.plot(p[k - 1:k + 1], x[k - 1:k + 1], **style)
+        bottom.plot(p[k - 1:k + 1], modulus[k - 1:k + 1], **style)
+    top.plot(p[found], x[found], ".", color="k", markersize=3)
+    top.plot([], [], "-", color="tab:blue", label="orbit, stable")
+    top.plot([], [], "--", color="tab:orange", label="orbit, unstable")
+    bottom.axhline(1.0, color="0.5", linewidth=0.8)
+    colours = {1: "tab:red", 2: "tab:purple", 3: "tab:green", 4: "0.6"}
+    seen = set()
+    for kind, at in zip(o.get("bifurcations/kind", []), o.get("bifurcations/parameter", [])):
+        name = o["kind_names"].get(int(kind), str(kind))
+        for ax in (top, bottom):
+            ax.axvline(at, color=colours.get(int(kind), "k"), linestyle=":", linewidth=1,
+                       label=None if ax is bottom or name in seen else f"{name.replace('_', ' ')}")
+        seen.add(name)
+        top.annotate(f"{name.replace('_', ' ')}\n{at:.4g}", (at, 1.0), xycoords=("data", "axes fraction"),
+                     rotation=90, va="top", ha="right", fontsize="x-small")
+    missing = p[~found]
+    if missing.size:
+        top.plot(missing, np.full(missing.size, np.nanmin(o["branch/section_x"]) if o["branch/section_x"].size
+                                  else 0.0), "x", color="tab:red", label="no orbit found")
+    top.set_ylabel("x at slip onset (m)")
+    top.set_title(f"Periodic orbit followed in {o['variable']} (stick-to-slip section)", fontsize="medium")
+    top.legend(fontsize="x-small", loc="lower left")
+    bottom.set_xlabel(o["variable"])
+    bottom.set_ylabel("largest |μ| of the section map")
     return fig
 
 

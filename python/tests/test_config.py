@@ -46,7 +46,7 @@ def test_afm_line_is_the_files_line_to_the_last_bit(friction, naf_map):
 def test_brake_is_the_programs_run_to_the_last_bit(friction, files):
     override = ("&brake t_end = 40.0, dt_out = 0.5 /\n"
                 "&analysis spectrum = .false., poincare = .false., lyapunov = .false., rosenstein = .false.,"
-                " lyapunov_spectrum = .false. /\n")
+                " lyapunov_spectrum = .false., orbit = .false. /\n")
     path = files("brake_40", [INPUTS / "brake.nml"], override)
     run = friction.brake([INPUTS / "brake.nml", path.parent / "brake_40_override.nml"])
     program = file_datasets(path, "brake")

@@ -102,6 +102,24 @@ def test_brake_pictures(brake_run, naf_map, tmp_path):
         friction.plot.brake_phase(naf_map)
 
 
+def test_orbit_pictures(brake_run, files, tmp_path):
+    data = friction.load(brake_run)
+    fig = friction.plot.floquet(data)
+    mu = data["brake/orbit/floquet_multipliers"].values
+    points = fig.axes[0].lines[1]
+    assert np.array_equal(points.get_xdata(), mu[:, 0]) and np.array_equal(points.get_ydata(), mu[:, 1])
+    assert "Newton steps" in fig.axes[0].get_title()
+    saved(fig, tmp_path / "floquet.png")
+    with pytest.raises(friction.FileError, match="no /brake/orbit/branch"):
+        friction.plot.orbit_branch(data)
+    line = files("continuation_short", [ROOT / "inputs" / "brake.nml", ROOT / "inputs" / "brake_continuation.nml",
+                                        ROOT / "tests" / "data" / "brake_continuation_short.nml"])
+    fig = friction.plot.orbit_branch(friction.load(line))
+    assert titles(fig)[0] == "Periodic orbit followed in mu (stick-to-slip section)"
+    assert fig.axes[1].get_xlabel() == "mu" and fig.axes[1].get_ylabel() == "largest |μ| of the section map"
+    saved(fig, tmp_path / "bifurcation.png")
+
+
 def test_sweep_pictures(brake_sweep, afm_sweep, tmp_path):
     figures = friction.plot.sweep(brake_sweep)
     assert set(figures) == {"bifurcation", "lyapunov"}

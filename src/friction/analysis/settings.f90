@@ -39,6 +39,15 @@ module friction_analysis_settings
       real(wp) :: lyapunov_spectrum_transient = 100.0_wp    !! from the start of the run
       real(wp) :: lyapunov_spectrum_duration = 0.0_wp       !! 0: to the end of the run
       real(wp) :: lyapunov_spectrum_renormalise = 1.0_wp    !! between QR factorisations
+      ! Periodic orbit by Newton shooting on the section (Floquet multipliers)
+      logical :: orbit = .false.
+      real(wp) :: orbit_transient = 100.0_wp       !! Newton starts from the first section point after it
+      real(wp) :: orbit_tolerance = 1.0e-9_wp      !! max |P(s) - s| accepted, in the section's units
+      integer :: orbit_max_iterations = 20         !! Newton steps
+      ! ... followed along a line of one variable of the scene (the branch)
+      character(len=16) :: continuation = ''        !! the variable varied; '' for none
+      real(wp) :: continuation_end = 0.0_wp         !! its value at the end of the line
+      integer :: continuation_points = 11           !! points on the line, both ends included
       ! ... and from the series (Rosenstein); lengths in samples of the strided series
       logical :: rosenstein = .false.
       integer :: rosenstein_stride = 4
@@ -82,6 +91,13 @@ contains
       call v%item('lyapunov_spectrum_transient', self%lyapunov_spectrum_transient, time_unit)
       call v%item('lyapunov_spectrum_duration', self%lyapunov_spectrum_duration, time_unit)
       call v%item('lyapunov_spectrum_renormalise', self%lyapunov_spectrum_renormalise, time_unit)
+      call v%item('orbit', self%orbit)
+      call v%item('orbit_transient', self%orbit_transient, time_unit)
+      call v%item('orbit_tolerance', self%orbit_tolerance, 'm')
+      call v%item('orbit_max_iterations', self%orbit_max_iterations)
+      call v%item('continuation', self%continuation, fold=.true.)
+      call v%item('continuation_end', self%continuation_end)
+      call v%item('continuation_points', self%continuation_points)
       call v%item('rosenstein', self%rosenstein)
       call v%item('rosenstein_stride', self%rosenstein_stride, 'samples')
       call v%item('rosenstein_dimension', self%rosenstein_dimension)
@@ -136,6 +152,15 @@ contains
          & call c%reject('analysis', 'lyapunov_spectrum_duration', rtoa(self%lyapunov_spectrum_duration), &
          & 'shorter than one renormalisation interval, lyapunov_spectrum_renormalise = ' &
          & //rtoa(self%lyapunov_spectrum_renormalise))
+      call c%nonnegative('analysis', 'orbit_transient', self%orbit_transient, 'τ')
+      call c%positive('analysis', 'orbit_tolerance', self%orbit_tolerance, 'm and m per unit time')
+      if (self%orbit_max_iterations < 1) call c%reject('analysis', 'orbit_max_iterations', &
+         & itoa(self%orbit_max_iterations), 'must be >= 1')
+      call c%finite('analysis', 'continuation_end', self%continuation_end)
+      if (self%continuation_points < 2) call c%reject('analysis', 'continuation_points', &
+         & itoa(self%continuation_points), 'must be >= 2 (both ends of the line)')
+      if (len_trim(self%continuation) > 0 .and. .not. self%orbit) call c%reject('analysis', 'continuation', &
+         & "'"//trim(self%continuation)//"'", 'follows the periodic orbit: needs orbit = .true.')
       if (self%rosenstein_stride < 1) call c%reject('analysis', 'rosenstein_stride', &
          & itoa(self%rosenstein_stride), 'must be >= 1')
       if (self%rosenstein_dimension < 1) call c%reject('analysis', 'rosenstein_dimension', &

@@ -7,7 +7,7 @@ module friction_brake_config
    use friction_brake_params, only: brake_parameters, brake_dimensional, derive_parameters
    use friction_analysis_settings, only: analysis_settings
    use friction_strings, only: rtoa, quoted, bytes_text
-   use friction_parameters, only: configurable, parameter_visitor
+   use friction_parameters, only: configurable, parameter_visitor, set_parameter_number
    use friction_checks, only: config_checker
    use friction_ode_solver, only: step_type_names, step_type_index
    use friction_ode_settings, only: visit_integrator, check_integrator, check_tolerance_bounds
@@ -15,12 +15,15 @@ module friction_brake_config
    private
 
    public :: brake_config, brake_check, model_names, units_names, brake_solver_defaults
-   public :: model_regularized, model_switched, series_names
+   public :: model_regularized, model_switched, series_names, continuation_names, continuation_config
 
    character(len=*), parameter :: model_names(2) = [character(len=11) :: 'switched', 'regularized']
    character(len=*), parameter :: units_names(2) = [character(len=14) :: 'nondimensional', 'dimensional']
    character(len=*), parameter :: model_switched = 'switched', model_regularized = 'regularized'
    character(len=*), parameter :: series_names(4) = [character(len=1) :: 'x', 'v', 'y', 'w']
+   !> The &brake variables a periodic orbit can be continued in (&analysis continuation).
+   character(len=*), parameter :: continuation_names(7) = [character(len=11) :: 'mu', 'mu_s', 'xi', 'kappa', &
+      & 'g_prime', 'delta_prime', 'v_dr_prime']
 
    !> &integrator defaults for the brake when no file sets them: rk8pd, tight
    !> (the benchmark: the switched model reaches 1e-8 on x this way); times in τ.
@@ -208,7 +211,51 @@ contains
       call check_tolerance_bounds(c, 'verify', 'check_rtol', 'check_atol', self%check%rtol, self%check%atol)
       call c%nonnegative('verify', 'check_limit', self%check%max_difference, 'm; 0 reports only')
       call self%analysis%validate(c, self%t_start, self%t_end, series_names)
+      if (c%failed() .or. len_trim(self%analysis%continuation) == 0) return
+      if (self%model /= model_switched) then
+         call c%reject('analysis', 'continuation', "'"//trim(self%analysis%continuation)//"'", &
+            & "follows the orbit on the located stick-to-slip section: needs model = 'switched'")
+         return
+      end if
+      if (.not. any(continuation_names == self%analysis%continuation)) then
+         call c%reject('analysis', 'continuation', "'"//trim(self%analysis%continuation)//"'", &
+            & 'not a variable of &brake the orbit can follow (known: '//quoted(continuation_names)//')')
+         return
+      end if
+      if (self%units == 'dimensional' .and. self%analysis%continuation /= 'mu' .and. &
+         & self%analysis%continuation /= 'mu_s') then
+         call c%reject('analysis', 'continuation', "'"//trim(self%analysis%continuation)//"'", &
+            & "with units = 'dimensional' only 'mu' and 'mu_s' (the others are derived from &brake_dimensional)")
+         return
+      end if
+      ! The other end of the line must be a valid brake too (the line is straight, the checks convex).
+      block
+         type(brake_config) :: end_point
+         type(config_checker) :: inner
+         end_point = continuation_config(self, self%analysis%continuation_end)
+         call end_point%validate(inner)
+         if (inner%failed()) then
+            ! The inner checker knows no file: drop its '(default): ' origin.
+            associate (message => inner%error%message, origin => index(inner%error%message, '(default): '))
+               call c%reject('analysis', 'continuation_end', rtoa(self%analysis%continuation_end), &
+                  & 'the end of the line is not a valid brake: '//message(merge(origin + 11, 1, origin == 1):))
+            end associate
+         end if
+      end block
    end subroutine validate
+
+   !> The configuration with the continuation variable set to `value` (and no
+   !> continuation of its own).
+   function continuation_config(self, value) result(point)
+      type(brake_config), intent(in) :: self
+      real(wp), intent(in) :: value
+      type(brake_config) :: point
+      character(len=:), allocatable :: problem
+
+      point = self
+      point%analysis%continuation = ''
+      call set_parameter_number(point, 'brake', trim(self%analysis%continuation), value, problem)
+   end function continuation_config
 
    !> With units = 'dimensional', derive params from the §6.2 data
    !> (keeping μ and μs); otherwise params stand as given.

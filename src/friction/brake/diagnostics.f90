@@ -17,6 +17,8 @@ module friction_brake_diagnostics
    use friction_analysis_lyapunov_spectrum, only: tangent_settings, spectrum_accumulator, kaplan_yorke, &
       & generic_frame
    use friction_analysis_lyapunov_series, only: rosenstein_settings, rosenstein_result, rosenstein_exponent
+   use friction_analysis_periodic_orbit, only: orbit_settings
+   use friction_brake_orbit, only: brake_orbit, brake_periodic_orbit, orbit_branch, follow_branch
    implicit none
    private
 
@@ -37,6 +39,8 @@ module friction_brake_diagnostics
       real(wp) :: kaplan_yorke = 0.0_wp
       type(rosenstein_result) :: series
       real(wp) :: series_dt = 0.0_wp   !! sample spacing of the strided series
+      type(brake_orbit) :: orbit       !! the periodic orbit through the section (Newton)
+      type(orbit_branch) :: branch     !! ... followed along the continuation line
    end type brake_diagnostics
 
 contains
@@ -131,6 +135,21 @@ contains
             if (allocated(error)) return
             result%exponents = result%qr%exponents()
             result%kaplan_yorke = kaplan_yorke(result%exponents)
+         end if
+         if (a%orbit .and. config%model /= model_switched) then
+            result%orbit%orbit%reason = "the section is the switched model's located slip onsets: model = 'switched'"
+         else if (a%orbit) then
+            ! Not finding one is a result (orbit%found), not an error.
+            call brake_periodic_orbit(config, events, a%orbit_transient, &
+               & orbit_settings(tolerance=a%orbit_tolerance, max_iterations=a%orbit_max_iterations), &
+               & result%orbit, error)
+            if (allocated(error)) return
+            if (len_trim(a%continuation) > 0) then
+               call follow_branch(config, result%orbit, a%continuation_end, a%continuation_points, &
+                  & a%orbit_transient, orbit_settings(tolerance=a%orbit_tolerance, &
+                  & max_iterations=a%orbit_max_iterations), result%branch, error)
+               if (allocated(error)) return
+            end if
          end if
          if (a%rosenstein) then
             result%series_dt = config%dt_out * a%rosenstein_stride

@@ -12,6 +12,7 @@ module friction_brake_output
    use friction_brake_record, only: brake_trajectory, brake_event_table, event_kind_names
    use friction_brake_simulate, only: brake_comparison
    use friction_brake_diagnostics, only: brake_diagnostics
+   use friction_brake_orbit, only: orbit_branch, bifurcation_names, continuation_unit
    use friction_output_h5, only: h5_file
    use friction_output_parameters, only: write_parameter_attributes
    use friction_output_summary, only: run_summary, write_run_attributes
@@ -224,6 +225,7 @@ contains
             call file%write_vector('/brake/lyapunov/benettin_time', d%flow%time(1:d%flow%n), 'tau')
             call file%write_vector('/brake/lyapunov/benettin_estimate', d%flow%estimate(1:d%flow%n), '1/tau')
          end if
+         if (a%orbit) call write_orbit(file, d)
          if (a%rosenstein) then
             call file%write_attribute_real('/brake/lyapunov', 'rosenstein_exponent', d%series%exponent, '1/tau')
             ! OpenTSTool's largelyap unit: log2 per sample of the series.
@@ -245,5 +247,72 @@ contains
          end if
       end associate
    end subroutine write_diagnostics
+
+   !> /brake/orbit (docs/output.md): the periodic orbit through the
+   !> stick-to-slip section, or found = 0 and the reason.
+   subroutine write_orbit(file, d)
+      type(h5_file), intent(inout) :: file
+      type(brake_diagnostics), intent(in) :: d
+      character(len=*), parameter :: group = '/brake/orbit'
+      real(wp) :: parts(2, 4)
+
+      associate (a => d%settings, o => d%orbit)
+         call file%create_group(group)
+         call file%write_attribute_integer(group, 'found', merge(1_i8, 0_i8, o%orbit%found))
+         if (.not. o%orbit%found) call file%write_attribute_text(group, 'reason', o%orbit%reason)
+         call file%write_attribute_text(group, 'section', 'stick_to_slip')
+         call file%write_attribute_integer(group, 'static_limit', int(nint(o%limit), i8))
+         call file%write_attribute_real(group, 'guess_time', o%guess_time, 'tau')
+         call file%write_attribute_real(group, 'transient', a%orbit_transient, 'tau')
+         call file%write_attribute_real(group, 'tolerance', a%orbit_tolerance, 'm')
+         call file%write_attribute_integer(group, 'iterations', int(o%orbit%iterations, i8))
+         call file%write_attribute_real(group, 'residual', o%orbit%residual, 'm')
+         ! The fixed point, or Newton's last iterate when none was found.
+         call file%write_vector(group//'/point', o%state, 'm, m per unit tau, m, m per unit tau')
+         call file%write_attribute_text(group//'/point', 'names', 'x, v, y, w')
+         if (len_trim(a%continuation) > 0) call write_branch(file, d%branch)
+         if (.not. o%orbit%found) return
+         call file%write_attribute_real(group, 'period', o%orbit%period, 'tau')
+         call file%write_matrix(group//'/section_jacobian', o%orbit%jacobian, '1')
+         parts(1, :) = real(o%multipliers)
+         parts(2, :) = aimag(o%multipliers)
+         call file%write_matrix(group//'/floquet_multipliers', parts, '1')
+         call file%write_attribute_text(group//'/floquet_multipliers', 'columns', 'real, imag')
+         call file%write_vector(group//'/floquet_exponents', o%exponents, '1/tau')
+         call file%write_vector_integer(group//'/events_per_period', o%pattern, '1')
+         call file%write_attribute_text(group//'/events_per_period', 'names', join(event_kind_names))
+      end associate
+   end subroutine write_orbit
+
+   !> /brake/orbit/branch and /brake/orbit/bifurcations (docs/output.md).
+   subroutine write_branch(file, b)
+      type(h5_file), intent(inout) :: file
+      type(orbit_branch), intent(in) :: b
+      character(len=*), parameter :: group = '/brake/orbit/branch'
+      character(len=32) :: codes(size(bifurcation_names))
+      integer :: k
+
+      call file%create_group(group)
+      call file%write_attribute_text(group, 'variable', trim(b%variable))
+      call file%write_vector(group//'/parameter', b%parameter, continuation_unit(b%variable))
+      call file%write_vector_integer(group//'/found', merge(1, 0, b%found), '1')
+      call file%write_vector_integer(group//'/source', b%source, '1')
+      call file%write_attribute_text(group//'/source', 'names', '1 = continued, 2 = from the attractor')
+      call file%write_vector(group//'/period', b%period, 'tau')
+      call file%write_matrix(group//'/point', b%state, 'm, m per unit tau, m, m per unit tau')
+      call file%write_matrix(group//'/floquet_multipliers_real', real(b%multipliers), '1')
+      call file%write_matrix(group//'/floquet_multipliers_imag', aimag(b%multipliers), '1')
+      call file%write_vector(group//'/max_modulus', b%max_modulus, '1')
+      call file%write_matrix(group//'/events_per_period', real(b%pattern, wp), '1')
+      call file%write_vector(group//'/section_parameter', b%section_parameter, continuation_unit(b%variable))
+      call file%write_vector(group//'/section_x', b%section_x, 'm')
+      call file%create_group('/brake/orbit/bifurcations')
+      do k = 1, size(bifurcation_names)
+         write (codes(k), '(i0, a)') k, ' = '//trim(bifurcation_names(k))
+      end do
+      call file%write_attribute_text('/brake/orbit/bifurcations', 'kind_names', join(codes))
+      call file%write_vector_integer('/brake/orbit/bifurcations/kind', b%kind, '1')
+      call file%write_vector('/brake/orbit/bifurcations/parameter', b%at, continuation_unit(b%variable))
+   end subroutine write_branch
 
 end module friction_brake_output

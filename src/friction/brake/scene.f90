@@ -174,7 +174,8 @@ contains
          ! Benettin, of the settings): every rank computes the same numbers, so
          ! the file does not depend on the number of ranks.
          associate (a => settings%analysis)
-            self%analysing = a%spectrum .or. a%poincare .or. a%lyapunov .or. a%rosenstein .or. a%lyapunov_spectrum
+            self%analysing = a%spectrum .or. a%poincare .or. a%lyapunov .or. a%rosenstein .or. a%lyapunov_spectrum &
+               & .or. a%orbit
          end associate
          if (self%analysing) then
             call diagnose_brake(settings, main_run%trajectory, main_run%events, self%diagnostics, error)
@@ -223,7 +224,10 @@ contains
       type(point_result), allocatable :: results(:)
 
       results = [point_result('events', '1', .true.), point_result('peak_frequency', '1/tau', .false.), &
-         & point_result('lyapunov', '1/tau', .false.), point_result('stick_fraction', '1', .false.)]
+         & point_result('lyapunov', '1/tau', .false.), point_result('stick_fraction', '1', .false.), &
+         & point_result('orbit_found', '1', .true.), point_result('orbit_period', 'tau', .false.), &
+         & point_result('orbit_max_multiplier', '1', .false.), point_result('orbit_critical_real', '1', .false.), &
+         & point_result('orbit_critical_imag', '1', .false.)]
    end function brake_point_results
 
    subroutine brake_point_series(self, name, unit)
@@ -234,8 +238,9 @@ contains
       unit = 'm'
    end subroutine brake_point_series
 
-   !> A sweep point: the run, its diagnostics and the local maxima of x after
-   !> the transient (the bifurcation diagram).
+   !> A sweep point: the run, its diagnostics, its periodic orbit (found,
+   !> period, the largest |μ| and the critical μ; 0 when none or off) and the
+   !> local maxima of x after the transient (the bifurcation diagram).
    subroutine brake_run_point(self, results, series, error)
       class(brake_scene), intent(inout) :: self
       real(wp), intent(out) :: results(:)
@@ -255,11 +260,20 @@ contains
       call integrate_brake(run, point, silent, error)
       if (allocated(error)) return
       associate (a => point%analysis)
-         if (a%spectrum .or. a%lyapunov) then
+         if (a%spectrum .or. a%lyapunov .or. a%orbit) then
+            ! A point is one run: the orbit is not continued from another point's.
+            point%analysis%continuation = ''
             call diagnose_brake(point, run%trajectory, run%events, diagnostics, error)
             if (allocated(error)) return
             if (a%spectrum) results(2) = diagnostics%spectrum%peak_frequency
             if (a%lyapunov) results(3) = diagnostics%flow%current()
+            if (diagnostics%orbit%orbit%found) then
+               ! The section map's multiplier of largest modulus (the critical one).
+               associate (o => diagnostics%orbit)
+                  results(5:9) = [1.0_wp, o%orbit%period, abs(o%multipliers(2)), real(o%multipliers(2)), &
+                     & aimag(o%multipliers(2))]
+               end associate
+            end if
          end if
          results(1) = run%events%n
          results(4) = run%stick_time() / (point%t_end - point%t_start)

@@ -59,6 +59,8 @@ module friction_brake_switched
       procedure :: start => switched_start
       procedure :: advance_to
       procedure :: is_sticking => switched_sticking
+      procedure :: start_slipping
+      procedure :: advance_to_slip_onset
    end type switched_integrator
 
 contains
@@ -199,6 +201,34 @@ contains
       call events%clear()
    end subroutine init
 
+   !> Start at (t0, y0) slipping in direction s = ±1 whatever the state:
+   !> a point of the stick-to-slip section (v_rel = 0 on the static limit)
+   !> at the instant the slip begins (the periodic orbits, brake/orbit.f90).
+   subroutine start_slipping(self, config, t0, y0, s, events, error)
+      class(switched_integrator), target, intent(inout) :: self
+      type(brake_config), intent(in) :: config
+      real(wp), intent(in) :: t0, y0(4), s
+      type(brake_event_table), intent(inout) :: events
+      type(error_type), allocatable, intent(out) :: error
+
+      call self%init(config%params, config%solver, config%event_tolerance, t0, y0, events, error)
+      if (allocated(error)) return
+      self%sticking = .false.
+      call start_slip_in(self, s, self%h_start)
+   end subroutine start_slipping
+
+   !> Advance to the next stick-to-slip event (found) and stop there, just
+   !> after it (in slip, Φ through the saltation), or to t_limit (not found).
+   subroutine advance_to_slip_onset(self, t_limit, events, found, error)
+      class(switched_integrator), intent(inout) :: self
+      real(wp), intent(in) :: t_limit
+      type(brake_event_table), intent(inout) :: events
+      logical, intent(out) :: found
+      type(error_type), allocatable, intent(out) :: error
+
+      call advance_switched(self, t_limit, events, error, found)
+   end subroutine advance_to_slip_onset
+
    !> Advance to t_target, through any number of stick and slip phases;
    !> events go into the table.  On error, t is the time reached.
    subroutine advance_to(self, t_target, events, error)
@@ -206,10 +236,23 @@ contains
       real(wp), intent(in) :: t_target
       type(brake_event_table), intent(inout) :: events
       type(error_type), allocatable, intent(out) :: error
+
+      call advance_switched(self, t_target, events, error)
+   end subroutine advance_to
+
+   !> advance_to, or with slip_onset present, up to the first stick-to-slip
+   !> event (slip_onset = .true.) if it comes before t_target.
+   subroutine advance_switched(self, t_target, events, error, slip_onset)
+      class(switched_integrator), intent(inout) :: self
+      real(wp), intent(in) :: t_target
+      type(brake_event_table), intent(inout) :: events
+      type(error_type), allocatable, intent(out) :: error
+      logical, intent(out), optional :: slip_onset
       logical :: found
       real(wp) :: t_end
       integer :: which
 
+      if (present(slip_onset)) slip_onset = .false.
       do while (self%t < t_target)
          if (self%sticking) then
             call self%stick%find_end(self%t, t_target, found, t_end, which)
@@ -231,6 +274,10 @@ contains
             if (self%tangent) call stick_exit_saltation(self, which)
             call start_slip(self, -1.0_wp)
             call events%add(self%t, event_stick_to_slip, self%y)
+            if (present(slip_onset)) then
+               slip_onset = .true.
+               return
+            end if
          else
             call self%locator_advance(t_target, error)
             if (allocated(error)) then
@@ -264,7 +311,7 @@ contains
             end select
          end if
       end do
-   end subroutine advance_to
+   end subroutine advance_switched
 
    !> Slip from the current state in the direction of the unbalanced force
    !> -(2x - y) (its rate when the force is exactly 0).

@@ -1,0 +1,412 @@
+!> Periodic orbits by Newton shooting on a Poincaré section (docs/physics.md,
+!> periodic orbits and their stability).  A section map P takes a point s of
+!> the section, in the section's own coordinates, to the next point where
+!> the orbit through it comes back, with the return time T(s) and the
+!> Jacobian DP(s) (the monodromy matrix over the return, saltation matrices
+!> included for a nonsmooth flow, projected along the flow onto the
+!> section).  A periodic orbit is a fixed point P(s) = s; Newton solves
+!> (DP - I) δ = -(P(s) - s), halving δ while the residual does not drop.
+!> The multipliers of the orbit are the eigenvalues of DP at the fixed
+!> point, plus the trivial 1 along the flow (and 0 for each direction a
+!> nonsmooth flow forgets, which the caller adds).
+!>
+!> Not finding an orbit (no return, no convergence within the iterations,
+!> a step that cannot reduce the residual) is a result, `found = .false.`
+!> with the reason, not an error: errors are failures of the integration.
+!>
+!> `hyperplane_map` is the section map of a smooth ode_system through the
+!> hyperplane y_k = c crossed upwards, the section coordinates being the
+!> other n - 1 components.
+module friction_analysis_periodic_orbit
+   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_negative_inf
+   use friction_kinds, only: wp
+   use friction_error, only: error_type, fatal_error, error_input
+   use friction_ode_system, only: ode_system
+   use friction_ode_events, only: event_system, event_locator, event_rising
+   use friction_ode_solver, only: solver_settings
+   use friction_analysis_lyapunov_spectrum, only: tangent_system, pack_tangent, unpack_tangent
+   implicit none
+   private
+
+   public :: section_map, orbit_settings, periodic_orbit, find_periodic_orbit, section_multipliers
+   public :: floquet_multipliers, floquet_exponents, hyperplane_map
+
+   !> Largest section dimension whose multipliers are computed (closed form):
+   !> the brake's section is 2-dimensional, a planar flow's 1.
+   integer, parameter :: max_section = 2
+
+   !> A return map of a section, in section coordinates.
+   type, abstract :: section_map
+   contains
+      !> The section's dimension.
+      procedure(map_dimension_interface), deferred :: dimension
+      !> image = P(s), jacobian = DP(s), period = T(s); returned = .false.
+      !> (and `reason`) when no return was found.
+      procedure(map_evaluate_interface), deferred :: evaluate
+   end type section_map
+
+   abstract interface
+      pure integer function map_dimension_interface(self)
+         import :: section_map
+         class(section_map), intent(in) :: self
+      end function map_dimension_interface
+
+      subroutine map_evaluate_interface(self, s, image, jacobian, period, returned, reason, error)
+         import :: section_map, wp, error_type
+         class(section_map), intent(inout) :: self
+         real(wp), intent(in) :: s(:)
+         real(wp), intent(out) :: image(:), jacobian(:, :), period
+         logical, intent(out) :: returned
+         character(len=:), allocatable, intent(out) :: reason
+         type(error_type), allocatable, intent(out) :: error
+      end subroutine map_evaluate_interface
+   end interface
+
+   type :: orbit_settings
+      real(wp) :: tolerance = 1.0e-9_wp   !! max |P(s) - s| accepted, in the section's units
+      integer :: max_iterations = 20      !! Newton steps
+      integer :: max_halvings = 10        !! step halvings per Newton step
+   end type orbit_settings
+
+   type :: periodic_orbit
+      logical :: found = .false.
+      real(wp) :: period = 0.0_wp
+      real(wp), allocatable :: point(:)          !! section coordinates of the fixed point (or the last iterate)
+      real(wp), allocatable :: jacobian(:, :)    !! DP there
+      complex(wp), allocatable :: multipliers(:) !! eigenvalues of DP, by decreasing modulus
+      integer :: iterations = 0                  !! Newton steps taken
+      real(wp) :: residual = huge(1.0_wp)        !! max |P(s) - s| at the last iterate
+      character(len=:), allocatable :: reason    !! why not found ('' when found)
+   end type periodic_orbit
+
+   !> A smooth system with the hyperplane y_k = c as its (only) event.
+   type, extends(event_system) :: hyperplane_system
+      class(ode_system), allocatable :: base
+      integer :: coordinate = 1
+      real(wp) :: level = 0.0_wp
+   contains
+      procedure :: dimension => hyperplane_dimension
+      procedure :: rhs => hyperplane_rhs
+      procedure :: jacobian => hyperplane_jacobian
+      procedure :: event_count => hyperplane_event_count
+      procedure :: event_values => hyperplane_event_values
+   end type hyperplane_system
+
+   !> The return map of y_k = c crossed upwards (y_k' > 0) for a smooth system;
+   !> returns later than max_return count as none.
+   type, extends(section_map) :: hyperplane_map
+      type(tangent_system), allocatable :: extended
+      type(solver_settings) :: solver
+      integer :: coordinate = 1
+      real(wp) :: level = 0.0_wp
+      real(wp) :: max_return = 1000.0_wp
+      real(wp) :: event_tolerance = 1.0e-12_wp
+   contains
+      procedure :: setup => hyperplane_setup
+      procedure :: dimension => hyperplane_map_dimension
+      procedure :: evaluate => hyperplane_evaluate
+   end type hyperplane_map
+
+contains
+
+   !> Newton from `guess` (section coordinates) to a fixed point of `map`.
+   subroutine find_periodic_orbit(map, guess, settings, orbit, error)
+      class(section_map), intent(inout) :: map
+      real(wp), intent(in) :: guess(:)
+      type(orbit_settings), intent(in) :: settings
+      type(periodic_orbit), intent(out) :: orbit
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: s(size(guess)), image(size(guess)), jac(size(guess), size(guess)), step(size(guess))
+      real(wp) :: trial(size(guess)), trial_image(size(guess)), trial_jac(size(guess), size(guess))
+      real(wp) :: period, trial_period, residual, trial_residual, scale
+      logical :: returned, solved
+      character(len=:), allocatable :: reason
+      integer :: n, halving
+
+      n = map%dimension()
+      if (size(guess) /= n .or. n < 1 .or. n > max_section) then
+         call fatal_error(error, 'periodic orbit: the section must have 1 to 2 dimensions and the guess as many', &
+            & error_input)
+         return
+      end if
+      s = guess
+      orbit%point = s
+      orbit%reason = ''
+      call map%evaluate(s, image, jac, period, returned, reason, error)
+      if (allocated(error)) return
+      if (.not. returned) then
+         orbit%reason = reason
+         return
+      end if
+      residual = maxval(abs(image - s))
+      do
+         orbit%point = s
+         orbit%jacobian = jac
+         orbit%period = period
+         orbit%residual = residual
+         if (residual <= settings%tolerance) exit
+         if (orbit%iterations >= settings%max_iterations) then
+            orbit%reason = 'no convergence in orbit_max_iterations Newton steps'
+            return
+         end if
+         call solve_shifted(jac, -(image - s), step, solved)
+         if (.not. solved) then
+            orbit%reason = 'a multiplier equals 1: DP - I is singular'
+            return
+         end if
+         orbit%iterations = orbit%iterations + 1
+         scale = 1.0_wp
+         do halving = 0, settings%max_halvings
+            trial = s + scale * step
+            call map%evaluate(trial, trial_image, trial_jac, trial_period, returned, reason, error)
+            if (allocated(error)) return
+            if (returned) then
+               trial_residual = maxval(abs(trial_image - trial))
+               if (trial_residual < residual) exit
+            end if
+            scale = scale / 2
+         end do
+         if (.not. (returned .and. trial_residual < residual)) then
+            orbit%reason = 'no Newton step reduces the residual'
+            if (.not. returned) orbit%reason = orbit%reason//' ('//reason//')'
+            return
+         end if
+         s = trial
+         image = trial_image
+         jac = trial_jac
+         period = trial_period
+         residual = trial_residual
+      end do
+      orbit%found = .true.
+      orbit%multipliers = section_multipliers(orbit%jacobian)
+   end subroutine find_periodic_orbit
+
+   !> (J - I) x = b by Gaussian elimination with partial pivoting (n <= 2).
+   pure subroutine solve_shifted(jac, b, x, solved)
+      real(wp), intent(in) :: jac(:, :), b(:)
+      real(wp), intent(out) :: x(:)
+      logical, intent(out) :: solved
+      real(wp) :: a(size(b), size(b)), det
+      integer :: i
+
+      a = jac
+      do i = 1, size(b)
+         a(i, i) = a(i, i) - 1.0_wp
+      end do
+      solved = .false.
+      x = 0.0_wp
+      select case (size(b))
+      case (1)
+         if (a(1, 1) == 0.0_wp) return
+         x(1) = b(1) / a(1, 1)
+      case (2)
+         det = a(1, 1) * a(2, 2) - a(1, 2) * a(2, 1)
+         if (det == 0.0_wp) return
+         x(1) = (a(2, 2) * b(1) - a(1, 2) * b(2)) / det
+         x(2) = (a(1, 1) * b(2) - a(2, 1) * b(1)) / det
+      case default
+         return
+      end select
+      solved = all(abs(x) < huge(1.0_wp))
+   end subroutine solve_shifted
+
+   !> Eigenvalues of a 1 x 1 or 2 x 2 section Jacobian, by decreasing modulus
+   !> (a complex pair: positive imaginary part first).
+   pure function section_multipliers(jac) result(mu)
+      real(wp), intent(in) :: jac(:, :)
+      complex(wp), allocatable :: mu(:)
+      real(wp) :: half_trace, det, disc, root
+      complex(wp) :: swap
+
+      allocate (mu(size(jac, 1)))
+      select case (size(jac, 1))
+      case (1)
+         mu(1) = cmplx(jac(1, 1), 0.0_wp, wp)
+      case (2)
+         half_trace = (jac(1, 1) + jac(2, 2)) / 2
+         det = jac(1, 1) * jac(2, 2) - jac(1, 2) * jac(2, 1)
+         disc = half_trace**2 - det
+         if (disc >= 0.0_wp) then
+            ! The larger root without cancellation, the other from the product.
+            root = half_trace + sign(sqrt(disc), half_trace)
+            mu(1) = cmplx(root, 0.0_wp, wp)
+            mu(2) = cmplx(0.0_wp, 0.0_wp, wp)
+            if (root /= 0.0_wp) mu(2) = cmplx(det / root, 0.0_wp, wp)
+            if (abs(mu(2)) > abs(mu(1))) then
+               swap = mu(1)
+               mu(1) = mu(2)
+               mu(2) = swap
+            end if
+         else
+            mu(1) = cmplx(half_trace, sqrt(-disc), wp)
+            mu(2) = conjg(mu(1))
+         end if
+      end select
+   end function section_multipliers
+
+   !> All Floquet multipliers of an orbit: the trivial 1 (along the flow),
+   !> those of the section map, and `lost` zeros for directions the flow
+   !> maps to zero exactly (the brake's velocity in stick).
+   pure function floquet_multipliers(orbit, lost) result(mu)
+      type(periodic_orbit), intent(in) :: orbit
+      integer, intent(in) :: lost
+      complex(wp) :: mu(1 + size(orbit%multipliers) + lost)
+
+      mu = cmplx(0.0_wp, 0.0_wp, wp)
+      mu(1) = cmplx(1.0_wp, 0.0_wp, wp)
+      mu(2:1 + size(orbit%multipliers)) = orbit%multipliers
+   end function floquet_multipliers
+
+   !> Floquet exponents ln|μ| / T; -inf for μ = 0 exactly (as the Lyapunov
+   !> spectrum reports a lost direction).
+   function floquet_exponents(mu, period) result(lambda)
+      complex(wp), intent(in) :: mu(:)
+      real(wp), intent(in) :: period
+      real(wp) :: lambda(size(mu))
+      integer :: i
+
+      do i = 1, size(mu)
+         if (abs(mu(i)) > 0.0_wp) then
+            lambda(i) = log(abs(mu(i))) / period
+         else
+            lambda(i) = ieee_value(1.0_wp, ieee_negative_inf)
+         end if
+      end do
+   end function floquet_exponents
+
+   pure function hyperplane_dimension(self) result(n)
+      class(hyperplane_system), intent(in) :: self
+      integer :: n
+
+      n = self%base%dimension()
+   end function hyperplane_dimension
+
+   pure subroutine hyperplane_rhs(self, t, y, dydt)
+      class(hyperplane_system), intent(in) :: self
+      real(wp), intent(in) :: t
+      real(wp), intent(in) :: y(:)
+      real(wp), intent(out) :: dydt(:)
+
+      call self%base%rhs(t, y, dydt)
+   end subroutine hyperplane_rhs
+
+   pure subroutine hyperplane_jacobian(self, t, y, dfdy, dfdt)
+      class(hyperplane_system), intent(in) :: self
+      real(wp), intent(in) :: t
+      real(wp), intent(in) :: y(:)
+      real(wp), intent(out) :: dfdy(:, :)
+      real(wp), intent(out) :: dfdt(:)
+
+      call self%base%jacobian(t, y, dfdy, dfdt)
+   end subroutine hyperplane_jacobian
+
+   pure function hyperplane_event_count(self) result(m)
+      class(hyperplane_system), intent(in) :: self
+      integer :: m
+
+      m = 1
+   end function hyperplane_event_count
+
+   pure subroutine hyperplane_event_values(self, t, y, g)
+      class(hyperplane_system), intent(in) :: self
+      real(wp), intent(in) :: t
+      real(wp), intent(in) :: y(:)
+      real(wp), intent(out) :: g(:)
+
+      g(1) = y(self%coordinate) - self%level
+   end subroutine hyperplane_event_values
+
+   !> The section y_k = c of an autonomous system.
+   subroutine hyperplane_setup(self, system, solver, coordinate, level, max_return, event_tolerance)
+      class(hyperplane_map), intent(inout) :: self
+      class(ode_system), intent(in) :: system
+      type(solver_settings), intent(in) :: solver
+      integer, intent(in) :: coordinate
+      real(wp), intent(in) :: level, max_return, event_tolerance
+      type(hyperplane_system) :: plane
+
+      allocate (plane%base, source=system)
+      plane%coordinate = coordinate
+      plane%level = level
+      if (allocated(self%extended)) deallocate (self%extended)
+      allocate (self%extended)
+      allocate (self%extended%base, source=plane)
+      self%solver = solver
+      self%coordinate = coordinate
+      self%level = level
+      self%max_return = max_return
+      self%event_tolerance = event_tolerance
+   end subroutine hyperplane_setup
+
+   pure integer function hyperplane_map_dimension(self)
+      class(hyperplane_map), intent(in) :: self
+
+      hyperplane_map_dimension = self%extended%base%dimension() - 1
+   end function hyperplane_map_dimension
+
+   !> From the section point s (y_k = c) with Φ = I to the next upward
+   !> crossing; DP = the other rows and columns of (I - f nᵀ/(nᵀ f)) Φ(T),
+   !> n = e_k: the monodromy matrix projected along the flow onto the section.
+   subroutine hyperplane_evaluate(self, s, image, jacobian, period, returned, reason, error)
+      class(hyperplane_map), intent(inout) :: self
+      real(wp), intent(in) :: s(:)
+      real(wp), intent(out) :: image(:), jacobian(:, :), period
+      logical, intent(out) :: returned
+      character(len=:), allocatable, intent(out) :: reason
+      type(error_type), allocatable, intent(out) :: error
+      type(event_locator) :: locator
+      real(wp) :: y(size(s) + 1), phi(size(s) + 1, size(s) + 1), f(size(s) + 1), z((size(s) + 1) * (size(s) + 2))
+      real(wp) :: t, h
+      integer :: n, i, k
+      integer, allocatable :: others(:)
+
+      n = size(s) + 1
+      k = self%coordinate
+      others = pack([(i, i=1, n)], [(i, i=1, n)] /= k)
+      y(others) = s
+      y(k) = self%level
+      phi = 0.0_wp
+      do i = 1, n
+         phi(i, i) = 1.0_wp
+      end do
+      image = s
+      jacobian = 0.0_wp
+      period = 0.0_wp
+      returned = .false.
+      reason = ''
+      h = self%solver%h_start
+      if (.not. (h > 0.0_wp)) h = 1.0e-3_wp
+      call locator%init(self%extended, self%solver, [event_rising], [.true.], self%event_tolerance, h, error)
+      if (allocated(error)) return
+      t = 0.0_wp
+      z = pack_tangent(y, phi)
+      call locator%restart(t, z, h)
+      do while (t < self%max_return)
+         call locator%advance(t, self%max_return, z, error)
+         if (allocated(error)) return
+         if (locator%n_hits > 0) then
+            if (locator%hits(locator%n_hits)%terminal) then
+               ! A function exactly 0 at a restart crosses at once (ode/events.f90):
+               ! that first hit, within a few event tolerances, is the start itself.
+               if (t > 1.0e3_wp * self%event_tolerance) exit
+               call locator%restart(t, z, 0.0_wp)
+               locator%n_hits = 0
+            end if
+         end if
+      end do
+      if (.not. (locator%n_hits > 0)) then
+         reason = 'no return to the section within the longest return time'
+         return
+      end if
+      call unpack_tangent(z, y, phi)
+      call self%extended%base%rhs(t, y, f)
+      do i = 1, n
+         phi(i, :) = phi(i, :) - f(i) * phi(k, :) / f(k)
+      end do
+      image = y(others)
+      jacobian = phi(others, others)
+      period = t
+      returned = .true.
+   end subroutine hyperplane_evaluate
+
+end module friction_analysis_periodic_orbit

@@ -1,0 +1,454 @@
+!> Periodic orbits of the switched brake and their Floquet multipliers
+!> (docs/physics.md, periodic orbits): Newton shooting on the stick-to-slip
+!> section (analysis/periodic_orbit.f90).
+!>
+!> Section.  A slip starts when the elastic force reaches the static limit,
+!> 2x - y = σ μs N'(y) with σ = ±1, at v = v'_dr.  Given σ, the points of
+!> the section are (y, w): x = (y + σ μs N'(y))/2 and v = v'_dr follow.
+!> The return map P(y, w) starts a slip there (direction -σ), integrates
+!> through any number of slips, slip reversals and sticks with the tangent
+!> matrix Φ (saltation matrices at every switching, the exact stick flow)
+!> and stops at the next stick-to-slip event, located by the event
+!> machinery.  DP = the (y, w) rows of (I - f nᵀ/(nᵀ f)) Φ B: Φ projected
+!> along the flow f onto the section (normal n), B the section's tangent
+!> vectors ∂(x, v, y, w)/∂(y, w).  A return at the other limit (σ changes)
+!> is no return of this section.
+!>
+!> Multipliers.  The orbit's four: the trivial 1 along the flow, the two of
+!> DP, and 0 exactly -- the stick forgets the block's velocity, the
+!> direction the Lyapunov spectrum reports with exponent -inf.
+module friction_brake_orbit
+   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
+   use friction_kinds, only: wp, pi
+   use friction_error, only: error_type
+   use friction_brake_config, only: brake_config, continuation_config
+   use friction_brake_simulate, only: brake_run, simulate_brake
+   use friction_brake_params, only: brake_parameters
+   use friction_brake_record, only: brake_event_table, event_stick_to_slip, event_kind_names
+   use friction_brake_switched, only: switched_integrator, brake_slip
+   use friction_analysis_periodic_orbit, only: section_map, orbit_settings, periodic_orbit, &
+      & find_periodic_orbit, floquet_multipliers, floquet_exponents
+   implicit none
+   private
+
+   public :: brake_section_map, brake_orbit, brake_periodic_orbit, section_state, section_limit
+   public :: orbit_branch, follow_branch, bifurcation_names, continuation_unit
+   public :: bifurcation_period_doubling, bifurcation_fold, bifurcation_neimark_sacker, bifurcation_discontinuity
+
+   !> Where a multiplier of the section map leaves (or enters) the unit circle.
+   integer, parameter :: bifurcation_period_doubling = 1  !! a real multiplier through -1
+   integer, parameter :: bifurcation_fold = 2             !! a real multiplier through +1
+   integer, parameter :: bifurcation_neimark_sacker = 3   !! a complex pair through |μ| = 1
+   !> The orbits at two consecutive points are not on one smooth branch:
+   !> their patterns of events differ, or the period jumps by more than half
+   !> the crank's period in stick, π/ω with ω = √(κ/ξ) (the stick ends at
+   !> another lobe of the static limit: a grazing of the stick's exit), or
+   !> Newton jumped to another orbit.
+   integer, parameter :: bifurcation_discontinuity = 4
+   character(len=*), parameter :: bifurcation_names(4) = [character(len=15) :: 'period_doubling', 'fold', &
+      & 'neimark_sacker', 'discontinuity']
+
+   !> Most slip onsets of the attractor kept per point of the line (the diagram).
+   integer, parameter :: max_section_points = 400
+
+   !> The orbit followed along a line of one variable (docs/physics.md).
+   type :: orbit_branch
+      character(len=16) :: variable = ''
+      real(wp), allocatable :: parameter(:)          !! (n) the variable's values
+      logical, allocatable :: found(:)               !! (n)
+      integer, allocatable :: source(:)              !! (n) 1: continued from the previous orbit, 2: from the attractor
+      real(wp), allocatable :: period(:)             !! (n) τ; NaN where none
+      real(wp), allocatable :: state(:, :)           !! (4, n) slip onset of the orbit
+      complex(wp), allocatable :: multipliers(:, :)  !! (4, n) as brake_orbit%multipliers
+      real(wp), allocatable :: max_modulus(:)        !! (n) largest |μ| of the section map
+      integer, allocatable :: pattern(:, :)          !! (3, n) as brake_orbit%pattern
+      integer, allocatable :: kind(:)                !! bifurcations: bifurcation_* ...
+      real(wp), allocatable :: at(:)                 !! ... at these values (linear interpolation of |μ| - 1)
+      real(wp), allocatable :: section_parameter(:)  !! the attractor's slip onsets: the variable ...
+      real(wp), allocatable :: section_x(:)          !! ... and x there (the bifurcation diagram)
+   end type orbit_branch
+
+   !> The return map of the stick-to-slip section at the limit σ.
+   type, extends(section_map) :: brake_section_map
+      type(brake_config) :: config
+      real(wp) :: limit = 1.0_wp          !! σ
+      real(wp) :: max_return = 1.0e4_wp   !! τ; no slip onset by then: no return
+      logical :: tangent = .true.         !! .false.: P alone (jacobian = 0)
+      integer :: counts(size(event_kind_names)) = 0   !! events by kind over the last return
+   contains
+      procedure :: dimension => brake_map_dimension
+      procedure :: evaluate => brake_map_evaluate
+   end type brake_section_map
+
+   !> A brake run's periodic orbit (/brake/orbit, docs/output.md).
+   type :: brake_orbit
+      type(periodic_orbit) :: orbit
+      real(wp) :: limit = 1.0_wp              !! σ of the section
+      real(wp) :: guess_time = 0.0_wp         !! τ of the run's slip onset Newton started from
+      real(wp) :: state(4) = 0.0_wp           !! the orbit's slip onset (x, v, y, w)
+      complex(wp) :: multipliers(4) = (0.0_wp, 0.0_wp)  !! 1, those of DP (by modulus), 0
+      real(wp) :: exponents(4) = 0.0_wp       !! ln|μ|/T; -inf for the stick's 0
+      !> Events of each kind over one period (stick-to-slip, slip-to-stick,
+      !> slip reversal): the orbit's pattern, which a continuous branch keeps.
+      integer :: pattern(size(event_kind_names)) = 0
+   end type brake_orbit
+
+contains
+
+   !> The section's state at (y, w) = s for the limit σ.
+   pure function section_state(p, limit, s) result(z)
+      type(brake_parameters), intent(in) :: p
+      real(wp), intent(in) :: limit, s(2)
+      real(wp) :: z(4)
+
+      z = [(s(1) + limit * p%mu_s * p%normal_force(s(1))) / 2, p%v_dr, s(1), s(2)]
+   end function section_state
+
+   !> σ of a slip onset: the sign of the elastic force 2x - y there.
+   pure real(wp) function section_limit(p, z)
+      type(brake_parameters), intent(in) :: p
+      real(wp), intent(in) :: z(4)
+
+      section_limit = sign(1.0_wp, p%elastic_force(z(1), z(3)))
+   end function section_limit
+
+   pure integer function brake_map_dimension(self)
+      class(brake_section_map), intent(in) :: self
+
+      brake_map_dimension = 2
+   end function brake_map_dimension
+
+   subroutine brake_map_evaluate(self, s, image, jacobian, period, returned, reason, error)
+      class(brake_section_map), intent(inout) :: self
+      real(wp), intent(in) :: s(:)
+      real(wp), intent(out) :: image(:), jacobian(:, :), period
+      logical, intent(out) :: returned
+      character(len=:), allocatable, intent(out) :: reason
+      type(error_type), allocatable, intent(out) :: error
+      type(switched_integrator), target :: run
+      type(brake_event_table) :: events
+      type(brake_slip) :: slip
+      real(wp) :: normal(4), f(4), b(4, 2), projected(4, 2)
+      integer :: i
+
+      image = s
+      jacobian = 0.0_wp
+      period = 0.0_wp
+      returned = .false.
+      reason = ''
+      associate (p => self%config%params, sigma => self%limit)
+         run%tangent = self%tangent
+         call run%start_slipping(self%config, 0.0_wp, section_state(p, sigma, s), -sigma, events, error)
+         if (allocated(error)) return
+         call run%advance_to_slip_onset(self%max_return, events, returned, error)
+         if (allocated(error)) then
+            ! A trial point of Newton's whose orbit leaves Eq. 10 (the pad lifts
+            ! off) or defeats the stepper returns nowhere: a result of the search.
+            returned = .false.
+            reason = error%message
+            deallocate (error)
+            return
+         end if
+         if (.not. returned) then
+            reason = 'no slip onset within the longest return time'
+            return
+         end if
+         if (section_limit(p, run%y) /= sigma) then
+            returned = .false.
+            reason = 'the slip starts at the other static limit'
+            return
+         end if
+         do i = 1, size(self%counts)
+            self%counts(i) = count(events%kind(1:events%n) == i)
+         end do
+         period = run%t
+         image = run%y(3:4)
+         if (.not. self%tangent) return
+         ! h = μs N' - σ (2x - y) (switched.f90, stick_exit_saltation).
+         normal = [-2.0_wp * sigma, 0.0_wp, p%mu_s * (1.0_wp - p%kappa) + sigma, 0.0_wp]
+         slip%params = p
+         slip%direction = -sigma
+         call slip%rhs(run%t, run%y, f)
+         b = 0.0_wp
+         b(:, 1) = [(1.0_wp + sigma * p%mu_s * (1.0_wp - p%kappa)) / 2, 0.0_wp, 1.0_wp, 0.0_wp]
+         b(4, 2) = 1.0_wp
+         projected = matmul(run%phi, b)
+         do i = 1, 2
+            projected(:, i) = projected(:, i) - f * dot_product(normal, projected(:, i)) / dot_product(normal, f)
+         end do
+         jacobian = projected(3:4, :)
+      end associate
+   end subroutine brake_map_evaluate
+
+   !> The periodic orbit through the run's first slip onset at or after
+   !> t_start + transient (the guess), Newton on its section.  No slip onset
+   !> there, or no convergence: found = .false. with the reason.
+   subroutine brake_periodic_orbit(config, events, transient, settings, result, error)
+      type(brake_config), intent(in) :: config
+      type(brake_event_table), intent(in) :: events
+      real(wp), intent(in) :: transient
+      type(orbit_settings), intent(in) :: settings
+      type(brake_orbit), intent(out) :: result
+      type(error_type), allocatable, intent(out) :: error
+      integer :: j
+
+      do j = 1, events%n
+         if (events%kind(j) == event_stick_to_slip .and. events%t(j) >= config%t_start + transient) exit
+      end do
+      if (j > events%n) then
+         result%orbit%reason = 'no slip onset after orbit_transient'
+         return
+      end if
+      result%guess_time = events%t(j)
+      result%limit = section_limit(config%params, events%state(:, j))
+      call continue_orbit(config, result%limit, events%state(3:4, j), settings, result, error)
+   end subroutine brake_periodic_orbit
+
+   !> Newton from the section point (y, w) = guess at the limit σ.
+   subroutine continue_orbit(config, limit, guess, settings, result, error)
+      type(brake_config), intent(in) :: config
+      real(wp), intent(in) :: limit, guess(2)
+      type(orbit_settings), intent(in) :: settings
+      type(brake_orbit), intent(inout) :: result
+      type(error_type), allocatable, intent(out) :: error
+      type(brake_section_map) :: map
+
+      map%config = config
+      map%limit = limit
+      map%max_return = config%t_end - config%t_start
+      result%limit = limit
+      call find_periodic_orbit(map, guess, settings, result%orbit, error)
+      if (allocated(error)) return
+      result%state = section_state(config%params, limit, result%orbit%point)
+      if (.not. result%orbit%found) return
+      ! Newton's last evaluation was at the fixed point.
+      result%pattern = map%counts
+      result%multipliers = floquet_multipliers(result%orbit, 1)
+      result%exponents = floquet_exponents(result%multipliers, result%orbit%period)
+   end subroutine continue_orbit
+
+   !> The orbit `first` of the run (config) followed along the line from the
+   !> continuation variable's value in config to `last` in n points: at each
+   !> point Newton starts from the previous point's orbit (halving the step
+   !> in the variable up to 5 times when it fails); where there was none or
+   !> that fails, from the first slip onset after `transient` of a run at
+   !> the point.  Every point's run also gives the attractor's slip onsets.
+   !> Sequential: the result does not depend on ranks.
+   subroutine follow_branch(config, first, last, n, transient, settings, branch, error)
+      type(brake_config), intent(in) :: config
+      type(brake_orbit), intent(in) :: first
+      real(wp), intent(in) :: last, transient
+      integer, intent(in) :: n
+      type(orbit_settings), intent(in) :: settings
+      type(orbit_branch), intent(out) :: branch
+      type(error_type), allocatable, intent(out) :: error
+      type(brake_orbit) :: previous, current
+      type(brake_config) :: point
+      real(wp) :: start
+      real(wp), allocatable :: onsets(:)
+      integer :: k
+
+      branch%variable = config%analysis%continuation
+      start = parameter_value(config)
+      allocate (branch%parameter(n), branch%found(n), branch%source(n), branch%period(n), branch%state(4, n), &
+         & branch%multipliers(4, n), branch%max_modulus(n), branch%kind(0), branch%at(0), &
+         & branch%pattern(size(event_kind_names), n), &
+         & branch%section_parameter(0), branch%section_x(0))
+      do k = 1, n
+         branch%parameter(k) = start + (last - start) * real(k - 1, wp) / real(n - 1, wp)
+      end do
+      branch%parameter(n) = last
+      previous = first
+      do k = 1, n
+         point = continuation_config(config, branch%parameter(k))
+         if (k == 1) then
+            current = first
+            branch%source(k) = 2
+            call attractor_onsets(point, transient, onsets, current, .false., error)
+         else
+            current = brake_orbit()
+            if (previous%orbit%found) then
+               call continue_along(config, branch%parameter(k - 1), branch%parameter(k), previous, settings, &
+                  & current, error)
+               if (allocated(error)) return
+            end if
+            branch%source(k) = merge(1, 2, current%orbit%found)
+            call attractor_onsets(point, transient, onsets, current, .not. current%orbit%found, error, settings)
+         end if
+         if (allocated(error)) return
+         branch%section_parameter = [branch%section_parameter, spread(branch%parameter(k), 1, size(onsets))]
+         branch%section_x = [branch%section_x, onsets]
+         call record(k, current)
+         previous = current
+      end do
+      call detect_bifurcations(config, branch)
+
+   contains
+
+      subroutine record(k, o)
+         integer, intent(in) :: k
+         type(brake_orbit), intent(in) :: o
+
+         branch%found(k) = o%orbit%found
+         branch%state(:, k) = o%state
+         branch%multipliers(:, k) = o%multipliers
+         branch%pattern(:, k) = o%pattern
+         if (o%orbit%found) then
+            branch%period(k) = o%orbit%period
+            branch%max_modulus(k) = maxval(abs(o%orbit%multipliers))
+         else
+            branch%period(k) = ieee_value(1.0_wp, ieee_quiet_nan)
+            branch%max_modulus(k) = ieee_value(1.0_wp, ieee_quiet_nan)
+         end if
+      end subroutine record
+
+   end subroutine follow_branch
+
+   !> The unit of a continuation variable (as &brake gives it).
+   pure function continuation_unit(name) result(unit)
+      character(len=*), intent(in) :: name
+      character(len=:), allocatable :: unit
+
+      select case (trim(name))
+      case ('g_prime')
+         unit = 'm'
+      case ('delta_prime')
+         unit = 'tau/m'
+      case ('v_dr_prime')
+         unit = 'm/tau'
+      case default
+         unit = '1'
+      end select
+   end function continuation_unit
+
+   !> The continuation variable's value in config.
+   real(wp) function parameter_value(config) result(value)
+      type(brake_config), intent(in) :: config
+
+      select case (trim(config%analysis%continuation))
+      case ('mu')
+         value = config%params%mu
+      case ('mu_s')
+         value = config%params%mu_s
+      case ('xi')
+         value = config%params%xi
+      case ('kappa')
+         value = config%params%kappa
+      case ('g_prime')
+         value = config%params%g_prime
+      case ('delta_prime')
+         value = config%params%delta_prime
+      case default
+         value = config%params%v_dr
+      end select
+   end function parameter_value
+
+   !> From the orbit `previous` at the value `from` to the value `to`.
+   subroutine continue_along(config, from, to, previous, settings, result, error)
+      type(brake_config), intent(in) :: config
+      real(wp), intent(in) :: from, to
+      type(brake_orbit), intent(in) :: previous
+      type(orbit_settings), intent(in) :: settings
+      type(brake_orbit), intent(out) :: result
+      type(error_type), allocatable, intent(out) :: error
+      type(brake_orbit) :: reached
+      real(wp) :: at, step, trial
+      integer :: halvings
+
+      reached = previous
+      at = from
+      step = to - from
+      halvings = 0
+      do
+         trial = at + step
+         if (abs(to - trial) <= 1.0e-12_wp * abs(to - from)) trial = to
+         result = brake_orbit()
+         call continue_orbit(continuation_config(config, trial), reached%limit, reached%orbit%point, settings, &
+            & result, error)
+         if (allocated(error)) return
+         if (result%orbit%found) then
+            if (trial == to) return
+            reached = result
+            at = trial
+            step = to - at
+         else
+            halvings = halvings + 1
+            if (halvings > 5) return
+            step = step / 2
+         end if
+      end do
+   end subroutine continue_along
+
+   !> A run at the point: x at its slip onsets after `transient` (at most
+   !> max_section_points, the last ones) and, with `fresh`, the orbit through
+   !> the first of them.  A run that fails (the pad lifts off) gives none.
+   subroutine attractor_onsets(point, transient, onsets, orbit, fresh, error, settings)
+      type(brake_config), intent(in) :: point
+      real(wp), intent(in) :: transient
+      real(wp), allocatable, intent(out) :: onsets(:)
+      type(brake_orbit), intent(inout) :: orbit
+      logical, intent(in) :: fresh
+      type(error_type), allocatable, intent(out) :: error
+      type(orbit_settings), intent(in), optional :: settings
+      type(brake_run), target :: run
+      type(error_type), allocatable :: run_error
+      logical, allocatable :: keep(:)
+
+      allocate (onsets(0))
+      call simulate_brake(point, run, run_error)
+      if (allocated(run_error)) then
+         if (fresh) orbit%orbit%reason = 'the run at this point failed: '//run_error%message
+         return
+      end if
+      associate (e => run%events)
+         keep = e%kind(1:e%n) == event_stick_to_slip .and. e%t(1:e%n) >= point%t_start + transient
+         onsets = pack(e%state(1, 1:e%n), keep)
+         if (size(onsets) > max_section_points) onsets = onsets(size(onsets) - max_section_points + 1:)
+      end associate
+      if (fresh) call brake_periodic_orbit(point, run%events, transient, settings, orbit, error)
+   end subroutine attractor_onsets
+
+   !> Between consecutive points with an orbit: a discontinuity (recorded at
+   !> the midpoint, no multiplier compared), or
+   !> the largest |μ| of the section map crossing 1: the kind from the critical multiplier on the
+   !> outer side (complex: Neimark–Sacker; real < 0: period doubling; real
+   !> > 0: fold), the value by linear interpolation of |μ| - 1.
+   subroutine detect_bifurcations(config, branch)
+      type(brake_config), intent(in) :: config
+      type(orbit_branch), intent(inout) :: branch
+      integer :: k, outer, kind
+      real(wp) :: m0, m1, half_crank_period
+      complex(wp) :: critical
+
+      do k = 2, size(branch%parameter)
+         if (.not. (branch%found(k - 1) .and. branch%found(k))) cycle
+         ! κ, ξ at the midpoint (they can be the continuation variable).
+         associate (p => continuation_config(config, (branch%parameter(k - 1) + branch%parameter(k)) / 2))
+            half_crank_period = pi / sqrt(p%params%kappa / p%params%xi)
+         end associate
+         if (any(branch%pattern(:, k) /= branch%pattern(:, k - 1)) .or. &
+            & abs(branch%period(k) - branch%period(k - 1)) > half_crank_period) then
+            branch%kind = [branch%kind, bifurcation_discontinuity]
+            branch%at = [branch%at, (branch%parameter(k - 1) + branch%parameter(k)) / 2]
+            cycle
+         end if
+         m0 = branch%max_modulus(k - 1)
+         m1 = branch%max_modulus(k)
+         if (.not. ((m0 - 1.0_wp) * (m1 - 1.0_wp) < 0.0_wp)) cycle
+         outer = merge(k, k - 1, m1 > 1.0_wp)
+         ! Multipliers 2:3 are the section map's, the larger first.
+         critical = branch%multipliers(2, outer)
+         if (aimag(critical) /= 0.0_wp) then
+            kind = bifurcation_neimark_sacker
+         else if (real(critical) < 0.0_wp) then
+            kind = bifurcation_period_doubling
+         else
+            kind = bifurcation_fold
+         end if
+         branch%kind = [branch%kind, kind]
+         branch%at = [branch%at, branch%parameter(k - 1) + (1.0_wp - m0) / (m1 - m0) &
+            & * (branch%parameter(k) - branch%parameter(k - 1))]
+      end do
+   end subroutine detect_bifurcations
+
+end module friction_brake_orbit
