@@ -34,8 +34,9 @@ from matplotlib.patches import Polygon, Rectangle
 from ._data import FileError, load, reading, require
 
 __all__ = ["afm_maps", "friction_loop", "graphite_net", "stacked_lines", "brake_phase", "brake_x",
-           "brake_spectrum", "poincare", "lyapunov", "floquet", "orbit_branch", "sweep", "bifurcation", "sweep_lyapunov", "atlas",
-           "sweep_friction", "work_precision", "failure_map", "friction_velocity", "sang_fit", "Figure"]
+           "brake_spectrum", "poincare", "lyapunov", "floquet", "orbit_branch", "sweep", "bifurcation",
+           "sweep_lyapunov", "atlas", "sweep_friction", "work_precision", "failure_map", "friction_velocity",
+           "sang_fit", "Figure"]
 
 
 class Figure(_Figure):
