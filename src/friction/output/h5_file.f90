@@ -36,7 +36,7 @@ module friction_output_h5
       end function h5fget_mdc_size
    end interface
 
-   public :: h5_file
+   public :: h5_file, error_printing
 
    !> H5E_DEFAULT of the C API: the default error stack (hid_t is int64_t
    !> since HDF5 1.10).
