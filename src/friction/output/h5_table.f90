@@ -468,6 +468,7 @@ contains
          call h5aopen_by_name_f(self%id, object, name, attr, stat)
          call h5aget_type_f(attr, type, stat)
          call h5tget_size_f(type, size, stat)
+         deallocate (text)
          allocate (character(len=size) :: text)
          call h5aread_f(attr, type, text, [1_hsize_t], stat)
          if (stat /= 0) text = ''
