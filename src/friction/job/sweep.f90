@@ -32,7 +32,7 @@ module friction_job_sweep
    use friction_kinds, only: wp, i8
    use friction_clock, only: wall_seconds
    use friction_error, only: error_type, fatal_error, error_interrupted, error_input, error_numerical, error_io
-   use friction_strings, only: itoa, text_hash
+   use friction_strings, only: itoa, text_hash, bytes_text
    use friction_version, only: version_string
    use friction_ode_solver, only: integrator_statistics
    use friction_parameters, only: set_parameter_number, split_name, parameter_info, list_parameters
@@ -42,7 +42,7 @@ module friction_job_sweep
    use friction_output_h5, only: h5_file
    use friction_output_h5_table, only: h5_table
    use friction_output_summary, only: run_summary, write_run_attributes
-   use friction_files, only: remove_file, file_exists
+   use friction_files, only: remove_file, file_exists, free_bytes, min_free_bytes, rename_file
    use friction_scene_report, only: job_reporter
    use friction_scene_context, only: job_context, temporary_name, publish, ranks_text, agree_on_error, job_wall_time
    implicit none
@@ -63,6 +63,9 @@ module friction_job_sweep
    real(wp), parameter :: batch_seconds = 10.0_wp
    !> Points per piece of the final copy into the output.
    integer, parameter :: copy_points = 4096
+
+   !> The kinds of the checkpoint's columns of column_names (h5_table's add_column).
+   character(len=7), parameter :: column_kinds = 'iirlili'
 
    integer, parameter :: tag_header = 7301, tag_numbers = 7302, tag_reason = 7303
 
@@ -229,6 +232,7 @@ contains
          computed = computed + 1
          t0 = wall_seconds()
          call run_point(config, i, results, series, point_error)
+         if (.not. allocated(series)) allocate (series(0))
          cost = wall_seconds() - t0
          mine%header = [i, status_done, size(names), size(series), 0]
          mine%reason = ''
@@ -236,7 +240,8 @@ contains
             mine%header(2) = status_failed
             mine%reason = one_line(point_error%message)
             results = 0.0_wp
-            deallocate (series, point_error)
+            deallocate (point_error)
+            if (allocated(series)) deallocate (series)
             allocate (series(0))
          end if
          mine%header(4) = size(series)
@@ -268,8 +273,7 @@ contains
          call write_batch(ckpt, batch, names, .true.)
          if (ckpt%opened) call ckpt%file%close(error)
          if (allocated(error) .and. .not. allocated(ckpt%error)) call move_alloc(error, ckpt%error)
-         if (allocated(ckpt%error)) call fatal_error(error, 'the checkpoint could not be written, so the ' &
-            & //'points of this run are lost: '//ckpt%error%message, error_io)
+         if (allocated(ckpt%error)) call fatal_error(error, checkpoint_lost(ckpt), error_io)
       end if
       flag = merge(1, 0, interrupted)
       if (job%parallel()) call MPI_Allreduce(MPI_IN_PLACE, flag, 1, MPI_INTEGER, MPI_MAX, job%comm)
@@ -499,8 +503,19 @@ contains
       if (.not. (now .or. batch%n == batch_points .or. batch%n_series >= batch_series .or. ckpt%received == 0 &
          & .or. wall_seconds() - batch%since >= batch_seconds)) return
       ckpt%received = ckpt%received + batch%n
+      ! Not on a (nearly) full disk: a write that fails there leaves HDF5
+      ! unable to close the file; with room to spare, the checkpoint closes.
       if (.not. allocated(ckpt%error)) then
-         if (.not. ckpt%opened) call create_checkpoint(ckpt, names)
+         if (.not. room_for(ckpt%path, 8.0_wp * (batch%n_series + batch%n * (size(names) + 8)) &
+            & + len(batch%reasons))) then
+            if (ckpt%opened) call ckpt%file%close(ckpt%error)
+            if (.not. allocated(ckpt%error)) call fatal_error(ckpt%error, ckpt%path//': the disk is full (' &
+               & //bytes_text(free_bytes(ckpt%path))//' free)', error_io)
+            ckpt%opened = .false.
+            call remove_file(ckpt%path)
+         else if (.not. ckpt%opened) then
+            call create_checkpoint(ckpt, names)
+         end if
       end if
       if (allocated(ckpt%error)) then
          batch%n = 0   ! nowhere to keep them: the run fails at its end
@@ -547,12 +562,42 @@ contains
       end do
       call ckpt%file%flush()
       if (ckpt%file%failed()) call ckpt%file%close(ckpt%error)
-      if (allocated(ckpt%error)) ckpt%opened = .false.
+      ! A checkpoint that failed a write cannot be trusted: it goes, and the
+      ! run fails at its end (checkpoint_lost).
+      if (allocated(ckpt%error)) then
+         ckpt%opened = .false.
+         call remove_file(ckpt%path)
+      end if
       batch%n = 0
       batch%n_series = 0
       batch%reasons = ''
       batch%since = wall_seconds()
    end subroutine write_batch
+
+   !> Whether the disk at path has room for `bytes` more and min_free_bytes
+   !> to spare (true where it cannot tell).
+   logical function room_for(path, bytes)
+      character(len=*), intent(in) :: path
+      real(wp), intent(in) :: bytes
+      real(wp) :: free
+
+      free = free_bytes(path)
+      room_for = free < 0.0_wp .or. free >= bytes + min_free_bytes
+   end function room_for
+
+   !> Why the run failed when its checkpoint could not be written.
+   function checkpoint_lost(ckpt) result(message)
+      type(checkpoint), intent(in) :: ckpt
+      character(len=:), allocatable :: message
+      real(wp) :: free
+
+      message = ckpt%error%message
+      free = free_bytes(ckpt%path)
+      if (free >= 0.0_wp .and. free < min_free_bytes) message = message//' (the disk is full: ' &
+         & //bytes_text(free)//' free)'
+      message = message//'; the checkpoint could not be written and was removed (a failed write leaves it ' &
+         & //'untrustworthy), and the points of this run are lost with it: run again when there is room'
+   end function checkpoint_lost
 
    !> The permutation that sorts `keys` (a batch: insertion sort, as the
    !> points come nearly in order).
@@ -575,34 +620,46 @@ contains
    end function sorted_order
 
    !> A new checkpoint: the input's hash, the number of points and results,
-   !> and its columns (zeros: every point pending).
+   !> its columns (zeros: every point pending) and a reserve of
+   !> reserve_bytes.  The reserve is what a full disk gives back: after a
+   !> failed write the file is cut to no bytes before it is closed
+   !> (h5_table's close), and closing needs room for what HDF5 still holds.
+   !> Made under another name and renamed, so it appears whole, reserve and all.
    subroutine create_checkpoint(ckpt, names)
       type(checkpoint), intent(inout) :: ckpt
       type(point_result), intent(in) :: names(:)
+      integer, parameter :: reserve_bytes = 1048576
+      character(len=:), allocatable :: fresh
       integer :: j
       integer(i8) :: n
 
       n = ckpt%points
-      call ckpt%file%create(ckpt%path, ckpt%error)
+      fresh = ckpt%path//'.new'
+      call ckpt%file%create(fresh, ckpt%error)
       if (allocated(ckpt%error)) return
       call ckpt%file%set_text('/', 'input_hash', ckpt%hash)
       call ckpt%file%set_integer('/', 'points', n)
       call ckpt%file%set_integer('/', 'results', int(size(names), i8))
       call ckpt%file%set_integer('/', 'runs', int(ckpt%run, i8))
-      call ckpt%file%add_column('status', 'i', n, '')
-      call ckpt%file%add_column('run', 'i', n, '')
-      call ckpt%file%add_column('compute_time', 'r', n, 's')
-      call ckpt%file%add_column('series_offset', 'l', n, '')
-      call ckpt%file%add_column('series_count', 'i', n, '')
-      call ckpt%file%add_column('reason_offset', 'l', n, '')
-      call ckpt%file%add_column('reason_length', 'i', n, '')
+      do j = 1, 7
+         call ckpt%file%add_column(trim(column_names(j)), column_kinds(j:j), n, '')
+      end do
       do j = 1, size(names)
          call ckpt%file%add_column('result'//itoa(j), 'r', n, '')
       end do
       call ckpt%file%add_column('series', 'r', -1_i8, '')
       call ckpt%file%add_column('reason', 'b', -1_i8, '')
-      ckpt%opened = .true.
-      if (ckpt%file%failed()) call ckpt%file%close(ckpt%error)
+      call ckpt%file%add_column('reserve', 'b', int(reserve_bytes, i8), '')
+      call ckpt%file%put('reserve', 0_i8, repeat(' ', reserve_bytes))
+      call ckpt%file%close(ckpt%error)
+      if (.not. allocated(ckpt%error)) call rename_file(fresh, ckpt%path, ckpt%error)
+      if (allocated(ckpt%error)) then
+         call remove_file(fresh)
+         return
+      end if
+      call ckpt%file%open(ckpt%path, ckpt%error)
+      ckpt%opened = .not. allocated(ckpt%error)
+      if (.not. ckpt%opened) call remove_file(ckpt%path)
    end subroutine create_checkpoint
 
    !> --resume: open the checkpoint, check it is of this input and whole, and
@@ -623,6 +680,12 @@ contains
       if (allocated(error)) then
          call fatal_error(error, ckpt%path//': the checkpoint is damaged (it does not open as HDF5); remove it, ' &
             & //'and --resume computes every point again', error_input)
+         return
+      end if
+      if (len(ckpt%file%text('/', 'input_hash')) == 0 .or. ckpt%file%integer('/', 'runs') < 1) then
+         call ckpt%file%close(ignored)
+         call fatal_error(error, ckpt%path//': the checkpoint is damaged (it lacks its input_hash or runs); ' &
+            & //'remove it, and --resume computes every point again', error_input)
          return
       end if
       if (ckpt%file%text('/', 'input_hash') /= input_hash) then

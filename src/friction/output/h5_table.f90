@@ -15,7 +15,8 @@ module friction_output_h5_table
    use hdf5
    use friction_kinds, only: wp, i8
    use friction_error, only: error_type, fatal_error, error_io
-   use friction_output_h5, only: error_printing
+   use friction_files, only: truncate_file
+   use friction_output_h5, only: error_printing, room_to_close
    implicit none
    private
 
@@ -97,9 +98,15 @@ contains
    subroutine table_flush(self)
       class(h5_table), intent(inout) :: self
       type(error_printing) :: printing
+      character(len=:), allocatable :: problem
       integer :: stat
 
       if (self%status /= 0 .or. self%id < 0) return
+      problem = room_to_close(self%id, self%path)
+      if (len(problem) > 0) then
+         call self%check(1, problem)
+         return
+      end if
       call printing%silence()
       call h5fflush_f(self%id, H5F_SCOPE_GLOBAL_F, stat)
       call self%check(stat, 'flushing the file')
@@ -116,11 +123,21 @@ contains
    subroutine table_close(self, error)
       class(h5_table), intent(inout) :: self
       type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: problem
       type(error_printing) :: printing
       integer :: stat
 
+      if (self%id >= 0 .and. self%status == 0) then
+         problem = room_to_close(self%id, self%path)
+         if (len(problem) > 0) call self%check(1, problem)
+      end if
       call printing%silence()
       if (self%id >= 0) then
+         ! After a failed write (a full disk) the file is cut to no bytes
+         ! first: that gives its space back, so closing, which writes what
+         ! HDF5 still holds, succeeds and leaves no handle open (HDF5's
+         ! clean-up at exit would crash on one).  Such a file is for removal.
+         if (self%status /= 0) call truncate_file(self%path)
          call h5fclose_f(self%id, stat)
          call self%check(stat, 'closing the file')
          self%id = -1
