@@ -249,14 +249,13 @@ contains
          mine%numbers = [results, cost, series]
          if (job%rank == 0) then
             call add_point(batch, mine)
+            call write_batch(ckpt, batch, names, .false.)   ! (every add is followed by one: a batch never overflows)
             call receive_points(job, ckpt, batch, names, finished, .false.)
-            call write_batch(ckpt, batch, names, .false.)
             call reporter%progress(real(ckpt%received, wp), real(n_work, wp), 'points', .false.)
          else
             call send_point(job, outbox, slot, mine)
          end if
       end do
-      if (dynamic) call MPI_Win_free(window)
       if (todo_unit >= 0) close (todo_unit)
       ! This rank has finished: it says so (and whether it was interrupted),
       ! and rank 0 takes every point still on its way.
@@ -275,6 +274,9 @@ contains
          if (allocated(error) .and. .not. allocated(ckpt%error)) call move_alloc(error, ckpt%error)
          if (allocated(ckpt%error)) call fatal_error(error, checkpoint_lost(ckpt), error_io)
       end if
+      ! (Collective: only once every point is on its way, or a rank waiting
+      ! for rank 0 to take its points would wait for ever.)
+      if (dynamic) call MPI_Win_free(window)
       flag = merge(1, 0, interrupted)
       if (job%parallel()) call MPI_Allreduce(MPI_IN_PLACE, flag, 1, MPI_INTEGER, MPI_MAX, job%comm)
       interrupted = flag /= 0
