@@ -251,7 +251,8 @@ contains
             call add_point(batch, mine)
             call write_batch(ckpt, batch, names, .false.)   ! (every add is followed by one: a batch never overflows)
             call receive_points(job, ckpt, batch, names, finished, .false.)
-            call reporter%progress(real(ckpt%received, wp), real(n_work, wp), 'points', .false.)
+            ! (The points rank 0 has taken: those written and those in its batch.)
+            call reporter%progress(real(ckpt%received + batch%n, wp), real(n_work, wp), 'points', .false.)
          else
             call send_point(job, outbox, slot, mine)
          end if

@@ -41,7 +41,6 @@ module friction_output_h5_table
       procedure :: add_column
       procedure :: add_text_column
       procedure :: length
-      procedure :: has
       procedure, private :: put_real, put_int, put_long, put_bytes, put_text
       generic :: put => put_real, put_int, put_long, put_bytes, put_text
       procedure, private :: get_real, get_int, get_long, get_bytes
@@ -233,21 +232,6 @@ contains
       call h5sclose_f(space, stat)
       call printing%restore()
    end subroutine make_column
-
-   !> Whether the file holds an object of that name.
-   logical function has(self, name)
-      class(h5_table), intent(inout) :: self
-      character(len=*), intent(in) :: name
-      integer :: stat
-      type(error_printing) :: printing
-
-      has = .false.
-      if (self%status /= 0) return
-      call printing%silence()
-      call h5lexists_f(self%id, name, has, stat)
-      if (stat /= 0) has = .false.
-      call printing%restore()
-   end function has
 
    !> The number of elements of column name (-1 where there is none).
    integer(i8) function length(self, name)
