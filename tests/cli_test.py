@@ -1508,6 +1508,16 @@ def case_sweep_grid_ranks(args):
     if not (counts[failed].sum() == 0 and counts[~failed].min() > 0 and counts.sum() == total and
             np.array_equal(offsets, np.concatenate([[0], np.cumsum(counts)[:-1]]))):
         fail("the maxima's offsets and counts do not index the flat list in point order")
+    # An explicit list longer than the 1024 values a list once held, on
+    # several lines: every value becomes a point, in order.
+    listed = np.round(np.linspace(0.1, 0.5, 1100), 6)
+    lines = ",\n ".join(", ".join(repr(float(x)) for x in listed[k:k + 10]) for k in range(0, listed.size, 10))
+    write(args, "list.nml", f"&sweep sweep_variable2 = '', sweep_variable = 'brake.xi', sweep_spacing = 'list',\n"
+          f" sweep_values = {lines} /\n")
+    friction(args, "-o", "list.h5", brake, grid, os.path.join(args.workdir, "list.nml"))
+    with h5py.File(os.path.join(args.workdir, "list.h5"), "r") as handle:
+        if not (np.array_equal(handle["sweep/values"][()], listed) and np.all(handle["sweep/status"][()] == 1)):
+            fail("a list of 1100 values did not give its 1100 points")
 
 
 def case_sweep_large_resume(args):
