@@ -18,10 +18,22 @@ Measures and prints (not a test; nothing fails on a missed target):
   and for a large AFM sweep (inputs/afm_sweep.nml as a 32 x 32 grid of V0 and
   velocity, --large points in all, small maps), with a quarter of the points
   for comparison: memory per rank must not grow with the points.
+* Scale (--scale): a cheap 2-D brake grid (tau = 60, both variables in
+  &brake) of 1e3, 1e4 and 1e5 points (--counts) on 1 and 2 ranks: points per
+  second per core, peak memory per rank (VmHWM), the file's size, and the
+  cost the sweep adds per point besides computing it (wall time less the
+  points' compute time, per point: messages, checkpoint, the copy into the
+  output).  Then the cost of an atlas point (a point of
+  inputs/brake_sweep.nml, the median of its 48), and from both the projected
+  wall time of a 1e6-point atlas on 1, 16 and 64 nodes of --cores-per-node
+  cores: max(points x cost / ranks, points x added cost), the second term
+  being rank 0's share (taking every point's message, batch and copy; the
+  larger added cost of 1 and 2 ranks), which does not shrink with more ranks.
 
 Usage (normally through scripts/benchmark_sweep, which builds first):
 
-    python3 scripts/benchmark_sweep.py [--repeats N] [--large N] [--memory-only] [--binary PATH] [--mpiexec PATH]
+    python3 scripts/benchmark_sweep.py [--repeats N] [--large N] [--memory-only] [--scale]
+                                       [--counts N ...] [--cores-per-node N] [--binary PATH] [--mpiexec PATH]
 """
 import argparse
 import os
@@ -55,6 +67,61 @@ def run(args, workdir, ranks, files, name):
                 f["sweep/peak_memory_per_rank"][()], f["sweep/compute_time"][()])
 
 
+# The cheap grid of --scale: mu (valid, below mu_s = 0.59) by xi, tau = 60.
+CHEAP = ("&brake mu = 0.5, mu_s = 0.59, t_end = 60.0, dt_out = 0.5 /\n"
+         "&analysis window_start = 10.0, window_end = 60.0, spectrum = .false., lyapunov = .false.,"
+         " rosenstein = .false., lyapunov_spectrum = .false. /\n"
+         "&sweep sweep_variable = 'brake.mu', sweep_spacing = 'linear', sweep_from = 0.3, sweep_to = 0.58,"
+         " sweep_count = {rows},\n sweep_variable2 = 'brake.xi', sweep_spacing2 = 'linear', sweep_from2 = 0.1,"
+         " sweep_to2 = 0.5, sweep_count2 = {columns} /\n")
+
+
+def grid_shape(n):
+    """rows x columns = n, as square as n allows."""
+    rows = int(np.sqrt(n))
+    while n % rows:
+        rows -= 1
+    return rows, n // rows
+
+
+def hours(seconds):
+    return f"{seconds / 3600:.2f} h" if seconds >= 3600 else f"{seconds / 60:.1f} min"
+
+
+def scale(args, workdir):
+    """The --scale section: throughput and memory against the number of points, and the projection."""
+    brake = ROOT / "inputs" / "brake.nml"
+    print(f"{'points':>7} {'ranks':>5} {'wall s':>8} {'points/s/core':>14} {'VmHWM per rank MiB':>19} "
+          f"{'file MiB':>9} {'added ms/point':>15}")
+    added = {}
+    for n in args.counts:
+        rows, columns = grid_shape(n)
+        (workdir / "cheap.nml").write_text(CHEAP.format(rows=rows, columns=columns))
+        for ranks in (1, 2):
+            points, wall, memory, cost = run(args, workdir, ranks, [brake, workdir / "cheap.nml"], "cheap.h5")
+            size = (workdir / "cheap.h5").stat().st_size / 2**20
+            # Rank 0 computes too: what the sweep adds per point is the wall
+            # time less the compute time of the points, shared by the ranks.
+            extra = (wall - cost.sum() / ranks) / points
+            added[n] = max(added.get(n, 0.0), extra)
+            print(f"{points:>7} {ranks:>5} {wall:>8.2f} {points / wall / ranks:>14.0f} "
+                  f"{', '.join(f'{m / 1024:.1f}' for m in memory):>19} {size:>9.1f} {1e3 * extra:>15.3f}")
+    # An atlas point: a point of inputs/brake_sweep.nml.
+    _, _, _, cost = run(args, workdir, 2, [ROOT / "inputs" / "brake_sweep.nml"], "atlas.h5")
+    point = float(np.median(cost))
+    extra = added[max(added)]
+    n = 1_000_000
+    print(f"\natlas point (inputs/brake_sweep.nml, median of {cost.size}): {point * 1e3:.1f} ms; "
+          f"added by the sweep per point (the larger of 1 and 2 ranks, {max(added)} points): {extra * 1e3:.3f} ms")
+    print(f"projected 1e6-point atlas, {args.cores_per_node} ranks per node:")
+    for nodes in (1, 16, 64):
+        ranks = nodes * args.cores_per_node
+        compute = n * point / ranks
+        writer = n * extra
+        print(f"  {nodes:>3} node(s), {ranks:>5} ranks: {hours(max(compute, writer))} "
+              f"(computing {hours(compute)}, rank 0's share {hours(writer)})")
+
+
 def rate(args, workdir, ranks, files):
     rates = []
     for k in range(args.repeats):
@@ -66,16 +133,23 @@ def rate(args, workdir, ranks, files):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=3)
-    parser.add_argument("--large", type=int, default=1000, help="points of the memory sweep (at most 1024)")
+    parser.add_argument("--large", type=int, default=1000, help="points of the memory sweep")
     parser.add_argument("--memory-only", action="store_true", help="only the memory figures")
+    parser.add_argument("--scale", action="store_true", help="only the scale figures and the atlas projection")
+    parser.add_argument("--counts", type=int, nargs="+", default=[1000, 10000, 100000],
+                        help="points of the scale sweeps")
+    parser.add_argument("--cores-per-node", type=int, default=32, help="ranks per node of the projection")
     parser.add_argument("--binary", default=str(ROOT / "build" / "friction"))
     parser.add_argument("--mpiexec", default=shutil.which("mpiexec") or "mpiexec")
     args = parser.parse_args()
-    if not 4 <= args.large <= 1024:
-        parser.error("--large must be in [4, 1024]")
+    if args.large < 4:
+        parser.error("--large must be at least 4")
     sweep = ROOT / "inputs" / "brake_sweep.nml"
     with tempfile.TemporaryDirectory() as tmp:
         workdir = Path(tmp)
+        if args.scale:
+            scale(args, workdir)
+            return 0
         (workdir / "uneven.nml").write_text(UNEVEN)
         (workdir / "static.nml").write_text(STATIC)
         (workdir / "longer.nml").write_text(LONGER)

@@ -9,7 +9,7 @@ quasistatic-failure, thermal-zero, thermal-ranks, thermal-equipartition, thermal
 and bad-<name> for each bad input in BAD_INPUTS; for the brake scene
 brake-run, brake-ranks, brake-dimensional, brake-verify, brake-failure, brake-analysis and
 bad-brake-<name> for each bad input in BAD_BRAKE_INPUTS; for sweeps sweep-ranks,
-sweep-failure, sweep-resume, sweep-signal and bad-sweep-<name> for each bad input in BAD_SWEEP_INPUTS;
+sweep-failure, sweep-resume, sweep-signal, sweep-grid-ranks, sweep-large-resume and bad-sweep-<name> for each bad input in BAD_SWEEP_INPUTS;
 serial-files and serial-no-mpi for runs without a launcher (no MPI).  Each asserts on exit codes,
 messages and file contents (read with h5py); none asserts on timings.
 """
@@ -20,6 +20,7 @@ import signal
 import subprocess
 import sys
 import re
+import threading
 import time
 
 import h5py
@@ -1278,10 +1279,11 @@ BAD_SWEEP_INPUTS = {
     "variable2-same": ("&sweep sweep_variable = 'brake.mu', sweep_values = 0.5,\n"
                        " sweep_variable2 = 'brake.mu', sweep_values2 = 0.4 /\n",
                        ["bad.nml:2", "&sweep", "sweep_variable2", "already"]),
+    # No cap but the integer that counts the points: 100000 x 100000 > 2**31 - 1.
     "grid-too-large": ("&sweep sweep_variable = 'brake.mu', sweep_spacing = 'linear', sweep_from = 0.1,\n"
-                       " sweep_to = 0.5, sweep_count = 100, sweep_variable2 = 'brake.xi',\n"
-                       " sweep_spacing2 = 'linear', sweep_from2 = 0.1, sweep_to2 = 0.5, sweep_count2 = 11 /\n",
-                       ["&sweep", "sweep_count2", "100 x 11", "1024"]),
+                       " sweep_to = 0.5, sweep_count = 100000, sweep_variable2 = 'brake.xi',\n"
+                       " sweep_spacing2 = 'linear', sweep_from2 = 0.1, sweep_to2 = 0.5, sweep_count2 = 100000 /\n",
+                       ["&sweep", "sweep_count2", "100000 x 100000", "2147483647"]),
     "spacing": ("&sweep sweep_variable = 'brake.mu', sweep_spacing = 'geometric' /\n",
                 ["bad.nml:1", "&sweep", "sweep_spacing", "'log'"]),
     "log-mixed-sign": ("&sweep sweep_variable = 'brake.v_dr_prime', sweep_spacing = 'log',\n"
@@ -1473,9 +1475,9 @@ def case_sweep_failure(args):
 
 def case_sweep_resume(args):
     """A sweep stopped after 3 of 7 points (the sweep_stop_after hook) leaves a
-    valid file (3 done, 4 pending) and its checkpoints; --resume on another
+    valid file (3 done, 4 pending) and its one checkpoint; --resume on another
     number of ranks computes only the 4 missing points and writes what an
-    uninterrupted run writes, then removes the checkpoints."""
+    uninterrupted run writes, then removes the checkpoint."""
     brake = os.path.join(args.inputs, "brake.nml")
     small = write(args, "small.nml", SWEEP_SMALL)
     friction(args, "-o", "full.h5", brake, small, ranks=1)
@@ -1487,8 +1489,9 @@ def case_sweep_resume(args):
     with h5py.File(os.path.join(args.workdir, "part.h5"), "r") as handle:
         if handle["sweep"].attrs["complete"] != 0:
             fail("the interrupted file does not say it is incomplete")
-    if len([f for f in leftovers(args) if f.endswith(".ckpt")]) != 3:
-        fail(f"expected 3 checkpoints, found {leftovers(args)}")
+    # One checkpoint for the sweep, none per point.
+    if leftovers(args) != ["full.h5", "part.h5", "part.h5.ckpt"]:
+        fail(f"expected the file and its one checkpoint, found {leftovers(args)}")
     friction(args, "--resume", "-o", "part.h5", brake, small, ranks=3)
     full, _ = sweep_results(os.path.join(args.workdir, "full.h5"))
     resumed, _ = sweep_results(os.path.join(args.workdir, "part.h5"))
@@ -1513,8 +1516,9 @@ def case_sweep_signal(args):
     longer = write(args, "long.nml", "&brake t_end = 1500.0 /\n&sweep sweep_count = 40 /\n")
     process = subprocess.Popen([args.binary, "--quiet", "-o", "cut.h5", brake, small, longer], cwd=args.workdir,
                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    # Signal once the first point is checkpointed (not after a fixed time: no timing assumptions).
-    first = os.path.join(args.workdir, "cut.h5.point-1.ckpt")
+    # Signal once the first point is checkpointed (not after a fixed time: no
+    # timing assumptions): the checkpoint appears with the first point.
+    first = os.path.join(args.workdir, "cut.h5.ckpt")
     deadline = time.monotonic() + 120
     while not os.path.exists(first) and process.poll() is None and time.monotonic() < deadline:
         time.sleep(0.02)
@@ -1532,6 +1536,125 @@ def case_sweep_signal(args):
             fail("the resumed sweep is not complete")
         if int(np.sum(handle["sweep/computed_by_this_run"][()])) != 40 - done:
             fail(f"the resumed run recomputed finished points: {handle['sweep/computed_by_this_run'][()]}")
+
+
+# A cheap 2-D sweep with both variables in &brake: 50 x 30 = 1500 points (more
+# than the 1024 a sweep was once capped at), ~0.5 ms each; mu above mu_s = 0.59
+# fails (420 points with their reasons), the others have maxima after t = 10.
+GRID_SMALL = ("&brake mu = 0.5, mu_s = 0.59, t_end = 60.0, dt_out = 0.5 /\n"
+              "&analysis window_start = 10.0, window_end = 60.0, spectrum = .false., lyapunov = .false.,"
+              " rosenstein = .false., lyapunov_spectrum = .false. /\n"
+              "&sweep sweep_variable = 'brake.mu', sweep_spacing = 'linear', sweep_from = 0.3, sweep_to = 0.7,"
+              " sweep_count = 50,\n sweep_variable2 = 'brake.xi', sweep_spacing2 = 'linear', sweep_from2 = 0.1,"
+              " sweep_to2 = 0.5, sweep_count2 = 30 /\n")
+SWEEP_RUN_DEPENDENT = ("compute_time", "peak_memory_per_rank", "computed_by_this_run")   # how, not what
+
+
+def same_sweep(args, first, second, label, ignore=()):
+    """fail() unless two sweep files hold the same objects and values, bit for
+    bit, aside from what says how the run went (timings, ranks, which run
+    computed a point) and the objects in `ignore`."""
+    a, b = (comparable(os.path.join(args.workdir, name)) for name in (first, second))
+    a, b = ({k: v for k, v in items.items() if not any(t in k for t in SWEEP_RUN_DEPENDENT) and k not in ignore}
+            for items in (a, b))
+    if a.keys() != b.keys():
+        fail(f"{label}: {first} and {second} hold different objects: {sorted(set(a) ^ set(b))}")
+    for key, value in a.items():
+        if not np.array_equal(np.asarray(value), np.asarray(b[key])):
+            fail(f"{label}: {key} differs between {first} and {second}")
+
+
+def case_sweep_grid_ranks(args):
+    """Two variables of one group (&brake mu and xi) on a 50 x 30 grid: the
+    files of 1, 2 and 3 ranks (dynamic) and 2 ranks (static) are identical;
+    the grid is mu over rows, xi fastest; the points with mu > mu_s failed
+    with their reason, the others are done."""
+    grid = write(args, "grid.nml", GRID_SMALL)
+    static = write(args, "static.nml", "&sweep sweep_schedule = 'static' /\n")
+    brake = os.path.join(args.inputs, "brake.nml")
+    for label, ranks, extra in (("1", 1, []), ("2", 2, []), ("3", 3, []), ("2s", 2, [static])):
+        friction(args, "-o", f"g{label}.h5", brake, grid, *extra, ranks=ranks)
+    for label in ("2", "3", "2s"):
+        # (the static run's input says so)
+        same_sweep(args, "g1.h5", f"g{label}.h5", f"1 rank and {label}",
+                   ignore=("@input", "@sweep_schedule") if label == "2s" else ())
+    with h5py.File(os.path.join(args.workdir, "g1.h5"), "r") as handle:
+        mu, xi = handle["sweep/values"][()], handle["sweep/values2"][()]
+        status = handle["sweep/status"][()]
+        reasons = [r.decode().rstrip() for r in handle["sweep/reason"][()]]
+        counts, offsets = handle["sweep/maxima_count"][()], handle["sweep/maxima_offset"][()]
+        total = handle["sweep/maxima"].shape[0]
+    # (the program's linspace: from + (to - from) (k - 1) / (count - 1); numpy's
+    # differs in the last bit)
+    if not (np.allclose(mu, np.repeat(np.linspace(0.3, 0.7, 50), 30), rtol=4e-16, atol=0) and
+            np.allclose(xi, np.tile(np.linspace(0.1, 0.5, 30), 50), rtol=4e-16, atol=0)):
+        fail("the grid is not mu over rows and xi fastest")
+    failed = mu > 0.59
+    if not (np.array_equal(status, np.where(failed, 2, 1)) and failed.sum() == 420):
+        fail(f"statuses {np.unique(status, return_counts=True)}, expected 420 failed (mu > mu_s)")
+    if not all(("mu_s" in r) == bad for r, bad in zip(reasons, failed)):
+        fail("the failed points do not carry their reason, or a done point carries one")
+    if not (counts[failed].sum() == 0 and counts[~failed].min() > 0 and counts.sum() == total and
+            np.array_equal(offsets, np.concatenate([[0], np.cumsum(counts)[:-1]]))):
+        fail("the maxima's offsets and counts do not index the flat list in point order")
+    # An explicit list longer than the 1024 values a list once held, on
+    # several lines: every value becomes a point, in order.
+    listed = np.round(np.linspace(0.1, 0.5, 1100), 6)
+    lines = ",\n ".join(", ".join(repr(float(x)) for x in listed[k:k + 10]) for k in range(0, listed.size, 10))
+    write(args, "list.nml", f"&sweep sweep_variable2 = '', sweep_variable = 'brake.xi', sweep_spacing = 'list',\n"
+          f" sweep_values = {lines} /\n")
+    friction(args, "-o", "list.h5", brake, grid, os.path.join(args.workdir, "list.nml"))
+    with h5py.File(os.path.join(args.workdir, "list.h5"), "r") as handle:
+        if not (np.array_equal(handle["sweep/values"][()], listed) and np.all(handle["sweep/status"][()] == 1)):
+            fail("a list of 1100 values did not give its 1100 points")
+
+
+def case_sweep_large_resume(args):
+    """The 1500-point grid stopped after point 700 on 2 ranks and resumed on 3
+    gives the file of an uninterrupted run (every dataset and attribute but
+    the timings and computed_by_this_run); the resumed run computes only the
+    points left; no file per point ever appears beside the output (the
+    directory is watched while the runs go), only the one checkpoint."""
+    grid = write(args, "grid.nml", GRID_SMALL)
+    brake = os.path.join(args.inputs, "brake.nml")
+    seen = set()
+    watching = threading.Event()
+
+    def watch():
+        while not watching.is_set():
+            seen.update(os.listdir(args.workdir))
+            time.sleep(0.002)
+
+    watcher = threading.Thread(target=watch)
+    watcher.start()
+    try:
+        friction(args, "-o", "full.h5", brake, grid, ranks=2)
+        friction(args, "-o", "part.h5", brake, grid, ranks=2, expect=6,
+                 extra_env={"FRICTION_TEST_STOP_AFTER": "700"})
+        after_stop = leftovers(args)
+        with h5py.File(os.path.join(args.workdir, "part.h5"), "r") as handle:
+            done = int(np.sum(handle["sweep/status"][()] != 0))
+            if handle["sweep"].attrs["complete"] != 0 or not 0 < done < 1500:
+                fail(f"the interrupted file: {done} points done, complete = {handle['sweep'].attrs['complete']}")
+        friction(args, "--resume", "-o", "part.h5", brake, grid, ranks=3)
+    finally:
+        watching.set()
+        watcher.join()
+    if after_stop != ["full.h5", "part.h5", "part.h5.ckpt"]:
+        fail(f"after the stop: {after_stop}, expected the file and its one checkpoint")
+    same_sweep(args, "full.h5", "part.h5", "uninterrupted and resumed")
+    with h5py.File(os.path.join(args.workdir, "part.h5"), "r") as handle:
+        computed = handle["sweep/computed_by_this_run"][()]
+        if int(computed.sum()) != 1500 - done or handle["sweep"].attrs["complete"] != 1:
+            fail(f"the resumed run computed {int(computed.sum())} points, expected {1500 - done}")
+    if leftovers(args) != ["full.h5", "part.h5"]:
+        fail(f"files left after the resumed sweep: {leftovers(args)}")
+    # Besides inputs, outputs and their temporary names: the checkpoint, its
+    # temporary name and the resumed run's list of points to do.
+    expected = re.compile(r"^(full|part)\.h5(\.tmp-\d+|\.ckpt|\.ckpt\.new|\.ckpt-todo)?$")
+    strays = sorted(f for f in seen if not f.endswith(".nml") and not expected.match(f))
+    if strays:
+        fail(f"files beside the output during the runs: {strays}")
 
 
 def case_bad_sweep(args, name):
@@ -1671,6 +1794,7 @@ def main():
     elif args.case.startswith("sweep-"):
         {"sweep-ranks": case_sweep_ranks, "sweep-failure": case_sweep_failure,
          "sweep-resume": case_sweep_resume, "sweep-signal": case_sweep_signal,
+         "sweep-grid-ranks": case_sweep_grid_ranks, "sweep-large-resume": case_sweep_large_resume,
          "sweep-afm": case_sweep_afm}[args.case](args)
     elif args.case.startswith("bad-brake-"):
         case_bad_brake(args, args.case[len("bad-brake-"):])

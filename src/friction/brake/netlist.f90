@@ -23,6 +23,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       character(len=:), allocatable :: law
 
+      note = ''   ! (a note only for the switched model; the caller reads it always)
       associate (p => c%params)
          law = '* Friction law: the regularized arctan law of Eq. 10 (epsilon_prime = '//num(p%epsilon_prime)//').'
          if (trim(c%model) == model_switched) then

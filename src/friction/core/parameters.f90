@@ -50,6 +50,9 @@ module friction_parameters
          & logical_scalar, text_scalar, text_array
       generic :: item => real_scalar, real_array, integer_scalar, integer_array, long_scalar, &
          & logical_scalar, text_scalar, text_array
+      !> A real list of any length (allocatable): a list given whole
+      !> replaces it; an element past its end lengthens it.
+      procedure :: real_list
       procedure, private :: wants, add_info, add_line, element_ok
    end type parameter_visitor
 
@@ -213,6 +216,63 @@ contains
          end do
       end select
    end subroutine real_array
+
+   !> A real list of any length (the sweep's values: as many as the input
+   !> gives).  Setting it whole replaces it; setting element `first` past
+   !> its end lengthens it (the elements between take `fill`).
+   subroutine real_list(self, name, value, fill, unit)
+      class(parameter_visitor), intent(inout) :: self
+      character(len=*), intent(in) :: name
+      real(wp), allocatable, intent(inout) :: value(:)
+      real(wp), intent(in) :: fill   !! an element that was never given
+      character(len=*), intent(in), optional :: unit
+      real(wp), allocatable :: grown(:)
+      integer, allocatable :: from(:), to(:)
+      integer :: k, stat, first, last
+
+      if (.not. allocated(value)) allocate (value(0))
+      select case (self%mode)
+      case (mode_list, mode_write)
+         call self%real_array(name, value, unit, fill)
+      case default
+         if (.not. self%wants(name)) return
+         if (self%mode == mode_get) then
+            call self%real_array(name, value, unit, fill)
+            return
+         end if
+         self%found = .true.
+         first = max(1, self%first)
+         if (self%from_number) then
+            last = first
+         else
+            call value_items(self%text, huge(1), self%first, from, to, self%problem)
+            if (len(self%problem) > 0) return
+            last = first + size(from) - 1
+         end if
+         if (self%first == 0) then
+            deallocate (value)
+            allocate (value(last), source=fill)
+         else if (last > size(value)) then
+            allocate (grown(last), source=fill)
+            grown(1:size(value)) = value
+            call move_alloc(grown, value)
+         end if
+         if (self%from_number) then
+            value(first) = self%number
+            return
+         end if
+         do k = 1, size(from)
+            if (to(k) < from(k)) cycle   ! a null value leaves the element
+            read (self%text(from(k):to(k)), *, iostat=stat) value(first + k - 1)
+            if (stat /= 0) then
+               self%problem = 'expected '//kind_text('r')
+               return
+            end if
+            self%problem = range_problem(self%text(from(k):to(k)), value(first + k - 1))
+            if (len(self%problem) > 0) return
+         end do
+      end select
+   end subroutine real_list
 
    subroutine integer_scalar(self, name, value, unit)
       class(parameter_visitor), intent(inout) :: self

@@ -2,7 +2,7 @@
 !> &sweep; read from namelist files (later files override earlier values
 !> variable by variable) and checked by the configurations themselves.
 module friction_job_config
-   use friction_kinds, only: wp
+   use friction_kinds, only: wp, i8
    use friction_strings, only: itoa, rtoa, join, quoted, lower
    use friction_error, only: error_type, fatal_error, error_input
    use friction_parameters, only: configurable, parameter_visitor, parameter_info, list_parameters, &
@@ -14,19 +14,22 @@ module friction_job_config
    implicit none
    private
 
-   public :: job_config, sweep_settings, read_input, check_job, max_sweep_values, all_parameters, job_text, &
+   public :: job_config, sweep_settings, read_input, check_job, all_parameters, job_text, &
       & parameter_groups, not_in_scene
-
-   integer, parameter :: max_sweep_values = 1024
 
    !> &sweep: one or two numeric variables of the scene ('group.name'), each
    !> over a list, a linspace or a logspace; the points are the grid of the
-   !> two, the second varying fastest (docs/sweeps.md).
+   !> two, the second varying fastest (docs/sweeps.md).  No cap on the
+   !> points: a list holds as many values as the input gives, and a spaced
+   !> range's values are computed when asked for (`value`), so nothing here
+   !> grows with the number of points but the lists the input itself holds.
+   !> Point counts are default integers: at most huge(1) = 2147483647
+   !> points (a 1e6-point atlas is far below).
    type :: sweep_settings
       ! As the input gives them
       character(len=64) :: variables(2) = ''       !! 'group.name', e.g. 'brake.v_dr_prime'
       character(len=8) :: spacings(2) = 'list'     !! 'list', 'linear' or 'log'
-      real(wp) :: listed(max_sweep_values, 2) = huge(1.0_wp)   !! sweep_values, sweep_values2 (huge: unused)
+      real(wp), allocatable :: listed1(:), listed2(:)   !! sweep_values, sweep_values2 (huge: not given)
       real(wp) :: from(2) = 0.0_wp, to(2) = 0.0_wp
       integer :: count(2) = 0
       character(len=8) :: schedule = 'dynamic'     !! 'dynamic' (on demand) or 'static' (contiguous blocks)
@@ -34,10 +37,12 @@ module friction_job_config
       integer :: n_variables = 0
       logical :: integer_valued(2) = .false.       !! an integer variable (values are whole numbers)
       integer :: shape(2) = 1                      !! values per variable (1 for an absent second)
-      real(wp), allocatable :: values(:, :)        !! (n_variables, points): each point's values, in order
    contains
       procedure :: enabled => sweep_enabled
       procedure :: visit => sweep_visit
+      procedure :: points => sweep_points
+      procedure :: value => sweep_value
+      procedure :: point_value => sweep_point_value
    end type sweep_settings
 
    !> Everything a run needs from its input files.
@@ -63,13 +68,13 @@ contains
 
       call v%begin_group('sweep')
       call v%item('sweep_variable', self%variables(1), fold=.true.)
-      call v%item('sweep_values', self%listed(:, 1), fill=huge(1.0_wp))
+      call v%real_list('sweep_values', self%listed1, fill=huge(1.0_wp))
       call v%item('sweep_from', self%from(1))
       call v%item('sweep_to', self%to(1))
       call v%item('sweep_count', self%count(1))
       call v%item('sweep_spacing', self%spacings(1), fold=.true.)
       call v%item('sweep_variable2', self%variables(2), fold=.true.)
-      call v%item('sweep_values2', self%listed(:, 2), fill=huge(1.0_wp))
+      call v%real_list('sweep_values2', self%listed2, fill=huge(1.0_wp))
       call v%item('sweep_from2', self%from(2))
       call v%item('sweep_to2', self%to(2))
       call v%item('sweep_count2', self%count(2))
@@ -77,6 +82,56 @@ contains
       call v%item('sweep_schedule', self%schedule, fold=.true.)
       call v%end_group()
    end subroutine sweep_visit
+
+   !> The number of points (after check_job).
+   integer function sweep_points(self)
+      class(sweep_settings), intent(in) :: self
+
+      sweep_points = self%shape(1) * self%shape(2)
+   end function sweep_points
+
+   !> Value k of variable a: the k-th listed value, or the k-th of the
+   !> linspace or logspace, computed here (rounded for an integer variable).
+   real(wp) function sweep_value(self, a, k) result(x)
+      class(sweep_settings), intent(in) :: self
+      integer, intent(in) :: a, k
+
+      select case (trim(self%spacings(a)))
+      case ('list')
+         if (a == 1) then
+            x = self%listed1(k)
+         else
+            x = self%listed2(k)
+         end if
+         return
+      case ('linear')
+         if (self%count(a) == 1) then
+            x = self%from(a)
+         else
+            x = self%from(a) + (self%to(a) - self%from(a)) * (k - 1) / (self%count(a) - 1)
+         end if
+      case default
+         if (self%count(a) == 1) then
+            x = self%from(a)
+         else
+            x = sign(exp(log(abs(self%from(a))) + (log(abs(self%to(a))) - log(abs(self%from(a)))) * (k - 1) &
+               & / (self%count(a) - 1)), self%from(a))
+         end if
+      end select
+      if (self%integer_valued(a)) x = anint(x)
+   end function sweep_value
+
+   !> Point i's value of variable a (the second variable varies fastest).
+   real(wp) function sweep_point_value(self, a, i) result(x)
+      class(sweep_settings), intent(in) :: self
+      integer, intent(in) :: a, i
+
+      if (a == 1) then
+         x = self%value(1, (i - 1) / self%shape(2) + 1)
+      else
+         x = self%value(2, mod(i - 1, self%shape(2)) + 1)
+      end if
+   end function sweep_point_value
 
    !> &job, the scene's groups, &sweep.
    subroutine job_visit(self, v)
@@ -266,8 +321,7 @@ contains
       type(job_config), intent(inout) :: config
       type(config_checker), intent(inout) :: c
       type(parameter_info), allocatable :: mine(:), universe(:)
-      real(wp), allocatable :: axes(:, :)
-      integer :: counts(2), v, i1, i2, p
+      integer :: counts(2)
 
       call config%scene%check(c)
       if (c%failed() .or. .not. config%sweep%enabled()) return
@@ -277,44 +331,34 @@ contains
             & "'"//trim(s%schedule)//"'", "unknown schedule (known: 'dynamic', 'static')")
          mine = list_parameters(config%scene)
          universe = all_parameters()
-         allocate (axes(max_sweep_values, 2), source=0.0_wp)
          counts = 1
-         call sweep_axis(1, '', axes(:, 1), counts(1))
+         call sweep_axis(1, '', counts(1))
          if (s%n_variables == 2) then
             if (s%variables(2) == s%variables(1)) call c%reject('sweep', 'sweep_variable2', &
                & "'"//trim(s%variables(2))//"'", 'is sweep_variable already')
-            call sweep_axis(2, '2', axes(:, 2), counts(2))
+            call sweep_axis(2, '2', counts(2))
          end if
          if (c%failed()) return
-         if (counts(1) * counts(2) > max_sweep_values) then
+         ! The only limit on the points: a default integer counts them.
+         if (int(counts(1), i8) * counts(2) > huge(1)) then
             call c%reject('sweep', 'sweep_count2', itoa(counts(2)), 'the grid of '//itoa(counts(1))//' x ' &
-               & //itoa(counts(2))//' points exceeds '//itoa(max_sweep_values)//' points')
+               & //itoa(counts(2))//' points exceeds '//itoa(huge(1))//' points')
             return
          end if
-         v = s%n_variables
          s%shape = counts
-         if (allocated(s%values)) deallocate (s%values)
-         allocate (s%values(v, counts(1) * counts(2)))
-         p = 0
-         do i1 = 1, counts(1)
-            do i2 = 1, counts(2)
-               p = p + 1
-               s%values(1, p) = axes(i1, 1)
-               if (v == 2) s%values(2, p) = axes(i2, 2)
-            end do
-         end do
       end associate
 
    contains
 
       !> One swept variable (`suffix` '' or '2' names its namelist variables):
       !> a numeric variable of a group of this scene, and its values.
-      subroutine sweep_axis(a, suffix, axis, n)
+      subroutine sweep_axis(a, suffix, n)
          integer, intent(in) :: a
          character(len=*), intent(in) :: suffix
-         real(wp), intent(out) :: axis(:)
          integer, intent(out) :: n
          character(len=:), allocatable :: group, name, shown
+         real(wp), allocatable :: listed(:)
+         real(wp) :: x, previous
          integer :: k, found
          logical :: whole
 
@@ -351,17 +395,32 @@ contains
             s%integer_valued(a) = whole
             select case (trim(s%spacings(a)))
             case ('list')
-               do while (n < max_sweep_values)
-                  if (s%listed(n + 1, a) == huge(1.0_wp)) exit
-                  n = n + 1
+               if (a == 1) then
+                  if (.not. allocated(s%listed1)) allocate (s%listed1(0))
+                  listed = s%listed1
+               else
+                  if (.not. allocated(s%listed2)) allocate (s%listed2(0))
+                  listed = s%listed2
+               end if
+               ! The values given, up to the first never given (a list is
+               ! read whole; huge marks an element skipped with a null value).
+               n = size(listed)
+               do k = 1, size(listed)
+                  if (listed(k) == huge(1.0_wp)) then
+                     n = k - 1
+                     exit
+                  end if
                end do
                if (n == 0) call c%reject('sweep', 'sweep_values'//suffix, '(none)', "give at least one value for " &
                   & //"sweep_spacing"//suffix//" = 'list'")
-               axis(1:n) = s%listed(1:n, a)
+               if (a == 1) then
+                  s%listed1 = listed(1:n)
+               else
+                  s%listed2 = listed(1:n)
+               end if
             case ('linear', 'log')
-               if (s%count(a) < 1 .or. s%count(a) > max_sweep_values) then
-                  call c%reject('sweep', 'sweep_count'//suffix, itoa(s%count(a)), 'must be in [1, ' &
-                     & //itoa(max_sweep_values)//']')
+               if (s%count(a) < 1) then
+                  call c%reject('sweep', 'sweep_count'//suffix, itoa(s%count(a)), 'must be at least 1')
                   return
                end if
                call c%finite('sweep', 'sweep_from'//suffix, s%from(a))
@@ -379,39 +438,31 @@ contains
                end if
                if (c%failed()) return
                n = s%count(a)
-               associate (from => s%from(a), to => s%to(a), count => s%count(a))
-                  do k = 1, count
-                     if (count == 1) then
-                        axis(k) = from
-                     else if (s%spacings(a) == 'linear') then
-                        axis(k) = from + (to - from) * (k - 1) / (count - 1)
-                     else
-                        axis(k) = sign(exp(log(abs(from)) + (log(abs(to)) - log(abs(from))) * (k - 1) &
-                           & / (count - 1)), from)
+               ! An integer variable takes whole values: a spaced range is
+               ! rounded (sweep_value) and must not repeat a value (monotonic:
+               ! a repeat is next to its twin).
+               if (whole) then
+                  previous = s%value(a, 1)
+                  do k = 2, n
+                     x = s%value(a, k)
+                     if (x == previous) then
+                        call c%reject('sweep', 'sweep_count'//suffix, itoa(n), 'integer variable '//name &
+                           & //' takes whole values: '//itoa(n)//' points from '//rtoa(s%from(a))//' to ' &
+                           & //rtoa(s%to(a))//' repeat '//rtoa(x))
+                        return
                      end if
+                     previous = x
                   end do
-                  ! An integer variable takes whole values: a spaced range is rounded
-                  ! (and must not repeat a value).
-                  if (whole) then
-                     axis(1:n) = anint(axis(1:n))
-                     do k = 2, n
-                        if (axis(k) == axis(k - 1)) then
-                           call c%reject('sweep', 'sweep_count'//suffix, itoa(count), 'integer variable '//name &
-                              & //' takes whole values: '//itoa(count)//' points from '//rtoa(from)//' to ' &
-                              & //rtoa(to)//' repeat '//rtoa(axis(k)))
-                           return
-                        end if
-                     end do
-                  end if
-               end associate
+               end if
             case default
                call c%reject('sweep', 'sweep_spacing'//suffix, "'"//trim(s%spacings(a))//"'", &
                   & "unknown spacing (known: 'list', 'linear', 'log')")
             end select
             if (whole .and. n > 0) then
                do k = 1, n
-                  if (axis(k) /= anint(axis(k)) .or. abs(axis(k)) > 2.0_wp**30) then
-                     call c%reject('sweep', 'sweep_values'//suffix, rtoa(axis(k)), 'integer variable '//name// &
+                  x = s%value(a, k)
+                  if (x /= anint(x) .or. abs(x) > 2.0_wp**30) then
+                     call c%reject('sweep', 'sweep_values'//suffix, rtoa(x), 'integer variable '//name// &
                         & ' takes whole values')
                      return
                   end if

@@ -11,19 +11,28 @@
 !> Each point is computed alone and deterministically: the results do not
 !> depend on which rank took it or on the number of ranks.
 !>
-!> Output: one rank-0 writer after reductions.  A point's results are a few
-!> numbers and a few hundred maxima (kB), so the gathered data are small and
-!> parallel HDF5's collective metadata would buy nothing.  A rank holds one
-!> point's trajectory or map at a time and n numbers per result: its memory
-!> does not grow with the points other ranks hold.
+!> Streaming, with memory per rank independent of the number of points: a
+!> rank sends each finished point to rank 0 at once (at most `in_flight`
+!> sends unmatched, so rank 0's MPI queue is bounded too), and rank 0
+!> gathers them in a batch of at most `batch_points` points that it writes
+!> into the checkpoint OUTPUT.ckpt, one HDF5 file of chunked columns
+!> indexed by point (output/h5_table.f90), flushed after each batch.  At the
+!> end rank 0 copies the checkpoint into the output in point order, a chunk
+!> of points at a time.  No rank holds an array over all points.
+!>
+!> Why a checkpoint file beside the output and not the output in progress:
+!> points finish in an order that depends on the ranks, and a point's maxima
+!> are a list of its own length; the output keeps them in one flat list in
+!> point order (the documented layout, the same bits on any number of
+!> ranks), which only a copy at the end can give.  The checkpoint keeps them
+!> in the order they came, indexed by offset and count per point.
 module friction_job_sweep
    use, intrinsic :: iso_c_binding, only: c_ptr, c_f_pointer
    use mpi_f08
    use friction_kinds, only: wp, i8
    use friction_clock, only: wall_seconds
-   use friction_error, only: error_type, fatal_error, error_interrupted, error_input, error_numerical
-   use friction_strings, only: itoa, text_hash
-   use friction_output_checkpoint, only: save_checkpoint, checkpoint_body, real_line, next_line
+   use friction_error, only: error_type, fatal_error, error_interrupted, error_input, error_numerical, error_io
+   use friction_strings, only: itoa, text_hash, bytes_text
    use friction_version, only: version_string
    use friction_ode_solver, only: integrator_statistics
    use friction_parameters, only: set_parameter_number, split_name, parameter_info, list_parameters
@@ -31,22 +40,69 @@ module friction_job_sweep
    use friction_scene, only: scene, point_result
    use friction_job_config, only: job_config
    use friction_output_h5, only: h5_file
+   use friction_output_h5_table, only: h5_table
    use friction_output_summary, only: run_summary, write_run_attributes
-   use friction_files, only: remove_file
+   use friction_files, only: remove_file, file_exists, free_bytes, min_free_bytes, rename_file
    use friction_scene_report, only: job_reporter
-   use friction_scene_context, only: job_context, temporary_name, publish, ranks_text, sum_to_root_real, &
-      & sum_to_root_integer, agree_on_error, job_wall_time
+   use friction_scene_context, only: job_context, temporary_name, publish, ranks_text, agree_on_error, job_wall_time
    implicit none
    private
 
    public :: run_sweep_job
 
-   !> A failed point's reason ('' for the others).
-   type :: reason_text
-      character(len=:), allocatable :: text
-   end type reason_text
+   integer, parameter :: status_pending = 0, status_done = 1, status_failed = 2
 
-   integer, parameter :: status_done = 1, status_failed = 2
+   !> Sends of finished points a rank may have unmatched by rank 0: what
+   !> rank 0's MPI layer can hold for each rank while it computes a point.
+   integer, parameter :: in_flight = 16
+   !> Points rank 0 gathers before it writes them to the checkpoint (and
+   !> values of their series: the batch is written when either is reached).
+   integer, parameter :: batch_points = 1024, batch_series = 1048576
+   !> Seconds after which a batch is written however small (how much a
+   !> killed run can lose).
+   real(wp), parameter :: batch_seconds = 10.0_wp
+   !> Points per piece of the final copy into the output.
+   integer, parameter :: copy_points = 4096
+
+   !> The kinds of the checkpoint's columns of column_names (h5_table's add_column).
+   character(len=7), parameter :: column_kinds = 'iirlili'
+
+   integer, parameter :: tag_header = 7301, tag_numbers = 7302, tag_reason = 7303
+
+   !> One finished point as sent to rank 0: header = point (0: this rank has
+   !> finished; then header(2) says whether it was interrupted), status,
+   !> number of results, series length, reason length.
+   type :: point_message
+      integer :: header(5) = 0
+      real(wp), allocatable :: numbers(:)   !! results, cost, series
+      character(len=:), allocatable :: reason
+      type(MPI_Request) :: requests(3)
+      logical :: busy = .false.
+   end type point_message
+
+   !> Rank 0's points not yet in the checkpoint, in the order they came.
+   type :: point_batch
+      integer :: n = 0
+      integer, allocatable :: point(:), status(:), series_count(:), reason_length(:)
+      real(wp), allocatable :: results(:, :), cost(:)
+      real(wp), allocatable :: series(:)
+      integer :: n_series = 0
+      character(len=:), allocatable :: reasons
+      real(wp) :: since = 0.0_wp   !! when the last batch was written
+   end type point_batch
+
+   !> Rank 0's checkpoint: the file, this run's number, where its flat lists end.
+   type :: checkpoint
+      type(h5_table) :: file
+      character(len=:), allocatable :: path
+      character(len=:), allocatable :: hash   !! of the input it belongs to
+      integer :: points = 0
+      logical :: opened = .false.
+      integer :: run = 1
+      integer(i8) :: series_end = 0, reason_end = 0
+      integer :: received = 0   !! points done in this run
+      type(error_type), allocatable :: error   !! the first failure to write it
+   end type checkpoint
 
 contains
 
@@ -60,58 +116,65 @@ contains
       character(len=:), allocatable, intent(out) :: summary
       type(error_type), allocatable, intent(out) :: error
       type(error_type), allocatable :: point_error
-      character(len=:), allocatable :: temporary, series_name, series_unit, reason
+      character(len=:), allocatable :: temporary, series_name, series_unit, input_hash, todo_path, first_reason
       type(point_result), allocatable :: names(:)
-      type(reason_text), allocatable :: reasons(:)
-      type(error_type), allocatable :: checkpoint_error
-      character(len=:), allocatable :: input_hash, problem
-      integer :: unsaved, last_taken
-      logical :: all_failed
-      real(wp), allocatable :: results(:, :), cost(:), maxima(:), point_maxima(:), flat(:)
-      integer, allocatable :: status(:), counts(:), offsets(:), owner(:), computed_by_run(:)
+      type(point_message), allocatable :: outbox(:)
+      type(point_message) :: mine
+      type(checkpoint) :: ckpt
+      type(point_batch) :: batch
+      real(wp), allocatable :: results(:), series(:)
       integer, allocatable :: memory(:)
-      integer :: n, i, k, next, total, computed, flag
+      integer :: n, n_work, w, i, next, computed, flag, last_taken, slot, finished, todo_unit, counts(3), stat
       integer(kind=MPI_ADDRESS_KIND) :: window_size
       integer :: one(1), fetched(1), block_first, block_last
       type(c_ptr) :: counter_base
       integer, pointer :: counter_value
       type(MPI_Win) :: window
       type(run_summary) :: record
-      real(wp) :: wall, t0
+      real(wp) :: wall, t0, cost
       character(len=12) :: seconds
-      logical :: dynamic, interrupted, loaded
+      logical :: dynamic, interrupted, all_failed, use_todo
 
       names = config%scene%point_results()
       call config%scene%point_series(series_name, series_unit)
-      n = size(config%sweep%values, 2)
+      n = config%sweep%points()
       input_hash = text_hash(job%input_text)
-      ! --resume: every checkpoint there is must be of this very input and
-      ! whole, or nothing is computed (README: Parameter sweeps).
-      if (job%resume) then
-         if (job%rank == 0) then
-            do i = 1, n
-               problem = checkpoint_problem(checkpoint_name(job, i), input_hash, config%sweep%values(:, i))
-               if (len(problem) > 0) then
-                  if (index(problem, 'another input') > 0 .or. index(problem, 'other values') > 0) then
-                     problem = problem//'; --resume reuses only the checkpoints of the same input: run with ' &
-                        & //'the input of the interrupted run, or remove '//job%output//'.point-*.ckpt to start afresh'
-                  else
-                     problem = problem//'; remove it, and --resume computes that point again'
-                  end if
-                  call fatal_error(error, problem, error_input)
-                  exit
-               end if
-            end do
+      ckpt%path = job%output//'.ckpt'
+      ckpt%hash = input_hash
+      ckpt%points = n
+      todo_path = job%output//'.ckpt-todo'
+      n_work = n
+      use_todo = .false.
+      ! --resume: the checkpoint must be of this very input and whole, or
+      ! nothing is computed (README: Parameter sweeps).  Rank 0 lists the
+      ! points still to do in a file every rank reads, so that no rank holds
+      ! a list over all points.
+      if (job%rank == 0) then
+         if (job%resume .and. file_exists(ckpt%path)) then
+            call open_checkpoint(ckpt, input_hash, n, size(names), todo_path, n_work, error)
+            use_todo = .not. allocated(error)
+         else
+            call remove_file(ckpt%path)   ! another run's, which this one does not resume
          end if
+      end if
+      call agree_on_error(job, error)
+      if (allocated(error)) return
+      if (job%parallel()) then
+         call MPI_Bcast(n_work, 1, MPI_INTEGER, 0, job%comm)
+         call MPI_Bcast(use_todo, 1, MPI_LOGICAL, 0, job%comm)
+      end if
+      todo_unit = -1
+      if (use_todo) then
+         open (newunit=todo_unit, file=todo_path, access='stream', form='unformatted', action='read', &
+            & status='old', iostat=stat)
+         if (stat /= 0) call fatal_error(error, todo_path//': cannot read the list of points to do', error_io)
          call agree_on_error(job, error)
          if (allocated(error)) return
       end if
-      unsaved = 0
-      allocate (results(size(names), n), cost(n), source=0.0_wp)
-      allocate (status(n), counts(n), owner(n), computed_by_run(n), source=0)
-      allocate (reasons(n))
-      allocate (maxima(0))
 
+      allocate (results(size(names)))
+      allocate (outbox(in_flight))
+      if (job%rank == 0) call start_batch(batch, size(names))
       one = 1
       window_size = merge(4, 0, job%rank == 0)
       ! (One rank needs no counter; Open MPI may have no one-sided component for it.)
@@ -131,11 +194,13 @@ contains
          end if
          call MPI_Barrier(job%comm)
       end if
-      block_first = int(int(n, i8) * job%rank / job%nranks)
-      block_last = int(int(n, i8) * (job%rank + 1) / job%nranks)
+      block_first = int(int(n_work, i8) * job%rank / job%nranks)
+      block_last = int(int(n_work, i8) * (job%rank + 1) / job%nranks)
       computed = 0
       interrupted = .false.
       last_taken = 0
+      slot = 0
+      finished = 0
       do
          ! Between points: a stop request ends the sweep here, the point in hand done.
          ! (The test hook likewise, once this rank has done point stop_after:
@@ -148,96 +213,73 @@ contains
             ! The naive static split, for the benchmark: contiguous blocks of
             ! points, so a run of expensive neighbours lands on one rank.
             next = block_first + computed
-            if (next >= block_last) next = n
+            if (next >= block_last) next = n_work
          else
             call MPI_Win_lock(MPI_LOCK_EXCLUSIVE, 0, 0, window)
             call MPI_Fetch_and_op(one, fetched, MPI_INTEGER, 0, 0_MPI_ADDRESS_KIND, MPI_SUM, window)
             call MPI_Win_unlock(0, window)
             next = fetched(1)
          end if
-         i = next + 1
-         if (i > n) exit
+         w = next + 1
+         if (w > n_work) exit
+         i = w
+         if (use_todo) read (todo_unit, pos=int(w - 1, i8) * 4 + 1) i
          last_taken = i
          if (job%stop_after > 0 .and. i > job%stop_after) then
             interrupted = .true.   ! the test hook: as if a signal came after that point
             exit
          end if
          computed = computed + 1
-         owner(i) = job%rank + 1
-         if (job%resume) then
-            call load_point(checkpoint_name(job, i), input_hash, config%sweep%values(:, i), status(i), results(:, i), &
-               & cost(i), reason, point_maxima, loaded)
-            if (loaded) then
-               counts(i) = size(point_maxima)
-               maxima = [maxima, point_maxima]
-               reasons(i)%text = reason
-               cycle
-            end if
-         end if
-         computed_by_run(i) = 1
          t0 = wall_seconds()
-         call run_point(config, i, results(:, i), point_maxima, point_error)
+         call run_point(config, i, results, series, point_error)
+         if (.not. allocated(series)) allocate (series(0))
+         cost = wall_seconds() - t0
+         mine%header = [i, status_done, size(names), size(series), 0]
+         mine%reason = ''
          if (allocated(point_error)) then
-            status(i) = status_failed
-            reasons(i)%text = point_error%message
-            results(:, i) = 0.0_wp
-            if (allocated(point_maxima)) deallocate (point_maxima)
-            allocate (point_maxima(0))
+            mine%header(2) = status_failed
+            mine%reason = one_line(point_error%message)
+            results = 0.0_wp
+            deallocate (point_error)
+            if (allocated(series)) deallocate (series)
+            allocate (series(0))
+         end if
+         mine%header(4) = size(series)
+         mine%header(5) = len(mine%reason)
+         mine%numbers = [results, cost, series]
+         if (job%rank == 0) then
+            call add_point(batch, mine)
+            call write_batch(ckpt, batch, names, .false.)   ! (every add is followed by one: a batch never overflows)
+            call receive_points(job, ckpt, batch, names, finished, .false.)
+            ! (The points rank 0 has taken: those written and those in its batch.)
+            call reporter%progress(real(ckpt%received + batch%n, wp), real(n_work, wp), 'points', .false.)
          else
-            status(i) = status_done
-            reasons(i)%text = ''
+            call send_point(job, outbox, slot, mine)
          end if
-         counts(i) = size(point_maxima)
-         maxima = [maxima, point_maxima]
-         cost(i) = wall_seconds() - t0
-         call save_point(checkpoint_name(job, i), input_hash, config%sweep%values(:, i), status(i), results(:, i), &
-            & cost(i), reasons(i)%text, point_maxima, problem)
-         if (len(problem) > 0) then
-            unsaved = unsaved + 1
-            if (.not. allocated(checkpoint_error)) call fatal_error(checkpoint_error, problem)
-         end if
-         deallocate (point_maxima)
-         if (allocated(point_error)) deallocate (point_error)
-         if (job%rank == 0) call reporter%progress(real(i, wp), real(n, wp), 'points', .false.)
       end do
+      if (todo_unit >= 0) close (todo_unit)
+      ! This rank has finished: it says so (and whether it was interrupted),
+      ! and rank 0 takes every point still on its way.
+      if (job%rank /= 0) then
+         mine%header = [0, merge(1, 0, interrupted), 0, 0, 0]
+         mine%numbers = [real(wp) ::]
+         mine%reason = ''
+         call send_point(job, outbox, slot, mine)
+         do slot = 1, in_flight
+            if (outbox(slot)%busy) call MPI_Waitall(3, outbox(slot)%requests, MPI_STATUSES_IGNORE)
+         end do
+      else
+         if (job%parallel()) call receive_points(job, ckpt, batch, names, finished, .true.)
+         call write_batch(ckpt, batch, names, .true.)
+         if (ckpt%opened) call ckpt%file%close(error)
+         if (allocated(error) .and. .not. allocated(ckpt%error)) call move_alloc(error, ckpt%error)
+         if (allocated(ckpt%error)) call fatal_error(error, checkpoint_lost(ckpt), error_io)
+      end if
+      ! (Collective: only once every point is on its way, or a rank waiting
+      ! for rank 0 to take its points would wait for ever.)
       if (dynamic) call MPI_Win_free(window)
-      ! Checkpoints that could not be written: the points are in memory and go
-      ! into the file, but an interrupted run would compute them again.
-      if (job%parallel()) call MPI_Allreduce(MPI_IN_PLACE, unsaved, 1, MPI_INTEGER, MPI_SUM, job%comm)
-      call agree_on_error(job, checkpoint_error)
-      if (unsaved > 0 .and. job%rank == 0) call reporter%note('warning: '//itoa(unsaved) &
-         & //' checkpoint(s) could not be written, so --resume would compute those points again; first: ' &
-         & //checkpoint_error%message)
-
-      ! Each point has exactly one owner; the others hold zeros, so a sum gathers it exactly.
-      if (job%parallel()) call MPI_Allreduce(MPI_IN_PLACE, counts, n, MPI_INTEGER, MPI_SUM, job%comm)
-      allocate (offsets(n))
-      total = 0
-      do i = 1, n
-         offsets(i) = total
-         total = total + counts(i)
-      end do
-      allocate (flat(total), source=0.0_wp)
-      k = 0
-      do i = 1, n
-         if (owner(i) == 0) cycle
-         flat(offsets(i) + 1:offsets(i) + counts(i)) = maxima(k + 1:k + counts(i))
-         k = k + counts(i)
-      end do
-      call sum_to_root_real(job, flat)
-      do k = 1, size(names)
-         call sum_to_root_real(job, results(k, :))
-      end do
-      call sum_to_root_real(job, cost)
-      call sum_to_root_integer(job, status, n)
-      call gather_reasons(job, owner, reasons)
-      call sum_to_root_integer(job, owner, n)
-      call sum_to_root_integer(job, computed_by_run, n)
       flag = merge(1, 0, interrupted)
       if (job%parallel()) call MPI_Allreduce(MPI_IN_PLACE, flag, 1, MPI_INTEGER, MPI_MAX, job%comm)
-      ! A stop request after the last point stopped nothing: the sweep is complete.
-      if (job%rank == 0 .and. flag /= 0 .and. all(status /= 0)) flag = 0
-      if (job%parallel()) call MPI_Bcast(flag, 1, MPI_INTEGER, 0, job%comm)
       interrupted = flag /= 0
 
       ! Peak resident memory of every rank, for the benchmark (docs/sweeps.md).
@@ -256,36 +298,35 @@ contains
       record%wall_time = wall
       record%stats = integrator_statistics(0, 0, 0, 0)
       temporary = temporary_name(job)
-      if (job%rank == 0) call write_sweep_file(temporary, config, record, names, series_name, series_unit, &
-         & results, flat, offsets, counts, status, reasons, cost, computed_by_run, memory, interrupted, &
-         & job%parallel(), error)
+      counts = 0
+      first_reason = ''
+      if (job%rank == 0 .and. .not. allocated(error)) call write_sweep_file(temporary, ckpt, config, record, &
+         & names, series_name, series_unit, memory, interrupted, job%parallel(), counts, first_reason, error)
+      if (job%parallel()) call MPI_Bcast(counts, 3, MPI_INTEGER, 0, job%comm)
+      ! A stop request after the last point stopped nothing: the sweep is complete.
+      interrupted = interrupted .and. counts(1) + counts(2) < n
       call publish(job, temporary, error)
+      if (job%rank == 0 .and. use_todo) call remove_file(todo_path)
       if (allocated(error)) return
       write (seconds, '(f12.2)') wall
-      summary = itoa(count(status /= 0))//' of '//itoa(n)//' sweep points done, ' &
-         & //itoa(count(status == status_failed))//' failed, '//itoa(sum(computed_by_run)) &
-         & //' computed in this run, '//trim(adjustl(seconds))//' s '//ranks_text(job%nranks)
+      summary = itoa(counts(1) + counts(2))//' of '//itoa(n)//' sweep points done, '//itoa(counts(2)) &
+         & //' failed, '//itoa(counts(3))//' computed in this run, '//trim(adjustl(seconds))//' s ' &
+         & //ranks_text(job%nranks)
       if (interrupted) then
          call fatal_error(error, 'sweep interrupted; the file marks the points not done as pending ' &
             & //'(status 0): run again with --resume to compute only those', error_interrupted)
          return
       end if
-      ! Complete: the checkpoints have served.
-      if (job%rank == 0) then
-         do i = 1, n
-            call remove_file(checkpoint_name(job, i))
-         end do
-      end if
+      ! Complete: the checkpoint has served.
+      if (job%rank == 0) call remove_file(ckpt%path)
       ! A sweep of which no point succeeded has no result to show: the file
       ! holds every point's reason, and the exit says it failed (rank 0 holds
-      ! the reasons; its message is the one every rank returns).
-      all_failed = n > 0 .and. count(status == status_failed) == n   ! (rank 0 holds the statuses)
-      if (job%parallel()) call MPI_Bcast(all_failed, 1, MPI_LOGICAL, 0, job%comm)
+      ! point 1's reason; its message is the one every rank returns).
+      all_failed = n > 0 .and. counts(2) == n
       if (all_failed) then
-         reason = ''
-         if (job%rank == 0 .and. allocated(reasons(1)%text)) reason = ': point 1: '//reasons(1)%text
+         if (len(first_reason) > 0) first_reason = ': point 1: '//first_reason
          call fatal_error(error, 'every one of the '//itoa(n)//' sweep points failed; the file holds each ' &
-            & //'point''s reason (/sweep/reason)'//reason, error_numerical)
+            & //'point''s reason (/sweep/reason)'//first_reason, error_numerical)
          call agree_on_error(job, error)
       end if
    end subroutine run_sweep_job
@@ -308,7 +349,7 @@ contains
       allocate (point, source=config%scene)
       do v = 1, config%sweep%n_variables
          call split_name(config%sweep%variables(v), group, name)
-         call set_parameter_number(point, group, name, config%sweep%values(v, i), problem)
+         call set_parameter_number(point, group, name, config%sweep%point_value(v, i), problem)
          if (len(problem) > 0) then
             call fatal_error(error, 'sweep point '//itoa(i)//': &'//group//': '//name//': '//problem, error_input)
             return
@@ -324,78 +365,429 @@ contains
       call point%run_point(results, series, error)
    end subroutine run_point
 
-   !> Every failed point's reason to rank 0, as text: each rank sends the
-   !> reasons of the points it owns, in order.
-   subroutine gather_reasons(job, owner, reasons)
+   !> A reason on one line.
+   function one_line(text) result(line)
+      character(len=*), intent(in) :: text
+      character(len=:), allocatable :: line
+      integer :: k
+
+      line = trim(text)
+      do k = 1, len(line)
+         if (line(k:k) == new_line('a') .or. line(k:k) == achar(13)) line(k:k) = ' '
+      end do
+   end function one_line
+
+   ! ---- a finished point's way to rank 0 ----
+
+   !> Send a finished point (or the end) to rank 0 from the next slot of the
+   !> outbox, waiting first for that slot's previous sends to be matched.
+   subroutine send_point(job, outbox, slot, point)
       type(job_context), intent(in) :: job
-      integer, intent(in) :: owner(:)
-      type(reason_text), intent(inout) :: reasons(:)
-      integer, allocatable :: lengths(:), sizes(:), displacements(:), owners(:)
-      character(len=:), allocatable :: mine, all
-      integer :: i, r, at, total
+      type(point_message), intent(inout) :: outbox(:)
+      integer, intent(inout) :: slot
+      type(point_message), intent(in) :: point
 
-      if (.not. job%parallel()) return   ! serial: this process holds every reason
-      allocate (lengths(size(owner)), source=0)
-      mine = ''
-      do i = 1, size(owner)
-         if (owner(i) /= job%rank + 1) cycle
-         if (.not. allocated(reasons(i)%text)) reasons(i)%text = ''
-         lengths(i) = len(reasons(i)%text)
-         mine = mine//reasons(i)%text
+      slot = mod(slot, size(outbox)) + 1
+      associate (box => outbox(slot))
+         if (box%busy) call MPI_Waitall(3, box%requests, MPI_STATUSES_IGNORE)
+         box%header = point%header
+         box%numbers = point%numbers
+         box%reason = point%reason
+         box%requests = MPI_REQUEST_NULL
+         ! Synchronous sends: done only when rank 0 has taken them, so a rank
+         ! has at most size(outbox) points on their way.
+         call MPI_Issend(box%header, 5, MPI_INTEGER, 0, tag_header, job%comm, box%requests(1))
+         if (box%header(1) > 0) then
+            call MPI_Issend(box%numbers, size(box%numbers), MPI_DOUBLE_PRECISION, 0, tag_numbers, job%comm, &
+               & box%requests(2))
+            if (len(box%reason) > 0) call MPI_Issend(box%reason, len(box%reason), MPI_CHARACTER, 0, tag_reason, &
+               & job%comm, box%requests(3))
+         end if
+         box%busy = .true.
+      end associate
+   end subroutine send_point
+
+   !> Rank 0: take the points the other ranks have sent; with `wait`, until
+   !> every other rank has said it finished.
+   subroutine receive_points(job, ckpt, batch, names, finished, wait)
+      type(job_context), intent(in) :: job
+      type(checkpoint), intent(inout) :: ckpt
+      type(point_batch), intent(inout) :: batch
+      type(point_result), intent(in) :: names(:)
+      integer, intent(inout) :: finished
+      logical, intent(in) :: wait
+      type(point_message) :: point
+      type(MPI_Status) :: status
+      logical :: arrived
+      integer :: source
+
+      if (.not. job%parallel()) return
+      do
+         if (wait) then
+            if (finished == job%nranks - 1) return
+            call MPI_Probe(MPI_ANY_SOURCE, tag_header, job%comm, status)
+         else
+            call MPI_Iprobe(MPI_ANY_SOURCE, tag_header, job%comm, arrived, status)
+            if (.not. arrived) return
+         end if
+         source = status%MPI_SOURCE
+         call MPI_Recv(point%header, 5, MPI_INTEGER, source, tag_header, job%comm, MPI_STATUS_IGNORE)
+         if (point%header(1) == 0) then
+            finished = finished + 1
+            cycle
+         end if
+         if (allocated(point%numbers)) deallocate (point%numbers)
+         allocate (point%numbers(point%header(3) + 1 + point%header(4)))
+         call MPI_Recv(point%numbers, size(point%numbers), MPI_DOUBLE_PRECISION, source, tag_numbers, job%comm, &
+            & MPI_STATUS_IGNORE)
+         if (allocated(point%reason)) deallocate (point%reason)
+         allocate (character(len=point%header(5)) :: point%reason)
+         if (point%header(5) > 0) call MPI_Recv(point%reason, point%header(5), MPI_CHARACTER, source, tag_reason, &
+            & job%comm, MPI_STATUS_IGNORE)
+         call add_point(batch, point)
+         call write_batch(ckpt, batch, names, .false.)
       end do
-      allocate (sizes(job%nranks), displacements(job%nranks))
-      call MPI_Gather(len(mine), 1, MPI_INTEGER, sizes, 1, MPI_INTEGER, 0, job%comm)
-      call sum_to_root_integer(job, lengths, size(lengths))
-      owners = owner
-      call sum_to_root_integer(job, owners, size(owners))
-      total = 0
-      if (job%rank == 0) then
-         do r = 1, job%nranks
-            displacements(r) = total
-            total = total + sizes(r)
-         end do
+   end subroutine receive_points
+
+   ! ---- rank 0's batch and checkpoint ----
+
+   subroutine start_batch(batch, n_results)
+      type(point_batch), intent(inout) :: batch
+      integer, intent(in) :: n_results
+
+      allocate (batch%point(batch_points), batch%status(batch_points), batch%series_count(batch_points), &
+         & batch%reason_length(batch_points), source=0)
+      allocate (batch%results(n_results, batch_points), batch%cost(batch_points), source=0.0_wp)
+      allocate (batch%series(1024))
+      batch%reasons = ''
+      batch%since = wall_seconds()
+   end subroutine start_batch
+
+   subroutine add_point(batch, point)
+      type(point_batch), intent(inout) :: batch
+      type(point_message), intent(in) :: point
+      real(wp), allocatable :: grown(:)
+      integer :: k, m, nres
+
+      k = batch%n + 1
+      nres = point%header(3)
+      m = point%header(4)
+      batch%point(k) = point%header(1)
+      batch%status(k) = point%header(2)
+      batch%series_count(k) = m
+      batch%reason_length(k) = len(point%reason)
+      batch%results(:, k) = point%numbers(1:nres)
+      batch%cost(k) = point%numbers(nres + 1)
+      if (batch%n_series + m > size(batch%series)) then
+         allocate (grown(max(2 * size(batch%series), batch%n_series + m)))
+         grown(1:batch%n_series) = batch%series(1:batch%n_series)
+         call move_alloc(grown, batch%series)
       end if
-      allocate (character(len=max(1, total)) :: all)
-      call MPI_Gatherv(mine, len(mine), MPI_CHARACTER, all, sizes, displacements, MPI_CHARACTER, 0, job%comm)
-      if (job%rank /= 0) return
-      ! Walk the ranks' texts in rank order, each its own points in order.
-      do r = 1, job%nranks
-         at = displacements(r)
-         do i = 1, size(owners)
-            if (owners(i) /= r) cycle
-            reasons(i)%text = all(at + 1:at + lengths(i))
-            at = at + lengths(i)
+      batch%series(batch%n_series + 1:batch%n_series + m) = point%numbers(nres + 2:nres + 1 + m)
+      batch%n_series = batch%n_series + m
+      batch%reasons = batch%reasons//point%reason
+      batch%n = k
+   end subroutine add_point
+
+   !> Write the batch into the checkpoint (creating it at the first point)
+   !> and flush it, when it is full, when it waited long enough, at the
+   !> first point of a run, or always with `now`.
+   subroutine write_batch(ckpt, batch, names, now)
+      type(checkpoint), intent(inout) :: ckpt
+      type(point_batch), intent(inout) :: batch
+      type(point_result), intent(in) :: names(:)
+      logical, intent(in) :: now
+      integer, allocatable :: order(:)
+      integer(i8), allocatable :: series_offset(:), reason_offset(:)
+      integer(i8) :: s, r
+      integer :: k, a, b, j
+
+      if (batch%n == 0) return
+      if (.not. (now .or. batch%n == batch_points .or. batch%n_series >= batch_series .or. ckpt%received == 0 &
+         & .or. wall_seconds() - batch%since >= batch_seconds)) return
+      ckpt%received = ckpt%received + batch%n
+      ! Not on a (nearly) full disk: a write that fails there leaves HDF5
+      ! unable to close the file; with room to spare, the checkpoint closes.
+      if (.not. allocated(ckpt%error)) then
+         if (.not. room_for(ckpt%path, 8.0_wp * (batch%n_series + batch%n * (size(names) + 8)) &
+            & + len(batch%reasons))) then
+            if (ckpt%opened) call ckpt%file%close(ckpt%error)
+            if (.not. allocated(ckpt%error)) call fatal_error(ckpt%error, ckpt%path//': the disk is full (' &
+               & //bytes_text(free_bytes(ckpt%path))//' free)', error_io)
+            ckpt%opened = .false.
+            call remove_file(ckpt%path)
+         else if (.not. ckpt%opened) then
+            call create_checkpoint(ckpt, names)
+         end if
+      end if
+      if (allocated(ckpt%error)) then
+         batch%n = 0   ! nowhere to keep them: the run fails at its end
+         batch%n_series = 0
+         batch%reasons = ''
+         return
+      end if
+      ! Each point's place in the flat lists, in the order they came.
+      allocate (series_offset(batch%n), reason_offset(batch%n))
+      s = ckpt%series_end
+      r = ckpt%reason_end
+      do k = 1, batch%n
+         series_offset(k) = s
+         reason_offset(k) = r
+         s = s + batch%series_count(k)
+         r = r + batch%reason_length(k)
+      end do
+      call ckpt%file%put('series', ckpt%series_end, batch%series(1:batch%n_series))
+      call ckpt%file%put('reason', ckpt%reason_end, batch%reasons)
+      ckpt%series_end = s
+      ckpt%reason_end = r
+      ! The per-point columns, a run of consecutive points at a time.
+      order = sorted_order(batch%point(1:batch%n))
+      a = 1
+      do while (a <= batch%n)
+         b = a
+         do while (b < batch%n)
+            if (batch%point(order(b + 1)) /= batch%point(order(b)) + 1) exit
+            b = b + 1
+         end do
+         associate (first => int(batch%point(order(a)) - 1, i8), pick => order(a:b))
+            call ckpt%file%put('status', first, batch%status(pick))
+            call ckpt%file%put('run', first, [(ckpt%run, j = a, b)])
+            call ckpt%file%put('compute_time', first, batch%cost(pick))
+            call ckpt%file%put('series_offset', first, series_offset(pick))
+            call ckpt%file%put('series_count', first, batch%series_count(pick))
+            call ckpt%file%put('reason_offset', first, reason_offset(pick))
+            call ckpt%file%put('reason_length', first, batch%reason_length(pick))
+            do j = 1, size(names)
+               call ckpt%file%put('result'//itoa(j), first, batch%results(j, pick))
+            end do
+         end associate
+         a = b + 1
+      end do
+      call ckpt%file%flush()
+      if (ckpt%file%failed()) call ckpt%file%close(ckpt%error)
+      ! A checkpoint that failed a write cannot be trusted: it goes, and the
+      ! run fails at its end (checkpoint_lost).
+      if (allocated(ckpt%error)) then
+         ckpt%opened = .false.
+         call remove_file(ckpt%path)
+      end if
+      batch%n = 0
+      batch%n_series = 0
+      batch%reasons = ''
+      batch%since = wall_seconds()
+   end subroutine write_batch
+
+   !> Whether the disk at path has room for `bytes` more and min_free_bytes
+   !> to spare (true where it cannot tell).
+   logical function room_for(path, bytes)
+      character(len=*), intent(in) :: path
+      real(wp), intent(in) :: bytes
+      real(wp) :: free
+
+      free = free_bytes(path)
+      room_for = free < 0.0_wp .or. free >= bytes + min_free_bytes
+   end function room_for
+
+   !> Why the run failed when its checkpoint could not be written.
+   function checkpoint_lost(ckpt) result(message)
+      type(checkpoint), intent(in) :: ckpt
+      character(len=:), allocatable :: message
+      real(wp) :: free
+
+      message = ckpt%error%message
+      free = free_bytes(ckpt%path)
+      if (free >= 0.0_wp .and. free < min_free_bytes) message = message//' (the disk is full: ' &
+         & //bytes_text(free)//' free)'
+      message = message//'; the checkpoint could not be written and was removed (a failed write leaves it ' &
+         & //'untrustworthy), and the points of this run are lost with it: run again when there is room'
+   end function checkpoint_lost
+
+   !> The permutation that sorts `keys` (a batch: insertion sort, as the
+   !> points come nearly in order).
+   function sorted_order(keys) result(order)
+      integer, intent(in) :: keys(:)
+      integer, allocatable :: order(:)
+      integer :: k, j, held
+
+      order = [(k, k = 1, size(keys))]
+      do k = 2, size(keys)
+         held = order(k)
+         j = k - 1
+         do while (j >= 1)
+            if (keys(order(j)) <= keys(held)) exit
+            order(j + 1) = order(j)
+            j = j - 1
+         end do
+         order(j + 1) = held
+      end do
+   end function sorted_order
+
+   !> A new checkpoint: the input's hash, the number of points and results,
+   !> its columns (zeros: every point pending) and a reserve of
+   !> reserve_bytes.  The reserve is what a full disk gives back: after a
+   !> failed write the file is cut to no bytes before it is closed
+   !> (h5_table's close), and closing needs room for what HDF5 still holds.
+   !> Made under another name and renamed, so it appears whole, reserve and all.
+   subroutine create_checkpoint(ckpt, names)
+      type(checkpoint), intent(inout) :: ckpt
+      type(point_result), intent(in) :: names(:)
+      integer, parameter :: reserve_bytes = 1048576
+      character(len=:), allocatable :: fresh
+      integer :: j
+      integer(i8) :: n
+
+      n = ckpt%points
+      fresh = ckpt%path//'.new'
+      call ckpt%file%create(fresh, ckpt%error)
+      if (allocated(ckpt%error)) return
+      call ckpt%file%set_text('/', 'input_hash', ckpt%hash)
+      call ckpt%file%set_integer('/', 'points', n)
+      call ckpt%file%set_integer('/', 'results', int(size(names), i8))
+      call ckpt%file%set_integer('/', 'runs', int(ckpt%run, i8))
+      do j = 1, 7
+         call ckpt%file%add_column(trim(column_names(j)), column_kinds(j:j), n, '')
+      end do
+      do j = 1, size(names)
+         call ckpt%file%add_column('result'//itoa(j), 'r', n, '')
+      end do
+      call ckpt%file%add_column('series', 'r', -1_i8, '')
+      call ckpt%file%add_column('reason', 'b', -1_i8, '')
+      call ckpt%file%add_column('reserve', 'b', int(reserve_bytes, i8), '')
+      call ckpt%file%put('reserve', 0_i8, repeat(' ', reserve_bytes))
+      call ckpt%file%close(ckpt%error)
+      if (.not. allocated(ckpt%error)) call rename_file(fresh, ckpt%path, ckpt%error)
+      if (allocated(ckpt%error)) then
+         call remove_file(fresh)
+         return
+      end if
+      call ckpt%file%open(ckpt%path, ckpt%error)
+      ckpt%opened = .not. allocated(ckpt%error)
+      if (.not. ckpt%opened) call remove_file(ckpt%path)
+   end subroutine create_checkpoint
+
+   !> --resume: open the checkpoint, check it is of this input and whole, and
+   !> list the points still to do (pending ones) in the file todo_path.
+   subroutine open_checkpoint(ckpt, input_hash, n, n_results, todo_path, n_todo, error)
+      type(checkpoint), intent(inout) :: ckpt
+      character(len=*), intent(in) :: input_hash, todo_path
+      integer, intent(in) :: n, n_results
+      integer, intent(out) :: n_todo
+      type(error_type), allocatable, intent(out) :: error
+      type(error_type), allocatable :: ignored
+      integer, allocatable :: status(:)
+      integer :: unit, stat, first, count, k, j
+      logical :: whole
+
+      n_todo = 0
+      call ckpt%file%open(ckpt%path, error)
+      if (allocated(error)) then
+         call fatal_error(error, ckpt%path//': the checkpoint is damaged (it does not open as HDF5); remove it, ' &
+            & //'and --resume computes every point again', error_input)
+         return
+      end if
+      if (len(ckpt%file%text('/', 'input_hash')) == 0 .or. ckpt%file%integer('/', 'runs') < 1) then
+         call ckpt%file%close(ignored)
+         call fatal_error(error, ckpt%path//': the checkpoint is damaged (it lacks its input_hash or runs); ' &
+            & //'remove it, and --resume computes every point again', error_input)
+         return
+      end if
+      if (ckpt%file%text('/', 'input_hash') /= input_hash) then
+         call ckpt%file%close(ignored)
+         call fatal_error(error, ckpt%path//': the checkpoint is of another input; --resume reuses only the ' &
+            & //'checkpoint of the same input: run with the input of the interrupted run, or remove ' &
+            & //ckpt%path//' to start afresh', error_input)
+         return
+      end if
+      whole = ckpt%file%integer('/', 'points') == n .and. ckpt%file%integer('/', 'results') == n_results &
+         & .and. ckpt%file%integer('/', 'runs') >= 1
+      do k = 1, 7
+         whole = whole .and. ckpt%file%length(trim(column_names(k))) == n
+      end do
+      do j = 1, n_results
+         whole = whole .and. ckpt%file%length('result'//itoa(j)) == n
+      end do
+      whole = whole .and. ckpt%file%length('series') >= 0 .and. ckpt%file%length('reason') >= 0
+      if (.not. whole) then
+         call ckpt%file%close(ignored)
+         call fatal_error(error, ckpt%path//': the checkpoint is damaged (its columns are not those of this ' &
+            & //'sweep); remove it, and --resume computes every point again', error_input)
+         return
+      end if
+      ckpt%opened = .true.
+      ckpt%run = int(ckpt%file%integer('/', 'runs')) + 1
+      call ckpt%file%set_integer('/', 'runs', int(ckpt%run, i8))
+      ckpt%series_end = ckpt%file%length('series')
+      ckpt%reason_end = ckpt%file%length('reason')
+      open (newunit=unit, file=todo_path, access='stream', form='unformatted', action='write', &
+         & status='replace', iostat=stat)
+      if (stat /= 0) then
+         call fatal_error(error, todo_path//': cannot write the list of points to do', error_io)
+         return
+      end if
+      allocate (status(copy_points))
+      do first = 1, n, copy_points
+         count = min(copy_points, n - first + 1)
+         call ckpt%file%get('status', int(first - 1, i8), status(1:count))
+         do k = 1, count
+            if (status(k) /= status_pending) cycle
+            write (unit, iostat=stat) first + k - 1
+            n_todo = n_todo + 1
          end do
       end do
-   end subroutine gather_reasons
+      close (unit)
+      if (ckpt%file%failed()) then
+         call ckpt%file%close(ignored)
+         call fatal_error(error, ckpt%path//': the checkpoint is damaged (its statuses do not read); remove ' &
+            & //'it, and --resume computes every point again', error_input)
+      end if
+   end subroutine open_checkpoint
 
-   !> The sweep file, written by rank 0 alone.
-   subroutine write_sweep_file(path, config, record, names, series_name, series_unit, results, flat, offsets, &
-      & counts, status, reasons, cost, computed_by_run, memory, interrupted, parallel, error)
+   !> The checkpoint's per-point columns besides the results.
+   pure function column_names(k) result(name)
+      integer, intent(in) :: k
+      character(len=16) :: name
+      character(len=16), parameter :: names(7) = [character(len=16) :: 'status', 'run', 'compute_time', &
+         & 'series_offset', 'series_count', 'reason_offset', 'reason_length']
+
+      name = names(k)
+   end function column_names
+
+   ! ---- the output ----
+
+   !> The sweep file, written by rank 0 alone from the checkpoint: the run's
+   !> attributes first, then every column, a piece of copy_points points at
+   !> a time in point order.  counts = points done, failed, computed in this
+   !> run; first_reason = point 1's reason.
+   subroutine write_sweep_file(path, ckpt, config, record, names, series_name, series_unit, memory, &
+      & interrupted, parallel, counts, first_reason, error)
       character(len=*), intent(in) :: path
+      type(checkpoint), intent(inout) :: ckpt
       type(job_config), intent(in) :: config
       type(run_summary), intent(in) :: record
       type(point_result), intent(in) :: names(:)
       character(len=*), intent(in) :: series_name, series_unit
-      real(wp), intent(in) :: results(:, :), flat(:), cost(:)
-      integer, intent(in) :: offsets(:), counts(:), status(:), computed_by_run(:), memory(:)
-      type(reason_text), intent(in) :: reasons(:)
+      integer, intent(in) :: memory(:)
       logical, intent(in) :: interrupted
       logical, intent(in) :: parallel   !! on MPI (rank 0 writes through MPI_COMM_SELF), else serial
+      integer, intent(out) :: counts(3)
+      character(len=:), allocatable, intent(out) :: first_reason
       type(error_type), allocatable, intent(out) :: error
+      type(error_type), allocatable :: ignored
       type(h5_file) :: file
-      character(len=:), allocatable :: name, lines(:)
-      integer :: i, k, longest
+      type(h5_table) :: out
+      character(len=:), allocatable :: name, texts(:)
+      integer, allocatable :: status(:), run(:), series_count(:), reason_length(:), whole(:)
+      integer(i8), allocatable :: series_offset(:), reason_offset(:), out_offset(:)
+      real(wp), allocatable :: cost(:), values(:), results(:), series(:)
+      integer(i8) :: total, written
+      integer :: n, k, j, first, piece, longest, a, b
+      logical :: have
 
-      longest = 1
-      do i = 1, size(status)
-         if (allocated(reasons(i)%text)) longest = max(longest, len(reasons(i)%text))
-      end do
-      allocate (character(len=longest) :: lines(size(status)))
-      do i = 1, size(status)
-         lines(i) = ''
-         if (allocated(reasons(i)%text)) lines(i) = reasons(i)%text
-      end do
+      n = config%sweep%points()
+      counts = 0
+      first_reason = ''
+      ! The run's attributes and the small datasets, through the program's
+      ! one file type; then the columns, streamed.
       call file%create(path, merge(MPI_COMM_SELF, MPI_COMM_NULL, parallel), error)
       if (allocated(error)) return
       call write_run_attributes(file, 'sweep', config%scene%method(), record)
@@ -407,34 +799,144 @@ contains
       call file%create_group('/sweep')
       call file%write_attribute_integer('/sweep', 'shape', int(config%sweep%shape(1), i8))
       call file%write_attribute_integer('/sweep', 'shape2', int(config%sweep%shape(2), i8))
-      do k = 1, config%sweep%n_variables
-         name = '/sweep/values'
-         if (k == 2) name = '/sweep/values2'
-         call file%write_vector(name, config%sweep%values(k, :), variable_unit(k))
-         call file%write_attribute_text(name, 'variable', trim(config%sweep%variables(k)))
-      end do
-      do k = 1, size(names)
-         if (names(k)%whole) then
-            call file%write_integer_vector('/sweep/'//trim(names(k)%name), nint(results(k, :)))
-         else
-            call file%write_vector('/sweep/'//trim(names(k)%name), results(k, :), trim(names(k)%unit))
-         end if
-      end do
-      if (len(series_name) > 0) then
-         call file%write_vector('/sweep/'//series_name, flat, series_unit)
-         call file%write_integer_vector('/sweep/'//series_name//'_offset', offsets)
-         call file%write_integer_vector('/sweep/'//series_name//'_count', counts)
-      end if
-      call file%write_integer_vector('/sweep/status', status)
-      call file%write_attribute_text('/sweep/status', 'meaning', '0 pending, 1 done, 2 failed')
-      call file%write_text_vector('/sweep/reason', lines)
-      call file%write_attribute_text('/sweep/reason', 'meaning', 'a failed point''s error message (empty otherwise)')
-      call file%write_vector('/sweep/compute_time', cost, 's')
-      call file%write_integer_vector('/sweep/computed_by_this_run', computed_by_run)
       call file%write_integer_vector('/sweep/peak_memory_per_rank', memory)
       call file%write_attribute_text('/sweep/peak_memory_per_rank', 'units', 'kB (VmHWM; 0: unknown)')
-      call file%write_attribute_integer('/sweep', 'complete', int(merge(0, 1, interrupted), i8))
       call file%close(error)
+      if (allocated(error)) return
+
+      have = file_exists(ckpt%path)
+      if (have) then
+         call ckpt%file%open(ckpt%path, error)
+         if (allocated(error)) return
+      end if
+      call out%open(path, error)
+      if (allocated(error)) then
+         if (have) call ckpt%file%close(ignored)
+         return
+      end if
+      allocate (status(copy_points), run(copy_points), series_count(copy_points), reason_length(copy_points), &
+         & whole(copy_points), source=0)
+      allocate (series_offset(copy_points), reason_offset(copy_points), out_offset(copy_points), source=0_i8)
+      allocate (cost(copy_points), values(copy_points), results(copy_points), source=0.0_wp)
+      ! First pass: the length of the flat series and of the longest reason.
+      total = 0
+      longest = 1
+      if (have) then
+         do first = 1, n, copy_points
+            piece = min(copy_points, n - first + 1)
+            call ckpt%file%get('series_count', int(first - 1, i8), series_count(1:piece))
+            call ckpt%file%get('reason_length', int(first - 1, i8), reason_length(1:piece))
+            total = total + sum(int(series_count(1:piece), i8))
+            longest = max(longest, maxval(reason_length(1:piece)))
+         end do
+      end if
+      do k = 1, config%sweep%n_variables
+         name = merge('sweep/values ', 'sweep/values2', k == 1)
+         call out%add_column(trim(name), 'r', int(n, i8), variable_unit(k))
+         call out%set_text(trim(name), 'variable', trim(config%sweep%variables(k)))
+      end do
+      do j = 1, size(names)
+         call out%add_column('sweep/'//trim(names(j)%name), merge('i', 'r', names(j)%whole), int(n, i8), &
+            & trim(names(j)%unit))
+      end do
+      if (len(series_name) > 0) then
+         call out%add_column('sweep/'//series_name, 'r', total, series_unit)
+         call out%add_column('sweep/'//series_name//'_offset', 'l', int(n, i8), '')
+         call out%add_column('sweep/'//series_name//'_count', 'i', int(n, i8), '')
+      end if
+      call out%add_column('sweep/status', 'i', int(n, i8), '')
+      call out%set_text('sweep/status', 'meaning', '0 pending, 1 done, 2 failed')
+      call out%add_text_column('sweep/reason', longest, int(n, i8))
+      call out%set_text('sweep/reason', 'meaning', 'a failed point''s error message (empty otherwise)')
+      call out%add_column('sweep/compute_time', 'r', int(n, i8), 's')
+      call out%add_column('sweep/computed_by_this_run', 'i', int(n, i8), '')
+      allocate (character(len=longest) :: texts(copy_points))
+
+      ! Second pass: every column, a piece at a time, in point order.
+      written = 0
+      do first = 1, n, copy_points
+         piece = min(copy_points, n - first + 1)
+         associate (at => int(first - 1, i8), c => piece)
+            status(1:c) = status_pending
+            run(1:c) = 0
+            cost(1:c) = 0.0_wp
+            series_count(1:c) = 0
+            reason_length(1:c) = 0
+            if (have) then
+               call ckpt%file%get('status', at, status(1:c))
+               call ckpt%file%get('run', at, run(1:c))
+               call ckpt%file%get('compute_time', at, cost(1:c))
+               call ckpt%file%get('series_offset', at, series_offset(1:c))
+               call ckpt%file%get('series_count', at, series_count(1:c))
+               call ckpt%file%get('reason_offset', at, reason_offset(1:c))
+               call ckpt%file%get('reason_length', at, reason_length(1:c))
+            end if
+            do k = 1, config%sweep%n_variables
+               do j = 1, c
+                  values(j) = config%sweep%point_value(k, first + j - 1)
+               end do
+               name = merge('sweep/values ', 'sweep/values2', k == 1)
+               call out%put(trim(name), at, values(1:c))
+            end do
+            do j = 1, size(names)
+               results(1:c) = 0.0_wp
+               if (have) call ckpt%file%get('result'//itoa(j), at, results(1:c))
+               if (names(j)%whole) then
+                  whole(1:c) = nint(results(1:c))
+                  call out%put('sweep/'//trim(names(j)%name), at, whole(1:c))
+               else
+                  call out%put('sweep/'//trim(names(j)%name), at, results(1:c))
+               end if
+            end do
+            ! The series of the piece, read a run of adjacent ones at a time.
+            if (len(series_name) > 0) then
+               allocate (series(sum(series_count(1:c))))
+               b = 0
+               a = 1
+               do while (a <= c)
+                  j = a
+                  do while (j < c)
+                     if (series_offset(j + 1) /= series_offset(j) + series_count(j)) exit
+                     j = j + 1
+                  end do
+                  k = sum(series_count(a:j))
+                  if (k > 0) call ckpt%file%get('series', series_offset(a), series(b + 1:b + k))
+                  b = b + k
+                  a = j + 1
+               end do
+               do j = 1, c
+                  out_offset(j) = written
+                  written = written + series_count(j)
+               end do
+               call out%put('sweep/'//series_name, out_offset(1), series)
+               call out%put('sweep/'//series_name//'_offset', at, out_offset(1:c))
+               call out%put('sweep/'//series_name//'_count', at, series_count(1:c))
+               deallocate (series)
+            end if
+            do j = 1, c
+               texts(j) = ''
+               if (reason_length(j) > 0) call ckpt%file%get('reason', reason_offset(j), texts(j)(1:reason_length(j)))
+            end do
+            if (first == 1) first_reason = trim(texts(1))
+            call out%put('sweep/status', at, status(1:c))
+            call out%put('sweep/reason', at, texts(1:c))
+            call out%put('sweep/compute_time', at, cost(1:c))
+            whole(1:c) = merge(1, 0, run(1:c) == ckpt%run .and. status(1:c) /= status_pending)
+            call out%put('sweep/computed_by_this_run', at, whole(1:c))
+            counts(1) = counts(1) + count(status(1:c) == status_done)
+            counts(2) = counts(2) + count(status(1:c) == status_failed)
+            counts(3) = counts(3) + sum(whole(1:c))
+         end associate
+      end do
+      call out%set_integer('sweep', 'complete', int(merge(0, 1, interrupted .and. counts(1) + counts(2) < n), i8))
+      if (have) then
+         call ckpt%file%close(error)
+         if (allocated(error)) then
+            call out%close(ignored)
+            return
+         end if
+      end if
+      call out%close(error)
 
    contains
 
@@ -459,91 +961,6 @@ contains
 
    end subroutine write_sweep_file
 
-   !> A finished point's checkpoint (output/checkpoint.f90): its swept
-   !> values, status, results, cost, reason and maxima.  `problem` says why
-   !> it could not be written ('' when written).
-   subroutine save_point(path, input_hash, values, status, results, cost, reason, maxima, problem)
-      character(len=*), intent(in) :: path, input_hash, reason
-      real(wp), intent(in) :: values(:), results(:), cost, maxima(:)
-      integer, intent(in) :: status
-      character(len=:), allocatable, intent(out) :: problem
-      character(len=:), allocatable :: text, one_line
-      integer :: k
-
-      ! The reason on one line.
-      one_line = trim(reason)
-      do k = 1, len(one_line)
-         if (one_line(k:k) == new_line('a') .or. one_line(k:k) == achar(13)) one_line(k:k) = ' '
-      end do
-      text = real_line(values)//itoa(status)//' '//itoa(size(results))//' '//itoa(size(maxima))//new_line('a') &
-         & //real_line([results, cost])//one_line//new_line('a')
-      do k = 1, size(maxima)
-         text = text//real_line(maxima(k:k))
-      end do
-      call save_checkpoint(path, input_hash, text, problem)
-   end subroutine save_point
-
-   !> Why the checkpoint at `path` cannot serve this run ('' when it can, or
-   !> when there is none): written for another input, damaged, or for other
-   !> values of the swept variables.
-   function checkpoint_problem(path, input_hash, values) result(problem)
-      character(len=*), intent(in) :: path, input_hash
-      real(wp), intent(in) :: values(:)
-      character(len=:), allocatable :: problem
-      character(len=:), allocatable :: body
-      real(wp) :: saved(size(values))
-      integer :: stat
-
-      call checkpoint_body(path, input_hash, body, problem)
-      if (len(problem) > 0 .or. .not. allocated(body)) return
-      read (body, *, iostat=stat) saved
-      if (stat /= 0) then
-         problem = path//': the checkpoint is damaged (its values do not read)'
-      else if (.not. all(saved == values)) then
-         problem = path//': the checkpoint is for other values of the swept variables'
-      end if
-   end function checkpoint_problem
-
-   !> A point's checkpoint, if there is a whole one for the same input and
-   !> values (checkpoint_problem finds none).
-   subroutine load_point(path, input_hash, values, status, results, cost, reason, maxima, loaded)
-      character(len=*), intent(in) :: path, input_hash
-      real(wp), intent(in) :: values(:)
-      integer, intent(inout) :: status
-      real(wp), intent(inout) :: results(:), cost
-      character(len=:), allocatable, intent(out) :: reason
-      real(wp), allocatable, intent(out) :: maxima(:)
-      logical, intent(out) :: loaded
-      real(wp) :: numbers(size(results) + 1)
-      character(len=:), allocatable :: body, problem, line
-      integer :: stat, found(3), at
-
-      loaded = .false.
-      reason = ''
-      if (len(checkpoint_problem(path, input_hash, values)) > 0) return
-      call checkpoint_body(path, input_hash, body, problem)
-      if (.not. allocated(body)) return
-      ! Lines: values, counts, results and cost, reason, then maxima.
-      at = 1
-      line = next_line(body, at)   ! (the values, checked above)
-      line = next_line(body, at)
-      read (line, *, iostat=stat) found
-      if (stat /= 0 .or. found(2) /= size(results) .or. found(3) < 0) return
-      line = next_line(body, at)
-      read (line, *, iostat=stat) numbers
-      if (stat /= 0) return
-      reason = next_line(body, at)
-      allocate (maxima(found(3)))
-      if (found(3) > 0) then
-         read (body(at:), *, iostat=stat) maxima
-         if (stat /= 0) return
-      end if
-      status = found(1)
-      results = numbers(1:size(results))
-      cost = numbers(size(results) + 1)
-      loaded = .true.
-   end subroutine load_point
-
    !> This process's peak resident set (VmHWM of /proc/self/status) in kB;
    !> 0 where there is no such file.
    integer function peak_memory_kb() result(kb)
@@ -564,14 +981,5 @@ contains
       end do
       close (unit)
    end function peak_memory_kb
-
-   !> Where point i's checkpoint lives: beside the output.
-   function checkpoint_name(job, i) result(name)
-      type(job_context), intent(in) :: job
-      integer, intent(in) :: i
-      character(len=:), allocatable :: name
-
-      name = job%output//'.point-'//itoa(i)//'.ckpt'
-   end function checkpoint_name
 
 end module friction_job_sweep

@@ -36,7 +36,7 @@ module friction_output_h5
       end function h5fget_mdc_size
    end interface
 
-   public :: h5_file
+   public :: h5_file, error_printing, room_to_close
 
    !> H5E_DEFAULT of the C API: the default error stack (hid_t is int64_t
    !> since HDF5 1.10).
@@ -544,18 +544,12 @@ contains
    !> failed flush leaves the cache unable to close.
    subroutine give_back_space(self)
       class(h5_file), intent(inout) :: self
-      integer(c_size_t) :: max_size, min_clean, cached
-      integer(c_int) :: entries
+      character(len=:), allocatable :: problem
       integer :: failed
-      real(c_double) :: free
 
       if (self%rank == 0 .and. self%status == 0) then
-         if (h5fget_mdc_size(self%id, max_size, min_clean, cached, entries) >= 0) then
-            free = free_bytes(self%path)
-            if (free >= 0.0_c_double .and. free < 1.25_c_double * real(cached, c_double) + 8192.0_c_double) &
-               & call self%check(1, 'writing the file: the disk is full ('//bytes_text(real(free, wp)) &
-               & //' free, closing needs up to '//bytes_text(1.25_wp * real(cached, wp) + 8192.0_wp)//')')
-         end if
+         problem = room_to_close(self%id, self%path)
+         if (len(problem) > 0) call self%check(1, problem)
       end if
       failed = merge(1, 0, self%status /= 0)
       if (self%parallel) call MPI_Allreduce(MPI_IN_PLACE, failed, 1, MPI_INTEGER, MPI_MAX, self%comm)
@@ -565,6 +559,26 @@ contains
       if (self%rank == 0) call truncate_file(self%path)
       if (self%parallel) call MPI_Barrier(self%comm)
    end subroutine give_back_space
+
+   !> Whether the disk has room for the metadata HDF5 holds in its cache for
+   !> file `id` at `path` (with 1 MB to spare): '' if it has, else the
+   !> failure to report.  A flush or close that fails for want of room
+   !> leaves the file half open (see give_back_space), so it is not tried.
+   function room_to_close(id, path) result(problem)
+      integer(hid_t), intent(in) :: id
+      character(len=*), intent(in) :: path
+      character(len=:), allocatable :: problem
+      integer(c_size_t) :: max_size, min_clean, cached
+      integer(c_int) :: entries
+      real(c_double) :: free
+
+      problem = ''
+      if (h5fget_mdc_size(id, max_size, min_clean, cached, entries) < 0) return
+      free = free_bytes(path)
+      if (free >= 0.0_c_double .and. free < 1.25_c_double * real(cached, c_double) + 8192.0_c_double) &
+         & problem = 'writing the file: the disk is full ('//bytes_text(real(free, wp))//' free, closing needs ' &
+         & //'up to '//bytes_text(1.25_wp * real(cached, wp) + 8192.0_wp)//')'
+   end function room_to_close
 
    !> Create a dataset on every rank, or none: on a failure anywhere the
    !> dataset (where created) and `filespace` are closed, and false returned.
