@@ -19,6 +19,7 @@ module friction_afm_config
    use friction_ode_settings, only: visit_integrator, check_integrator
    use friction_afm_thermal, only: thermal_settings
    use friction_afm_langevin, only: langevin_time_step, largest_curvature
+   use friction_afm_kramers, only: kmc_barrier_floor
    implicit none
    private
 
@@ -230,22 +231,23 @@ contains
       !> spatial-diffusion regime needs the damping not weak.  Below
       !> gamma = c/m ~ omega k_B T/Delta E the escape is limited by energy
       !> diffusion (Mel'nikov-Meshkov) and the rate is too high; the model
-      !> jumps deterministically below 3 k_B T, so gamma >= omega/3 (omega
-      !> = sqrt(k/m) of either lateral spring) keeps every rate it uses in
-      !> the regime it holds in.
+      !> jumps deterministically below kmc_barrier_floor k_B T (1), so gamma
+      !> >= omega/kmc_barrier_floor (omega = sqrt(k/m) of either lateral
+      !> spring) keeps every rate it uses in the regime it holds in.
       subroutine check_kramers()
-         real(wp) :: omega
+         real(wp) :: omega, least
+         character(len=:), allocatable :: why
 
          if (self%model /= 'inertial') return
          omega = sqrt(max(self%kx, self%ky) / self%mass)
-         if (self%cx / self%mass < omega / 3.0_wp) call c%reject('tip', 'cx', rtoa(self%cx), 'is too weak ' &
-            & //"a damping for &thermal model = 'kramers' (c/m = "//rtoa(self%cx / self%mass)//' /s below ' &
-            & //'omega/3 = '//rtoa(omega / 3.0_wp)//" /s: escape is then limited by energy diffusion, where " &
-            & //"Kramers' rate does not hold); use model = 'langevin'")
-         if (self%cy / self%mass < omega / 3.0_wp) call c%reject('tip', 'cy', rtoa(self%cy), 'is too weak ' &
-            & //"a damping for &thermal model = 'kramers' (c/m = "//rtoa(self%cy / self%mass)//' /s below ' &
-            & //'omega/3 = '//rtoa(omega / 3.0_wp)//" /s: escape is then limited by energy diffusion, where " &
-            & //"Kramers' rate does not hold); use model = 'langevin'")
+         least = omega / kmc_barrier_floor
+         why = "a damping for &thermal model = 'kramers' (c/m = "
+         if (self%cx / self%mass < least) call c%reject('tip', 'cx', rtoa(self%cx), 'is too weak '//why &
+            & //rtoa(self%cx / self%mass)//' /s below omega = '//rtoa(least)//" /s: escape is then limited " &
+            & //"by energy diffusion, where Kramers' rate does not hold); use model = 'langevin'")
+         if (self%cy / self%mass < least) call c%reject('tip', 'cy', rtoa(self%cy), 'is too weak '//why &
+            & //rtoa(self%cy / self%mass)//' /s below omega = '//rtoa(least)//" /s: escape is then limited " &
+            & //"by energy diffusion, where Kramers' rate does not hold); use model = 'langevin'")
       end subroutine check_kramers
 
       !> The overdamped model divides by the damping of every moving direction.

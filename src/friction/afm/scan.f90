@@ -45,7 +45,7 @@ module friction_afm_scan
    use friction_afm_thermal, only: welford_add, welford_sem
    use friction_afm_langevin, only: langevin_integrator, langevin_state, langevin_time_step, boltzmann
    use friction_afm_kramers, only: find_minimum, hazard_path, hazard_start, hazard_advance, jump_landing, &
-      & hazard_running, hazard_low_barrier
+      & hazard_running, hazard_low_barrier, kmc_barrier_floor
    use friction_random, only: random_stream
    use friction_afm_quasistatic, only: newton_equilibrium, equilibrium_tangent
    use friction_surface_potential, only: surface_potential
@@ -93,11 +93,11 @@ module friction_afm_scan
    !> turned by ±exit_angle, rad: 40°, between the motion and the diagonal
    !> saddles of a square lattice); the support travel between two searches, Å (a tenth of
    !> NaF's shortest well spacing); the barrier, in k_B T, below which an
-   !> exit fires at once (Kramers' rate holds for barriers of several
-   !> k_B T, its corrections O(k_B T/ΔE)).
+   !> exit fires at once: friction_afm_kramers' kmc_barrier_floor (1 k_B T,
+   !> down to which the Kramers rate of a cubic barrier holds within 10 %).
    integer, parameter :: n_exits = 6
    real(wp), parameter :: exit_angle = 40.0_wp * pi / 180.0_wp, search_distance = 0.1_wp
-   real(wp), parameter :: barrier_floor = 3.0_wp
+   real(wp), parameter :: barrier_floor = kmc_barrier_floor
 
    !> One trip's samples: values(i, q) for sample i and quantity q (output units).
    type :: trip_record
