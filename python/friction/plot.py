@@ -881,7 +881,8 @@ def friction_velocity(rows):
         if not pts:
             continue
         v, f, e = map(np.array, zip(*pts))
-        ax.errorbar(v, f, yerr=e, marker=marker, color=colour, linestyle="none", capsize=3, label=label)
+        ax.errorbar(v, f, yerr=e, marker=marker, color=colour, linestyle="none", capsize=3, label=label,
+                    markerfacecolor="none" if model == "langevin" else colour)
     slow = sorted((r["velocity"], r["friction"], r["sem"]) for r in rows
                   if r["model"] == "kramers" and r["velocity"] < 3.0)
     if len(slow) >= 3:
@@ -892,7 +893,10 @@ def friction_velocity(rows):
                 label=f"Sang et al.: $F_c$ = {fc:.3f} nN, $v_c$ = {vc:.3g} Å/s")
     ax.set_xscale("log")
     ax.set_xlabel("support velocity (Å/s)")
+    top = ax.secondary_xaxis("top", functions=(lambda v: v * 1e-10, lambda v: v * 1e10))
+    top.set_xlabel("support velocity (m/s)")
     ax.set_ylabel("mean friction (nN)")
-    ax.set_title("NaF, 300 K: friction against velocity")
+    ax.set_title("NaF, 300 K: friction against velocity", fontsize="medium")
     ax.legend(fontsize="small")
+    fig.tight_layout()
     return fig

@@ -232,22 +232,27 @@ contains
       !> gamma = c/m ~ omega k_B T/Delta E the escape is limited by energy
       !> diffusion (Mel'nikov-Meshkov) and the rate is too high; the model
       !> jumps deterministically below kmc_barrier_floor k_B T (1), so gamma
-      !> >= omega/kmc_barrier_floor (omega = sqrt(k/m) of either lateral
-      !> spring) keeps every rate it uses in the regime it holds in.
+      !> >= omega/kmc_barrier_floor keeps every rate it uses in the regime
+      !> it holds in.  omega = sqrt(k/m) with the spring along the scan, the
+      !> direction the jumps go (a stiff spring across it, which keeps the
+      !> tip on a row, does not take part in them).
       subroutine check_kramers()
-         real(wp) :: omega, least
+         real(wp) :: omega, least, theta
          character(len=:), allocatable :: why
 
          if (self%model /= 'inertial') return
-         omega = sqrt(max(self%kx, self%ky) / self%mass)
+         theta = self%angle * pi / 180.0_wp
+         omega = sqrt((self%kx * cos(theta)**2 + self%ky * sin(theta)**2) / self%mass)
          least = omega / kmc_barrier_floor
          why = "a damping for &thermal model = 'kramers' (c/m = "
          if (self%cx / self%mass < least) call c%reject('tip', 'cx', rtoa(self%cx), 'is too weak '//why &
-            & //rtoa(self%cx / self%mass)//' /s below omega = '//rtoa(least)//" /s: escape is then limited " &
-            & //"by energy diffusion, where Kramers' rate does not hold); use model = 'langevin'")
+            & //rtoa(self%cx / self%mass)//' /s below omega = '//rtoa(least)//" /s, with the spring along " &
+            & //"the scan: escape is then limited by energy diffusion, where Kramers' rate does not hold); " &
+            & //"use model = 'langevin'")
          if (self%cy / self%mass < least) call c%reject('tip', 'cy', rtoa(self%cy), 'is too weak '//why &
-            & //rtoa(self%cy / self%mass)//' /s below omega = '//rtoa(least)//" /s: escape is then limited " &
-            & //"by energy diffusion, where Kramers' rate does not hold); use model = 'langevin'")
+            & //rtoa(self%cy / self%mass)//' /s below omega = '//rtoa(least)//" /s, with the spring along " &
+            & //"the scan: escape is then limited by energy diffusion, where Kramers' rate does not hold); " &
+            & //"use model = 'langevin'")
       end subroutine check_kramers
 
       !> The overdamped model divides by the damping of every moving direction.

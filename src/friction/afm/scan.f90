@@ -154,6 +154,7 @@ module friction_afm_scan
       procedure :: run_trip
       procedure :: run_thermal_trip
       procedure :: run_kramers_trip
+      procedure :: kramers_escape_hazards
       procedure :: run_line
       procedure :: time_step
       procedure :: statistics
@@ -549,20 +550,24 @@ contains
    !> the force -k u_min is the mean over the well's thermal spread up to
    !> O(k_B T) anharmonic terms.  Slips: every jump, with the support where
    !> it happened, the force before it and the move of the minimum.
-   subroutine run_kramers_trip(self, j, forward, realization, record, error, slips)
+   subroutine run_kramers_trip(self, j, forward, realization, record, error, slips, jump_hazards)
       class(afm_scanner), intent(inout) :: self
       integer, intent(in) :: j, realization
       logical, intent(in) :: forward
       type(trip_record), intent(inout) :: record
       type(error_type), allocatable, intent(out) :: error
       type(slip_list), intent(inout), optional :: slips
+      !> A probe (see kramers_escape_hazards): no clock fires, every jump
+      !> comes at the floor or a fold, and for each the hazard ∫ r dt all
+      !> exits accumulated since the previous jump is listed here.
+      real(wp), allocatable, intent(out), optional :: jump_hazards(:)
       !> Searches allowed between two samples before the trip is reported
       !> as stuck.
       integer, parameter :: max_searches = 100000
       type(hazard_path) :: paths(n_exits)
       real(wp) :: along(3), across(3), s_start, force(3), tip_r(3), t_sample, targets(n_exits), motion(3)
-      real(wp) :: u_cur(3), u_next(3), t_cur, t_end, temperature, t_event, t_first
-      logical :: active(n_exits), need_search
+      real(wp) :: u_cur(3), u_next(3), t_cur, t_end, temperature, t_event, t_first, carried
+      logical :: active(n_exits), need_search, probing
       integer(i8) :: now
       integer :: i, k, nx, nd, status, searches, p, first
 
@@ -579,6 +584,9 @@ contains
          t_cur = 0.0_wp
          call find_minimum(tip, t_cur, u_next(1:nd), u_cur(1:nd), error)
          need_search = .true.
+         probing = present(jump_hazards)
+         carried = 0.0_wp
+         if (probing) allocate (jump_hazards(0))
          do k = 1, nx
             i = merge(k, nx + 1 - k, forward)
             t_sample = abs(support_at(c, i - 1) - s_start) / c%velocity
@@ -620,9 +628,11 @@ contains
                end do
                if (allocated(error)) exit
                if (first > 0) then
+                  if (probing) call note_jump(sum(paths%hazard, mask=active))
                   call jump(paths(first), t_first)
                   need_search = .true.
                else if (first < 0) then
+                  if (probing) carried = carried + sum(paths%hazard, mask=active)
                   t_cur = paths(-first)%t
                   u_cur = paths(-first)%u_min
                   need_search = .true.
@@ -696,6 +706,7 @@ contains
             end do
             do q = 1, found
                targets(q) = self%stream%exponential()
+               if (probing) targets(q) = huge(1.0_wp)
             end do
          end associate
       end subroutine start_exits
@@ -706,11 +717,22 @@ contains
          associate (tip => self%tip)
             call find_minimum(tip, t_end, u_cur(1:nd), u_next(1:nd), error)
             if (allocated(error)) return
-            if (norm2(u_next(1:nd) - u_cur(1:nd)) > slip_distance) call add_slip(t_end, u_cur, u_next)
+            if (norm2(u_next(1:nd) - u_cur(1:nd)) > slip_distance) then
+               call add_slip(t_end, u_cur, u_next)
+               if (probing) call note_jump(0.0_wp)
+            end if
             u_cur = u_next
             t_cur = t_end
          end associate
       end subroutine follow_minimum
+
+      !> A probe's jump after `hazard` on the exits since the last search.
+      subroutine note_jump(hazard)
+         real(wp), intent(in) :: hazard
+
+         jump_hazards = [jump_hazards, carried + hazard]
+         carried = 0.0_wp
+      end subroutine note_jump
 
       !> The jump at support time te from the path's minimum over its saddle.
       subroutine jump(path, te)
@@ -739,6 +761,22 @@ contains
       end subroutine add_slip
 
    end subroutine run_kramers_trip
+
+   !> Where the thermal reduced model holds (friction_afm_validity): line
+   !> 0's trace with clocks that never fire, so that every jump comes where
+   !> an exit's barrier reaches the floor (or at a fold).  For each jump,
+   !> the hazard H = ∫ Σ r dt its exits accumulated before it: at this
+   !> velocity the model forces that jump at the floor with probability
+   !> exp(-H) (no clock fired before), and H scales as 1/v (the path of the
+   !> minimum and the saddles does not depend on v).
+   subroutine kramers_escape_hazards(self, hazards, error)
+      class(afm_scanner), intent(inout) :: self
+      real(wp), allocatable, intent(out) :: hazards(:)
+      type(error_type), allocatable, intent(out) :: error
+      type(trip_record) :: record
+
+      call self%run_kramers_trip(0, .true., 0, record, error, jump_hazards=hazards)
+   end subroutine kramers_escape_hazards
 
    subroutine slips_clear(self)
       class(slip_list), intent(inout) :: self
