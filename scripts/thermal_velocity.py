@@ -46,29 +46,39 @@ POINTS = [("kramers", v) for v in (1e-4, 1e-3, 1e-2, 0.1, 0.3, 1.0, 3.0, 10.0, 3
 LANGEVIN_STEP = 5.0e-6
 
 
+def run_point(binary, files, override, tag, ranks, workdir, mpiexec="mpiexec"):
+    """One run of `friction` on the files and the namelist text `override`:
+    (mean friction over the lines, its standard error (nN; the lines are
+    independent), wall seconds)."""
+    import h5py
+    import numpy as np
+    extra = os.path.join(workdir, f"{tag}.nml")
+    out = os.path.join(workdir, f"{tag}.h5")
+    with open(extra, "w") as handle:
+        handle.write(override)
+    cmd = [binary, "--quiet", "--force", "-o", out, *files, extra]
+    if ranks > 1:
+        cmd = [mpiexec, "-n", str(ranks)] + cmd
+    start = time.perf_counter()
+    subprocess.run(cmd, check=True)
+    seconds = time.perf_counter() - start
+    with h5py.File(out, "r") as f:
+        lines = f["afm/friction"][()]
+        sems = f["afm/friction_sem"][()] if "afm/friction_sem" in f else np.zeros_like(lines)
+    return float(lines.mean()), float(np.sqrt(np.sum(sems ** 2)) / len(lines)), seconds
+
+
 def run_curve(binary, inputs, ranks, workdir, mpiexec="mpiexec"):
     """Every point of POINTS: a list of dicts (model, velocity in Å/s,
     friction and its standard error in nN, wall seconds)."""
-    import h5py
-    import numpy as np
     rows = []
     base = os.path.join(inputs, "naf_thermal_velocity.nml")
     for model, velocity in POINTS:
-        override = os.path.join(workdir, f"{model}_{velocity:g}.nml")
-        out = os.path.join(workdir, f"{model}_{velocity:g}.h5")
-        with open(override, "w") as handle:
-            step = LANGEVIN_STEP if model == "langevin" else 0.0
-            handle.write(f"&scan velocity = {velocity!r} /\n&thermal model = '{model}', time_step = {step!r} /\n")
-        cmd = [binary, "--quiet", "--force", "-o", out, base, override]
-        if ranks > 1:
-            cmd = [mpiexec, "-n", str(ranks)] + cmd
-        start = time.perf_counter()
-        subprocess.run(cmd, check=True)
-        seconds = time.perf_counter() - start
-        with h5py.File(out, "r") as f:
-            lines, sems = f["afm/friction"][()], f["afm/friction_sem"][()]
-        rows.append({"model": model, "velocity": velocity, "friction": float(lines.mean()),
-                     "sem": float(np.sqrt(np.sum(sems ** 2)) / len(lines)), "seconds": seconds})
+        step = LANGEVIN_STEP if model == "langevin" else 0.0
+        override = f"&scan velocity = {velocity!r} /\n&thermal model = '{model}', time_step = {step!r} /\n"
+        friction, sem, seconds = run_point(binary, [base], override, f"{model}_{velocity:g}", ranks, workdir,
+                                           mpiexec)
+        rows.append({"model": model, "velocity": velocity, "friction": friction, "sem": sem, "seconds": seconds})
     return rows
 
 
