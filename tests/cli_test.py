@@ -108,6 +108,12 @@ BAD_INPUTS = {
                             ["bad.nml:1", "&tip", "model", "quasistatic", "thermal"]),
     "thermal-kramers-time-step": ("&thermal\n  temperature = 300.0\n  model = 'kramers'\n  time_step = 1e-7\n/\n", 3,
                                   ["bad.nml:4", "&thermal", "time_step", "kramers", "leave it 0"]),
+    "thermal-lj-undamped-z": ("&surface potential = 'lj' /\n&tip\n  cx = 2e-4\n  cy = 2e-4\n  cz = 0.0\n/\n"
+                              "&thermal temperature = 300.0 /\n", 3,
+                              ["bad.nml:5", "&tip", "cz", "> 0", "heat bath"]),
+    "thermal-lj-kramers": ("&surface potential = 'lj' /\n&tip cx = 2e-4, cy = 2e-4, cz = 2e-4 /\n"
+                           "&thermal temperature = 300.0, model = 'kramers' /\n", 3,
+                           ["bad.nml:3", "&thermal", "model", "kramers", "lj", "langevin"]),
     "thermal-kramers-weak-damping": ("&tip\n  cx = 1.0e-5\n/\n&thermal temperature = 300.0, model = 'kramers' /\n", 3,
                                      ["bad.nml:2", "&tip", "cx", "energy diffusion", "langevin"]),
 }
@@ -766,6 +772,70 @@ def case_thermal_equipartition(args):
             print(f"{model}: friction = {mean:.5f} +- {se:.5f} nN, drag c v = {drag:.5f} nN")
             if abs(mean - drag) > 3 * se:
                 fail(f"{model}: mean friction {mean} +- {se} nN is not the drag c v = {drag} nN within 3 SE")
+
+
+def case_thermal_lj(args):
+    """The 3D Lennard-Jones tip at 300 K (Langevin, BAOAB on x, y and z).
+
+    Equipartition with the surface out of reach: the support 30 Å above
+    the contact height puts the tip beyond the lattice sum's cutoff
+    (13.4 Å), where V = 0 exactly, so per axis the variance of the spring
+    force over the realizations is k k_B T (BAOAB is exact for a harmonic
+    tip at any stable step), within 3 standard errors from the scatter over
+    the lines, the standard error below 2 %.  kx = ky = kz = 0.25 N/m,
+    c = 2e-4 N s/m (inputs/graphite_damped.nml), a 2 Å lead-in (20 decay
+    times 2m/c).  Then near the surface (the damped graphite case on a
+    small net): the documented datasets with fz, tip_z and their standard
+    errors, the load fz = -kz 6 Å = -0.15 nN on average within 3 standard
+    errors plus the surface's own pull, and the same file bit for bit on 1,
+    2 and 3 ranks."""
+    graphite = os.path.join(args.inputs, "graphite.nml")
+    damped = os.path.join(args.inputs, "graphite_damped.nml")
+    kt = 1.380649e-23 * 300.0
+    variance = 0.25 * kt * 1e18                   # nN^2
+    far = write(args, "far.nml", "&surface shells = 2 /\n&tip support_z = 30.0 /\n"
+                "&scan nx = 64, ny = 12, lead_in = 2.0 /\n"
+                "&thermal temperature = 300.0, realizations = 16, seed = 13 /\n")
+    friction(args, "-o", "far.h5", graphite, damped, far, ranks=2)
+    with h5py.File(os.path.join(args.workdir, "far.h5"), "r") as f:
+        n = f["afm"].attrs["realizations"]
+        if f.attrs["method"].decode() != "baoab":
+            fail(f"root method {f.attrs['method']!r}, expected 'baoab'")
+        for axis in ("fx", "fy", "fz"):
+            per_line = np.concatenate([n * f[f"afm/{trip}/{axis}_sem"][()] ** 2
+                                       for trip in ("trace", "retrace")], axis=1).mean(axis=1)
+            ratio, se = per_line.mean() / variance, per_line.std(ddof=1) / np.sqrt(len(per_line)) / variance
+            print(f"LJ tip far from the surface, {axis}: k<du^2>/kT = {ratio:.4f} +- {se:.4f}")
+            if se > 0.02:
+                fail(f"{axis}: standard error {se} of k<du^2>/kT above 2 %")
+            if abs(ratio - 1.0) > 3 * se:
+                fail(f"{axis}: k<du^2>/kT = {ratio} +- {se}, not 1 within 3 SE")
+    near = write(args, "near.nml", "&surface shells = 4 /\n&scan nx = 16, ny = 3, length = 2.0, lead_in = 0.5 /\n"
+                 "&thermal temperature = 300.0, realizations = 2, seed = 13 /\n")
+    files = {}
+    for ranks in (1, 2, 3):
+        friction(args, "-o", f"near_{ranks}.h5", graphite, damped, near, ranks=ranks)
+        files[ranks] = comparable(os.path.join(args.workdir, f"near_{ranks}.h5"))
+    for ranks in (2, 3):
+        if files[1].keys() != files[ranks].keys():
+            fail(f"1 and {ranks} ranks wrote different objects: {set(files[1]) ^ set(files[ranks])}")
+        for key, value in files[1].items():
+            if not np.array_equal(np.asarray(value), np.asarray(files[ranks][key])):
+                fail(f"{key} differs between 1 and {ranks} ranks")
+    with h5py.File(os.path.join(args.workdir, "near_1.h5"), "r") as f:
+        for trip in ("trace", "retrace"):
+            for name in ("fz", "tip_z", "fz_sem", "tip_z_sem"):
+                if f"afm/{trip}/{name}" not in f or f[f"afm/{trip}/{name}"].shape != (3, 16):
+                    fail(f"/afm/{trip}/{name} missing or not of shape (3, 16)")
+        fz = f["afm/trace/fz"][()]
+        print(f"LJ tip on graphite at 300 K: mean fz = {fz.mean():.4f} nN")
+        # The z spring presses the tip with kz 6 Å = 0.15 nN at the origin's
+        # contact height (the wall is stiff: the tip sinks a negligible amount);
+        # over the lines the contact height follows the corrugation by ~0.1 Å,
+        # 0.0025 nN, and the thermal mean of fz is -kz <u_z> with a spread of
+        # kz sqrt(k_B T/(kz + V_zz)) per sample: 0.15 nN within 0.01.
+        if not -0.16 < fz.mean() < -0.14:
+            fail(f"mean fz = {fz.mean()} nN, not the load -0.15 nN")
 
 
 def case_thermal_kramers(args):
@@ -1638,6 +1708,7 @@ def main():
           "set": case_set, "other-scene-group": case_other_scene_group,
           "thermal-ranks": case_thermal_ranks, "thermal-equipartition": case_thermal_equipartition,
           "thermal-kramers": case_thermal_kramers, "thermal-kramers-law": case_thermal_kramers_law,
+          "thermal-lj": case_thermal_lj,
           "serial-files": case_serial_files, "serial-no-mpi": case_serial_no_mpi}[args.case](args)
     print("1 passed, 0 failed")
 

@@ -11,7 +11,7 @@ module friction_afm_config
    use friction_surface_net, only: crystal_net, graphite_net, square_net, read_xyz, max_local_density, sort_order
    use friction_surface_lennard_jones, only: new_lj_potential, cutoff_for_tolerance
    use friction_kinds, only: ev_per_angstrom_to_nn
-   use friction_afm_tip, only: afm_tip, model_inertial, model_overdamped, model_quasistatic
+   use friction_afm_tip, only: afm_tip, model_inertial, model_overdamped, model_quasistatic, find_height
    use friction_strings, only: itoa, rtoa, quoted, bytes_text
    use friction_files, only: file_exists
    use friction_parameters, only: configurable, parameter_visitor
@@ -209,9 +209,9 @@ contains
                & //"or 'overdamped' (with &thermal model = 'kramers' they choose the escape rate's prefactor)")
             return
          end if
-         if (self%potential == 'lj') then
-            call c%reject('thermal', 'temperature', rtoa(self%thermal%temperature), "is not available yet for " &
-               & //"potential = 'lj' (the lattice-sum surface): use 'naf' or 'hopg', or temperature = 0")
+         if (self%potential == 'lj' .and. self%thermal%model == 'kramers') then
+            call c%reject('thermal', 'model', "'kramers'", "is not available for potential = 'lj' (the " &
+               & //"lattice-sum surface, a tip moving in 3D): use model = 'langevin'")
             return
          end if
          ! Fluctuation-dissipation: the bath that heats an axis is its damper.
@@ -219,6 +219,9 @@ contains
             & ': the heat bath acts through the damper (fluctuation-dissipation), an undamped axis has none')
          if (.not. (self%cy > 0.0_wp)) call c%reject('tip', 'cy', rtoa(self%cy), 'must be > 0 (N s/m)'//at// &
             & ': the heat bath acts through the damper (fluctuation-dissipation), an undamped axis has none')
+         if (self%potential == 'lj' .and. .not. (self%cz > 0.0_wp)) call c%reject('tip', 'cz', rtoa(self%cz), &
+            & 'must be > 0 (N s/m)'//at//': the heat bath acts through the damper (fluctuation-dissipation), ' &
+            & //'an undamped axis has none')
          if (.not. c%failed() .and. self%thermal%model == 'kramers') call check_kramers()
          if (c%failed() .or. self%thermal%time_step == 0.0_wp) return
          limit = thermal_step_limit(self)
@@ -474,18 +477,40 @@ contains
 
    !> The largest curvature of the surface (eV/Å², >= 0) over one lattice
    !> cell, the Langevin step's scale (friction_afm_langevin): NaF over
-   !> ax × ay, HOPG over the rectangular cell a × a√3, on 32² points; 0 for
-   !> other surfaces.
+   !> ax × ay, HOPG over the rectangular cell a × a√3, on 32² points; for a
+   !> lattice sum (3D, its largest Hessian eigenvalue) over the scan's
+   !> bounding box in the plane and from the loaded tip's rest height above
+   !> the origin down 0.2 Å (three thermal spreads sqrt(k_B T/k_zz) at 300 K
+   !> on graphite: the wall is what is stiff), on 12³ points; 0 when that
+   !> height cannot be found (the run reports why).
    function surface_curvature(config, potential) result(curvature)
       type(afm_config), intent(in) :: config
       class(surface_potential), intent(in) :: potential
       real(wp) :: curvature
+      type(afm_tip) :: tip
+      type(error_type), allocatable :: error
+      real(wp) :: origin(3), corners(3, 4), contact, rest
+      integer :: k
 
       select case (trim(config%potential))
       case ('naf')
          curvature = largest_curvature(potential, [0.0_wp, 0.0_wp], [config%ax, config%ay], 32)
       case ('hopg')
          curvature = largest_curvature(potential, [0.0_wp, 0.0_wp], [config%a, sqrt(3.0_wp) * config%a], 32)
+      case ('lj')
+         curvature = 0.0_wp
+         origin = [config%origin_x, config%origin_y, 0.0_wp]
+         call new_tip(config, potential, tip)
+         call find_height(tip, origin, 0.0_wp, contact, error)
+         if (.not. allocated(error)) call find_height(tip, [origin(1), origin(2), contact + config%support_z], &
+            & tip%spring(3), rest, error)
+         if (allocated(error)) return
+         do k = 1, 4
+            corners(:, k) = origin + merge(config%length, 0.0_wp, k == 2 .or. k == 4) * config%scan_direction() &
+               & + merge(config%width, 0.0_wp, k >= 3) * config%across_direction()
+         end do
+         curvature = max(largest_curvature(potential, [minval(corners(1, :)), minval(corners(2, :)), &
+            & rest - 0.2_wp], [maxval(corners(1, :)), maxval(corners(2, :)), rest], 12), 0.0_wp)
       case default
          curvature = 0.0_wp
       end select
