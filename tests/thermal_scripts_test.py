@@ -107,3 +107,28 @@ def test_command_line():
     assert ok.returncode == 0 and "--binary" in ok.stdout and "--ranks" in ok.stdout
     bad = subprocess.run([sys.executable, script, "--no-such-option"], capture_output=True, text=True)
     assert bad.returncode == 2 and "Traceback" not in bad.stderr
+
+
+def test_temperature_fit():
+    """friction.plot.temperature_fit on F = F_c - C T^(2/3) exactly (with
+    a point above 300 K that it must leave out, and one whose standard
+    error is 0): F_c and C to 1e-9, the free exponent to its grid step
+    0.001."""
+    from friction.plot import temperature_fit
+    rows = [{"temperature": t, "friction": 0.8 - 0.015 * t ** (2.0 / 3.0), "sem": 0.01 if t != 50.0 else 0.0}
+            for t in (25.0, 50.0, 100.0, 150.0, 200.0, 250.0)]
+    rows.append({"temperature": 600.0, "friction": 0.0, "sem": 0.01})
+    rows.append({"temperature": 0.0, "friction": 0.81, "sem": 0.0})
+    fc, c, alpha, alpha_se = temperature_fit(rows)
+    assert abs(fc - 0.8) < 1e-9 and abs(c - 0.015) < 1e-9
+    assert abs(alpha - 2.0 / 3.0) <= 0.001 and alpha_se < 0.1
+
+
+def test_temperature_command_line():
+    """thermal_temperature.py: --help names the options; a bad option is
+    exit code 2."""
+    script = str(ROOT / "scripts" / "thermal_temperature.py")
+    ok = subprocess.run([sys.executable, script, "--help"], capture_output=True, text=True)
+    assert ok.returncode == 0 and "--binary" in ok.stdout
+    bad = subprocess.run([sys.executable, script, "--no-such-option"], capture_output=True, text=True)
+    assert bad.returncode == 2 and "Traceback" not in bad.stderr
