@@ -786,9 +786,9 @@ def case_thermal_lj(args):
     c = 2e-4 N s/m (inputs/graphite_damped.nml), a 2 Å lead-in (20 decay
     times 2m/c).  Then near the surface (the damped graphite case on a
     small net): the documented datasets with fz, tip_z and their standard
-    errors, the load fz = -kz 6 Å = -0.15 nN on average within 3 standard
-    errors plus the surface's own pull, and the same file bit for bit on 1,
-    2 and 3 ranks."""
+    errors, the load fz = -kz 6 Å = -0.15 nN on average within 0.01 nN,
+    and the same file bit for bit on 1, 2 and 3 ranks.  And T -> 0: at
+    1 mK the deterministic graphite run."""
     graphite = os.path.join(args.inputs, "graphite.nml")
     damped = os.path.join(args.inputs, "graphite_damped.nml")
     kt = 1.380649e-23 * 300.0
@@ -836,6 +836,23 @@ def case_thermal_lj(args):
         # kz sqrt(k_B T/(kz + V_zz)) per sample: 0.15 nN within 0.01.
         if not -0.16 < fz.mean() < -0.14:
             fail(f"mean fz = {fz.mean()} nN, not the load -0.15 nN")
+    # T -> 0: at 1 mK the Langevin tip is the deterministic graphite run (rkf45)
+    # up to the thermal spread sqrt(k k_B T) = 6e-5 nN per sample (k = 0.25 N/m)
+    # and the two integrators' difference (rkf45's atol 1e-4 Å is 2.5e-5 nN).
+    # Measured: friction within 2.4e-6 nN, samples within 1.1e-4 nN.
+    cold = write(args, "cold.nml", "&surface shells = 4 /\n&scan nx = 16, ny = 3, length = 2.0 /\n"
+                 "&thermal temperature = 1.0e-3, realizations = 2 /\n")
+    plain = write(args, "plain.nml", "&surface shells = 4 /\n&scan nx = 16, ny = 3, length = 2.0 /\n")
+    friction(args, "-o", "cold.h5", graphite, damped, cold)
+    friction(args, "-o", "plain.h5", graphite, damped, plain)
+    with h5py.File(os.path.join(args.workdir, "plain.h5"), "r") as f, \
+            h5py.File(os.path.join(args.workdir, "cold.h5"), "r") as g:
+        lines = np.max(np.abs(f["afm/friction"][()] - g["afm/friction"][()]))
+        samples = max(np.max(np.abs(f[f"afm/{trip}/{q}"][()] - g[f"afm/{trip}/{q}"][()]))
+                      for trip in ("trace", "retrace") for q in ("fx", "fy", "fz"))
+        print(f"LJ tip at 1 mK against T = 0: friction within {lines:.2e} nN, samples within {samples:.2e} nN")
+        if lines > 1e-4 or samples > 1e-3:
+            fail(f"1 mK is not close to T = 0 on graphite: friction {lines} nN, samples {samples} nN apart")
 
 
 def case_thermal_kramers(args):
