@@ -12,7 +12,8 @@ brake:        brake_phase (Fig. 12), brake_x, brake_spectrum (Fig. 13),
 sweeps:       sweep (every chart of a sweep file), bifurcation, sweep_lyapunov,
               sweep_friction
 speed:        work_precision, failure_map (files of scripts/work_precision)
-thermal:      friction_velocity (rows of scripts/thermal_velocity.py), sang_fit
+thermal:      friction_velocity (rows of scripts/thermal_velocity.py), sang_fit,
+              friction_temperature (rows of scripts/thermal_temperature.py), temperature_fit
 
 The figures are matplotlib.figure.Figure objects outside pyplot: nothing is
 shown or kept open behind the caller's back, and no display is needed.  In a
@@ -36,7 +37,7 @@ from ._data import FileError, load, reading, require
 __all__ = ["afm_maps", "friction_loop", "graphite_net", "stacked_lines", "brake_phase", "brake_x",
            "brake_spectrum", "poincare", "lyapunov", "floquet", "orbit_branch", "sweep", "bifurcation",
            "sweep_lyapunov", "atlas", "sweep_friction", "work_precision", "failure_map", "friction_velocity",
-           "sang_fit", "Figure"]
+           "sang_fit", "friction_temperature", "temperature_fit", "Figure"]
 
 
 class Figure(_Figure):
@@ -1058,7 +1059,8 @@ def friction_velocity(rows):
         if not pts:
             continue
         v, f, e = map(np.array, zip(*pts))
-        ax.errorbar(v, f, yerr=e, marker=marker, color=colour, linestyle="none", capsize=3, label=label)
+        ax.errorbar(v, f, yerr=e, marker=marker, color=colour, linestyle="none", capsize=3, label=label,
+                    markerfacecolor="none" if model == "langevin" else colour)
     slow = sorted((r["velocity"], r["friction"], r["sem"]) for r in rows
                   if r["model"] == "kramers" and r["velocity"] < 3.0)
     if len(slow) >= 3:
@@ -1069,7 +1071,65 @@ def friction_velocity(rows):
                 label=f"Sang et al.: $F_c$ = {fc:.3f} nN, $v_c$ = {vc:.3g} Å/s")
     ax.set_xscale("log")
     ax.set_xlabel("support velocity (Å/s)")
+    top = ax.secondary_xaxis("top", functions=(lambda v: v * 1e-10, lambda v: v * 1e10))
+    top.set_xlabel("support velocity (m/s)")
     ax.set_ylabel("mean friction (nN)")
-    ax.set_title("NaF, 300 K: friction against velocity")
+    ax.set_title("NaF, 300 K: friction against velocity", fontsize="medium")
     ax.legend(fontsize="small")
+    fig.tight_layout()
+    return fig
+
+
+def temperature_fit(rows, below=300.0):
+    """The law of thermally activated slips at a fixed velocity, F = F_c -
+    C T^(2/3) (Sang et al.'s F_c - [beta k_B T ln(v_c/v)]^(2/3) with the
+    logarithm's slow change with T left out), fitted by weighted least
+    squares through the points with 0 < T < below (K; above, jumps back
+    set in); and the free exponent alpha of F_c - C T^alpha with its
+    standard error (the profile of chi^2, Delta chi^2 = 1).  A point whose
+    realizations all agree (standard error below 1e-9 nN: at low T the jumps scatter
+    less than the sample spacing, so no sample tells them apart) gets the
+    smallest standard error of the others.  Returns (F_c in nN, C in
+    nN/K^(2/3), alpha, its standard error)."""
+    pts = [(r["temperature"], r["friction"], r["sem"]) for r in rows if 0.0 < r["temperature"] < below]
+    t, f, e = (np.array(x, float) for x in zip(*pts))
+    e = np.where(e > 1e-9, e, e[e > 1e-9].min())
+    w = 1.0 / e ** 2
+
+    def solve(alpha):
+        a = np.vstack([np.ones_like(t), -t ** alpha]).T
+        coef = np.linalg.solve(a.T @ (w[:, None] * a), a.T @ (w * f))
+        return coef, float(np.sum(w * (f - a @ coef) ** 2))
+
+    (fc, c), _ = solve(2.0 / 3.0)
+    alphas = np.linspace(0.2, 2.0, 1801)
+    chi = np.array([solve(a)[1] for a in alphas])
+    best = int(np.argmin(chi))
+    inside = alphas[chi <= chi[best] + 1.0]
+    return float(fc), float(c), float(alphas[best]), float(0.5 * (inside.max() - inside.min()))
+
+
+def friction_temperature(rows):
+    """The mean friction against the temperature with error bars (one
+    standard error) and the law F_c - C T^(2/3) fitted below 300 K
+    (temperature_fit).  rows: dicts with temperature (K), friction and sem
+    (nN), as scripts/thermal_temperature.py gives."""
+    fig = _figure(figsize=(6.4, 4.4))
+    ax = fig.add_subplot()
+    pts = sorted((r["temperature"], r["friction"], r["sem"]) for r in rows)
+    t, f, e = map(np.array, zip(*pts))
+    ax.errorbar(t, f, yerr=e, marker="o", color="tab:blue", linestyle="none", capsize=3,
+                label="reduced model (0 K: quasistatic tip)")
+    fc, c, alpha, alpha_se = temperature_fit(rows)
+    grid = np.linspace(0.0, t.max(), 300)
+    law = fc - c * grid ** (2.0 / 3.0)
+    ax.plot(grid[law > 0], law[law > 0], color="tab:orange", linewidth=1,
+            label=f"$F_c - C\\,T^{{2/3}}$ fitted below 300 K: $F_c$ = {fc:.3f} nN "
+                  f"(free exponent {alpha:.2f} ± {alpha_se:.2f})")
+    ax.axhline(0.0, color="grey", linewidth=0.5)
+    ax.set_xlabel("temperature (K)")
+    ax.set_ylabel("mean friction (nN)")
+    ax.set_title("NaF, 0.1 Å/s: friction against temperature", fontsize="medium")
+    ax.legend(fontsize="small")
+    fig.tight_layout()
     return fig

@@ -11,7 +11,7 @@ module friction_afm_config
    use friction_surface_net, only: crystal_net, graphite_net, square_net, read_xyz, max_local_density, sort_order
    use friction_surface_lennard_jones, only: new_lj_potential, cutoff_for_tolerance
    use friction_kinds, only: ev_per_angstrom_to_nn
-   use friction_afm_tip, only: afm_tip, model_inertial, model_overdamped, model_quasistatic
+   use friction_afm_tip, only: afm_tip, model_inertial, model_overdamped, model_quasistatic, find_height
    use friction_strings, only: itoa, rtoa, quoted, bytes_text
    use friction_files, only: file_exists
    use friction_parameters, only: configurable, parameter_visitor
@@ -20,6 +20,7 @@ module friction_afm_config
    use friction_afm_thermal, only: thermal_settings
    use friction_afm_langevin, only: langevin_time_step, largest_curvature
    use friction_ode_auto, only: oscillator_rate
+   use friction_afm_kramers, only: kmc_barrier_floor
    implicit none
    private
 
@@ -209,9 +210,9 @@ contains
                & //"or 'overdamped' (with &thermal model = 'kramers' they choose the escape rate's prefactor)")
             return
          end if
-         if (self%potential == 'lj') then
-            call c%reject('thermal', 'temperature', rtoa(self%thermal%temperature), "is not available yet for " &
-               & //"potential = 'lj' (the lattice-sum surface): use 'naf' or 'hopg', or temperature = 0")
+         if (self%potential == 'lj' .and. self%thermal%model == 'kramers') then
+            call c%reject('thermal', 'model', "'kramers'", "is not available for potential = 'lj' (the " &
+               & //"lattice-sum surface, a tip moving in 3D): use model = 'langevin'")
             return
          end if
          ! Fluctuation-dissipation: the bath that heats an axis is its damper.
@@ -219,6 +220,9 @@ contains
             & ': the heat bath acts through the damper (fluctuation-dissipation), an undamped axis has none')
          if (.not. (self%cy > 0.0_wp)) call c%reject('tip', 'cy', rtoa(self%cy), 'must be > 0 (N s/m)'//at// &
             & ': the heat bath acts through the damper (fluctuation-dissipation), an undamped axis has none')
+         if (self%potential == 'lj' .and. .not. (self%cz > 0.0_wp)) call c%reject('tip', 'cz', rtoa(self%cz), &
+            & 'must be > 0 (N s/m)'//at//': the heat bath acts through the damper (fluctuation-dissipation), ' &
+            & //'an undamped axis has none')
          if (.not. c%failed() .and. self%thermal%model == 'kramers') call check_kramers()
          if (c%failed() .or. self%thermal%time_step == 0.0_wp) return
          limit = thermal_step_limit(self)
@@ -231,22 +235,28 @@ contains
       !> spatial-diffusion regime needs the damping not weak.  Below
       !> gamma = c/m ~ omega k_B T/Delta E the escape is limited by energy
       !> diffusion (Mel'nikov-Meshkov) and the rate is too high; the model
-      !> jumps deterministically below 3 k_B T, so gamma >= omega/3 (omega
-      !> = sqrt(k/m) of either lateral spring) keeps every rate it uses in
-      !> the regime it holds in.
+      !> jumps deterministically below kmc_barrier_floor k_B T (1), so gamma
+      !> >= omega/kmc_barrier_floor keeps every rate it uses in the regime
+      !> it holds in.  omega = sqrt(k/m) with the spring along the scan, the
+      !> direction the jumps go (a stiff spring across it, which keeps the
+      !> tip on a row, does not take part in them).
       subroutine check_kramers()
-         real(wp) :: omega
+         real(wp) :: omega, least, theta
+         character(len=:), allocatable :: why
 
          if (self%model /= 'inertial') return
-         omega = sqrt(max(self%kx, self%ky) / self%mass)
-         if (self%cx / self%mass < omega / 3.0_wp) call c%reject('tip', 'cx', rtoa(self%cx), 'is too weak ' &
-            & //"a damping for &thermal model = 'kramers' (c/m = "//rtoa(self%cx / self%mass)//' /s below ' &
-            & //'omega/3 = '//rtoa(omega / 3.0_wp)//" /s: escape is then limited by energy diffusion, where " &
-            & //"Kramers' rate does not hold); use model = 'langevin'")
-         if (self%cy / self%mass < omega / 3.0_wp) call c%reject('tip', 'cy', rtoa(self%cy), 'is too weak ' &
-            & //"a damping for &thermal model = 'kramers' (c/m = "//rtoa(self%cy / self%mass)//' /s below ' &
-            & //'omega/3 = '//rtoa(omega / 3.0_wp)//" /s: escape is then limited by energy diffusion, where " &
-            & //"Kramers' rate does not hold); use model = 'langevin'")
+         theta = self%angle * pi / 180.0_wp
+         omega = sqrt((self%kx * cos(theta)**2 + self%ky * sin(theta)**2) / self%mass)
+         least = omega / kmc_barrier_floor
+         why = "a damping for &thermal model = 'kramers' (c/m = "
+         if (self%cx / self%mass < least) call c%reject('tip', 'cx', rtoa(self%cx), 'is too weak '//why &
+            & //rtoa(self%cx / self%mass)//' /s below omega = '//rtoa(least)//" /s, with the spring along " &
+            & //"the scan: escape is then limited by energy diffusion, where Kramers' rate does not hold); " &
+            & //"use model = 'langevin'")
+         if (self%cy / self%mass < least) call c%reject('tip', 'cy', rtoa(self%cy), 'is too weak '//why &
+            & //rtoa(self%cy / self%mass)//' /s below omega = '//rtoa(least)//" /s, with the spring along " &
+            & //"the scan: escape is then limited by energy diffusion, where Kramers' rate does not hold); " &
+            & //"use model = 'langevin'")
       end subroutine check_kramers
 
       !> The overdamped model divides by the damping of every moving direction.
@@ -468,18 +478,40 @@ contains
 
    !> The largest curvature of the surface (eV/Å², >= 0) over one lattice
    !> cell, the Langevin step's scale (friction_afm_langevin): NaF over
-   !> ax × ay, HOPG over the rectangular cell a × a√3, on 32² points; 0 for
-   !> other surfaces.
+   !> ax × ay, HOPG over the rectangular cell a × a√3, on 32² points; for a
+   !> lattice sum (3D, its largest Hessian eigenvalue) over the scan's
+   !> bounding box in the plane and from the loaded tip's rest height above
+   !> the origin down 0.2 Å (three thermal spreads sqrt(k_B T/k_zz) at 300 K
+   !> on graphite: the wall is what is stiff), on 12³ points; 0 when that
+   !> height cannot be found (the run reports why).
    function surface_curvature(config, potential) result(curvature)
       type(afm_config), intent(in) :: config
       class(surface_potential), intent(in) :: potential
       real(wp) :: curvature
+      type(afm_tip) :: tip
+      type(error_type), allocatable :: error
+      real(wp) :: origin(3), corners(3, 4), contact, rest
+      integer :: k
 
       select case (trim(config%potential))
       case ('naf')
          curvature = largest_curvature(potential, [0.0_wp, 0.0_wp], [config%ax, config%ay], 32)
       case ('hopg')
          curvature = largest_curvature(potential, [0.0_wp, 0.0_wp], [config%a, sqrt(3.0_wp) * config%a], 32)
+      case ('lj')
+         curvature = 0.0_wp
+         origin = [config%origin_x, config%origin_y, 0.0_wp]
+         call new_tip(config, potential, tip)
+         call find_height(tip, origin, 0.0_wp, contact, error)
+         if (.not. allocated(error)) call find_height(tip, [origin(1), origin(2), contact + config%support_z], &
+            & tip%spring(3), rest, error)
+         if (allocated(error)) return
+         do k = 1, 4
+            corners(:, k) = origin + merge(config%length, 0.0_wp, k == 2 .or. k == 4) * config%scan_direction() &
+               & + merge(config%width, 0.0_wp, k >= 3) * config%across_direction()
+         end do
+         curvature = max(largest_curvature(potential, [minval(corners(1, :)), minval(corners(2, :)), &
+            & rest - 0.2_wp], [maxval(corners(1, :)), maxval(corners(2, :)), rest], 12), 0.0_wp)
       case default
          curvature = 0.0_wp
       end select

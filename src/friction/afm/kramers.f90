@@ -54,6 +54,7 @@ module friction_afm_kramers
    use friction_error, only: error_type, fatal_error, error_input, error_numerical
    use friction_strings, only: rtoa, itoa
    use friction_symmetric, only: symmetric_eigen, determinant
+   use friction_special, only: expm1, log1p
    use friction_afm_tip, only: afm_tip, model_inertial, model_overdamped
    use friction_afm_langevin, only: boltzmann
    implicit none
@@ -62,7 +63,7 @@ module friction_afm_kramers
    public :: landscape_energy, landscape_gradient, landscape_hessian
    public :: find_minimum, find_saddle, unstable_growth_rate, langer_rate, jump_landing
    public :: hazard_path, hazard_start, hazard_advance
-   public :: hazard_running, hazard_jumped, hazard_low_barrier
+   public :: hazard_running, hazard_jumped, hazard_low_barrier, kmc_barrier_floor
 
    !> hazard_advance's outcomes
    integer, parameter :: hazard_running = 0      !! t_end reached, no jump yet
@@ -80,6 +81,16 @@ module friction_afm_kramers
    !> Default largest change of ln r per path step, and barrier floor in k_B T.
    real(wp), parameter :: default_log_change = 0.1_wp, default_floor = 3.0_wp
    integer, parameter :: max_iterations = 500
+   !> The barrier, in k_B T, below which the reduced model of the scan
+   !> (friction_afm_scan) fires an exit at once.  Near the fold where the
+   !> jumps come the barrier is cubic, and there the escape rate of a well
+   !> in equilibrium (the lowest eigenvalue of the Smoluchowski operator,
+   !> absorbing past the saddle) is Kramers' within 10 % down to 1 k_B T:
+   !> 0.91 to 0.96 of it from 1.5 to 7 k_B T, 1.04 at 1 k_B T, 1.28 at
+   !> 0.5 (docs/physics.md).  A 10 % rate error moves a jump by 0.1 k_B T
+   !> of barrier.  Below 1 k_B T escape is no longer slow against the
+   !> well's relaxation, and a rate stops describing it.
+   real(wp), parameter :: kmc_barrier_floor = 1.0_wp
 
    !> A KMC path: the tip's minimum and the saddle ahead of it at support
    !> time t, the rate there, and the hazard accumulated since the start.
@@ -703,29 +714,6 @@ contains
       end do
       t_event = path%t
    end subroutine hazard_advance
-
-   !> exp(x) - 1 and log(1 + x) without cancellation for small x.
-   elemental function expm1(x) result(y)
-      real(wp), intent(in) :: x
-      real(wp) :: y
-
-      if (abs(x) < 1.0e-3_wp) then
-         y = x * (1.0_wp + x / 2.0_wp * (1.0_wp + x / 3.0_wp * (1.0_wp + x / 4.0_wp * (1.0_wp + x / 5.0_wp))))
-      else
-         y = exp(x) - 1.0_wp
-      end if
-   end function expm1
-
-   elemental function log1p(x) result(y)
-      real(wp), intent(in) :: x
-      real(wp) :: y
-
-      if (abs(x) < 1.0e-3_wp) then
-         y = x * (1.0_wp - x * (1.0_wp / 2.0_wp - x * (1.0_wp / 3.0_wp - x * (1.0_wp / 4.0_wp - x / 5.0_wp))))
-      else
-         y = log(1.0_wp + x)
-      end if
-   end function log1p
 
    pure function vector_text(x) result(text)
       real(wp), intent(in) :: x(:)

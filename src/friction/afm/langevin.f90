@@ -66,6 +66,7 @@ module friction_afm_langevin
    use friction_error, only: error_type, fatal_error, error_input, error_numerical
    use friction_strings, only: rtoa, itoa
    use friction_random, only: random_stream
+   use friction_special, only: expm1
    use friction_symmetric, only: symmetric_eigen
    use friction_surface_potential, only: surface_potential
    use friction_afm_tip, only: afm_tip, model_inertial, model_overdamped
@@ -395,18 +396,6 @@ contains
             & ' s too large for the landscape, or an uninitialised random stream)', error_numerical)
       end if
    end subroutine advance
-
-   !> exp(x) - 1 without cancellation for small x.
-   elemental function expm1(x) result(y)
-      real(wp), intent(in) :: x
-      real(wp) :: y
-
-      if (abs(x) < 1.0e-3_wp) then
-         y = x * (1.0_wp + x / 2.0_wp * (1.0_wp + x / 3.0_wp * (1.0_wp + x / 4.0_wp * (1.0_wp + x / 5.0_wp))))
-      else
-         y = exp(x) - 1.0_wp
-      end if
-   end function expm1
 
    !> The default step and the stability limit for tip, given the largest
    !> curvature of V (eV/Å², >= 0; see largest_curvature).  With

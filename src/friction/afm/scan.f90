@@ -41,11 +41,11 @@ module friction_afm_scan
    use friction_error, only: error_type, fatal_error, error_input, error_numerical
    use friction_ode_solver, only: ode_solver, integrator_statistics
    use friction_afm_config, only: afm_config, new_tip, surface_curvature
-   use friction_afm_tip, only: afm_tip, model_inertial, model_quasistatic
+   use friction_afm_tip, only: afm_tip, model_inertial, model_quasistatic, find_height
    use friction_afm_thermal, only: welford_add, welford_sem
    use friction_afm_langevin, only: langevin_integrator, langevin_state, langevin_time_step, boltzmann
    use friction_afm_kramers, only: find_minimum, hazard_path, hazard_start, hazard_advance, jump_landing, &
-      & hazard_running, hazard_low_barrier
+      & hazard_running, hazard_low_barrier, kmc_barrier_floor
    use friction_random, only: random_stream
    use friction_afm_quasistatic, only: newton_equilibrium, equilibrium_tangent
    use friction_surface_potential, only: surface_potential
@@ -93,11 +93,11 @@ module friction_afm_scan
    !> turned by ±exit_angle, rad: 40°, between the motion and the diagonal
    !> saddles of a square lattice); the support travel between two searches, Å (a tenth of
    !> NaF's shortest well spacing); the barrier, in k_B T, below which an
-   !> exit fires at once (Kramers' rate holds for barriers of several
-   !> k_B T, its corrections O(k_B T/ΔE)).
+   !> exit fires at once: friction_afm_kramers' kmc_barrier_floor (1 k_B T,
+   !> down to which the Kramers rate of a cubic barrier holds within 10 %).
    integer, parameter :: n_exits = 6
    real(wp), parameter :: exit_angle = 40.0_wp * pi / 180.0_wp, search_distance = 0.1_wp
-   real(wp), parameter :: barrier_floor = 3.0_wp
+   real(wp), parameter :: barrier_floor = kmc_barrier_floor
 
    !> One trip's samples: values(i, q) for sample i and quantity q (output units).
    type :: trip_record
@@ -154,11 +154,13 @@ module friction_afm_scan
       procedure :: run_trip
       procedure :: run_thermal_trip
       procedure :: run_kramers_trip
+      procedure :: kramers_escape_hazards
       procedure :: run_line
       procedure :: time_step
       procedure :: statistics
       procedure, private :: follow
       procedure, private :: start_thermal_trip
+      procedure, private :: start_height
       procedure, private :: relax
    end type afm_scanner
 
@@ -386,8 +388,16 @@ contains
       if (allocated(error)) return
       associate (c => self%config, tip => self%tip)
          nx = c%nx
-         ! At the support, with a thermal velocity (inertial tip).
+         ! At the support (in z at its static equilibrium under the load),
+         ! with a thermal velocity (inertial tip).
          u0 = 0.0_wp
+         if (tip%ndim == 3) then
+            call self%start_height(j, u0(3), error)
+            if (allocated(error)) then
+               call self%stream%free()
+               return
+            end if
+         end if
          t = 0.0_wp
          if (self%lead_steps > 0) then
             call self%lead_langevin%start(self%stream, 0.0_wp, u0, state)
@@ -441,6 +451,17 @@ contains
             end if
             force = tip%lateral_force(state%u) * ev_per_angstrom_to_nn
             tip_r = tip%tip_position(t, state%u)
+            if (nd == 3) then
+               call check_above_net(tip, tip_r, 'the tip went below the layer of atoms at (' &
+                  & //rtoa(tip_r(1))//', '//rtoa(tip_r(2))//', '//rtoa(tip_r(3))//') Å (line '//itoa(j) &
+                  & //trim(merge(' trace  ', ' retrace', forward))//', realization '//itoa(realization) &
+                  & //'): off the edge of the net, or pressed through it by the load; scan over the net, or ' &
+                  & //'raise support_z', error)
+               if (allocated(error)) then
+                  call self%stream%free()
+                  return
+               end if
+            end if
             record%values(i, q_fx) = force(1)
             record%values(i, q_fy) = force(2)
             record%values(i, q_f_along) = dot_product(force, along)
@@ -485,6 +506,30 @@ contains
       end subroutine check_slips
 
    end subroutine run_thermal_trip
+
+   !> The tip's start in z (3D tip) on line j, the support's path set: the
+   !> support at its height, the tip at its static equilibrium under it;
+   !> returns u_z = z - z_M.  An error when the load presses the tip into
+   !> the layer of atoms.
+   subroutine start_height(self, j, u_z, error)
+      class(afm_scanner), intent(inout) :: self
+      integer, intent(in) :: j
+      real(wp), intent(out) :: u_z
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: z_start
+
+      associate (c => self%config, tip => self%tip)
+         u_z = 0.0_wp
+         tip%support_start(3) = self%support_height
+         call find_height(tip, tip%support_start, tip%spring(3), z_start, error)
+         if (allocated(error)) return
+         call check_above_net(tip, [tip%support_start(1:2), z_start], 'at the start of line '//itoa(j) &
+            & //' the load presses the tip into the layer of atoms (support_z = '//rtoa(c%support_z) &
+            & //' Å from the contact height, kz = '//rtoa(c%kz)//' N/m): raise support_z', error)
+         if (allocated(error)) return
+         u_z = z_start - self%support_height
+      end associate
+   end subroutine start_height
 
    !> What a trip at a temperature starts with: the support at the start of
    !> line j (0-based), moving forward (trace) or back, the trip's record,
@@ -549,20 +594,24 @@ contains
    !> the force -k u_min is the mean over the well's thermal spread up to
    !> O(k_B T) anharmonic terms.  Slips: every jump, with the support where
    !> it happened, the force before it and the move of the minimum.
-   subroutine run_kramers_trip(self, j, forward, realization, record, error, slips)
+   subroutine run_kramers_trip(self, j, forward, realization, record, error, slips, jump_hazards)
       class(afm_scanner), intent(inout) :: self
       integer, intent(in) :: j, realization
       logical, intent(in) :: forward
       type(trip_record), intent(inout) :: record
       type(error_type), allocatable, intent(out) :: error
       type(slip_list), intent(inout), optional :: slips
+      !> A probe (see kramers_escape_hazards): no clock fires, every jump
+      !> comes at the floor or a fold, and for each the hazard ∫ r dt all
+      !> exits accumulated since the previous jump is listed here.
+      real(wp), allocatable, intent(out), optional :: jump_hazards(:)
       !> Searches allowed between two samples before the trip is reported
       !> as stuck.
       integer, parameter :: max_searches = 100000
       type(hazard_path) :: paths(n_exits)
       real(wp) :: along(3), across(3), s_start, force(3), tip_r(3), t_sample, targets(n_exits), motion(3)
-      real(wp) :: u_cur(3), u_next(3), t_cur, t_end, temperature, t_event, t_first
-      logical :: active(n_exits), need_search
+      real(wp) :: u_cur(3), u_next(3), t_cur, t_end, temperature, t_event, t_first, carried
+      logical :: active(n_exits), need_search, probing
       integer(i8) :: now
       integer :: i, k, nx, nd, status, searches, p, first
 
@@ -579,6 +628,9 @@ contains
          t_cur = 0.0_wp
          call find_minimum(tip, t_cur, u_next(1:nd), u_cur(1:nd), error)
          need_search = .true.
+         probing = present(jump_hazards)
+         carried = 0.0_wp
+         if (probing) allocate (jump_hazards(0))
          do k = 1, nx
             i = merge(k, nx + 1 - k, forward)
             t_sample = abs(support_at(c, i - 1) - s_start) / c%velocity
@@ -620,9 +672,11 @@ contains
                end do
                if (allocated(error)) exit
                if (first > 0) then
+                  if (probing) call note_jump(sum(paths%hazard, mask=active))
                   call jump(paths(first), t_first)
                   need_search = .true.
                else if (first < 0) then
+                  if (probing) carried = carried + sum(paths%hazard, mask=active)
                   t_cur = paths(-first)%t
                   u_cur = paths(-first)%u_min
                   need_search = .true.
@@ -696,6 +750,7 @@ contains
             end do
             do q = 1, found
                targets(q) = self%stream%exponential()
+               if (probing) targets(q) = huge(1.0_wp)
             end do
          end associate
       end subroutine start_exits
@@ -706,11 +761,22 @@ contains
          associate (tip => self%tip)
             call find_minimum(tip, t_end, u_cur(1:nd), u_next(1:nd), error)
             if (allocated(error)) return
-            if (norm2(u_next(1:nd) - u_cur(1:nd)) > slip_distance) call add_slip(t_end, u_cur, u_next)
+            if (norm2(u_next(1:nd) - u_cur(1:nd)) > slip_distance) then
+               call add_slip(t_end, u_cur, u_next)
+               if (probing) call note_jump(0.0_wp)
+            end if
             u_cur = u_next
             t_cur = t_end
          end associate
       end subroutine follow_minimum
+
+      !> A probe's jump after `hazard` on the exits since the last search.
+      subroutine note_jump(hazard)
+         real(wp), intent(in) :: hazard
+
+         jump_hazards = [jump_hazards, carried + hazard]
+         carried = 0.0_wp
+      end subroutine note_jump
 
       !> The jump at support time te from the path's minimum over its saddle.
       subroutine jump(path, te)
@@ -739,6 +805,22 @@ contains
       end subroutine add_slip
 
    end subroutine run_kramers_trip
+
+   !> Where the thermal reduced model holds (friction_afm_validity): line
+   !> 0's trace with clocks that never fire, so that every jump comes where
+   !> an exit's barrier reaches the floor (or at a fold).  For each jump,
+   !> the hazard H = ∫ Σ r dt its exits accumulated before it: at this
+   !> velocity the model forces that jump at the floor with probability
+   !> exp(-H) (no clock fired before), and H scales as 1/v (the path of the
+   !> minimum and the saddles does not depend on v).
+   subroutine kramers_escape_hazards(self, hazards, error)
+      class(afm_scanner), intent(inout) :: self
+      real(wp), allocatable, intent(out) :: hazards(:)
+      type(error_type), allocatable, intent(out) :: error
+      type(trip_record) :: record
+
+      call self%run_kramers_trip(0, .true., 0, record, error, jump_hazards=hazards)
+   end subroutine kramers_escape_hazards
 
    subroutine slips_clear(self)
       class(slip_list), intent(inout) :: self
@@ -796,7 +878,7 @@ contains
       type(trip_record), intent(inout) :: record
       type(error_type), allocatable, intent(out) :: error
       real(wp) :: along(3), across(3), line_start(3)
-      real(wp) :: y(6), t, t_sample, s_start, force(3), tip_r(3), z_start
+      real(wp) :: y(6), t, t_sample, s_start, force(3), tip_r(3), u_z
       integer(i8) :: now
       integer :: i, k, nx, nd, jumps
       character(len=96) :: where
@@ -819,14 +901,9 @@ contains
          ! static equilibrium under the support (paper §3.1: z differs).
          y = 0.0_wp
          if (nd == 3) then
-            tip%support_start(3) = self%support_height
-            call find_height(tip, tip%support_start, tip%spring(3), z_start, error)
+            call self%start_height(j, u_z, error)
             if (allocated(error)) return
-            call check_above_net(tip, [tip%support_start(1:2), z_start], 'at the start of line '//itoa(j) &
-               & //' the load presses the tip into the layer of atoms (support_z = '//rtoa(c%support_z) &
-               & //' Å from the contact height, kz = '//rtoa(c%kz)//' N/m): raise support_z', error)
-            if (allocated(error)) return
-            y(3) = z_start - self%support_height
+            y(3) = u_z
          end if
          t = 0.0_wp
          jumps = 0
@@ -923,54 +1000,6 @@ contains
          & error_input)
    end subroutine allocate_trip
 
-   !> The height z at which the tip above (x, y) = at(1:2) is in equilibrium
-   !> between the surface and a z spring of constant `spring` (eV/Å²) held
-   !> at z_M = at(3): the root of g(z) = spring (z - z_M) + dV/dz.  Searched
-   !> downward from 20 Å above the support or the contact, so it is the
-   !> equilibrium a tip brought in from above reaches; refined by bisection
-   !> to 1e-12 Å.  spring = 0 gives the free tip's contact height.
-   subroutine find_height(tip, at, spring, z, error)
-      type(afm_tip), intent(in) :: tip
-      real(wp), intent(in) :: at(3), spring
-      real(wp), intent(out) :: z
-      type(error_type), allocatable, intent(out) :: error
-      real(wp) :: upper, lower, middle
-      integer :: k
-
-      upper = max(at(3), 0.0_wp) + 20.0_wp
-      lower = upper
-      do k = 1, 4000
-         lower = upper - 0.05_wp
-         if (force_balance(lower) < 0.0_wp) exit
-         upper = lower
-      end do
-      if (force_balance(lower) >= 0.0_wp) then
-         call fatal_error(error, 'no contact height found: the tip is not repelled anywhere above (' &
-            & //rtoa(at(1))//', '//rtoa(at(2))//') Å; is the scan over the net?', error_input)
-         return
-      end if
-      do k = 1, 200
-         middle = 0.5_wp * (lower + upper)
-         if (upper - lower < 1.0e-12_wp) exit
-         if (force_balance(middle) < 0.0_wp) then
-            lower = middle
-         else
-            upper = middle
-         end if
-      end do
-      z = 0.5_wp * (lower + upper)
-
-   contains
-
-      real(wp) function force_balance(height)
-         real(wp), intent(in) :: height
-         real(wp) :: g(3)
-
-         call tip%potential%gradient([at(1), at(2), height], g)
-         force_balance = spring * (height - at(3)) + g(3)
-      end function force_balance
-
-   end subroutine find_height
 
    !> The quasistatic tip from support time t to t1 (the next sample), u its
    !> displacement from the support (ndim components), jumps counted.

@@ -468,8 +468,13 @@ contains
          thermal%time_step = self%time_step
          thermal%scheme = self%scheme
          thermal%slips = self%slips
-         call write_afm_file(path, job%comm, self%ran, self%first, job%nranks, self%trace, self%retrace, &
-            & self%record, error, thermal=thermal)
+         if (self%three_d) then
+            call write_afm_file(path, job%comm, self%ran, self%first, job%nranks, self%trace, self%retrace, &
+               & self%record, error, self%surface, thermal=thermal)
+         else
+            call write_afm_file(path, job%comm, self%ran, self%first, job%nranks, self%trace, self%retrace, &
+               & self%record, error, thermal=thermal)
+         end if
       else if (self%three_d) then
          call write_afm_file(path, job%comm, self%ran, self%first, job%nranks, self%trace, self%retrace, &
             & self%record, error, self%surface)

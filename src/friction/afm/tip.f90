@@ -14,12 +14,14 @@
 !> into a new minimum after a jump.
 module friction_afm_tip
    use friction_kinds, only: wp
+   use friction_error, only: error_type, fatal_error, error_input
+   use friction_strings, only: rtoa
    use friction_ode_system, only: ode_system
    use friction_surface_potential, only: surface_potential
    implicit none
    private
 
-   public :: afm_tip, model_inertial, model_overdamped, model_quasistatic
+   public :: afm_tip, model_inertial, model_overdamped, model_quasistatic, find_height
 
    integer, parameter :: model_inertial = 1, model_overdamped = 2, model_quasistatic = 3
 
@@ -146,5 +148,55 @@ contains
          dfdt(nd + i) = -dot_product(h(i, 1:nd), self%support_velocity(1:nd)) / self%mass
       end do
    end subroutine jacobian
+
+
+   !> The height z at which the tip above (x, y) = at(1:2) is in equilibrium
+   !> between the surface and a z spring of constant `spring` (eV/Å²) held
+   !> at z_M = at(3): the root of g(z) = spring (z - z_M) + dV/dz.  Searched
+   !> downward from 20 Å above the support or the contact, so it is the
+   !> equilibrium a tip brought in from above reaches; refined by bisection
+   !> to 1e-12 Å.  spring = 0 gives the free tip's contact height.
+   subroutine find_height(tip, at, spring, z, error)
+      type(afm_tip), intent(in) :: tip
+      real(wp), intent(in) :: at(3), spring
+      real(wp), intent(out) :: z
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: upper, lower, middle
+      integer :: k
+
+      upper = max(at(3), 0.0_wp) + 20.0_wp
+      lower = upper
+      do k = 1, 4000
+         lower = upper - 0.05_wp
+         if (force_balance(lower) < 0.0_wp) exit
+         upper = lower
+      end do
+      if (force_balance(lower) >= 0.0_wp) then
+         call fatal_error(error, 'no contact height found: the tip is not repelled anywhere above (' &
+            & //rtoa(at(1))//', '//rtoa(at(2))//') Å; is the scan over the net?', error_input)
+         return
+      end if
+      do k = 1, 200
+         middle = 0.5_wp * (lower + upper)
+         if (upper - lower < 1.0e-12_wp) exit
+         if (force_balance(middle) < 0.0_wp) then
+            lower = middle
+         else
+            upper = middle
+         end if
+      end do
+      z = 0.5_wp * (lower + upper)
+
+   contains
+
+      real(wp) function force_balance(height)
+         real(wp), intent(in) :: height
+         real(wp) :: g(3)
+
+         call tip%potential%gradient([at(1), at(2), height], g)
+         force_balance = spring * (height - at(3)) + g(3)
+      end function force_balance
+
+   end subroutine find_height
 
 end module friction_afm_tip
