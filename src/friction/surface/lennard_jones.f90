@@ -1052,7 +1052,7 @@ contains
       do j = 1, n2
          do i = 1, n1
             if (symmetric) then
-               if (image_index(i, j) < column_index(i, j)) cycle
+               if (mirror_column(i, j) < column_index(i, j)) cycle
             end if
             dealt = dealt + 1
             if (mod(dealt - 1, share%ranks) /= share%rank) cycle
@@ -1064,7 +1064,7 @@ contains
       if (symmetric) then
          do j = 1, n2
             do i = 1, n1
-               if (image_index(i, j) >= column_index(i, j)) cycle
+               if (mirror_column(i, j) >= column_index(i, j)) cycle
                mi = mod(n1 - (i - 1), n1) + 1
                mj = mod(n2 - (j - 1), n2) + 1
                do v = 1, n_node_values
@@ -1085,11 +1085,11 @@ contains
       end function column_index
 
       !> The column index of the image of column (i, j) under s -> -s.
-      integer function image_index(i, j)
+      integer function mirror_column(i, j)
          integer, intent(in) :: i, j
 
-         image_index = column_index(mod(n1 - (i - 1), n1) + 1, mod(n2 - (j - 1), n2) + 1)
-      end function image_index
+         mirror_column = column_index(mod(n1 - (i - 1), n1) + 1, mod(n2 - (j - 1), n2) + 1)
+      end function mirror_column
 
    end subroutine fill_grid
 
