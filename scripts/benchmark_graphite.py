@@ -33,10 +33,27 @@ Measures and prints (this is not a test; nothing fails on a missed target):
       kz and load): the tip follows the support smoothly, the floor is far
       below the tolerance, and |dF| is the cutoff's own error.
 
+   Parts 1 and 2 measure the direct sum (&surface evaluation = 'direct').
+
+3. The surface table against the direct sum (&surface evaluation = 'table',
+   the default, against 'direct'; docs/physics.md, The tabulated surface):
+   a) speed: the paper's whole 24 x 128 case (inputs/graphite.nml, trace and
+      retrace) on --ranks ranks (default 2), median of --repeats runs each:
+      the file's wall_time (target: the table at least 20x faster), rhs
+      evaluations and time per evaluation (wall x ranks / rhs); the table's
+      build time (the summary line on stderr: the file leaves timings out),
+      its memory (/surface table_bytes), nodes and layers;
+   b) force error against the direct sum (target: at most 1e-4 nN): the
+      largest |F_table - F_direct| the table found at its 4096 check points
+      (/surface table_error), and on part 2's smooth-tip scan at rtol = atol
+      = 1e-10 (floor: the same at 1e-11) the largest |dF| between the two
+      maps; the paper's undamped tip is chaotic (part 2a), so its maps
+      differ by where the slips fall, printed for completeness.
+
 Usage (from anywhere; normally through scripts/benchmark_graphite, which builds first):
 
     python3 scripts/benchmark_graphite.py [--repeats N] [--quick] [--json FILE]
-                                          [--binary PATH] [--keep]
+                                          [--binary PATH] [--mpirun CMD] [--ranks N] [--keep]
 """
 
 from __future__ import annotations
@@ -45,6 +62,9 @@ import argparse
 import json
 import os
 import platform
+import re
+import resource
+import shlex
 import shutil
 import statistics
 import subprocess
@@ -77,6 +97,13 @@ DEFAULT_CUTOFF = f"&surface cutoff = 0.0, cutoff_tolerance = {CUTOFF_TOLERANCE:g
 FULL_CUTOFF = "&surface cutoff = 1000.0 /"
 SMOOTH_TIP = "&tip kx = 10.0, ky = 10.0, cx = 6.0e-3, cy = 6.0e-3, cz = 1.0e-3 /"
 FORCES = ("fx", "fy", "fz")
+DIRECT = "&surface evaluation = 'direct' /"
+TABLE = "&surface evaluation = 'table' /"
+TABLE_TARGET_SPEEDUP, TABLE_TARGET_ERROR = 20.0, 1e-4  # the issue's target: x, nN
+TABLE_ATTRS = ("table_tolerance", "table_error", "table_points", "table_bytes", "table_nodes",
+               "table_layers", "table_spacing", "table_floor", "table_energy_window", "table_differences")
+# "... s on N ranks; surface table 7.3 MB, built in 0.24 s)": the summary line on stderr
+BUILT = re.compile(r"surface table ([0-9.]+ [kMG]?B), built in ([0-9.]+) s")
 
 
 def log(msg: str) -> None:
@@ -136,6 +163,49 @@ class Friction(benchmark_afm.Friction):
                        atoms=int(atoms.shape[0]), cutoff=cutoff, near=near)
 
 
+@dataclass
+class MapRun:
+    """A whole map on some ranks: the file's timings and counts, the
+    /surface attributes, and the table's build time from the summary line."""
+
+    path: Path
+    wall: float  # root attribute wall_time, s
+    process: float  # the whole mpirun command, s
+    cpu: float  # CPU time of the command and its ranks (user + system), s
+    rhs: int
+    steps: int
+    evaluation: str
+    table: dict  # /surface table_* attributes (empty for the direct sum)
+    build: float | None  # s, from stderr; None without a table
+
+
+def run_map(fr: "Friction", launcher: list[str], ranks: int, overrides: list[Path]) -> MapRun:
+    """friction on `ranks` ranks without --quiet (the summary line carries the
+    table's build time); RuntimeError on failure."""
+    fr._count += 1
+    out = fr.workdir / f"map{fr._count:04d}.h5"
+    launch = launcher + ["-n", str(ranks)] if launcher else []
+    cmd = launch + [str(fr.binary), "--force", "-o", str(out), str(fr.inputs / CASE)] + [str(p) for p in overrides]
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    t0 = time.perf_counter()
+    proc = subprocess.run(cmd, env=fr.env, cwd=fr.workdir, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                          text=True)
+    elapsed = time.perf_counter() - t0
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    if proc.returncode != 0:
+        raise RuntimeError(f"friction failed with exit code {proc.returncode}: {shlex.join(cmd)}\n"
+                           f"{proc.stdout}{proc.stderr}")
+    built = BUILT.search(proc.stderr)
+    with h5py.File(out, "r") as f:
+        a, surf = f.attrs, f["surface"].attrs
+        evaluation = surf["evaluation"].decode()
+        table = {k: (surf[k].item() if hasattr(surf[k], "item") else surf[k]) for k in TABLE_ATTRS if k in surf}
+        return MapRun(path=out, wall=float(a["wall_time"]), process=elapsed, cpu=cpu, rhs=int(a["rhs_evaluations"]),
+                      steps=int(a["integrator_steps"]), evaluation=evaluation, table=table,
+                      build=float(built.group(2)) if built else None)
+
+
 def max_force_difference(a: Path, b: Path) -> float:
     worst = 0.0
     with h5py.File(a, "r") as fa, h5py.File(b, "r") as fb:
@@ -164,8 +234,11 @@ class Benchmark:
         self.fr = fr
         self.scan = fr.override("scan", QUICK_SCAN if args.quick else SCAN)
         self.setup_scan = fr.override("setup_scan", SETUP_SCAN)
+        self.direct = fr.override("direct", DIRECT)
+        self.table_override = fr.override("table", TABLE)
         self.sizes: list[dict] = []
         self.cutoff: list[dict] = []
+        self.table: dict = {}
 
     def flake(self, shells: int) -> Path:
         return self.fr.override(f"shells{shells}", f"&surface shells = {shells} /")
@@ -177,10 +250,10 @@ class Benchmark:
             setups, runs = [], []
             for i in range(reps):
                 log(f"flake shells = {shells}: set-up run {i + 1}/{reps}")
-                setups.append(self.fr.run([flake, self.setup_scan]))
+                setups.append(self.fr.run([flake, self.direct, self.setup_scan]))
             for i in range(reps):
                 log(f"flake shells = {shells}: scan run {i + 1}/{reps}")
-                runs.append(self.fr.run([flake, self.scan]))
+                runs.append(self.fr.run([flake, self.direct, self.scan]))
             last = runs[-1]
             setup = statistics.median(r.wall for r in setups)
             wall = statistics.median(r.wall for r in runs)
@@ -213,7 +286,7 @@ class Benchmark:
             for cut_name, cut in (("default", default), ("full", full)):
                 for tol_name, tol in (("tight", tight), ("tighter", tighter)):
                     log(f"cutoff check, {label}: cutoff {cut_name}, tolerance {tol_name}")
-                    runs[cut_name, tol_name] = self.fr.run([flake, self.scan, *tip, cut, tol])
+                    runs[cut_name, tol_name] = self.fr.run([flake, self.direct, self.scan, *tip, cut, tol])
             d = runs["default", "tight"]
             self.cutoff.append({
                 "tip": label, "overrides": [p.read_text().strip() for p in tip],
@@ -231,9 +304,63 @@ class Benchmark:
                 "wall_default_s": d.wall, "wall_full_s": runs["full", "tight"].wall,
             })
 
+    def table_part(self) -> None:
+        """Part 3: the table against the direct sum, speed and force error."""
+        reps, ranks = self.args.repeats, self.args.ranks
+        launcher = shlex.split(self.args.mpirun) if ranks > 1 else []
+        extra = [self.fr.override("quick_map", "&scan ny = 4 /")] if self.args.quick else []
+        runs: dict[str, list[MapRun]] = {"direct": [], "table": []}
+        for i in range(reps):   # interleaved, so that a change of the machine's load hits both alike
+            for mode, override in (("table", self.table_override), ("direct", self.direct)):
+                log(f"24 x 128 map, {mode}, {ranks} rank(s): run {i + 1}/{reps}")
+                runs[mode].append(run_map(self.fr, launcher, ranks, [override, *extra]))
+        direct, table = runs["direct"], runs["table"]
+        if table[-1].evaluation != "table":
+            raise RuntimeError("the table was not used: /surface evaluation = " + table[-1].evaluation)
+        wall = {m: statistics.median(r.wall for r in rs) for m, rs in runs.items()}
+        process = {m: statistics.median(r.process for r in rs) for m, rs in runs.items()}
+        cpu = {m: statistics.median(r.cpu for r in rs) for m, rs in runs.items()}
+        # The smooth tip: a map that a small change of force changes little.
+        flake = self.flake(FLAKES[0][0])
+        smooth = self.fr.override("smooth_tip", SMOOTH_TIP)
+        tight = self.fr.override("tol_tight", f"&integrator rtol = {TIGHT:g}, atol = {TIGHT:g} /")
+        tighter = self.fr.override("tol_tighter", f"&integrator rtol = {TIGHTER:g}, atol = {TIGHTER:g} /")
+        smooth_runs = {}
+        for mode, override in (("table", self.table_override), ("direct", self.direct)):
+            for tol_name, tol in (("tight", tight), ("tighter", tighter)):
+                log(f"smooth tip, {mode}, tolerance {tol_name}")
+                smooth_runs[mode, tol_name] = self.fr.run([flake, self.scan, smooth, tol, override])
+        self.table = {
+            "ranks": ranks, "repeats": reps, "map": "inputs/graphite.nml" + (" + &scan ny = 4" if extra else ""),
+            "wall_direct_s": wall["direct"], "wall_table_s": wall["table"],
+            "wall_direct_all_s": [r.wall for r in direct], "wall_table_all_s": [r.wall for r in table],
+            "process_direct_s": process["direct"], "process_table_s": process["table"],
+            "speedup": wall["direct"] / wall["table"],
+            "speedup_process": process["direct"] / process["table"],
+            "cpu_direct_s": cpu["direct"], "cpu_table_s": cpu["table"],
+            "speedup_cpu": cpu["direct"] / cpu["table"],
+            "rhs_direct": direct[-1].rhs, "rhs_table": table[-1].rhs,
+            "per_rhs_direct_s": wall["direct"] * ranks / direct[-1].rhs,
+            "per_rhs_table_s": wall["table"] * ranks / table[-1].rhs,
+            "build_s": statistics.median(r.build for r in table if r.build is not None),
+            "build_all_s": [r.build for r in table],
+            **table[-1].table,
+            "max_dF_paper_map_nN": max_force_difference(table[-1].path, direct[-1].path),
+            "force_range_nN": force_range(direct[-1].path),
+            "max_dF_smooth_nN": max_force_difference(smooth_runs["table", "tight"].path,
+                                                     smooth_runs["direct", "tight"].path),
+            "max_dF_smooth_at_tighter_nN": max_force_difference(smooth_runs["table", "tighter"].path,
+                                                                smooth_runs["direct", "tighter"].path),
+            "floor_smooth_nN": max(max_force_difference(smooth_runs[m, "tight"].path,
+                                                        smooth_runs[m, "tighter"].path)
+                                   for m in ("table", "direct")),
+        }
+
     def run(self) -> None:
-        self.sizes_part()
-        self.cutoff_part()
+        if not self.args.table_only:
+            self.sizes_part()
+            self.cutoff_part()
+        self.table_part()
 
     # ---------------------------------------------------------------- output
 
@@ -245,7 +372,9 @@ class Benchmark:
         for k, v in header.items():
             w(f"  {k:<9} {v}")
         w("")
-        w(f"1. Time per scan line against the flake size, 1 rank, trace only, "
+        if self.args.table_only:
+            return self.table_report(lines)
+        w(f"1. Time per scan line against the flake size, 1 rank, trace only, direct sum, "
           f"median of {self.args.repeats}")
         w(f"   scan: inputs/{CASE} + {self.scan.read_text().strip()}")
         hdr = (f"  {'shells':>6} {'atoms':>7} {'cutoff A':>8} {'in cutoff':>9} {'set-up ms':>9} "
@@ -286,20 +415,59 @@ class Benchmark:
             w(f"    at {TIGHT:g}: rhs evaluations {c['rhs_default']} (default cutoff) vs "
               f"{c['rhs_full']} (full sum), wall {c['wall_default_s']:.2f} s vs "
               f"{c['wall_full_s']:.2f} s")
+        return self.table_report(lines)
+
+    def table_report(self, lines: list[str]) -> str:
+        w = lines.append
+        t = self.table
+        w("")
+        w(f"3. The surface table (evaluation = 'table') against the direct sum: {t['map']} on "
+          f"{t['ranks']} rank(s), median of {t['repeats']}")
+        w(f"  {'':18} {'wall s':>8} {'mpirun s':>9} {'CPU s':>8} {'rhs':>10} {'us/rhs':>7}")
+        for mode in ("direct", "table"):
+            w(f"  {mode:18} {t[f'wall_{mode}_s']:>8.2f} {t[f'process_{mode}_s']:>9.2f} {t[f'cpu_{mode}_s']:>8.2f} "
+              f"{t[f'rhs_{mode}']:>10} {1e6 * t[f'per_rhs_{mode}_s']:>7.3f}")
+        ok = t["speedup"] >= TABLE_TARGET_SPEEDUP
+        w(f"  speed-up: {t['speedup']:.1f}x in wall_time ({t['speedup_process']:.1f}x for the whole mpirun "
+          f"command, {t['speedup_cpu']:.1f}x in CPU time); target >= {TABLE_TARGET_SPEEDUP:g}x: "
+          f"{'met' if ok else 'MISSED'}")
+        w("  (wall: the file's wall_time, MPI start-up to before the write; mpirun: the whole command;")
+        w("   CPU: user + system of the command and its ranks, less sensitive to a loaded machine)")
+        w(f"  the table: {t['table_nodes']} nodes ({t['table_layers']} layers, spacing "
+          f"{t['table_spacing']:.4f} A in the plane, floor {t['table_floor']:.3f} A), "
+          f"{t['table_bytes'] / 1e6:.1f} MB per rank, built in {t['build_s']:.3f} s "
+          f"(in the wall_time above), {t['table_differences']} differences summed directly")
+        ok = t["table_error"] <= TABLE_TARGET_ERROR
+        w(f"  force error against the direct sum at the table's {t['table_points']} check points: "
+          f"{t['table_error']:.2e} nN (bound {t['table_tolerance']:g} nN; target <= {TABLE_TARGET_ERROR:g} nN: "
+          f"{'met' if ok else 'MISSED'})")
+        w(f"  smooth tip ({SMOOTH_TIP}), part 2's scan: max |dF| table vs direct = "
+          f"{t['max_dF_smooth_nN']:.2e} nN at {TIGHT:g} ({t['max_dF_smooth_at_tighter_nN']:.2e} at {TIGHTER:g}); "
+          f"integration floor {t['floor_smooth_nN']:.2e} nN")
+        w(f"  the paper's undamped tip (chaotic, part 2a): its maps differ by {t['max_dF_paper_map_nN']:.3f} nN "
+          f"(forces span {t['force_range_nN']:.3f} nN): where the slips fall, not the table's error")
         return "\n".join(lines)
 
 
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(
         description="Benchmark friction's graphite lattice-sum scene: time per scan line "
-                    "against the flake size, and the cutoff error (prints a table; not a test).")
+                    "against the flake size, the cutoff error, and the surface table against the "
+                    "direct sum (prints a table; not a test).")
     p.add_argument("--repeats", type=int, default=None,
                    help="runs per timing, median reported (default 3; 1 with --quick)")
     p.add_argument("--quick", action="store_true",
-                   help="1 repeat and a shorter scan (1 line of 20 points over 2 angstrom)")
+                   help="1 repeat, a shorter scan (1 line of 20 points over 2 angstrom) and 4 lines of "
+                        "the 24 x 128 map")
     p.add_argument("--json", metavar="FILE", help="also save the results as JSON to FILE")
     p.add_argument("--binary", default=str(ROOT / "build" / "friction"),
                    help="the friction executable (default: build/friction)")
+    p.add_argument("--mpirun", default="mpirun",
+                   help="MPI launcher for part 3, '-n N' is appended (default: mpirun)")
+    p.add_argument("--ranks", type=int, default=2,
+                   help="ranks for part 3's 24 x 128 maps (default 2, as the issue measured; 1: no launcher)")
+    p.add_argument("--table-only", action="store_true",
+                   help="only part 3 (the table against the direct sum)")
     p.add_argument("--keep", action="store_true",
                    help="keep the temporary directory with all outputs")
     args = p.parse_args(argv)
@@ -307,6 +475,8 @@ def main(argv=None) -> int:
         args.repeats = 1 if args.quick else 3
     if args.repeats < 1:
         p.error("--repeats must be at least 1")
+    if args.ranks < 1:
+        p.error("--ranks must be at least 1")
 
     binary = Path(args.binary).resolve()
     if not os.access(binary, os.X_OK):
@@ -348,13 +518,14 @@ def main(argv=None) -> int:
         "machine": f"{platform.machine()}, {cpus} CPUs available, "
                    f"{platform.processor() or platform.system()}",
         "repeats": f"{args.repeats}{'  --quick' if args.quick else ''}",
+        "ranks": f"{args.ranks} (part 3)",
     }
     print(bench.report(header))
     print(f"\n(benchmark took {total:.0f} s)")
 
     if args.json:
         results = {
-            "sizes": bench.sizes, "cutoff": bench.cutoff,
+            "sizes": bench.sizes, "cutoff": bench.cutoff, "table": bench.table,
             "meta": {"version": version, "source": git_state(), "cpus": cpus,
                      "machine": platform.machine(), "repeats": args.repeats,
                      "quick": args.quick, "scan": bench.scan.read_text().strip(),

@@ -4,7 +4,7 @@
     cli_test.py --binary BIN --mpiexec MPIEXEC --inputs DIR --workdir DIR CASE
 
 Cases: datasets-naf, datasets-hopg, input-roundtrip, set, other-scene-group, ranks, override, force,
-numerical-failure, models,
+numerical-failure, graphite, graphite-ranks, graphite-defects, graphite-table, models,
 quasistatic-failure, thermal-zero, thermal-ranks, thermal-equipartition, thermal-kramers, thermal-kramers-law,
 and bad-<name> for each bad input in BAD_INPUTS; for the brake scene
 brake-run, brake-ranks, brake-dimensional, brake-verify, brake-failure, brake-analysis and
@@ -68,6 +68,11 @@ BAD_INPUTS = {
                            ["bad.nml:1", "&surface", "vacancies(2) = 601", "600 sites"]),
     "lj-unknown-net": ("&surface potential = 'lj', net = 'kagome' /\n", 3, ["bad.nml:1", "net", "kagome"]),
     "lj-no-kz": ("&surface potential = 'lj' /\n&tip kz = 0 /\n", 3, ["bad.nml:2", "&tip", "kz"]),
+    # The tabulated surface (docs/physics.md, The tabulated surface).
+    "lj-evaluation": ("&surface potential = 'lj'\n  evaluation = 'tabled'\n/\n", 3,
+                      ["bad.nml:2", "&surface", "evaluation", "'tabled'", "'table'", "'direct'"]),
+    "lj-table-tolerance": ("&surface potential = 'lj', table_tolerance = -1e-4 /\n", 3,
+                           ["bad.nml:1", "&surface", "table_tolerance", ">= 0"]),
     "xyz-count": ("&surface potential = 'lj', net = 'file', net_file = 'net.xyz' /\n", 3,
                   ["net.xyz:4", "ends after 1 atoms"]),
     "xyz-field": ("&surface potential = 'lj', net = 'file', net_file = 'net.xyz' /\n", 3,
@@ -498,17 +503,75 @@ def case_graphite(args):
 
 
 def case_graphite_ranks(args):
+    """The graphite map through the surface table (the default) is the same
+    file on 1, 2 and 3 ranks (the ranks build the table together, each its
+    share of the nodes and checks), and the table met its bound."""
     small = write(args, "small.nml", GRAPHITE_SMALL)
     files = {}
-    for n in (1, 2):
+    for n in (1, 2, 3):
         out = f"g_{n}.h5"
         friction(args, "-o", out, os.path.join(args.inputs, "graphite.nml"), small, ranks=n)
         files[n] = comparable(os.path.join(args.workdir, out))
-    if files[1].keys() != files[2].keys():
-        fail(f"different objects: {set(files[1]) ^ set(files[2])}")
-    for key, value in files[1].items():
-        if not np.array_equal(np.asarray(value), np.asarray(files[2][key])):
-            fail(f"{key} differs between 1 and 2 ranks")
+    if files[1]["surface@evaluation"] != b"table":
+        fail(f"evaluated by {files[1]['surface@evaluation']!r}, not the table")
+    if not 0 < files[1]["surface@table_error"] <= files[1]["surface@table_tolerance"]:
+        fail(f"table error {files[1]['surface@table_error']} against its bound {files[1]['surface@table_tolerance']}")
+    for n in (2, 3):
+        if files[1].keys() != files[n].keys():
+            fail(f"different objects on {n} ranks: {set(files[1]) ^ set(files[n])}")
+        for key, value in files[1].items():
+            if not np.array_equal(np.asarray(value), np.asarray(files[n][key])):
+                fail(f"{key} differs between 1 and {n} ranks")
+
+
+def case_graphite_table(args):
+    """The surface table against the direct sum (its oracle) on a map whose
+    tip follows the support smoothly (stiff, damped springs, tight
+    integration, so that a small change of force gives a small change of
+    the map): the forces agree within the table's bound of 1e-4 nN.  The
+    file records what ran: the table with its size and measured error, or
+    the direct sum without them; a net with no lattice falls back to the
+    direct sum with a note saying so."""
+    scan = write(args, "smooth.nml", "&tip kx = 10.0, ky = 10.0, cx = 6.0e-3, cy = 6.0e-3, cz = 1.0e-3 /\n"
+                 "&scan nx = 12, ny = 2, length = 2.0, retrace = .false. /\n"
+                 "&integrator rtol = 1e-10, atol = 1e-10 /\n")
+    direct = write(args, "direct.nml", "&surface evaluation = 'direct' /\n")
+    graphite = os.path.join(args.inputs, "graphite.nml")
+    friction(args, "-o", "table.h5", graphite, scan)
+    friction(args, "-o", "direct.h5", graphite, scan, direct)
+    with h5py.File(os.path.join(args.workdir, "table.h5"), "r") as t, \
+            h5py.File(os.path.join(args.workdir, "direct.h5"), "r") as d:
+        attrs = t["surface"].attrs
+        if attrs["evaluation"] != b"table":
+            fail(f"default evaluation {attrs['evaluation']!r}, not the table")
+        for name in ("table_tolerance", "table_error", "table_points", "table_bytes", "table_nodes",
+                     "table_layers", "table_spacing", "table_floor", "table_energy_window", "table_differences"):
+            if name not in attrs:
+                fail(f"/surface lacks {name}")
+        if attrs["table_bytes"] < 64 * attrs["table_nodes"]:
+            fail("table_bytes is less than 8 values of 8 bytes per node")
+        if d["surface"].attrs["evaluation"] != b"direct" or "table_error" in d["surface"].attrs:
+            fail("the direct run records a table")
+        worst = max(float(np.max(np.abs(t[f"afm/trace/{q}"][()] - d[f"afm/trace/{q}"][()])))
+                    for q in ("fx", "fy", "fz"))
+        if not worst <= attrs["table_tolerance"]:
+            fail(f"table and direct maps differ by {worst} nN, more than {attrs['table_tolerance']} nN")
+    # Atoms on no lattice (a jittered flake): the direct sum, and a note.
+    rng = np.random.default_rng(7)
+    lines = []
+    for i in range(-6, 7):
+        for j in range(-6, 7):
+            x, y = 1.42 * i + rng.uniform(-0.3, 0.3), 1.42 * j + rng.uniform(-0.3, 0.3)
+            lines.append(f"C {x:.6f} {y:.6f} 0.0")
+    write(args, "jitter.xyz", f"{len(lines)}\njittered\n" + "\n".join(lines) + "\n")
+    jitter = write(args, "jitter.nml", "&surface net = 'file', net_file = 'jitter.xyz' /\n"
+                   "&scan nx = 4, ny = 1, length = 0.5, origin_x = 0.0, origin_y = 0.0 /\n")
+    result = run(args, [args.binary, "-o", "jitter.h5", graphite, jitter], 0)
+    if not re.search(r"evaluation = 'table': the direct sum instead: no lattice found in \S*jitter\.xyz", result.stderr):
+        fail(f"no note of the fallback: {result.stderr!r}")
+    with h5py.File(os.path.join(args.workdir, "jitter.h5"), "r") as f:
+        if f["surface"].attrs["evaluation"] != b"direct" or b"no lattice" not in f["surface"].attrs["evaluation_note"]:
+            fail("the fallback is not recorded in /surface")
 
 
 def case_graphite_defects(args):
@@ -522,6 +585,10 @@ def case_graphite_defects(args):
             fail(f"expected 149 atoms with one N, got {len(species)} with {list(species).count(2)}")
         if f["surface"].attrs["species_names"].decode() != "C, N":
             fail("species_names is not 'C, N'")
+        # The file gives no lattice: the table found graphite's in it and adds
+        # the vacancy, the nitrogen and the flake's edges back.
+        if f["surface"].attrs["evaluation"] != b"table" or f["surface"].attrs["table_differences"] < 3:
+            fail(f"the file's net was not tabulated: {dict(f['surface'].attrs)}")
 
 
 def comparable(path):
@@ -1935,6 +2002,7 @@ def main():
          "numerical-failure": case_numerical_failure, "wall-time": case_wall_time,
          "graphite": case_graphite, "models": case_models, "quasistatic-failure": case_quasistatic_failure,
          "graphite-ranks": case_graphite_ranks, "graphite-defects": case_graphite_defects,
+         "graphite-table": case_graphite_table,
          "input-roundtrip": case_input_roundtrip, "thermal-zero": case_thermal_zero,
           "set": case_set, "other-scene-group": case_other_scene_group,
           "thermal-ranks": case_thermal_ranks, "thermal-equipartition": case_thermal_equipartition,

@@ -8,8 +8,11 @@ module friction_afm_config
    use friction_surface_potential, only: surface_potential
    use friction_surface_naf, only: new_naf_potential
    use friction_surface_hopg, only: new_hopg_potential
-   use friction_surface_net, only: crystal_net, graphite_net, square_net, read_xyz, max_local_density, sort_order
-   use friction_surface_lennard_jones, only: new_lj_potential, cutoff_for_tolerance
+   use friction_surface_net, only: crystal_net, graphite_net, square_net, read_xyz, max_local_density, sort_order, &
+      & net_lattice, graphite_lattice, square_lattice, detect_lattice
+   use friction_surface_lennard_jones, only: lj_potential, new_lj_potential, cutoff_for_tolerance, table_settings
+   use friction_clock, only: wall_seconds
+   use friction_sharing, only: work_sharing
    use friction_kinds, only: ev_per_angstrom_to_nn
    use friction_afm_tip, only: afm_tip, model_inertial, model_overdamped, model_quasistatic, find_height
    use friction_strings, only: itoa, rtoa, quoted, bytes_text
@@ -25,10 +28,23 @@ module friction_afm_config
    private
 
    public :: afm_config, potential_names, net_names, tip_model_names, new_potential, new_tip, net_sites, max_species, &
-      & max_defects, species_count, surface_curvature, thermal_step_limit, tip_stiffness
+      & max_defects, species_count, surface_curvature, thermal_step_limit, tip_stiffness, evaluation_names, &
+      & surface_evaluation, table_energy_window, table_reach
 
    character(len=*), parameter :: potential_names(3) = [character(len=4) :: 'naf', 'hopg', 'lj']
    character(len=*), parameter :: net_names(3) = [character(len=8) :: 'graphite', 'square', 'file']
+   !> &surface evaluation of a lattice sum: interpolated from a table of the
+   !> perfect lattice (where it meets table_tolerance), or the direct sum.
+   character(len=*), parameter :: evaluation_names(2) = [character(len=6) :: 'table', 'direct']
+   !> The table answers where the perfect lattice's energy is at most this
+   !> much above its minimum, eV (docs/physics.md, The tabulated surface):
+   !> 4 times the most the paper's undamped tip climbs at its samples (0.073 eV
+   !> above the minimum, inputs/graphite.nml), 12 k_B T at 300 K.  Higher, nearer the
+   !> atoms' cores, the direct sum answers: correct, only slower.
+   real(wp), parameter :: table_energy_window = 0.3_wp
+   !> How far beyond its support's scan box the table serves the tip, Å (the
+   !> cell list's reach less the cutoff: new_potential); farther, the direct sum.
+   real(wp), parameter :: table_reach = 10.0_wp
    !> &tip model: the full equations of motion, without inertia, or the
    !> equilibrium followed (docs/physics.md, reduced tip models).
    character(len=*), parameter :: tip_model_names(3) = [character(len=11) :: 'inertial', 'overdamped', &
@@ -59,6 +75,8 @@ module friction_afm_config
       character(len=8) :: substitution_species = ''
       real(wp) :: cutoff = 0.0_wp            !! Å; 0: from cutoff_tolerance
       real(wp) :: cutoff_tolerance = 1.0e-4_wp   !! largest force of the atoms beyond the cutoff, nN
+      character(len=16) :: evaluation = 'table'   !! 'table' or 'direct'
+      real(wp) :: table_tolerance = 0.0_wp       !! largest force error of the table, nN; 0: cutoff_tolerance
       ! &tip
       character(len=16) :: model = 'inertial'   !! 'inertial', 'overdamped' or 'quasistatic'
       real(wp) :: mass = 1.0e-8_wp     !! kg
@@ -94,6 +112,23 @@ module friction_afm_config
       procedure :: across_direction
    end type afm_config
 
+   !> How a lattice sum is evaluated (docs/output.md, /surface): the table's
+   !> size and its error measured against the direct sum, or why not.
+   type :: surface_evaluation
+      character(len=:), allocatable :: evaluation   !! what runs: 'table' or 'direct'
+      character(len=:), allocatable :: note         !! why the direct sum, when the table was asked for
+      real(wp) :: tolerance = 0.0_wp                !! the table's bound, nN
+      real(wp) :: error = 0.0_wp                    !! the largest force error measured, nN
+      integer :: points = 0                         !! points it was measured at
+      real(wp) :: bytes = 0.0_wp                    !! memory of the table
+      integer :: nodes(3) = 0                       !! nodes along a1 and a2 per cell, layers
+      real(wp) :: spacing = 0.0_wp                  !! the larger lateral node spacing, Å
+      real(wp) :: floor = 0.0_wp                    !! the lowest layer, Å
+      real(wp) :: energy_window = 0.0_wp            !! eV
+      integer :: differences = 0                    !! atoms where the net differs from the lattice
+      real(wp) :: build_time = 0.0_wp               !! s (this rank's)
+   end type surface_evaluation
+
 contains
 
    !> The groups &surface, &tip, &scan, &integrator and &thermal (docs/input.md).
@@ -119,6 +154,8 @@ contains
       call v%item('substitution_species', self%substitution_species)
       call v%item('cutoff', self%cutoff, 'angstrom')
       call v%item('cutoff_tolerance', self%cutoff_tolerance, 'nN')
+      call v%item('evaluation', self%evaluation, fold=.true.)
+      call v%item('table_tolerance', self%table_tolerance, 'nN')
       call v%end_group()
       call v%begin_group('tip')
       call v%item('model', self%model, fold=.true.)
@@ -290,6 +327,9 @@ contains
             & call c%reject('surface', 'cutoff', rtoa(self%cutoff), 'must not be below sigma ('// &
             & rtoa(maxval(self%sigma(1:max(ns, 1))))//' Å): the sum would miss the repulsive core')
          call c%positive('surface', 'cutoff_tolerance', self%cutoff_tolerance, 'nN')
+         if (.not. any(evaluation_names == self%evaluation)) call c%reject('surface', 'evaluation', &
+            & "'"//trim(self%evaluation)//"'", 'unknown evaluation (known: '//quoted(evaluation_names)//')')
+         call c%nonnegative('surface', 'table_tolerance', self%table_tolerance, 'nN; 0: cutoff_tolerance')
          select case (trim(self%net))
          case ('graphite')
             if (self%shells < 0) call c%reject('surface', 'shells', itoa(self%shells), 'must be >= 0')
@@ -440,14 +480,20 @@ contains
    end function scan_region
 
    !> The surface potential the settings name; for a lattice sum also the
-   !> net (for the output) and the cutoff used.
-   subroutine new_potential(config, potential, error, net, cutoff)
+   !> net (for the output), the cutoff used and how it is evaluated.
+   subroutine new_potential(config, potential, error, net, cutoff, evaluation, share)
       type(afm_config), intent(in) :: config
       class(surface_potential), allocatable, intent(out) :: potential
       type(error_type), allocatable, intent(out) :: error
       type(crystal_net), intent(out), optional :: net
       real(wp), intent(out), optional :: cutoff
+      type(surface_evaluation), intent(out), optional :: evaluation
+      !> the processes that build the same potential together (a lattice
+      !> sum's table: collective over them); absent, this process alone
+      class(work_sharing), intent(inout), optional :: share
       type(crystal_net) :: atoms
+      type(lj_potential) :: lattice_sum
+      type(surface_evaluation) :: how
       real(wp) :: rc
       integer :: ns
 
@@ -467,14 +513,71 @@ contains
          rc = config%cutoff
          if (rc <= 0.0_wp) rc = cutoff_for_tolerance(maxval(config%epsilon(1:ns) * config%sigma(1:ns)**6), &
             & 1.0_wp, net_density(atoms), config%cutoff_tolerance / ev_per_angstrom_to_nn)
-         allocate (potential, source=new_lj_potential(atoms, config%epsilon(1:ns), config%sigma(1:ns), rc, &
-            & scan_region(config, rc + 10.0_wp)))
+         lattice_sum = new_lj_potential(atoms, config%epsilon(1:ns), config%sigma(1:ns), rc, &
+            & scan_region(config, rc + table_reach))
+         how%evaluation = 'direct'
+         how%note = ''
+         if (config%evaluation == 'table') call tabulate_net(config, atoms, lattice_sum, how, share)
+         allocate (potential, source=lattice_sum)
          if (present(net)) net = atoms
          if (present(cutoff)) cutoff = rc
+         if (present(evaluation)) evaluation = how
       case default
          call fatal_error(error, "unknown potential '"//trim(config%potential)//"'", error_input)
       end select
    end subroutine new_potential
+
+   !> The table of a lattice sum (docs/physics.md, The tabulated surface),
+   !> recorded in `how`; when the net has no lattice to tabulate or the table
+   !> cannot meet its tolerance within its memory, the direct sum, and
+   !> how%note says why.
+   subroutine tabulate_net(config, atoms, lattice_sum, how, share)
+      type(afm_config), intent(in) :: config
+      type(crystal_net), intent(in) :: atoms
+      type(lj_potential), intent(inout) :: lattice_sum
+      type(surface_evaluation), intent(inout) :: how
+      class(work_sharing), intent(inout), optional :: share
+      type(net_lattice) :: lattice
+      type(table_settings) :: settings
+      character(len=:), allocatable :: reason
+      real(wp) :: start
+
+      start = wall_seconds()
+      how%tolerance = config%table_tolerance
+      if (how%tolerance <= 0.0_wp) how%tolerance = config%cutoff_tolerance
+      select case (trim(config%net))
+      case ('graphite')
+         lattice = graphite_lattice(config%a)
+      case ('square')
+         lattice = square_lattice(config%a, config%side)
+      case default
+         call detect_lattice(atoms, lattice, reason)
+         if (len(reason) > 0) then
+            how%note = 'no lattice found in '//trim(config%net_file)//' ('//reason//')'
+            return
+         end if
+      end select
+      settings%tolerance = how%tolerance / ev_per_angstrom_to_nn
+      settings%energy_window = table_energy_window
+      settings%box = scan_region(config, table_reach)
+      call lattice_sum%tabulate(lattice, settings, reason, share)
+      how%build_time = wall_seconds() - start
+      if (len(reason) > 0) then
+         how%note = reason
+         return
+      end if
+      associate (t => lattice_sum%table)
+         how%evaluation = 'table'
+         how%error = t%error * ev_per_angstrom_to_nn
+         how%points = t%points
+         how%bytes = t%grid%bytes()
+         how%nodes = t%nodes
+         how%spacing = max(norm2(t%vectors(:, 1)) / t%nodes(1), norm2(t%vectors(:, 2)) / t%nodes(2))
+         how%floor = t%floor
+         how%energy_window = t%energy_window
+         how%differences = t%difference_count
+      end associate
+   end subroutine tabulate_net
 
    !> The largest curvature of the surface (eV/Å², >= 0) over one lattice
    !> cell, the Langevin step's scale (friction_afm_langevin): NaF over

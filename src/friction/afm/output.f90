@@ -5,7 +5,7 @@ module friction_afm_output
    use friction_kinds, only: wp, i8
    use friction_error, only: error_type
    use friction_ode_solver, only: integrator_statistics
-   use friction_afm_config, only: afm_config
+   use friction_afm_config, only: afm_config, surface_evaluation
    use friction_afm_scan, only: quantity_names, quantity_units, quantity_count, q_f_along, q_jumps, &
       & support_along, support_across
    use friction_output_h5, only: h5_file
@@ -25,6 +25,7 @@ module friction_afm_output
       real(wp) :: cutoff = 0.0_wp           !! Å
       real(wp) :: contact_height = 0.0_wp   !! Å
       real(wp) :: support_height = 0.0_wp   !! Å
+      type(surface_evaluation) :: evaluation   !! the table, or the direct sum
    end type afm_surface_record
 
    !> A map at a temperature (README: Friction at a temperature): this
@@ -111,6 +112,7 @@ contains
          call file%write_integer_vector('/surface/species', surface%net%species)
          call file%write_attribute_text('/surface', 'species_names', join(surface%species_names))
          call file%write_attribute_real('/surface', 'cutoff', surface%cutoff, 'angstrom')
+         call write_evaluation(surface%evaluation)
       end if
       if (present(thermal)) then
          call file%write_attribute_real('/afm', 'temperature', config%thermal%temperature, 'K')
@@ -144,6 +146,29 @@ contains
       call file%close(error)
 
    contains
+
+      !> How the lattice sum was evaluated: /surface evaluation and, for the
+      !> table, its size and its force error measured against the direct sum
+      !> (docs/output.md).  (Not its build time: the file is the same for the
+      !> same input, however long a rank took.)
+      subroutine write_evaluation(how)
+         type(surface_evaluation), intent(in) :: how
+
+         call file%write_attribute_text('/surface', 'evaluation', how%evaluation)
+         if (len(how%note) > 0) call file%write_attribute_text('/surface', 'evaluation_note', how%note)
+         if (how%evaluation /= 'table') return
+         call file%write_attribute_real('/surface', 'table_tolerance', how%tolerance, 'nN')
+         call file%write_attribute_real('/surface', 'table_error', how%error, 'nN')
+         call file%write_attribute_integer('/surface', 'table_points', int(how%points, i8))
+         call file%write_attribute_integer('/surface', 'table_bytes', int(how%bytes, i8), 'B')
+         call file%write_attribute_integer('/surface', 'table_nodes', int(how%nodes(1), i8) * how%nodes(2) &
+            & * how%nodes(3))
+         call file%write_attribute_integer('/surface', 'table_layers', int(how%nodes(3), i8))
+         call file%write_attribute_real('/surface', 'table_spacing', how%spacing, 'angstrom')
+         call file%write_attribute_real('/surface', 'table_floor', how%floor, 'angstrom')
+         call file%write_attribute_real('/surface', 'table_energy_window', how%energy_window, 'eV')
+         call file%write_attribute_integer('/surface', 'table_differences', int(how%differences, i8))
+      end subroutine write_evaluation
 
       !> The datasets of a trip's quantities, their names + suffix ('_sem').
       subroutine write_trips(group, values, suffix)

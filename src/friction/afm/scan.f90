@@ -976,7 +976,7 @@ contains
          call p%highest_near(r(1:2), 2.0_wp * maxval(p%sigma), top, sigma_min)
          if (top > -huge(1.0_wp) .and. .not. (r(3) > top + 0.5_wp * sigma_min)) &
             & call fatal_error(error, reason, error_input)
-         if (top == -huge(1.0_wp) .and. r(3) < 0.5_wp * sigma_min + minval(p%position(3, :))) &
+         if (top == -huge(1.0_wp) .and. r(3) < 0.5_wp * sigma_min + minval(p%atoms%position(3, :))) &
             & call fatal_error(error, reason, error_input)
       end select
    end subroutine check_above_net

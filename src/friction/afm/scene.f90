@@ -17,7 +17,8 @@ module friction_afm_scene
    use friction_output_summary, only: run_summary
    use friction_scene, only: scene, point_result
    use friction_scene_report, only: job_reporter
-   use friction_scene_context, only: job_context, agree_on_error, ranks_text, share_of, job_wall_time
+   use friction_scene_context, only: job_context, agree_on_error, ranks_text, share_of, job_wall_time, &
+      & job_sharing, mpi_sharing
    use friction_afm_config, only: afm_config, new_potential, species_count, tip_stiffness
    use friction_afm_scan, only: afm_scanner, line_record, slip_list, n_quantities, q_fx, q_fy, q_f_along
    use friction_afm_output, only: write_afm_file, afm_surface_record, afm_thermal_record
@@ -146,6 +147,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(afm_scanner), target :: scanner
       class(surface_potential), allocatable :: potential
+      type(mpi_sharing) :: share
       type(line_record) :: line
       type(integrator_statistics) :: stats
       real(wp), allocatable :: local_slips(:, :)
@@ -161,12 +163,19 @@ contains
 
       self%ran = self%resolved()
       associate (c => self%ran)
-         ! The surface first, identically on every rank: a bad net or defect is
-         ! bad input, reported before any work.
-         call new_potential(c, potential, error, self%surface%net, self%surface%cutoff)
+         ! The surface first, identically on every rank (its table, if any,
+         ! built by all together): a bad net or defect is bad input,
+         ! reported before any work.
+         share = job_sharing(job)
+         call new_potential(c, potential, error, self%surface%net, self%surface%cutoff, self%surface%evaluation, &
+            & share)
          if (allocated(error)) return
          ! A reduced tip model outside where it holds (docs/physics.md, reduced tip models):
          ! one note per reason.
+         if (job%rank == 0 .and. c%potential == 'lj') then
+            if (len(self%surface%evaluation%note) > 0) call reporter%note("note: &surface evaluation = 'table': " &
+               & //'the direct sum instead: '//self%surface%evaluation%note)
+         end if
          if (job%rank == 0) then
             warnings = afm_model_warnings(c, potential)
             start = 1
@@ -493,6 +502,14 @@ contains
       write (seconds, '(f12.2)') self%record%wall_time
       text = itoa(self%ran%ny)//' lines x '//itoa(self%ran%nx)//' points, '//trim(adjustl(seconds))//' s ' &
          & //ranks_text(job%nranks)
+      ! The surface table's cost, which the file leaves out (it is a timing).
+      if (self%three_d .and. allocated(self%surface%evaluation%evaluation)) then
+         if (self%surface%evaluation%evaluation == 'table') then
+            write (seconds, '(f12.2)') self%surface%evaluation%build_time
+            text = text//'; surface table '//bytes_text(self%surface%evaluation%bytes)//', built in ' &
+               & //trim(adjustl(seconds))//' s'
+         end if
+      end if
    end function afm_summary
 
    function afm_point_results(self) result(results)

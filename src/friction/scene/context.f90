@@ -10,11 +10,12 @@ module friction_scene_context
    use friction_error, only: error_type, fatal_error, error_io
    use friction_strings, only: itoa, bytes_text
    use friction_files, only: publish_file, remove_file, process_id, free_bytes, min_free_bytes
+   use friction_sharing, only: work_sharing
    implicit none
    private
 
    public :: job_context, agree_on_error, temporary_name, publish, check_writable, default_output, &
-      & ranks_text, sum_to_root_real, sum_to_root_integer, share_of, job_wall_time
+      & ranks_text, sum_to_root_real, sum_to_root_integer, share_of, job_wall_time, job_sharing, mpi_sharing
 
    !> One job's run: where it runs, since when, what it read and writes.
    type :: job_context
@@ -32,7 +33,43 @@ module friction_scene_context
       procedure :: parallel
    end type job_context
 
+   !> The job's ranks as friction_sharing's work_sharing: the layers below
+   !> the scenes share work (a surface table's build) through it.
+   type, extends(work_sharing) :: mpi_sharing
+      type(MPI_Comm) :: comm = MPI_COMM_NULL
+   contains
+      procedure :: sum_reals => mpi_sum_reals
+      procedure :: max_real => mpi_max_real
+   end type mpi_sharing
+
 contains
+
+   !> The job's ranks, for work_sharing (serial: one process alone).
+   function job_sharing(job) result(share)
+      type(job_context), intent(in) :: job
+      type(mpi_sharing) :: share
+
+      share%comm = job%comm
+      share%rank = job%rank
+      share%ranks = merge(job%nranks, 1, job%parallel())
+   end function job_sharing
+
+   subroutine mpi_sum_reals(self, values, n)
+      class(mpi_sharing), intent(inout) :: self
+      integer, intent(in) :: n
+      real(wp), intent(inout) :: values(*)
+
+      if (self%comm == MPI_COMM_NULL .or. self%ranks < 2) return
+      call MPI_Allreduce(MPI_IN_PLACE, values, n, MPI_DOUBLE_PRECISION, MPI_SUM, self%comm)
+   end subroutine mpi_sum_reals
+
+   subroutine mpi_max_real(self, x)
+      class(mpi_sharing), intent(inout) :: self
+      real(wp), intent(inout) :: x
+
+      if (self%comm == MPI_COMM_NULL .or. self%ranks < 2) return
+      call MPI_Allreduce(MPI_IN_PLACE, x, 1, MPI_DOUBLE_PRECISION, MPI_MAX, self%comm)
+   end subroutine mpi_max_real
 
    !> Whether the job runs on MPI (false: serial, no MPI call may be made).
    logical function parallel(self)

@@ -7,38 +7,112 @@
 !> `cutoff_for_tolerance`), and the atoms are binned once into a cell list
 !> in the plane, so an evaluation visits only the cells within r_c of the
 !> tip: its cost grows with the atoms inside the cutoff, not with the sample.
+!>
+!> Tabulated evaluation (`tabulate`, docs/physics.md, "The tabulated
+!> surface"): a net cut from a periodic lattice is the perfect lattice plus
+!> its differences (the sites outside a flake, vacancies, substitutions),
+!> so V = V_lattice + Σ_differences ±φ.  V_lattice is periodic: it is
+!> tabulated once over one cell of the lattice (tricubic Hermite,
+!> friction_surface_tricubic) and the few differences within r_c of the tip
+!> are summed directly.  The table answers where the tip can be, above a
+!> floor set by an energy cap; elsewhere the direct sum does.
 module friction_surface_lennard_jones
    use friction_kinds, only: wp, pi
    use friction_surface_potential, only: surface_potential
-   use friction_surface_net, only: crystal_net
+   use friction_surface_net, only: crystal_net, net_lattice
+   use friction_surface_tricubic, only: tricubic_grid, new_tricubic_grid, n_node_values
+   use friction_surface_lj_columns, only: column_sums, difference_terms
+   use friction_strings, only: rtoa, itoa
+   use friction_sharing, only: work_sharing
    implicit none
    private
 
-   public :: lj_potential, new_lj_potential, cutoff_for_tolerance, lj_pair_energy
+   public :: lj_potential, new_lj_potential, cutoff_for_tolerance, lj_pair_energy, lj_table, table_settings
 
    !> Cells per cutoff length: smaller cells fit the disc of radius r_c more
    !> tightly (visited area (2 + 2/m)² r_c² against π r_c²) at more overhead;
    !> 3 was 8 % faster than 2 and 4 no faster on the graphite scene.
    integer, parameter :: cells_per_cutoff = 3
 
-   type, extends(surface_potential) :: lj_potential
-      real(wp), allocatable :: epsilon(:)   !! per species, eV
-      real(wp), allocatable :: sigma(:)     !! per species, Å
-      real(wp) :: cutoff = 0.0_wp           !! r_c, Å; 0 sums every atom
-      ! The net sorted by cell: atoms of cell c are cell_start(c) .. cell_start(c+1)-1.
+   !> Atoms binned into a grid of square cells in the plane: the atoms of
+   !> cell c are cell_start(c) .. cell_start(c+1)-1.
+   type :: atom_cells
       real(wp), allocatable :: position(:, :)
       integer, allocatable :: species(:)
+      real(wp), allocatable :: weight(:)    !! ±1 for a table's differences; absent: 1
       integer, allocatable :: cell_start(:)
       real(wp) :: origin(2) = 0.0_wp        !! lower corner of the cell grid, Å
       real(wp) :: cell = 1.0_wp             !! cell edge, Å
       integer :: ncell(2) = 1
+   end type atom_cells
+
+   !> A table's differences as lists per square cell of the plane: list c
+   !> holds every difference within the cutoff of any point of cell c
+   !> (copied, so that a list lies in one piece), entries start(c) ..
+   !> start(c+1)-1.  Most of the tip's path has empty lists: no cell walk.
+   type :: difference_lists
+      real(wp), allocatable :: position(:, :)
+      integer, allocatable :: species(:)
+      real(wp), allocatable :: weight(:)   !! +1 an atom the lattice lacks, -1 a site the net lacks
+      ! The same, one array per quantity, for difference_terms: x, y, z, σ²,
+      ! 4εw and φ(r_c)w.
+      real(wp), allocatable :: x(:), y(:), z(:), sigma2(:), e4w(:), shiftw(:)
+      integer, allocatable :: start(:)
+      real(wp) :: origin(2) = 0.0_wp, cell = 1.0_wp
+      integer :: ncell(2) = 1
+   end type difference_lists
+
+   !> How to build a table (`tabulate`).
+   type :: table_settings
+      !> largest force error allowed against the direct sum, eV/Å
+      real(wp) :: tolerance = 1.0e-4_wp / 1.602176634_wp
+      !> the table answers where the perfect lattice's energy is at most
+      !> this much above its minimum, eV; closer to the atoms the direct sum
+      real(wp) :: energy_window = 1.0_wp
+      real(wp) :: max_bytes = 512.0_wp * 1024.0_wp**2   !! the largest table allowed
+      !> box (x_min, x_max, y_min, y_max), Å, where the table answers: the
+      !> differences are complete within the cutoff of it
+      real(wp) :: box(4) = 0.0_wp
+      integer :: verify_points = 4096   !! points checked against the direct sum
+   end type table_settings
+
+   !> The tabulated perfect lattice and the net's differences from it.
+   type :: lj_table
+      type(tricubic_grid) :: grid           !! V over (s1, s2, z): s the fractional coordinates
+      real(wp) :: vectors(2, 2) = 0.0_wp    !! the lattice vectors (columns), Å
+      real(wp) :: to_fraction(2, 2) = 0.0_wp   !! s = to_fraction (x, y)
+      real(wp) :: box(4) = 0.0_wp           !! where the table answers, Å
+      real(wp) :: floor = 0.0_wp            !! lowest height of the table, Å
+      real(wp) :: top = 0.0_wp              !! the lattice's V is zero above, Å
+      real(wp) :: ceiling = 0.0_wp          !! every atom beyond the cutoff above, Å
+      real(wp) :: energy_cap = 0.0_wp       !! the table answers where V_lattice <= this, eV
+      real(wp), allocatable :: shift(:)     !! φ_s(r_c) per species, eV
+      type(difference_lists) :: differences   !! the net less the lattice
+      ! What was built and measured (for the output file).
+      integer :: nodes(3) = 0               !! nodes per cell along a1, a2 and layers
+      real(wp) :: error = 0.0_wp            !! largest force error found, eV/Å
+      real(wp) :: tolerance = 0.0_wp        !! the bound, eV/Å
+      real(wp) :: energy_window = 0.0_wp    !! eV
+      integer :: points = 0                 !! points the error was measured at
+      integer :: difference_count = 0       !! atoms in the differences
+   end type lj_table
+
+   type, extends(surface_potential) :: lj_potential
+      real(wp), allocatable :: epsilon(:)   !! per species, eV
+      real(wp), allocatable :: sigma(:)     !! per species, Å
+      real(wp) :: cutoff = 0.0_wp           !! r_c, Å; 0 sums every atom
+      type(atom_cells) :: atoms             !! the net, binned
+      logical :: tabulated = .false.        !! evaluate through `table` where it answers
+      type(lj_table) :: table
    contains
       procedure :: energy
       procedure :: gradient
       procedure :: hessian
       procedure :: dimensions
       procedure :: highest_near
-      procedure, private :: cell_range
+      procedure :: tabulate
+      procedure :: table_answers
+      procedure :: direct_gradient
    end type lj_potential
 
 contains
@@ -79,17 +153,34 @@ contains
       real(wp), intent(in) :: epsilon(:), sigma(:), cutoff
       real(wp), intent(in), optional :: region(4)
       type(lj_potential) :: self
+
+      allocate (self%epsilon, source=epsilon)
+      allocate (self%sigma, source=sigma)
+      self%cutoff = cutoff
+      self%atoms = new_atom_cells(net%position, net%species, cutoff, region)
+   end function new_lj_potential
+
+   !> Atoms binned for sums cut at `cutoff` (see new_lj_potential).
+   function new_atom_cells(position, species, cutoff, region, weight) result(self)
+      real(wp), intent(in) :: position(:, :)
+      integer, intent(in) :: species(:)
+      real(wp), intent(in) :: cutoff
+      real(wp), intent(in), optional :: region(4)
+      real(wp), intent(in), optional :: weight(:)
+      type(atom_cells) :: self
       integer, parameter :: max_cells = 4194304
       integer, allocatable :: cell_of(:), fill(:)
       real(wp) :: upper(2), extent(2)
       integer :: i, c, n, cells
 
-      allocate (self%epsilon, source=epsilon)
-      allocate (self%sigma, source=sigma)
-      self%cutoff = cutoff
-      n = net%size()
-      self%origin = minval(net%position(1:2, :), dim=2)
-      upper = maxval(net%position(1:2, :), dim=2)
+      n = size(species)
+      if (n > 0) then
+         self%origin = minval(position(1:2, :), dim=2)
+         upper = maxval(position(1:2, :), dim=2)
+      else
+         self%origin = 0.0_wp
+         upper = 0.0_wp
+      end if
       if (present(region)) then
          self%origin = max(self%origin, [region(1), region(3)])
          upper = min(upper, [region(2), region(4)])
@@ -110,7 +201,7 @@ contains
       cells = self%ncell(1) * self%ncell(2)
       allocate (cell_of(n), fill(cells + 1))
       do i = 1, n
-         cell_of(i) = cell_index(self, net%position(1:2, i))
+         cell_of(i) = cell_index(self, position(1:2, i))
       end do
       ! Counting sort of the atoms by cell (stable: keeps the net's order).
       fill = 0
@@ -123,19 +214,21 @@ contains
          self%cell_start(c + 1) = self%cell_start(c) + fill(c + 1)
       end do
       allocate (self%position(3, n), self%species(n))
+      if (present(weight)) allocate (self%weight(n))
       fill(1:cells) = self%cell_start(1:cells)
       do i = 1, n
          c = cell_of(i)
-         self%position(:, fill(c)) = net%position(:, i)
-         self%species(fill(c)) = net%species(i)
+         self%position(:, fill(c)) = position(:, i)
+         self%species(fill(c)) = species(i)
+         if (present(weight)) self%weight(fill(c)) = weight(i)
          fill(c) = fill(c) + 1
       end do
-   end function new_lj_potential
+   end function new_atom_cells
 
    !> The cell (1-based, x fastest) holding a point of the net; points
    !> outside the grid go to its border cells.
    pure integer function cell_index(self, p) result(c)
-      type(lj_potential), intent(in) :: self
+      type(atom_cells), intent(in) :: self
       real(wp), intent(in) :: p(2)
       integer :: ij(2)
 
@@ -143,23 +236,23 @@ contains
       c = ij(1) + ij(2) * self%ncell(1) + 1
    end function cell_index
 
-   !> Cells whose atoms may lie within the cutoff of r: x cells lo(1)..hi(1),
-   !> y cells lo(2)..hi(2) (0-based); empty when the tip is far off the net.
-   pure subroutine cell_range(self, r, lo, hi)
-      class(lj_potential), intent(in) :: self
-      real(wp), intent(in) :: r(3)
+   !> Cells whose atoms may lie within `radius` of xy in the plane: x cells
+   !> lo(1)..hi(1), y cells lo(2)..hi(2) (0-based); radius <= 0: all cells.
+   !> Clamped to the grid (in reals first: a tip far away must not overflow
+   !> an integer): a tip outside it visits the border cells, which hold the
+   !> atoms outside the grid.
+   pure subroutine cell_range(self, xy, radius, lo, hi)
+      type(atom_cells), intent(in) :: self
+      real(wp), intent(in) :: xy(2), radius
       integer, intent(out) :: lo(2), hi(2)
 
-      if (self%cutoff <= 0.0_wp) then
+      if (radius <= 0.0_wp) then
          lo = 0
          hi = self%ncell - 1
          return
       end if
-      ! Clamped to the grid (in reals first: a tip far away must not overflow
-      ! an integer): a tip outside it visits the border cells, which hold
-      ! the atoms outside the grid.
-      lo = int(min(real(self%ncell - 1, wp), max(0.0_wp, (r(1:2) - self%cutoff - self%origin) / self%cell)))
-      hi = int(min(real(self%ncell - 1, wp), max(0.0_wp, (r(1:2) + self%cutoff - self%origin) / self%cell)))
+      lo = int(min(real(self%ncell - 1, wp), max(0.0_wp, (xy - radius - self%origin) / self%cell)))
+      hi = int(min(real(self%ncell - 1, wp), max(0.0_wp, (xy + radius - self%origin) / self%cell)))
    end subroutine cell_range
 
    pure function energy(self, r) result(v)
@@ -167,7 +260,12 @@ contains
       real(wp), intent(in) :: r(3)
       real(wp) :: v
       real(wp) :: g(3), h(3, 3)
+      logical :: answered
 
+      if (self%tabulated) then
+         call self%table_answers(r, 0, answered, v, g, h)
+         if (answered) return
+      end if
       call sum_pairs(self, r, 0, v, g, h)
    end function energy
 
@@ -176,7 +274,12 @@ contains
       real(wp), intent(in) :: r(3)
       real(wp), intent(out) :: g(3)
       real(wp) :: v, h(3, 3)
+      logical :: answered
 
+      if (self%tabulated) then
+         call self%table_answers(r, 1, answered, v, g, h)
+         if (answered) return
+      end if
       call sum_pairs(self, r, 1, v, g, h)
    end subroutine gradient
 
@@ -185,9 +288,24 @@ contains
       real(wp), intent(in) :: r(3)
       real(wp), intent(out) :: h(3, 3)
       real(wp) :: v, g(3)
+      logical :: answered
 
+      if (self%tabulated) then
+         call self%table_answers(r, 2, answered, v, g, h)
+         if (answered) return
+      end if
       call sum_pairs(self, r, 2, v, g, h)
    end subroutine hessian
+
+   !> The gradient of the direct sum, whatever the evaluation.
+   pure subroutine direct_gradient(self, r, g)
+      class(lj_potential), intent(in) :: self
+      real(wp), intent(in) :: r(3)
+      real(wp), intent(out) :: g(3)
+      real(wp) :: v, h(3, 3)
+
+      call sum_pairs(self, r, 1, v, g, h)
+   end subroutine direct_gradient
 
    !> The pair sums over the atoms within the cutoff of r: `order` 0 the
    !> energy V, 1 the gradient, 2 the gradient and the Hessian, with s = σ/r,
@@ -195,6 +313,8 @@ contains
    !>   V = Σ 4ε (s¹² - s⁶),   dV/dr = Σ f d,  f = -24ε(2s¹² - s⁶)/r²,
    !>   d²V/dr_a dr_b = Σ [f δ_ab + 2 f' d_a d_b],  f' = df/d(r²) = 24ε(14s¹² - 4s⁶)/r⁴.
    !> One loop for all three, so they cannot disagree on which atoms count.
+   !> A tabulated potential's energies are shifted by φ(r_c) per pair (as its
+   !> table's, so the energy is continuous where one hands over to the other).
    pure subroutine sum_pairs(self, r, order, v, g, h)
       class(lj_potential), intent(in) :: self
       real(wp), intent(in) :: r(3)
@@ -207,33 +327,130 @@ contains
       g = 0.0_wp
       h = 0.0_wp
       rc2 = merge(self%cutoff**2, huge(1.0_wp), self%cutoff > 0.0_wp)
-      call self%cell_range(r, lo, hi)
-      do cy = lo(2), hi(2)
-         do cx = lo(1), hi(1)
-            c = cx + cy * self%ncell(1) + 1
-            do i = self%cell_start(c), self%cell_start(c + 1) - 1
-               d = r - self%position(:, i)
-               r2 = d(1)**2 + d(2)**2 + d(3)**2
-               if (r2 >= rc2) cycle
-               s = self%species(i)
-               s6 = (self%sigma(s)**2 / r2)**3
-               if (order == 0) then   ! (the energy only when asked: the gradient is the hot path)
-                  v = v + 4.0_wp * self%epsilon(s) * (s6 * s6 - s6)
-                  cycle
-               end if
-               f = -24.0_wp * self%epsilon(s) * (2.0_wp * s6 * s6 - s6) / r2
-               g = g + f * d
-               if (order < 2) cycle
-               ! s6 ~ r2^-3, so d(s6)/d(r2) = -3 s6/r2 and d(s12)/d(r2) = -6 s12/r2.
-               df = 24.0_wp * self%epsilon(s) * (14.0_wp * s6 * s6 - 4.0_wp * s6) / r2**2
-               do a = 1, 3
-                  h(:, a) = h(:, a) + 2.0_wp * df * d * d(a)
-                  h(a, a) = h(a, a) + f
+      call cell_range(self%atoms, r(1:2), self%cutoff, lo, hi)
+      associate (atoms => self%atoms)
+         do cy = lo(2), hi(2)
+            do cx = lo(1), hi(1)
+               c = cx + cy * atoms%ncell(1) + 1
+               do i = atoms%cell_start(c), atoms%cell_start(c + 1) - 1
+                  d = r - atoms%position(:, i)
+                  r2 = d(1)**2 + d(2)**2 + d(3)**2
+                  if (r2 >= rc2) cycle
+                  s = atoms%species(i)
+                  s6 = (self%sigma(s)**2 / r2)**3
+                  if (order == 0) then   ! (the energy only when asked: the gradient is the hot path)
+                     v = v + 4.0_wp * self%epsilon(s) * (s6 * s6 - s6)
+                     if (self%tabulated) v = v - self%table%shift(s)
+                     cycle
+                  end if
+                  f = -24.0_wp * self%epsilon(s) * (2.0_wp * s6 * s6 - s6) / r2
+                  g = g + f * d
+                  if (order < 2) cycle
+                  ! s6 ~ r2^-3, so d(s6)/d(r2) = -3 s6/r2 and d(s12)/d(r2) = -6 s12/r2.
+                  df = 24.0_wp * self%epsilon(s) * (14.0_wp * s6 * s6 - 4.0_wp * s6) / r2**2
+                  do a = 1, 3
+                     h(:, a) = h(:, a) + 2.0_wp * df * d * d(a)
+                     h(a, a) = h(a, a) + f
+                  end do
                end do
             end do
          end do
-      end do
+      end associate
    end subroutine sum_pairs
+
+   !> The table's answer at r, when it has one (`answered`): above the
+   !> ceiling zero (no atom within the cutoff); between the floor and the
+   !> ceiling, inside the table's box and where the lattice's interpolated
+   !> energy is at most the cap, the interpolated lattice plus the
+   !> differences summed directly.  Elsewhere (near the atoms' cores, below
+   !> the floor, outside the box) not answered: the direct sum's turn.
+   pure subroutine table_answers(self, r, order, answered, v, g, h)
+      class(lj_potential), intent(in) :: self
+      real(wp), intent(in) :: r(3)
+      integer, intent(in) :: order
+      logical, intent(out) :: answered
+      real(wp), intent(out) :: v, g(3), h(3, 3)
+      real(wp) :: s(2), gs(3), hs(3, 3), m(2, 2)
+
+      v = 0.0_wp
+      g = 0.0_wp
+      h = 0.0_wp
+      associate (t => self%table)
+         answered = r(3) >= t%ceiling
+         if (answered) return
+         if (r(3) < t%floor .or. r(1) < t%box(1) .or. r(1) > t%box(2) .or. r(2) < t%box(3) &
+            & .or. r(2) > t%box(4)) return
+         if (r(3) < t%top) then
+            m = t%to_fraction
+            s(1) = m(1, 1) * r(1) + m(1, 2) * r(2)
+            s(2) = m(2, 1) * r(1) + m(2, 2) * r(2)
+            s = s - floor(s)
+            ! (order 0: the energy alone; the cap needs it in any case)
+            call t%grid%evaluate([s(1), s(2), r(3)], order, v, gs, hs)
+            if (v > t%energy_cap) return
+            if (order >= 1) then
+               ! dV/dx_j = Σ_i dV/ds_i M_ij: the gradient is Mᵀ g_s.
+               g(1) = m(1, 1) * gs(1) + m(2, 1) * gs(2)
+               g(2) = m(1, 2) * gs(1) + m(2, 2) * gs(2)
+               g(3) = gs(3)
+            end if
+            if (order >= 2) then
+               h(1:2, 1:2) = matmul(transpose(m), matmul(hs(1:2, 1:2), m))
+               h(1:2, 3) = matmul(transpose(m), hs(1:2, 3))
+               h(3, 1:2) = h(1:2, 3)
+               h(3, 3) = hs(3, 3)
+            end if
+         end if
+         answered = .true.
+         call difference_sums(self, r, order, v, g, h)
+      end associate
+   end subroutine table_answers
+
+   !> Adds the pair terms of the table's differences within the cutoff of r
+   !> (weight +1 an atom the lattice lacks, -1 a site the net lacks), with
+   !> energies shifted by φ(r_c) as the table's.
+   pure subroutine difference_sums(self, r, order, v, g, h)
+      class(lj_potential), intent(in) :: self
+      real(wp), intent(in) :: r(3)
+      integer, intent(in) :: order
+      real(wp), intent(inout) :: v, g(3), h(3, 3)
+      real(wp) :: d(3), r2, rc2, s6, f, df, w, dv, dg(3)
+      integer :: ij(2), i, s, a, c
+
+      rc2 = self%cutoff**2
+      associate (list => self%table%differences)
+         ij = int(min(real(list%ncell - 1, wp), max(0.0_wp, (r(1:2) - list%origin) / list%cell)))
+         c = ij(1) + ij(2) * list%ncell(1) + 1
+         if (list%start(c + 1) == list%start(c)) return
+         if (order < 2) then
+            associate (from => list%start(c), to => list%start(c + 1) - 1)
+               call difference_terms(to - from + 1, list%x(from:to), list%y(from:to), list%z(from:to), &
+                  & list%sigma2(from:to), list%e4w(from:to), list%shiftw(from:to), rc2, r, order, dv, dg)
+            end associate
+            v = v + dv
+            g = g + dg
+            return
+         end if
+         do i = list%start(c), list%start(c + 1) - 1
+            d = r - list%position(:, i)
+            r2 = d(1)**2 + d(2)**2 + d(3)**2
+            if (r2 >= rc2) cycle
+            s = list%species(i)
+            w = list%weight(i)
+            s6 = (self%sigma(s)**2 / r2)**3
+            v = v + w * (4.0_wp * self%epsilon(s) * (s6 * s6 - s6) - self%table%shift(s))
+            if (order < 1) cycle
+            f = -24.0_wp * w * self%epsilon(s) * (2.0_wp * s6 * s6 - s6) / r2
+            g = g + f * d
+            if (order < 2) cycle
+            df = 24.0_wp * w * self%epsilon(s) * (14.0_wp * s6 * s6 - 4.0_wp * s6) / r2**2
+            do a = 1, 3
+               h(:, a) = h(:, a) + 2.0_wp * df * d * d(a)
+               h(a, a) = h(a, a) + f
+            end do
+         end do
+      end associate
+   end subroutine difference_sums
 
    !> The height of the highest atom within lateral distance `radius` of
    !> (x, y) = xy, and the smallest σ of the net's species; -huge when no
@@ -246,13 +463,12 @@ contains
 
       top = -huge(1.0_wp)
       sigma_min = minval(self%sigma)
-      lo = int(min(real(self%ncell - 1, wp), max(0.0_wp, (xy - radius - self%origin) / self%cell)))
-      hi = int(min(real(self%ncell - 1, wp), max(0.0_wp, (xy + radius - self%origin) / self%cell)))
+      call cell_range(self%atoms, xy, radius, lo, hi)
       do cy = lo(2), hi(2)
          do cx = lo(1), hi(1)
-            c = cx + cy * self%ncell(1) + 1
-            do i = self%cell_start(c), self%cell_start(c + 1) - 1
-               if (sum((self%position(1:2, i) - xy)**2) < radius**2) top = max(top, self%position(3, i))
+            c = cx + cy * self%atoms%ncell(1) + 1
+            do i = self%atoms%cell_start(c), self%atoms%cell_start(c + 1) - 1
+               if (sum((self%atoms%position(1:2, i) - xy)**2) < radius**2) top = max(top, self%atoms%position(3, i))
             end do
          end do
       end do
@@ -264,5 +480,673 @@ contains
 
       n = 3
    end function dimensions
+
+   ! ------------------------------------------------------------------
+   ! Building the table
+   ! ------------------------------------------------------------------
+
+   !> Tabulate the potential of a net cut from `lattice` (docs/physics.md,
+   !> "The tabulated surface"), so that its force is within
+   !> settings%tolerance of the direct sum wherever the table answers.
+   !> On success self%tabulated; otherwise `reason` says why not (and the
+   !> potential stays the direct sum).
+   !>
+   !> 1. The lattice's sites near one cell, and the differences between the
+   !>    net and the lattice within the cutoff of the box (atoms matched to
+   !>    sites within 1e-8 Å and of the same species are the lattice's).
+   !> 2. The heights: layers from the top (the lattice's atoms plus r_c,
+   !>    where V is zero) down, each spacing as large as keeps the error of
+   !>    the interpolation along z within 0.4 tolerance at check columns (36
+   !>    and the atoms' sites), until every check column's energy is above
+   !>    the cap (the lowest energy met plus the energy window): the floor.
+   !> 3. The lateral spacing: as large as keeps the error within 0.4
+   !>    tolerance at points in the layers, measured on trial spacings.
+   !> 4. The table: every node of one cell on every layer.
+   !> 5. The check: the force against the direct sum over the net at
+   !>    settings%verify_points quasi-random points (Halton, the same on
+   !>    every rank) in the box where the table answers; above the tolerance
+   !>    the targets are halved and the table built again (twice at most).
+   subroutine tabulate(self, lattice, settings, reason, share)
+      class(lj_potential), intent(inout) :: self
+      type(net_lattice), intent(in) :: lattice
+      type(table_settings), intent(in) :: settings
+      character(len=:), allocatable, intent(out) :: reason
+      !> the processes building the same table, each a share of its nodes and
+      !> checks (absent: this process alone)
+      class(work_sharing), intent(inout), optional :: share
+      type(work_sharing) :: alone
+      type(lj_potential) :: ideal
+      type(lj_table) :: t
+      real(wp), allocatable :: layers(:)
+      real(wp) :: target, spacing, vmin, measured, det
+      integer :: attempt, n1, n2
+
+      reason = ''
+      self%tabulated = .false.
+      if (.not. (self%cutoff > 0.0_wp)) then
+         reason = 'the table needs a finite cutoff'
+         return
+      end if
+      t%vectors = lattice%vectors
+      det = t%vectors(1, 1) * t%vectors(2, 2) - t%vectors(1, 2) * t%vectors(2, 1)
+      if (.not. (abs(det) > 1.0e-6_wp)) then
+         reason = 'the lattice vectors are parallel'
+         return
+      end if
+      t%to_fraction = reshape([t%vectors(2, 2), -t%vectors(2, 1), -t%vectors(1, 2), t%vectors(1, 1)], [2, 2]) / det
+      t%box = settings%box
+      ! A lattice so dense that a node would sum more pairs than this, or a
+      ! box holding more sites, costs more to tabulate than it saves.
+      associate (per_site => abs(det) / size(lattice%species), box => settings%box, rc => self%cutoff)
+         if (pi * rc**2 / per_site > 20000.0_wp) then
+            reason = 'the lattice has '//itoa(nint(pi * rc**2 / per_site))//' sites within the cutoff: ' &
+               & //'a table would cost more to build than it saves'
+            return
+         end if
+         if ((box(2) - box(1) + 2 * rc + 2) * (box(4) - box(3) + 2 * rc + 2) / per_site > 2.0e6_wp) then
+            reason = 'the box the tip can reach holds more than 2e6 sites of the lattice'
+            return
+         end if
+      end associate
+      t%tolerance = settings%tolerance
+      t%energy_window = settings%energy_window
+      t%shift = lj_pair_energy(self%epsilon, self%sigma, self%cutoff)
+      t%top = maxval(lattice%basis(3, :)) + self%cutoff
+      t%ceiling = max(t%top, maxval(self%atoms%position(3, :)) + self%cutoff)
+      ideal = lattice_near_cell(self, lattice)
+      call find_differences(self, lattice, t)
+      if (mostly_different(self, t)) then
+         reason = 'the net differs from its lattice at more places than it agrees with it, within the cutoff ' &
+            & //'of the middle of the scan (a flake smaller than the cutoff, or no lattice): the direct sum is cheaper'
+         return
+      end if
+      target = 0.4_wp * settings%tolerance
+      do attempt = 1, 3
+         call choose_layers(ideal, t, target, settings%energy_window, layers, vmin, reason)
+         if (len(reason) > 0) return
+         t%energy_cap = vmin + settings%energy_window
+         call choose_spacing(ideal, t, layers, target, spacing, reason)
+         if (len(reason) > 0) return
+         n1 = max(4, ceiling(norm2(t%vectors(:, 1)) / spacing))
+         n2 = max(4, ceiling(norm2(t%vectors(:, 2)) / spacing))
+         if (64.0_wp * (n1 + 1) * (n2 + 1) * size(layers) > settings%max_bytes) then
+            reason = 'a table of '//itoa(n1)//' x '//itoa(n2)//' x '//itoa(size(layers))//' nodes would exceed ' &
+               & //rtoa(settings%max_bytes / 1024.0_wp**2)//' MiB'
+            return
+         end if
+         t%grid = new_tricubic_grid(0.0_wp, 1.0_wp / n1, n1 + 1, 0.0_wp, 1.0_wp / n2, n2 + 1, layers)
+         if (present(share)) then
+            call fill_grid(ideal, t, centrosymmetric(lattice), share)
+         else
+            call fill_grid(ideal, t, centrosymmetric(lattice), alone)
+         end if
+         t%floor = layers(1)
+         t%nodes = [n1, n2, size(layers)]
+         self%table = t
+         deallocate (t%grid%node)   ! (one copy of the nodes, not two)
+         self%tabulated = .true.
+         if (present(share)) then
+            call verify(self, settings%verify_points, measured, share)
+         else
+            call verify(self, settings%verify_points, measured, alone)
+         end if
+         self%table%error = measured
+         if (measured <= settings%tolerance) return
+         self%tabulated = .false.
+         deallocate (self%table%grid%node)
+         target = 0.5_wp * target
+      end do
+      reason = 'the table missed the tolerance '//rtoa(settings%tolerance)//' eV/Å by '//rtoa(measured) &
+         & //' eV/Å after three refinements'
+   end subroutine tabulate
+
+   !> The perfect lattice's sites within the cutoff (and a margin) of the
+   !> cell spanned by its vectors at the origin, as a potential.
+   function lattice_near_cell(self, lattice) result(ideal)
+      type(lj_potential), intent(in) :: self
+      type(net_lattice), intent(in) :: lattice
+      type(lj_potential) :: ideal
+      real(wp) :: corners(2, 4), box(4), margin
+
+      corners(:, 1) = 0.0_wp
+      corners(:, 2) = lattice%vectors(:, 1)
+      corners(:, 3) = lattice%vectors(:, 2)
+      corners(:, 4) = lattice%vectors(:, 1) + lattice%vectors(:, 2)
+      margin = self%cutoff + 1.0_wp
+      box = [minval(corners(1, :)) - margin, maxval(corners(1, :)) + margin, &
+         & minval(corners(2, :)) - margin, maxval(corners(2, :)) + margin]
+      ideal = new_lj_potential(lattice%sites(box), self%epsilon, self%sigma, self%cutoff)
+   end function lattice_near_cell
+
+   !> The net's differences from the lattice within the cutoff (and a
+   !> margin) of the table's box: net atoms on no site of their species
+   !> (weight +1) and sites with no atom (weight -1).
+   subroutine find_differences(self, lattice, t)
+      type(lj_potential), intent(in) :: self
+      type(net_lattice), intent(in) :: lattice
+      type(lj_table), intent(inout) :: t
+      real(wp), parameter :: same = 1.0e-8_wp
+      type(crystal_net) :: sites
+      real(wp) :: region(4)
+      real(wp), allocatable :: position(:, :), weight(:)
+      integer, allocatable :: species(:)
+      logical, allocatable :: matched(:)
+      integer :: i, k, n
+
+      region = t%box + (self%cutoff + 1.0_wp) * [-1.0_wp, 1.0_wp, -1.0_wp, 1.0_wp]
+      sites = lattice%sites(region)
+      associate (atoms => self%atoms)
+         allocate (matched(size(atoms%species)), source=.false.)
+         n = sites%size() + size(atoms%species)
+         allocate (position(3, n), species(n), weight(n))
+         n = 0
+         do k = 1, sites%size()
+            if (match(k)) cycle
+            n = n + 1
+            position(:, n) = sites%position(:, k)
+            species(n) = sites%species(k)
+            weight(n) = -1.0_wp
+         end do
+         do i = 1, size(atoms%species)
+            if (matched(i)) cycle
+            if (atoms%position(1, i) < region(1) .or. atoms%position(1, i) > region(2) .or. &
+               & atoms%position(2, i) < region(3) .or. atoms%position(2, i) > region(4)) cycle
+            n = n + 1
+            position(:, n) = atoms%position(:, i)
+            species(n) = atoms%species(i)
+            weight(n) = 1.0_wp
+         end do
+      end associate
+      t%differences = new_difference_lists(position(:, 1:n), species(1:n), weight(1:n), self%cutoff, region)
+      associate (list => t%differences)
+         list%x = list%position(1, :)
+         list%y = list%position(2, :)
+         list%z = list%position(3, :)
+         list%sigma2 = self%sigma(list%species)**2
+         list%e4w = 4.0_wp * self%epsilon(list%species) * list%weight
+         list%shiftw = t%shift(list%species) * list%weight
+      end associate
+      t%difference_count = n
+
+   contains
+
+      !> Whether an atom of the net, not matched before, sits on site k.
+      logical function match(k)
+         integer, intent(in) :: k
+         integer :: lo(2), hi(2), cx, cy, c, i
+
+         match = .false.
+         associate (atoms => self%atoms)
+            call cell_range(atoms, sites%position(1:2, k), same, lo, hi)
+            do cy = lo(2), hi(2)
+               do cx = lo(1), hi(1)
+                  c = cx + cy * atoms%ncell(1) + 1
+                  do i = atoms%cell_start(c), atoms%cell_start(c + 1) - 1
+                     if (matched(i) .or. atoms%species(i) /= sites%species(k)) cycle
+                     if (all(abs(atoms%position(:, i) - sites%position(:, k)) <= same)) then
+                        matched(i) = .true.
+                        match = .true.
+                        return
+                     end if
+                  end do
+               end do
+            end do
+         end associate
+      end function match
+
+   end subroutine find_differences
+
+   !> The lists of the differences (see difference_lists) over `region`
+   !> (x_min, x_max, y_min, y_max, Å), in cells of 2 Å (or r_c/3 if smaller):
+   !> a list holds the atoms within r_c plus half the cell's diagonal of its
+   !> centre, some 20 % more than the disc of r_c holds.
+   function new_difference_lists(position, species, weight, cutoff, region) result(self)
+      real(wp), intent(in) :: position(:, :), weight(:), cutoff, region(4)
+      integer, intent(in) :: species(:)
+      type(difference_lists) :: self
+      real(wp) :: centre(2), reach2
+      integer :: cx, cy, c, i, total, pass
+
+      self%cell = min(2.0_wp, cutoff / 3.0_wp)
+      self%origin = [region(1), region(3)]
+      self%ncell = max(1, ceiling([region(2) - region(1), region(4) - region(3)] / self%cell))
+      reach2 = (cutoff + self%cell / sqrt(2.0_wp))**2
+      allocate (self%start(self%ncell(1) * self%ncell(2) + 1))
+      ! Two passes: the lists' lengths, then their entries.
+      do pass = 1, 2
+         total = 0
+         self%start(1) = 1
+         do cy = 0, self%ncell(2) - 1
+            do cx = 0, self%ncell(1) - 1
+               c = cx + cy * self%ncell(1) + 1
+               centre = self%origin + ([cx, cy] + 0.5_wp) * self%cell
+               do i = 1, size(species)
+                  if (sum((position(1:2, i) - centre)**2) >= reach2) cycle
+                  total = total + 1
+                  if (pass == 1) cycle
+                  self%position(:, total) = position(:, i)
+                  self%species(total) = species(i)
+                  self%weight(total) = weight(i)
+               end do
+               self%start(c + 1) = total + 1
+            end do
+         end do
+         if (pass == 1) allocate (self%position(3, total), self%species(total), self%weight(total))
+      end do
+   end function new_difference_lists
+
+   !> Whether, within the cutoff of the middle of the table's box, there are
+   !> more differences than atoms of the net: then every evaluation would
+   !> sum more pairs through the table than directly.
+   logical function mostly_different(self, t)
+      type(lj_potential), intent(in) :: self
+      type(lj_table), intent(in) :: t
+      real(wp) :: middle(2)
+      integer :: ij(2), c, i, lo(2), hi(2), cx, cy, atoms, differences
+
+      middle = [0.5_wp * (t%box(1) + t%box(2)), 0.5_wp * (t%box(3) + t%box(4))]
+      associate (list => t%differences)
+         ij = int(min(real(list%ncell - 1, wp), max(0.0_wp, (middle - list%origin) / list%cell)))
+         c = ij(1) + ij(2) * list%ncell(1) + 1
+         differences = count([(sum((list%position(1:2, i) - middle)**2) < self%cutoff**2, &
+            & i = list%start(c), list%start(c + 1) - 1)])
+      end associate
+      atoms = 0
+      call cell_range(self%atoms, middle, self%cutoff, lo, hi)
+      do cy = lo(2), hi(2)
+         do cx = lo(1), hi(1)
+            c = cx + cy * self%atoms%ncell(1) + 1
+            do i = self%atoms%cell_start(c), self%atoms%cell_start(c + 1) - 1
+               if (sum((self%atoms%position(1:2, i) - middle)**2) < self%cutoff**2) atoms = atoms + 1
+            end do
+         end do
+      end do
+      mostly_different = differences > atoms
+   end function mostly_different
+
+   !> The eight node values of the lattice potential at heights z(:) above
+   !> the point xy (Å), in the fractional coordinates of the lattice
+   !> (friction_surface_lj_columns' column_sums); the pairs within the
+   !> cutoff in the plane are gathered once per column.
+   pure subroutine column_values(ideal, t, xy, z, values)
+      type(lj_potential), intent(in) :: ideal
+      type(lj_table), intent(in) :: t
+      real(wp), intent(in) :: xy(2), z(:)
+      real(wp), intent(out) :: values(:, :)
+      real(wp), allocatable :: u1(:), u2(:), lateral(:), height(:), sigma2(:), e4(:), shift(:)
+      real(wp) :: a1(2), a2(2), c12, rc2, dx, dy
+      integer :: lo(2), hi(2), cx, cy, c, i, n, s, most
+
+      a1 = t%vectors(:, 1)
+      a2 = t%vectors(:, 2)
+      c12 = dot_product(a1, a2)
+      rc2 = ideal%cutoff**2
+      ! The sites within the cutoff in the plane, with what the pair terms
+      ! need of them (u_i = a_i . d does not change along the column).
+      call cell_range(ideal%atoms, xy, ideal%cutoff, lo, hi)
+      most = 0
+      do cy = lo(2), hi(2)
+         c = lo(1) + cy * ideal%atoms%ncell(1) + 1
+         most = most + ideal%atoms%cell_start(c + hi(1) - lo(1) + 1) - ideal%atoms%cell_start(c)
+      end do
+      allocate (u1(most), u2(most), lateral(most), height(most), sigma2(most), e4(most), shift(most))
+      n = 0
+      do cy = lo(2), hi(2)
+         do cx = lo(1), hi(1)
+            c = cx + cy * ideal%atoms%ncell(1) + 1
+            do i = ideal%atoms%cell_start(c), ideal%atoms%cell_start(c + 1) - 1
+               dx = xy(1) - ideal%atoms%position(1, i)
+               dy = xy(2) - ideal%atoms%position(2, i)
+               if (dx**2 + dy**2 >= rc2) cycle
+               n = n + 1
+               s = ideal%atoms%species(i)
+               lateral(n) = dx**2 + dy**2
+               u1(n) = a1(1) * dx + a1(2) * dy
+               u2(n) = a2(1) * dx + a2(2) * dy
+               height(n) = ideal%atoms%position(3, i)
+               sigma2(n) = ideal%sigma(s)**2
+               e4(n) = 4.0_wp * ideal%epsilon(s)
+               shift(n) = t%shift(s)
+            end do
+         end do
+      end do
+      call column_sums(n, lateral, u1, u2, height, sigma2, e4, shift, c12, rc2, z, values)
+   end subroutine column_values
+
+   !> The Cartesian point of fractional coordinates s.
+   pure function cartesian(t, s) result(xy)
+      type(lj_table), intent(in) :: t
+      real(wp), intent(in) :: s(2)
+      real(wp) :: xy(2)
+
+      xy = s(1) * t%vectors(:, 1) + s(2) * t%vectors(:, 2)
+   end function cartesian
+
+   !> The gradient of the lattice potential (direct sum) at r, Cartesian.
+   pure function lattice_gradient(ideal, t, r) result(g)
+      type(lj_potential), intent(in) :: ideal
+      type(lj_table), intent(in) :: t
+      real(wp), intent(in) :: r(3)
+      real(wp) :: g(3)
+      real(wp) :: values(n_node_values, 1)
+
+      call column_values(ideal, t, r(1:2), [r(3)], values)
+      ! (V_si = a_i . grad: back through the inverse.)
+      g(1) = t%to_fraction(1, 1) * values(2, 1) + t%to_fraction(2, 1) * values(3, 1)
+      g(2) = t%to_fraction(1, 2) * values(2, 1) + t%to_fraction(2, 2) * values(3, 1)
+      g(3) = values(4, 1)
+   end function lattice_gradient
+
+   !> Step 2 of `tabulate`: the heights of the layers, ascending, and the
+   !> lowest energy of the lattice met (at the check columns' nodes).
+   subroutine choose_layers(ideal, t, target, window, layers, vmin, reason)
+      type(lj_potential), intent(in) :: ideal
+      type(lj_table), intent(in) :: t
+      real(wp), intent(in) :: target, window
+      real(wp), allocatable, intent(out) :: layers(:)
+      real(wp), intent(out) :: vmin
+      character(len=:), allocatable, intent(inout) :: reason
+      integer, parameter :: side = 6, max_layers = 4000
+      real(wp), parameter :: check_at(3) = [0.2113248654051871_wp, 0.5_wp, 0.7886751345948129_wp]
+      real(wp), allocatable :: columns(:, :), upper(:, :), lower(:, :), found(:)
+      real(wp) :: step, z, z_new, worst, bottom, ratio, g(3), r(3), v, gi(3), s(2)
+      integer :: ncol, i, j, k, m
+      logical :: all_above
+
+      ! Check columns: a side x side grid of the cell (its corner, thirds and
+      ! halves among them) and the sites of the atoms in the cell.
+      allocate (columns(2, side * side + size(ideal%atoms%species)))
+      ncol = 0
+      do j = 0, side - 1
+         do i = 0, side - 1
+            ncol = ncol + 1
+            columns(:, ncol) = cartesian(t, [real(i, wp), real(j, wp)] / side)
+         end do
+      end do
+      do i = 1, size(ideal%atoms%species)
+         s = matmul(t%to_fraction, ideal%atoms%position(1:2, i))
+         if (any(s < 0.0_wp) .or. any(s >= 1.0_wp)) cycle
+         ncol = ncol + 1
+         columns(:, ncol) = ideal%atoms%position(1:2, i)
+      end do
+      allocate (upper(n_node_values, ncol), lower(n_node_values, ncol))
+      bottom = minval(ideal%atoms%position(3, :))
+      z = t%top
+      do m = 1, ncol
+         call column_values(ideal, t, columns(:, m), [z], upper(:, m:m))
+      end do
+      vmin = minval(upper(1, :))
+      found = [z]
+      step = 1.0_wp
+      do
+         z_new = z - step
+         if (z_new <= bottom) then
+            reason = 'no floor for the table: the energy stays below the cap down to the atoms'
+            return
+         end if
+         do m = 1, ncol
+            call column_values(ideal, t, columns(:, m), [z_new], lower(:, m:m))
+         end do
+         ! The error of the interpolation along z at the check columns, where
+         ! the energy is under the cap (the lowest energy so far: the cap
+         ! only falls as the march goes down through the well).
+         worst = 0.0_wp
+         do m = 1, ncol
+            do k = 1, size(check_at)
+               r = [columns(:, m), z_new + check_at(k) * step]
+               call hermite_column(lower(:, m), upper(:, m), z_new, z, r(3), v, gi)
+               if (v > min(vmin, minval(lower(1, :))) + window) cycle
+               g = lattice_gradient(ideal, t, r)
+               gi(1:2) = matmul(transpose(t%to_fraction), gi(1:2))
+               worst = max(worst, norm2(gi - g))
+            end do
+         end do
+         ratio = (target / max(worst, tiny(1.0_wp)))**(1.0_wp / 3.0_wp)
+         if (worst > target) then
+            step = step * max(0.2_wp, 0.9_wp * ratio)
+            if (step < 1.0e-4_wp) then
+               reason = 'the layers would need to be closer than 1e-4 Å'
+               return
+            end if
+            cycle
+         end if
+         z = z_new
+         upper = lower
+         found = [found, z]
+         vmin = min(vmin, minval(lower(1, :)))
+         if (size(found) > max_layers) then
+            reason = 'more than '//itoa(max_layers)//' layers'
+            return
+         end if
+         all_above = all(lower(1, :) > vmin + window)
+         if (all_above) exit
+         step = step * min(2.0_wp, 0.9_wp * ratio)
+      end do
+      layers = found(size(found):1:-1)
+   end subroutine choose_layers
+
+   !> The cubic Hermite interpolation along z between two nodes' values
+   !> (lower at z0, upper at z1) at height z: the energy and the gradient in
+   !> fractional coordinates (the lateral components from V_si and V_siz).
+   pure subroutine hermite_column(lower, upper, z0, z1, z, v, g)
+      real(wp), intent(in) :: lower(:), upper(:), z0, z1, z
+      real(wp), intent(out) :: v, g(3)
+      real(wp) :: t, w, h00, h01, h10, h11, d00, d01, d10, d11
+
+      w = z1 - z0
+      t = (z - z0) / w
+      h00 = 2 * t**3 - 3 * t**2 + 1
+      h01 = -2 * t**3 + 3 * t**2
+      h10 = (t**3 - 2 * t**2 + t) * w
+      h11 = (t**3 - t**2) * w
+      d00 = (6 * t**2 - 6 * t) / w
+      d01 = -d00
+      d10 = 3 * t**2 - 4 * t + 1
+      d11 = 3 * t**2 - 2 * t
+      v = h00 * lower(1) + h01 * upper(1) + h10 * lower(4) + h11 * upper(4)
+      g(3) = d00 * lower(1) + d01 * upper(1) + d10 * lower(4) + d11 * upper(4)
+      g(1) = h00 * lower(2) + h01 * upper(2) + h10 * lower(6) + h11 * upper(6)
+      g(2) = h00 * lower(3) + h01 * upper(3) + h10 * lower(7) + h11 * upper(7)
+   end subroutine hermite_column
+
+   !> Step 3 of `tabulate`: the lateral spacing (Å) that keeps the error of
+   !> the interpolation within the layers under `target`, measured at
+   !> quasi-random points of every layer (energy under the cap) on trial
+   !> spacings: the error goes as the spacing cubed.
+   subroutine choose_spacing(ideal, t, layers, target, spacing, reason)
+      type(lj_potential), intent(in) :: ideal
+      type(lj_table), intent(in) :: t
+      real(wp), intent(in) :: layers(:), target
+      real(wp), intent(out) :: spacing
+      character(len=:), allocatable, intent(inout) :: reason
+      integer, parameter :: per_layer = 16, trials = 6
+      real(wp) :: worst, s(2), f(2), n(2), corner(n_node_values, 2, 2), v, gi(3), g(3), hi(3, 3)
+      type(tricubic_grid) :: cell
+      integer :: trial, k, m, i, j, count_halton
+
+      spacing = 0.1_wp
+      do trial = 1, trials
+         n = max(4.0_wp, real(ceiling([norm2(t%vectors(:, 1)), norm2(t%vectors(:, 2))] / spacing), wp))
+         worst = 0.0_wp
+         count_halton = 0
+         do k = 1, size(layers)
+            do m = 1, per_layer
+               count_halton = count_halton + 1
+               s = [halton(count_halton + 16, 2), halton(count_halton + 16, 3)]
+               ! The cell holding s, its four corners at this layer.
+               f = floor(s * n)
+               do j = 0, 1
+                  do i = 0, 1
+                     call column_values(ideal, t, cartesian(t, (f + [i, j]) / n), [layers(k)], &
+                        & corner(:, i + 1:i + 1, j + 1))
+                  end do
+               end do
+               cell = new_tricubic_grid(f(1) / n(1), 1.0_wp / n(1), 2, f(2) / n(2), 1.0_wp / n(2), 2, &
+                  & [layers(k), layers(k) + 1.0_wp])
+               cell%node(:, :, :, 1) = corner
+               cell%node(:, :, :, 2) = corner
+               call cell%evaluate([s(1), s(2), layers(k)], 1, v, gi, hi)
+               if (v > t%energy_cap) cycle
+               gi(1:2) = matmul(transpose(t%to_fraction), gi(1:2))
+               g = lattice_gradient(ideal, t, [cartesian(t, s), layers(k)])
+               worst = max(worst, norm2(gi - g))
+            end do
+         end do
+         if (worst <= target .and. trial > 1) return
+         ! Error ~ spacing³: aim 10 % below the target.
+         spacing = spacing * min(1.5_wp, 0.9_wp * (target / max(worst, tiny(1.0_wp)))**(1.0_wp / 3.0_wp))
+         if (spacing < 1.0e-3_wp) then
+            reason = 'the lateral spacing would need to be below 1e-3 Å'
+            return
+         end if
+      end do
+      ! (The last trial's spacing, refined once more, stands: step 5 checks it.)
+   end subroutine choose_spacing
+
+   !> Whether the lattice is its own image under r -> -r (in the plane):
+   !> every atom of the cell has an atom of its species and height at minus
+   !> its position, less a lattice vector.
+   pure logical function centrosymmetric(lattice)
+      type(net_lattice), intent(in) :: lattice
+      real(wp) :: inverse(2, 2), f(2), det
+      integer :: b, c
+
+      associate (v => lattice%vectors)
+         det = v(1, 1) * v(2, 2) - v(1, 2) * v(2, 1)
+         inverse = reshape([v(2, 2), -v(2, 1), -v(1, 2), v(1, 1)], [2, 2]) / det
+      end associate
+      centrosymmetric = .true.
+      do b = 1, size(lattice%species)
+         centrosymmetric = .false.
+         do c = 1, size(lattice%species)
+            if (lattice%species(c) /= lattice%species(b)) cycle
+            if (abs(lattice%basis(3, c) - lattice%basis(3, b)) > 1.0e-9_wp) cycle
+            f = matmul(inverse, lattice%basis(1:2, b) + lattice%basis(1:2, c))
+            if (all(abs(f - nint(f)) < 1.0e-9_wp)) centrosymmetric = .true.
+         end do
+         if (.not. centrosymmetric) return
+      end do
+   end function centrosymmetric
+
+   !> Step 4 of `tabulate`: every node's values (the last row and column
+   !> repeat the first: the lattice is periodic).  The columns are dealt
+   !> round-robin over the processes of `share`, each its own, and summed.
+   !> A centrosymmetric lattice has V(-s) = V(s): of each pair of columns
+   !> s, -s one is computed and the other is its image (derivatives odd in
+   !> s1, s2 change sign), which halves the work.
+   subroutine fill_grid(ideal, t, symmetric, share)
+      type(lj_potential), intent(in) :: ideal
+      type(lj_table), intent(inout) :: t
+      logical, intent(in) :: symmetric
+      class(work_sharing), intent(inout) :: share
+      !> the sign of each value in the image of a column under s -> -s
+      real(wp), parameter :: parity(n_node_values) = [1.0_wp, -1.0_wp, -1.0_wp, 1.0_wp, 1.0_wp, -1.0_wp, &
+         & -1.0_wp, 1.0_wp]
+      integer :: i, j, n1, n2, mi, mj, dealt, v
+
+      n1 = t%grid%nx - 1
+      n2 = t%grid%ny - 1
+      ! (-0.0 where this process computes nothing: see work_sharing's sum.)
+      if (share%ranks > 1) t%grid%node = -0.0_wp
+      dealt = 0
+      do j = 1, n2
+         do i = 1, n1
+            if (symmetric) then
+               if (mirror_column(i, j) < column_index(i, j)) cycle
+            end if
+            dealt = dealt + 1
+            if (mod(dealt - 1, share%ranks) /= share%rank) cycle
+            call column_values(ideal, t, cartesian(t, [real(i - 1, wp) / n1, real(j - 1, wp) / n2]), t%grid%z, &
+               & t%grid%node(:, i, j, :))
+         end do
+      end do
+      if (share%ranks > 1) call share%sum_reals(t%grid%node, size(t%grid%node))
+      if (symmetric) then
+         do j = 1, n2
+            do i = 1, n1
+               if (mirror_column(i, j) >= column_index(i, j)) cycle
+               mi = mod(n1 - (i - 1), n1) + 1
+               mj = mod(n2 - (j - 1), n2) + 1
+               do v = 1, n_node_values
+                  t%grid%node(v, i, j, :) = parity(v) * t%grid%node(v, mi, mj, :)
+               end do
+            end do
+         end do
+      end if
+      t%grid%node(:, n1 + 1, 1:n2, :) = t%grid%node(:, 1, 1:n2, :)
+      t%grid%node(:, :, n2 + 1, :) = t%grid%node(:, :, 1, :)
+
+   contains
+
+      integer function column_index(i, j)
+         integer, intent(in) :: i, j
+
+         column_index = (i - 1) + (j - 1) * n1
+      end function column_index
+
+      !> The column index of the image of column (i, j) under s -> -s.
+      integer function mirror_column(i, j)
+         integer, intent(in) :: i, j
+
+         mirror_column = column_index(mod(n1 - (i - 1), n1) + 1, mod(n2 - (j - 1), n2) + 1)
+      end function mirror_column
+
+   end subroutine fill_grid
+
+   !> Step 5 of `tabulate`: the largest force error (eV/Å) of the tabulated
+   !> potential against the direct sum over the net, at `points`
+   !> quasi-random points where the table answers below the ceiling
+   !> (lateral: the box; height: uniform in the layer index, so the layers
+   !> near the floor, where the field is steep, get their share).
+   subroutine verify(self, points, measured, share)
+      type(lj_potential), intent(inout) :: self
+      integer, intent(in) :: points
+      real(wp), intent(out) :: measured
+      class(work_sharing), intent(inout) :: share
+      real(wp) :: r(3), u, v, g(3), h(3, 3), gd(3)
+      integer :: k, tried, counted, nz
+      logical :: answered
+
+      measured = 0.0_wp
+      counted = 0
+      tried = 0
+      nz = size(self%table%grid%z)
+      associate (t => self%table, box => self%table%box)
+         do while (counted < points .and. tried < 20 * points)
+            tried = tried + 1
+            r(1) = box(1) + (box(2) - box(1)) * halton(tried + 20, 2)
+            r(2) = box(3) + (box(4) - box(3)) * halton(tried + 20, 3)
+            u = (nz - 1) * halton(tried + 20, 5)
+            k = min(nz - 1, int(u) + 1)
+            r(3) = t%grid%z(k) + (u - (k - 1)) * (t%grid%z(k + 1) - t%grid%z(k))
+            call self%table_answers(r, 1, answered, v, g, h)
+            if (.not. answered) cycle
+            counted = counted + 1
+            ! (The points dealt round-robin over the processes; the largest error of all.)
+            if (mod(counted - 1, share%ranks) /= share%rank) cycle
+            call sum_pairs(self, r, 1, v, gd, h)
+            measured = max(measured, norm2(g - gd))
+         end do
+         t%points = counted
+      end associate
+      call share%max_real(measured)
+   end subroutine verify
+
+   !> The k-th element of the van der Corput sequence in base b (k >= 1):
+   !> Halton points, the same on every run and every rank.
+   pure real(wp) function halton(k, b) result(x)
+      integer, intent(in) :: k, b
+      real(wp) :: f
+      integer :: i
+
+      x = 0.0_wp
+      f = 1.0_wp
+      i = k
+      do while (i > 0)
+         f = f / b
+         x = x + f * mod(i, b)
+         i = i / b
+      end do
+   end function halton
 
 end module friction_surface_lennard_jones

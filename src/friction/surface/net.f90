@@ -16,7 +16,7 @@ module friction_surface_net
    private
 
    public :: crystal_net, graphite_net, square_net, read_xyz, write_xyz, vacancy_mark, sort_order, max_local_density, &
-      & first_duplicate
+      & first_duplicate, net_lattice, graphite_lattice, square_lattice, detect_lattice
 
    !> Species label that marks a vacant site in an XYZ file.
    character(len=*), parameter :: vacancy_mark = 'X'
@@ -30,7 +30,270 @@ module friction_surface_net
       procedure :: substitute
    end type crystal_net
 
+   !> The periodic lattice a net is cut from: the lateral lattice vectors
+   !> a1, a2 (columns of `vectors`, Å, in the plane of the net) and the
+   !> atoms of the cell at the origin.  A net of this lattice has its atoms
+   !> at i a1 + j a2 + basis(:, b) (integer i, j), less its vacancies and
+   !> edges, its substitutions of another species; friction_surface_lennard_jones
+   !> tabulates the potential of the perfect lattice over one cell and sums
+   !> the differences directly.
+   type :: net_lattice
+      real(wp) :: vectors(2, 2) = 0.0_wp
+      real(wp), allocatable :: basis(:, :)   !! (3, atoms per cell), Å
+      integer, allocatable :: species(:)     !! (atoms per cell)
+   contains
+      procedure :: sites => lattice_sites
+   end type net_lattice
+
 contains
+
+   !> The lattice of graphite_net(a, shells): vectors (a, 0), (a/2, a√3/2)
+   !> and the two atoms (0, ±a/√3, 0) of the hexagon centred on the origin.
+   pure function graphite_lattice(a) result(lattice)
+      real(wp), intent(in) :: a
+      type(net_lattice) :: lattice
+
+      lattice%vectors = reshape([a, 0.0_wp, a / 2, a * sqrt(3.0_wp) / 2], [2, 2])
+      lattice%basis = reshape([0.0_wp, a / sqrt(3.0_wp), 0.0_wp, 0.0_wp, -a / sqrt(3.0_wp), 0.0_wp], [3, 2])
+      lattice%species = [1, 1]
+   end function graphite_lattice
+
+   !> The lattice of square_net(a, side): vectors (a, 0), (0, a), one atom,
+   !> at the origin for an odd side and at (a/2, a/2) for an even one.
+   pure function square_lattice(a, side) result(lattice)
+      real(wp), intent(in) :: a
+      integer, intent(in) :: side
+      type(net_lattice) :: lattice
+      real(wp) :: offset
+
+      lattice%vectors = reshape([a, 0.0_wp, 0.0_wp, a], [2, 2])
+      offset = merge(0.0_wp, 0.5_wp * a, mod(side, 2) == 1)
+      lattice%basis = reshape([offset, offset, 0.0_wp], [3, 1])
+      lattice%species = [1]
+   end function square_lattice
+
+   !> The sites of the lattice whose (x, y) lie in box = (x_min, x_max,
+   !> y_min, y_max), Å, with their species, as a net.
+   pure function lattice_sites(self, box) result(net)
+      class(net_lattice), intent(in) :: self
+      real(wp), intent(in) :: box(4)
+      type(crystal_net) :: net
+      real(wp) :: inverse(2, 2), corner(2), s(2), lower(2), upper(2), p(2), det
+      integer :: i, j, b, k, n, lo(2), hi(2)
+      real(wp), allocatable :: position(:, :)
+      integer, allocatable :: species(:)
+
+      associate (v => self%vectors)
+         det = v(1, 1) * v(2, 2) - v(1, 2) * v(2, 1)
+         inverse = reshape([v(2, 2), -v(2, 1), -v(1, 2), v(1, 1)], [2, 2]) / det
+      end associate
+      ! The range of cell indices whose cells can reach into the box.
+      lower = huge(1.0_wp)
+      upper = -huge(1.0_wp)
+      do k = 1, 4
+         corner = [box(1 + merge(1, 0, k > 2)), box(3 + mod(k - 1, 2))]
+         do b = 1, size(self%species)
+            s = matmul(inverse, corner - self%basis(1:2, b))
+            lower = min(lower, s)
+            upper = max(upper, s)
+         end do
+      end do
+      lo = floor(lower) - 1
+      hi = ceiling(upper) + 1
+      allocate (position(3, (hi(1) - lo(1) + 1) * (hi(2) - lo(2) + 1) * size(self%species)))
+      allocate (species(size(position, 2)))
+      n = 0
+      do j = lo(2), hi(2)
+         do i = lo(1), hi(1)
+            do b = 1, size(self%species)
+               ! (As graphite_net computes its positions, so the sites match its atoms bit for bit.)
+               p = i * self%vectors(:, 1) + j * self%vectors(:, 2) + self%basis(1:2, b)
+               if (p(1) < box(1) .or. p(1) > box(2) .or. p(2) < box(3) .or. p(2) > box(4)) cycle
+               n = n + 1
+               position(1:2, n) = p
+               position(3, n) = self%basis(3, b)
+               species(n) = self%species(b)
+            end do
+         end do
+      end do
+      net%position = position(:, 1:n)
+      net%species = species(1:n)
+   end function lattice_sites
+
+   !> The lattice a net (read from a file) is cut from, found around its
+   !> middle; `reason` says why not when it has none (then empty on success).
+   !> Around an atom o near the middle (the median of the positions; the
+   !> next nearest when o is no site of a lattice, an adatom say) the 48
+   !> atoms nearest to it; a difference p_j - p_o in the plane is a lattice
+   !> vector when it carries at least 3/4 of those atoms onto atoms of their
+   !> species (a vacancy or an edge spoils a few).  a1 is the shortest such,
+   !> a2 the shortest not parallel to it (the two shortest independent
+   !> vectors of a plane lattice are a basis of it), each averaged over the
+   !> pairs it carries (positions in files are rounded).  The basis: the
+   !> positions of those atoms within the cell, by species, that hold at
+   !> least a quarter of the atoms of the most common one (a substitution
+   !> or an adatom is a difference, not a site).  Correctness does not rest
+   !> on this: the table adds every difference between the net and the
+   !> lattice back, a poor lattice only makes those many.
+   subroutine detect_lattice(net, lattice, reason)
+      type(crystal_net), intent(in) :: net
+      type(net_lattice), intent(out) :: lattice
+      character(len=:), allocatable, intent(out) :: reason
+      integer, parameter :: near = 48, tries = 4
+      real(wp), parameter :: same = 1.0e-6_wp
+      integer, allocatable :: by_x(:), by_distance(:)
+      real(wp) :: middle(2)
+      integer :: n, k, attempt
+
+      reason = ''
+      n = net%size()
+      if (n < 4) then
+         reason = 'fewer than 4 atoms'
+         return
+      end if
+      by_x = sort_order(net%position(1, :))
+      do k = 1, 2
+         block
+            integer, allocatable :: order(:)
+            order = sort_order(net%position(k, :))
+            middle(k) = 0.5_wp * (net%position(k, order((n + 1) / 2)) + net%position(k, order(n / 2 + 1)))
+         end block
+      end do
+      by_distance = sort_order((net%position(1, :) - middle(1))**2 + (net%position(2, :) - middle(2))**2)
+      do attempt = 1, min(tries, n)
+         call around(by_distance(attempt))
+         if (len(reason) == 0) return
+      end do
+
+   contains
+
+      !> The lattice around atom o, or `reason`.
+      subroutine around(o)
+         integer, intent(in) :: o
+         integer, allocatable :: local(:), lengths(:)
+         real(wp), allocatable :: candidates(:, :), averaged(:, :)
+         logical, allocatable :: accepted(:)
+         real(wp) :: t(3), total(2), inverse(2, 2), det, f(2), cross
+         integer :: m, i, j, found, partner, nc, first, second, most
+         integer, allocatable :: class_of(:), count_of(:)
+         real(wp), allocatable :: class_position(:, :)
+         integer, allocatable :: class_species(:)
+
+         reason = ''
+         m = min(near, n)
+         local = sort_order((net%position(1, :) - net%position(1, o))**2 &
+            & + (net%position(2, :) - net%position(2, o))**2)
+         local = local(1:m)
+         allocate (candidates(3, m), averaged(2, m), accepted(m))
+         nc = 0
+         do j = 1, m
+            t = net%position(:, local(j)) - net%position(:, o)
+            if (abs(t(3)) > same .or. norm2(t(1:2)) < 1.0e-3_wp) cycle
+            found = 0
+            total = 0.0_wp
+            do i = 1, m
+               partner = atom_at(net%position(:, local(i)) + t, net%species(local(i)))
+               if (partner == 0) cycle
+               found = found + 1
+               total = total + net%position(1:2, partner) - net%position(1:2, local(i))
+            end do
+            if (4 * found < 3 * m) cycle
+            nc = nc + 1
+            candidates(:, nc) = t
+            averaged(:, nc) = total / found
+         end do
+         if (nc < 2) then
+            reason = 'no two translations carry the atoms around the middle onto atoms'
+            return
+         end if
+         ! The shortest, then the shortest not parallel to it (ties: the order found).
+         lengths = sort_order(norm2(candidates(1:2, 1:nc), dim=1))
+         first = lengths(1)
+         second = 0
+         do k = 2, nc
+            j = lengths(k)
+            cross = averaged(1, first) * averaged(2, j) - averaged(2, first) * averaged(1, j)
+            if (abs(cross) > 1.0e-3_wp * norm2(averaged(:, first)) * norm2(averaged(:, j))) then
+               second = j
+               exit
+            end if
+         end do
+         if (second == 0) then
+            reason = 'the translations around the middle are all parallel'
+            return
+         end if
+         lattice%vectors(:, 1) = averaged(:, first)
+         lattice%vectors(:, 2) = averaged(:, second) * sign(1.0_wp, &
+            & averaged(1, first) * averaged(2, second) - averaged(2, first) * averaged(1, second))
+         associate (v => lattice%vectors)
+            det = v(1, 1) * v(2, 2) - v(1, 2) * v(2, 1)
+            inverse = reshape([v(2, 2), -v(2, 1), -v(1, 2), v(1, 1)], [2, 2]) / det
+         end associate
+         ! The basis: the atoms' positions in the cell of o, by species.
+         allocate (class_of(m), count_of(m), class_position(3, m), class_species(m))
+         most = 0
+         count_of = 0
+         k = 0
+         do i = 1, m
+            f = matmul(inverse, net%position(1:2, local(i)) - net%position(1:2, o))
+            f = f - floor(f + 1.0e-6_wp)
+            class_of(i) = 0
+            do j = 1, k
+               if (class_species(j) == net%species(local(i)) .and. &
+                  & all(abs(class_position(1:2, j) - f) < 1.0e-4_wp) .and. &
+                  & abs(class_position(3, j) - net%position(3, local(i))) < 1.0e-4_wp) class_of(i) = j
+            end do
+            if (class_of(i) == 0) then
+               k = k + 1
+               class_of(i) = k
+               class_position(:, k) = [f(1), f(2), net%position(3, local(i))]
+               class_species(k) = net%species(local(i))
+            end if
+            count_of(class_of(i)) = count_of(class_of(i)) + 1
+         end do
+         most = maxval(count_of(1:k))
+         lattice%basis = reshape([real(wp) ::], [3, 0])
+         lattice%species = [integer ::]
+         do j = 1, k
+            if (4 * count_of(j) < most) cycle
+            ! (Two species at one place: the more common is the lattice's.)
+            if (any(count_of(1:k) > count_of(j) .and. [(all(abs(class_position(:, i) - class_position(:, j)) &
+               & < 1.0e-4_wp), i = 1, k)])) cycle
+            lattice%basis = reshape([lattice%basis, net%position(1:2, o) + class_position(1, j) * lattice%vectors(:, 1) &
+               & + class_position(2, j) * lattice%vectors(:, 2), class_position(3, j)], [3, size(lattice%species) + 1])
+            lattice%species = [lattice%species, class_species(j)]
+         end do
+      end subroutine around
+
+      !> The atom of `species` within `same` of p, or 0 (through the order by x).
+      integer function atom_at(p, species) result(found)
+         real(wp), intent(in) :: p(3)
+         integer, intent(in) :: species
+         integer :: low, high, middle_index, k
+
+         found = 0
+         ! The first atom with x >= p(1) - same.
+         low = 1
+         high = n + 1
+         do while (low < high)
+            middle_index = (low + high) / 2
+            if (net%position(1, by_x(middle_index)) < p(1) - same) then
+               low = middle_index + 1
+            else
+               high = middle_index
+            end if
+         end do
+         do k = low, n
+            if (net%position(1, by_x(k)) > p(1) + same) exit
+            if (net%species(by_x(k)) /= species) cycle
+            if (all(abs(net%position(:, by_x(k)) - p) <= same)) then
+               found = by_x(k)
+               return
+            end if
+         end do
+      end function atom_at
+
+   end subroutine detect_lattice
 
    pure integer function net_size(self)
       class(crystal_net), intent(in) :: self
