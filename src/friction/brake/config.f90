@@ -7,7 +7,8 @@ module friction_brake_config
    use friction_brake_params, only: brake_parameters, brake_dimensional, derive_parameters
    use friction_analysis_settings, only: analysis_settings
    use friction_strings, only: rtoa, quoted, bytes_text
-   use friction_parameters, only: configurable, parameter_visitor, set_parameter_number
+   use friction_parameters, only: configurable, parameter_visitor, parameter_info, set_parameter_number, &
+      & get_parameter, list_parameters
    use friction_checks, only: config_checker
    use friction_ode_solver, only: step_type_names, step_type_index
    use friction_ode_settings, only: visit_integrator, check_integrator, check_tolerance_bounds
@@ -15,7 +16,8 @@ module friction_brake_config
    private
 
    public :: brake_config, brake_check, model_names, units_names, brake_solver_defaults
-   public :: model_regularized, model_switched, series_names, continuation_names, continuation_config
+   public :: model_regularized, model_switched, series_names, continuation_names, continuation_config, &
+      & continuation_variable
 
    character(len=*), parameter :: model_names(2) = [character(len=11) :: 'switched', 'regularized']
    character(len=*), parameter :: units_names(2) = [character(len=14) :: 'nondimensional', 'dimensional']
@@ -256,6 +258,27 @@ contains
       point%analysis%continuation = ''
       call set_parameter_number(point, 'brake', trim(self%analysis%continuation), value, problem)
    end function continuation_config
+
+   !> The continuation variable's value in self and its unit, through the
+   !> same description of the variables that continuation_config sets by.
+   subroutine continuation_variable(self, value, unit)
+      type(brake_config), intent(in) :: self
+      real(wp), intent(out) :: value
+      character(len=:), allocatable, intent(out) :: unit
+      type(brake_config) :: copy
+      type(parameter_info), allocatable :: list(:)
+      character(len=:), allocatable :: text, problem
+      integer :: k, stat
+
+      copy = self   ! (the visitor takes its object inout)
+      call get_parameter(copy, 'brake', trim(self%analysis%continuation), 0, text, problem)
+      read (text, *, iostat=stat) value   ! (round-trip text of a checked variable: it reads)
+      list = list_parameters(copy)
+      unit = ''
+      do k = 1, size(list)
+         if (list(k)%group == 'brake' .and. list(k)%name == self%analysis%continuation) unit = trim(list(k)%unit)
+      end do
+   end subroutine continuation_variable
 
    !> With units = 'dimensional', derive params from the §6.2 data
    !> (keeping μ and μs); otherwise params stand as given.

@@ -21,7 +21,7 @@ module friction_brake_orbit
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
    use friction_kinds, only: wp, pi
    use friction_error, only: error_type
-   use friction_brake_config, only: brake_config, continuation_config
+   use friction_brake_config, only: brake_config, continuation_config, continuation_variable
    use friction_brake_simulate, only: brake_run, simulate_brake
    use friction_brake_params, only: brake_parameters
    use friction_brake_record, only: brake_event_table, event_stick_to_slip, event_kind_names
@@ -32,7 +32,7 @@ module friction_brake_orbit
    private
 
    public :: brake_section_map, brake_orbit, brake_periodic_orbit, section_state, section_limit
-   public :: orbit_branch, follow_branch, bifurcation_names, continuation_unit
+   public :: orbit_branch, follow_branch, bifurcation_names
    public :: bifurcation_period_doubling, bifurcation_fold, bifurcation_neimark_sacker, bifurcation_discontinuity
 
    !> Where a multiplier of the section map leaves (or enters) the unit circle.
@@ -54,6 +54,7 @@ module friction_brake_orbit
    !> The orbit followed along a line of one variable (docs/physics.md).
    type :: orbit_branch
       character(len=16) :: variable = ''
+      character(len=:), allocatable :: unit          !! the variable's unit (as &brake gives it)
       real(wp), allocatable :: parameter(:)          !! (n) the variable's values
       logical, allocatable :: found(:)               !! (n)
       integer, allocatable :: source(:)              !! (n) 1: continued from the previous orbit, 2: from the attractor
@@ -249,7 +250,7 @@ contains
       integer :: k
 
       branch%variable = config%analysis%continuation
-      start = parameter_value(config)
+      call continuation_variable(config, start, branch%unit)
       allocate (branch%parameter(n), branch%found(n), branch%source(n), branch%period(n), branch%state(4, n), &
          & branch%multipliers(4, n), branch%max_modulus(n), branch%kind(0), branch%at(0), &
          & branch%pattern(size(event_kind_names), n), &
@@ -303,45 +304,6 @@ contains
       end subroutine record
 
    end subroutine follow_branch
-
-   !> The unit of a continuation variable (as &brake gives it).
-   pure function continuation_unit(name) result(unit)
-      character(len=*), intent(in) :: name
-      character(len=:), allocatable :: unit
-
-      select case (trim(name))
-      case ('g_prime')
-         unit = 'm'
-      case ('delta_prime')
-         unit = 'tau/m'
-      case ('v_dr_prime')
-         unit = 'm/tau'
-      case default
-         unit = '1'
-      end select
-   end function continuation_unit
-
-   !> The continuation variable's value in config.
-   real(wp) function parameter_value(config) result(value)
-      type(brake_config), intent(in) :: config
-
-      select case (trim(config%analysis%continuation))
-      case ('mu')
-         value = config%params%mu
-      case ('mu_s')
-         value = config%params%mu_s
-      case ('xi')
-         value = config%params%xi
-      case ('kappa')
-         value = config%params%kappa
-      case ('g_prime')
-         value = config%params%g_prime
-      case ('delta_prime')
-         value = config%params%delta_prime
-      case default
-         value = config%params%v_dr
-      end select
-   end function parameter_value
 
    !> From the orbit `previous` at the value `from` to the value `to`.
    subroutine continue_along(config, from, to, previous, settings, result, error)

@@ -12,7 +12,7 @@ module friction_brake_output
    use friction_brake_record, only: brake_trajectory, brake_event_table, event_kind_names
    use friction_brake_simulate, only: brake_comparison
    use friction_brake_diagnostics, only: brake_diagnostics
-   use friction_brake_orbit, only: orbit_branch, bifurcation_names, continuation_unit
+   use friction_brake_orbit, only: orbit_branch, bifurcation_names
    use friction_output_h5, only: h5_file
    use friction_output_parameters, only: write_parameter_attributes
    use friction_output_summary, only: run_summary, write_run_attributes
@@ -294,7 +294,7 @@ contains
 
       call file%create_group(group)
       call file%write_attribute_text(group, 'variable', trim(b%variable))
-      call file%write_vector(group//'/parameter', b%parameter, continuation_unit(b%variable))
+      call file%write_vector(group//'/parameter', b%parameter, b%unit)
       call file%write_vector_integer(group//'/found', merge(1, 0, b%found), '1')
       call file%write_vector_integer(group//'/source', b%source, '1')
       call file%write_attribute_text(group//'/source', 'names', '1 = continued, 2 = from the attractor')
@@ -304,7 +304,7 @@ contains
       call file%write_matrix(group//'/floquet_multipliers_imag', aimag(b%multipliers), '1')
       call file%write_vector(group//'/max_modulus', b%max_modulus, '1')
       call file%write_matrix(group//'/events_per_period', real(b%pattern, wp), '1')
-      call file%write_vector(group//'/section_parameter', b%section_parameter, continuation_unit(b%variable))
+      call file%write_vector(group//'/section_parameter', b%section_parameter, b%unit)
       call file%write_vector(group//'/section_x', b%section_x, 'm')
       call file%create_group('/brake/orbit/bifurcations')
       do k = 1, size(bifurcation_names)
@@ -312,7 +312,7 @@ contains
       end do
       call file%write_attribute_text('/brake/orbit/bifurcations', 'kind_names', join(codes))
       call file%write_vector_integer('/brake/orbit/bifurcations/kind', b%kind, '1')
-      call file%write_vector('/brake/orbit/bifurcations/parameter', b%at, continuation_unit(b%variable))
+      call file%write_vector('/brake/orbit/bifurcations/parameter', b%at, b%unit)
    end subroutine write_branch
 
 end module friction_brake_output
