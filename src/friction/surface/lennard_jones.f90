@@ -320,8 +320,8 @@ contains
       real(wp), intent(in) :: r(3)
       integer, intent(in) :: order
       real(wp), intent(out) :: v, g(3), h(3, 3)
-      real(wp) :: d(3), r2, rc2, s6, f, df
-      integer :: lo(2), hi(2), cx, cy, i, s, a, c
+      real(wp) :: d(3), r2, rc2, s6
+      integer :: lo(2), hi(2), cx, cy, i, s, c
 
       v = 0.0_wp
       g = 0.0_wp
@@ -343,20 +343,33 @@ contains
                      if (self%tabulated) v = v - self%table%shift(s)
                      cycle
                   end if
-                  f = -24.0_wp * self%epsilon(s) * (2.0_wp * s6 * s6 - s6) / r2
-                  g = g + f * d
-                  if (order < 2) cycle
-                  ! s6 ~ r2^-3, so d(s6)/d(r2) = -3 s6/r2 and d(s12)/d(r2) = -6 s12/r2.
-                  df = 24.0_wp * self%epsilon(s) * (14.0_wp * s6 * s6 - 4.0_wp * s6) / r2**2
-                  do a = 1, 3
-                     h(:, a) = h(:, a) + 2.0_wp * df * d * d(a)
-                     h(a, a) = h(a, a) + f
-                  end do
+                  call add_pair_derivatives(self%epsilon(s), s6, r2, d, order, g, h)
                end do
             end do
          end do
       end associate
    end subroutine sum_pairs
+
+   !> One pair's share of sum_pairs' gradient (order >= 1) and Hessian
+   !> (order 2), added to g and h: ε the pair's well depth (times a weight),
+   !> s6 = (σ²/r²)³, d = r - r_i.
+   pure subroutine add_pair_derivatives(epsilon, s6, r2, d, order, g, h)
+      real(wp), intent(in) :: epsilon, s6, r2, d(3)
+      integer, intent(in) :: order
+      real(wp), intent(inout) :: g(3), h(3, 3)
+      real(wp) :: f, df
+      integer :: a
+
+      f = -24.0_wp * epsilon * (2.0_wp * s6 * s6 - s6) / r2
+      g = g + f * d
+      if (order < 2) return
+      ! s6 ~ r2^-3, so d(s6)/d(r2) = -3 s6/r2 and d(s12)/d(r2) = -6 s12/r2.
+      df = 24.0_wp * epsilon * (14.0_wp * s6 * s6 - 4.0_wp * s6) / r2**2
+      do a = 1, 3
+         h(:, a) = h(:, a) + 2.0_wp * df * d * d(a)
+         h(a, a) = h(a, a) + f
+      end do
+   end subroutine add_pair_derivatives
 
    !> The table's answer at r, when it has one (`answered`): above the
    !> ceiling zero (no atom within the cutoff); between the floor and the
@@ -414,8 +427,8 @@ contains
       real(wp), intent(in) :: r(3)
       integer, intent(in) :: order
       real(wp), intent(inout) :: v, g(3), h(3, 3)
-      real(wp) :: d(3), r2, rc2, s6, f, df, w, dv, dg(3)
-      integer :: ij(2), i, s, a, c
+      real(wp) :: d(3), r2, rc2, s6, w, dv, dg(3)
+      integer :: ij(2), i, s, c
 
       rc2 = self%cutoff**2
       associate (list => self%table%differences)
@@ -440,14 +453,7 @@ contains
             s6 = (self%sigma(s)**2 / r2)**3
             v = v + w * (4.0_wp * self%epsilon(s) * (s6 * s6 - s6) - self%table%shift(s))
             if (order < 1) cycle
-            f = -24.0_wp * w * self%epsilon(s) * (2.0_wp * s6 * s6 - s6) / r2
-            g = g + f * d
-            if (order < 2) cycle
-            df = 24.0_wp * w * self%epsilon(s) * (14.0_wp * s6 * s6 - 4.0_wp * s6) / r2**2
-            do a = 1, 3
-               h(:, a) = h(:, a) + 2.0_wp * df * d * d(a)
-               h(a, a) = h(a, a) + f
-            end do
+            call add_pair_derivatives(w * self%epsilon(s), s6, r2, d, order, g, h)
          end do
       end associate
    end subroutine difference_sums
