@@ -36,7 +36,7 @@ module friction_output_h5
       end function h5fget_mdc_size
    end interface
 
-   public :: h5_file, error_printing, room_to_close
+   public :: h5_file, error_printing, room_to_close, new_text_attribute, new_scalar_attribute
 
    !> H5E_DEFAULT of the C API: the default error stack (hid_t is int64_t
    !> since HDF5 1.10).
@@ -410,25 +410,65 @@ contains
       class(h5_file), intent(inout) :: self
       integer(hid_t), intent(in) :: obj
       character(len=*), intent(in) :: name, text
-      integer(hid_t) :: space, type, attr
-      integer(hsize_t) :: dims(1) = [1]
       integer :: stat
+      character(len=:), allocatable :: what
 
       if (self%status /= 0) return
-      call h5screate_f(H5S_SCALAR_F, space, stat)
-      call h5tcopy_f(H5T_FORTRAN_S1, type, stat)
-      call h5tset_size_f(type, int(max(1, len(text)), size_t), stat)
-      call h5tset_cset_f(type, H5T_CSET_UTF8_F, stat)
-      call h5acreate_f(obj, name, type, space, attr, stat)
-      call self%check(stat, 'creating attribute '//name)
-      if (stat == 0) then
-         call h5awrite_f(attr, type, text, dims, stat)
-         call self%check(stat, 'writing attribute '//name)
-         call h5aclose_f(attr, stat)
-      end if
-      call h5tclose_f(type, stat)
-      call h5sclose_f(space, stat)
+      call new_text_attribute(obj, name, text, stat, what)
+      call self%check(stat, what)
    end subroutine attribute_text
+
+   !> Create the scalar text attribute name (UTF-8, its length that of text)
+   !> on the open object obj; stat is HDF5's, `what` the step that failed.
+   !> (Shared by the files this module and h5_table write.)
+   subroutine new_text_attribute(obj, name, text, stat, what)
+      integer(hid_t), intent(in) :: obj
+      character(len=*), intent(in) :: name, text
+      integer, intent(out) :: stat
+      character(len=:), allocatable, intent(out) :: what
+      integer(hid_t) :: space, type, attr
+      integer :: ignored
+
+      what = ''
+      call h5screate_f(H5S_SCALAR_F, space, ignored)
+      call h5tcopy_f(H5T_FORTRAN_S1, type, ignored)
+      call h5tset_size_f(type, int(max(1, len(text)), size_t), ignored)
+      call h5tset_cset_f(type, H5T_CSET_UTF8_F, ignored)
+      call h5acreate_f(obj, name, type, space, attr, stat)
+      if (stat /= 0) then
+         what = 'creating attribute '//name
+      else
+         call h5awrite_f(attr, type, text, [1_hsize_t], stat)
+         if (stat /= 0) what = 'writing attribute '//name
+         call h5aclose_f(attr, ignored)
+      end if
+      call h5tclose_f(type, ignored)
+      call h5sclose_f(space, ignored)
+   end subroutine new_text_attribute
+
+   !> Create the scalar attribute name of HDF5 type `type` on the open object
+   !> obj and write it from the address value; stat and `what` as above.
+   subroutine new_scalar_attribute(obj, name, type, value, stat, what)
+      integer(hid_t), intent(in) :: obj, type
+      character(len=*), intent(in) :: name
+      type(c_ptr), intent(in) :: value
+      integer, intent(out) :: stat
+      character(len=:), allocatable, intent(out) :: what
+      integer(hid_t) :: space, attr
+      integer :: ignored
+
+      what = ''
+      call h5screate_f(H5S_SCALAR_F, space, ignored)
+      call h5acreate_f(obj, name, type, space, attr, stat)
+      if (stat /= 0) then
+         what = 'creating attribute '//name
+      else
+         call h5awrite_f(attr, type, value, stat)
+         if (stat /= 0) what = 'writing attribute '//name
+         call h5aclose_f(attr, ignored)
+      end if
+      call h5sclose_f(space, ignored)
+   end subroutine new_scalar_attribute
 
    !> A real attribute; with `units`, its unit goes beside it as the text
    !> attribute NAME_units (attributes cannot carry attributes).
@@ -470,8 +510,9 @@ contains
       character(len=*), intent(in) :: object, name
       integer(hid_t), intent(in) :: type
       type(c_ptr), intent(in) :: value
-      integer(hid_t) :: obj, space, attr
+      integer(hid_t) :: obj
       integer :: stat
+      character(len=:), allocatable :: what
       type(error_printing) :: printing
 
       if (self%status /= 0) return
@@ -479,15 +520,8 @@ contains
       call h5oopen_f(self%id, object, obj, stat)
       call self%check(stat, 'opening '//object)
       if (stat == 0) then
-         call h5screate_f(H5S_SCALAR_F, space, stat)
-         call h5acreate_f(obj, name, type, space, attr, stat)
-         call self%check(stat, 'creating attribute '//name)
-         if (stat == 0) then
-            call h5awrite_f(attr, type, value, stat)
-            call self%check(stat, 'writing attribute '//name)
-            call h5aclose_f(attr, stat)
-         end if
-         call h5sclose_f(space, stat)
+         call new_scalar_attribute(obj, name, type, value, stat, what)
+         call self%check(stat, what)
          call h5oclose_f(obj, stat)
       end if
       call printing%restore()

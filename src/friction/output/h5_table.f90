@@ -16,7 +16,7 @@ module friction_output_h5_table
    use friction_kinds, only: wp, i8
    use friction_error, only: error_type, fatal_error, error_io
    use friction_files, only: truncate_file
-   use friction_output_h5, only: error_printing, room_to_close
+   use friction_output_h5, only: error_printing, room_to_close, new_text_attribute, new_scalar_attribute
    implicit none
    private
 
@@ -420,8 +420,9 @@ contains
    subroutine set_text_attribute(self, object, name, text)
       class(h5_table), intent(inout) :: self
       character(len=*), intent(in) :: object, name, text
-      integer(hid_t) :: obj, space, type, attr
+      integer(hid_t) :: obj
       integer :: stat
+      character(len=:), allocatable :: what
       logical :: exists
       type(error_printing) :: printing
 
@@ -432,19 +433,8 @@ contains
       if (stat == 0) then
          call h5aexists_f(obj, name, exists, stat)
          if (exists) call h5adelete_f(obj, name, stat)
-         call h5screate_f(H5S_SCALAR_F, space, stat)
-         call h5tcopy_f(H5T_FORTRAN_S1, type, stat)
-         call h5tset_size_f(type, int(max(1, len(text)), size_t), stat)
-         call h5tset_cset_f(type, H5T_CSET_UTF8_F, stat)
-         call h5acreate_f(obj, name, type, space, attr, stat)
-         call self%check(stat, 'creating attribute '//name)
-         if (stat == 0) then
-            call h5awrite_f(attr, type, text, [1_hsize_t], stat)
-            call self%check(stat, 'writing attribute '//name)
-            call h5aclose_f(attr, stat)
-         end if
-         call h5tclose_f(type, stat)
-         call h5sclose_f(space, stat)
+         call new_text_attribute(obj, name, text, stat, what)
+         call self%check(stat, what)
          call h5oclose_f(obj, stat)
       end if
       call printing%restore()
@@ -484,8 +474,9 @@ contains
       class(h5_table), intent(inout) :: self
       character(len=*), intent(in) :: object, name
       integer(i8), intent(in), target :: value
-      integer(hid_t) :: obj, space, attr
+      integer(hid_t) :: obj
       integer :: stat
+      character(len=:), allocatable :: what
       logical :: exists
       type(error_printing) :: printing
 
@@ -496,15 +487,8 @@ contains
       if (stat == 0) then
          call h5aexists_f(obj, name, exists, stat)
          if (exists) call h5adelete_f(obj, name, stat)
-         call h5screate_f(H5S_SCALAR_F, space, stat)
-         call h5acreate_f(obj, name, kind_type('l'), space, attr, stat)
-         call self%check(stat, 'creating attribute '//name)
-         if (stat == 0) then
-            call h5awrite_f(attr, kind_type('l'), c_loc(value), stat)
-            call self%check(stat, 'writing attribute '//name)
-            call h5aclose_f(attr, stat)
-         end if
-         call h5sclose_f(space, stat)
+         call new_scalar_attribute(obj, name, kind_type('l'), c_loc(value), stat, what)
+         call self%check(stat, what)
          call h5oclose_f(obj, stat)
       end if
       call printing%restore()
