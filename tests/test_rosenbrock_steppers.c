@@ -20,7 +20,7 @@
  *                handler, which aborts, stays installed); no Jacobian is
  *                GSL_EFAULT.
  *
- * Usage: test_rosenbrock (exit status 0 when every check passes). */
+ * Usage: test_rosenbrock_steppers (exit status 0 when every check passes). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -319,6 +319,6 @@ int main(void)
         check_dfdt(methods[m].name, type);
         check_bad_paths(methods[m].name, type, methods[m].gamma);
     }
-    if (failures == 0) printf("test_rosenbrock: all checks passed\n");
+    if (failures == 0) printf("test_rosenbrock_steppers: all checks passed\n");
     return failures == 0 ? 0 : 1;
 }
