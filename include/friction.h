@@ -105,7 +105,9 @@ int friction_config_read(friction_config *cfg, const char *path, friction_error 
  * reader's message ("&scan: nx = 'many': expected an integer"); the value is
  * then left as it was.  The scene itself (job.scene) cannot change.
  *   integrator.method  GSL step type: rk2 rk4 rkf45 rkck rk8pd rk1imp rk2imp
- *                      rk4imp bsimp msadams msbdf, or "auto" (docs/speed.md) */
+ *                      rk4imp bsimp msadams msbdf rodas3 rodas4, or "auto"
+ *                      (docs/speed.md; rodas3 and rodas4 are the library's
+ *                      own Rosenbrock steppers in GSL's stepper interface) */
 int friction_config_set(friction_config *cfg, const char *name, const char *value, friction_error *err);
 /* The same for a number, without text in between: a real variable, or an
  * integer one when x is whole; NaN and infinities are set (and refused by

@@ -7,8 +7,9 @@ Measures and prints (this is not a test; nothing fails on a missed target):
   t_end = 1000 and dt_out = 1 and the &analysis diagnostics off (a plain
   integration writing the trajectory, the output ngspice gives), for both
   models along a tolerance ladder with method = 'auto' (atol = rtol / 100;
-  switched: event tolerance min(1e-10, rtol / 10)); and once the input as it
-  is (with its &analysis), for scale.
+  switched: event tolerance min(1e-10, rtol / 10)), the regularized law also
+  with the Rosenbrock steppers rodas3 and rodas4 along half-decade rungs;
+  and once the input as it is (with its &analysis), for scale.
 * ngspice on the paper's network model, the netlist `friction --netlist`
   writes for the same input (the regularized arctan law; written once, not
   timed), along reltol = --ngspice-ladder (vntol = abstol = chgtol =
@@ -21,8 +22,13 @@ Errors: the largest |x - x_ref| (m) on the grid tau = 1, ..., 1000 against
 the program's reference of the same model (regularized: rk8pd rtol 1e-13;
 switched: rk8pd rtol 1e-14, event tolerance 1e-13), so ngspice is measured
 on the law its netlist holds and SciPy on the switched model.  At each
-peer's ladder point the cheapest run of the program's ladder with an equal
-or smaller error is taken (no interpolation), and the ratio printed.
+peer's ladder point the cheapest run of the program's ladders with an equal
+or smaller error is taken (no interpolation), and the ratios printed, of
+the process wall clock and of the process CPU time (user + system).
+
+The program's runs and ngspice's are interleaved: each round runs every
+setting once, and the medians are over --repeats rounds, so a change of the
+shared machine's load falls on all of them alike.
 
 Usage (normally through scripts/benchmark_brake_peers, which builds first):
 
@@ -57,6 +63,7 @@ T_END = 1000.0
 PLAIN = ("&analysis spectrum = .false., poincare = .false., lyapunov = .false., rosenstein = .false.,"
          " lyapunov_spectrum = .false. /\n")
 TARGET_RATIO = 20.0
+ROSENBROCK = ("rodas3", "rodas4")
 
 
 def log(msg: str) -> None:
@@ -101,17 +108,36 @@ def error_on_grid(t: np.ndarray, x: np.ndarray, t_ref: np.ndarray, x_ref: np.nda
     return float(np.max(np.abs(x[keep] - x_ref[keep])))
 
 
-def program_ladder(prog: Program, model: str, tols, ref) -> list[dict]:
+def program_text(model: str, method: str, rtol: float) -> str:
+    extra = f"&brake t_end = {T_END}, dt_out = 1.0, model = '{model}'"
+    if model == "switched":
+        extra += f", event_tolerance = {min(1e-10, rtol / 10):.17g}"
+    return PLAIN + extra + " /\n" + integrator(method, rtol, rtol / 100)
+
+
+def program_jobs(model: str, method: str, tols) -> list[dict]:
+    return [{"model": model, "method": method, "rtol": rtol, "walls": [], "cpus": [], "computes": []}
+            for rtol in tols]
+
+
+def run_job(prog: Program, job: dict) -> None:
+    """One run of a program setting; its times appended, its result kept."""
+    log(f"program {job['model']} {job['method']} rtol {job['rtol']:g}")
+    r = prog.run(program_text(job["model"], job["method"], job["rtol"]), repeats=1)
+    job["walls"].append(r["wall"])
+    job["cpus"].append(r["cpu"])
+    job["computes"].append(r["compute"])
+    job["result"] = r
+
+
+def finish_jobs(jobs: list[dict], ref) -> list[dict]:
+    """Rows of medians and errors."""
     rows = []
-    for rtol in tols:
-        extra = f"&brake t_end = {T_END}, dt_out = 1.0, model = '{model}'"
-        if model == "switched":
-            extra += f", event_tolerance = {min(1e-10, rtol / 10):.17g}"
-        text = PLAIN + extra + " /\n" + integrator("auto", rtol, rtol / 100)
-        log(f"program {model} rtol {rtol:g}")
-        r = prog.run(text)
-        rows.append({"rtol": rtol, "method": r["method"], "error": error_on_grid(r["t"], r["x"], *ref),
-                     "wall": r["wall"], "cpu": r["cpu"], "compute": r["compute"]})
+    for job in jobs:
+        r = job["result"]
+        rows.append({"rtol": job["rtol"], "method": r["method"], "error": error_on_grid(r["t"], r["x"], *ref),
+                     "wall": statistics.median(job["walls"]), "cpu": statistics.median(job["cpus"]),
+                     "compute": statistics.median(job["computes"])})
     return rows
 
 
@@ -168,39 +194,67 @@ def main(argv=None) -> int:
 
         reg_tols = [10.0 ** -k for k in range(3, 8 if args.quick else 12)]
         sw_tols = [10.0 ** -k for k in range(3, 8 if args.quick else 13)]
-        reg = program_ladder(prog, "regularized", reg_tols, refs["regularized"])
-        sw = program_ladder(prog, "switched", sw_tols, refs["switched"])
-        print_program("The program, regularized law, whole process (method = 'auto')", reg)
-        print_program("The program, switched model, whole process (method = 'auto')", sw)
-        record["program_regularized"], record["program_switched"] = reg, sw
-
-        # ngspice on the netlist of the regularized law.
-        print("\nngspice on the netlist (`friction --netlist`, regularized law), against the program at the same "
-              "error (regularized law, whole processes):")
-        print("| reltol | error (m) | ngspice process | its analysis time | program process | ratio |")
-        print("|---|---|---|---|---|---|")
+        ros_tols = ([1e-4, 1e-5, 1e-6] if args.quick else
+                    [1e-3, 3e-4, 1e-4, 3e-5, 1e-5, 3e-6, 1e-6, 3e-7, 1e-7, 1e-8])
+        reg_jobs = program_jobs("regularized", "auto", reg_tols)
+        sw_jobs = program_jobs("switched", "auto", sw_tols)
+        ros_jobs = {m: program_jobs("regularized", m, ros_tols) for m in ROSENBROCK}
+        jobs = reg_jobs + sw_jobs + [job for m in ROSENBROCK for job in ros_jobs[m]]
         ladder = [float(x) for x in args.ngspice_ladder.split(",")]
         if args.quick:
             ladder = ladder[:2]
-        if shutil.which(args.ngspice) is None:
-            print(f"ngspice skipped: {args.ngspice} not found (Debian: apt-get install ngspice)")
-        else:
-            spice_rows = []
-            for reltol in ladder:
-                log(f"ngspice reltol {reltol:g}")
+        have_ngspice = shutil.which(args.ngspice) is not None
+        spice = [{"reltol": reltol, "walls": [], "cpus": [], "analysis": []} for reltol in ladder] \
+            if have_ngspice else []
+        # Interleaved rounds: every setting once per round.
+        for round_number in range(repeats):
+            log(f"round {round_number + 1} of {repeats}")
+            for job in jobs:
+                run_job(prog, job)
+            for s in spice:
+                log(f"ngspice reltol {s['reltol']:g}")
                 row = ngspice_compare.ngspice_work_precision(
-                    [BRAKE], [reltol], refs["regularized"][0], refs["regularized"][1], binary=binary,
-                    ngspice=args.ngspice, atol=reltol / 100, window=(1.0, T_END), repeats=1,
+                    [BRAKE], [s["reltol"]], refs["regularized"][0], refs["regularized"][1], binary=binary,
+                    ngspice=args.ngspice, atol=s["reltol"] / 100, window=(1.0, T_END), repeats=1,
                     extra=f"&brake t_end = {T_END}, dt_out = 1.0 /\n")[0]
-                mine, note = matched(reg, row["error"], "wall")
-                ratio = f"{row['wall_time'] / mine:.0f}" if mine else "-"
-                print(f"| {reltol:.0e} | {row['error']:.2e} | {row['wall_time'] * 1e3:.0f} ms | "
-                      f"{row['cpu_time'] * 1e3:.0f} ms | {mine * 1e3:.1f} ms {note} | {ratio} |"
-                      if mine else f"| {reltol:.0e} | {row['error']:.2e} | {row['wall_time'] * 1e3:.0f} ms | "
-                      f"{row['cpu_time'] * 1e3:.0f} ms | {note} | - |")
-                spice_rows.append({**row, "program_wall": mine})
-            record["ngspice"] = spice_rows
-
+                s["walls"].append(row["wall_time"])
+                s["cpus"].append(row["process_cpu"])
+                s["analysis"].append(row["cpu_time"])
+                s["error"] = row["error"]
+        reg = finish_jobs(reg_jobs, refs["regularized"])
+        sw = finish_jobs(sw_jobs, refs["switched"])
+        ros = {m: finish_jobs(ros_jobs[m], refs["regularized"]) for m in ROSENBROCK}
+        print_program("The program, regularized law, whole process (method = 'auto')", reg)
+        for m in ROSENBROCK:
+            print_program(f"The program, regularized law, whole process ({m})", ros[m])
+        print_program("The program, switched model, whole process (method = 'auto')", sw)
+        record["program_regularized"], record["program_switched"] = reg, sw
+        record["program_rosenbrock"] = ros
+        # ngspice on the netlist of the regularized law.
+        candidates = reg + [row for m in ROSENBROCK for row in ros[m]]
+        print("\nngspice on the netlist (`friction --netlist`, regularized law), against the program at the same "
+              "error (regularized law, whole processes, the cheapest of 'auto', rodas3 and rodas4):")
+        print("| reltol | error (m) | ngspice process wall, CPU | its analysis time | program process wall "
+              "(its run) | program process CPU (its run) | ratio, wall | ratio, CPU |")
+        print("|---|---|---|---|---|---|---|---|")
+        if not have_ngspice:
+            print(f"ngspice skipped: {args.ngspice} not found (Debian: apt-get install ngspice)")
+        spice_rows = []
+        for s in spice:
+            wall, cpu = statistics.median(s["walls"]), statistics.median(s["cpus"])
+            analysis = statistics.median(s["analysis"])
+            mine_wall, note_wall = matched(candidates, s["error"], "wall")
+            mine_cpu, note_cpu = matched(candidates, s["error"], "cpu")
+            if mine_wall:
+                print(f"| {s['reltol']:.0e} | {s['error']:.2e} | {wall * 1e3:.0f} ms, {cpu * 1e3:.0f} ms | "
+                      f"{analysis * 1e3:.0f} ms | {mine_wall * 1e3:.1f} ms {note_wall} | "
+                      f"{mine_cpu * 1e3:.1f} ms {note_cpu} | {wall / mine_wall:.1f} | {cpu / mine_cpu:.1f} |")
+            else:
+                print(f"| {s['reltol']:.0e} | {s['error']:.2e} | {wall * 1e3:.0f} ms, {cpu * 1e3:.0f} ms | "
+                      f"{analysis * 1e3:.0f} ms | {note_wall} | | - | - |")
+            spice_rows.append({"reltol": s["reltol"], "error": s["error"], "wall_time": wall, "process_cpu": cpu,
+                               "analysis_time": analysis, "program_wall": mine_wall, "program_cpu": mine_cpu})
+        record["ngspice"] = spice_rows
         # SciPy DOP853 on the switched model.
         print("\nSciPy DOP853, switched model with events (scripts/scipy_brake.py), against the program at the "
               "same error (switched model):")

@@ -6,8 +6,9 @@ Measures and prints (this is not a test; nothing fails on a missed target):
 * The whole process `friction inputs/naf.nml` (128 x 128, trace + retrace,
   serial, no mpirun): wall clock and CPU time, median of --repeats, next to
   the target (under 0.3 s).
-* Work against error on that map for the program (rkf45, rkck, rk8pd along
-  rtol = atol = 1e-3 ... 1e-9) and for a C program on CVODE
+* Work against error on that map for the program (rkf45, rkck, rk8pd and
+  the Rosenbrock steppers rodas3, rodas4 along rtol = atol = 1e-3 ... 1e-9)
+  and for a C program on CVODE
   (scripts/cvode_naf.c: BDF with the dense analytic Jacobian, rtol = atol =
   1e-3 ... 1e-10), the error being the largest |F - F_ref| over fx and fy
   of trace and retrace against the program's rk8pd at rtol = atol = 1e-11
@@ -17,12 +18,12 @@ Measures and prints (this is not a test; nothing fails on a missed target):
   wall_time: input, set-up, integration, not the write; CVODE: its
   integration and sampling), whole-process wall clock and CPU time.
 * The stiff tips of method = 'auto' (docs/speed.md, Stiff tips): the same
-  map with 16 lines and the damping --stiff-damping (N s/m), 'auto' (which
-  picks bsimp there) against rkck, rk8pd and CVODE at equal error.
+  map with 16 lines and the damping --stiff-damping (N s/m), 'auto' against
+  bsimp, rodas3, rodas4, rkck, rk8pd and CVODE at equal error.
 * With --crossover, instead of all that: the crossover of the rule, tips of
   growing stiffness S (NaF and HOPG, 4 lines of 128 samples), the fastest
-  explicit stepper (rkck, rk8pd) against bsimp at equal error, and the
-  stepper 'auto' picks.
+  explicit stepper (rkck, rk8pd) against bsimp and rodas4 at equal error,
+  and the stepper 'auto' picks at rtol 1e-3.
 
 The CVODE program is compiled here with $CC (default cc) against SUNDIALS
 (Debian: libsundials-dev); without it the CVODE rows are skipped with a
@@ -215,9 +216,10 @@ def compare(title: str, series: dict, levels: list[float], summary: list) -> Non
 
 
 def crossover(bench: Bench, levels: list[float]) -> list[dict]:
-    """The explicit pairs against bsimp on tips of growing stiffness."""
-    print("| tip | auto picks | error level | fastest explicit | its time | bsimp's time | explicit / bsimp |")
-    print("|---|---|---|---|---|---|---|")
+    """The explicit pairs against bsimp and rodas4 on tips of growing stiffness."""
+    print("| tip | auto picks | error level | fastest explicit | its time | bsimp's time | explicit / bsimp | "
+          "rodas4's time | explicit / rodas4 |")
+    print("|---|---|---|---|---|---|---|---|---|")
     rows = []
     for label, base, override in CROSSOVER:
         scan = f", {override}" if override.startswith("velocity") else ""
@@ -227,7 +229,7 @@ def crossover(bench: Bench, levels: list[float]) -> list[dict]:
         ref = bench.friction("rk8pd", 1e-12, 1e-12, extra, repeats=1, base=base)[1]
         picked = bench.friction("auto", 1e-3, 1e-3, extra, repeats=1, base=base)[0]["ran"]
         series = {}
-        for method in ("rkck", "rk8pd", "bsimp"):
+        for method in ("rkck", "rk8pd", "bsimp", "rodas4"):
             series[method] = []
             for rtol in (1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8):
                 cost, forces = bench.friction(method, rtol, rtol, extra, base=base)
@@ -239,13 +241,16 @@ def crossover(bench: Bench, levels: list[float]) -> list[dict]:
             explicit = [(m, cost_at(series[m], level, "compute")) for m in ("rkck", "rk8pd")]
             explicit = [e for e in explicit if e[1] is not None]
             implicit = cost_at(series["bsimp"], level, "compute")
+            rosenbrock = cost_at(series["rodas4"], level, "compute")
             best = min(explicit, key=lambda e: e[1]) if explicit else None
             ratio = f"{best[1] / implicit:.2f}" if best and implicit else "-"
+            ratio_r = f"{best[1] / rosenbrock:.2f}" if best and rosenbrock else "-"
             print(f"| {label} | {picked} | {level:.0e} | {best[0] if best else '-'} | "
                   f"{best[1] * 1e3:.1f} ms | " if best else f"| {label} | {picked} | {level:.0e} | - | - | ", end="")
-            print(f"{implicit * 1e3:.1f} ms | {ratio} |" if implicit else "not reached | - |")
+            print(f"{implicit * 1e3:.1f} ms | {ratio} | " if implicit else "not reached | - | ", end="")
+            print(f"{rosenbrock * 1e3:.1f} ms | {ratio_r} |" if rosenbrock else "not reached | - |")
             rows.append({"tip": label, "auto": picked, "level": level, "explicit": best,
-                         "bsimp": implicit})
+                         "bsimp": implicit, "rodas4": rosenbrock})
     return rows
 
 
@@ -286,9 +291,10 @@ def main(argv=None) -> int:
             record["input_file"] = plain
 
         for title, lines, damping, methods in (
-                (f"NaF {ny} x 128, the paper's tip (c = 1e-3 N s/m)", ny, 1.0e-3, ("rkf45", "rkck", "rk8pd")),
+                (f"NaF {ny} x 128, the paper's tip (c = 1e-3 N s/m)", ny, 1.0e-3,
+                 ("rkf45", "rkck", "rk8pd", "rodas3", "rodas4")),
                 (f"NaF 16 x 128, stiff tip (c = {args.stiff_damping:g} N s/m)", 16, args.stiff_damping,
-                 ("auto", "rkck", "rk8pd"))):
+                 ("auto", "bsimp", "rodas3", "rodas4", "rkck", "rk8pd"))):
             extra = (f"&scan ny = {lines} /\n&tip cx = {damping:.17g}, cy = {damping:.17g} /\n")
             log(f"{title}: reference")
             ref = bench.friction("rk8pd", 1e-11, 1e-11, extra, repeats=1)[1]

@@ -59,6 +59,7 @@ import argparse
 import json
 import os
 import re
+import resource
 import shutil
 import statistics
 import subprocess
@@ -199,13 +200,16 @@ def run_ngspice(ngspice: str, binary: Path, inputs: list[Path], extra: str, work
     text = netlist.read_text()
     scene = netlist_scene(text)
     data = workdir / f"{name}.data"
-    cpu, wall = [], []
+    cpu, wall, process_cpu = [], [], []
     for _ in range(repeats):
         if data.exists():
             data.unlink()
+        before = resource.getrusage(resource.RUSAGE_CHILDREN)
         start = time.perf_counter()
         result = subprocess.run([ngspice, "-b", netlist.name], cwd=workdir, capture_output=True, text=True)
         wall.append(time.perf_counter() - start)
+        after = resource.getrusage(resource.RUSAGE_CHILDREN)
+        process_cpu.append(after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime)
         analysis = re.search(r"Transient analysis time\s*=\s*([0-9.eE+-]+)", result.stdout)
         if result.returncode != 0 or not data.exists() or not analysis:
             tail = "\n".join((result.stdout + result.stderr).strip().splitlines()[-15:])
@@ -223,7 +227,7 @@ def run_ngspice(ngspice: str, binary: Path, inputs: list[Path], extra: str, work
         value, derivative = columns["f_along"], columns["d_f_along"]
     return {"scene": scene, "t": columns["time"] + t_start, "values": value, "derivatives": derivative,
             "cpu_time": statistics.median(cpu), "wall_time": statistics.median(wall),
-            "points": int(table.shape[0]), "netlist": netlist}
+            "process_cpu": statistics.median(process_cpu), "points": int(table.shape[0]), "netlist": netlist}
 
 
 # ---------------------------------------------------------- comparison
@@ -269,7 +273,8 @@ def ngspice_work_precision(inputs, reltols, reference_t, reference_values, *, bi
     (e.g. "&brake t_end = 300.0 /\n").  Returns one dict per reltol:
     reltol, atol, error (largest difference on the grid, m or nN), t_error
     (where), cpu_time (ngspice's transient analysis time, s, median of
-    repeats), wall_time (the ngspice process, s), points (saved time points).
+    repeats), wall_time and process_cpu (the ngspice process's wall clock
+    and CPU time, user + system, s), points (saved time points).
     """
     rows = []
     inputs = [Path(p).resolve() for p in inputs]
@@ -282,7 +287,7 @@ def ngspice_work_precision(inputs, reltols, reference_t, reference_values, *, bi
             error, where = max_difference(spice, np.asarray(reference_t), np.asarray(reference_values), window)
             rows.append({"reltol": reltol, "atol": atol, "error": error, "t_error": where,
                          "cpu_time": spice["cpu_time"], "wall_time": spice["wall_time"],
-                         "points": spice["points"]})
+                         "process_cpu": spice["process_cpu"], "points": spice["points"]})
     return rows
 
 

@@ -28,26 +28,34 @@ from helpers import fail  # noqa: E402
 
 # (scene, input file, override, rtol, the table's stepper)
 AFM_SMALL = "&scan nx = 8, ny = 2, length = 4.0, width = 2.0 /\n"
+# The table's rows need a tip that is not stiff: 24 samples over 4 Å (0.43 ms
+# apart at 400 Å/s) give the paper's tips S = 51 (NaF) and 67 (HOPG), below
+# the Rosenbrock band's S = 100; AFM_SMALL's 1.43 ms would give 167 and 220.
+AFM_TABLE = "&scan nx = 24, ny = 2, length = 4.0, width = 2.0 /\n"
 STIFF_TIP = "&tip cx = 3e-2, cy = 3e-2 /\n"
 LJ_SMALL = "&scan nx = 4, ny = 1, length = 1.0 /\n"
 BRAKE_SHORT = ("&brake model = '{model}', t_end = 40.0, dt_out = 0.5 /\n"
                "&analysis spectrum = .false., poincare = .false., lyapunov = .false., rosenstein = .false.,"
                " lyapunov_spectrum = .false., orbit = .false. /\n")
 TABLE = [
-    ("naf", "naf.nml", AFM_SMALL, 1e-3, "rkck"),
-    ("naf", "naf.nml", AFM_SMALL, 1e-7, "rkck"),
-    ("naf", "naf.nml", AFM_SMALL, 1e-9, "rk8pd"),
-    ("hopg", "hopg.nml", AFM_SMALL, 1e-4, "rkck"),
-    ("hopg", "hopg.nml", AFM_SMALL, 1e-8, "rk8pd"),
+    ("naf", "naf.nml", AFM_TABLE, 1e-3, "rkck"),
+    ("naf", "naf.nml", AFM_TABLE, 1e-7, "rkck"),
+    ("naf", "naf.nml", AFM_TABLE, 1e-9, "rk8pd"),
+    ("hopg", "hopg.nml", AFM_TABLE, 1e-4, "rkck"),
+    ("hopg", "hopg.nml", AFM_TABLE, 1e-8, "rk8pd"),
     # Stiff tips (docs/speed.md, Stiff tips): S = rate x sample interval.  The
     # small scan's sample interval is 4/7 Å / 400 Å/s = 1.43 ms; damping
     # 3e-2 N s/m gives a decay rate of 3.0e6 /s (NaF) and 3.0e6 /s (HOPG),
-    # S = 4300: bsimp at any rtol.  The paper's NaF tip (rate 1.17e5 /s)
-    # scanned at 4 Å/s has S = 1.17e5 x 0.143 s = 16700: bsimp too.
-    ("naf_stiff", "naf.nml", AFM_SMALL + STIFF_TIP, 1e-3, "bsimp"),
+    # S = 4300: rodas4 down to rtol 1e-6, bsimp tighter.  The paper's NaF tip
+    # (rate 1.17e5 /s) scanned at 4 Å/s has S = 1.17e5 x 0.143 s = 16700:
+    # rodas4 at 1e-5.  Damping 3e-3 N s/m (rate 3.1e5 /s) gives S = 440,
+    # between 100 and 1000: rodas4 down to rtol 1e-4, the table tighter.
+    ("naf_stiff", "naf.nml", AFM_SMALL + STIFF_TIP, 1e-3, "rodas4"),
     ("naf_stiff", "naf.nml", AFM_SMALL + STIFF_TIP, 1e-9, "bsimp"),
-    ("hopg_stiff", "hopg.nml", AFM_SMALL + STIFF_TIP, 1e-4, "bsimp"),
-    ("naf_slow", "naf.nml", AFM_SMALL.replace(" /", ", velocity = 4.0 /"), 1e-5, "bsimp"),
+    ("hopg_stiff", "hopg.nml", AFM_SMALL + STIFF_TIP, 1e-4, "rodas4"),
+    ("naf_slow", "naf.nml", AFM_SMALL.replace(" /", ", velocity = 4.0 /"), 1e-5, "rodas4"),
+    ("naf_band", "naf.nml", AFM_SMALL + "&tip cx = 3e-3, cy = 3e-3 /\n", 1e-3, "rodas4"),
+    ("naf_band", "naf.nml", AFM_SMALL + "&tip cx = 3e-3, cy = 3e-3 /\n", 1e-5, "rkck"),
     ("graphite", "graphite.nml", LJ_SMALL, 1e-4, "rk8pd"),
     ("brake_regularized", "brake.nml", BRAKE_SHORT.format(model="regularized"), 1e-3, "rk2"),
     ("brake_regularized", "brake.nml", BRAKE_SHORT.format(model="regularized"), 1e-5, "rk4imp"),
@@ -124,8 +132,9 @@ def main():
         for scene, _, _, rtol, expected in TABLE:
             if scene in ("naf", "hopg", "naf_stiff", "hopg_stiff"):
                 potential = scene.split("_")[0]
-                values = {"surface.potential": potential, "scan.nx": 32, "scan.ny": 1, "integrator.rtol": rtol,
-                          "integrator.atol": rtol}
+                # 128 samples over 20 Å keep the paper's tips below S = 100 (46, 60).
+                values = {"surface.potential": potential, "scan.nx": 32 if scene.endswith("_stiff") else 128,
+                          "scan.ny": 1, "integrator.rtol": rtol, "integrator.atol": rtol}
                 if scene.endswith("_stiff"):
                     values.update({"tip.cx": 3e-2, "tip.cy": 3e-2})
                 if potential == "hopg":

@@ -387,6 +387,33 @@ static void check_results(friction_error *err) {
                      "afm_line of the brake");
   fx[0] = 12345.0;
   CHECK(friction_afm_line(cfg, 0, 1, fx, fy, 15, err) != FRICTION_OK && fx[0] == 12345.0, "a refused line wrote");
+
+  /* The library's own Rosenbrock steppers by name: a line with rodas3 and
+   * rodas4 at rtol = atol = 1e-8 against rk8pd at 1e-11.  On the full NaF
+   * map rodas4 at 1e-7 is off by 1.3e-9 nN and rodas3 at 1e-7 by 2e-8 nN
+   * (docs/speed.md); 1e-6 nN leaves a factor of 50 and more, and is far below
+   * the 1e-3 nN that a wrong stepper (or a wrong Jacobian) gives. */
+  {
+    friction_config *tight = small_naf(err);
+    double rx[16], ry[16], ox[16], oy[16];
+    const char *own[] = {"'rodas3'", "'rodas4'"};
+    int k, i;
+    expect_ok(friction_config_set(tight, "integrator.method", "'rk8pd'", err), err, "rk8pd");
+    expect_ok(friction_config_set_real(tight, "integrator.rtol", 1e-11, err), err, "rtol");
+    expect_ok(friction_config_set_real(tight, "integrator.atol", 1e-11, err), err, "atol");
+    expect_ok(friction_afm_line(tight, 1, 1, rx, ry, 16, err), err, "rk8pd line");
+    for (k = 0; k < 2; k++) {
+      double worst = 0.0;
+      expect_ok(friction_config_set(tight, "integrator.method", own[k], err), err, own[k]);
+      expect_ok(friction_config_set_real(tight, "integrator.rtol", 1e-8, err), err, "rtol");
+      expect_ok(friction_config_set_real(tight, "integrator.atol", 1e-8, err), err, "atol");
+      expect_ok(friction_config_check(tight, err), err, own[k]);
+      expect_ok(friction_afm_line(tight, 1, 1, ox, oy, 16, err), err, own[k]);
+      for (i = 0; i < 16; i++) worst = fmax(worst, fmax(fabs(ox[i] - rx[i]), fabs(oy[i] - ry[i])));
+      CHECK(worst < 1e-6, "%s line against rk8pd: %.3e nN", own[k], worst);
+    }
+    friction_config_free(tight);
+  }
   expect_ok(friction_afm_line(cfg, 2, 0, fx, fy, 16, err), err, "retrace of line 2");
 
   friction_result *res = friction_compute(cfg, err);

@@ -17,7 +17,7 @@ module test_systems
    !> cannot go untested.
    character(len=*), parameter :: step_types_with_cases(*) = [character(len=7) :: &
       & 'rk2', 'rk4', 'rkf45', 'rkck', 'rk8pd', 'rk1imp', 'rk2imp', 'rk4imp', 'bsimp', &
-      & 'msadams', 'msbdf']
+      & 'msadams', 'msbdf', 'rodas3', 'rodas4']
 
    !> Lorenz (σ, ρ, β) = (10, 28, 8/3): maximum exponent 0.906.
    type, extends(ode_system) :: lorenz

@@ -6,7 +6,8 @@
  *    include/friction.h documents the same names (a test compares).
  *    GSL exposes its step types as global pointer variables, which
  *    gfortran cannot import through bind(c) (it defines a zero copy of its
- *    own), so the table holds their addresses.
+ *    own), so the table holds their addresses.  The Rosenbrock steppers of
+ *    rosenbrock.c are step types of the same kind, the library's own.
  * 2. GSL's error handler: a process-wide variable that belongs to the
  *    program.  The library neither leaves it changed nor lets GSL abort
  *    (the default handler) or call the program's handler for an error of
@@ -28,6 +29,8 @@
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_odeiv2.h>
 
+#include "rosenbrock.h"
+
 /* ---- the step types ---- */
 
 static const struct step_type_entry {
@@ -46,6 +49,9 @@ static const struct step_type_entry {
     {"bsimp", &gsl_odeiv2_step_bsimp, 1},
     {"msadams", &gsl_odeiv2_step_msadams, 0},
     {"msbdf", &gsl_odeiv2_step_msbdf, 1},
+    /* the library's own (rosenbrock.c) */
+    {"rodas3", &friction_step_rodas3, 1},
+    {"rodas4", &friction_step_rodas4, 1},
 };
 enum { step_type_count = (int)(sizeof step_types / sizeof step_types[0]) };
 

@@ -1,0 +1,324 @@
+/* The Rosenbrock steppers (src/friction/ode/rosenbrock.c) as GSL step types,
+ * on problems with exact solutions:
+ *
+ *   order        Prothero-Robinson y' = lambda (y - g(t)) + g'(t), y = g(t)
+ *                (non-autonomous: g = sin t + cos 2t), lambda = -1, fixed
+ *                steps halving: the observed order of the global error, and
+ *                of the embedded error estimate over one step, within 0.2
+ *                of the method's.  A 2 x 2 linear system with a rotation
+ *                (y = exp(At) y0 in closed form) the same way.
+ *   stiff        one step of y' = -1e9 y with h = 1: L-stable and stiffly
+ *                accurate, so |y| ends near 0 (not near 1 as for an A-stable
+ *                method with R(-inf) = -1 or 1).
+ *   df/dt        y' = -lambda (y - sin t) + cos t, lambda = 1e4, y = sin t:
+ *                the error through GSL's evolve at rtol 1e-8; with df/dt
+ *                withheld (set to 0) the same fixed steps are far worse.
+ *   bad paths    a singular matrix I/(h gamma) - J fails the step with
+ *                GSL_ESING and y unchanged, and evolve recovers by halving
+ *                the step; a Jacobian of NaN fails every step and evolve
+ *                gives up with that status (no hang, no abort: GSL's default
+ *                handler, which aborts, stays installed); no Jacobian is
+ *                GSL_EFAULT.
+ *
+ * Usage: test_rosenbrock_steppers (exit status 0 when every check passes). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_odeiv2.h>
+
+extern const gsl_odeiv2_step_type *friction_step_rodas3;
+extern const gsl_odeiv2_step_type *friction_step_rodas4;
+
+static int failures = 0;
+
+#define CHECK(cond, ...)                                  \
+    do {                                                  \
+        if (!(cond)) {                                    \
+            failures++;                                   \
+            fprintf(stderr, "FAIL %s:%d: ", __FILE__, __LINE__); \
+            fprintf(stderr, __VA_ARGS__);                 \
+            fputc('\n', stderr);                          \
+        }                                                 \
+    } while (0)
+
+/* ---- Prothero-Robinson ---- */
+
+struct pr {
+    double lambda;
+    int with_dfdt;   /* 0: the Jacobian withholds df/dt (wrong on purpose) */
+};
+
+static double g(double t) { return sin(t) + cos(2.0 * t); }
+static double gp(double t) { return cos(t) - 2.0 * sin(2.0 * t); }
+static double gpp(double t) { return -sin(t) - 4.0 * cos(2.0 * t); }
+
+static int pr_f(double t, const double y[], double f[], void *params)
+{
+    const struct pr *p = params;
+    f[0] = p->lambda * (y[0] - g(t)) + gp(t);
+    return GSL_SUCCESS;
+}
+
+static int pr_jac(double t, const double y[], double *dfdy, double dfdt[], void *params)
+{
+    const struct pr *p = params;
+    (void)y;
+    dfdy[0] = p->lambda;
+    dfdt[0] = p->with_dfdt ? -p->lambda * gp(t) + gpp(t) : 0.0;
+    return GSL_SUCCESS;
+}
+
+/* ---- y' = A y, A = [[-a, w], [-w, -a]]: y = exp(-a t) R(-w t) y0 ---- */
+
+static const double lin_a = 0.5, lin_w = 3.0;
+
+static int lin_f(double t, const double y[], double f[], void *params)
+{
+    (void)t;
+    (void)params;
+    f[0] = -lin_a * y[0] + lin_w * y[1];
+    f[1] = -lin_w * y[0] - lin_a * y[1];
+    return GSL_SUCCESS;
+}
+
+static int lin_jac(double t, const double y[], double *dfdy, double dfdt[], void *params)
+{
+    (void)t;
+    (void)y;
+    (void)params;
+    dfdy[0] = -lin_a;
+    dfdy[1] = lin_w;
+    dfdy[2] = -lin_w;
+    dfdy[3] = -lin_a;
+    dfdt[0] = dfdt[1] = 0.0;
+    return GSL_SUCCESS;
+}
+
+static void lin_exact(double t, double y[2])
+{
+    double e = exp(-lin_a * t);
+    y[0] = e * cos(lin_w * t);   /* y0 = (1, 0) */
+    y[1] = -e * sin(lin_w * t);
+}
+
+/* Global error at t_end after n fixed steps (no error control). */
+static double fixed_steps(const gsl_odeiv2_step_type *type, gsl_odeiv2_system *sys, const double y0[],
+                          double t_end, int n, void (*exact)(double, double[]))
+{
+    size_t dim = sys->dimension, i;
+    gsl_odeiv2_step *s = gsl_odeiv2_step_alloc(type, dim);
+    double y[2], yerr[2], dydt_out[2], want[2], h = t_end / n, t = 0.0, error = 0.0;
+    int k, status = GSL_SUCCESS;
+
+    memcpy(y, y0, dim * sizeof *y);
+    for (k = 0; k < n && status == GSL_SUCCESS; k++) {
+        status = gsl_odeiv2_step_apply(s, t, h, y, yerr, NULL, dydt_out, sys);
+        t = (k + 1) * h;
+    }
+    gsl_odeiv2_step_free(s);
+    if (status != GSL_SUCCESS) return NAN;
+    exact(t_end, want);
+    for (i = 0; i < dim; i++) error = fmax(error, fabs(y[i] - want[i]));
+    return error;
+}
+
+static void pr_exact(double t, double y[]) { y[0] = g(t); }
+
+/* |yerr| of one step of size h from the exact y(t0). */
+static double one_step_estimate(const gsl_odeiv2_step_type *type, gsl_odeiv2_system *sys, double t0, double h)
+{
+    gsl_odeiv2_step *s = gsl_odeiv2_step_alloc(type, 1);
+    double y = g(t0), yerr = 0.0, out;
+    int status = gsl_odeiv2_step_apply(s, t0, h, &y, &yerr, NULL, &out, sys);
+    gsl_odeiv2_step_free(s);
+    return status == GSL_SUCCESS ? fabs(yerr) : NAN;
+}
+
+static void check_order(const char *name, const gsl_odeiv2_step_type *type, double order)
+{
+    struct pr p = {-1.0, 1};
+    gsl_odeiv2_system pr_sys = {pr_f, pr_jac, 1, &p};
+    gsl_odeiv2_system lin_sys = {lin_f, lin_jac, 2, NULL};
+    double y0[2] = {g(0.0), 0.0}, y0_lin[2] = {1.0, 0.0};
+    int n;
+
+    /* Global error over [0, 2] with 10 ... 80 steps: log2 of successive
+     * ratios.  (The errors stay far above rounding: 1e-9 and more.) */
+    for (n = 10; n <= 40; n *= 2) {
+        double e1 = fixed_steps(type, &pr_sys, y0, 2.0, n, pr_exact);
+        double e2 = fixed_steps(type, &pr_sys, y0, 2.0, 2 * n, pr_exact);
+        double observed = log2(e1 / e2);
+        CHECK(fabs(observed - order) <= 0.2, "%s: Prothero-Robinson order %.3f with %d -> %d steps (errors %.3e, %.3e)",
+              name, observed, n, 2 * n, e1, e2);
+        e1 = fixed_steps(type, &lin_sys, y0_lin, 2.0, n, lin_exact);
+        e2 = fixed_steps(type, &lin_sys, y0_lin, 2.0, 2 * n, lin_exact);
+        observed = log2(e1 / e2);
+        CHECK(fabs(observed - order) <= 0.2, "%s: linear system order %.3f with %d -> %d steps (errors %.3e, %.3e)",
+              name, observed, n, 2 * n, e1, e2);
+    }
+    /* The embedded estimate is y_new minus a solution of order p - 1: the
+     * local error of that one, O(h^p). */
+    for (n = 0; n < 3; n++) {
+        double h = 0.02 / (1 << n);
+        double e1 = one_step_estimate(type, &pr_sys, 0.3, h), e2 = one_step_estimate(type, &pr_sys, 0.3, h / 2);
+        double observed = log2(e1 / e2);
+        CHECK(fabs(observed - order) <= 0.2, "%s: embedded estimate of order %.3f (h = %g: %.3e, %.3e)", name,
+              observed, h, e1, e2);
+    }
+}
+
+/* ---- stiff decay ---- */
+
+static int decay_f(double t, const double y[], double f[], void *params)
+{
+    (void)t;
+    f[0] = *(const double *)params * y[0];
+    return GSL_SUCCESS;
+}
+
+static int decay_jac(double t, const double y[], double *dfdy, double dfdt[], void *params)
+{
+    (void)t;
+    (void)y;
+    dfdy[0] = *(const double *)params;
+    dfdt[0] = 0.0;
+    return GSL_SUCCESS;
+}
+
+static void check_stiff_decay(const char *name, const gsl_odeiv2_step_type *type)
+{
+    double rate = -1.0e9, y = 1.0, yerr, out;
+    gsl_odeiv2_system sys = {decay_f, decay_jac, 1, &rate};
+    gsl_odeiv2_step *s = gsl_odeiv2_step_alloc(type, 1);
+    int status = gsl_odeiv2_step_apply(s, 0.0, 1.0, &y, &yerr, NULL, &out, &sys);
+
+    gsl_odeiv2_step_free(s);
+    /* R(z) of an L-stable method falls as 1/z: about 1e-9 here.  An A-stable
+     * method without that (R(-inf) = +-1) would leave |y| near 1. */
+    CHECK(status == GSL_SUCCESS && fabs(y) < 1.0e-6, "%s: one step of y' = -1e9 y, h = 1: y = %.3e (status %d)",
+          name, y, status);
+}
+
+/* ---- df/dt ---- */
+
+static double nonautonomous_error(const gsl_odeiv2_step_type *type, int with_dfdt, int fixed)
+{
+    struct pr p = {-1.0e4, with_dfdt};
+    gsl_odeiv2_system sys = {pr_f, pr_jac, 1, &p};
+    double t = 0.0, y = g(0.0), t_end = 3.0, h = 1.0e-3;
+
+    if (fixed) {
+        double y0[1] = {g(0.0)};
+        return fixed_steps(type, &sys, y0, t_end, 100, pr_exact);
+    }
+    {
+        gsl_odeiv2_driver *d = gsl_odeiv2_driver_alloc_y_new(&sys, type, h, 1.0e-8, 1.0e-8);
+        int status = gsl_odeiv2_driver_apply(d, &t, t_end, &y);
+        gsl_odeiv2_driver_free(d);
+        return status == GSL_SUCCESS ? fabs(y - g(t_end)) : NAN;
+    }
+}
+
+static void check_dfdt(const char *name, const gsl_odeiv2_step_type *type)
+{
+    double adaptive = nonautonomous_error(type, 1, 0);
+    double right = nonautonomous_error(type, 1, 1), withheld = nonautonomous_error(type, 0, 1);
+
+    /* A local tolerance of 1e-8 on a contracting problem (lambda = -1e4):
+     * the global error stays of that order; 1e-7 leaves a factor 10. */
+    CHECK(adaptive < 1.0e-7, "%s: y' = -1e4 (y - g) + g' through evolve at 1e-8: error %.3e", name, adaptive);
+    /* 100 fixed steps (h lambda = -300): with df/dt the stiffly accurate
+     * method follows g; without it each step misses a term of order h g'',
+     * damped only by 1/(h lambda), so the error is far larger. */
+    CHECK(right < 1.0e-4 && withheld > 10.0 * right,
+          "%s: 100 fixed steps: error %.3e with df/dt, %.3e without", name, right, withheld);
+}
+
+/* ---- bad paths ---- */
+
+static int nan_jac(double t, const double y[], double *dfdy, double dfdt[], void *params)
+{
+    (void)t;
+    (void)y;
+    (void)params;
+    dfdy[0] = NAN;
+    dfdt[0] = 0.0;
+    return GSL_SUCCESS;
+}
+
+static void check_bad_paths(const char *name, const gsl_odeiv2_step_type *type, double gamma)
+{
+    /* y' = c y with c = 1/(h gamma): the matrix I/(h gamma) - J is zero. */
+    double c = 2.0, h = 1.0 / (c * gamma), y = 1.0, yerr, out, t = 0.0;
+    gsl_odeiv2_system sys = {decay_f, decay_jac, 1, &c};
+    gsl_odeiv2_step *s = gsl_odeiv2_step_alloc(type, 1);
+    int status = gsl_odeiv2_step_apply(s, 0.0, h, &y, &yerr, NULL, &out, &sys);
+
+    CHECK(status == GSL_ESING && y == 1.0, "%s: singular matrix: status %d, y = %g", name, status, y);
+    gsl_odeiv2_step_free(s);
+    {
+        /* Through evolve: the failed step is halved and the run goes on to
+         * the right answer e^(c t). */
+        gsl_odeiv2_driver *d = gsl_odeiv2_driver_alloc_y_new(&sys, type, h, 1.0e-10, 1.0e-10);
+        y = 1.0;
+        status = gsl_odeiv2_evolve_apply(d->e, d->c, d->s, &sys, &t, 1.0, &d->h, &y);
+        CHECK(status == GSL_SUCCESS && t > 0.0 && d->e->failed_steps >= 1,
+              "%s: evolve after a singular matrix: status %d, t = %g, %lu failed", name, status, t,
+              (unsigned long)d->e->failed_steps);
+        status = gsl_odeiv2_driver_apply(d, &t, 1.0, &y);
+        CHECK(status == GSL_SUCCESS && fabs(y / exp(c) - 1.0) < 1.0e-8, "%s: y' = 2y to t = 1: %.12g (status %d)",
+              name, y, status);
+        gsl_odeiv2_driver_free(d);
+    }
+    {
+        /* A Jacobian of NaN: every try fails; evolve halves the step until it
+         * no longer moves t, then returns the status with t and y as they were. */
+        gsl_odeiv2_system bad = {decay_f, nan_jac, 1, &c};
+        gsl_odeiv2_driver *d = gsl_odeiv2_driver_alloc_y_new(&bad, type, 0.1, 1.0e-6, 1.0e-6);
+        t = 0.0;
+        y = 1.0;
+        status = gsl_odeiv2_evolve_apply(d->e, d->c, d->s, &bad, &t, 1.0, &d->h, &y);
+        CHECK(status == GSL_ESING && t == 0.0 && y == 1.0, "%s: NaN Jacobian: status %d, t = %g, y = %g", name,
+              status, t, y);
+        gsl_odeiv2_driver_free(d);
+    }
+    {
+        gsl_error_handler_t *old = gsl_set_error_handler_off();
+        gsl_odeiv2_system none = {decay_f, NULL, 1, &c};
+        s = gsl_odeiv2_step_alloc(type, 1);
+        y = 1.0;
+        status = gsl_odeiv2_step_apply(s, 0.0, 0.1, &y, &yerr, NULL, &out, &none);
+        CHECK(status == GSL_EFAULT && y == 1.0, "%s: no Jacobian: status %d", name, status);
+        gsl_odeiv2_step_free(s);
+        gsl_set_error_handler(old);
+    }
+}
+
+int main(void)
+{
+    const struct {
+        const char *name;
+        const gsl_odeiv2_step_type *type;
+        double order, gamma;
+    } methods[] = {{"rodas3", NULL, 3.0, 0.5}, {"rodas4", NULL, 4.0, 0.25}};
+    const gsl_odeiv2_step_type *types[] = {friction_step_rodas3, friction_step_rodas4};
+    size_t m;
+
+    for (m = 0; m < 2; m++) {
+        const gsl_odeiv2_step_type *type = types[m];
+        gsl_odeiv2_step *s = gsl_odeiv2_step_alloc(type, 1);
+        CHECK(strcmp(gsl_odeiv2_step_name(s), methods[m].name) == 0, "name %s", gsl_odeiv2_step_name(s));
+        /* GSL's control takes the order of the error estimate's local error. */
+        CHECK(gsl_odeiv2_step_order(s) == (unsigned int)methods[m].order, "%s: order %u", methods[m].name,
+              gsl_odeiv2_step_order(s));
+        gsl_odeiv2_step_free(s);
+        check_order(methods[m].name, type, methods[m].order);
+        check_stiff_decay(methods[m].name, type);
+        check_dfdt(methods[m].name, type);
+        check_bad_paths(methods[m].name, type, methods[m].gamma);
+    }
+    if (failures == 0) printf("test_rosenbrock_steppers: all checks passed\n");
+    return failures == 0 ? 0 : 1;
+}
