@@ -5,6 +5,7 @@
 module friction_surface_hopg
    use friction_kinds, only: wp, pi
    use friction_surface_potential, only: surface_potential
+   use friction_special, only: sin_cos
    implicit none
    private
 
@@ -46,10 +47,11 @@ contains
       class(hopg_potential), intent(in) :: self
       real(wp), intent(in) :: r(3)
       real(wp), intent(out) :: g(3)
-      real(wp) :: sx, cx, sy, cy
+      real(wp) :: sx, cx, sy, cy, phase_sin(2), phase_cos(2)
 
-      sx = sin(self%qx * r(1)); cx = cos(self%qx * r(1))
-      sy = sin(self%qy * r(2)); cy = cos(self%qy * r(2))
+      call sin_cos([self%qx * r(1), self%qy * r(2)], phase_sin, phase_cos)
+      sx = phase_sin(1); cx = phase_cos(1)
+      sy = phase_sin(2); cy = phase_cos(2)
       g(1) = 2.0_wp * self%v0 * self%qx * sx * cy
       ! sin(2 qy y) = 2 sy cy
       g(2) = 2.0_wp * self%v0 * self%qy * (cx * sy + 2.0_wp * sy * cy)
@@ -60,10 +62,11 @@ contains
       class(hopg_potential), intent(in) :: self
       real(wp), intent(in) :: r(3)
       real(wp), intent(out) :: h(3, 3)
-      real(wp) :: sx, cx, sy, cy
+      real(wp) :: sx, cx, sy, cy, phase_sin(2), phase_cos(2)
 
-      sx = sin(self%qx * r(1)); cx = cos(self%qx * r(1))
-      sy = sin(self%qy * r(2)); cy = cos(self%qy * r(2))
+      call sin_cos([self%qx * r(1), self%qy * r(2)], phase_sin, phase_cos)
+      sx = phase_sin(1); cx = phase_cos(1)
+      sy = phase_sin(2); cy = phase_cos(2)
       h = 0.0_wp
       h(1, 1) = 2.0_wp * self%v0 * self%qx**2 * cx * cy
       ! cos(2 qy y) = cy² - sy²
