@@ -277,7 +277,7 @@ contains
       logical :: answered
 
       if (self%tabulated) then
-         call self%table_answers(r, 1, answered, v, g, h)
+         call table_answers(self, r, 1, answered, v, g, h)
          if (answered) return
       end if
       call sum_pairs(self, r, 1, v, g, h)

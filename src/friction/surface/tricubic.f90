@@ -119,6 +119,14 @@ contains
    pure integer function layer_below(self, height) result(k)
       class(tricubic_grid), intent(in) :: self
       real(wp), intent(in) :: height
+
+      k = find_layer(self, height)
+   end function layer_below
+
+   !> layer_below's work (a plain call, which evaluate can have inlined).
+   pure integer function find_layer(self, height) result(k)
+      type(tricubic_grid), intent(in) :: self
+      real(wp), intent(in) :: height
       integer :: last
 
       last = size(self%z) - 1
@@ -129,7 +137,7 @@ contains
          if (self%z(k + 1) > height) exit
          k = k + 1
       end do
-   end function layer_below
+   end function find_layer
 
    !> The interpolant at p = (x, y, z): its value v, and for order >= 1 its
    !> gradient g, for order 2 also its Hessian h (zero when not asked for).
@@ -146,7 +154,7 @@ contains
       t = (p(2) - self%y0) * self%inverse_hy
       i = int(min(real(self%nx - 2, wp), max(0.0_wp, s)))
       j = int(min(real(self%ny - 2, wp), max(0.0_wp, t)))
-      k = self%layer_below(p(3))
+      k = find_layer(self, p(3))
       if (allocated(self%cell)) then
          associate (op => self%image(i, j))
             call cell_polynomial(self%cell(:, self%slot(i, j) + self%slots * (k - 1)), op, s - i, t - j, &
@@ -182,6 +190,7 @@ contains
       class(tricubic_grid), intent(inout) :: self
       logical, intent(in), optional :: inversion, swap
       real(wp) :: c(4, 4, 4)
+      real(wp) :: w
       integer :: i, j, k, ox, oy, oz, a, b, op, n, m, there(2), first
       logical :: used(3)
 
@@ -244,19 +253,20 @@ contains
                      end do
                   end do
                end do
+               w = self%z(k + 1) - self%z(k)
                do b = 1, 4
                   do a = 1, 4
-                     c(:, a, b) = power_coefficients(c(:, a, b), self%hx)
+                     call to_power(c(1, a, b), c(2, a, b), c(3, a, b), c(4, a, b), self%hx)
                   end do
                end do
                do b = 1, 4
                   do a = 1, 4
-                     c(a, :, b) = power_coefficients(c(a, :, b), self%hy)
+                     call to_power(c(a, 1, b), c(a, 2, b), c(a, 3, b), c(a, 4, b), self%hy)
                   end do
                end do
                do b = 1, 4
                   do a = 1, 4
-                     c(a, b, :) = power_coefficients(c(a, b, :), self%z(k + 1) - self%z(k))
+                     call to_power(c(a, b, 1), c(a, b, 2), c(a, b, 3), c(a, b, 4), w)
                   end do
                end do
                self%cell(:, self%slot(i, j) + self%slots * (k - 1)) = reshape(c, [n_cell_coefficients])
@@ -284,19 +294,22 @@ contains
 
    end subroutine set_polynomials
 
-   !> The power-basis coefficients (p0, p1, p2, p3) of the cubic Hermite
-   !> data (f0, f1, d0, d1) on an interval of width w (set_polynomials).
-   pure function power_coefficients(hermite, w) result(p)
-      real(wp), intent(in) :: hermite(4), w
-      real(wp) :: p(4)
+   !> The cubic Hermite data (f0, f1, d0, d1) on an interval of width w
+   !> replaced by the power-basis coefficients (p0, p1, p2, p3) of the same
+   !> cubic (set_polynomials).
+   elemental subroutine to_power(f0, f1, d0, d1, w)
+      real(wp), intent(inout) :: f0, f1, d0, d1
+      real(wp), intent(in) :: w
+      real(wp) :: v0, v1, s0, s1
 
-      associate (f0 => hermite(1), f1 => hermite(2), d0 => w * hermite(3), d1 => w * hermite(4))
-         p(1) = f0
-         p(2) = d0
-         p(3) = 3.0_wp * (f1 - f0) - 2.0_wp * d0 - d1
-         p(4) = 2.0_wp * (f0 - f1) + d0 + d1
-      end associate
-   end function power_coefficients
+      v0 = f0
+      v1 = f1
+      s0 = w * d0
+      s1 = w * d1
+      f1 = s0
+      d0 = 3.0_wp * (v1 - v0) - 2.0_wp * s0 - s1
+      d1 = 2.0_wp * (v0 - v1) + s0 + s1
+   end subroutine to_power
 
    !> The value v, gradient g (order >= 1) and Hessian h (order 2; else
    !> zero) at local coordinates (ξ, η, ζ) = (px, py, z) of a cell whose
