@@ -568,10 +568,18 @@ contains
       end if
       target = 0.4_wp * settings%tolerance
       do attempt = 1, 3
-         call choose_layers(ideal, t, target, settings%energy_window, layers, vmin, reason)
+         if (present(share)) then
+            call choose_layers(ideal, t, target, settings%energy_window, layers, vmin, reason, share)
+         else
+            call choose_layers(ideal, t, target, settings%energy_window, layers, vmin, reason, alone)
+         end if
          if (len(reason) > 0) return
          t%energy_cap = vmin + settings%energy_window
-         call choose_spacing(ideal, t, layers, target, spacing, reason)
+         if (present(share)) then
+            call choose_spacing(ideal, t, layers, target, spacing, reason, share)
+         else
+            call choose_spacing(ideal, t, layers, target, spacing, reason, alone)
+         end if
          if (len(reason) > 0) return
          n1 = max(4, ceiling(norm2(t%vectors(:, 1)) / spacing))
          n2 = max(4, ceiling(norm2(t%vectors(:, 2)) / spacing))
@@ -861,14 +869,17 @@ contains
    end function cartesian_gradient
 
    !> Step 2 of `tabulate`: the heights of the layers, ascending, and the
-   !> lowest energy of the lattice met (at the check columns' nodes).
-   subroutine choose_layers(ideal, t, target, window, layers, vmin, reason)
+   !> lowest energy of the lattice met (at the check columns' nodes).  The
+   !> processes share the check columns, and all take the same steps.
+   subroutine choose_layers(ideal, t, target, window, layers, vmin, reason, share)
       type(lj_potential), intent(in) :: ideal
       type(lj_table), intent(in) :: t
       real(wp), intent(in) :: target, window
       real(wp), allocatable, intent(out) :: layers(:)
       real(wp), intent(out) :: vmin
       character(len=:), allocatable, intent(inout) :: reason
+      !> the processes sharing the columns (each a share, then summed)
+      class(work_sharing), intent(inout) :: share
       integer, parameter :: side = 6, max_layers = 4000
       real(wp), parameter :: check_at(3) = [0.2113248654051871_wp, 0.5_wp, 0.7886751345948129_wp]
       real(wp), allocatable :: columns(:, :), upper(:, :), lower(:, :), found(:), checked(:, :, :)
@@ -908,11 +919,16 @@ contains
             return
          end if
          ! The new layer's values and the lattice's at the check heights,
-         ! column by column (one gathering of the pairs for all four).
+         ! column by column (one gathering of the pairs for all four), the
+         ! columns dealt round-robin over the processes and summed (-0.0
+         ! where a process computes nothing: the same values on every one).
+         if (share%ranks > 1) checked = -0.0_wp
          do m = 1, ncol
+            if (mod(m - 1, share%ranks) /= share%rank) cycle
             call column_values(ideal, t, columns(:, m), [z_new, z_new + check_at * step], checked(:, :, m))
-            lower(:, m) = checked(:, 1, m)
          end do
+         if (share%ranks > 1) call share%sum_reals(checked, size(checked))
+         lower = checked(:, 1, :)
          ! The error of the interpolation along z at the check columns, where
          ! the energy is under the cap (the lowest energy so far: the cap
          ! only falls as the march goes down through the well).
@@ -978,13 +994,16 @@ contains
    !> Step 3 of `tabulate`: the lateral spacing (Å) that keeps the error of
    !> the interpolation within the layers under `target`, measured at
    !> quasi-random points of every layer (energy under the cap) on trial
-   !> spacings: the error goes as the spacing cubed.
-   subroutine choose_spacing(ideal, t, layers, target, spacing, reason)
+   !> spacings: the error goes as the spacing cubed.  The processes share
+   !> the points and take the largest error of all.
+   subroutine choose_spacing(ideal, t, layers, target, spacing, reason, share)
       type(lj_potential), intent(in) :: ideal
       type(lj_table), intent(in) :: t
       real(wp), intent(in) :: layers(:), target
       real(wp), intent(out) :: spacing
       character(len=:), allocatable, intent(inout) :: reason
+      !> the processes sharing the points (each a share, then the largest error)
+      class(work_sharing), intent(inout) :: share
       integer, parameter :: per_layer = 16, trials = 6
       real(wp) :: worst, s(2), f(2), n(2), corner(n_node_values, 2, 2), v, gi(3), g(3), hi(3, 3)
       type(tricubic_grid) :: cell
@@ -998,6 +1017,7 @@ contains
          do k = 1, size(layers)
             do m = 1, per_layer
                count_halton = count_halton + 1
+               if (mod(count_halton - 1, share%ranks) /= share%rank) cycle
                s = [halton(count_halton + 16, 2), halton(count_halton + 16, 3)]
                ! The cell holding s, its four corners at this layer.
                f = floor(s * n)
@@ -1018,6 +1038,7 @@ contains
                worst = max(worst, norm2(gi - g))
             end do
          end do
+         call share%max_real(worst)
          if (worst <= target .and. trial > 1) return
          ! Error ~ spacing³: aim 10 % below the target.
          spacing = spacing * min(1.5_wp, 0.9_wp * (target / max(worst, tiny(1.0_wp)))**(1.0_wp / 3.0_wp))
@@ -1103,6 +1124,7 @@ contains
          & -1.0_wp, 1.0_wp]
       !> where each value goes in the image of a column under the swap
       integer, parameter :: swapped(n_node_values) = [1, 3, 2, 4, 5, 7, 6, 8]
+      real(wp), allocatable :: packed(:, :, :)
       integer :: i, j, n1, n2, dealt, op, image(2)
       logical :: used(3)
 
@@ -1110,19 +1132,39 @@ contains
       n2 = t%grid%ny - 1
       ! (op 1: the inversion, 2: the swap, 3: both.)
       used = [inversion, swap .and. n1 == n2, inversion .and. swap .and. n1 == n2]
-      ! (-0.0 where this process computes nothing: see work_sharing's sum.)
-      if (share%ranks > 1) t%grid%node = -0.0_wp
-      dealt = 0
-      do j = 1, n2
-         do i = 1, n1
-            if (.not. first_of_orbit(i, j)) cycle
-            dealt = dealt + 1
-            if (mod(dealt - 1, share%ranks) /= share%rank) cycle
-            call column_values(ideal, t, cartesian(t, [real(i - 1, wp) / n1, real(j - 1, wp) / n2]), t%grid%z, &
-               & t%grid%node(:, i, j, :))
+      if (share%ranks == 1) then
+         do j = 1, n2
+            do i = 1, n1
+               if (.not. first_of_orbit(i, j)) cycle
+               call column_values(ideal, t, cartesian(t, [real(i - 1, wp) / n1, real(j - 1, wp) / n2]), t%grid%z, &
+                  & t%grid%node(:, i, j, :))
+            end do
          end do
-      end do
-      if (share%ranks > 1) call share%sum_reals(t%grid%node, size(t%grid%node))
+      else
+         ! The columns computed, packed, dealt round-robin and summed (-0.0
+         ! where this process computes nothing: see work_sharing's sum).
+         allocate (packed(n_node_values, size(t%grid%z), count([((first_of_orbit(i, j), i = 1, n1), j = 1, n2)])), &
+            & source=-0.0_wp)
+         dealt = 0
+         do j = 1, n2
+            do i = 1, n1
+               if (.not. first_of_orbit(i, j)) cycle
+               dealt = dealt + 1
+               if (mod(dealt - 1, share%ranks) /= share%rank) cycle
+               call column_values(ideal, t, cartesian(t, [real(i - 1, wp) / n1, real(j - 1, wp) / n2]), t%grid%z, &
+                  & packed(:, :, dealt))
+            end do
+         end do
+         call share%sum_reals(packed, size(packed))
+         dealt = 0
+         do j = 1, n2
+            do i = 1, n1
+               if (.not. first_of_orbit(i, j)) cycle
+               dealt = dealt + 1
+               t%grid%node(:, i, j, :) = packed(:, :, dealt)
+            end do
+         end do
+      end if
       do j = 1, n2
          do i = 1, n1
             if (.not. first_of_orbit(i, j)) cycle
