@@ -507,7 +507,8 @@ contains
    !>    the cap (the lowest energy met plus the energy window): the floor.
    !> 3. The lateral spacing: as large as keeps the error within 0.4
    !>    tolerance at points in the layers, measured on trial spacings.
-   !> 4. The table: every node of one cell on every layer.
+   !> 4. The table: every node of one cell on every layer, then the cells'
+   !>    polynomials (once per orbit of the lattice's symmetries).
    !> 5. The check: the force against the direct sum over the net at
    !>    settings%verify_points quasi-random points (Halton, the same on
    !>    every rank) in the box where the table answers; above the tolerance

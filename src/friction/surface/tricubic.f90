@@ -105,7 +105,7 @@ contains
       end do
    end function new_tricubic_grid
 
-   !> Memory of the node values, bytes.
+   !> Memory of the node values and the cells' polynomials, bytes.
    pure real(wp) function bytes(self)
       class(tricubic_grid), intent(in) :: self
 
