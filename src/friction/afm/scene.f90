@@ -570,7 +570,7 @@ contains
       max_force = 0.0_wp
       call new_potential(c, potential, error)
       if (allocated(error)) return
-      call scanner%init(c, potential, error)
+      call scanner%init_owning(c, potential, error)
       if (allocated(error)) return
       total = 0.0_wp
       do j = 0, c%ny - 1
