@@ -27,9 +27,9 @@ module friction_afm_config
    implicit none
    private
 
-   public :: afm_config, potential_names, net_names, tip_model_names, new_potential, new_tip, net_sites, max_species, &
-      & max_defects, species_count, surface_curvature, thermal_step_limit, tip_stiffness, evaluation_names, &
-      & surface_evaluation, table_energy_window, table_reach
+   public :: afm_config, potential_names, net_names, tip_model_names, new_potential, new_tip, new_tip_owning, &
+      & net_sites, max_species, max_defects, species_count, surface_curvature, thermal_step_limit, tip_stiffness, &
+      & evaluation_names, surface_evaluation, table_energy_window, table_reach
 
    character(len=*), parameter :: potential_names(3) = [character(len=4) :: 'naf', 'hopg', 'lj']
    character(len=*), parameter :: net_names(3) = [character(len=8) :: 'graphite', 'square', 'file']
@@ -492,7 +492,6 @@ contains
       !> sum's table: collective over them); absent, this process alone
       class(work_sharing), intent(inout), optional :: share
       type(crystal_net) :: atoms
-      type(lj_potential) :: lattice_sum
       type(surface_evaluation) :: how
       real(wp) :: rc
       integer :: ns
@@ -513,12 +512,17 @@ contains
          rc = config%cutoff
          if (rc <= 0.0_wp) rc = cutoff_for_tolerance(maxval(config%epsilon(1:ns) * config%sigma(1:ns)**6), &
             & 1.0_wp, net_density(atoms), config%cutoff_tolerance / ev_per_angstrom_to_nn)
-         lattice_sum = new_lj_potential(atoms, config%epsilon(1:ns), config%sigma(1:ns), rc, &
-            & scan_region(config, rc + table_reach))
-         how%evaluation = 'direct'
-         how%note = ''
-         if (config%evaluation == 'table') call tabulate_net(config, atoms, lattice_sum, how, share)
-         allocate (potential, source=lattice_sum)
+         ! (Built where it stays: a copy of a table costs as much as a good
+         ! part of its build.)
+         allocate (lj_potential :: potential)
+         select type (lattice_sum => potential)
+         type is (lj_potential)
+            lattice_sum = new_lj_potential(atoms, config%epsilon(1:ns), config%sigma(1:ns), rc, &
+               & scan_region(config, rc + table_reach))
+            how%evaluation = 'direct'
+            how%note = ''
+            if (config%evaluation == 'table') call tabulate_net(config, atoms, lattice_sum, how, share)
+         end select
          if (present(net)) net = atoms
          if (present(cutoff)) cutoff = rc
          if (present(evaluation)) evaluation = how
@@ -684,6 +688,25 @@ contains
       type(afm_tip), intent(out) :: tip
 
       allocate (tip%potential, source=potential)
+      call set_up_tip(config, tip)
+   end subroutine new_tip
+
+   !> new_tip, the tip taking `potential` over (deallocated on return)
+   !> instead of a copy: a tabulated surface is megabytes.
+   subroutine new_tip_owning(config, potential, tip)
+      type(afm_config), intent(in) :: config
+      class(surface_potential), allocatable, intent(inout) :: potential
+      type(afm_tip), intent(out) :: tip
+
+      call move_alloc(potential, tip%potential)
+      call set_up_tip(config, tip)
+   end subroutine new_tip_owning
+
+   !> The tip's model and constants around its potential (new_tip).
+   subroutine set_up_tip(config, tip)
+      type(afm_config), intent(in) :: config
+      type(afm_tip), intent(inout) :: tip
+
       tip%ndim = tip%potential%dimensions()
       tip%mass = config%mass * kg_to_internal
       tip%spring = [config%kx, config%ky, config%kz] * n_per_m_to_internal
@@ -697,6 +720,6 @@ contains
       case default
          tip%model = model_inertial
       end select
-   end subroutine new_tip
+   end subroutine set_up_tip
 
 end module friction_afm_config

@@ -40,7 +40,7 @@ module friction_afm_scan
    use friction_kinds, only: wp, i8, pi, ev_per_angstrom_to_nn
    use friction_error, only: error_type, fatal_error, error_input, error_numerical
    use friction_ode_solver, only: ode_solver, integrator_statistics
-   use friction_afm_config, only: afm_config, new_tip, surface_curvature
+   use friction_afm_config, only: afm_config, new_tip, new_tip_owning, surface_curvature
    use friction_afm_tip, only: afm_tip, model_inertial, model_quasistatic, find_height
    use friction_afm_thermal, only: welford_add, welford_sem
    use friction_afm_langevin, only: langevin_integrator, langevin_state, langevin_time_step, boltzmann
@@ -151,6 +151,7 @@ module friction_afm_scan
       type(random_stream) :: stream
    contains
       procedure :: init
+      procedure :: init_owning
       procedure :: run_trip
       procedure :: run_thermal_trip
       procedure :: run_kramers_trip
@@ -219,13 +220,36 @@ contains
       type(afm_config), intent(in) :: config
       class(surface_potential), intent(in) :: potential
       type(error_type), allocatable, intent(out) :: error
+
+      if (allocated(self%tip)) deallocate (self%tip)
+      allocate (self%tip)
+      call new_tip(config, potential, self%tip)
+      call set_up(self, config, error)
+   end subroutine init
+
+   !> init, the scanner's tip taking `potential` over (deallocated on
+   !> return) instead of a copy.
+   subroutine init_owning(self, config, potential, error)
+      class(afm_scanner), intent(inout) :: self
+      type(afm_config), intent(in) :: config
+      class(surface_potential), allocatable, intent(inout) :: potential
+      type(error_type), allocatable, intent(out) :: error
+
+      if (allocated(self%tip)) deallocate (self%tip)
+      allocate (self%tip)
+      call new_tip_owning(config, potential, self%tip)
+      call set_up(self, config, error)
+   end subroutine init_owning
+
+   !> The rest of init, around the tip made.
+   subroutine set_up(self, config, error)
+      class(afm_scanner), intent(inout) :: self
+      type(afm_config), intent(in) :: config
+      type(error_type), allocatable, intent(out) :: error
       real(wp) :: sample_time, period
 
       self%config = config
       call system_clock(self%clock_start, self%clock_rate)
-      if (allocated(self%tip)) deallocate (self%tip)
-      allocate (self%tip)
-      call new_tip(config, potential, self%tip)
       if (self%tip%ndim == 3) then
          ! The support's height is set from the contact of the free tip at the
          ! scan origin: z_M = z0 + support_z (support_z < 0 presses the tip).
@@ -268,7 +292,7 @@ contains
       subroutine init_thermal()
          real(wp) :: curvature, dt, limit, lead_time
 
-         curvature = surface_curvature(config, potential)
+         curvature = surface_curvature(config, self%tip%potential)
          call langevin_time_step(self%tip, curvature, dt, limit, error)
          if (allocated(error)) return
          if (config%thermal%time_step > 0.0_wp) dt = config%thermal%time_step
@@ -292,7 +316,7 @@ contains
          end if
       end subroutine init_thermal
 
-   end subroutine init
+   end subroutine set_up
 
    !> The Langevin step between samples, s (0 at T = 0).
    pure real(wp) function time_step(self)

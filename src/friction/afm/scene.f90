@@ -192,7 +192,7 @@ contains
          if (allocated(self%retrace)) deallocate (self%retrace)
          ! The map's share of this rank, checked before it is allocated.
          call allocate_share(error)
-         if (.not. allocated(error)) call scanner%init(c, potential, error)
+         if (.not. allocated(error)) call scanner%init_owning(c, potential, error)
           if (allocated(self%trace_sem)) deallocate (self%trace_sem)
           if (allocated(self%retrace_sem)) deallocate (self%retrace_sem)
           if (allocated(self%friction_sem)) deallocate (self%friction_sem)
@@ -570,7 +570,7 @@ contains
       max_force = 0.0_wp
       call new_potential(c, potential, error)
       if (allocated(error)) return
-      call scanner%init(c, potential, error)
+      call scanner%init_owning(c, potential, error)
       if (allocated(error)) return
       total = 0.0_wp
       do j = 0, c%ny - 1

@@ -692,7 +692,7 @@ contains
          return
       end if
       call new_potential(c, potential, error)
-      if (.not. allocated(error)) call scanner%init(c, potential, error)
+      if (.not. allocated(error)) call scanner%init_owning(c, potential, error)
       if (allocated(error)) then
          continue
       else if (scanner%thermal) then
@@ -795,7 +795,7 @@ contains
 
       call new_potential(c, potential, error)
       if (allocated(error)) return
-      call scanner%init(c, potential, error)
+      call scanner%init_owning(c, potential, error)
       if (allocated(error)) return
       ! (line j's samples are trace(:, j, q): row-major (ny, nx) as it lies)
       allocate (trace(c%nx, c%ny, size(quantity_names)), retrace(c%nx, merge(c%ny, 0, c%retrace), &

@@ -277,7 +277,7 @@ contains
       logical :: answered
 
       if (self%tabulated) then
-         call self%table_answers(r, 1, answered, v, g, h)
+         call table_answers(self, r, 1, answered, v, g, h)
          if (answered) return
       end if
       call sum_pairs(self, r, 1, v, g, h)
@@ -507,7 +507,8 @@ contains
    !>    the cap (the lowest energy met plus the energy window): the floor.
    !> 3. The lateral spacing: as large as keeps the error within 0.4
    !>    tolerance at points in the layers, measured on trial spacings.
-   !> 4. The table: every node of one cell on every layer.
+   !> 4. The table: every node of one cell on every layer, then the cells'
+   !>    polynomials (once per orbit of the lattice's symmetries).
    !> 5. The check: the force against the direct sum over the net at
    !>    settings%verify_points quasi-random points (Halton, the same on
    !>    every rank) in the box where the table answers; above the tolerance
@@ -523,7 +524,7 @@ contains
       type(work_sharing) :: alone
       type(lj_potential) :: ideal
       type(lj_table) :: t
-      real(wp), allocatable :: layers(:)
+      real(wp), allocatable :: layers(:), node(:, :, :, :), cell(:, :)
       real(wp) :: target, spacing, vmin, measured, det
       integer :: attempt, n1, n2
 
@@ -568,28 +569,44 @@ contains
       end if
       target = 0.4_wp * settings%tolerance
       do attempt = 1, 3
-         call choose_layers(ideal, t, target, settings%energy_window, layers, vmin, reason)
+         if (present(share)) then
+            call choose_layers(ideal, t, target, settings%energy_window, layers, vmin, reason, share)
+         else
+            call choose_layers(ideal, t, target, settings%energy_window, layers, vmin, reason, alone)
+         end if
          if (len(reason) > 0) return
          t%energy_cap = vmin + settings%energy_window
-         call choose_spacing(ideal, t, layers, target, spacing, reason)
+         if (present(share)) then
+            call choose_spacing(ideal, t, layers, target, spacing, reason, share)
+         else
+            call choose_spacing(ideal, t, layers, target, spacing, reason, alone)
+         end if
          if (len(reason) > 0) return
          n1 = max(4, ceiling(norm2(t%vectors(:, 1)) / spacing))
          n2 = max(4, ceiling(norm2(t%vectors(:, 2)) / spacing))
-         if (64.0_wp * (n1 + 1) * (n2 + 1) * size(layers) > settings%max_bytes) then
+         if (64.0_wp * (n1 + 1) * (n2 + 1) * size(layers) + 512.0_wp * n1 * n2 * (size(layers) - 1) &
+            & > settings%max_bytes) then
             reason = 'a table of '//itoa(n1)//' x '//itoa(n2)//' x '//itoa(size(layers))//' nodes would exceed ' &
                & //rtoa(settings%max_bytes / 1024.0_wp**2)//' MiB'
             return
          end if
          t%grid = new_tricubic_grid(0.0_wp, 1.0_wp / n1, n1 + 1, 0.0_wp, 1.0_wp / n2, n2 + 1, layers)
          if (present(share)) then
-            call fill_grid(ideal, t, centrosymmetric(lattice), share)
+            call fill_grid(ideal, t, centrosymmetric(lattice), swap_symmetric(lattice), share)
          else
-            call fill_grid(ideal, t, centrosymmetric(lattice), alone)
+            call fill_grid(ideal, t, centrosymmetric(lattice), swap_symmetric(lattice), alone)
          end if
+         ! (The table's grid is the cell [0, 1]²: s -> -s is the reflection
+         ! through its middle, by periodicity.)
+         call t%grid%set_polynomials(centrosymmetric(lattice), swap_symmetric(lattice))
          t%floor = layers(1)
          t%nodes = [n1, n2, size(layers)]
+         ! (One copy of the nodes and the cells' polynomials, not two.)
+         call move_alloc(t%grid%node, node)
+         call move_alloc(t%grid%cell, cell)
          self%table = t
-         deallocate (t%grid%node)   ! (one copy of the nodes, not two)
+         call move_alloc(node, self%table%grid%node)
+         call move_alloc(cell, self%table%grid%cell)
          self%tabulated = .true.
          if (present(share)) then
             call verify(self, settings%verify_points, measured, share)
@@ -599,7 +616,7 @@ contains
          self%table%error = measured
          if (measured <= settings%tolerance) return
          self%tabulated = .false.
-         deallocate (self%table%grid%node)
+         deallocate (self%table%grid%node, self%table%grid%cell, self%table%grid%slot, self%table%grid%image)
          target = 0.5_wp * target
       end do
       reason = 'the table missed the tolerance '//rtoa(settings%tolerance)//' eV/Å by '//rtoa(measured) &
@@ -837,24 +854,36 @@ contains
       real(wp) :: values(n_node_values, 1)
 
       call column_values(ideal, t, r(1:2), [r(3)], values)
-      ! (V_si = a_i . grad: back through the inverse.)
-      g(1) = t%to_fraction(1, 1) * values(2, 1) + t%to_fraction(2, 1) * values(3, 1)
-      g(2) = t%to_fraction(1, 2) * values(2, 1) + t%to_fraction(2, 2) * values(3, 1)
-      g(3) = values(4, 1)
+      g = cartesian_gradient(t, values(:, 1))
    end function lattice_gradient
 
+   !> The Cartesian gradient from a node's values (V_si = a_i . grad: back
+   !> through the inverse).
+   pure function cartesian_gradient(t, values) result(g)
+      type(lj_table), intent(in) :: t
+      real(wp), intent(in) :: values(n_node_values)
+      real(wp) :: g(3)
+
+      g(1) = t%to_fraction(1, 1) * values(2) + t%to_fraction(2, 1) * values(3)
+      g(2) = t%to_fraction(1, 2) * values(2) + t%to_fraction(2, 2) * values(3)
+      g(3) = values(4)
+   end function cartesian_gradient
+
    !> Step 2 of `tabulate`: the heights of the layers, ascending, and the
-   !> lowest energy of the lattice met (at the check columns' nodes).
-   subroutine choose_layers(ideal, t, target, window, layers, vmin, reason)
+   !> lowest energy of the lattice met (at the check columns' nodes).  The
+   !> processes share the check columns, and all take the same steps.
+   subroutine choose_layers(ideal, t, target, window, layers, vmin, reason, share)
       type(lj_potential), intent(in) :: ideal
       type(lj_table), intent(in) :: t
       real(wp), intent(in) :: target, window
       real(wp), allocatable, intent(out) :: layers(:)
       real(wp), intent(out) :: vmin
       character(len=:), allocatable, intent(inout) :: reason
+      !> the processes sharing the columns (each a share, then summed)
+      class(work_sharing), intent(inout) :: share
       integer, parameter :: side = 6, max_layers = 4000
       real(wp), parameter :: check_at(3) = [0.2113248654051871_wp, 0.5_wp, 0.7886751345948129_wp]
-      real(wp), allocatable :: columns(:, :), upper(:, :), lower(:, :), found(:)
+      real(wp), allocatable :: columns(:, :), upper(:, :), lower(:, :), found(:), checked(:, :, :)
       real(wp) :: step, z, z_new, worst, bottom, ratio, g(3), r(3), v, gi(3), s(2)
       integer :: ncol, i, j, k, m
       logical :: all_above
@@ -875,7 +904,7 @@ contains
          ncol = ncol + 1
          columns(:, ncol) = ideal%atoms%position(1:2, i)
       end do
-      allocate (upper(n_node_values, ncol), lower(n_node_values, ncol))
+      allocate (upper(n_node_values, ncol), lower(n_node_values, ncol), checked(n_node_values, 4, ncol))
       bottom = minval(ideal%atoms%position(3, :))
       z = t%top
       do m = 1, ncol
@@ -890,9 +919,17 @@ contains
             reason = 'no floor for the table: the energy stays below the cap down to the atoms'
             return
          end if
+         ! The new layer's values and the lattice's at the check heights,
+         ! column by column (one gathering of the pairs for all four), the
+         ! columns dealt round-robin over the processes and summed (-0.0
+         ! where a process computes nothing: the same values on every one).
+         if (share%ranks > 1) checked = -0.0_wp
          do m = 1, ncol
-            call column_values(ideal, t, columns(:, m), [z_new], lower(:, m:m))
+            if (mod(m - 1, share%ranks) /= share%rank) cycle
+            call column_values(ideal, t, columns(:, m), [z_new, z_new + check_at * step], checked(:, :, m))
          end do
+         if (share%ranks > 1) call share%sum_reals(checked, size(checked))
+         lower = checked(:, 1, :)
          ! The error of the interpolation along z at the check columns, where
          ! the energy is under the cap (the lowest energy so far: the cap
          ! only falls as the march goes down through the well).
@@ -902,7 +939,7 @@ contains
                r = [columns(:, m), z_new + check_at(k) * step]
                call hermite_column(lower(:, m), upper(:, m), z_new, z, r(3), v, gi)
                if (v > min(vmin, minval(lower(1, :))) + window) cycle
-               g = lattice_gradient(ideal, t, r)
+               g = cartesian_gradient(t, checked(:, 1 + k, m))
                gi(1:2) = matmul(transpose(t%to_fraction), gi(1:2))
                worst = max(worst, norm2(gi - g))
             end do
@@ -958,13 +995,16 @@ contains
    !> Step 3 of `tabulate`: the lateral spacing (Å) that keeps the error of
    !> the interpolation within the layers under `target`, measured at
    !> quasi-random points of every layer (energy under the cap) on trial
-   !> spacings: the error goes as the spacing cubed.
-   subroutine choose_spacing(ideal, t, layers, target, spacing, reason)
+   !> spacings: the error goes as the spacing cubed.  The processes share
+   !> the points and take the largest error of all.
+   subroutine choose_spacing(ideal, t, layers, target, spacing, reason, share)
       type(lj_potential), intent(in) :: ideal
       type(lj_table), intent(in) :: t
       real(wp), intent(in) :: layers(:), target
       real(wp), intent(out) :: spacing
       character(len=:), allocatable, intent(inout) :: reason
+      !> the processes sharing the points (each a share, then the largest error)
+      class(work_sharing), intent(inout) :: share
       integer, parameter :: per_layer = 16, trials = 6
       real(wp) :: worst, s(2), f(2), n(2), corner(n_node_values, 2, 2), v, gi(3), g(3), hi(3, 3)
       type(tricubic_grid) :: cell
@@ -978,6 +1018,7 @@ contains
          do k = 1, size(layers)
             do m = 1, per_layer
                count_halton = count_halton + 1
+               if (mod(count_halton - 1, share%ranks) /= share%rank) cycle
                s = [halton(count_halton + 16, 2), halton(count_halton + 16, 3)]
                ! The cell holding s, its four corners at this layer.
                f = floor(s * n)
@@ -998,6 +1039,7 @@ contains
                worst = max(worst, norm2(gi - g))
             end do
          end do
+         call share%max_real(worst)
          if (worst <= target .and. trial > 1) return
          ! Error ~ spacing³: aim 10 % below the target.
          spacing = spacing * min(1.5_wp, 0.9_wp * (target / max(worst, tiny(1.0_wp)))**(1.0_wp / 3.0_wp))
@@ -1034,68 +1076,153 @@ contains
       end do
    end function centrosymmetric
 
+   !> Whether the lattice is its own image under the swap of its fractional
+   !> coordinates, s = (s1, s2) -> (s2, s1): a1 and a2 equally long (the
+   !> swap is then the mirror through their bisector), and every atom of the
+   !> cell has an atom of its species and height at its swapped position,
+   !> less a lattice vector (graphite's a1, a2 at 60°).
+   pure logical function swap_symmetric(lattice)
+      type(net_lattice), intent(in) :: lattice
+      real(wp) :: inverse(2, 2), f(2), g(2), det
+      integer :: b, c
+
+      associate (v => lattice%vectors)
+         swap_symmetric = abs(norm2(v(:, 1)) - norm2(v(:, 2))) <= 1.0e-12_wp * norm2(v(:, 1))
+         if (.not. swap_symmetric) return
+         det = v(1, 1) * v(2, 2) - v(1, 2) * v(2, 1)
+         inverse = reshape([v(2, 2), -v(2, 1), -v(1, 2), v(1, 1)], [2, 2]) / det
+      end associate
+      do b = 1, size(lattice%species)
+         swap_symmetric = .false.
+         f = matmul(inverse, lattice%basis(1:2, b))
+         do c = 1, size(lattice%species)
+            if (lattice%species(c) /= lattice%species(b)) cycle
+            if (abs(lattice%basis(3, c) - lattice%basis(3, b)) > 1.0e-9_wp) cycle
+            g = matmul(inverse, lattice%basis(1:2, c)) - [f(2), f(1)]
+            if (all(abs(g - nint(g)) < 1.0e-9_wp)) swap_symmetric = .true.
+         end do
+         if (.not. swap_symmetric) return
+      end do
+   end function swap_symmetric
+
    !> Step 4 of `tabulate`: every node's values (the last row and column
    !> repeat the first: the lattice is periodic).  The columns are dealt
    !> round-robin over the processes of `share`, each its own, and summed.
-   !> A centrosymmetric lattice has V(-s) = V(s): of each pair of columns
-   !> s, -s one is computed and the other is its image (derivatives odd in
-   !> s1, s2 change sign), which halves the work.
-   subroutine fill_grid(ideal, t, symmetric, share)
+   !> The lattice's symmetries among s -> -s (`inversion`, V(-s) = V(s))
+   !> and s -> (s2, s1) (`swap`, with as many nodes along a1 as along a2)
+   !> map columns of nodes onto columns: of each orbit one column is
+   !> computed (the first in the grid's order) and the others are its
+   !> images (the derivatives odd in s1, s2 change sign under the inversion
+   !> and trade places under the swap), which halves the work, or quarters
+   !> it with both (graphite).
+   subroutine fill_grid(ideal, t, inversion, swap, share)
       type(lj_potential), intent(in) :: ideal
       type(lj_table), intent(inout) :: t
-      logical, intent(in) :: symmetric
+      logical, intent(in) :: inversion, swap
       class(work_sharing), intent(inout) :: share
       !> the sign of each value in the image of a column under s -> -s
       real(wp), parameter :: parity(n_node_values) = [1.0_wp, -1.0_wp, -1.0_wp, 1.0_wp, 1.0_wp, -1.0_wp, &
          & -1.0_wp, 1.0_wp]
-      integer :: i, j, n1, n2, mi, mj, dealt, v
+      !> where each value goes in the image of a column under the swap
+      integer, parameter :: swapped(n_node_values) = [1, 3, 2, 4, 5, 7, 6, 8]
+      real(wp), allocatable :: packed(:, :, :)
+      integer :: i, j, n1, n2, dealt, op, image(2)
+      logical :: used(3)
 
       n1 = t%grid%nx - 1
       n2 = t%grid%ny - 1
-      ! (-0.0 where this process computes nothing: see work_sharing's sum.)
-      if (share%ranks > 1) t%grid%node = -0.0_wp
-      dealt = 0
-      do j = 1, n2
-         do i = 1, n1
-            if (symmetric) then
-               if (mirror_column(i, j) < column_index(i, j)) cycle
-            end if
-            dealt = dealt + 1
-            if (mod(dealt - 1, share%ranks) /= share%rank) cycle
-            call column_values(ideal, t, cartesian(t, [real(i - 1, wp) / n1, real(j - 1, wp) / n2]), t%grid%z, &
-               & t%grid%node(:, i, j, :))
-         end do
-      end do
-      if (share%ranks > 1) call share%sum_reals(t%grid%node, size(t%grid%node))
-      if (symmetric) then
+      ! (op 1: the inversion, 2: the swap, 3: both.)
+      used = [inversion, swap .and. n1 == n2, inversion .and. swap .and. n1 == n2]
+      if (share%ranks == 1) then
          do j = 1, n2
             do i = 1, n1
-               if (mirror_column(i, j) >= column_index(i, j)) cycle
-               mi = mod(n1 - (i - 1), n1) + 1
-               mj = mod(n2 - (j - 1), n2) + 1
-               do v = 1, n_node_values
-                  t%grid%node(v, i, j, :) = parity(v) * t%grid%node(v, mi, mj, :)
-               end do
+               if (.not. first_of_orbit(i, j)) cycle
+               call column_values(ideal, t, cartesian(t, [real(i - 1, wp) / n1, real(j - 1, wp) / n2]), t%grid%z, &
+                  & t%grid%node(:, i, j, :))
+            end do
+         end do
+      else
+         ! The columns computed, packed, dealt round-robin and summed (-0.0
+         ! where this process computes nothing: see work_sharing's sum).
+         allocate (packed(n_node_values, size(t%grid%z), count([((first_of_orbit(i, j), i = 1, n1), j = 1, n2)])), &
+            & source=-0.0_wp)
+         dealt = 0
+         do j = 1, n2
+            do i = 1, n1
+               if (.not. first_of_orbit(i, j)) cycle
+               dealt = dealt + 1
+               if (mod(dealt - 1, share%ranks) /= share%rank) cycle
+               call column_values(ideal, t, cartesian(t, [real(i - 1, wp) / n1, real(j - 1, wp) / n2]), t%grid%z, &
+                  & packed(:, :, dealt))
+            end do
+         end do
+         call share%sum_reals(packed, size(packed))
+         dealt = 0
+         do j = 1, n2
+            do i = 1, n1
+               if (.not. first_of_orbit(i, j)) cycle
+               dealt = dealt + 1
+               t%grid%node(:, i, j, :) = packed(:, :, dealt)
             end do
          end do
       end if
+      do j = 1, n2
+         do i = 1, n1
+            if (.not. first_of_orbit(i, j)) cycle
+            do op = 1, 3
+               if (.not. used(op)) cycle
+               image = mapped(op, i, j)
+               ! (A column its own image, or another op's image, keeps what it has.)
+               if (first_of_orbit(image(1), image(2))) cycle
+               select case (op)
+               case (1)
+                  t%grid%node(:, image(1), image(2), :) = spread(parity, 2, size(t%grid%z)) * t%grid%node(:, i, j, :)
+               case (2)
+                  t%grid%node(:, image(1), image(2), :) = t%grid%node(swapped, i, j, :)
+               case default
+                  t%grid%node(:, image(1), image(2), :) = spread(parity, 2, size(t%grid%z)) &
+                     & * t%grid%node(swapped, i, j, :)
+               end select
+            end do
+         end do
+      end do
       t%grid%node(:, n1 + 1, 1:n2, :) = t%grid%node(:, 1, 1:n2, :)
       t%grid%node(:, :, n2 + 1, :) = t%grid%node(:, :, 1, :)
 
    contains
 
-      integer function column_index(i, j)
-         integer, intent(in) :: i, j
+      integer function column_index(column)
+         integer, intent(in) :: column(2)
 
-         column_index = (i - 1) + (j - 1) * n1
+         column_index = (column(1) - 1) + (column(2) - 1) * n1
       end function column_index
 
-      !> The column index of the image of column (i, j) under s -> -s.
-      integer function mirror_column(i, j)
-         integer, intent(in) :: i, j
+      !> The column (i, j) is mapped to by op.
+      function mapped(op, i, j) result(column)
+         integer, intent(in) :: op, i, j
+         integer :: column(2)
 
-         mirror_column = column_index(mod(n1 - (i - 1), n1) + 1, mod(n2 - (j - 1), n2) + 1)
-      end function mirror_column
+         select case (op)
+         case (1)
+            column = [mod(n1 - (i - 1), n1) + 1, mod(n2 - (j - 1), n2) + 1]
+         case (2)
+            column = [j, i]
+         case default
+            column = [mod(n1 - (j - 1), n1) + 1, mod(n2 - (i - 1), n2) + 1]
+         end select
+      end function mapped
+
+      !> Whether column (i, j) comes first among its images (it is computed).
+      logical function first_of_orbit(i, j)
+         integer, intent(in) :: i, j
+         integer :: op
+
+         first_of_orbit = .true.
+         do op = 1, 3
+            if (.not. used(op)) cycle
+            if (column_index(mapped(op, i, j)) < column_index([i, j])) first_of_orbit = .false.
+         end do
+      end function first_of_orbit
 
    end subroutine fill_grid
 

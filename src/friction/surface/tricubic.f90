@@ -11,6 +11,17 @@
 !> reproduces any polynomial of degree <= 3 in each variable exactly, and
 !> for a smooth f its gradient is wrong by O(h^3) (value O(h^4)).
 !>
+!> For speed the grid can also hold each cell's polynomial in the power
+!> basis of its local coordinates (`set_polynomials`, after the nodes are
+!> filled): 64 coefficients per cell, contiguous, so that an evaluation
+!> reads one block and contracts it by Horner's rule along z, y and x
+!> instead of gathering and weighting eight corners' data.  It is the same
+!> polynomial, to rounding.  Data symmetric under the point reflection
+!> through the middle of the grid's (x, y) rectangle, or under the swap of
+!> x and y, share polynomials: a cell whose image comes first is evaluated
+!> through it, at the image point (a graphite table stores a quarter of its
+!> cells, 2 times the nodes' memory instead of 8).
+!>
 !> Why this scheme: a lattice sum gives its derivatives analytically (the
 !> cross derivatives too, from the pair's radial derivatives), so the data
 !> cost one pass over the atoms per node; the interpolant is local (no
@@ -24,10 +35,12 @@ module friction_surface_tricubic
    implicit none
    private
 
-   public :: tricubic_grid, new_tricubic_grid, n_node_values
+   public :: tricubic_grid, new_tricubic_grid, n_node_values, n_cell_coefficients
 
    !> Values per node: f, f_x, f_y, f_z, f_xy, f_xz, f_yz, f_xyz.
    integer, parameter :: n_node_values = 8
+   !> Coefficients of a cell's polynomial (set_polynomials).
+   integer, parameter :: n_cell_coefficients = 64
 
    type :: tricubic_grid
       real(wp) :: x0 = 0.0_wp, hx = 1.0_wp   !! first node and spacing along x
@@ -43,8 +56,18 @@ module friction_surface_tricubic
       real(wp), allocatable :: inverse_dz(:)
       !> node(:, i, j, k): the eight values of node (x0 + (i-1) hx, y0 + (j-1) hy, z(k))
       real(wp), allocatable :: node(:, :, :, :)
+      !> cell(:, c): when allocated, the polynomial of a cell in its local
+      !> coordinates ξ, η, ζ in [0, 1], coefficient 1 + l + 4m + 16n of
+      !> ξ^l η^m ζ^n; cell (i, j) of layer k (i, j 0-based, k the layer
+      !> below) is c = slot(i, j) + slots (k - 1), evaluated at the point
+      !> mapped by image(i, j) (see `to_image`).  evaluate uses it instead of
+      !> the nodes.
+      real(wp), allocatable :: cell(:, :)
+      integer, allocatable :: slot(:, :), image(:, :)
+      integer :: slots = 0
    contains
       procedure :: evaluate
+      procedure :: set_polynomials
       procedure :: layer_below
       procedure :: bytes
    end type tricubic_grid
@@ -82,18 +105,27 @@ contains
       end do
    end function new_tricubic_grid
 
-   !> Memory of the node values, bytes.
+   !> Memory of the node values and the cells' polynomials, bytes.
    pure real(wp) function bytes(self)
       class(tricubic_grid), intent(in) :: self
 
       bytes = 0.0_wp
       if (allocated(self%node)) bytes = real(storage_size(self%node), wp) / 8.0_wp * real(size(self%node), wp)
+      if (allocated(self%cell)) bytes = bytes + real(storage_size(self%cell), wp) / 8.0_wp * real(size(self%cell), wp)
    end function bytes
 
    !> The layer k with z(k) <= height < z(k+1) (1 <= k <= nz - 1; the end
    !> layers for heights outside: the interpolant continues as a cubic).
    pure integer function layer_below(self, height) result(k)
       class(tricubic_grid), intent(in) :: self
+      real(wp), intent(in) :: height
+
+      k = find_layer(self, height)
+   end function layer_below
+
+   !> layer_below's work (a plain call, which evaluate can have inlined).
+   pure integer function find_layer(self, height) result(k)
+      type(tricubic_grid), intent(in) :: self
       real(wp), intent(in) :: height
       integer :: last
 
@@ -105,7 +137,7 @@ contains
          if (self%z(k + 1) > height) exit
          k = k + 1
       end do
-   end function layer_below
+   end function find_layer
 
    !> The interpolant at p = (x, y, z): its value v, and for order >= 1 its
    !> gradient g, for order 2 also its Hessian h (zero when not asked for).
@@ -122,7 +154,15 @@ contains
       t = (p(2) - self%y0) * self%inverse_hy
       i = int(min(real(self%nx - 2, wp), max(0.0_wp, s)))
       j = int(min(real(self%ny - 2, wp), max(0.0_wp, t)))
-      k = self%layer_below(p(3))
+      k = find_layer(self, p(3))
+      if (allocated(self%cell)) then
+         associate (op => self%image(i, j))
+            call cell_polynomial(self%cell(:, self%slot(i, j) + self%slots * (k - 1)), op, s - i, t - j, &
+               & (p(3) - self%z(k)) * self%inverse_dz(k), [self%inverse_hx, self%inverse_hy, self%inverse_dz(k)], &
+               & order, v, g, h)
+         end associate
+         return
+      end if
       dz = self%z(k + 1) - self%z(k)
       call hermite_basis(s - i, self%hx, self%inverse_hx, order, bx)
       call hermite_basis(t - j, self%hy, self%inverse_hy, order, by)
@@ -134,6 +174,235 @@ contains
          call with_hessian(self, i, j, k, bx, by, bz, v, g, h)
       end if
    end subroutine evaluate
+
+   !> Each cell's polynomial in the power basis of its local coordinates
+   !> (the component `cell`), from the nodes' values, which must be set;
+   !> evaluate then uses these.  Along each axis, the cubic Hermite data of
+   !> a cell of width w (values f0, f1 and derivatives d0, d1 at its ends)
+   !> are the cubic p0 + p1 t + p2 t² + p3 t³ with p0 = f0, p1 = w d0,
+   !> p2 = 3 (f1 - f0) - w (2 d0 + d1), p3 = 2 (f0 - f1) + w (d0 + d1).
+   !> `inversion`: the data are symmetric under the point reflection through
+   !> the middle of the (x, y) rectangle, (x, y) -> (2 x_m - x, 2 y_m - y);
+   !> `swap`: under (x - x0, y - y0) -> (y - y0, x - x0) (ignored unless
+   !> nx = ny and hx = hy).  A cell mapped by these onto one that comes
+   !> earlier shares that cell's polynomial (to rounding, the same).
+   pure subroutine set_polynomials(self, inversion, swap)
+      class(tricubic_grid), intent(inout) :: self
+      logical, intent(in), optional :: inversion, swap
+      real(wp) :: c(4, 4, 4)
+      real(wp) :: w
+      integer :: i, j, k, ox, oy, oz, a, b, op, n, m, there(2), first
+      logical :: used(3)
+
+      n = self%nx - 1
+      m = self%ny - 1
+      used = .false.
+      if (present(inversion)) used(1) = inversion
+      if (present(swap)) used(2) = swap .and. n == m .and. self%hx == self%hy
+      used(3) = used(1) .and. used(2)
+      if (allocated(self%cell)) deallocate (self%cell)
+      if (allocated(self%slot)) deallocate (self%slot, self%image)
+      allocate (self%slot(0:n - 1, 0:m - 1), self%image(0:n - 1, 0:m - 1))
+      ! Each cell's image that comes first (the ops with the identity form
+      ! a group, so that is the first of its orbit, its own image 0): the
+      ! cells computed.
+      self%slots = 0
+      do j = 0, m - 1
+         do i = 0, n - 1
+            self%image(i, j) = 0
+            first = i + n * j
+            do op = 1, 3
+               if (.not. used(op)) cycle
+               there = image_cell(op, i, j)
+               if (there(1) + n * there(2) >= first) cycle
+               first = there(1) + n * there(2)
+               self%image(i, j) = op
+            end do
+            if (self%image(i, j) /= 0) cycle
+            self%slots = self%slots + 1
+            self%slot(i, j) = self%slots
+         end do
+      end do
+      do j = 0, m - 1
+         do i = 0, n - 1
+            if (self%image(i, j) == 0) cycle
+            there = image_cell(self%image(i, j), i, j)
+            self%slot(i, j) = self%slot(there(1), there(2))
+         end do
+      end do
+      allocate (self%cell(n_cell_coefficients, self%slots * (size(self%z) - 1)))
+      do k = 1, size(self%z) - 1
+         do j = 0, m - 1
+            do i = 0, n - 1
+               if (self%image(i, j) /= 0) cycle
+               ! The cell's 64 Hermite data: index 1, 2 the lower and upper
+               ! node's value along an axis, 3, 4 their derivatives.
+               do oz = 0, 1
+                  do oy = 0, 1
+                     do ox = 0, 1
+                        associate (q => self%node(:, i + 1 + ox, j + 1 + oy, k + oz))
+                           c(1 + ox, 1 + oy, 1 + oz) = q(1)
+                           c(3 + ox, 1 + oy, 1 + oz) = q(2)
+                           c(1 + ox, 3 + oy, 1 + oz) = q(3)
+                           c(1 + ox, 1 + oy, 3 + oz) = q(4)
+                           c(3 + ox, 3 + oy, 1 + oz) = q(5)
+                           c(3 + ox, 1 + oy, 3 + oz) = q(6)
+                           c(1 + ox, 3 + oy, 3 + oz) = q(7)
+                           c(3 + ox, 3 + oy, 3 + oz) = q(8)
+                        end associate
+                     end do
+                  end do
+               end do
+               w = self%z(k + 1) - self%z(k)
+               do b = 1, 4
+                  do a = 1, 4
+                     call to_power(c(1, a, b), c(2, a, b), c(3, a, b), c(4, a, b), self%hx)
+                  end do
+               end do
+               do b = 1, 4
+                  do a = 1, 4
+                     call to_power(c(a, 1, b), c(a, 2, b), c(a, 3, b), c(a, 4, b), self%hy)
+                  end do
+               end do
+               do b = 1, 4
+                  do a = 1, 4
+                     call to_power(c(a, b, 1), c(a, b, 2), c(a, b, 3), c(a, b, 4), w)
+                  end do
+               end do
+               self%cell(:, self%slot(i, j) + self%slots * (k - 1)) = reshape(c, [n_cell_coefficients])
+            end do
+         end do
+      end do
+
+   contains
+
+      !> The cell (0-based) that cell (i, j) maps onto under op (1 the
+      !> reflection, 2 the swap, 3 both).
+      pure function image_cell(op, i, j) result(cell)
+         integer, intent(in) :: op, i, j
+         integer :: cell(2)
+
+         select case (op)
+         case (1)
+            cell = [n - 1 - i, m - 1 - j]
+         case (2)
+            cell = [j, i]
+         case default
+            cell = [m - 1 - j, n - 1 - i]
+         end select
+      end function image_cell
+
+   end subroutine set_polynomials
+
+   !> The cubic Hermite data (f0, f1, d0, d1) on an interval of width w
+   !> replaced by the power-basis coefficients (p0, p1, p2, p3) of the same
+   !> cubic (set_polynomials).
+   elemental subroutine to_power(f0, f1, d0, d1, w)
+      real(wp), intent(inout) :: f0, f1, d0, d1
+      real(wp), intent(in) :: w
+      real(wp) :: v0, v1, s0, s1
+
+      v0 = f0
+      v1 = f1
+      s0 = w * d0
+      s1 = w * d1
+      f1 = s0
+      d0 = 3.0_wp * (v1 - v0) - 2.0_wp * s0 - s1
+      d1 = 2.0_wp * (v0 - v1) + s0 + s1
+   end subroutine to_power
+
+   !> The value v, gradient g (order >= 1) and Hessian h (order 2; else
+   !> zero) at local coordinates (ξ, η, ζ) = (px, py, z) of a cell whose
+   !> polynomial is that of cell c at the image point under op (0 none, 1
+   !> the reflection: (1 - ξ, 1 - η), 2 the swap: (η, ξ), 3 both:
+   !> (1 - η, 1 - ξ); set_polynomials), with inverse(:) the reciprocal cell
+   !> widths.  The image's derivatives come back through the map (odd in
+   !> x, y under the reflection, x and y trading places under the swap).
+   pure subroutine cell_polynomial(c, op, px, py, z, inverse, order, v, g, h)
+      real(wp), intent(in) :: c(n_cell_coefficients), px, py, z, inverse(3)
+      integer, intent(in) :: op, order
+      real(wp), intent(out) :: v, g(3), h(3, 3)
+      real(wp) :: x, y
+
+      select case (op)
+      case (0)
+         x = px
+         y = py
+      case (1)
+         x = 1.0_wp - px
+         y = 1.0_wp - py
+      case (2)
+         x = py
+         y = px
+      case default
+         x = 1.0_wp - py
+         y = 1.0_wp - px
+      end select
+      call power_polynomial(c, x, y, z, inverse, order, v, g, h)
+      if (op == 0) return
+      if (op /= 1) then
+         g(1:2) = [g(2), g(1)]
+         if (order >= 2) h = h([2, 1, 3], [2, 1, 3])
+      end if
+      if (op /= 2) then
+         g(1:2) = -g(1:2)
+         if (order >= 2) then
+            h(1:2, 3) = -h(1:2, 3)
+            h(3, 1:2) = -h(3, 1:2)
+         end if
+      end if
+   end subroutine cell_polynomial
+
+   !> The value v, gradient g (order >= 1) and Hessian h (order 2; else
+   !> zero) of one cell's polynomial c (set_polynomials) at local
+   !> coordinates (x, y, z), with inverse(:) the reciprocal cell widths:
+   !> Horner's rule along z (16 cubics at once), then y (4), then x.
+   pure subroutine power_polynomial(c, x, y, z, inverse, order, v, g, h)
+      real(wp), intent(in) :: c(n_cell_coefficients), x, y, z, inverse(3)
+      integer, intent(in) :: order
+      real(wp), intent(out) :: v, g(3), h(3, 3)
+      ! (aN: N-th z derivative, 16 cubics in x, y; bMN: M-th y derivative
+      ! and N-th z derivative, 4 cubics in x.)
+      real(wp) :: a0(16), a1(16), a2(16), b00(4), b10(4), b01(4), b20(4), b11(4), b02(4)
+      integer :: l
+
+      a0 = c(1:16) + z * (c(17:32) + z * (c(33:48) + z * c(49:64)))
+      h = 0.0_wp
+      g = 0.0_wp
+      if (order < 1) then
+         do l = 1, 4
+            b00(l) = a0(l) + y * (a0(l + 4) + y * (a0(l + 8) + y * a0(l + 12)))
+         end do
+         v = b00(1) + x * (b00(2) + x * (b00(3) + x * b00(4)))
+         return
+      end if
+      a1 = c(17:32) + z * (2.0_wp * c(33:48) + 3.0_wp * z * c(49:64))
+      do l = 1, 4
+         b00(l) = a0(l) + y * (a0(l + 4) + y * (a0(l + 8) + y * a0(l + 12)))
+         b10(l) = a0(l + 4) + y * (2.0_wp * a0(l + 8) + 3.0_wp * y * a0(l + 12))
+         b01(l) = a1(l) + y * (a1(l + 4) + y * (a1(l + 8) + y * a1(l + 12)))
+      end do
+      v = b00(1) + x * (b00(2) + x * (b00(3) + x * b00(4)))
+      g(1) = (b00(2) + x * (2.0_wp * b00(3) + 3.0_wp * x * b00(4))) * inverse(1)
+      g(2) = (b10(1) + x * (b10(2) + x * (b10(3) + x * b10(4)))) * inverse(2)
+      g(3) = (b01(1) + x * (b01(2) + x * (b01(3) + x * b01(4)))) * inverse(3)
+      if (order < 2) return
+      a2 = 2.0_wp * c(33:48) + 6.0_wp * z * c(49:64)
+      do l = 1, 4
+         b20(l) = 2.0_wp * a0(l + 8) + 6.0_wp * y * a0(l + 12)
+         b11(l) = a1(l + 4) + y * (2.0_wp * a1(l + 8) + 3.0_wp * y * a1(l + 12))
+         b02(l) = a2(l) + y * (a2(l + 4) + y * (a2(l + 8) + y * a2(l + 12)))
+      end do
+      h(1, 1) = (2.0_wp * b00(3) + 6.0_wp * x * b00(4)) * inverse(1)**2
+      h(2, 2) = (b20(1) + x * (b20(2) + x * (b20(3) + x * b20(4)))) * inverse(2)**2
+      h(3, 3) = (b02(1) + x * (b02(2) + x * (b02(3) + x * b02(4)))) * inverse(3)**2
+      h(1, 2) = (b10(2) + x * (2.0_wp * b10(3) + 3.0_wp * x * b10(4))) * inverse(1) * inverse(2)
+      h(1, 3) = (b01(2) + x * (2.0_wp * b01(3) + 3.0_wp * x * b01(4))) * inverse(1) * inverse(3)
+      h(2, 3) = (b11(1) + x * (b11(2) + x * (b11(3) + x * b11(4)))) * inverse(2) * inverse(3)
+      h(2, 1) = h(1, 2)
+      h(3, 1) = h(1, 3)
+      h(3, 2) = h(2, 3)
+   end subroutine power_polynomial
 
    !> The value and gradient in cell (i, j, k) (0-based lower corner in x
    !> and y, k the layer below) from the axes' basis values: corner by
