@@ -32,7 +32,7 @@ module friction_brake_orbit
    private
 
    public :: brake_section_map, brake_orbit, brake_periodic_orbit, section_state, section_limit
-   public :: orbit_branch, follow_branch, bifurcation_names
+   public :: orbit_branch, follow_branch, detect_bifurcations, bifurcation_names
    public :: bifurcation_period_doubling, bifurcation_fold, bifurcation_neimark_sacker, bifurcation_discontinuity
 
    !> Where a multiplier of the section map leaves (or enters) the unit circle.
