@@ -40,8 +40,11 @@ program friction_main
       logical :: quiet = .false.
       logical :: resume = .false.
       logical :: print_input = .false.           !! --print-input: print the resolved input, run nothing
-      character(len=4096), allocatable :: files(:)
-      character(len=4096), allocatable :: sets(:)  !! --set group.variable=value, in order
+      !> As long as the longest argument, so none is cut short (a --set of a
+      !> long list of sweep values is as long as it needs to be).
+      character(len=:), allocatable :: files(:) !! files(1:nfiles), the input files in order
+      character(len=:), allocatable :: sets(:)  !! sets(1:nsets), --set group.variable=value, in order
+      integer :: nfiles = 0, nsets = 0
    end type options
 
    type(options) :: opts
@@ -63,13 +66,14 @@ program friction_main
    if (opts%print_input) then
       ! One process prints the resolved input, without MPI.
       if (rank /= 0) call finish(0)
-      call resolve_input(opts%files, comm, reporter, text, error, opts%sets)
+      call resolve_input(opts%files(1:opts%nfiles), comm, reporter, text, error, opts%sets(1:opts%nsets))
       if (.not. allocated(error)) write (output_unit, '(a)', advance='no') text
       opts%output = ''
    else if (allocated(opts%netlist)) then
       ! One process writes the netlist, without MPI: the others of a launch have nothing to do.
       if (rank /= 0) call finish(0)
-      call write_netlist(opts%files, opts%netlist, opts%force, comm, reporter, summary, error, opts%sets)
+      call write_netlist(opts%files(1:opts%nfiles), opts%netlist, opts%force, comm, reporter, summary, error, &
+         & opts%sets(1:opts%nsets))
       opts%output = opts%netlist
    else
       if (launched() .or. forced_mpi()) then
@@ -79,8 +83,8 @@ program friction_main
          call MPI_Comm_rank(comm, rank)
       end if
       if (.not. allocated(opts%output)) opts%output = default_output(opts%files(1))
-      call run_job(opts%files, opts%output, opts%force, opts%resume, comm, reporter, summary, error, &
-         & stop_after=test_stop_after(), overrides=opts%sets)
+      call run_job(opts%files(1:opts%nfiles), opts%output, opts%force, opts%resume, comm, reporter, summary, &
+         & error, stop_after=test_stop_after(), overrides=opts%sets(1:opts%nsets))
    end if
    ! An interrupted sweep has written its file: say what it holds, then why it stopped.
    if (rank == 0 .and. .not. opts%quiet .and. allocated(summary)) &
@@ -161,12 +165,17 @@ contains
    !> Arguments; returns -1 to go on, else the exit code to finish with.
    integer function parse_arguments(opts) result(code)
       type(options), intent(inout) :: opts
-      character(len=4096) :: arg
-      integer :: i, n
+      character(len=:), allocatable :: arg
+      integer :: i, n, width, length
 
       code = -1
-      allocate (opts%files(0), opts%sets(0))
       n = command_argument_count()
+      width = 1
+      do i = 1, n
+         call get_command_argument(i, length=length)
+         width = max(width, length)
+      end do
+      allocate (character(len=width) :: arg, opts%files(n), opts%sets(n))
       i = 0
       do while (i < n)
          i = i + 1
@@ -217,7 +226,8 @@ contains
                   & //trim(arg)//'"')
                return
             end if
-            opts%sets = [character(len=4096) :: opts%sets, arg]
+            opts%nsets = opts%nsets + 1
+            opts%sets(opts%nsets) = arg
          case ('--print-input')
             opts%print_input = .true.
          case ('-f', '--force')
@@ -231,10 +241,11 @@ contains
                code = usage_error('unknown option '//trim(arg))
                return
             end if
-            opts%files = [character(len=4096) :: opts%files, arg]
+            opts%nfiles = opts%nfiles + 1
+            opts%files(opts%nfiles) = arg
          end select
       end do
-      if (size(opts%files) == 0) code = usage_error('no input file given')
+      if (opts%nfiles == 0) code = usage_error('no input file given')
       if (code < 0 .and. opts%print_input .and. (allocated(opts%output) .or. allocated(opts%netlist) .or. &
          & opts%resume)) code = usage_error('--print-input writes nothing: it takes no -o, --netlist or --resume')
    end function parse_arguments

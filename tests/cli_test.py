@@ -310,6 +310,15 @@ def case_set(args):
     for wanted in ["sigma=2.4945,3.5,6*0.0", "method='rk8pd'", "kx=12.5"]:
         if wanted not in text:
             fail(f"{wanted} not in the printed input:\n{printed}")
+    # An argument of any length: 1000 sweep values in one --set (7 kB; the
+    # command line once cut its arguments at 4096 characters, silently).
+    values = [f"{0.3 + i * 1e-4:.4f}" for i in range(1000)]
+    printed = friction(args, "--print-input", os.path.join(args.inputs, "brake_sweep.nml"),
+                       "--set", "sweep.sweep_spacing='list'", "--set", "sweep.sweep_values=" + ",".join(values)).stdout
+    text = printed.replace(" ", "").replace("\n", "")
+    listed = text.split("sweep_values=", 1)[1].split("sweep_", 1)[0].rstrip(",").split(",") if "sweep_values=" in text else []
+    if [float(v) for v in listed] != [float(v) for v in values]:
+        fail(f"the 1000 values of a long --set were not read whole: {len(listed)} values, the last {listed[-1:]}")
     if leftovers(args) != ["file.h5", "set.h5"]:
         fail(f"unexpected files: {leftovers(args)}")
 
