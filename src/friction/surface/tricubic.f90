@@ -191,7 +191,7 @@ contains
       logical, intent(in), optional :: inversion, swap
       real(wp) :: c(4, 4, 4)
       real(wp) :: w
-      integer :: i, j, k, ox, oy, oz, a, b, op, n, m, there(2), first
+      integer :: i, j, k, a, b, op, n, m, there(2), first
       logical :: used(3)
 
       n = self%nx - 1
@@ -235,24 +235,7 @@ contains
          do j = 0, m - 1
             do i = 0, n - 1
                if (self%image(i, j) /= 0) cycle
-               ! The cell's 64 Hermite data: index 1, 2 the lower and upper
-               ! node's value along an axis, 3, 4 their derivatives.
-               do oz = 0, 1
-                  do oy = 0, 1
-                     do ox = 0, 1
-                        associate (q => self%node(:, i + 1 + ox, j + 1 + oy, k + oz))
-                           c(1 + ox, 1 + oy, 1 + oz) = q(1)
-                           c(3 + ox, 1 + oy, 1 + oz) = q(2)
-                           c(1 + ox, 3 + oy, 1 + oz) = q(3)
-                           c(1 + ox, 1 + oy, 3 + oz) = q(4)
-                           c(3 + ox, 3 + oy, 1 + oz) = q(5)
-                           c(3 + ox, 1 + oy, 3 + oz) = q(6)
-                           c(1 + ox, 3 + oy, 3 + oz) = q(7)
-                           c(3 + ox, 3 + oy, 3 + oz) = q(8)
-                        end associate
-                     end do
-                  end do
-               end do
+               c = hermite_data(self, i, j, k)
                w = self%z(k + 1) - self%z(k)
                do b = 1, 4
                   do a = 1, 4
@@ -446,16 +429,12 @@ contains
       end do
    end subroutine value_gradient
 
-   !> The value, gradient and Hessian in cell (i, j, k) (see value_gradient):
-   !> the 64 coefficients in the Hermite basis (index 1, 2 the values at the
-   !> lower and upper node of an axis, 3, 4 the slopes there), contracted
-   !> along z, y and x.
-   pure subroutine with_hessian(self, i, j, k, bx, by, bz, v, g, h)
+   !> The 64 Hermite data of cell (i, j, k): index 1, 2 the lower and upper
+   !> node's value along an axis, 3, 4 their derivatives.
+   pure function hermite_data(self, i, j, k) result(c)
       type(tricubic_grid), intent(in) :: self
       integer, intent(in) :: i, j, k
-      real(wp), intent(in) :: bx(4, 0:2), by(4, 0:2), bz(4, 0:2)
-      real(wp), intent(out) :: v, g(3), h(3, 3)
-      real(wp) :: c(4, 4, 4), z0(4, 4), z1(4, 4), z2(4, 4), y00(4), y10(4), y01(4), y11(4), y20(4), y02(4)
+      real(wp) :: c(4, 4, 4)
       integer :: ox, oy, oz
 
       do oz = 0, 1
@@ -474,6 +453,20 @@ contains
             end do
          end do
       end do
+   end function hermite_data
+
+   !> The value, gradient and Hessian in cell (i, j, k) (see value_gradient):
+   !> the 64 coefficients in the Hermite basis (index 1, 2 the values at the
+   !> lower and upper node of an axis, 3, 4 the slopes there), contracted
+   !> along z, y and x.
+   pure subroutine with_hessian(self, i, j, k, bx, by, bz, v, g, h)
+      type(tricubic_grid), intent(in) :: self
+      integer, intent(in) :: i, j, k
+      real(wp), intent(in) :: bx(4, 0:2), by(4, 0:2), bz(4, 0:2)
+      real(wp), intent(out) :: v, g(3), h(3, 3)
+      real(wp) :: c(4, 4, 4), z0(4, 4), z1(4, 4), z2(4, 4), y00(4), y10(4), y01(4), y11(4), y20(4), y02(4)
+
+      c = hermite_data(self, i, j, k)
       ! (zN: N-th z derivative; yMN: M-th in y, N-th in z.)
       z0 = c(:, :, 1) * bz(1, 0) + c(:, :, 2) * bz(2, 0) + c(:, :, 3) * bz(3, 0) + c(:, :, 4) * bz(4, 0)
       z1 = c(:, :, 1) * bz(1, 1) + c(:, :, 2) * bz(2, 1) + c(:, :, 3) * bz(3, 1) + c(:, :, 4) * bz(4, 1)
