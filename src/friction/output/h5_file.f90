@@ -36,7 +36,7 @@ module friction_output_h5
       end function h5fget_mdc_size
    end interface
 
-   public :: h5_file, error_printing, room_to_close, new_text_attribute, new_scalar_attribute
+   public :: h5_file, h5_status, error_printing, room_to_close, new_text_attribute, new_scalar_attribute
 
    !> H5E_DEFAULT of the C API: the default error stack (hid_t is int64_t
    !> since HDF5 1.10).
@@ -71,15 +71,23 @@ module friction_output_h5
       end function h5e_set_auto2
    end interface
 
-   type :: h5_file
+   !> The first HDF5 failure of a file, kept until checked (h5_file here,
+   !> h5_table of the sweep's checkpoint): `check` records a call's status
+   !> and what it was doing, unless an earlier failure is already kept.
+   type :: h5_status
+      integer :: status = 0
+      character(len=:), allocatable :: failed_at
+   contains
+      procedure :: check
+   end type h5_status
+
+   type, extends(h5_status) :: h5_file
       private
       integer(hid_t) :: id = -1
       character(len=:), allocatable :: path
       integer :: rank = 0         !! this process in the communicator
       type(MPI_Comm) :: comm      !! the file's communicator
       logical :: parallel = .true. !! written through MPI-IO (.false.: serial, MPI not started; sec2 driver)
-      integer :: status = 0       !! first HDF5 failure, kept until checked
-      character(len=:), allocatable :: failed_at
    contains
       procedure :: create
       procedure :: create_group
@@ -95,7 +103,6 @@ module friction_output_h5
       procedure :: write_attribute_integer
       procedure :: has_attribute
       procedure :: close
-      procedure, private :: check
       procedure, private :: agree
       procedure, private :: create_dataset
    end type h5_file
@@ -648,7 +655,7 @@ contains
    end subroutine agree
 
    subroutine check(self, stat, what)
-      class(h5_file), intent(inout) :: self
+      class(h5_status), intent(inout) :: self
       integer, intent(in) :: stat
       character(len=*), intent(in) :: what
 

@@ -16,7 +16,7 @@ module friction_output_h5_table
    use friction_kinds, only: wp, i8
    use friction_error, only: error_type, fatal_error, error_io
    use friction_files, only: truncate_file
-   use friction_output_h5, only: error_printing, room_to_close, new_text_attribute, new_scalar_attribute
+   use friction_output_h5, only: h5_status, error_printing, room_to_close, new_text_attribute, new_scalar_attribute
    implicit none
    private
 
@@ -26,12 +26,10 @@ module friction_output_h5_table
    !> for its chunk cache (1 MB per open dataset).
    integer(hsize_t), parameter :: chunk_points = 4096
 
-   type :: h5_table
+   type, extends(h5_status) :: h5_table
       private
       integer(hid_t) :: id = -1
       character(len=:), allocatable :: path
-      integer :: status = 0
-      character(len=:), allocatable :: failed_at
    contains
       procedure :: create => table_create
       procedure :: open => table_open
@@ -49,7 +47,6 @@ module friction_output_h5_table
       procedure :: text => text_attribute
       procedure :: set_integer => set_integer_attribute
       procedure :: integer => integer_attribute
-      procedure, private :: check
       procedure, private :: transfer_range
    end type h5_table
 
@@ -518,16 +515,5 @@ contains
       end if
       call printing%restore()
    end function integer_attribute
-
-   subroutine check(self, stat, what)
-      class(h5_table), intent(inout) :: self
-      integer, intent(in) :: stat
-      character(len=*), intent(in) :: what
-
-      if (stat /= 0 .and. self%status == 0) then
-         self%status = stat
-         self%failed_at = what
-      end if
-   end subroutine check
 
 end module friction_output_h5_table
