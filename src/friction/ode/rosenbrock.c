@@ -13,8 +13,9 @@
  * with J = df/dy and df/dt at (t, y) from the system's jacobian (the
  * systems here are non-autonomous: the AFM support moves with t).  One
  * Jacobian, one LU factorisation of the n x n matrix and s solves per
- * step; no Newton iteration.  The order of the method needs the exact
- * Jacobian.
+ * step (a step retried from the same point after a rejection keeps its
+ * Jacobian and factorises again); no Newton iteration.  The order of the
+ * method needs the exact Jacobian.
  *
  * Methods (coefficients from the papers, in the form above):
  *   rodas3  4 stages, order 3 with an embedded order 2, L-stable and
@@ -109,10 +110,12 @@ struct kept_rhs {
 
 struct rosenbrock_state {
     const struct rosenbrock_method *method;
+    int reuses_f[max_stages];        /* the stage's argument is the previous stage's: its f stands */
     size_t dim;
     double *y0, *ytmp, *f, *dfdt, *jac, *lu, *k;  /* k: stages x dim */
     size_t *pivot;
     struct kept_rhs start, end;
+    int jacobian_at_start;           /* jac and dfdt are those at `start` (a retried step reuses them) */
 };
 
 static void kept_clear(struct kept_rhs *kept)
@@ -141,6 +144,7 @@ static void *alloc_with(const struct rosenbrock_method *method, size_t dim)
     struct rosenbrock_state *s;
     double *block;
     size_t doubles;
+    int stage, other;
 
     if (dim == 0) {
         GSL_ERROR_NULL("dimension of the system must be positive", GSL_EINVAL);
@@ -157,6 +161,12 @@ static void *alloc_with(const struct rosenbrock_method *method, size_t dim)
         GSL_ERROR_NULL("failed to allocate space for the rosenbrock state", GSL_ENOMEM);
     }
     s->method = method;
+    for (stage = 1; stage < method->stages; stage++) {
+        int same = method->alpha[stage] == method->alpha[stage - 1] && method->a[stage][stage - 1] == 0.0;
+        for (other = 0; other < stage - 1 && same; other++)
+            if (method->a[stage][other] != method->a[stage - 1][other]) same = 0;
+        s->reuses_f[stage] = same;
+    }
     s->dim = dim;
     s->y0 = block;
     s->ytmp = s->y0 + dim;
@@ -171,6 +181,7 @@ static void *alloc_with(const struct rosenbrock_method *method, size_t dim)
     s->k = s->lu + dim * dim;
     kept_clear(&s->start);
     kept_clear(&s->end);
+    s->jacobian_at_start = 0;
     return s;
 }
 
@@ -245,6 +256,9 @@ static int step(struct rosenbrock_state *s, double t, double h, double y[], doub
     size_t i, j;
     int stage, other, status;
 
+    /* A retry from the same point (a rejected step) keeps the Jacobian. */
+    if (!kept_matches(&s->start, sys, t, y, n)) s->jacobian_at_start = 0;
+
     /* f(t, y): given, kept from the last step's end or from this point's
      * previous try, or evaluated. */
     if (dydt_in != NULL) {
@@ -259,8 +273,11 @@ static int step(struct rosenbrock_state *s, double t, double h, double y[], doub
     }
     kept_set(&s->start, sys, t, y, s->f, n);
 
-    status = GSL_ODEIV_JA_EVAL(sys, t, y, s->jac, s->dfdt);
-    if (status != GSL_SUCCESS) return status;
+    if (!s->jacobian_at_start) {
+        status = GSL_ODEIV_JA_EVAL(sys, t, y, s->jac, s->dfdt);
+        if (status != GSL_SUCCESS) return status;
+        s->jacobian_at_start = 1;
+    }
     for (i = 0; i < n * n; i++) s->lu[i] = -s->jac[i];
     for (i = 0; i < n; i++) s->lu[i * n + i] += diagonal;
     status = lu_factor(s->lu, s->pivot, n);
@@ -268,12 +285,8 @@ static int step(struct rosenbrock_state *s, double t, double h, double y[], doub
 
     for (stage = 0; stage < m->stages; stage++) {
         double *k = s->k + (size_t)stage * n;
-        int same_argument = stage > 0 && m->alpha[stage] == m->alpha[stage - 1];
 
-        for (other = 0; other < stage && same_argument; other++)
-            if (m->a[stage][other] != m->a[stage - 1][other]) same_argument = 0;
-        if (same_argument && m->a[stage][stage - 1] != 0.0) same_argument = 0;
-        if (stage > 0 && !same_argument) {
+        if (stage > 0 && !s->reuses_f[stage]) {
             for (i = 0; i < n; i++) {
                 double sum = y[i];
                 for (other = 0; other < stage; other++)
@@ -344,6 +357,7 @@ static int rosenbrock_reset(void *vstate, size_t dim)
     (void)dim;
     kept_clear(&s->start);
     kept_clear(&s->end);
+    s->jacobian_at_start = 0;
     return GSL_SUCCESS;
 }
 
