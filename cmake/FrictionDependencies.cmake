@@ -34,7 +34,31 @@ if(NOT HDF5_IS_PARALLEL)
   message(FATAL_ERROR "friction needs the parallel (MPI) build of HDF5, found a serial one.\n"
     "On Debian/Ubuntu: sudo apt-get install libhdf5-openmpi-dev")
 endif()
+add_library(friction::hdf5_headers INTERFACE IMPORTED)
+target_include_directories(friction::hdf5_headers INTERFACE ${HDF5_Fortran_INCLUDE_DIRS} ${HDF5_INCLUDE_DIRS})
+target_compile_definitions(friction::hdf5_headers INTERFACE ${HDF5_Fortran_DEFINITIONS})
 add_library(friction::hdf5 INTERFACE IMPORTED)
-target_include_directories(friction::hdf5 INTERFACE ${HDF5_Fortran_INCLUDE_DIRS} ${HDF5_INCLUDE_DIRS})
-target_link_libraries(friction::hdf5 INTERFACE ${HDF5_Fortran_LIBRARIES} ${HDF5_LIBRARIES})
-target_compile_definitions(friction::hdf5 INTERFACE ${HDF5_Fortran_DEFINITIONS})
+target_link_libraries(friction::hdf5 INTERFACE friction::hdf5_headers
+  ${HDF5_Fortran_LIBRARIES} ${HDF5_LIBRARIES})
+
+# The program's HDF5: each of HDF5's own shared libraries replaced by the
+# static archive beside it, when there is one (Debian's libhdf5-*-dev ship
+# them); the other libraries HDF5 names stay as they are.  Without the
+# archives, or with -DFRICTION_STATIC_HDF5=OFF, the shared ones.
+option(FRICTION_STATIC_HDF5 "Link the friction program with HDF5's static archives" ON)
+set(friction_hdf5_program_libraries)
+foreach(library IN LISTS HDF5_Fortran_LIBRARIES HDF5_LIBRARIES)
+  get_filename_component(library_name "${library}" NAME)
+  string(REGEX REPLACE "\\.so$" ".a" archive "${library}")
+  if(FRICTION_STATIC_HDF5 AND library_name MATCHES "^libhdf5.*\\.so$" AND EXISTS "${archive}")
+    list(APPEND friction_hdf5_program_libraries "${archive}")
+  else()
+    list(APPEND friction_hdf5_program_libraries "${library}")
+  endif()
+endforeach()
+list(REMOVE_DUPLICATES friction_hdf5_program_libraries)
+add_library(friction::hdf5_program INTERFACE IMPORTED)
+# (MPI after the archives: they call it, and a static archive's needs are
+# met only by libraries that follow it.)
+target_link_libraries(friction::hdf5_program INTERFACE friction::hdf5_headers
+  ${friction_hdf5_program_libraries} MPI::MPI_C)
