@@ -113,6 +113,7 @@ struct rosenbrock_state {
     int reuses_f[max_stages];        /* the stage's argument is the previous stage's: its f stands */
     size_t dim;
     double *y0, *ytmp, *f, *dfdt, *jac, *lu, *k;  /* k: stages x dim */
+    double *inverse_pivot;           /* 1 / the factors' diagonal (lu_factor) */
     size_t *pivot;
     struct kept_rhs start, end;
     int jacobian_at_start;           /* jac and dfdt are those at `start` (a retried step reuses them) */
@@ -150,8 +151,8 @@ static void *alloc_with(const struct rosenbrock_method *method, size_t dim)
         GSL_ERROR_NULL("dimension of the system must be positive", GSL_EINVAL);
     }
     s = calloc(1, sizeof *s);
-    /* y0, ytmp, f, dfdt, 4 kept vectors: 8 n; jac, lu: 2 n^2; k: stages n */
-    doubles = 8 * dim + 2 * dim * dim + (size_t)method->stages * dim;
+    /* y0, ytmp, f, dfdt, 4 kept vectors, inverse_pivot: 9 n; jac, lu: 2 n^2; k: stages n */
+    doubles = 9 * dim + 2 * dim * dim + (size_t)method->stages * dim;
     block = s != NULL ? malloc(doubles * sizeof *block) : NULL;
     if (block != NULL) s->pivot = malloc(dim * sizeof *s->pivot);
     if (s == NULL || block == NULL || s->pivot == NULL) {
@@ -179,6 +180,7 @@ static void *alloc_with(const struct rosenbrock_method *method, size_t dim)
     s->jac = s->end.f + dim;
     s->lu = s->jac + dim * dim;
     s->k = s->lu + dim * dim;
+    s->inverse_pivot = s->k + (size_t)method->stages * dim;
     kept_clear(&s->start);
     kept_clear(&s->end);
     s->jacobian_at_start = 0;
@@ -196,8 +198,10 @@ static void *rodas4_alloc(size_t dim)
 }
 
 /* LU factorisation with partial pivoting of the row-major n x n matrix a,
- * in place; GSL_ESING for a zero or non-finite pivot. */
-static int lu_factor(double *a, size_t *pivot, size_t n)
+ * in place, and the reciprocals of U's diagonal (the solves multiply: a
+ * division costs several multiplications' time and the stages' solves are
+ * most of a step's own work); GSL_ESING for a zero or non-finite pivot. */
+static int lu_factor(double *restrict a, double *restrict inverse_pivot, size_t *pivot, size_t n)
 {
     size_t i, j, col, best;
 
@@ -211,6 +215,7 @@ static int lu_factor(double *a, size_t *pivot, size_t n)
             }
         pivot[col] = best;
         if (!(largest > 0.0) || !isfinite(largest)) return GSL_ESING;
+        inverse_pivot[col] = 1.0 / a[best * n + col];
         if (best != col)
             for (j = 0; j < n; j++) {
                 double swap = a[col * n + j];
@@ -218,7 +223,7 @@ static int lu_factor(double *a, size_t *pivot, size_t n)
                 a[best * n + j] = swap;
             }
         for (i = col + 1; i < n; i++) {
-            double factor = a[i * n + col] / a[col * n + col];
+            double factor = a[i * n + col] * inverse_pivot[col];
             a[i * n + col] = factor;
             for (j = col + 1; j < n; j++) a[i * n + j] -= factor * a[col * n + j];
         }
@@ -226,8 +231,11 @@ static int lu_factor(double *a, size_t *pivot, size_t n)
     return GSL_SUCCESS;
 }
 
-/* Solve with the factors of lu_factor: b is overwritten by x. */
-static void lu_solve(const double *lu, const size_t *pivot, size_t n, double b[])
+/* Solve with the factors of lu_factor: b is overwritten by x.  (Each row's
+ * sum is kept in a register, not in b, which the compiler must otherwise
+ * store and reload at every term.) */
+static void lu_solve(const double *restrict lu, const double *restrict inverse_pivot,
+                     const size_t *restrict pivot, size_t n, double *restrict b)
 {
     size_t i, j;
 
@@ -238,11 +246,15 @@ static void lu_solve(const double *lu, const size_t *pivot, size_t n, double b[]
             b[pivot[i]] = swap;
         }
     }
-    for (i = 1; i < n; i++)
-        for (j = 0; j < i; j++) b[i] -= lu[i * n + j] * b[j];
+    for (i = 1; i < n; i++) {
+        double sum = b[i];
+        for (j = 0; j < i; j++) sum -= lu[i * n + j] * b[j];
+        b[i] = sum;
+    }
     for (i = n; i-- > 0;) {
-        for (j = i + 1; j < n; j++) b[i] -= lu[i * n + j] * b[j];
-        b[i] /= lu[i * n + i];
+        double sum = b[i];
+        for (j = i + 1; j < n; j++) sum -= lu[i * n + j] * b[j];
+        b[i] = sum * inverse_pivot[i];
     }
 }
 
@@ -252,7 +264,8 @@ static int step(struct rosenbrock_state *s, double t, double h, double y[], doub
 {
     const struct rosenbrock_method *m = s->method;
     const size_t n = s->dim;
-    const double diagonal = 1.0 / (h * m->gamma);
+    const double diagonal = 1.0 / (h * m->gamma), inverse_h = 1.0 / h;
+    double c_over_h[max_stages][max_stages];
     size_t i, j;
     int stage, other, status;
 
@@ -280,8 +293,10 @@ static int step(struct rosenbrock_state *s, double t, double h, double y[], doub
     }
     for (i = 0; i < n * n; i++) s->lu[i] = -s->jac[i];
     for (i = 0; i < n; i++) s->lu[i * n + i] += diagonal;
-    status = lu_factor(s->lu, s->pivot, n);
+    status = lu_factor(s->lu, s->inverse_pivot, s->pivot, n);
     if (status != GSL_SUCCESS) return status;
+    for (stage = 1; stage < m->stages; stage++)
+        for (other = 0; other < stage; other++) c_over_h[stage][other] = m->c[stage][other] * inverse_h;
 
     for (stage = 0; stage < m->stages; stage++) {
         double *k = s->k + (size_t)stage * n;
@@ -299,10 +314,10 @@ static int step(struct rosenbrock_state *s, double t, double h, double y[], doub
         for (i = 0; i < n; i++) {
             double sum = s->f[i] + m->gamma_sum[stage] * h * s->dfdt[i];
             for (other = 0; other < stage; other++)
-                sum += m->c[stage][other] / h * s->k[(size_t)other * n + i];
+                sum += c_over_h[stage][other] * s->k[(size_t)other * n + i];
             k[i] = sum;
         }
-        lu_solve(s->lu, s->pivot, n, k);
+        lu_solve(s->lu, s->inverse_pivot, s->pivot, n, k);
     }
 
     for (i = 0; i < n; i++) {
