@@ -5,8 +5,11 @@
  *                (non-autonomous: g = sin t + cos 2t), lambda = -1, fixed
  *                steps halving: the observed order of the global error, and
  *                of the embedded error estimate over one step, within 0.2
- *                of the method's.  A 2 x 2 linear system with a rotation
- *                (y = exp(At) y0 in closed form) the same way.
+ *                of the method's.  Linear systems of 1, 2 and 3 damped
+ *                rotations, each 2 x 2 with its own frequency (y = exp(At) y0
+ *                in closed form), the same way: dimensions 2, 4 and 6, so
+ *                that the stepper's loops for general sizes and those it
+ *                specialises (4 and 6) are all checked.
  *   stiff        one step of y' = -1e9 y with h = 1: L-stable and stiffly
  *                accurate, so |y| ends near 0 (not near 1 as for an A-stable
  *                method with R(-inf) = -1 or 1).
@@ -70,37 +73,53 @@ static int pr_jac(double t, const double y[], double *dfdy, double dfdt[], void 
     return GSL_SUCCESS;
 }
 
-/* ---- y' = A y, A = [[-a, w], [-w, -a]]: y = exp(-a t) R(-w t) y0 ---- */
+/* ---- y' = A y, A block diagonal with lin_blocks blocks [[-a, w_b], [-w_b, -a]]:
+ * y = exp(-a t) R(-w_b t) y0 in each ---- */
 
-static const double lin_a = 0.5, lin_w = 3.0;
+enum { max_blocks = 3 };
+static const double lin_a = 0.5;
+static int lin_blocks = 1;
+
+static double lin_w(int block) { return 3.0 + block; }
 
 static int lin_f(double t, const double y[], double f[], void *params)
 {
+    int b;
     (void)t;
     (void)params;
-    f[0] = -lin_a * y[0] + lin_w * y[1];
-    f[1] = -lin_w * y[0] - lin_a * y[1];
+    for (b = 0; b < lin_blocks; b++) {
+        f[2 * b] = -lin_a * y[2 * b] + lin_w(b) * y[2 * b + 1];
+        f[2 * b + 1] = -lin_w(b) * y[2 * b] - lin_a * y[2 * b + 1];
+    }
     return GSL_SUCCESS;
 }
 
 static int lin_jac(double t, const double y[], double *dfdy, double dfdt[], void *params)
 {
+    const int n = 2 * lin_blocks;
+    int b;
     (void)t;
     (void)y;
     (void)params;
-    dfdy[0] = -lin_a;
-    dfdy[1] = lin_w;
-    dfdy[2] = -lin_w;
-    dfdy[3] = -lin_a;
-    dfdt[0] = dfdt[1] = 0.0;
+    memset(dfdy, 0, (size_t)(n * n) * sizeof *dfdy);
+    for (b = 0; b < lin_blocks; b++) {
+        dfdy[2 * b * n + 2 * b] = -lin_a;
+        dfdy[2 * b * n + 2 * b + 1] = lin_w(b);
+        dfdy[(2 * b + 1) * n + 2 * b] = -lin_w(b);
+        dfdy[(2 * b + 1) * n + 2 * b + 1] = -lin_a;
+        dfdt[2 * b] = dfdt[2 * b + 1] = 0.0;
+    }
     return GSL_SUCCESS;
 }
 
-static void lin_exact(double t, double y[2])
+static void lin_exact(double t, double y[])
 {
     double e = exp(-lin_a * t);
-    y[0] = e * cos(lin_w * t);   /* y0 = (1, 0) */
-    y[1] = -e * sin(lin_w * t);
+    int b;
+    for (b = 0; b < lin_blocks; b++) {
+        y[2 * b] = e * cos(lin_w(b) * t);   /* y0 = (1, 0) in each block */
+        y[2 * b + 1] = -e * sin(lin_w(b) * t);
+    }
 }
 
 /* Global error at t_end after n fixed steps (no error control). */
@@ -109,7 +128,8 @@ static double fixed_steps(const gsl_odeiv2_step_type *type, gsl_odeiv2_system *s
 {
     size_t dim = sys->dimension, i;
     gsl_odeiv2_step *s = gsl_odeiv2_step_alloc(type, dim);
-    double y[2], yerr[2], dydt_out[2], want[2], h = t_end / n, t = 0.0, error = 0.0;
+    double y[2 * max_blocks], yerr[2 * max_blocks], dydt_out[2 * max_blocks], want[2 * max_blocks];
+    double h = t_end / n, t = 0.0, error = 0.0;
     int k, status = GSL_SUCCESS;
 
     memcpy(y, y0, dim * sizeof *y);
@@ -141,7 +161,7 @@ static void check_order(const char *name, const gsl_odeiv2_step_type *type, doub
     struct pr p = {-1.0, 1};
     gsl_odeiv2_system pr_sys = {pr_f, pr_jac, 1, &p};
     gsl_odeiv2_system lin_sys = {lin_f, lin_jac, 2, NULL};
-    double y0[2] = {g(0.0), 0.0}, y0_lin[2] = {1.0, 0.0};
+    double y0[2] = {g(0.0), 0.0}, y0_lin[2 * max_blocks] = {1.0, 0.0, 1.0, 0.0, 1.0, 0.0};
     int n;
 
     /* Global error over [0, 2] with 10 ... 80 steps: log2 of successive
@@ -152,11 +172,15 @@ static void check_order(const char *name, const gsl_odeiv2_step_type *type, doub
         double observed = log2(e1 / e2);
         CHECK(fabs(observed - order) <= 0.2, "%s: Prothero-Robinson order %.3f with %d -> %d steps (errors %.3e, %.3e)",
               name, observed, n, 2 * n, e1, e2);
-        e1 = fixed_steps(type, &lin_sys, y0_lin, 2.0, n, lin_exact);
-        e2 = fixed_steps(type, &lin_sys, y0_lin, 2.0, 2 * n, lin_exact);
-        observed = log2(e1 / e2);
-        CHECK(fabs(observed - order) <= 0.2, "%s: linear system order %.3f with %d -> %d steps (errors %.3e, %.3e)",
-              name, observed, n, 2 * n, e1, e2);
+        for (lin_blocks = 1; lin_blocks <= max_blocks; lin_blocks++) {
+            lin_sys.dimension = (size_t)(2 * lin_blocks);
+            e1 = fixed_steps(type, &lin_sys, y0_lin, 2.0, n, lin_exact);
+            e2 = fixed_steps(type, &lin_sys, y0_lin, 2.0, 2 * n, lin_exact);
+            observed = log2(e1 / e2);
+            CHECK(fabs(observed - order) <= 0.2,
+                  "%s: linear system of dimension %d, order %.3f with %d -> %d steps (errors %.3e, %.3e)", name,
+                  2 * lin_blocks, observed, n, 2 * n, e1, e2);
+        }
     }
     /* The embedded estimate is y_new minus a solution of order p - 1: the
      * local error of that one, O(h^p). */

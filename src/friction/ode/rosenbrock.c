@@ -201,7 +201,7 @@ static void *rodas4_alloc(size_t dim)
  * in place, and the reciprocals of U's diagonal (the solves multiply: a
  * division costs several multiplications' time and the stages' solves are
  * most of a step's own work); GSL_ESING for a zero or non-finite pivot. */
-static int lu_factor(double *restrict a, double *restrict inverse_pivot, size_t *pivot, size_t n)
+static inline __attribute__((always_inline)) int lu_factor(double *restrict a, double *restrict inverse_pivot, size_t *pivot, size_t n)
 {
     size_t i, j, col, best;
 
@@ -234,7 +234,7 @@ static int lu_factor(double *restrict a, double *restrict inverse_pivot, size_t 
 /* Solve with the factors of lu_factor: b is overwritten by x.  (Each row's
  * sum is kept in a register, not in b, which the compiler must otherwise
  * store and reload at every term.) */
-static void lu_solve(const double *restrict lu, const double *restrict inverse_pivot,
+static inline __attribute__((always_inline)) void lu_solve(const double *restrict lu, const double *restrict inverse_pivot,
                      const size_t *restrict pivot, size_t n, double *restrict b)
 {
     size_t i, j;
@@ -258,12 +258,15 @@ static void lu_solve(const double *restrict lu, const double *restrict inverse_p
     }
 }
 
-/* The step, with y unchanged unless it succeeds. */
-static int step(struct rosenbrock_state *s, double t, double h, double y[], double yerr[],
-                const double dydt_in[], double dydt_out[], const gsl_odeiv2_system *sys)
+/* The step, with y unchanged unless it succeeds; n = s->dim and stages =
+ * s->method->stages, passed apart so that `step` can call it with
+ * constants (below). */
+static inline __attribute__((always_inline)) int step_sized(struct rosenbrock_state *s, double t, double h,
+                                                            double y[], double yerr[], const double dydt_in[],
+                                                            double dydt_out[], const gsl_odeiv2_system *sys,
+                                                            const size_t n, const int stages)
 {
     const struct rosenbrock_method *m = s->method;
-    const size_t n = s->dim;
     const double diagonal = 1.0 / (h * m->gamma), inverse_h = 1.0 / h;
     double c_over_h[max_stages][max_stages];
     size_t i, j;
@@ -295,10 +298,10 @@ static int step(struct rosenbrock_state *s, double t, double h, double y[], doub
     for (i = 0; i < n; i++) s->lu[i * n + i] += diagonal;
     status = lu_factor(s->lu, s->inverse_pivot, s->pivot, n);
     if (status != GSL_SUCCESS) return status;
-    for (stage = 1; stage < m->stages; stage++)
+    for (stage = 1; stage < stages; stage++)
         for (other = 0; other < stage; other++) c_over_h[stage][other] = m->c[stage][other] * inverse_h;
 
-    for (stage = 0; stage < m->stages; stage++) {
+    for (stage = 0; stage < stages; stage++) {
         double *k = s->k + (size_t)stage * n;
 
         if (stage > 0 && !s->reuses_f[stage]) {
@@ -322,7 +325,7 @@ static int step(struct rosenbrock_state *s, double t, double h, double y[], doub
 
     for (i = 0; i < n; i++) {
         double sum = y[i], error = 0.0;
-        for (stage = 0; stage < m->stages; stage++) {
+        for (stage = 0; stage < stages; stage++) {
             sum += m->m[stage] * s->k[(size_t)stage * n + i];
             error += m->e[stage] * s->k[(size_t)stage * n + i];
         }
@@ -338,6 +341,24 @@ static int step(struct rosenbrock_state *s, double t, double h, double y[], doub
     }
     for (j = 0; j < n; j++) y[j] = s->ytmp[j];
     return GSL_SUCCESS;
+}
+
+/* The step for the systems here, their sizes and the methods' stages as
+ * constants: the compiler then unrolls the factorisation's, the solves' and
+ * the stages' short loops, whose trip counts (1, 2, 3 ...) otherwise change
+ * from loop to loop and cost a mispredicted branch each (the step's own
+ * work was 210 ns, more than its right-hand sides, on the regularized
+ * brake).  Any other size takes the general loops. */
+static int step(struct rosenbrock_state *s, double t, double h, double y[], double yerr[],
+                const double dydt_in[], double dydt_out[], const gsl_odeiv2_system *sys)
+{
+    const int stages = s->method->stages;
+
+    if (s->dim == 4 && stages == 4) return step_sized(s, t, h, y, yerr, dydt_in, dydt_out, sys, 4, 4);
+    if (s->dim == 4 && stages == 6) return step_sized(s, t, h, y, yerr, dydt_in, dydt_out, sys, 4, 6);
+    if (s->dim == 6 && stages == 4) return step_sized(s, t, h, y, yerr, dydt_in, dydt_out, sys, 6, 4);
+    if (s->dim == 6 && stages == 6) return step_sized(s, t, h, y, yerr, dydt_in, dydt_out, sys, 6, 6);
+    return step_sized(s, t, h, y, yerr, dydt_in, dydt_out, sys, s->dim, stages);
 }
 
 static int rosenbrock_apply(void *vstate, size_t dim, double t, double h, double y[], double yerr[],
