@@ -9,8 +9,10 @@ build directory, with a PATH of symbolic links to every program of the
 system's PATH except the test tools (ngspice, gnuplot, h5dump), builds it,
 and checks: the build succeeds; `friction --version` runs; and the CMake
 cache has no entry for a test tool (ngspice, gnuplot, h5dump, pFUnit,
-Python), i.e. configuration did not even look for one.  It compiles the
-library once (about 20 s on two cores: label `slow`).
+Python), i.e. configuration did not even look for one.  It also builds the
+program with -DFRICTION_STATIC_HDF5=OFF, the other way of linking it, and
+checks that this program does load the shared HDF5 (`ldd`).  It compiles
+the library once (about 20 s on two cores: label `slow`).
 """
 import argparse
 import os
@@ -64,7 +66,8 @@ def main():
 
     step([args.cmake, "-S", args.source, "-B", build, "-G", args.generator,
           f"-DCMAKE_MAKE_PROGRAM={args.make_program}", f"-DCMAKE_Fortran_COMPILER={args.fortran}",
-          f"-DCMAKE_C_COMPILER={args.c}", "-DCMAKE_BUILD_TYPE=Release", "-DFRICTION_BUILD_TESTS=OFF"])
+          f"-DCMAKE_C_COMPILER={args.c}", "-DCMAKE_BUILD_TYPE=Release", "-DFRICTION_BUILD_TESTS=OFF",
+          "-DFRICTION_STATIC_HDF5=OFF"])
     with open(os.path.join(build, "CMakeCache.txt")) as handle:
         cache = handle.read()
     for entry in TEST_CACHE_ENTRIES:
@@ -72,6 +75,8 @@ def main():
     step([args.cmake, "--build", build, "-j", "2"])
     version = step([os.path.join(build, "friction"), "--version"]).stdout
     require(version.startswith("friction "), f"the program built without tests runs: {version.strip()}")
+    libraries = step(["ldd", os.path.join(build, "friction")]).stdout
+    require("libhdf5" in libraries, "with FRICTION_STATIC_HDF5=OFF the program loads the shared HDF5")
     print("1 passed, 0 failed")
 
 
