@@ -12,7 +12,9 @@ Measures and prints (this is not a test; nothing fails on a missed target):
   (scripts/cvode_naf.c: BDF with the dense analytic Jacobian, rtol = atol =
   1e-3 ... 1e-10), the error being the largest |F - F_ref| over fx and fy
   of trace and retrace against the program's rk8pd at rtol = atol = 1e-11
-  (itself checked against 1e-10).  At the error levels --levels the cost
+  (itself checked against 1e-10).  The --repeats rounds are interleaved:
+  after the first, which walks the ladders, each round runs every setting
+  of the program and of CVODE once.  At the error levels --levels the cost
   each needs is interpolated log-log between its ladder points; the best of
   the program's steppers is set against CVODE: compute time (the file's
   wall_time: input, set-up, integration, not the write; CVODE: its
@@ -302,17 +304,23 @@ def main(argv=None) -> int:
             ref_check = float(np.abs(check - ref).max())
             print(f"\n{title}: reference rk8pd rtol = atol = 1e-11; against 1e-10: {ref_check:.1e} nN")
             series, rows, failures = {}, [], []
+            # A first round runs each ladder until it is done (and gives
+            # the errors); the other rounds run every setting of the program
+            # and of CVODE once each, in turn, so that a change of the
+            # machine's load falls on both, not on one ladder.
+            reruns = []
             tols = [10.0 ** -k for k in range(3, 6 if args.quick else 10)]
             for method in methods:
                 series[method] = []
                 for rtol in tols:
                     log(f"{title}: {method} {rtol:g}")
-                    cost, forces = bench.friction(method, rtol, rtol, extra)
+                    cost, forces = bench.friction(method, rtol, rtol, extra, repeats=1)
                     error = float(np.abs(forces - ref).max())
                     label = method if method != "auto" else f"auto ({cost['ran']})"
                     row = {"method": label, "rtol": rtol, "error": error, **cost}
                     rows.append(row)
                     series[method].append(row)
+                    reruns.append((row, lambda m=method, r=rtol: bench.friction(m, r, r, extra, repeats=1)[0]))
                     if error < 10 * ref_check or cost["compute"] > 10.0:
                         break
             if bench.peer is not None:
@@ -320,7 +328,7 @@ def main(argv=None) -> int:
                 for rtol in [10.0 ** -k for k in range(3, 6 if args.quick else 11)]:
                     log(f"{title}: CVODE BDF {rtol:g}")
                     try:
-                        cost, forces = bench.cvode(rtol, 128, lines, damping)
+                        cost, forces = bench.cvode(rtol, 128, lines, damping, repeats=1)
                     except RuntimeError as exc:
                         failures.append(f"CVODE BDF at rtol {rtol:g}: " + " ".join(str(exc).split()))
                         continue
@@ -328,8 +336,19 @@ def main(argv=None) -> int:
                     row = {"method": "CVODE BDF", "rtol": rtol, "error": error, **cost}
                     rows.append(row)
                     series["cvode"].append(row)
+                    reruns.append((row, lambda r=rtol, n=lines, c=damping: bench.cvode(r, 128, n, c, repeats=1)[0]))
                     if error < 10 * ref_check or cost["compute"] > 20.0:
                         break
+            samples = {id(row): {key: [row[key]] for key in ("compute", "wall", "cpu")} for row, _ in reruns}
+            for round_ in range(2, repeats + 1):
+                log(f"{title}: round {round_} of {repeats}")
+                for row, rerun in reruns:
+                    cost = rerun()
+                    for key in samples[id(row)]:
+                        samples[id(row)][key].append(cost[key])
+            for row, _ in reruns:
+                for key, values in samples[id(row)].items():
+                    row[key] = statistics.median(values)
             ladder_table(title, rows)
             for failure in failures:
                 print(f"failed: {failure}")
