@@ -29,7 +29,7 @@ module friction_afm_config
 
    public :: afm_config, potential_names, net_names, tip_model_names, new_potential, new_tip, new_tip_owning, &
       & net_sites, max_species, max_defects, species_count, surface_curvature, thermal_step_limit, tip_stiffness, &
-      & evaluation_names, surface_evaluation, table_energy_window, table_reach
+      & evaluation_names, surface_evaluation, table_energy_window, table_reach, scan_region
 
    character(len=*), parameter :: potential_names(3) = [character(len=4) :: 'naf', 'hopg', 'lj']
    character(len=*), parameter :: net_names(3) = [character(len=8) :: 'graphite', 'square', 'file']

@@ -152,6 +152,7 @@ module friction_afm_scan
    contains
       procedure :: init
       procedure :: init_owning
+      procedure :: release_potential
       procedure :: run_trip
       procedure :: run_thermal_trip
       procedure :: run_kramers_trip
@@ -240,6 +241,18 @@ contains
       call new_tip_owning(config, potential, self%tip)
       call set_up(self, config, error)
    end subroutine init_owning
+
+   !> The surface potential handed back (init_owning's in reverse), for a
+   !> later scan of the same surface; the scanner can no longer run.
+   subroutine release_potential(self, potential)
+      class(afm_scanner), intent(inout) :: self
+      class(surface_potential), allocatable, intent(inout) :: potential
+
+      if (allocated(potential)) deallocate (potential)
+      if (allocated(self%tip)) then
+         if (allocated(self%tip%potential)) call move_alloc(self%tip%potential, potential)
+      end if
+   end subroutine release_potential
 
    !> The rest of init, around the tip made.
    subroutine set_up(self, config, error)

@@ -8,18 +8,18 @@ module friction_afm_scene
    use friction_files, only: available_memory, remove_file
    use friction_strings, only: itoa, bytes_text, text_hash
    use friction_version, only: version_string
-   use friction_parameters, only: parameter_visitor
+   use friction_parameters, only: parameter_visitor, parameters_text
    use friction_checks, only: config_checker
    use friction_clock, only: wall_seconds
    use friction_ode_solver, only: integrator_statistics
    use friction_ode_auto, only: auto_name, auto_method
    use friction_surface_potential, only: surface_potential
    use friction_output_summary, only: run_summary
-   use friction_scene, only: scene, point_result
+   use friction_scene, only: scene, point_result, point_memory
    use friction_scene_report, only: job_reporter
    use friction_scene_context, only: job_context, agree_on_error, ranks_text, share_of, job_wall_time, &
       & job_sharing, mpi_sharing
-   use friction_afm_config, only: afm_config, new_potential, species_count, tip_stiffness
+   use friction_afm_config, only: afm_config, new_potential, species_count, tip_stiffness, scan_region
    use friction_afm_scan, only: afm_scanner, line_record, slip_list, n_quantities, q_fx, q_fy, q_f_along
    use friction_afm_output, only: write_afm_file, afm_surface_record, afm_thermal_record
    use friction_afm_validity, only: afm_model_warnings, quasistatic_friction_warning
@@ -527,15 +527,16 @@ contains
       unit = ''
    end subroutine afm_point_series
 
-   subroutine afm_run_point(self, results, series, error)
+   subroutine afm_run_point(self, results, series, memory, error)
       class(afm_scene), intent(inout) :: self
       real(wp), intent(out) :: results(:)
       real(wp), allocatable, intent(out) :: series(:)
+      type(point_memory), intent(inout) :: memory
       type(error_type), allocatable, intent(out) :: error
 
       results = 0.0_wp
       allocate (series(0))
-      call afm_friction(self%resolved(), results(1), results(2), error)
+      call afm_friction(self%resolved(), results(1), results(2), error, memory)
    end subroutine afm_run_point
 
    subroutine afm_netlist_text(self, data_file, version, text, note, error)
@@ -556,19 +557,33 @@ contains
    !> the mean trace f_along without retrace) and the maximum lateral force
    !> |(fx, fy)| over all samples, both nN; at a temperature both of the
    !> samples' means over the realizations.  Holds one line at a time.
-   subroutine afm_friction(c, mean_friction, max_force, error)
+   !> With `memory`, the surface is taken from it when it was made from the
+   !> same settings (surface_key) and left in it for the next point: a sweep
+   !> over the tip, the scan's speed or sampling or the integrator builds a
+   !> lattice sum's table once per process, not once per point.
+   subroutine afm_friction(c, mean_friction, max_force, error, memory)
       type(afm_config), intent(in) :: c
       real(wp), intent(out) :: mean_friction, max_force
       type(error_type), allocatable, intent(out) :: error
+      type(point_memory), intent(inout), optional :: memory
       type(afm_scanner), target :: scanner
       class(surface_potential), allocatable :: potential
       type(line_record) :: line
+      character(len=:), allocatable :: key
       real(wp) :: total
       integer :: j
 
       mean_friction = 0.0_wp
       max_force = 0.0_wp
-      call new_potential(c, potential, error)
+      if (present(memory)) then
+         key = surface_key(c)
+         if (allocated(memory%surface) .and. allocated(memory%surface_key)) then
+            if (memory%surface_key == key) call move_alloc(memory%surface, potential)
+         end if
+         ! (Until it is given back below, memory holds nothing.)
+         if (allocated(memory%surface)) deallocate (memory%surface)
+      end if
+      if (.not. allocated(potential)) call new_potential(c, potential, error)
       if (allocated(error)) return
       call scanner%init_owning(c, potential, error)
       if (allocated(error)) return
@@ -584,6 +599,24 @@ contains
          end if
       end do
       mean_friction = total / (real(c%nx, wp) * c%ny * merge(2, 1, c%retrace))
+      if (present(memory)) then
+         call scanner%release_potential(memory%surface)
+         memory%surface_key = key
+      end if
    end subroutine afm_friction
+
+   !> What the surface new_potential builds depends on: the &surface group
+   !> and the scan's rectangle (the lattice sum keeps the atoms near it and
+   !> tabulates over it), as exact text (the rectangle's bits in hex).
+   function surface_key(c) result(key)
+      type(afm_config), intent(in) :: c
+      character(len=:), allocatable :: key
+      type(afm_config) :: copy
+      character(len=68) :: rectangle
+
+      copy = c
+      write (rectangle, '(4(1x, z16.16))') transfer(scan_region(c, 0.0_wp), [0_i8])
+      key = parameters_text(copy, [character(len=7) :: 'surface'])//' scan rectangle'//rectangle
+   end function surface_key
 
 end module friction_afm_scene

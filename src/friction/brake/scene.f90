@@ -14,7 +14,7 @@ module friction_brake_scene
    use friction_checks, only: config_checker
    use friction_ode_solver, only: integrator_statistics
    use friction_ode_auto, only: auto_name, auto_method
-   use friction_scene, only: scene, point_result
+   use friction_scene, only: scene, point_result, point_memory
    use friction_scene_report, only: job_reporter
    use friction_scene_context, only: job_context, agree_on_error, ranks_text, job_wall_time
    use friction_brake_config, only: brake_config, model_switched
@@ -240,11 +240,13 @@ contains
 
    !> A sweep point: the run, its diagnostics, its periodic orbit (found,
    !> period, the largest |μ| and the critical μ; 0 when none or off) and the
-   !> local maxima of x after the transient (the bifurcation diagram).
-   subroutine brake_run_point(self, results, series, error)
+   !> local maxima of x after the transient (the bifurcation diagram).  (A
+   !> brake point keeps nothing in `memory`: its set-up costs nothing.)
+   subroutine brake_run_point(self, results, series, memory, error)
       class(brake_scene), intent(inout) :: self
       real(wp), intent(out) :: results(:)
       real(wp), allocatable, intent(out) :: series(:)
+      type(point_memory), intent(inout) :: memory
       type(error_type), allocatable, intent(out) :: error
       type(brake_config) :: point
       type(brake_run), target :: run

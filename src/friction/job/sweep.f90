@@ -37,7 +37,7 @@ module friction_job_sweep
    use friction_ode_solver, only: integrator_statistics
    use friction_parameters, only: set_parameter_number, split_name, parameter_info, list_parameters
    use friction_checks, only: config_checker
-   use friction_scene, only: scene, point_result
+   use friction_scene, only: scene, point_result, point_memory
    use friction_job_config, only: job_config
    use friction_output_h5, only: h5_file
    use friction_output_h5_table, only: h5_table
@@ -122,6 +122,7 @@ contains
       type(point_message) :: mine
       type(checkpoint) :: ckpt
       type(point_batch) :: batch
+      type(point_memory) :: kept   !! what this rank's points leave for its next ones
       real(wp), allocatable :: results(:), series(:)
       integer, allocatable :: memory(:)
       integer :: n, n_work, w, i, next, computed, flag, last_taken, slot, finished, todo_unit, counts(3), stat
@@ -231,7 +232,7 @@ contains
          end if
          computed = computed + 1
          t0 = wall_seconds()
-         call run_point(config, i, results, series, point_error)
+         call run_point(config, i, results, series, kept, point_error)
          if (.not. allocated(series)) allocate (series(0))
          cost = wall_seconds() - t0
          mine%header = [i, status_done, size(names), size(series), 0]
@@ -332,12 +333,14 @@ contains
    end subroutine run_sweep_job
 
    !> Point i: a copy of the scene with the swept variables set in memory,
-   !> checked as the input is, then run on this process.
-   subroutine run_point(config, i, results, series, error)
+   !> checked as the input is, then run on this process, with what its
+   !> earlier points left in `kept` (point_memory).
+   subroutine run_point(config, i, results, series, kept, error)
       type(job_config), intent(in) :: config
       integer, intent(in) :: i
       real(wp), intent(out) :: results(:)
       real(wp), allocatable, intent(out) :: series(:)
+      type(point_memory), intent(inout) :: kept
       type(error_type), allocatable, intent(out) :: error
       class(scene), allocatable :: point
       type(config_checker) :: checker
@@ -362,7 +365,7 @@ contains
          return
       end if
       deallocate (series)
-      call point%run_point(results, series, error)
+      call point%run_point(results, series, kept, error)
    end subroutine run_point
 
    !> A reason on one line.

@@ -12,10 +12,11 @@ module friction_scene
    use friction_checks, only: config_checker
    use friction_scene_report, only: job_reporter
    use friction_scene_context, only: job_context
+   use friction_surface_potential, only: surface_potential
    implicit none
    private
 
-   public :: scene, point_result
+   public :: scene, point_result, point_memory
 
    !> One named result of a sweep point (docs/sweeps.md).
    type :: point_result
@@ -23,6 +24,17 @@ module friction_scene
       character(len=16) :: unit = ''
       logical :: whole = .false.   !! written as integers (counts)
    end type point_result
+
+   !> What one process keeps from a sweep point for its next points: set-up
+   !> that costs much and that the swept variables may leave as it was.  A
+   !> scene fills it and decides when it still holds (`surface_key`: the
+   !> settings it was made from, compared as text).  The AFM scene keeps its
+   !> surface, whose table takes longer to build than a short scan takes to
+   !> run (docs/sweeps.md, What a point keeps).
+   type :: point_memory
+      character(len=:), allocatable :: surface_key
+      class(surface_potential), allocatable :: surface
+   end type point_memory
 
    type, abstract, extends(configurable) :: scene
    contains
@@ -46,7 +58,8 @@ module friction_scene
       procedure(results_interface), deferred :: point_results
       procedure(series_interface), deferred :: point_series
       !> One sweep point on this process alone: its results, in the order of
-      !> point_results, and its series.
+      !> point_results, and its series; `memory` is what the process kept from its
+      !> earlier points (point_memory).
       procedure(point_interface), deferred :: run_point
       !> The scene as a SPICE netlist for ngspice.
       procedure(netlist_interface), deferred :: netlist
@@ -106,11 +119,12 @@ module friction_scene
          character(len=:), allocatable, intent(out) :: name, unit
       end subroutine series_interface
 
-      subroutine point_interface(self, results, series, error)
-         import :: scene, wp, error_type
+      subroutine point_interface(self, results, series, memory, error)
+         import :: scene, wp, error_type, point_memory
          class(scene), intent(inout) :: self
          real(wp), intent(out) :: results(:)
          real(wp), allocatable, intent(out) :: series(:)
+         type(point_memory), intent(inout) :: memory
          type(error_type), allocatable, intent(out) :: error
       end subroutine point_interface
 
