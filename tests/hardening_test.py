@@ -695,6 +695,28 @@ def case_lj_geometry(args):
             fail("the tip scanned inside the layer")
 
 
+
+def case_lj_off_edge(args):
+    """A scan that runs off the flake is an error at the first sample with no
+    atoms under the tip, not a map of a tip hanging below the layer: the
+    paper's flake (600 atoms, 9 shells, under 25 Å from its middle) scanned
+    30 Å from its middle, so the last samples have no atom within the
+    cutoff below them and the load (support_z = -6 Å) pulls the tip under
+    the layer.  The table is built (the scan's middle lies on the flake);
+    the check runs at every sample, on 1 and on 2 ranks (exit 3, bad input,
+    naming where the tip was, nothing written)."""
+    write(args, "edge.nml", "&scan nx = 12, ny = 1, length = 30.0, width = 0.0, origin_x = 0.0, "
+          "origin_y = 0.0, retrace = .false. /\n")
+    for ranks in (1, 2):
+        out = f"edge{ranks}.h5"
+        result = friction(args, "-o", out, inputs(args, "graphite.nml"), "edge.nml", ranks=ranks, expect=3)
+        contains(result, "the tip went below the layer of atoms at (", "trace", "off the edge of the net",
+                 "support_z")
+        if "evaluation = 'table'" in result.stderr:
+            fail(f"the table was not built for the scan: {result.stderr}")
+        if os.path.exists(path(args, out)):
+            fail(f"{out} was written for a scan that failed")
+
 CASES = {name[len("case_"):].replace("_", "-"): function for name, function in globals().items()
          if name.startswith("case_")}
 
