@@ -13,6 +13,12 @@ Measures and prints (not a test; nothing fails on a missed target):
     stands in for sweeps where long or chaotic points cluster at one end).
   Points/s = points / the file's wall_time (whole run: start-up, input,
   every point, output); the median of --repeats runs.
+* What a point keeps (docs/sweeps.md): a graphite sweep of the tip's kx (8
+  points of a 2-line, 12-sample scan of inputs/graphite.nml) on 1 and 2
+  ranks; each rank builds the surface table for its first point and keeps
+  it, so its first point's cost (/sweep/compute_time) holds the build and
+  the others do not: printed are the first points' costs, the median of the
+  others, and the points per second.
 * Peak resident memory (VmHWM) of every rank, from /sweep/peak_memory_per_rank,
   for a large sweep (--large points of a short brake run) on 1 and 2 ranks,
   and for a large AFM sweep (inputs/afm_sweep.nml as a 32 x 32 grid of V0 and
@@ -122,6 +128,30 @@ def scale(args, workdir):
               f"(computing {hours(compute)}, rank 0's share {hours(writer)})")
 
 
+KEPT = ("&scan nx = 12, ny = 2, length = 2.0, width = 1.0 /\n"
+        "&sweep sweep_variable = 'tip.kx', sweep_spacing = 'linear', sweep_from = 0.25, sweep_to = 2.5,"
+        " sweep_count = 8 /\n")
+
+
+def kept(args, workdir):
+    """The graphite table built once per rank, not once per point."""
+    (workdir / "kept.nml").write_text(KEPT)
+    for ranks in (1, 2):
+        walls, firsts, others = [], [], []
+        for _ in range(args.repeats):
+            points, wall, _, cost = run(args, workdir, ranks, [ROOT / "inputs" / "graphite.nml",
+                                                               workdir / "kept.nml"], "kept.h5")
+            # (Dynamic scheduling hands out points 1, 2, ... in order: with
+            # r ranks the first r points are the ranks' first.)
+            walls.append(wall)
+            firsts.append(float(np.max(cost[:ranks])))
+            others.append(float(np.median(cost[ranks:])))
+        print(f"graphite kx sweep ({points} points) on {ranks} rank(s): first point per rank "
+              f"{1e3 * statistics.median(firsts):.0f} ms (table built), other points "
+              f"{1e3 * statistics.median(others):.0f} ms (table kept); "
+              f"{points / statistics.median(walls):.1f} points/s")
+
+
 def rate(args, workdir, ranks, files):
     rates = []
     for k in range(args.repeats):
@@ -162,6 +192,8 @@ def main():
                 two, _ = rate(args, workdir, 2, files + extra)
                 print(f"{label:<22} {2:>5} {schedule:>9} {two:>9.2f} {two / one:>9.2f}")
             print(f"{'':<22} point cost {cost.min():.3f} .. {cost.max():.3f} s, total {cost.sum():.2f} s")
+        if not args.memory_only:
+            kept(args, workdir)
         (workdir / "large.nml").write_text(
             "&brake t_end = 200.0, dt_out = 0.1 /\n"
             "&analysis window_start = 50.0, window_end = 200.0, lyapunov_transient = 50.0 /\n"
