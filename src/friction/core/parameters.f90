@@ -40,7 +40,10 @@ module friction_parameters
       character(len=:), allocatable :: base    !! set: directory that relative paths are relative to
       character(len=:), allocatable :: problem !! set: why the value does not fit ('' when it did)
       logical :: found = .false.
+      !> list: the variables, list(1:listed) (grown by doubling: appending
+      !> one at a time copied the whole list at every variable)
       type(parameter_info), allocatable :: list(:)
+      integer :: listed = 0
       character(len=32), allocatable :: only(:)  !! write: the groups to write (all when unallocated)
       logical :: in_group = .false.
    contains
@@ -128,14 +131,21 @@ contains
       integer, intent(in) :: n
       character(len=*), intent(in), optional :: unit
       type(parameter_info) :: info
+      type(parameter_info), allocatable :: grown(:)
 
       info%group = self%group
       info%name = name
       info%kind = kind
       info%size = n
       if (present(unit)) info%unit = unit
-      if (.not. allocated(self%list)) allocate (self%list(0))
-      self%list = [self%list, info]
+      if (.not. allocated(self%list)) allocate (self%list(64))
+      if (self%listed == size(self%list)) then
+         allocate (grown(2 * size(self%list)))
+         grown(1:self%listed) = self%list(1:self%listed)
+         call move_alloc(grown, self%list)
+      end if
+      self%listed = self%listed + 1
+      self%list(self%listed) = info
    end subroutine add_info
 
    subroutine add_line(self, name, value)
@@ -506,9 +516,12 @@ contains
       type(parameter_visitor) :: v
 
       v%mode = mode_list
-      allocate (v%list(0))
       call obj%visit(v)
-      call move_alloc(v%list, list)
+      if (allocated(v%list)) then
+         list = v%list(1:v%listed)
+      else
+         allocate (list(0))
+      end if
    end function list_parameters
 
    !> Set group.name (elements from `first` on, 0 for the whole variable)
