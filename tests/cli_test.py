@@ -258,6 +258,37 @@ def same_run(args, first, second, label):
             fail(f"{label}: {key} differs between {first} and {second}")
 
 
+def case_shortest_reals(args):
+    """The echoed input writes each real with the fewest significant digits
+    that read back to the same double: against Python's repr (the shortest
+    round-tripping decimal, the nearest to the double when several have as
+    few digits), for 600 values of a sweep list: doubles with all 17 digits,
+    short decimals, and decimals of 15 to 17 digits (the program counts a
+    15-digit rounding's digits and tries 16 and 17 only when 15 fail)."""
+    from decimal import Decimal
+    rng = np.random.default_rng(20261124)
+    values = list(rng.uniform(0.01, 0.58, 200))
+    values += [round(float(v), int(d)) for v, d in zip(rng.uniform(0.01, 0.58, 200), rng.integers(1, 10, 200))]
+    values += [float(f"{v:.{int(d) - 1}e}") for v, d in zip(rng.uniform(0.01, 0.58, 200), rng.integers(15, 18, 200))]
+    values = list(dict.fromkeys(float(v) for v in values))   # (repeats would be written n*value)
+    rng.shuffle(values)
+    text = "&sweep sweep_variable = 'brake.mu', sweep_spacing = 'list', sweep_values = " + \
+        ", ".join(repr(v) for v in values) + " /\n"
+    printed = friction(args, "--print-input", os.path.join(args.inputs, "brake.nml"),
+                       write(args, "values.nml", text)).stdout
+    line = next(l for l in printed.splitlines() if l.strip().startswith("sweep_values ="))
+    words = [w.strip() for w in line.split("=", 1)[1].split(",")]
+    if len(words) != len(values):
+        fail(f"{len(words)} values echoed, {len(values)} given")
+    for word, value in zip(words, values):
+        if float(word) != value:
+            fail(f"{word} does not read back to {value!r}")
+        mine, best = Decimal(word).normalize(), Decimal(repr(value)).normalize()
+        if len(mine.as_tuple().digits) != len(best.as_tuple().digits) or mine != best:
+            fail(f"{value!r} echoed as {word}, the shortest is {repr(value)}")
+    print(f"shortest-reals: {len(values)} values echoed with the fewest digits")
+
+
 def case_input_roundtrip(args):
     """The root `input` attribute is a namelist that reads back to the same
     run, and --print-input prints that text without running or writing
@@ -2076,7 +2107,8 @@ def main():
          "graphite": case_graphite, "models": case_models, "quasistatic-failure": case_quasistatic_failure,
          "graphite-ranks": case_graphite_ranks, "graphite-defects": case_graphite_defects,
          "graphite-table": case_graphite_table,
-         "input-roundtrip": case_input_roundtrip, "thermal-zero": case_thermal_zero,
+         "input-roundtrip": case_input_roundtrip, "shortest-reals": case_shortest_reals,
+          "thermal-zero": case_thermal_zero,
           "set": case_set, "other-scene-group": case_other_scene_group,
           "thermal-ranks": case_thermal_ranks, "thermal-equipartition": case_thermal_equipartition,
           "thermal-kramers": case_thermal_kramers, "thermal-kramers-law": case_thermal_kramers_law,

@@ -660,12 +660,31 @@ contains
          write (word, '(f0.1)') x
          return
       end if
-      do digits = 1, 17
+      ! The fewest digits that read back: when 15 do, the 15-digit rounding
+      ! is that shortest decimal padded with zeros (it lies within half an
+      ! ulp of x, closer than any other 15-digit decimal can), so its
+      ! significant digits are counted; else 16 or 17.  (Trying 1, 2, ...
+      ! digits in turn cost two formatted writes and a read each, most of a
+      ! short run's time spent echoing its input.)
+      write (buffer, '(es32.14e3)') x
+      read (buffer, *, iostat=stat) back
+      if (stat == 0 .and. back == x) then
+         buffer = adjustl(buffer)
+         cut = index(buffer, 'E') - 1
+         do while (buffer(cut:cut) == '0')
+            cut = cut - 1
+         end do
+         digits = count([(verify(buffer(e:e), '0123456789') == 0, e = 1, cut)])
          write (form, '(a, i0, a)') '(es32.', digits - 1, 'e3)'
          write (buffer, form) x
-         read (buffer, *, iostat=stat) back
-         if (stat == 0 .and. back == x) exit
-      end do
+      else
+         do digits = 16, 17
+            write (form, '(a, i0, a)') '(es32.', digits - 1, 'e3)'
+            write (buffer, form) x
+            read (buffer, *, iostat=stat) back
+            if (stat == 0 .and. back == x) exit
+         end do
+      end if
       buffer = adjustl(buffer)
       ! 1.50000e-003 -> 1.5e-3; plain decimals for moderate exponents.
       e = index(buffer, 'E')
