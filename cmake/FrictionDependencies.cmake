@@ -59,7 +59,26 @@ endforeach()
 list(REMOVE_DUPLICATES friction_hdf5_program_libraries)
 set(FRICTION_PROGRAM_STATIC_HDF5 OFF)
 if(friction_hdf5_program_libraries MATCHES "libhdf5[^;]*\\.a(;|$)")
-  set(FRICTION_PROGRAM_STATIC_HDF5 ON)
+  # Archives built without position-independent code (some sites' own
+  # HDF5) cannot go into the program, which the compiler makes
+  # position-independent: a small program linked the same way tells, and
+  # without it the shared libraries serve.
+  include(CheckFortranSourceCompiles)
+  set(CMAKE_REQUIRED_INCLUDES ${HDF5_Fortran_INCLUDE_DIRS} ${HDF5_INCLUDE_DIRS})
+  set(CMAKE_REQUIRED_LIBRARIES ${friction_hdf5_program_libraries} MPI::MPI_C)
+  set(CMAKE_REQUIRED_LINK_OPTIONS "LINKER:--as-needed")
+  set(CMAKE_REQUIRED_QUIET ON)
+  check_fortran_source_compiles("program probe\n  use hdf5\n  integer :: status\n  call h5open_f(status)\nend program probe\n"
+    FRICTION_HDF5_ARCHIVES_LINK SRC_EXT F90)
+  unset(CMAKE_REQUIRED_INCLUDES)
+  unset(CMAKE_REQUIRED_LIBRARIES)
+  unset(CMAKE_REQUIRED_LINK_OPTIONS)
+  unset(CMAKE_REQUIRED_QUIET)
+  if(FRICTION_HDF5_ARCHIVES_LINK)
+    set(FRICTION_PROGRAM_STATIC_HDF5 ON)
+  else()
+    set(friction_hdf5_program_libraries ${HDF5_Fortran_LIBRARIES} ${HDF5_LIBRARIES})
+  endif()
 endif()
 message(STATUS "friction: the program links HDF5's static archives: ${FRICTION_PROGRAM_STATIC_HDF5}")
 add_library(friction::hdf5_program INTERFACE IMPORTED)
