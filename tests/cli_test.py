@@ -108,6 +108,10 @@ BAD_INPUTS = {
                              ["bad.nml:3", "&thermal", "realizations = 0", ">= 1"]),
     "thermal-step-above-limit": ("&thermal temperature = 300.0, time_step = 1.0e-4 /\n", 3,
                                  ["bad.nml:1", "&thermal", "time_step", "stability limit"]),
+    # (A lattice sum's limit comes from the sum itself, no table built for the check.)
+    "thermal-lj-step-above-limit": ("&surface potential = 'lj' /\n&tip cx = 2e-4, cy = 2e-4, cz = 2e-4 /\n"
+                                    "&thermal temperature = 300.0, time_step = 1.0 /\n", 3,
+                                    ["bad.nml:3", "&thermal", "time_step", "stability limit"]),
     "thermal-unknown-model": ("&thermal temperature = 300.0, model = 'metropolis' /\n", 3,
                               ["bad.nml:1", "&thermal", "model", "metropolis", "langevin"]),
     "thermal-quasistatic": ("&tip model = 'quasistatic' /\n&thermal temperature = 300.0 /\n", 3,
