@@ -271,23 +271,23 @@ static inline __attribute__((always_inline)) int step_sized(struct rosenbrock_st
     double c_over_h[max_stages][max_stages];
     size_t i, j;
     int stage, other, status;
+    /* A retry from the same point (a rejected step) keeps f and the Jacobian. */
+    const int retry = kept_matches(&s->start, sys, t, y, n);
 
-    /* A retry from the same point (a rejected step) keeps the Jacobian. */
-    if (!kept_matches(&s->start, sys, t, y, n)) s->jacobian_at_start = 0;
-
-    /* f(t, y): given, kept from the last step's end or from this point's
-     * previous try, or evaluated. */
+    if (!retry) s->jacobian_at_start = 0;
+    /* f(t, y): given, kept from this point's previous try or from the last
+     * step's end, or evaluated. */
     if (dydt_in != NULL) {
         memcpy(s->f, dydt_in, n * sizeof *s->f);
+    } else if (retry) {
+        memcpy(s->f, s->start.f, n * sizeof *s->f);
     } else if (kept_matches(&s->end, sys, t, y, n)) {
         memcpy(s->f, s->end.f, n * sizeof *s->f);
-    } else if (kept_matches(&s->start, sys, t, y, n)) {
-        memcpy(s->f, s->start.f, n * sizeof *s->f);
     } else {
         status = GSL_ODEIV_FN_EVAL(sys, t, y, s->f);
         if (status != GSL_SUCCESS) return status;
     }
-    kept_set(&s->start, sys, t, y, s->f, n);
+    if (!retry || dydt_in != NULL) kept_set(&s->start, sys, t, y, s->f, n);
 
     if (!s->jacobian_at_start) {
         status = GSL_ODEIV_JA_EVAL(sys, t, y, s->jac, s->dfdt);
