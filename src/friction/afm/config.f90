@@ -644,8 +644,8 @@ contains
       exact%evaluation = 'direct'
       call new_potential(exact, potential, error)
       if (allocated(error)) return
-      call new_tip(config, potential, tip)
-      call langevin_time_step(tip, surface_curvature(config, potential), dt, limit, error)
+      call new_tip_owning(config, potential, tip)
+      call langevin_time_step(tip, surface_curvature(config, tip%potential), dt, limit, error)
       if (allocated(error)) limit = 0.0_wp
    end function thermal_step_limit
 

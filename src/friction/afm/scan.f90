@@ -40,7 +40,7 @@ module friction_afm_scan
    use friction_kinds, only: wp, i8, pi, ev_per_angstrom_to_nn
    use friction_error, only: error_type, fatal_error, error_input, error_numerical
    use friction_ode_solver, only: ode_solver, integrator_statistics
-   use friction_afm_config, only: afm_config, new_tip, new_tip_owning, surface_curvature
+   use friction_afm_config, only: afm_config, new_tip_owning, surface_curvature
    use friction_afm_tip, only: afm_tip, model_inertial, model_quasistatic, find_height
    use friction_afm_thermal, only: welford_add, welford_sem
    use friction_afm_langevin, only: langevin_integrator, langevin_state, langevin_time_step, boltzmann
@@ -216,16 +216,16 @@ contains
       end do
    end function support_across
 
+   !> init_owning on a copy of `potential`.
    subroutine init(self, config, potential, error)
       class(afm_scanner), intent(inout) :: self
       type(afm_config), intent(in) :: config
       class(surface_potential), intent(in) :: potential
       type(error_type), allocatable, intent(out) :: error
+      class(surface_potential), allocatable :: copy
 
-      if (allocated(self%tip)) deallocate (self%tip)
-      allocate (self%tip)
-      call new_tip(config, potential, self%tip)
-      call set_up(self, config, error)
+      allocate (copy, source=potential)
+      call self%init_owning(config, copy, error)
    end subroutine init
 
    !> init, the scanner's tip taking `potential` over (deallocated on
