@@ -122,7 +122,10 @@ contains
          & main_run => self%main_run)
          check%enabled = settings%check%enabled
          check_rank = merge(1, 0, job%nranks > 1)
-         if (job%rank == 0) call integrate_brake(main_run, settings, reporter, error)
+         if (job%rank == 0) then
+            if (len(settings%creep_band_warning()) > 0) call reporter%note('warning: '//settings%creep_band_warning())
+            call integrate_brake(main_run, settings, reporter, error)
+         end if
          if (check%enabled) then
             check_config = settings%check_settings()
             if (job%rank == check_rank) then
