@@ -1503,7 +1503,12 @@ def case_brake_creep_band(args):
     1e-7: 3.8e-7) there is no warning and the events are the reference's,
     kind by kind.  A warning for the resolved run, or none for the loose one,
     fails; so does a loose run with the right events (the warning would then
-    claim a harm it does not measure)."""
+    claim a harm it does not measure).  A sweep on 2 ranks warns once for
+    all its points (their event counts are in /sweep), with the number of
+    points and the first: all 3 of a loose sweep; of the resolved settings
+    over v'_dr = -4.5e-3, -3.5e-3, -2.5e-3 (velocity tolerances 5.5e-7,
+    4.5e-7, 3.5e-7 against the bound 5e-7) point 1 alone; none over
+    -3e-3 ... -1e-3."""
     brake = os.path.join(args.inputs, "brake.nml")
     plain = ("&brake model = 'regularized', t_end = 300.0, dt_out = 1.0 /\n"
              + BRAKE_SHORT.splitlines(keepends=True)[1])
@@ -1523,6 +1528,17 @@ def case_brake_creep_band(args):
         fail(f"the loose run's events ({len(runs['loose'])}) are not more than the reference's ({len(reference)})")
     if len(runs["resolved"]) != len(reference) or not (runs["resolved"] == reference).all():
         fail(f"resolved run: {len(runs['resolved'])} events against the reference's {len(reference)}")
+    for name, start, end, count in (("loose", -0.004, -0.002, 3), ("resolved", -0.0045, -0.0025, 1),
+                                    ("resolved", -0.003, -0.001, 0)):
+        sweep = write(args, "sweep.nml", "&brake t_end = 50.0 /\n&sweep sweep_variable = 'brake.v_dr_prime', "
+                      f"sweep_spacing = 'linear', sweep_from = {start}, sweep_to = {end}, sweep_count = 3 /\n")
+        result = friction(args, "-o", f"sweep_{name}_{count}.h5", brake, os.path.join(args.workdir, f"{name}.nml"),
+                          sweep, ranks=2)
+        lines = [line for line in result.stderr.splitlines() if "warning:" in line]
+        expected = [f"friction: warning: {count} of the sweep points computed in this run, the first point 1: "
+                    "&integrator: the velocity tolerance in stick"] if count else []
+        if len(lines) != len(expected) or not all(line.startswith(e) for line, e in zip(lines, expected)):
+            fail(f"sweep {name}: warnings {lines}")
 
 
 # A small sweep of the belt velocity (docs/sweeps.md).

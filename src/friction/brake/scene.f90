@@ -48,6 +48,7 @@ module friction_brake_scene
       procedure :: point_series => brake_point_series
       procedure :: run_point => brake_run_point
       procedure :: netlist => brake_netlist_text
+      procedure :: settings_warning => brake_settings_warning
       procedure :: resolved
    end type brake_scene
 
@@ -116,6 +117,7 @@ contains
       real(wp) :: wall, stick_time
       integer(i8) :: counts(4)
       character(len=240) :: line
+      character(len=:), allocatable :: warning
 
       self%ran = self%resolved()
       associate (settings => self%ran, check => self%check_record, record => self%record, &
@@ -123,7 +125,8 @@ contains
          check%enabled = settings%check%enabled
          check_rank = merge(1, 0, job%nranks > 1)
          if (job%rank == 0) then
-            if (len(settings%creep_band_warning()) > 0) call reporter%note('warning: '//settings%creep_band_warning())
+            warning = settings%creep_band_warning()
+            if (len(warning) > 0) call reporter%note('warning: '//warning)
             call integrate_brake(main_run, settings, reporter, error)
          end if
          if (check%enabled) then
@@ -291,6 +294,17 @@ contains
          end associate
       end associate
    end subroutine brake_run_point
+
+   !> The creep band's warning (brake_config%creep_band_warning) for the
+   !> resolved settings.
+   function brake_settings_warning(self) result(text)
+      class(brake_scene), intent(in) :: self
+      character(len=:), allocatable :: text
+      type(brake_config) :: resolved
+
+      resolved = self%resolved()
+      text = resolved%creep_band_warning()
+   end function brake_settings_warning
 
    subroutine brake_netlist_text(self, data_file, version, text, note, error)
       class(brake_scene), intent(in) :: self

@@ -117,6 +117,9 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(error_type), allocatable :: point_error
       character(len=:), allocatable :: temporary, series_name, series_unit, input_hash, todo_path, first_reason
+      character(len=:), allocatable :: warning
+      !> points of this run whose settings the scene warns about, and the first of them
+      integer :: warned, first_warned
       type(point_result), allocatable :: names(:)
       type(point_message), allocatable :: outbox(:)
       type(point_message) :: mine
@@ -198,6 +201,8 @@ contains
       block_first = int(int(n_work, i8) * job%rank / job%nranks)
       block_last = int(int(n_work, i8) * (job%rank + 1) / job%nranks)
       computed = 0
+      warned = 0
+      first_warned = huge(1)
       interrupted = .false.
       last_taken = 0
       slot = 0
@@ -232,7 +237,11 @@ contains
          end if
          computed = computed + 1
          t0 = wall_seconds()
-         call run_point(config, i, results, series, kept, point_error)
+         call run_point(config, i, results, series, kept, warning, point_error)
+         if (len(warning) > 0) then
+            warned = warned + 1
+            first_warned = min(first_warned, i)
+         end if
          if (.not. allocated(series)) allocate (series(0))
          cost = wall_seconds() - t0
          mine%header = [i, status_done, size(names), size(series), 0]
@@ -282,6 +291,17 @@ contains
       flag = merge(1, 0, interrupted)
       if (job%parallel()) call MPI_Allreduce(MPI_IN_PLACE, flag, 1, MPI_INTEGER, MPI_MAX, job%comm)
       interrupted = flag /= 0
+      ! One warning for the whole sweep, not one a point: how many points
+      ! the scene warned about, and the first one's words.
+      if (job%parallel()) then
+         call MPI_Allreduce(MPI_IN_PLACE, warned, 1, MPI_INTEGER, MPI_SUM, job%comm)
+         call MPI_Allreduce(MPI_IN_PLACE, first_warned, 1, MPI_INTEGER, MPI_MIN, job%comm)
+      end if
+      if (job%rank == 0 .and. warned > 0) then
+         warning = point_warning(config, first_warned)
+         call reporter%note('warning: '//itoa(warned)//' of the sweep points computed in this run, the first ' &
+            & //'point '//itoa(first_warned)//': '//warning)
+      end if
 
       ! Peak resident memory of every rank, for the benchmark (docs/sweeps.md).
       allocate (memory(job%nranks))
@@ -334,21 +354,53 @@ contains
 
    !> Point i: a copy of the scene with the swept variables set in memory,
    !> checked as the input is, then run on this process, with what its
-   !> earlier points left in `kept` (point_memory).
-   subroutine run_point(config, i, results, series, kept, error)
+   !> earlier points left in `kept` (point_memory).  `warning`: the scene's
+   !> settings_warning for the point ('' for none, or when its check failed).
+   subroutine run_point(config, i, results, series, kept, warning, error)
       type(job_config), intent(in) :: config
       integer, intent(in) :: i
       real(wp), intent(out) :: results(:)
       real(wp), allocatable, intent(out) :: series(:)
       type(point_memory), intent(inout) :: kept
+      character(len=:), allocatable, intent(out) :: warning
       type(error_type), allocatable, intent(out) :: error
       class(scene), allocatable :: point
+
+      results = 0.0_wp
+      warning = ''
+      allocate (series(0))
+      call point_scene(config, i, point, error)
+      if (allocated(error)) return
+      warning = point%settings_warning()
+      deallocate (series)
+      call point%run_point(results, series, kept, error)
+   end subroutine run_point
+
+   !> The scene's warning about point i's settings ('' for none or a point
+   !> that fails its check).
+   function point_warning(config, i) result(text)
+      type(job_config), intent(in) :: config
+      integer, intent(in) :: i
+      character(len=:), allocatable :: text
+      class(scene), allocatable :: point
+      type(error_type), allocatable :: error
+
+      text = ''
+      call point_scene(config, i, point, error)
+      if (.not. allocated(error)) text = point%settings_warning()
+   end function point_warning
+
+   !> Point i's scene: a copy with the swept variables set in memory,
+   !> checked as the input is.
+   subroutine point_scene(config, i, point, error)
+      type(job_config), intent(in) :: config
+      integer, intent(in) :: i
+      class(scene), allocatable, intent(out) :: point
+      type(error_type), allocatable, intent(out) :: error
       type(config_checker) :: checker
       character(len=:), allocatable :: group, name, problem
       integer :: v
 
-      results = 0.0_wp
-      allocate (series(0))
       allocate (point, source=config%scene)
       do v = 1, config%sweep%n_variables
          call split_name(config%sweep%variables(v), group, name)
@@ -360,13 +412,8 @@ contains
          call checker%set_origin(group, name, 'sweep point '//itoa(i))
       end do
       call point%check(checker)
-      if (checker%failed()) then
-         call move_alloc(checker%error, error)
-         return
-      end if
-      deallocate (series)
-      call point%run_point(results, series, kept, error)
-   end subroutine run_point
+      if (checker%failed()) call move_alloc(checker%error, error)
+   end subroutine point_scene
 
    !> A reason on one line.
    function one_line(text) result(line)

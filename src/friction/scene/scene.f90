@@ -63,6 +63,10 @@ module friction_scene
       procedure(point_interface), deferred :: run_point
       !> The scene as a SPICE netlist for ngspice.
       procedure(netlist_interface), deferred :: netlist
+      !> '' or a warning that the settings, though valid, make a result
+      !> unreliable; cheap, from the settings alone (a sweep asks it of every
+      !> point).  None by default.
+      procedure :: settings_warning
    end type scene
 
    abstract interface
@@ -136,5 +140,14 @@ module friction_scene
          type(error_type), allocatable, intent(out) :: error
       end subroutine netlist_interface
    end interface
+
+contains
+
+   function settings_warning(self) result(text)
+      class(scene), intent(in) :: self
+      character(len=:), allocatable :: text
+
+      text = ''
+   end function settings_warning
 
 end module friction_scene
