@@ -117,18 +117,13 @@ contains
       real(wp) :: wall, stick_time
       integer(i8) :: counts(4)
       character(len=240) :: line
-      character(len=:), allocatable :: warning
 
       self%ran = self%resolved()
       associate (settings => self%ran, check => self%check_record, record => self%record, &
          & main_run => self%main_run)
          check%enabled = settings%check%enabled
          check_rank = merge(1, 0, job%nranks > 1)
-         if (job%rank == 0) then
-            warning = settings%creep_band_warning()
-            if (len(warning) > 0) call reporter%note('warning: '//warning)
-            call integrate_brake(main_run, settings, reporter, error)
-         end if
+         if (job%rank == 0) call integrate_brake(main_run, settings, reporter, error)
          if (check%enabled) then
             check_config = settings%check_settings()
             if (job%rank == check_rank) then

@@ -183,7 +183,7 @@ contains
       class(job_reporter), intent(inout) :: reporter
       character(len=:), allocatable, intent(out) :: summary
       type(error_type), allocatable, intent(out) :: error
-      character(len=:), allocatable :: temporary
+      character(len=:), allocatable :: temporary, warning
 
       job%replace = force .or. (job%resume .and. config%sweep%enabled())
       ! Find out now, not after the computation, whether the output can be written.
@@ -195,6 +195,11 @@ contains
       if (config%sweep%enabled()) then
          call run_sweep_job(job, config, reporter, summary, error)
          return
+      end if
+      ! (A sweep says its points' warnings once, at its end.)
+      if (job%rank == 0) then
+         warning = config%scene%settings_warning()
+         if (len(warning) > 0) call reporter%note('warning: '//warning)
       end if
       call config%scene%run(job, reporter, error)
       if (allocated(error)) return

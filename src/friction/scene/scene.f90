@@ -64,8 +64,8 @@ module friction_scene
       !> The scene as a SPICE netlist for ngspice.
       procedure(netlist_interface), deferred :: netlist
       !> '' or a warning that the settings, though valid, make a result
-      !> unreliable; cheap, from the settings alone (a sweep asks it of every
-      !> point).  None by default.
+      !> unreliable; cheap, from the settings alone.  The job says it before
+      !> a run, and a sweep once for all its points.  None by default.
       procedure :: settings_warning
    end type scene
 
