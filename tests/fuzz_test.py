@@ -635,8 +635,11 @@ def main():
     parser.add_argument("--long", action="store_true", help="a long run: fresh random seeds, 10x the budget")
     parser.add_argument("classes", nargs="+", choices=sorted(CLASSES) + ["all"])
     args = parser.parse_args()
+    # (Absolute: the cases run in directories of their own, and a relative
+    # path, as scripts/fuzz gives, would name nothing there.)
     args.binary = os.path.abspath(args.binary)
     args.inputs = os.path.abspath(args.inputs)
+    args.workdir = os.path.abspath(args.workdir)
     if "capi-values" in args.classes or "all" in args.classes:
         if not args.library:
             parser.error("the class capi-values needs --library")
