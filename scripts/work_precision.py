@@ -2,7 +2,8 @@
 """Speed against accuracy: work-precision charts and a failure map for friction.
 
 For each scene (NaF, HOPG, graphite, the brake's regularized law and its
-switched model) every applicable GSL stepper climbs a ladder of tolerances;
+switched model) every GSL stepper and the library's Rosenbrock steppers
+(rodas3, rodas4) climb a ladder of tolerances;
 each run's error against a far tighter reference is set against its CPU time.
 Writes, into --out (default: the current directory):
 
@@ -64,11 +65,20 @@ charts: a JSON list of {"scene": "<scene>", "label": "...", "error": [...],
 "cpu_time": [...]} in the units of that scene's chart.  They are drawn dashed
 in black and stored under /<scene>/extra/<label>.
 
+--add-to DIR measures only the --methods given and adds them to the files
+in DIR (work_precision.h5 and failure_map.h5), measured as the file was (its
+scenes, ladders, repeats and cap), replacing those methods' earlier series;
+what depends on all the methods together is computed again (the failure
+map's 'slow', the ranking behind 'auto', the best method per error level)
+and DIR's charts are redrawn.  The added groups carry the attribute 'added'
+(when, and the program's source revision).
+
 Usage (normally through scripts/work_precision, which builds first):
 
     python3 scripts/work_precision.py [--quick] [--out DIR] [--extra FILE]
                                       [--repeats N] [--cap S] [--binary PATH]
-                                      [--scenes a,b] [--no-failure-map]
+                                      [--scenes a,b] [--methods a,b] [--no-failure-map]
+    python3 scripts/work_precision.py --add-to DIR --methods a,b [--scenes a,b] [--no-failure-map]
 """
 
 from __future__ import annotations
@@ -103,7 +113,8 @@ import ngspice_compare  # noqa: E402  (the paper's network model in ngspice, as 
 
 ROOT = Path(__file__).resolve().parent.parent
 INPUTS = ROOT / "inputs"
-METHODS = benchmark_brake.METHODS  # all 11 GSL step types
+GSL_METHODS = benchmark_brake.METHODS  # all 11 GSL step types
+METHODS = GSL_METHODS + ("rodas3", "rodas4")  # and the library's two Rosenbrock steppers
 QUICK_METHODS = ("rkf45", "rk8pd", "rk4imp")
 QUICK_TOLS = (1e-4, 1e-6, 1e-8)
 REPEAT_BELOW = 2.0  # s: repeat runs faster than this (median), one run above
@@ -447,23 +458,49 @@ def write_scene(f: h5py.File, res, extras) -> None:
     a["reference_time"] = res["ref"].time
     a["reference_check_rtol"] = scene.ref_tol * 10
     a["reference_check"] = res["check"]
-    a["smallest_error"] = res["smallest"]
-    a["reference_converged"] = res["converged"]
     for method, pts in res["rows"].items():
-        m = g.create_group(method)
-        m.create_dataset("tolerance", data=np.array([p.rtol for p in pts]))
-        m.create_dataset("atol", data=np.array([p.atol for p in pts]))
-        m.create_dataset("error", data=np.array([p.error for p in pts]))
-        m.create_dataset("cpu_time", data=np.array([p.time for p in pts]))
-        m.create_dataset("rhs_evaluations", data=np.array([p.rhs for p in pts], dtype=np.int64))
-        m.create_dataset("status", data=[p.status for p in pts], dtype=h5py.string_dtype())
-        m.create_dataset("message", data=[p.message for p in pts], dtype=h5py.string_dtype())
+        write_method(g, method, pts)
     if extras:
         e = g.create_group("extra")
         for ex in extras:
             s = e.create_group(ex["label"])
             s.create_dataset("error", data=np.asarray(ex["error"], dtype=float))
             s.create_dataset("cpu_time", data=np.asarray(ex["cpu_time"], dtype=float))
+    write_derived(g, res)
+
+
+def write_method(g, method: str, pts) -> None:
+    """One method's ladder as the group /<scene>/<method>."""
+    m = g.create_group(method)
+    m.create_dataset("tolerance", data=np.array([p.rtol for p in pts]))
+    m.create_dataset("atol", data=np.array([p.atol for p in pts]))
+    m.create_dataset("error", data=np.array([p.error for p in pts]))
+    m.create_dataset("cpu_time", data=np.array([p.time for p in pts]))
+    m.create_dataset("rhs_evaluations", data=np.array([p.rhs for p in pts], dtype=np.int64))
+    m.create_dataset("status", data=[p.status for p in pts], dtype=h5py.string_dtype())
+    m.create_dataset("message", data=[p.message for p in pts], dtype=h5py.string_dtype())
+
+
+def read_method(m, method: str) -> list:
+    """A method's ladder back from its group (write_method)."""
+    text = [[v.decode() if isinstance(v, bytes) else str(v) for v in m[d][()]] for d in ("status", "message")]
+    return [Point(method, float(rtol), float(atol), status, message, error=float(error), time=float(time),
+                  rhs=int(rhs))
+            for rtol, atol, error, time, rhs, status, message in zip(
+                m["tolerance"][()], m["atol"][()], m["error"][()], m["cpu_time"][()], m["rhs_evaluations"][()],
+                *text)]
+
+
+def write_derived(g, res) -> None:
+    """What the scene's attributes say of all its methods together: the
+    smallest error drawn, whether the reference resolves it, the ranking
+    behind method = 'auto' and the best method at the error levels."""
+    ok_errors = [p.error for pts in res["rows"].values() for p in pts if p.status == "ok"]
+    res["smallest"] = min(ok_errors) if ok_errors else math.nan
+    res["converged"] = bool(ok_errors) and 10 * res["check"] < res["smallest"]
+    a = g.attrs
+    a["smallest_error"] = res["smallest"]
+    a["reference_converged"] = res["converged"]
     ev = auto_evidence(res)
     a["auto_evidence"] = json.dumps(ev)
     levels = {}
@@ -491,16 +528,30 @@ def failure_column(scene, methods, label) -> dict:
         return {"label": label, "ref_check": math.nan, "points": [
             Point(m, rtol, atol, "no reference", str(exc)) for m in methods], "codes": [-1] * len(methods)}
     pts = [measure(scene, m, rtol, atol, 1, ref.q) for m in methods]
-    codes = []
     for p in pts:
         # Wrong only where the reference resolves it: its own difference
         # (10x looser) must stay 10x below the error called wrong.
         if p.status == "ok" and p.error > 100 * p.scale and p.error > 10 * check:
             p.status = "wrong"
+    codes = category_codes(pts)
+    for p, code in zip(pts, codes):
+        log(f"  failure map {label} {p.method:7s}: {CATEGORIES[code]:6s} "
+            + (f"error {p.error:.1e} (100x asked {100 * p.scale:.1e}), {p.time:.4f} s"
+               if p.status in ("ok", "wrong") else p.message[:90]))
+    return {"label": label, "ref_check": check, "points": pts, "codes": codes}
+
+
+def category_codes(pts) -> list:
+    """The failure map's category of each method's point at one setting
+    (status 'wrong' already given): slow is relative to the fastest method
+    that is neither failed nor wrong, so it depends on all the methods."""
     good = [p.time for p in pts if p.status == "ok"]
     best = min(good) if good else math.nan
+    codes = []
     for p in pts:
-        if p.status == "ok" and p.time > 10 * best:
+        if p.status == "no reference":
+            codes.append(-1)
+        elif p.status == "ok" and p.time > 10 * best:
             codes.append(1)
         elif p.status == "ok":
             codes.append(0)
@@ -510,10 +561,7 @@ def failure_column(scene, methods, label) -> dict:
             codes.append(3)
         else:
             codes.append(2)
-        log(f"  failure map {label} {p.method:7s}: {CATEGORIES[codes[-1]]:6s} "
-            + (f"error {p.error:.1e} (100x asked {100 * p.scale:.1e}), {p.time:.4f} s"
-               if p.status in ("ok", "wrong") else p.message[:90]))
-    return {"label": label, "ref_check": check, "points": pts, "codes": codes}
+    return codes
 
 
 def failure_maps(afm_fr, brake_fr, methods, cap, quick) -> list:
@@ -564,19 +612,47 @@ def write_failure_maps(path: Path, maps, methods, meta) -> None:
             if "c" in mp:
                 g.create_dataset("c", data=np.array(mp["c"]))
                 g["c"].attrs["unit"] = "N s/m (cx; cy likewise from ky)"
-            g.create_dataset("methods", data=list(methods), dtype=h5py.string_dtype())
-            cols = mp["columns"]
-            g.create_dataset("category", data=np.array([c["codes"] for c in cols], dtype=np.int8).T)
-            g.create_dataset("error", data=np.array([[p.error for p in c["points"]] for c in cols]).T)
-            g.create_dataset("cpu_time", data=np.array([[p.time for p in c["points"]] for c in cols]).T)
-            g.create_dataset("asked_tolerance", data=np.array([[p.scale for p in c["points"]] for c in cols]).T)
-            g.create_dataset("status", data=np.array([[p.status for p in c["points"]] for c in cols],
-                                                      dtype=object).T, dtype=h5py.string_dtype())
-            g.create_dataset("message", data=np.array([[p.message for p in c["points"]] for c in cols],
-                                                       dtype=object).T, dtype=h5py.string_dtype())
-            g.create_dataset("reference_check", data=np.array([c["ref_check"] for c in cols]))
-            for d in ("category", "error", "cpu_time", "status"):
-                g[d].attrs["axes"] = f"methods x {mp['parameter']}"
+            write_map_points(g, mp["parameter"], methods, mp["columns"])
+
+
+MAP_POINT_DATA = ("methods", "category", "error", "cpu_time", "asked_tolerance", "status", "message",
+                  "reference_check")
+
+
+def write_map_points(g, parameter: str, methods, cols) -> None:
+    """A failure map's points (methods x settings) and categories."""
+    for d in MAP_POINT_DATA:
+        if d in g:
+            del g[d]
+    g.create_dataset("methods", data=list(methods), dtype=h5py.string_dtype())
+    g.create_dataset("category", data=np.array([c["codes"] for c in cols], dtype=np.int8).T)
+    g.create_dataset("error", data=np.array([[p.error for p in c["points"]] for c in cols]).T)
+    g.create_dataset("cpu_time", data=np.array([[p.time for p in c["points"]] for c in cols]).T)
+    g.create_dataset("asked_tolerance", data=np.array([[p.scale for p in c["points"]] for c in cols]).T)
+    g.create_dataset("status", data=np.array([[p.status for p in c["points"]] for c in cols],
+                                              dtype=object).T, dtype=h5py.string_dtype())
+    g.create_dataset("message", data=np.array([[p.message for p in c["points"]] for c in cols],
+                                               dtype=object).T, dtype=h5py.string_dtype())
+    g.create_dataset("reference_check", data=np.array([c["ref_check"] for c in cols]))
+    for d in ("category", "error", "cpu_time", "status"):
+        g[d].attrs["axes"] = f"methods x {parameter}"
+
+
+def read_map_columns(g, parameter: str) -> tuple[list, list]:
+    """A failure map's methods and its columns of points back from the file
+    (write_map_points)."""
+    def text(d):
+        return [[v.decode() if isinstance(v, bytes) else str(v) for v in row] for row in g[d][()]]
+    methods = [m.decode() if isinstance(m, bytes) else str(m) for m in g["methods"][()]]
+    status, message = text("status"), text("message")
+    error, time, asked = g["error"][()], g["cpu_time"][()], g["asked_tolerance"][()]
+    cols = []
+    for j in range(g[parameter].shape[0]):
+        pts = [Point(m, FAILURE_RTOL, math.nan, status[i][j], message[i][j], error=float(error[i, j]),
+                     time=float(time[i, j]), scale=float(asked[i, j])) for i, m in enumerate(methods)]
+        cols.append({"points": pts, "ref_check": float(g["reference_check"][j]),
+                     "codes": [int(c) for c in g["category"][:, j]]})
+    return methods, cols
 
 
 # --------------------------------------------------------------------------
@@ -634,6 +710,53 @@ def save(figure, path: Path) -> None:
     figure.savefig(path, dpi=90)
 
 
+def add_to(directory: Path, results, maps, methods, meta) -> tuple[list, list, list]:
+    """Add the methods measured now to the files in directory (replacing
+    their earlier series), and recompute what depends on all the methods
+    together: the scenes' derived attributes and the failure map's
+    categories.  Returns the merged results, maps and methods."""
+    stamp = f"{meta['created']}, {meta['source']}"
+    merged_results = []
+    with h5py.File(directory / "work_precision.h5", "r+") as f:
+        known = [m for m in str(f.attrs["methods"]).split(",") if m]
+        all_methods = known + [m for m in methods if m not in known]
+        for res in results:
+            g = f[res["scene"].name]
+            before = float(g.attrs["reference_check"])
+            if not (res["check"] <= 2 * before and before <= 2 * res["check"]):
+                log(f"{res['scene'].name}: the reference's own check is {res['check']:.2e} now against "
+                    f"{before:.2e} in the file: the program's reference has changed (the added series are "
+                    "measured against today's)")
+            for method, pts in res["rows"].items():
+                if method in g:
+                    del g[method]
+                write_method(g, method, pts)
+                g[method].attrs["added"] = stamp
+            rows = {m: read_method(g[m], m) for m in all_methods if m in g}
+            merged = dict(res, rows=rows)
+            write_derived(g, merged)
+            merged_results.append(merged)
+        f.attrs["methods"] = ",".join(all_methods)
+    merged_maps = []
+    if maps:
+        with h5py.File(directory / "failure_map.h5", "r+") as f:
+            for mp in maps:
+                g = f[mp["name"]]
+                if not np.allclose(g[mp["parameter"]][()], mp["values"]):
+                    raise RuntimeError(f"failure map {mp['name']}: the file's {mp['parameter']} values differ "
+                                       "from this run's (a --quick file and a full run?)")
+                old_methods, old_cols = read_map_columns(g, mp["parameter"])
+                map_methods = [m for m in old_methods if m not in methods] + list(methods)
+                cols = []
+                for old, new in zip(old_cols, mp["columns"]):
+                    pts = [p for p in old["points"] if p.method not in methods] + new["points"]
+                    cols.append(dict(new, points=pts, codes=category_codes(pts)))
+                write_map_points(g, mp["parameter"], map_methods, cols)
+                merged_maps.append(dict(mp, columns=cols, methods=map_methods))
+            f.attrs["added"] = f"{','.join(methods)}: {stamp}"
+    return merged_results, merged_maps, all_methods
+
+
 def summary_table(results) -> str:
     lines = ["| scene | error level | best method | time | rkf45 time | rkf45 / best |",
              "|---|---|---|---|---|---|"]
@@ -679,6 +802,10 @@ def main(argv=None) -> int:
     p.add_argument("--ngspice", action="store_true",
                    help="also chart the paper's network model in ngspice (friction --netlist) on its two "
                         "scenes, brake_regularized and naf_trace (added to the scenes run)")
+    p.add_argument("--add-to", type=Path, metavar="DIR",
+                   help="measure only --methods and add them to DIR's work_precision.h5 and failure_map.h5 "
+                        "(replacing their earlier series; the file's scenes, ladders, repeats and cap), "
+                        "recompute what depends on all methods, and redraw DIR's charts")
     p.add_argument("--replot", type=Path, metavar="H5",
                    help="measure nothing: redraw the charts of this work_precision.h5 into --out, adding "
                         "the --extra series to the file")
@@ -692,10 +819,29 @@ def main(argv=None) -> int:
         return replot(args.replot, args.out, load_extras(args.extra, make_scenes(False)))
     repeats = args.repeats or (1 if args.quick else 3)
     cap = args.cap or (3.0 if args.quick else 10.0)
+    in_file = None
+    if args.add_to:
+        wp = args.add_to / "work_precision.h5"
+        if not wp.exists():
+            p.error(f"--add-to {args.add_to}: no work_precision.h5 there")
+        if not args.methods:
+            p.error("--add-to needs --methods (the methods to add)")
+        if args.ngspice or args.extra:
+            p.error("--add-to adds measured methods only (no --ngspice, no --extra)")
+        with h5py.File(wp, "r") as f:
+            # Measured as the file was: its ladders, repeats and cap.
+            args.quick = bool(f.attrs["quick"])
+            repeats, cap = int(f.attrs["repeats"]), float(f.attrs["max_wall_time"])
+            in_file = [n for n in f if n in make_scenes(args.quick)]
+        if not (args.add_to / "failure_map.h5").exists():
+            args.no_failure_map = True
+        args.out = args.add_to
     scenes = make_scenes(args.quick)
-    names = (args.scenes.split(",") if args.scenes else
+    names = (args.scenes.split(",") if args.scenes else in_file if in_file is not None else
              (["naf", "brake_switched"] if args.quick else
               [n for n in scenes if n not in ("naf_line", "naf_trace")]))
+    if in_file is not None and any(n not in in_file for n in names):
+        p.error(f"--add-to: the file has the scenes {', '.join(in_file)} only")
     if args.ngspice:
         if not shutil.which("ngspice"):
             p.error("--ngspice: no ngspice on PATH (scripts/install-deps installs it)")
@@ -742,18 +888,26 @@ def main(argv=None) -> int:
     meta = {"program": "work_precision", "created": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
             "source": benchmark_afm.git_state(), "quick": args.quick, "repeats": repeats,
             "max_wall_time": cap, "seconds": total}
-    with h5py.File(args.out / "work_precision.h5", "w") as f:
-        for k, v in meta.items():
-            f.attrs[k] = v
-        f.attrs["methods"] = ",".join(methods)
-        for res in results:
-            write_scene(f, res, extras.get(res["scene"].name, []))
+    if args.add_to:
+        try:
+            results, maps, methods = add_to(args.add_to, results, maps, methods, meta)
+        except RuntimeError as exc:
+            log(str(exc))
+            return 1
+    else:
+        with h5py.File(args.out / "work_precision.h5", "w") as f:
+            for k, v in meta.items():
+                f.attrs[k] = v
+            f.attrs["methods"] = ",".join(methods)
+            for res in results:
+                write_scene(f, res, extras.get(res["scene"].name, []))
+        if maps:
+            write_failure_maps(args.out / "failure_map.h5", maps, methods, meta)
     charts = friction.load(args.out / "work_precision.h5")
     for res in results:
         name = res["scene"].name
         save(friction.plot.work_precision(charts, name), args.out / f"work_precision_{name}.png")
     if maps:
-        write_failure_maps(args.out / "failure_map.h5", maps, methods, meta)
         save(friction.plot.failure_map(args.out / "failure_map.h5"), args.out / "failure_map.png")
 
     print("# Speed against accuracy\n")
@@ -768,7 +922,7 @@ def main(argv=None) -> int:
         print(f"\nFailure map: {mp['title']}\n")
         print("| method | " + " | ".join(c["label"] for c in mp["columns"]) + " |")
         print("|---|" + "---|" * len(mp["columns"]))
-        for i, m in enumerate(methods):
+        for i, m in enumerate(mp.get("methods", methods)):
             print(f"| {m} | " + " | ".join(
                 (CATEGORIES[c["codes"][i]] if c["codes"][i] >= 0 else "no ref")
                 + (f" {c['points'][i].time * 1e3:.1f} ms" if c["points"][i].status in ("ok", "wrong") else

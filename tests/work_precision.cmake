@@ -6,6 +6,9 @@
 #                          (rkf45, rk8pd), the reference passes its own check,
 #                          the failure map's categories (tests/check_work_precision.py)
 #   work_precision.png     the three PNGs are complete images
+#   work_precision.add     --add-to adds rodas3 to a copy of those files: nothing
+#                          measured before changes, the failure map's categories
+#                          follow its rule (tests/check_work_precision_add.py)
 #   auto-method            method = 'auto' resolves to docs/speed.md's table and
 #                          runs as the named method (CLI and C API)
 # Included from tests/CMakeLists.txt after scripts.cmake (which checks for
@@ -33,6 +36,12 @@ add_test(NAME work_precision.png
           "${_wp_work}/failure_map.png")
 set_tests_properties(work_precision.png PROPERTIES FIXTURES_REQUIRED work_precision_quick
   LABELS scripts)
+
+add_test(NAME work_precision.add
+  COMMAND ${Python3_EXECUTABLE} "${_fs_tests}/check_work_precision_add.py" --script "${_fs_scripts}/work_precision.py"
+          --binary $<TARGET_FILE:friction_app> --from "${_wp_work}" --workdir "${_wp_work}/add")
+set_tests_properties(work_precision.add PROPERTIES FIXTURES_REQUIRED work_precision_quick
+  LABELS scripts TIMEOUT 300)
 
 add_test(NAME auto-method
   COMMAND ${Python3_EXECUTABLE} "${_fs_tests}/auto_method_test.py"

@@ -936,7 +936,8 @@ def sweep(data):
 STYLE = {"rk2": ("tab:gray", "o"), "rk4": ("tab:brown", "s"), "rkf45": ("tab:blue", "o"),
          "rkck": ("tab:cyan", "^"), "rk8pd": ("tab:red", "D"), "rk1imp": ("tab:olive", "v"),
          "rk2imp": ("tab:pink", "<"), "rk4imp": ("tab:green", ">"), "bsimp": ("tab:purple", "p"),
-         "msadams": ("gold", "h"), "msbdf": ("tab:orange", "*"), "switched": ("k", "x")}
+         "msadams": ("gold", "h"), "msbdf": ("tab:orange", "*"), "rodas3": ("darkblue", "P"),
+         "rodas4": ("darkgreen", "X"), "switched": ("k", "x")}
 
 
 def work_precision(data, scene):
