@@ -107,7 +107,10 @@ class Friction:
         except subprocess.TimeoutExpired:
             return Run(False, f"killed: still running {self.max_wall + 60.0:g} s after its start")
         if proc.returncode != 0:
-            return Run(False, proc.stderr.strip().replace("friction: error: ", ""))
+            # The error itself, not a warning said before it (the creep band's).
+            lines = proc.stderr.strip().splitlines()
+            errors = [ln.replace("friction: error: ", "") for ln in lines if ln.startswith("friction: error: ")]
+            return Run(False, " ".join(errors) if errors else proc.stderr.strip())
         with h5py.File(out, "r") as f:
             result = Run(True, "", float(f["brake"].attrs["compute_time"]), int(f.attrs["rhs_evaluations"]),
                          int(f.attrs["integrator_steps"]), int(f["brake/events/t"].size),
