@@ -59,7 +59,9 @@ TABLE = [
     ("graphite", "graphite.nml", LJ_SMALL, 1e-4, "rk8pd"),
     ("brake_regularized", "brake.nml", BRAKE_SHORT.format(model="regularized"), 1e-3, "rk2"),
     ("brake_regularized", "brake.nml", BRAKE_SHORT.format(model="regularized"), 1e-5, "rk4imp"),
-    ("brake_regularized", "brake.nml", BRAKE_SHORT.format(model="regularized"), 1e-8, "rkck"),
+    ("brake_regularized", "brake.nml", BRAKE_SHORT.format(model="regularized"), 1e-6, "rk4imp"),
+    ("brake_regularized", "brake.nml", BRAKE_SHORT.format(model="regularized"), 1e-7, "rodas4"),
+    ("brake_regularized", "brake.nml", BRAKE_SHORT.format(model="regularized"), 1e-9, "rodas4"),
     ("brake_regularized", "brake.nml", BRAKE_SHORT.format(model="regularized"), 1e-10, "rk8pd"),
     ("brake_switched", "brake.nml", BRAKE_SHORT.format(model="switched"), 1e-8, "rk8pd"),
 ]
