@@ -6,7 +6,7 @@
 #                          (rkf45, rk8pd), the reference passes its own check,
 #                          the failure map's categories (tests/check_work_precision.py)
 #   work_precision.png     the three PNGs are complete images
-#   work_precision.add     --add-to adds rodas3 to a copy of those files: nothing
+#   work_precision.add     --add-to adds rodas4 to a copy of those files: nothing
 #                          measured before changes, the failure map's categories
 #                          follow its rule (tests/check_work_precision_add.py)
 #   auto-method            method = 'auto' resolves to docs/speed.md's table and
