@@ -155,6 +155,28 @@ def matched(rows: list[dict], level: float, key: str) -> tuple[float | None, str
     return best[key], f"({best['method']} at {best['rtol']:.0e})"
 
 
+NGSPICE_HEADER = ("| reltol | error (m) | ngspice process wall, CPU | its analysis time | program process wall "
+                  "(its run) | program process CPU (its run) | ratio, wall | ratio, CPU |\n"
+                  "|---|---|---|---|---|---|---|---|")
+
+
+def print_ngspice_row(s_row: dict, candidates: list[dict]) -> tuple[float | None, float | None]:
+    """One ngspice setting against the cheapest of the candidates at its
+    error (matched), printed as a row of NGSPICE_HEADER; the program's
+    wall and CPU times (None when no candidate is that accurate)."""
+    wall, cpu = s_row["wall_time"], s_row["process_cpu"]
+    mine_wall, note_wall = matched(candidates, s_row["error"], "wall")
+    mine_cpu, note_cpu = matched(candidates, s_row["error"], "cpu")
+    head = (f"| {s_row['reltol']:.0e} | {s_row['error']:.2e} | {wall * 1e3:.0f} ms, {cpu * 1e3:.0f} ms | "
+            f"{s_row['analysis_time'] * 1e3:.0f} ms | ")
+    if mine_wall:
+        print(head + f"{mine_wall * 1e3:.1f} ms {note_wall} | {mine_cpu * 1e3:.1f} ms {note_cpu} | "
+              f"{wall / mine_wall:.1f} | {cpu / mine_cpu:.1f} |")
+    else:
+        print(head + f"{note_wall} | | - | - |")
+    return mine_wall, mine_cpu
+
+
 def print_program(title: str, rows: list[dict]) -> None:
     print(f"\n{title}:")
     print("| rtol | method | error (m) | process wall | process CPU | integration |")
@@ -248,46 +270,24 @@ def main(argv=None) -> int:
         candidates = reg + [row for m in ROSENBROCK for row in ros[m]]
         print("\nngspice on the netlist (`friction --netlist`, regularized law), against the program at the same "
               "error (regularized law, whole processes, the cheapest of 'auto', rodas3 and rodas4):")
-        print("| reltol | error (m) | ngspice process wall, CPU | its analysis time | program process wall "
-              "(its run) | program process CPU (its run) | ratio, wall | ratio, CPU |")
-        print("|---|---|---|---|---|---|---|---|")
+        print(NGSPICE_HEADER)
         if not have_ngspice:
             print(f"ngspice skipped: {args.ngspice} not found (Debian: apt-get install ngspice)")
-        spice_rows = []
-        for s in spice:
-            wall, cpu = statistics.median(s["walls"]), statistics.median(s["cpus"])
-            analysis = statistics.median(s["analysis"])
-            mine_wall, note_wall = matched(candidates, s["error"], "wall")
-            mine_cpu, note_cpu = matched(candidates, s["error"], "cpu")
-            if mine_wall:
-                print(f"| {s['reltol']:.0e} | {s['error']:.2e} | {wall * 1e3:.0f} ms, {cpu * 1e3:.0f} ms | "
-                      f"{analysis * 1e3:.0f} ms | {mine_wall * 1e3:.1f} ms {note_wall} | "
-                      f"{mine_cpu * 1e3:.1f} ms {note_cpu} | {wall / mine_wall:.1f} | {cpu / mine_cpu:.1f} |")
-            else:
-                print(f"| {s['reltol']:.0e} | {s['error']:.2e} | {wall * 1e3:.0f} ms, {cpu * 1e3:.0f} ms | "
-                      f"{analysis * 1e3:.0f} ms | {note_wall} | | - | - |")
-            spice_rows.append({"reltol": s["reltol"], "error": s["error"], "wall_time": wall, "process_cpu": cpu,
-                               "analysis_time": analysis, "program_wall": mine_wall, "program_cpu": mine_cpu})
+        spice_rows = [{"reltol": s["reltol"], "error": s["error"], "wall_time": statistics.median(s["walls"]),
+                       "process_cpu": statistics.median(s["cpus"]), "analysis_time": statistics.median(s["analysis"])}
+                      for s in spice]
+        for s_row in spice_rows:
+            s_row["program_wall"], s_row["program_cpu"] = print_ngspice_row(s_row, candidates)
         record["ngspice"] = spice_rows
         # The same, with the switched model admitted: its runs measured
         # against the arctan law's reference (model difference included).
         print(f"\nThe switched model's reference against the regularized law's: {model_gap:.2e} m over tau = 1 ... "
               f"{T_END:g}.  ngspice against the program with the switched model admitted, its runs measured "
               "against the regularized law's reference (the model's difference included):")
-        print("| reltol | error (m) | ngspice process wall, CPU | program process wall (its run) | "
-              "program process CPU (its run) | ratio, wall | ratio, CPU |")
-        print("|---|---|---|---|---|---|---|")
-        either = candidates + sw_as_regularized
+        print(NGSPICE_HEADER)
         for s_row in spice_rows:
-            mine_wall, note_wall = matched(either, s_row["error"], "wall")
-            mine_cpu, note_cpu = matched(either, s_row["error"], "cpu")
-            ratios = (f"{s_row['wall_time'] / mine_wall:.1f} | {s_row['process_cpu'] / mine_cpu:.1f}"
-                      if mine_wall else "- | -")
-            mine = (f"{mine_wall * 1e3:.1f} ms {note_wall} | {mine_cpu * 1e3:.1f} ms {note_cpu}"
-                    if mine_wall else f"{note_wall} |")
-            print(f"| {s_row['reltol']:.0e} | {s_row['error']:.2e} | {s_row['wall_time'] * 1e3:.0f} ms, "
-                  f"{s_row['process_cpu'] * 1e3:.0f} ms | {mine} | {ratios} |")
-            s_row["either_model_wall"], s_row["either_model_cpu"] = mine_wall, mine_cpu
+            s_row["either_model_wall"], s_row["either_model_cpu"] = print_ngspice_row(
+                s_row, candidates + sw_as_regularized)
         record["model_gap"] = model_gap
         record["program_switched_against_regularized"] = sw_as_regularized
         # SciPy DOP853 on the switched model.

@@ -351,10 +351,17 @@ def run_scene(scene, methods, repeats) -> dict:
                    ("ok", "unresolved") else p.message[:100]))
             pts.append(p)
         rows[method] = pts
+    res = {"scene": scene, "ref": ref, "check": check, "rows": rows}
+    res["smallest"], res["converged"] = resolution(rows, check)
+    return res
+
+
+def resolution(rows, check) -> tuple[float, bool]:
+    """The smallest error drawn (of the 'ok' points) and whether the
+    reference's own check lies 10x below it."""
     ok_errors = [p.error for pts in rows.values() for p in pts if p.status == "ok"]
     smallest = min(ok_errors) if ok_errors else math.nan
-    return {"scene": scene, "ref": ref, "check": check, "rows": rows, "smallest": smallest,
-            "converged": bool(ok_errors) and 10 * check < smallest}
+    return smallest, bool(ok_errors) and 10 * check < smallest
 
 
 # ngspice's reltol ladders (the charts' own rtol ladders, less the loosest rungs,
@@ -499,9 +506,7 @@ def write_derived(g, res) -> None:
     """What the scene's attributes say of all its methods together: the
     smallest error drawn, whether the reference resolves it, the ranking
     behind method = 'auto' and the best method at the error levels."""
-    ok_errors = [p.error for pts in res["rows"].values() for p in pts if p.status == "ok"]
-    res["smallest"] = min(ok_errors) if ok_errors else math.nan
-    res["converged"] = bool(ok_errors) and 10 * res["check"] < res["smallest"]
+    res["smallest"], res["converged"] = resolution(res["rows"], res["check"])
     a = g.attrs
     a["smallest_error"] = res["smallest"]
     a["reference_converged"] = res["converged"]
