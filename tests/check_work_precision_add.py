@@ -48,6 +48,15 @@ def datasets(group, prefix=""):
     return out
 
 
+def same(a, b):
+    """Bit for bit the same dataset: a point the fixture lost to the time cap
+    (a loaded machine) keeps NaN for its error and time, and NaN != NaN."""
+    a, b = np.asarray(a), np.asarray(b)
+    if a.dtype.kind == "f" and b.dtype.kind == "f":
+        return a.shape == b.shape and a.tobytes() == b.tobytes()
+    return np.array_equal(a, b)
+
+
 def text(values):
     return [v.decode() if isinstance(v, bytes) else str(v) for v in values]
 
@@ -82,7 +91,7 @@ def main():
         with h5py.File(work / "work_precision.h5", "r") as f:
             after = datasets(f)
             for key, value in before.items():
-                need(key in after and np.array_equal(after[key], value), f"{key} changed or lost")
+                need(key in after and same(after[key], value), f"{key} changed or lost")
             need(text(str(f.attrs["methods"]).split(",")) == methods_before + ["rodas4"],
                  f"root attribute methods: {f.attrs['methods']}")
             for scene in QUICK_SCENES:
