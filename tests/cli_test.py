@@ -1503,7 +1503,9 @@ def case_brake_creep_band(args):
     1e-7: 3.8e-7) there is no warning and the events are the reference's,
     kind by kind.  A warning for the resolved run, or none for the loose one,
     fails; so does a loose run with the right events (the warning would then
-    claim a harm it does not measure).  A sweep on 2 ranks warns once for
+    claim a harm it does not measure).  (Both rodas3 runs also draw the
+    stepper's warning, about x: brake-stepper-warning.)  A sweep on 2 ranks
+    (with rk8pd, which draws no stepper warning) warns once for
     all its points (their event counts are in /sweep), with the number of
     points and the first: all 3 of a loose sweep; of the resolved settings
     over v'_dr = -4.5e-3, -3.5e-3, -2.5e-3 (velocity tolerances 5.5e-7,
@@ -1530,7 +1532,10 @@ def case_brake_creep_band(args):
         fail(f"resolved run: {len(runs['resolved'])} events against the reference's {len(reference)}")
     for name, start, end, count in (("loose", -0.004, -0.002, 3), ("resolved", -0.0045, -0.0025, 1),
                                     ("resolved", -0.003, -0.001, 0)):
-        sweep = write(args, "sweep.nml", "&brake t_end = 50.0 /\n&sweep sweep_variable = 'brake.v_dr_prime', "
+        # rk8pd: rodas3 would add the stepper's warning at these tolerances
+        # (brake-stepper-warning), at every point.
+        sweep = write(args, "sweep.nml", "&brake t_end = 50.0 /\n&integrator method = 'rk8pd' /\n"
+                      "&sweep sweep_variable = 'brake.v_dr_prime', "
                       f"sweep_spacing = 'linear', sweep_from = {start}, sweep_to = {end}, sweep_count = 3 /\n")
         result = friction(args, "-o", f"sweep_{name}_{count}.h5", brake, os.path.join(args.workdir, f"{name}.nml"),
                           sweep, ranks=2)
@@ -1539,6 +1544,54 @@ def case_brake_creep_band(args):
                     "&integrator: the velocity tolerance in stick"] if count else []
         if len(lines) != len(expected) or not all(line.startswith(e) for line, e in zip(lines, expected)):
             fail(f"sweep {name}: warnings {lines}")
+
+
+
+def case_brake_stepper_warning(args):
+    """The regularized law's stepper warning (brake_config%stepper_warning)
+    against the harm it claims.  The oracle is rk8pd at rtol 1e-13 (atol
+    1e-15), whose own difference from rtol 1e-12 is about 2e-13 m.  Over
+    tau in [100, 1000] of the paper's brake (epsilon' = 3.5e7), a run is
+    wrong when max |x - x_ref| exceeds 100 times the asked tolerance atol +
+    rtol max |x_ref|, the failure map's rule.  Each run with the warning
+    must be wrong, and each without it right: bsimp at rtol 1e-8 (measured
+    4e7 times), rodas4 at 3e-5 (velocity tolerance 13.5 widths of the
+    arctan's transition, bound 3: 656 times), rk4imp at 1e-9 (270 times)
+    warn; rodas4 at 1e-6 (0.45 widths: 22 times), rodas3 at 1e-5 (4.5
+    widths, bound 10: 41 times) and rk4imp at 1e-6 (33 times) do not.  The
+    100-times line sits between the two groups with a margin of 2.4 at
+    least (rodas3 at 1e-5), and a warning that fires for a right run, or
+    a wrong run without it, fails."""
+    brake = os.path.join(args.inputs, "brake.nml")
+    plain = ("&brake model = 'regularized', t_end = 1000.0, dt_out = 1.0 /\n"
+             + BRAKE_SHORT.splitlines(keepends=True)[1])
+    marker = "on the regularized law was measured wrong by more than 100 times"
+
+    def x_of(name, method, rtol, atol):
+        nml = write(args, f"{name}.nml", plain + f"&integrator method = '{method}', rtol = {rtol}, atol = {atol} /\n")
+        result = friction(args, "-o", f"{name}.h5", brake, nml)
+        data = brake_file(args, f"{name}.h5")
+        window = data["t"] >= 100.0 - 1e-9
+        return data["x"][window], marker in result.stderr
+
+    ref, warned = x_of("reference", "rk8pd", 1e-13, 1e-15)
+    if warned:
+        fail("the reference rk8pd run drew the stepper warning")
+    check, _ = x_of("reference_check", "rk8pd", 1e-12, 1e-14)
+    ref_check = float(np.max(np.abs(check - ref)))
+    for method, rtol, expect in (("bsimp", 1e-8, True), ("rodas4", 3e-5, True), ("rk4imp", 1e-9, True),
+                                 ("rodas4", 1e-6, False), ("rodas3", 1e-5, False), ("rk4imp", 1e-6, False)):
+        x, warned = x_of(f"{method}_{rtol:g}", method, rtol, rtol / 100)
+        asked = rtol / 100 + rtol * float(np.max(np.abs(ref)))
+        error = float(np.max(np.abs(x - ref)))
+        if error < 10 * ref_check:
+            fail(f"{method} rtol {rtol:g}: error {error:.2e} m not resolved by the reference ({ref_check:.1e} m)")
+        if warned != expect:
+            fail(f"{method} rtol {rtol:g}: stepper warning {'given' if warned else 'missing'}")
+        if (error > 100 * asked) != expect:
+            fail(f"{method} rtol {rtol:g}: error {error:.2e} m is {error / asked:.0f} times the asked {asked:.1e} m: "
+                 f"the warning {'claims a harm the run does not show' if expect else 'is missing for a wrong run'}")
+        print(f"{method} rtol {rtol:g}: error {error / asked:.0f} times the asked tolerance, warning {warned}")
 
 
 # A small sweep of the belt velocity (docs/sweeps.md).
@@ -2153,7 +2206,8 @@ def main():
         {"brake-run": case_brake_run, "brake-ranks": case_brake_ranks,
          "brake-dimensional": case_brake_dimensional, "brake-verify": case_brake_verify,
          "brake-failure": case_brake_failure, "brake-analysis": case_brake_analysis,
-         "brake-orbit": case_brake_orbit, "brake-creep-band": case_brake_creep_band}[args.case](args)
+         "brake-orbit": case_brake_orbit, "brake-creep-band": case_brake_creep_band,
+         "brake-stepper-warning": case_brake_stepper_warning}[args.case](args)
     else:
         {"ranks": case_ranks, "override": case_override, "force": case_force,
          "numerical-failure": case_numerical_failure, "wall-time": case_wall_time,

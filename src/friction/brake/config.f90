@@ -6,12 +6,13 @@ module friction_brake_config
    use friction_ode_solver, only: solver_settings
    use friction_brake_params, only: brake_parameters, brake_dimensional, derive_parameters
    use friction_analysis_settings, only: analysis_settings
-   use friction_strings, only: rtoa, quoted, bytes_text
+   use friction_strings, only: rtoa, itoa, quoted, bytes_text
    use friction_parameters, only: configurable, parameter_visitor, parameter_info, set_parameter_number, &
       & get_parameter, list_parameters
    use friction_checks, only: config_checker
    use friction_ode_solver, only: step_type_names, step_type_index
    use friction_ode_settings, only: visit_integrator, check_integrator, check_tolerance_bounds
+   use friction_ode_auto, only: rodas4_transition_bound, transition_bound
    implicit none
    private
 
@@ -70,6 +71,8 @@ module friction_brake_config
       procedure :: grid_time
       procedure :: check_settings
       procedure :: creep_band_warning
+      procedure :: transition_tolerance
+      procedure :: stepper_warning
    end type brake_config
 
 contains
@@ -351,5 +354,74 @@ contains
          & //' m/tau: the stepper cannot hold |v_rel| inside the creep band, and /brake/events and the ' &
          & //'stick flags may hold spurious stick and slip events; lower atol and rtol (or raise stick_velocity)'
    end function creep_band_warning
+
+   !> The velocity tolerance in stick, atol + rtol |v_dr_prime|, in units of
+   !> the arctan law's transition, whose slope changes over |v_rel| of about
+   !> 1/epsilon_prime: epsilon_prime (atol + rtol |v_dr_prime|).  Above a few,
+   !> a step may cross the transition without the error estimate seeing it
+   !> (stepper_warning).  Resolved settings.
+   pure real(wp) function transition_tolerance(self)
+      class(brake_config), intent(in) :: self
+
+      transition_tolerance = self%params%epsilon_prime * (self%solver%atol + self%solver%rtol * abs(self%params%v_dr))
+   end function transition_tolerance
+
+   !> '' or a warning: on the regularized law the stepper, at these settings,
+   !> falls in a region where it was measured wrong by more than 100 times
+   !> the asked tolerance while reporting success: x over τ in [100, 1000] of
+   !> the paper's brake against rk8pd at rtol 1e-13, epsilon_prime from 1e3
+   !> to 1e10, rtol from 1e-3 to 1e-10 with atol = rtol / 100 (docs/speed.md,
+   !> "The regularized law's steppers").
+   !> - GSL's rk1imp, rk2imp, msadams and msbdf from epsilon_prime = 1e4 on
+   !>   (at the paper's 3.5e7: 480 to 2e5 times at every rtol), bsimp from
+   !>   1e6 on (2000 to 4e7 times); below, they were right or nearly.
+   !> - Where the velocity tolerance does not resolve the arctan's transition
+   !>   (transition_tolerance above a bound, friction_ode_auto's
+   !>   rodas4_transition_bound and transition_bound, with the measurements):
+   !>   rodas4 above 3, rodas3, rkf45 and rkck above 10.
+   !> - rk4 and rk4imp at rtol below 5e-8 with epsilon_prime from 1e7 on:
+   !>   their error grows faster than the tolerance falls (at the paper's
+   !>   epsilon_prime rk4imp 110 to 510 times from rtol 1e-8 on, rk4 180 to
+   !>   750 times; 1e8 and 1e9 alike).
+   !> rk2, rk8pd and rk4imp at rtol 5e-8 and above were within 100 times
+   !> everywhere measured.  Resolved settings.
+   function stepper_warning(self) result(text)
+      class(brake_config), intent(in) :: self
+      character(len=:), allocatable :: text
+      character(len=:), allocatable :: why
+      real(wp) :: eps, resolution
+
+      text = ''
+      if (self%model /= model_regularized) return
+      eps = self%params%epsilon_prime
+      resolution = self%transition_tolerance()
+      why = ''
+      select case (trim(self%solver%method))
+      case ('rk1imp', 'rk2imp', 'msadams', 'msbdf')
+         if (eps >= 1.0e4_wp) why = 'from epsilon_prime = 1e4 on (here '//rtoa(eps)//')'
+      case ('bsimp')
+         if (eps >= 1.0e6_wp) why = 'from epsilon_prime = 1e6 on (here '//rtoa(eps)//')'
+      case ('rodas4')
+         if (resolution > rodas4_transition_bound) why = transition_text(rodas4_transition_bound)
+      case ('rodas3', 'rkf45', 'rkck')
+         if (resolution > transition_bound) why = transition_text(transition_bound)
+      case ('rk4', 'rk4imp')
+         if (eps >= 1.0e7_wp .and. self%solver%rtol < 5.0e-8_wp) why = 'at rtol below 5e-8 from ' &
+            & //'epsilon_prime = 1e7 on (here '//rtoa(self%solver%rtol)//' and '//rtoa(eps)//')'
+      end select
+      if (len(why) == 0) return
+      text = '&integrator: method = '''//trim(self%solver%method)//''' on the regularized law was measured wrong ' &
+         & //'by more than 100 times the asked tolerance, while reporting success, '//why &
+         & //' (docs/speed.md, "The regularized law''s steppers"); method = ''auto'' picks a stepper measured ' &
+         & //'right, or check with &verify'
+   contains
+      function transition_text(bound) result(phrase)
+         real(wp), intent(in) :: bound
+         character(len=:), allocatable :: phrase
+
+         phrase = 'where the velocity tolerance in stick spans more than '//itoa(nint(bound))//' widths of the ' &
+            & //'arctan''s transition: epsilon_prime (atol + rtol |v_dr_prime|) = '//rtoa(resolution)
+      end function transition_text
+   end function stepper_warning
 
 end module friction_brake_config

@@ -216,7 +216,7 @@ contains
             error%message = error%message//' (regularized model'
             if (.not. is_implicit_step_type(self%method)) error%message = error%message &
                & //'; with a large epsilon_prime the law is stiff near v_rel = 0: try an implicit' &
-               & //' stepper (rodas4, rodas3, rk4imp; bsimp and msbdf need far tighter tolerances here)' &
+               & //' stepper (rodas4, rodas3, rk4imp; bsimp and msbdf are wrong here at most tolerances)' &
                & //' or the switched model'
             error%message = error%message//')'
             return

@@ -92,8 +92,9 @@ contains
       type(error_type), allocatable :: error
 
       c = self%config
-      if (c%solver%method == auto_name) c%solver%method = auto_method('brake', c%model, c%solver%rtol)
       call c%resolve(error)   ! (cannot fail on checked settings)
+      if (c%solver%method == auto_name) c%solver%method = auto_method('brake', c%model, c%solver%rtol, &
+         & transition=c%transition_tolerance())
    end function resolved
 
    function brake_method(self) result(name)
@@ -290,15 +291,22 @@ contains
       end associate
    end subroutine brake_run_point
 
-   !> The creep band's warning (brake_config%creep_band_warning) for the
-   !> resolved settings.
+   !> The creep band's warning and the stepper's (brake_config%creep_band_warning,
+   !> %stepper_warning) for the resolved settings, one after the other.
    function brake_settings_warning(self) result(text)
       class(brake_scene), intent(in) :: self
       character(len=:), allocatable :: text
+      character(len=:), allocatable :: stepper
       type(brake_config) :: resolved
 
       resolved = self%resolved()
       text = resolved%creep_band_warning()
+      stepper = resolved%stepper_warning()
+      if (len(text) > 0 .and. len(stepper) > 0) then
+         text = text//'; and '//stepper
+      else if (len(stepper) > 0) then
+         text = stepper
+      end if
    end function brake_settings_warning
 
    subroutine brake_netlist_text(self, data_file, version, text, note, error)

@@ -27,6 +27,7 @@ module friction_ode_auto
 
    public :: auto_name, auto_method, stiff_threshold, stiff_method, oscillator_rate
    public :: rosenbrock_threshold, rosenbrock_method, rosenbrock_rtol, rosenbrock_stiff_rtol
+   public :: rodas4_transition_bound, transition_bound
 
    !> The method name that asks for the choice.
    character(len=*), parameter :: auto_name = 'auto'
@@ -63,17 +64,35 @@ module friction_ode_auto
    real(wp), parameter :: rosenbrock_threshold = 100.0_wp
    real(wp), parameter :: rosenbrock_rtol = 1.0e-4_wp
 
+   !> The regularized brake law's transition: its slope changes over |v_rel|
+   !> of about 1/epsilon_prime, and a stepper whose velocity tolerance in
+   !> stick (atol + rtol |v_dr'|) spans several such widths may step across
+   !> it without its error estimate seeing it.  Measured on the paper's
+   !> brake, epsilon_prime 1e5 to 1e10 (docs/speed.md, "The regularized
+   !> law's steppers"), against T = epsilon_prime (atol + rtol |v_dr'|):
+   !> rodas4 within 31 times the asked tolerance up to T = 1.4, 88 to 113
+   !> times at 3.8 to 4.5, 350 to 12 500 times from 13 on; rodas3 within 56
+   !> times up to T = 6.4, 99 to 107 at 12.8 to 13.5, 280 to 980 beyond; the
+   !> explicit rkf45 and rkck 140 to 330 times from 12.8 on.  Above
+   !> rodas4_transition_bound `auto` does not pick rodas4, and the brake
+   !> warns about rodas4; above transition_bound about rodas3, rkf45, rkck.
+   real(wp), parameter :: rodas4_transition_bound = 3.0_wp
+   real(wp), parameter :: transition_bound = 10.0_wp
+
 contains
 
    !> The stepper for a scene ('afm' or 'brake'), its model (for the AFM the
    !> potential: 'naf', 'hopg', 'lj'; for the brake 'regularized' or
    !> 'switched'), the asked relative tolerance and, where the caller can
    !> tell, the stiffness S (see above; absent or 0: not known, the table
-   !> alone decides).  Always a known step type.
-   pure function auto_method(scene, model, rtol, stiffness) result(method)
+   !> alone decides).  For the regularized brake law, `transition` is its
+   !> velocity tolerance in units of the arctan's transition (see
+   !> rodas4_transition_bound; absent: resolved, as on the paper's brake at
+   !> rtol below 1e-6).  Always a known step type.
+   pure function auto_method(scene, model, rtol, stiffness, transition) result(method)
       character(len=*), intent(in) :: scene, model
       real(wp), intent(in) :: rtol
-      real(wp), intent(in), optional :: stiffness
+      real(wp), intent(in), optional :: stiffness, transition
       character(len=16) :: method
 
       if (present(stiffness)) then
@@ -96,14 +115,22 @@ contains
             ! Stiff near v_rel = 0 (epsilon' = 3.5e7): the L-stable rk4imp is
             ! cheapest down to 1e-6 among those right at their rtol; tighter,
             ! the library's rodas4 (L-stable, one LU a step) is 2.5 to 3.5
-            ! times faster than the explicit pairs down to 1e-9; tighter
-            ! still, accuracy costs more than stability and rk8pd wins.
+            ! times faster than the explicit pairs down to 1e-9, where its
+            ! velocity tolerance resolves the law's transition; where it does
+            ! not (epsilon' above about 1e8 at rtol 1e-6), rk8pd, right at
+            ! every epsilon' and rtol measured.  Tighter than 1e-9 accuracy
+            ! costs more than stability and rk8pd wins.  (rk2, rk4imp and
+            ! rk8pd in their bands were within 90 times the asked tolerance
+            ! at every epsilon' from 1e3 to 1e10 measured.)
             if (rtol >= 1.0e-3_wp) then
                method = 'rk2'
             else if (rtol >= 1.0e-6_wp) then
                method = 'rk4imp'
             else if (rtol >= 1.0e-9_wp) then
                method = 'rodas4'
+               if (present(transition)) then
+                  if (transition > rodas4_transition_bound) method = 'rk8pd'
+               end if
             else
                method = 'rk8pd'
             end if
