@@ -70,10 +70,12 @@ module friction_ode_auto
    !> it without its error estimate seeing it.  Measured on the paper's
    !> brake, epsilon_prime 1e5 to 1e10 (docs/speed.md, "The regularized
    !> law's steppers"), against T = epsilon_prime (atol + rtol |v_dr'|):
-   !> rodas4 within 31 times the asked tolerance up to T = 1.4, 88 to 113
-   !> times at 3.8 to 4.5, 350 to 12 500 times from 13 on; rodas3 within 56
+   !> rodas4 within 32 times the asked tolerance up to T = 1.4, 88 to 113
+   !> times at 3.8 to 4.5, 289 to 12 500 times from 11.5 on; rodas3 within 56
    !> times up to T = 6.4, 99 to 107 at 12.8 to 13.5, 280 to 980 beyond; the
-   !> explicit rkf45 and rkck 140 to 330 times from 12.8 on.  Above
+   !> explicit rkf45 and rkck 140 to 1300 times from 12.8 on.  T, not the
+   !> split between atol and rtol, decides (the same at atol = rtol / 100
+   !> and at atol from 1e-10 to 1e-6 with rtol 1e-8 or 1e-4).  Above
    !> rodas4_transition_bound `auto` does not pick rodas4, and the brake
    !> warns about rodas4; above transition_bound about rodas3, rkf45, rkck.
    real(wp), parameter :: rodas4_transition_bound = 3.0_wp
@@ -117,7 +119,7 @@ contains
             ! the library's rodas4 (L-stable, one LU a step) is 2.5 to 3.5
             ! times faster than the explicit pairs down to 1e-9, where its
             ! velocity tolerance resolves the law's transition; where it does
-            ! not (epsilon' above about 1e8 at rtol 1e-6), rk8pd, right at
+            ! not (epsilon' above about 2e8 at rtol 1e-6), rk8pd, right at
             ! every epsilon' and rtol measured.  Tighter than 1e-9 accuracy
             ! costs more than stability and rk8pd wins.  (rk2, rk4imp and
             ! rk8pd in their bands were within 90 times the asked tolerance
