@@ -492,9 +492,14 @@ def write_method(g, method: str, pts) -> None:
     m.create_dataset("message", data=[p.message for p in pts], dtype=h5py.string_dtype())
 
 
+def strings(values) -> list:
+    """HDF5 strings (bytes or str) as str."""
+    return [v.decode() if isinstance(v, bytes) else str(v) for v in values]
+
+
 def read_method(m, method: str) -> list:
     """A method's ladder back from its group (write_method)."""
-    text = [[v.decode() if isinstance(v, bytes) else str(v) for v in m[d][()]] for d in ("status", "message")]
+    text = [strings(m[d][()]) for d in ("status", "message")]
     return [Point(method, float(rtol), float(atol), status, message, error=float(error), time=float(time),
                   rhs=int(rhs))
             for rtol, atol, error, time, rhs, status, message in zip(
@@ -651,8 +656,8 @@ def read_map_columns(g, parameter: str) -> tuple[list, list]:
     """A failure map's methods and its columns of points back from the file
     (write_map_points)."""
     def text(d):
-        return [[v.decode() if isinstance(v, bytes) else str(v) for v in row] for row in g[d][()]]
-    methods = [m.decode() if isinstance(m, bytes) else str(m) for m in g["methods"][()]]
+        return [strings(row) for row in g[d][()]]
+    methods = strings(g["methods"][()])
     status, message = text("status"), text("message")
     error, time, asked = g["error"][()], g["cpu_time"][()], g["asked_tolerance"][()]
     cols = []

@@ -133,9 +133,9 @@ DOCUMENTED = ["fx", "fy", "f_along", "f_across", "tip_x", "tip_y"]
 
 # The brake scene (inputs/brake.nml) on a short span for the tests.
 # (The chaos diagnostics of inputs/brake.nml are off here: the brake-analysis case tests them.)
-BRAKE_SHORT = ("&brake t_end = 100.0, dt_out = 0.1 /\n"
-               "&analysis spectrum = .false., poincare = .false., lyapunov = .false., rosenstein = .false.,"
-               " lyapunov_spectrum = .false., orbit = .false. /\n")
+BRAKE_NO_ANALYSIS = ("&analysis spectrum = .false., poincare = .false., lyapunov = .false., rosenstein = .false.,"
+                     " lyapunov_spectrum = .false., orbit = .false. /\n")
+BRAKE_SHORT = "&brake t_end = 100.0, dt_out = 0.1 /\n" + BRAKE_NO_ANALYSIS
 # The chaos diagnostics on a short span (brake-analysis).
 BRAKE_ANALYSIS = ("&brake t_end = 400.0, dt_out = 0.1 /\n"
                   "&analysis window_start = 50.0, window_end = 400.0, lyapunov_transient = 50.0,"
@@ -1462,7 +1462,7 @@ def case_brake_verify(args):
     loose = write(args, "loose.nml", "&brake model = 'regularized', t_end = 200.0, dt_out = 0.5 /\n"
                   "&integrator method = 'msbdf', rtol = 1e-6, atol = 1e-8 /\n"
                   "&verify check = .true., check_method = 'rk4imp', check_rtol = 1e-10, check_atol = 1e-12 /\n"
-                  + BRAKE_SHORT.splitlines(keepends=True)[1])
+                  + BRAKE_NO_ANALYSIS)
     brake = os.path.join(args.inputs, "brake.nml")
     result = friction(args, "-o", "v.h5", brake, loose)
     if "friction: verify: rk4imp" not in result.stderr or "max |dx|" not in result.stderr:
@@ -1513,7 +1513,7 @@ def case_brake_creep_band(args):
     -3e-3 ... -1e-3."""
     brake = os.path.join(args.inputs, "brake.nml")
     plain = ("&brake model = 'regularized', t_end = 300.0, dt_out = 1.0 /\n"
-             + BRAKE_SHORT.splitlines(keepends=True)[1])
+             + BRAKE_NO_ANALYSIS)
     runs = {}
     for name, method, rtol, atol in (("reference", "rodas4", 1e-9, 1e-11), ("loose", "rodas3", 1e-3, 1e-5),
                                      ("resolved", "rodas3", 1e-4, 1e-7)):
@@ -1564,7 +1564,7 @@ def case_brake_stepper_warning(args):
     a wrong run without it, fails."""
     brake = os.path.join(args.inputs, "brake.nml")
     plain = ("&brake model = 'regularized', t_end = 1000.0, dt_out = 1.0 /\n"
-             + BRAKE_SHORT.splitlines(keepends=True)[1])
+             + BRAKE_NO_ANALYSIS)
     marker = "on the regularized law was measured wrong by more than 100 times"
 
     def x_of(name, method, rtol, atol):

@@ -71,6 +71,7 @@ module friction_brake_config
       procedure :: grid_time
       procedure :: check_settings
       procedure :: creep_band_warning
+      procedure :: velocity_tolerance
       procedure :: transition_tolerance
       procedure :: stepper_warning
    end type brake_config
@@ -347,7 +348,7 @@ contains
 
       text = ''
       if (self%model /= model_regularized) return
-      tolerance = self%solver%atol + self%solver%rtol * abs(self%params%v_dr)
+      tolerance = self%velocity_tolerance()
       if (tolerance <= 0.5_wp * self%stick_velocity) return
       text = '&integrator: the velocity tolerance in stick, atol + rtol |v_dr_prime| = '//rtoa(tolerance) &
          & //' m/tau, is not below half of &brake stick_velocity = '//rtoa(self%stick_velocity) &
@@ -355,15 +356,23 @@ contains
          & //'stick flags may hold spurious stick and slip events; lower atol and rtol (or raise stick_velocity)'
    end function creep_band_warning
 
-   !> The velocity tolerance in stick, atol + rtol |v_dr_prime|, in units of
-   !> the arctan law's transition, whose slope changes over |v_rel| of about
-   !> 1/epsilon_prime: epsilon_prime (atol + rtol |v_dr_prime|).  Above a few,
-   !> a step may cross the transition without the error estimate seeing it
+   !> The step control's hold on the velocity in stick, where x' = v_dr_prime:
+   !> atol + rtol |v_dr_prime| (m/tau).  Resolved settings.
+   pure real(wp) function velocity_tolerance(self)
+      class(brake_config), intent(in) :: self
+
+      velocity_tolerance = self%solver%atol + self%solver%rtol * abs(self%params%v_dr)
+   end function velocity_tolerance
+
+   !> The velocity tolerance in stick in units of the arctan law's
+   !> transition, whose slope changes over |v_rel| of about 1/epsilon_prime:
+   !> epsilon_prime (atol + rtol |v_dr_prime|).  Above a few, a step may
+   !> cross the transition without the error estimate seeing it
    !> (stepper_warning).  Resolved settings.
    pure real(wp) function transition_tolerance(self)
       class(brake_config), intent(in) :: self
 
-      transition_tolerance = self%params%epsilon_prime * (self%solver%atol + self%solver%rtol * abs(self%params%v_dr))
+      transition_tolerance = self%params%epsilon_prime * self%velocity_tolerance()
    end function transition_tolerance
 
    !> '' or a warning: on the regularized law the stepper, at these settings,
