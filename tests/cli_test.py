@@ -10,7 +10,7 @@ and bad-<name> for each bad input in BAD_INPUTS; for the brake scene
 brake-run, brake-ranks, brake-dimensional, brake-verify, brake-failure, brake-analysis,
 brake-creep-band and
 bad-brake-<name> for each bad input in BAD_BRAKE_INPUTS; for sweeps sweep-ranks,
-sweep-failure, sweep-resume, sweep-signal, sweep-grid-ranks, sweep-large-resume and bad-sweep-<name> for each bad input in BAD_SWEEP_INPUTS;
+sweep-failure, sweep-resume, sweep-signal, sweep-grid-ranks, sweep-large-resume, sweep-method and bad-sweep-<name> for each bad input in BAD_SWEEP_INPUTS;
 serial-files and serial-no-mpi for runs without a launcher (no MPI).  Each asserts on exit codes,
 messages and file contents (read with h5py); none asserts on timings.
 """
@@ -1602,7 +1602,7 @@ SWEEP_SMALL = ("&brake mu = 0.5, mu_s = 0.59, t_end = 300.0, dt_out = 0.1 /\n"
                " sweep_from = -0.004, sweep_to = -0.001, sweep_count = 7 /\n")
 SWEEP_PER_POINT = ["values", "maxima", "maxima_offset", "maxima_count", "peak_frequency", "lyapunov",
                    "stick_fraction", "events", "status", "orbit_found", "orbit_period", "orbit_max_multiplier",
-                   "orbit_critical_real", "orbit_critical_imag"]
+                   "orbit_critical_real", "orbit_critical_imag", "method"]
 
 # Bad &sweep input: (override text, words of the message).
 BAD_SWEEP_INPUTS = {
@@ -1815,6 +1815,69 @@ def case_sweep_afm(args):
         if not (np.all(handle["sweep/status"][()] == 1) and
                 np.array_equal(handle["sweep/values"][()], [16.0, 24.0])):
             fail(f"integer sweep: status {handle['sweep/status'][()]}, values {handle['sweep/values'][()]}")
+
+
+# method = 'auto' resolved per point: the regularized brake at rtol 9e-7 runs
+# rodas4 at the paper's epsilon' and rk8pd at 1e9 (the transition bound,
+# docs/speed.md); a NaF tip at rtol 1e-3 runs rkck with the paper's damping and
+# rodas4 with 3e-2 N s/m (S = 4300).
+SWEEP_METHOD_BRAKE = ("&brake model = 'regularized', t_end = 40.0, dt_out = 0.5 /\n" + BRAKE_NO_ANALYSIS +
+                      "&integrator method = 'auto', rtol = 9e-7, atol = 9e-9 /\n"
+                      "&sweep sweep_variable = 'brake.epsilon_prime', sweep_spacing = 'list',"
+                      " sweep_values = 3.5121e7, -1.0, 1e9, sweep_variable2 = 'integrator.max_steps',"
+                      " sweep_spacing2 = 'list', sweep_values2 = 10000000, 10 /\n")
+SWEEP_METHOD_AFM = ("&scan nx = 24, ny = 2, length = 4.0, width = 2.0 /\n"
+                    "&integrator method = 'auto', rtol = 1e-3, atol = 1e-3 /\n"
+                    "&sweep sweep_variable = 'tip.cx', sweep_spacing = 'list', sweep_values = 1e-3, 3e-2,"
+                    " sweep_variable2 = 'tip.cy', sweep_spacing2 = 'list', sweep_values2 = 1e-3, 3e-2 /\n")
+
+
+def case_sweep_method(args):
+    """/sweep/method: the stepper each point ran, where method = 'auto'
+    resolves differently from point to point.  The oracle is the plain run of
+    the point's values, whose root attribute `method` records the stepper it
+    resolved: every point must name the same.  A point that fails its check
+    names none; a point whose integration fails (max_steps = 10) names the
+    stepper that failed.  2 ranks, as the points travel to rank 0."""
+    cases = (("brake", "brake.nml", SWEEP_METHOD_BRAKE, ("brake", "epsilon_prime"), ("integrator", "max_steps")),
+             ("afm", "naf.nml", SWEEP_METHOD_AFM, ("tip", "cx"), ("tip", "cy")))
+    for label, scene, text, (group, name), (group2, name2) in cases:
+        scene = os.path.join(args.inputs, scene)
+        sweep = write(args, f"{label}.nml", text)
+        friction(args, "-o", f"{label}.h5", scene, sweep, ranks=2)
+        with h5py.File(os.path.join(args.workdir, f"{label}.h5"), "r") as handle:
+            values, values2 = handle["sweep/values"][()], handle["sweep/values2"][()]
+            status = handle["sweep/status"][()]
+            methods = [m.decode().rstrip() for m in handle["sweep/method"][()]]
+        expected = {}
+        for i, (value, value2) in enumerate(zip(values, values2)):
+            if value < 0:
+                if status[i] != 2 or methods[i] != "":
+                    fail(f"{label} point {i + 1} (bad {name} = {value}): status {status[i]}, method "
+                         f"{methods[i]!r}; expected failed with no method")
+                continue
+            key = float(value)
+            if key not in expected:
+                point = write(args, f"{label}_point{i}.nml", f"&{group} {name} = {key!r} /\n"
+                              f"&sweep sweep_variable = '' /\n")
+                out = os.path.join(args.workdir, f"{label}_p{i}.h5")
+                friction(args, "-o", out, scene, sweep, point)
+                with h5py.File(out, "r") as handle:
+                    expected[key] = handle.attrs["method"].decode()
+            if label == "brake" and value2 == 10:
+                if status[i] != 2:
+                    fail(f"{label} point {i + 1}: max_steps = 10 should fail, status {status[i]}")
+            elif status[i] != 1:
+                fail(f"{label} point {i + 1}: status {status[i]}")
+            if label == "afm" and value != value2:
+                continue   # (only the plain runs of cx = cy are made)
+            if methods[i] != expected[key]:
+                fail(f"{label} point {i + 1} ({name} = {value}, {name2} = {value2}): the sweep records "
+                     f"{methods[i]!r}, the plain run resolved {expected[key]!r}")
+        # The points must resolve differently, or the test proves nothing.
+        if len(set(expected.values())) < 2:
+            fail(f"{label}: every point resolved to {set(expected.values())}")
+        print(f"sweep-method {label}: {list(zip(map(float, values), map(float, values2), methods))}")
 
 
 def case_sweep_failure(args):
@@ -2197,7 +2260,8 @@ def main():
         {"sweep-ranks": case_sweep_ranks, "sweep-failure": case_sweep_failure,
          "sweep-resume": case_sweep_resume, "sweep-signal": case_sweep_signal,
          "sweep-grid-ranks": case_sweep_grid_ranks, "sweep-large-resume": case_sweep_large_resume,
-         "sweep-afm": case_sweep_afm, "sweep-table-kept": case_sweep_table_kept}[args.case](args)
+         "sweep-afm": case_sweep_afm, "sweep-table-kept": case_sweep_table_kept,
+         "sweep-method": case_sweep_method}[args.case](args)
     elif args.case.startswith("bad-brake-"):
         case_bad_brake(args, args.case[len("bad-brake-"):])
     elif args.case.startswith("bad-"):

@@ -34,7 +34,7 @@ module friction_job_sweep
    use friction_error, only: error_type, fatal_error, error_interrupted, error_input, error_numerical, error_io
    use friction_strings, only: itoa, text_hash, bytes_text
    use friction_version, only: version_string
-   use friction_ode_solver, only: integrator_statistics
+   use friction_ode_solver, only: integrator_statistics, step_type_index, step_type_names, step_type_name_length
    use friction_parameters, only: set_parameter_number, split_name, parameter_info, list_parameters
    use friction_checks, only: config_checker
    use friction_scene, only: scene, point_result, point_memory
@@ -68,6 +68,13 @@ module friction_job_sweep
    character(len=7), parameter :: column_kinds = 'iirlili'
 
    integer, parameter :: tag_header = 7301, tag_numbers = 7302, tag_reason = 7303
+
+   !> The result the sweep adds after the scene's own: the stepper point i ran,
+   !> carried as its step type's index (0: none, the point failed its check)
+   !> and written as its name, /sweep/method.  A point resolves method =
+   !> 'auto' for its own values, so a sweep over a tip's damping, epsilon' or
+   !> a tolerance can run different steppers at different points.
+   character(len=*), parameter :: method_result = 'method'
 
    !> One finished point as sent to rank 0: header = point (0: this rank has
    !> finished; then header(2) says whether it was interrupted), status,
@@ -139,7 +146,7 @@ contains
       character(len=12) :: seconds
       logical :: dynamic, interrupted, all_failed, use_todo
 
-      names = config%scene%point_results()
+      names = [config%scene%point_results(), point_result(method_result, '', .false.)]
       call config%scene%point_series(series_name, series_unit)
       n = config%sweep%points()
       input_hash = text_hash(job%input_text)
@@ -249,7 +256,7 @@ contains
          if (allocated(point_error)) then
             mine%header(2) = status_failed
             mine%reason = one_line(point_error%message)
-            results = 0.0_wp
+            results(:size(results) - 1) = 0.0_wp   ! (the stepper it ran stays)
             deallocate (point_error)
             if (allocated(series)) deallocate (series)
             allocate (series(0))
@@ -354,8 +361,10 @@ contains
 
    !> Point i: a copy of the scene with the swept variables set in memory,
    !> checked as the input is, then run on this process, with what its
-   !> earlier points left in `kept` (point_memory).  `warning`: the scene's
-   !> settings_warning for the point ('' for none, or when its check failed).
+   !> earlier points left in `kept` (point_memory).  `results`: the scene's
+   !> point results, then the index of the stepper it ran (method_result).
+   !> `warning`: the scene's settings_warning for the point ('' for none, or
+   !> when its check failed).
    subroutine run_point(config, i, results, series, kept, warning, error)
       type(job_config), intent(in) :: config
       integer, intent(in) :: i
@@ -372,8 +381,9 @@ contains
       call point_scene(config, i, point, error)
       if (allocated(error)) return
       warning = point%settings_warning()
+      results(size(results)) = real(step_type_index(point%method()), wp)
       deallocate (series)
-      call point%run_point(results, series, kept, error)
+      call point%run_point(results(:size(results) - 1), series, kept, error)
    end subroutine run_point
 
    !> The scene's warning about point i's settings ('' for none or a point
@@ -826,6 +836,8 @@ contains
       type(h5_file) :: file
       type(h5_table) :: out
       character(len=:), allocatable :: name, texts(:)
+      character(len=step_type_name_length), allocatable :: steppers(:)
+      character(len=:), allocatable :: stepper(:)   !! as wide as the column (the memory type is the file's)
       integer, allocatable :: status(:), run(:), series_count(:), reason_length(:), whole(:)
       integer(i8), allocatable :: series_offset(:), reason_offset(:), out_offset(:)
       real(wp), allocatable :: cost(:), values(:), results(:), series(:)
@@ -868,6 +880,8 @@ contains
          & whole(copy_points), source=0)
       allocate (series_offset(copy_points), reason_offset(copy_points), out_offset(copy_points), source=0_i8)
       allocate (cost(copy_points), values(copy_points), results(copy_points), source=0.0_wp)
+      steppers = step_type_names()
+      allocate (character(len=maxval(len_trim(steppers))) :: stepper(copy_points))
       ! First pass: the length of the flat series and of the longest reason.
       total = 0
       longest = 1
@@ -886,8 +900,14 @@ contains
          call out%set_text(trim(name), 'variable', trim(config%sweep%variables(k)))
       end do
       do j = 1, size(names)
-         call out%add_column('sweep/'//trim(names(j)%name), merge('i', 'r', names(j)%whole), int(n, i8), &
-            & trim(names(j)%unit))
+         if (names(j)%name == method_result) then
+            call out%add_text_column('sweep/'//method_result, len(stepper), int(n, i8))
+            call out%set_text('sweep/'//method_result, 'meaning', 'the stepper the point ran (method = ''auto'' ' &
+               & //'resolved for its own values); empty for a point that failed its check or is pending')
+         else
+            call out%add_column('sweep/'//trim(names(j)%name), merge('i', 'r', names(j)%whole), int(n, i8), &
+               & trim(names(j)%unit))
+         end if
       end do
       if (len(series_name) > 0) then
          call out%add_column('sweep/'//series_name, 'r', total, series_unit)
@@ -931,7 +951,14 @@ contains
             do j = 1, size(names)
                results(1:c) = 0.0_wp
                if (have) call ckpt%file%get('result'//itoa(j), at, results(1:c))
-               if (names(j)%whole) then
+               if (names(j)%name == method_result) then
+                  do k = 1, c
+                     stepper(k) = ''
+                     if (nint(results(k)) >= 1 .and. nint(results(k)) <= size(steppers)) &
+                        & stepper(k) = steppers(nint(results(k)))
+                  end do
+                  call out%put('sweep/'//method_result, at, stepper(1:c))
+               else if (names(j)%whole) then
                   whole(1:c) = nint(results(1:c))
                   call out%put('sweep/'//trim(names(j)%name), at, whole(1:c))
                else
