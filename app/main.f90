@@ -274,7 +274,7 @@ contains
          & '', &
          & 'Input files are namelist files read in order; a later file overrides', &
          & 'earlier values variable by variable, and --set values override the files.', &
-         & 'Groups: &job &surface &tip &scan &integrator &thermal (see docs/input.md).', &
+         & 'Groups: &job &surface &tip &scan &integrator &verify &thermal (see docs/input.md).', &
          & 'A group of another scene is ignored with a warning when &job names the scene,', &
          & 'and is an error when the scene is the default (afm): &job is missing.', &
          & '', &

@@ -4,7 +4,7 @@
     cli_test.py --binary BIN --mpiexec MPIEXEC --inputs DIR --workdir DIR CASE
 
 Cases: datasets-naf, datasets-hopg, input-roundtrip, set, other-scene-group, ranks, override, force,
-numerical-failure, graphite, graphite-ranks, graphite-defects, graphite-table, models,
+numerical-failure, graphite, graphite-ranks, graphite-defects, graphite-table, afm-verify, models,
 quasistatic-failure, thermal-zero, thermal-ranks, thermal-equipartition, thermal-kramers, thermal-kramers-law,
 and bad-<name> for each bad input in BAD_INPUTS; for the brake scene
 brake-run, brake-ranks, brake-dimensional, brake-verify, brake-failure, brake-analysis,
@@ -93,6 +93,14 @@ BAD_INPUTS = {
     # AFM map is not what was meant (docs/cli.md, Groups of another scene).
     "no-job-brake-group": ("&brake\n  mu = 0.2\n/\n", 3,
                            ["bad.nml:1", "&brake", "scene 'brake'", "no &job scene", "'afm'"]),
+    # &verify integrates the map twice at two tolerances: not the quasi-static
+    # tip (no integration) nor a temperature (a fixed Langevin step).
+    "verify-quasistatic": ("&tip model = 'quasistatic' /\n&verify check = .true. /\n", 3,
+                           ["bad.nml:2", "&verify", "check = .true.", "quasistatic"]),
+    "verify-thermal": ("&thermal temperature = 300.0 /\n&verify\n  check = .true.\n/\n", 3,
+                       ["bad.nml:3", "&verify", "check = .true.", "fixed time step"]),
+    "verify-check-method": ("&verify check = .true., check_method = 'rk9' /\n", 3,
+                            ["bad.nml:1", "&verify", "check_method", "rk9", "rk8pd"]),
     # The reduced tip models (docs/physics.md, Reduced tip models).
     "tip-model-unknown": ("&tip model = 'massless' /\n", 3,
                           ["bad.nml:1", "&tip", "model", "massless", "quasistatic"]),
@@ -1478,6 +1486,88 @@ def case_brake_verify(args):
         fail("a failed verification wrote its file")
 
 
+# A NaF tip at damping ratio 0.01 (c = 2 zeta sqrt(m k)): it rings after each
+# slip, and rkck at rtol 1e-6 is off by far more than its tolerance
+# (docs/speed.md, Failure map).
+AFM_VERIFY = ("&scan nx = 32, ny = 3 /\n&tip cx = 6.3246e-6, cy = 6.3246e-6 /\n"
+              "&integrator method = 'rkck', rtol = 1e-6, atol = 1e-6 /\n")
+
+
+def force_difference(first, second, components=("fx", "fy")):
+    """The largest |dF| of each force component over both trips of two map files."""
+    with h5py.File(first, "r") as a, h5py.File(second, "r") as b:
+        return {q: max(float(np.max(np.abs(a[f"afm/{trip}/{q}"][()] - b[f"afm/{trip}/{q}"][()])))
+                       for trip in ("trace", "retrace")) for q in components}
+
+
+def case_afm_verify(args):
+    """&verify on a map: the map integrated again at rtol / 1000 (or with
+    check_method) and the largest force difference recorded.  The oracle is
+    the two plain runs, the map's and the check's settings, differenced here:
+    the same kernels on the same samples, so the recorded differences must be
+    those exactly.  1 and 2 ranks agree; the map itself is the plain run's
+    bit for bit; check_limit below the difference fails the run (exit 4,
+    nothing written).  A graphite map (3D tip, surface table) records fz too."""
+    naf = os.path.join(args.inputs, "naf.nml")
+    base = write(args, "base.nml", AFM_VERIFY)
+    check = write(args, "check.nml", "&verify check = .true. /\n")
+    # (The check's default is the run's tolerances / 1000, 1e-6 / 1000 in
+    # binary: not the double nearest 1e-9.)
+    thousandth = 1e-6 / 1000
+    tight = write(args, "tight.nml", f"&integrator rtol = {thousandth!r}, atol = {thousandth!r} /\n")
+    recorded = {}
+    for ranks in (1, 2):
+        result = friction(args, "-o", f"v{ranks}.h5", naf, base, check, ranks=ranks)
+        if "friction: verify: rkck at rtol 1.00E-09, atol 1.00E-09: max |dF| =" not in result.stderr:
+            fail("no verify report on stderr: " + result.stderr)
+        with h5py.File(os.path.join(args.workdir, f"v{ranks}.h5"), "r") as handle:
+            recorded[ranks] = dict(handle["afm/verify"].attrs)
+    friction(args, "-o", "plain.h5", naf, base)
+    friction(args, "-o", "tight.h5", naf, base, tight)
+    expected = force_difference(os.path.join(args.workdir, "plain.h5"), os.path.join(args.workdir, "tight.h5"))
+    got = recorded[1]
+    if got["method"] != b"rkck" or got["rtol"] != thousandth or got["atol"] != thousandth:
+        fail(f"/afm/verify settings {got}")
+    for q in ("fx", "fy"):
+        if got[f"max_difference_{q}"] != expected[q]:
+            fail(f"max_difference_{q} {got[f'max_difference_{q}']!r}, the two plain runs differ by {expected[q]!r}")
+    if got["max_difference"] != max(expected.values()) or "max_difference_fz" in got:
+        fail(f"max_difference {got['max_difference']!r} (expected {max(expected.values())!r}), or fz on a 2D tip")
+    # The ringing tip: far beyond the asked tolerance (the failure map's
+    # 2600 times at rtol 1e-6 over a longer line), which is why it is checked.
+    if not got["max_difference"] > 1e-4:
+        fail(f"the ringing tip's check differs by only {got['max_difference']} nN")
+    if {k: v for k, v in recorded[2].items()} != got:
+        fail(f"/afm/verify differs between 1 and 2 ranks: {got} vs {recorded[2]}")
+    same_map = force_difference(os.path.join(args.workdir, "plain.h5"), os.path.join(args.workdir, "v2.h5"))
+    if any(same_map.values()):
+        fail(f"verify changed the map: {same_map}")
+    limit = write(args, "limit.nml", f"&verify check_limit = {float(got['max_difference']) / 2!r} /\n")
+    result = friction(args, "-o", "w.h5", naf, base, check, limit, ranks=2, expect=4)
+    if "verify failed" not in result.stderr or "check_limit" not in result.stderr:
+        fail("no verify failure message: " + result.stderr)
+    if os.path.exists(os.path.join(args.workdir, "w.h5")):
+        fail("a failed verification wrote its file")
+    # Graphite: a 3D tip over the table, handed to the check run unbuilt again.
+    graphite = os.path.join(args.inputs, "graphite.nml")
+    small = write(args, "gsmall.nml", GRAPHITE_SMALL + "&integrator rtol = 1e-5, atol = 1e-5 /\n")
+    other = write(args, "gcheck.nml", "&verify check = .true., check_method = 'rk8pd', check_rtol = 1e-8, "
+                  "check_atol = 1e-8 /\n")
+    friction(args, "-o", "g.h5", graphite, small, other)
+    friction(args, "-o", "gplain.h5", graphite, small)
+    friction(args, "-o", "gtight.h5", graphite, small,
+             write(args, "gtight.nml", "&integrator method = 'rk8pd', rtol = 1e-8, atol = 1e-8 /\n"))
+    expected = force_difference(os.path.join(args.workdir, "gplain.h5"), os.path.join(args.workdir, "gtight.h5"),
+                                ("fx", "fy", "fz"))
+    with h5py.File(os.path.join(args.workdir, "g.h5"), "r") as handle:
+        got = dict(handle["afm/verify"].attrs)
+    for q in ("fx", "fy", "fz"):
+        if got.get(f"max_difference_{q}") != expected[q]:
+            fail(f"graphite max_difference_{q} {got.get(f'max_difference_{q}')!r}, plain runs {expected[q]!r}")
+    print(f"afm-verify: NaF ringing tip {recorded[1]['max_difference']:.3g} nN, graphite "
+          f"{got['max_difference']:.3g} nN, both as the plain runs differ")
+
+
 def case_brake_failure(args):
     """An explicit stepper on the stiff law with a small budget stops with
     a message naming the stepper, the budget, the time; nothing written."""
@@ -1635,6 +1725,11 @@ BAD_SWEEP_INPUTS = {
     "no-values": ("&sweep sweep_variable = 'brake.mu' /\n", ["&sweep", "sweep_values", "at least one"]),
     "schedule": ("&sweep sweep_variable = 'brake.mu', sweep_values = 0.5, sweep_schedule = 'greedy' /\n",
                  ["bad.nml:1", "&sweep", "sweep_schedule", "'dynamic'"]),
+    # A sweep runs no &verify: asking for it, or sweeping its settings, would be ignored.
+    "verify-check": ("&sweep sweep_variable = 'brake.mu', sweep_values = 0.5 /\n&verify\n  check = .true.\n/\n",
+                     ["bad.nml:3", "&verify", "check = .true.", "sweep"]),
+    "verify-variable": ("&sweep sweep_variable = 'verify.check_rtol', sweep_values = 1e-9 /\n",
+                        ["bad.nml:1", "&sweep", "verify.check_rtol", "not run for a sweep"]),
 }
 
 
@@ -2277,7 +2372,7 @@ def main():
          "numerical-failure": case_numerical_failure, "wall-time": case_wall_time,
          "graphite": case_graphite, "models": case_models, "quasistatic-failure": case_quasistatic_failure,
          "graphite-ranks": case_graphite_ranks, "graphite-defects": case_graphite_defects,
-         "graphite-table": case_graphite_table,
+         "graphite-table": case_graphite_table, "afm-verify": case_afm_verify,
          "input-roundtrip": case_input_roundtrip, "shortest-reals": case_shortest_reals,
           "thermal-zero": case_thermal_zero,
           "set": case_set, "other-scene-group": case_other_scene_group,

@@ -401,6 +401,35 @@ THERMAL_MAP = ("&scan nx = 16, ny = 5, checkpoint_interval = 0.0 /\n"
                "&thermal temperature = 300.0, realizations = 2, seed = 3 /\n")
 
 
+VERIFY = "&verify check = .true. /\n"
+
+
+def verify_resumed(args):
+    """MAP with &verify on 2 ranks (4 and 3 lines), stopped by the test hook
+    after 5 lines of each rank's, the check's counted after the map's: both
+    ranks finish their map and stop in the check (exit 6, the message says
+    so, no file, every line of the map checkpointed); --resume runs the check
+    alone and writes the uninterrupted file."""
+    write(args, "stopped.nml", MAP + VERIFY)
+    files = [inputs(args, "naf.nml"), "stopped.nml"]
+    friction(args, "-o", "stopped_whole.h5", *files, ranks=2)
+    result = friction(args, "-o", "stopped.h5", *files, ranks=2, expect=6, env={"FRICTION_TEST_STOP_AFTER": "5"})
+    contains(result, "interrupted in its &verify run", "--resume")
+    checkpoints = sorted(f for f in listing(args.workdir) if f.startswith("stopped.h5.line-"))
+    if len(checkpoints) != 7 or os.path.exists(path(args, "stopped.h5")):
+        fail(f"stopped in the check: {checkpoints} and {'a' if os.path.exists(path(args, 'stopped.h5')) else 'no'} "
+             "file; expected the 7 lines and no file")
+    friction(args, "--resume", "-o", "stopped.h5", *files, ranks=2)
+    whole, resumed = file_contents(path(args, "stopped_whole.h5")), file_contents(path(args, "stopped.h5"))
+    if sorted(whole) != sorted(resumed) or "afm/verify@max_difference" not in whole:
+        fail(f"the resumed check's file holds {sorted(set(whole) ^ set(resumed))} the other does not")
+    for key in whole:
+        if not np.array_equal(np.asarray(whole[key]), np.asarray(resumed[key])):
+            fail(f"{key} differs between the uninterrupted and the resumed check")
+    if [f for f in listing(args.workdir) if ".ckpt" in f]:
+        fail("checkpoints left after the check completed")
+
+
 def map_resumed(args, name, text, ranks):
     """An uninterrupted map, then the same map stopped after 2 lines of each
     rank (exit 6, no file, a checkpoint per line done) and resumed: the
@@ -433,11 +462,14 @@ def map_resumed(args, name, text, ranks):
 
 def case_map_resume(args):
     """A NaF map on 2 ranks, and the same at 300 K with 2 realizations (the
-    standard errors and the slips in the checkpoints), resume to the
-    uninterrupted file; a checkpoint of another input or a damaged one is
-    refused (exit 3, naming it)."""
+    standard errors and the slips in the checkpoints), and with &verify,
+    resume to the uninterrupted file; so does a map stopped in its &verify
+    run; a checkpoint of another input or a damaged one is refused (exit 3,
+    naming it)."""
     files = map_resumed(args, "map", MAP, 2)
     map_resumed(args, "warm", THERMAL_MAP, 2)
+    map_resumed(args, "checked", MAP + VERIFY, 2)
+    verify_resumed(args)
     os.remove(path(args, "map.h5"))
     friction(args, "-o", "map.h5", *files, expect=6, env={"FRICTION_TEST_STOP_AFTER": "1"})
     write(args, "v0.nml", "&surface v0 = 1.1 /\n")

@@ -19,7 +19,7 @@ module friction_afm_config
    use friction_files, only: file_exists
    use friction_parameters, only: configurable, parameter_visitor
    use friction_checks, only: config_checker
-   use friction_ode_settings, only: visit_integrator, check_integrator
+   use friction_ode_settings, only: visit_integrator, check_integrator, verify_settings, visit_verify, check_verify
    use friction_afm_thermal, only: thermal_settings
    use friction_afm_langevin, only: langevin_time_step, largest_curvature
    use friction_ode_auto, only: oscillator_rate
@@ -103,6 +103,8 @@ module friction_afm_config
       logical :: retrace = .true.      !! scan every line back as well
       ! &integrator
       type(solver_settings) :: solver
+      ! &verify: the map integrated again and its forces compared
+      type(verify_settings) :: check
       ! &thermal
       type(thermal_settings) :: thermal
    contains
@@ -182,6 +184,7 @@ contains
       call v%item('checkpoint_interval', self%checkpoint_interval, 's')
       call v%end_group()
       call visit_integrator(self%solver, v, 's')
+      call visit_verify(self%check, v, 'state units', 'nN')
       call self%thermal%visit(v)
    end subroutine visit
 
@@ -229,7 +232,17 @@ contains
          & //' samples, more than 2147483647 per dataset (and '//bytes_text(8.0_wp * n_trip_quantities &
          & * real(self%nx, wp) * self%ny)//' of memory for the trace alone)')
       call check_integrator(self%solver, c)
+      call check_verify(self%check, c, 'nN')
       call self%thermal%validate(c)
+      ! (The check is of the stepper's tolerances: the quasi-static tip
+      ! follows its equilibrium without them, the Langevin schemes take a
+      ! fixed step.)
+      if (self%check%enabled .and. self%model == 'quasistatic') call c%reject('verify', 'check', '.true.', &
+         & "compares two integrations of the tip: model = 'quasistatic' follows the equilibrium without " &
+         & //"integrating (use 'inertial' or 'overdamped')")
+      if (self%check%enabled .and. self%thermal%enabled()) call c%reject('verify', 'check', '.true.', &
+         & 'compares two integrations at two tolerances: at a temperature the Langevin scheme takes a fixed ' &
+         & //'time step (compare runs at two &thermal time_step values instead)')
       if (.not. c%failed() .and. self%thermal%enabled()) call check_thermal()
 
    contains

@@ -16,7 +16,7 @@ module friction_afm_output
    implicit none
    private
 
-   public :: write_afm_file, line_friction, afm_surface_record, afm_thermal_record
+   public :: write_afm_file, line_friction, afm_surface_record, afm_thermal_record, afm_verify_record
 
    !> The sample of a lattice-sum scene, for pictures that overlay it.
    type :: afm_surface_record
@@ -41,6 +41,18 @@ module friction_afm_output
       !> trip, support (Å), force (nN), jump along and across (Å) for each
       real(wp), allocatable :: slips(:, :)
    end type afm_thermal_record
+
+   !> &verify: the check run's stepper settings, the largest difference of
+   !> each force component between the map and the check run over every
+   !> sample of both trips (fz: 3D tips), and the check run's right-hand
+   !> sides, all ranks'.
+   type :: afm_verify_record
+      logical :: enabled = .false.
+      character(len=16) :: method = ''
+      real(wp) :: rtol = 0.0_wp, atol = 0.0_wp
+      real(wp) :: max_difference(3) = 0.0_wp   !! fx, fy, fz; nN
+      integer(i8) :: rhs_evaluations = 0
+   end type afm_verify_record
 
 
 contains
@@ -67,7 +79,8 @@ contains
    !> realizations, time_step (the Langevin step used) and scheme; and the
    !> slips, /afm/slips/line, realization, trip, support, force, jump,
    !> jump_across.
-   subroutine write_afm_file(path, comm, config, first, stride, trace, retrace, summary, error, surface, thermal)
+   subroutine write_afm_file(path, comm, config, first, stride, trace, retrace, summary, error, surface, thermal, &
+      & verify)
       character(len=*), intent(in) :: path
       type(MPI_Comm), intent(in) :: comm
       type(afm_config), intent(in) :: config
@@ -79,6 +92,8 @@ contains
       type(afm_surface_record), intent(in), optional :: surface
       !> present at a temperature
       type(afm_thermal_record), intent(in), optional :: thermal
+      !> /afm/verify when present and enabled
+      type(afm_verify_record), intent(in), optional :: verify
       type(h5_file) :: file
       type(error_type), allocatable :: close_error
       type(afm_config) :: copy
@@ -142,6 +157,20 @@ contains
          call file%write_vector('/afm/slips/force', thermal%slips(5, :), 'nN')
          call file%write_vector('/afm/slips/jump', thermal%slips(6, :), 'angstrom')
          call file%write_vector('/afm/slips/jump_across', thermal%slips(7, :), 'angstrom')
+      end if
+      if (present(verify)) then
+         if (verify%enabled) then
+            call file%create_group('/afm/verify')
+            call file%write_attribute_text('/afm/verify', 'method', trim(verify%method))
+            call file%write_attribute_real('/afm/verify', 'rtol', verify%rtol)
+            call file%write_attribute_real('/afm/verify', 'atol', verify%atol)
+            call file%write_attribute_real('/afm/verify', 'max_difference', maxval(verify%max_difference), 'nN')
+            call file%write_attribute_real('/afm/verify', 'max_difference_fx', verify%max_difference(1), 'nN')
+            call file%write_attribute_real('/afm/verify', 'max_difference_fy', verify%max_difference(2), 'nN')
+            if (present(surface)) call file%write_attribute_real('/afm/verify', 'max_difference_fz', &
+               & verify%max_difference(3), 'nN')
+            call file%write_attribute_integer('/afm/verify', 'rhs_evaluations', verify%rhs_evaluations)
+         end if
       end if
       call file%close(error)
 

@@ -4,7 +4,7 @@
 module friction_afm_scene
    use mpi_f08
    use friction_kinds, only: wp, i8
-   use friction_error, only: error_type, fatal_error, error_input, error_interrupted
+   use friction_error, only: error_type, fatal_error, error_input, error_interrupted, error_numerical
    use friction_files, only: available_memory, remove_file
    use friction_strings, only: itoa, bytes_text, text_hash
    use friction_version, only: version_string
@@ -13,6 +13,7 @@ module friction_afm_scene
    use friction_clock, only: wall_seconds
    use friction_ode_solver, only: integrator_statistics
    use friction_ode_auto, only: auto_name, auto_method
+   use friction_ode_settings, only: verify_solver
    use friction_surface_potential, only: surface_potential
    use friction_output_summary, only: run_summary
    use friction_scene, only: scene, point_result, point_memory
@@ -20,8 +21,8 @@ module friction_afm_scene
    use friction_scene_context, only: job_context, agree_on_error, ranks_text, share_of, job_wall_time, &
       & job_sharing, mpi_sharing
    use friction_afm_config, only: afm_config, new_potential, species_count, tip_stiffness, scan_region
-   use friction_afm_scan, only: afm_scanner, line_record, slip_list, n_quantities, q_fx, q_fy, q_f_along
-   use friction_afm_output, only: write_afm_file, afm_surface_record, afm_thermal_record
+   use friction_afm_scan, only: afm_scanner, line_record, slip_list, n_quantities, q_fx, q_fy, q_f_along, q_fz
+   use friction_afm_output, only: write_afm_file, afm_surface_record, afm_thermal_record, afm_verify_record
    use friction_afm_validity, only: afm_model_warnings, quasistatic_friction_warning
    use friction_afm_netlist, only: afm_netlist
    use friction_afm_line_checkpoint, only: line_checkpoint_name, save_line, load_line
@@ -49,6 +50,7 @@ module friction_afm_scene
       real(wp), private :: time_step = 0.0_wp   !! the Langevin step, s
       character(len=:), allocatable, private :: scheme
       type(afm_surface_record), private :: surface
+      type(afm_verify_record), private :: verify
       type(run_summary), private :: record
       integer, private :: first = 0
       logical, private :: three_d = .false.
@@ -85,6 +87,8 @@ contains
       ! &thermal only at a temperature: at T = 0 its other variables do
       ! nothing, and the echo is the deterministic program's.
       if (self%config%thermal%enabled()) names = [character(len=32) :: names, 'thermal']
+      ! &verify likewise only when it checks.
+      if (self%config%check%enabled) names = [character(len=32) :: names, 'verify']
    end subroutine afm_groups
 
    subroutine afm_visit(self, v)
@@ -162,6 +166,7 @@ contains
       integer :: start, end
 
       self%ran = self%resolved()
+      self%verify = afm_verify_record()
       associate (c => self%ran)
          ! The surface first, identically on every rank (its table, if any,
          ! built by all together): a bad net or defect is bad input,
@@ -262,6 +267,8 @@ contains
                & //'compute only the others', error_interrupted)
             return
          end if
+         if (c%check%enabled) call verify_map(error)
+         if (allocated(error)) return
          if (c%model == 'quasistatic') call check_friction()
          if (scanner%thermal) call gather_slips()
 
@@ -284,6 +291,87 @@ contains
       end associate
 
    contains
+
+      !> &verify: this rank's lines integrated again on the same surface with
+      !> the check's stepper settings, and the largest difference of each
+      !> force component over every rank's samples of both trips; beyond
+      !> check_limit the run fails (nothing written).  Collective.
+      subroutine verify_map(error)
+         type(error_type), allocatable, intent(out) :: error
+         type(afm_scanner) :: checker
+         type(afm_config) :: check_config
+         type(line_record) :: again
+         type(integrator_statistics) :: check_stats
+         integer :: j, q, stopped
+         integer, parameter :: forces(3) = [q_fx, q_fy, q_fz]
+         character(len=300) :: text
+
+         associate (c => self%ran)
+            check_config = c
+            check_config%check%enabled = .false.
+            check_config%solver = verify_solver(c%check, c%solver)
+            self%verify%enabled = .true.
+            self%verify%method = check_config%solver%method
+            self%verify%rtol = check_config%solver%rtol
+            self%verify%atol = check_config%solver%atol
+            ! (The surface the map ran on, handed over: a table is not built again.)
+            call scanner%release_potential(potential)
+            call checker%init_owning(check_config, potential, error)
+            stopped = 0
+            do j = 1, count
+               if (allocated(error)) exit
+               ! (The test hook counts the check's lines after the map's.)
+               if (reporter%stop_requested() .or. (job%stop_after > 0 .and. computed + j - 1 >= job%stop_after)) then
+                  stopped = 1
+                  exit
+               end if
+               call checker%run_line(self%first + (j - 1) * job%nranks, again, error)
+               if (allocated(error)) exit
+               do q = 1, merge(3, 2, self%three_d)
+                  self%verify%max_difference(q) = max(self%verify%max_difference(q), &
+                     & maxval(abs(again%trace(:, forces(q)) - self%trace(:, j, forces(q)))))
+                  if (c%retrace) self%verify%max_difference(q) = max(self%verify%max_difference(q), &
+                     & maxval(abs(again%retrace(:, forces(q)) - self%retrace(:, j, forces(q)))))
+               end do
+               if (job%rank == 0) call reporter%progress(real(lines_done(j), wp), real(c%ny, wp), 'lines (verify)', &
+                  & j == count)
+            end do
+            if (allocated(error)) error%message = 'verify run: '//error%message
+            call agree_on_error(job, error)
+            if (allocated(error)) return
+            if (job%parallel()) call MPI_Allreduce(MPI_IN_PLACE, stopped, 1, MPI_INTEGER, MPI_MAX, job%comm)
+            if (stopped /= 0) then
+               ! Every line of the map is done: --resume then runs the check alone.
+               call save_lines(count, error)
+               if (.not. allocated(error)) call fatal_error(error, 'map interrupted in its &verify run: no file ' &
+                  & //'written; the map''s lines are checkpointed beside the output (' &
+                  & //line_checkpoint_name(job%output, 0)//' ...): run again with --resume to run only the check', &
+                  & error_interrupted)
+               call agree_on_error(job, error)
+               return
+            end if
+            check_stats = checker%statistics()
+            self%verify%rhs_evaluations = check_stats%rhs_evaluations
+            if (job%parallel()) then
+               call MPI_Allreduce(MPI_IN_PLACE, self%verify%max_difference, 3, MPI_DOUBLE_PRECISION, MPI_MAX, job%comm)
+               call MPI_Allreduce(MPI_IN_PLACE, self%verify%rhs_evaluations, 1, MPI_INTEGER8, MPI_SUM, job%comm)
+            end if
+            associate (d => self%verify)
+               if (job%rank == 0) then
+                  write (text, '(a, es8.2, a, es8.2, a, es8.2, a)') 'verify: '//trim(d%method)//' at rtol ', d%rtol, &
+                     & ', atol ', d%atol, ': max |dF| = ', maxval(d%max_difference), ' nN over the map'
+                  call reporter%note(trim(text))
+               end if
+               if (c%check%max_difference > 0.0_wp .and. .not. (maxval(d%max_difference) <= c%check%max_difference)) &
+                  & then
+                  write (text, '(a, es8.2, a, es8.2, a)') 'verify failed: the check run''s forces differ by ', &
+                     & maxval(d%max_difference), ' nN, more than check_limit = ', c%check%max_difference, &
+                     & ' nN (docs/speed.md, which steppers need verify)'
+                  call fatal_error(error, trim(text), error_numerical)
+               end if
+            end associate
+         end associate
+      end subroutine verify_map
 
       !> The scanner's integrator counts so far.
       function scanner_counts() result(now)
@@ -479,17 +567,17 @@ contains
          thermal%slips = self%slips
          if (self%three_d) then
             call write_afm_file(path, job%comm, self%ran, self%first, job%nranks, self%trace, self%retrace, &
-               & self%record, error, self%surface, thermal=thermal)
+               & self%record, error, self%surface, thermal=thermal, verify=self%verify)
          else
             call write_afm_file(path, job%comm, self%ran, self%first, job%nranks, self%trace, self%retrace, &
-               & self%record, error, thermal=thermal)
+               & self%record, error, thermal=thermal, verify=self%verify)
          end if
       else if (self%three_d) then
          call write_afm_file(path, job%comm, self%ran, self%first, job%nranks, self%trace, self%retrace, &
-            & self%record, error, self%surface)
+            & self%record, error, self%surface, verify=self%verify)
       else
          call write_afm_file(path, job%comm, self%ran, self%first, job%nranks, self%trace, self%retrace, &
-            & self%record, error)
+            & self%record, error, verify=self%verify)
       end if
    end subroutine afm_write
 

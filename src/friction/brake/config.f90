@@ -10,13 +10,13 @@ module friction_brake_config
    use friction_parameters, only: configurable, parameter_visitor, parameter_info, set_parameter_number, &
       & get_parameter, list_parameters
    use friction_checks, only: config_checker
-   use friction_ode_solver, only: step_type_names, step_type_index
-   use friction_ode_settings, only: visit_integrator, check_integrator, check_tolerance_bounds
+   use friction_ode_settings, only: visit_integrator, check_integrator, verify_settings, visit_verify, check_verify, &
+      & verify_solver
    use friction_ode_auto, only: rodas4_transition_bound, transition_bound
    implicit none
    private
 
-   public :: brake_config, brake_check, model_names, units_names, brake_solver_defaults
+   public :: brake_config, model_names, units_names, brake_solver_defaults
    public :: model_regularized, model_switched, series_names, continuation_names, continuation_config, &
       & continuation_variable
 
@@ -33,15 +33,6 @@ module friction_brake_config
    type(solver_settings), parameter :: brake_solver_defaults = solver_settings(method='rk8pd', &
       & rtol=1.0e-10_wp, atol=1.0e-12_wp, h_start=0.0_wp, h_min=0.0_wp, max_steps=10000000_i8, &
       & max_wall_time=0.0_wp)
-
-   !> The second run of `verify`: another stepper or tighter tolerances.
-   type :: brake_check
-      logical :: enabled = .false.
-      character(len=16) :: method = ''     !! '' for the main run's stepper
-      real(wp) :: rtol = 0.0_wp            !! 0 for the main run's / 1000
-      real(wp) :: atol = 0.0_wp            !! 0 for the main run's / 1000
-      real(wp) :: max_difference = 0.0_wp  !! > 0: a larger difference in x fails the run
-   end type brake_check
 
    type, extends(configurable) :: brake_config
       character(len=16) :: model = model_switched      !! 'switched' (Fig. 10) or 'regularized' (Eq. 10)
@@ -61,7 +52,7 @@ module friction_brake_config
       real(wp) :: event_tolerance = 1.0e-10_wp  !! bound on located event times, τ
       real(wp) :: stick_velocity = 1.0e-6_wp    !! regularized: |v_rel| below this counts as stick
       type(solver_settings) :: solver = brake_solver_defaults
-      type(brake_check) :: check
+      type(verify_settings) :: check   !! &verify: the difference compared is x's
       type(analysis_settings) :: analysis   !! chaos diagnostics (&analysis)
    contains
       procedure :: visit
@@ -123,13 +114,7 @@ contains
          call v%item('v_dr_si', d%v_dr, 'm/s')
       end associate
       call v%end_group()
-      call v%begin_group('verify')
-      call v%item('check', self%check%enabled)
-      call v%item('check_method', self%check%method, fold=.true.)
-      call v%item('check_rtol', self%check%rtol, '1')
-      call v%item('check_atol', self%check%atol, 'm')
-      call v%item('check_limit', self%check%max_difference, 'm')
-      call v%end_group()
+      call visit_verify(self%check, v, 'm', 'm')
       call self%analysis%visit(v, 'tau')
    end subroutine visit
 
@@ -210,13 +195,7 @@ contains
             & "the initial normal force N' = (1 - kappa) y0 + g_prime = "//rtoa(normal) &
             & //' must be > 0 (kappa = '//rtoa(p%kappa)//', g_prime = '//rtoa(p%g_prime)//')')
       end associate
-      if (len_trim(self%check%method) > 0 .and. step_type_index(self%check%method) == 0) &
-         & call c%reject('verify', 'check_method', "'"//trim(self%check%method)//"'", &
-         & "unknown GSL step type (known: ''"//', '//quoted(step_type_names())//')')
-      call c%nonnegative('verify', 'check_rtol', self%check%rtol, '0 for rtol / 1000')
-      call c%nonnegative('verify', 'check_atol', self%check%atol, '0 for atol / 1000')
-      call check_tolerance_bounds(c, 'verify', 'check_rtol', 'check_atol', self%check%rtol, self%check%atol)
-      call c%nonnegative('verify', 'check_limit', self%check%max_difference, 'm; 0 reports only')
+      call check_verify(self%check, c, 'm')
       call self%analysis%validate(c, self%t_start, self%t_end, series_names)
       if (c%failed() .or. len_trim(self%analysis%continuation) == 0) return
       if (self%model /= model_switched) then
@@ -322,11 +301,7 @@ contains
 
       other = self
       other%check%enabled = .false.
-      if (len_trim(self%check%method) > 0) other%solver%method = self%check%method
-      other%solver%rtol = self%check%rtol
-      if (.not. (other%solver%rtol > 0.0_wp)) other%solver%rtol = self%solver%rtol / 1000.0_wp
-      other%solver%atol = self%check%atol
-      if (.not. (other%solver%atol > 0.0_wp)) other%solver%atol = self%solver%atol / 1000.0_wp
+      other%solver = verify_solver(self%check, self%solver)
       other%event_tolerance = self%event_tolerance / 1000.0_wp
    end function check_settings
 

@@ -1,5 +1,6 @@
 !> &integrator: the stepper settings as a namelist group, shared by every
-!> scene (each scene keeps its own defaults), and their checks.
+!> scene (each scene keeps its own defaults), and their checks; and
+!> &verify, the second integration that checks a run.
 module friction_ode_settings
    use friction_kinds, only: wp
    use friction_strings, only: itoa, quoted, rtoa
@@ -11,6 +12,17 @@ module friction_ode_settings
    private
 
    public :: visit_integrator, check_integrator, check_tolerance_bounds
+   public :: verify_settings, visit_verify, check_verify, verify_solver
+
+   !> &verify: the run integrated again with another stepper or tighter
+   !> tolerances, and the two compared (docs/input.md, &verify).
+   type :: verify_settings
+      logical :: enabled = .false.
+      character(len=16) :: method = ''     !! '' for the run's stepper
+      real(wp) :: rtol = 0.0_wp            !! 0 for the run's / 1000
+      real(wp) :: atol = 0.0_wp            !! 0 for the run's / 1000
+      real(wp) :: max_difference = 0.0_wp  !! > 0: a larger difference fails the run
+   end type verify_settings
 
 contains
 
@@ -67,5 +79,50 @@ contains
       if (atol > 1.0_wp) call c%reject(group, atol_name, rtoa(atol), 'must be <= 1: an absolute tolerance above ' &
          & //'1 (Å, Å/s; the brake''s m, m/τ) accepts steps of any size')
    end subroutine check_tolerance_bounds
+
+   !> The group &verify; `atol_unit` is that of the state, `limit_unit` that
+   !> of the quantity compared (the brake's x in m, the map's forces in nN).
+   subroutine visit_verify(s, v, atol_unit, limit_unit)
+      type(verify_settings), intent(inout) :: s
+      type(parameter_visitor), intent(inout) :: v
+      character(len=*), intent(in) :: atol_unit, limit_unit
+
+      call v%begin_group('verify')
+      call v%item('check', s%enabled)
+      call v%item('check_method', s%method, fold=.true.)
+      call v%item('check_rtol', s%rtol, '1')
+      call v%item('check_atol', s%atol, atol_unit)
+      call v%item('check_limit', s%max_difference, limit_unit)
+      call v%end_group()
+   end subroutine visit_verify
+
+   subroutine check_verify(s, c, limit_unit)
+      type(verify_settings), intent(in) :: s
+      type(config_checker), intent(inout) :: c
+      character(len=*), intent(in) :: limit_unit
+
+      if (len_trim(s%method) > 0 .and. step_type_index(s%method) == 0) &
+         & call c%reject('verify', 'check_method', "'"//trim(s%method)//"'", &
+         & "unknown GSL step type (known: ''"//', '//quoted(step_type_names())//')')
+      call c%nonnegative('verify', 'check_rtol', s%rtol, '0 for rtol / 1000')
+      call c%nonnegative('verify', 'check_atol', s%atol, '0 for atol / 1000')
+      call check_tolerance_bounds(c, 'verify', 'check_rtol', 'check_atol', s%rtol, s%atol)
+      call c%nonnegative('verify', 'check_limit', s%max_difference, limit_unit//'; 0 reports only')
+   end subroutine check_verify
+
+   !> The check run's stepper settings: check_method, else the run's
+   !> (resolved) stepper; check_rtol and check_atol, else the run's / 1000.
+   function verify_solver(s, run) result(other)
+      type(verify_settings), intent(in) :: s
+      type(solver_settings), intent(in) :: run
+      type(solver_settings) :: other
+
+      other = run
+      if (len_trim(s%method) > 0) other%method = s%method
+      other%rtol = s%rtol
+      if (.not. (other%rtol > 0.0_wp)) other%rtol = run%rtol / 1000.0_wp
+      other%atol = s%atol
+      if (.not. (other%atol > 0.0_wp)) other%atol = run%atol / 1000.0_wp
+   end function verify_solver
 
 end module friction_ode_settings
