@@ -461,6 +461,12 @@ static void check_results(friction_error *err) {
   expect_ok(friction_config_check(brake, err), err, "the sweep checks");
   CHECK(friction_compute(brake, err) == NULL, "compute of a sweep");
   expect_input_error(friction_error_status(err), err, "friction_compute computes one scene", "compute of a sweep");
+  /* and so is a check: friction_compute would skip it without a word */
+  expect_ok(friction_config_set(cfg, "verify.check", ".true.", err), err, "verify");
+  expect_ok(friction_config_check(cfg, err), err, "the check checks");
+  CHECK(friction_compute(cfg, err) == NULL, "compute with a check");
+  expect_input_error(friction_error_status(err), err, "friction_compute runs no check", "compute with a check");
+  expect_ok(friction_config_set(cfg, "verify.check", ".false.", err), err, "verify off");
   friction_config_free(brake);
   friction_config_free(cfg);
 }

@@ -260,7 +260,7 @@ def compute(scene, files=(), values=None):
     """The scene's computation on this process, without a file: a dict of
     numpy arrays named as in the program's file ("trace/fx" (ny, nx), ...,
     "support_x"; "t", "x", ..., "events/t").  &analysis, &verify and &sweep
-    are for jobs (run())."""
+    are for jobs (run()): a &sweep or &verify check = .true. is refused."""
     with Config(scene, files, values) as cfg:
         return cfg.compute()
 
