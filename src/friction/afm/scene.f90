@@ -67,6 +67,7 @@ module friction_afm_scene
       procedure :: point_series => afm_point_series
       procedure :: run_point => afm_run_point
       procedure :: netlist => afm_netlist_text
+      procedure :: verifies => afm_verifies
       procedure :: resolved
    end type afm_scene
 
@@ -88,8 +89,14 @@ contains
       ! nothing, and the echo is the deterministic program's.
       if (self%config%thermal%enabled()) names = [character(len=32) :: names, 'thermal']
       ! &verify likewise only when it checks.
-      if (self%config%check%enabled) names = [character(len=32) :: names, 'verify']
+      if (self%verifies()) names = [character(len=32) :: names, 'verify']
    end subroutine afm_groups
+
+   logical function afm_verifies(self)
+      class(afm_scene), intent(in) :: self
+
+      afm_verifies = self%config%check%enabled
+   end function afm_verifies
 
    subroutine afm_visit(self, v)
       class(afm_scene), intent(inout) :: self

@@ -49,6 +49,7 @@ module friction_brake_scene
       procedure :: run_point => brake_run_point
       procedure :: netlist => brake_netlist_text
       procedure :: settings_warning => brake_settings_warning
+      procedure :: verifies => brake_verifies
       procedure :: resolved
    end type brake_scene
 
@@ -293,6 +294,12 @@ contains
 
    !> The creep band's warning and the stepper's (brake_config%creep_band_warning,
    !> %stepper_warning) for the resolved settings, one after the other.
+   logical function brake_verifies(self)
+      class(brake_scene), intent(in) :: self
+
+      brake_verifies = self%config%check%enabled
+   end function brake_verifies
+
    function brake_settings_warning(self) result(text)
       class(brake_scene), intent(in) :: self
       character(len=:), allocatable :: text

@@ -726,7 +726,6 @@ contains
       type(error_type), allocatable :: error
       type(job_config) :: work
       integer(c_int) :: status
-      character(len=:), allocatable :: check, problem
 
       res = c_null_ptr
       if (config_of(cfg, config, error)) call check_config(config, work, error)
@@ -735,10 +734,8 @@ contains
          & //'friction_run_config', error_input)
       ! (A check asked for and not run would pass without a word.)
       if (.not. allocated(error)) then
-         call get_parameter(work%scene, 'verify', 'check', 0, check, problem)
-         if (len(problem) == 0 .and. check == '.true.') call fatal_error(error, '&verify: check = .true.: ' &
-            & //'friction_compute runs no check; run the job with friction_run_config, which writes the ' &
-            & //'check''s result', error_input)
+         if (work%scene%verifies()) call fatal_error(error, '&verify: check = .true.: friction_compute runs ' &
+            & //'no check; run the job with friction_run_config, which writes the check''s result', error_input)
       end if
       if (allocated(error)) then
          status = report(handle, error)

@@ -6,7 +6,7 @@ module friction_job_config
    use friction_strings, only: itoa, rtoa, join, quoted, lower
    use friction_error, only: error_type, fatal_error, error_input
    use friction_parameters, only: configurable, parameter_visitor, parameter_info, list_parameters, &
-      & parameters_text, split_name, get_parameter
+      & parameters_text, split_name
    use friction_checks, only: config_checker
    use friction_input_reader, only: namelist_source, scan_files, apply_files, override_source, source_place, last_text
    use friction_scene, only: scene
@@ -321,7 +321,6 @@ contains
       type(job_config), intent(inout) :: config
       type(config_checker), intent(inout) :: c
       type(parameter_info), allocatable :: mine(:), universe(:)
-      character(len=:), allocatable :: text, problem
       integer :: counts(2)
 
       call config%scene%check(c)
@@ -350,12 +349,9 @@ contains
          ! &verify checks one run against a second: a sweep reduces each point
          ! to a few numbers and runs no check, so asking for one (or sweeping
          ! its settings) would be ignored without a word.
-         if (any(mine%group == 'verify')) then
-            call get_parameter(config%scene, 'verify', 'check', 0, text, problem)
-            if (len(problem) == 0 .and. text == '.true.') call c%reject('verify', 'check', '.true.', &
-               & "is not run for a sweep's points: verify a point with a plain run of its values " &
-               & //"(&sweep sweep_variable = '')")
-         end if
+         if (config%scene%verifies()) call c%reject('verify', 'check', '.true.', &
+            & "is not run for a sweep's points: verify a point with a plain run of its values " &
+            & //"(&sweep sweep_variable = '')")
       end associate
 
    contains

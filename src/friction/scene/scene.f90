@@ -67,6 +67,10 @@ module friction_scene
       !> unreliable; cheap, from the settings alone.  The job says it before
       !> a run, and a sweep once for all its points.  None by default.
       procedure :: settings_warning
+      !> Whether the settings ask for &verify's second integration, which a
+      !> job runs and a sweep or the C API's friction_compute cannot.  No by
+      !> default.
+      procedure :: verifies
    end type scene
 
    abstract interface
@@ -149,5 +153,11 @@ contains
 
       text = ''
    end function settings_warning
+
+   logical function verifies(self)
+      class(scene), intent(in) :: self
+
+      verifies = .false.
+   end function verifies
 
 end module friction_scene
