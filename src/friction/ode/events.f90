@@ -57,7 +57,7 @@ module friction_ode_events
 
    !> Largest state dimension the locator keeps copies of: a state of 4
    !> with its 4 x 4 tangent matrix (the Lyapunov spectrum of the brake).
-   integer, parameter :: max_state = 20
+   integer, parameter :: max_state = 20, max_events = 8
 
    !> An ODE system with event functions.
    type, abstract, extends(ode_system) :: event_system
@@ -124,6 +124,7 @@ module friction_ode_events
       !> Events of the last advance, in time order; a terminal one is last.
       !> (Up to two per function and step: out across zero and back.)
       type(event_hit), allocatable, public :: hits(:)
+      type(event_hit), allocatable :: found(:)   !! advance's work: the events of a step
       integer, public :: n_hits = 0
    contains
       procedure :: init
@@ -160,7 +161,8 @@ contains
       self%system => system
       self%n = system%dimension()
       self%m = system%event_count()
-      if (size(direction) /= self%m .or. size(terminal) /= self%m .or. self%n > max_state) then
+      if (size(direction) /= self%m .or. size(terminal) /= self%m .or. self%n > max_state &
+         & .or. self%m > max_events) then
          call fatal_error(error, 'event locator: inconsistent event settings', error_internal)
          return
       end if
@@ -197,6 +199,8 @@ contains
       call self%probe%set_time_label(trim(self%time_name), trim(self%time_unit))
       if (allocated(self%hits)) deallocate (self%hits)
       allocate (self%hits(max(1, 2 * self%m)))
+      if (allocated(self%found)) deallocate (self%found)
+      allocate (self%found(max(1, 2 * self%m)))
       if (allocated(self%g)) deallocate (self%last_sign, self%g)
       allocate (self%last_sign(self%m), self%g(self%m))
       self%steps = 0
@@ -244,12 +248,15 @@ contains
       real(wp), intent(in) :: t1
       real(wp), intent(inout) :: y(:)
       type(error_type), allocatable, intent(out) :: error
-      real(wp) :: t0, y0(max_state), g0(self%m), f0(max_state)
-      real(wp) :: tc, yc(max_state), gc(self%m), theta, h, slope0(self%m), slope1(self%m)
-      type(event_hit) :: found(2 * self%m), swap
-      integer :: k, nfound, i, j, first_terminal, near
+      ! (Fixed sizes, and the events found in the locator's own `found`:
+      ! automatic arrays would be allocated on the heap at every call.)
+      real(wp) :: t0, y0(max_state), g0(max_events), f0(max_state)
+      real(wp) :: tc, yc(max_state), gc(max_events), theta, h, slope0(max_events), slope1(max_events)
+      type(event_hit) :: swap
+      integer :: k, nfound, i, j, first_terminal, near, m
       real(wp), parameter :: nudge = 1.0e-3_wp
 
+      m = self%m
       self%n_hits = 0
       if (.not. self%ready) then
          call fatal_error(error, 'event locator: advance before restart', error_internal)
@@ -258,7 +265,7 @@ contains
       do while (t < t1)
          t0 = t
          y0(1:self%n) = y(1:self%n)
-         g0 = self%g
+         g0(1:m) = self%g
          if (.not. self%f_valid) then
             call self%system%rhs(t0, y0(1:self%n), self%f(1:self%n))
             self%extra_rhs = self%extra_rhs + 1
@@ -278,7 +285,8 @@ contains
                & error_numerical)
             return
          end if
-         if (self%max_wall_time > 0.0_wp) then
+         ! (The clock every 16 steps: reading it took 2 % of a sweep point.)
+         if (self%max_wall_time > 0.0_wp .and. mod(self%steps, 16_i8) == 0) then
             if (self%elapsed() > self%max_wall_time) then
                call fatal_error(error, trim(self%method)//': max_wall_time = '//rtoa(self%max_wall_time) &
                   & //' s reached at '//self%main%time_at(t)//' after '//itoa(self%steps)//' steps', &
@@ -296,21 +304,21 @@ contains
          ! interpolant (θ = (t - t0)/h): with g at the ends they define a
          ! cubic in θ for each g_k, exact when g_k is linear in the state.
          if (self%m > 0) then
-            yc(1:self%n) = hermite(nudge, h, y0(1:self%n), f0(1:self%n), y(1:self%n), self%f(1:self%n))
-            call self%system%event_values(t0 + nudge * h, yc(1:self%n), gc)
-            slope0 = (gc - g0) / nudge
-            yc(1:self%n) = hermite(1.0_wp - nudge, h, y0(1:self%n), f0(1:self%n), y(1:self%n), &
-               & self%f(1:self%n))
-            call self%system%event_values(t - nudge * h, yc(1:self%n), gc)
-            slope1 = (self%g - gc) / nudge
+            call hermite(nudge, h, y0(1:self%n), f0(1:self%n), y(1:self%n), self%f(1:self%n), yc(1:self%n))
+            call self%system%event_values(t0 + nudge * h, yc(1:self%n), gc(1:m))
+            slope0(1:m) = (gc(1:m) - g0(1:m)) / nudge
+            call hermite(1.0_wp - nudge, h, y0(1:self%n), f0(1:self%n), y(1:self%n), self%f(1:self%n), &
+               & yc(1:self%n))
+            call self%system%event_values(t - nudge * h, yc(1:self%n), gc(1:m))
+            slope1(1:m) = (self%g - gc(1:m)) / nudge
          end if
          do k = 1, self%m
             near = self%last_sign(k)
             if (crossed(near, self%g(k), self%direction(k))) then
                nfound = nfound + 1
                call self%locate(k, t0, y0(1:self%n), g0(k), t, y(1:self%n), -near, &
-                  & found(nfound)%t, found(nfound)%y(1:self%n), error)
-               call describe(found(nfound), k, -near)
+                  & self%found(nfound)%t, self%found(nfound)%y(1:self%n), error)
+               call describe(self%found(nfound), k, -near)
                if (allocated(error)) return
                cycle
             end if
@@ -326,22 +334,22 @@ contains
             call self%probe%advance(tc, t0 + theta * h, yc(1:self%n), error)
             self%probes = self%probes + 1
             if (allocated(error)) return
-            call self%system%event_values(tc, yc(1:self%n), gc)
+            call self%system%event_values(tc, yc(1:self%n), gc(1:m))
             if (gc(k) == 0.0_wp .or. (gc(k) > 0.0_wp .eqv. near > 0)) cycle   ! the interpolant erred
             ! Out across zero ...
             if (crossed(near, gc(k), self%direction(k))) then
                nfound = nfound + 1
                call self%locate(k, t0, y0(1:self%n), g0(k), tc, yc(1:self%n), -near, &
-                  & found(nfound)%t, found(nfound)%y(1:self%n), error)
-               call describe(found(nfound), k, -near)
+                  & self%found(nfound)%t, self%found(nfound)%y(1:self%n), error)
+               call describe(self%found(nfound), k, -near)
                if (allocated(error)) return
             end if
             ! ... and back, if that direction counts.
             if (crossed(-near, self%g(k), self%direction(k))) then
                nfound = nfound + 1
                call self%locate(k, tc, yc(1:self%n), gc(k), t, y(1:self%n), near, &
-                  & found(nfound)%t, found(nfound)%y(1:self%n), error)
-               call describe(found(nfound), k, near)
+                  & self%found(nfound)%t, self%found(nfound)%y(1:self%n), error)
+               call describe(self%found(nfound), k, near)
                if (allocated(error)) return
             end if
          end do
@@ -350,33 +358,33 @@ contains
          end do
          if (nfound == 0) cycle
          do i = 1, nfound
-            found(i)%terminal = self%terminal(found(i)%which)
+            self%found(i)%terminal = self%terminal(self%found(i)%which)
          end do
          ! Time order (few events per step: insertion sort).
          do i = 2, nfound
-            swap = found(i)
+            swap = self%found(i)
             j = i - 1
             do while (j >= 1)
-               if (found(j)%t <= swap%t) exit
-               found(j + 1) = found(j)
+               if (self%found(j)%t <= swap%t) exit
+               self%found(j + 1) = self%found(j)
                j = j - 1
             end do
-            found(j + 1) = swap
+            self%found(j + 1) = swap
          end do
          first_terminal = 0
          do i = 1, nfound
-            if (found(i)%terminal) then
+            if (self%found(i)%terminal) then
                first_terminal = i
                exit
             end if
          end do
          if (first_terminal > 0) then
             nfound = first_terminal
-            t = found(nfound)%t
-            y(1:self%n) = found(nfound)%y(1:self%n)
+            t = self%found(nfound)%t
+            y(1:self%n) = self%found(nfound)%y(1:self%n)
             self%ready = .false.
          end if
-         self%hits(1:nfound) = found(1:nfound)
+         self%hits(1:nfound) = self%found(1:nfound)
          self%n_hits = nfound
          self%located = self%located + nfound
          return
@@ -432,15 +440,17 @@ contains
 
    !> The cubic Hermite interpolant at θ in [0, 1] of a step of length h
    !> from (y0, f0) to (y1, f1): error O(h⁴).
-   pure function hermite(theta, h, y0, f0, y1, f1) result(y)
+   !> (A subroutine, not a function: a function's result of this size
+   !> would be allocated on the heap at every call.)
+   pure subroutine hermite(theta, h, y0, f0, y1, f1, y)
       real(wp), intent(in) :: theta, h, y0(:), f0(:), y1(:), f1(:)
-      real(wp) :: y(size(y0))
+      real(wp), intent(out) :: y(:)
 
       y = (2.0_wp * theta**3 - 3.0_wp * theta**2 + 1.0_wp) * y0 &
          & + (theta**3 - 2.0_wp * theta**2 + theta) * h * f0 &
          & + (-2.0_wp * theta**3 + 3.0_wp * theta**2) * y1 &
          & + (theta**3 - theta**2) * h * f1
-   end function hermite
+   end subroutine hermite
 
    !> The crossing of g_k in [ta, tb], where g_k(ta) = ga is on the near side
    !> and g_k(tb) on the far side, whose sign is far.  Returns the far end of
@@ -542,7 +552,7 @@ contains
          end if
          if (.not. (t > a .and. t < b)) t = 0.5_wp * (a + b)
          theta = (t - ta) / h
-         ya_ = hermite(theta, h, ya, fa, yb, fb)
+         call hermite(theta, h, ya, fa, yb, fb, ya_)
          call self%system%event_values(t, ya_, g)
          vc = g(k)
          if (on_far_side(vc, far)) then
