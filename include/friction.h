@@ -24,10 +24,13 @@
  *
  * Threads.  Handles are independent, and threads may work at once, each on
  * its own handles (configuration, result, error).  A handle must not be used
- * by two threads at once.  The only state shared between calls is a
+ * by two threads at once.  The state shared between calls is a
  * mutex-guarded count of the threads inside GSL, so that the host's GSL
- * handler is back when the last of them returns.  The job functions may use
- * MPI and must be called from one thread at a time.
+ * handler is back when the last of them returns, and a lock that runs the
+ * job functions one at a time: they use HDF5, FFTW's planner and MPI, which
+ * are the whole process's, so a job called while another thread's runs
+ * waits for it to end.  A job started from a job's own report callback (the
+ * same thread) is refused with FRICTION_ERROR_INPUT.
  *
  * Units are those of the namelist input (docs/input.md).
  */

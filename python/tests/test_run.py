@@ -121,3 +121,51 @@ def test_resume_an_interrupted_sweep(friction, program, brake_sweep, tmp_path):
     assert resumed.group_attrs["sweep"]["complete"] == 1
     for name in ("sweep/maxima", "sweep/lyapunov", "sweep/stick_fraction", "sweep/status"):
         assert np.array_equal(resumed[name].values, full[name].values), name
+
+
+def test_jobs_on_several_threads_run_one_at_a_time(friction, naf_map, brake_run, tmp_path):
+    """Jobs started on several threads at once (ctypes lets them call the
+    library together) each write the file a job alone writes: the library
+    runs them one after the other.  Before, they shared HDF5 and FFTW's
+    planner, reported false errors (a namelist that "cannot be opened", HDF5
+    failing to create a dataset) and crashed the interpreter."""
+    import threading
+
+    BRAKE = [INPUTS / "brake.nml", DATA / "brake_short.nml"]
+    failures = []
+
+    def job(k, files, reference):
+        try:
+            out = friction.run(files, output=tmp_path / f"job{k}.h5", force=True, progress=False)
+            same_files(out, reference)
+        except Exception as error:  # noqa: BLE001 - collected and reported below
+            failures.append(f"job {k}: {error!r}")
+
+    for _ in range(3):
+        threads = [threading.Thread(target=job, args=(k, NAF, naf_map) if k % 2 == 0 else (k, BRAKE, brake_run))
+                   for k in range(4)]
+        for thread in threads:
+            thread.start()
+        for thread in threads:
+            thread.join()
+    assert not failures, failures
+
+
+def test_a_job_from_its_own_callback_is_refused(friction, tmp_path):
+    """A job started from the report callback of a job on the same thread
+    cannot wait for that job to end: it is refused with a message, not left
+    to deadlock, and the outer job finishes."""
+    inner = []
+
+    def progress(message, fraction):
+        if not inner:
+            try:
+                friction.run(NAF, output=tmp_path / "inner.h5", progress=False)
+                inner.append("ran")
+            except friction.FrictionError as error:
+                inner.append(str(error))
+
+    out = friction.run(NAF, output=tmp_path / "outer.h5", progress=progress)
+    assert out.is_file()
+    assert len(inner) == 1 and "already running on this thread" in inner[0], inner
+    assert not (tmp_path / "inner.h5").exists()

@@ -110,6 +110,16 @@ module friction_capi
          type(c_ptr), value :: s
          integer(c_size_t) :: n
       end function c_strlen
+
+      !> One job at a time in the process (job_lock.c): 0 once the calling
+      !> thread may run its job, 1 if it is running one already.
+      function friction_job_begin() bind(c, name='friction_job_begin') result(busy)
+         import :: c_int
+         integer(c_int) :: busy
+      end function friction_job_begin
+
+      subroutine friction_job_end() bind(c, name='friction_job_end')
+      end subroutine friction_job_end
    end interface
 
 contains
@@ -1081,15 +1091,19 @@ contains
             paths(k) = path
          end do
       end if
-      call prepare_job(flags, comm, error)
+      if (.not. allocated(error)) call begin_job(error)
       if (allocated(error)) then
          status = report(handle, error)
          return
       end if
-      reporter%user = user
-      if (c_associated(report_fn)) call c_f_procpointer(report_fn, reporter%call)
-      call run_job(paths, c_string(output), iand(flags, job_force) /= 0, iand(flags, job_resume) /= 0, &
-         & comm, reporter, summary, error)
+      call prepare_job(flags, comm, error)
+      if (.not. allocated(error)) then
+         reporter%user = user
+         if (c_associated(report_fn)) call c_f_procpointer(report_fn, reporter%call)
+         call run_job(paths, c_string(output), iand(flags, job_force) /= 0, iand(flags, job_resume) /= 0, &
+            & comm, reporter, summary, error)
+      end if
+      call friction_job_end()
       status = report(handle, error)
    end function friction_run_job
 
@@ -1109,17 +1123,31 @@ contains
       if (config_of(cfg, config, error)) then
          if (.not. c_associated(output)) call fatal_error(error, 'output is a null pointer', error_input)
       end if
-      call prepare_job(flags, comm, error)
+      if (.not. allocated(error)) call begin_job(error)
       if (allocated(error)) then
          status = report(handle, error)
          return
       end if
-      reporter%user = user
-      if (c_associated(report_fn)) call c_f_procpointer(report_fn, reporter%call)
-      call run_job_config(config%job, c_string(output), iand(flags, job_force) /= 0, iand(flags, job_resume) /= 0, &
-         & comm, reporter, summary, error, config%origins)
+      call prepare_job(flags, comm, error)
+      if (.not. allocated(error)) then
+         reporter%user = user
+         if (c_associated(report_fn)) call c_f_procpointer(report_fn, reporter%call)
+         call run_job_config(config%job, c_string(output), iand(flags, job_force) /= 0, &
+            & iand(flags, job_resume) /= 0, comm, reporter, summary, error, config%origins)
+      end if
+      call friction_job_end()
       status = report(handle, error)
    end function friction_run_config
+
+   !> Wait until no other thread runs a job (job_lock.c); refused on a thread
+   !> that runs one already (a report callback starting a job).  On success
+   !> the caller ends with friction_job_end.
+   subroutine begin_job(error)
+      type(error_type), allocatable, intent(out) :: error
+
+      if (friction_job_begin() /= 0) call fatal_error(error, 'a job is already running on this thread ' &
+         & //'(a job cannot be started from its own report callback)', error_input)
+   end subroutine begin_job
 
    subroutine callback_progress(self, done, total, what, last)
       class(callback_reporter), intent(inout) :: self

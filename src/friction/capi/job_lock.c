@@ -1,0 +1,32 @@
+/* One job at a time in a process (friction_run_job, friction_run_config).
+ *
+ * A job uses state that is the whole process's: HDF5 (a build without its
+ * thread-safe option, as Debian's and ours are), FFTW's planner, MPI and a
+ * sweep's signal handlers.  Two jobs at once on two threads of a host (a
+ * Python program's threads: ctypes lets them call at once) reported false
+ * errors and crashed the host.  So a job waits for the one running on
+ * another thread to finish; one started on the thread already running a job
+ * (from that job's report callback) cannot wait for itself and is refused.
+ * The in-memory computations (friction_compute, friction_afm_line) use none
+ * of that state and stay free to run at once. */
+#include <pthread.h>
+
+static pthread_mutex_t job_mutex = PTHREAD_MUTEX_INITIALIZER;
+static _Thread_local int job_running = 0;   /* this thread holds job_mutex */
+
+/* 0: the calling thread may run its job (after waiting for another's);
+ * 1: it is running one already, and must not start another. */
+int friction_job_begin(void)
+{
+    if (job_running) return 1;
+    pthread_mutex_lock(&job_mutex);
+    job_running = 1;
+    return 0;
+}
+
+/* After a job that friction_job_begin let run. */
+void friction_job_end(void)
+{
+    job_running = 0;
+    pthread_mutex_unlock(&job_mutex);
+}
