@@ -120,3 +120,30 @@ def test_a_closed_configuration(friction):
     with pytest.raises(ValueError, match="closed"):
         cfg.get("brake.mu")
     assert "closed" in repr(cfg)
+
+
+def test_threads_read_files_at_once(friction):
+    """Configurations read from files on several threads at once (the Fortran
+    runtime's file units are the process's: two threads reading at once got
+    false "cannot open the file" errors, then corrupted the heap and aborted
+    the interpreter).  Every read must succeed and give the one text."""
+    import threading
+
+    expected = friction.Config("afm", files=[INPUTS / "naf.nml"]).text()
+    failures = []
+
+    def reads():
+        try:
+            for _ in range(300):
+                with friction.Config("afm", files=[INPUTS / "naf.nml"]) as cfg:
+                    if cfg.text() != expected:
+                        failures.append("a different text")
+        except Exception as error:  # noqa: BLE001 - collected and reported below
+            failures.append(repr(error))
+
+    threads = [threading.Thread(target=reads) for _ in range(3)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    assert not failures, failures[:3]

@@ -120,6 +120,16 @@ module friction_capi
 
       subroutine friction_job_end() bind(c, name='friction_job_end')
       end subroutine friction_job_end
+
+      !> Around friction_config_read's file reading (job_lock.c): 1 if it
+      !> took the lock, 0 if this thread holds it for its job.
+      function friction_read_begin() bind(c, name='friction_read_begin') result(taken)
+         import :: c_int
+         integer(c_int) :: taken
+      end function friction_read_begin
+
+      subroutine friction_read_end() bind(c, name='friction_read_end')
+      end subroutine friction_read_end
    end interface
 
 contains
@@ -508,12 +518,19 @@ contains
       integer(c_size_t), value :: len
       type(capi_config), pointer :: config
       type(job_config) :: work
+      character(len=:), allocatable :: text
+      integer(c_int) :: taken
 
       status = error_input
       if (.not. c_associated(cfg)) return
       call c_f_pointer(cfg, config)
       work = config%job
-      status = text_status(job_text(work), buf, len, needed)
+      ! (The text is formatted by the Fortran runtime's internal writes, which
+      ! raced with another thread's file reading: under the read lock.)
+      taken = friction_read_begin()
+      text = job_text(work)
+      if (taken /= 0) call friction_read_end()
+      status = text_status(text, buf, len, needed)
    end function friction_config_text
 
    !> Text into a buffer: 0 when it fits; a size query (buf null, len 0)
@@ -574,6 +591,7 @@ contains
       character(len=:), allocatable :: path, problem, where
       character(len=4096) :: paths(1)
       integer :: k
+      integer(c_int) :: taken
 
       if (.not. config_of(cfg, config, error)) then
          status = report(handle, error)
@@ -590,8 +608,11 @@ contains
       end if
       paths(1) = path
       universe = all_parameters()
+      ! (One file read and parsed at a time in the process: job_lock.c.)
+      taken = friction_read_begin()
       call scan_files(paths, parameter_groups(universe), sources, error)
       if (allocated(error)) then
+         if (taken /= 0) call friction_read_end()
          status = report(handle, error)
          return
       end if
@@ -620,6 +641,7 @@ contains
          origins = config%origins
          call apply_files(sources, universe, work, origins, error)
       end if
+      if (taken /= 0) call friction_read_end()
       if (.not. allocated(error)) then
          config%job = work
          config%origins = origins

@@ -8,7 +8,13 @@
  * another thread to finish; one started on the thread already running a job
  * (from that job's report callback) cannot wait for itself and is refused.
  * The in-memory computations (friction_compute, friction_afm_line) use none
- * of that state and stay free to run at once. */
+ * of that state and stay free to run at once.
+ *
+ * Reading a namelist file (friction_config_read) takes the same lock: the
+ * Fortran runtime's file units are shared by the process, and two threads
+ * reading at once got false "cannot open the file" errors and then
+ * corrupted the heap.  A read on the thread that runs a job (from its
+ * callback) already holds it. */
 #include <pthread.h>
 
 static pthread_mutex_t job_mutex = PTHREAD_MUTEX_INITIALIZER;
@@ -28,5 +34,19 @@ int friction_job_begin(void)
 void friction_job_end(void)
 {
     job_running = 0;
+    pthread_mutex_unlock(&job_mutex);
+}
+
+/* Around a file read: 1 if the lock was taken (release it with
+ * friction_read_end), 0 if this thread holds it already for its job. */
+int friction_read_begin(void)
+{
+    if (job_running) return 0;
+    pthread_mutex_lock(&job_mutex);
+    return 1;
+}
+
+void friction_read_end(void)
+{
     pthread_mutex_unlock(&job_mutex);
 }
