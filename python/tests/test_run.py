@@ -169,3 +169,18 @@ def test_a_job_from_its_own_callback_is_refused(friction, tmp_path):
     assert out.is_file()
     assert len(inner) == 1 and "already running on this thread" in inner[0], inner
     assert not (tmp_path / "inner.h5").exists()
+
+
+def test_config_run_never_writes_over_a_file_it_read(friction, tmp_path):
+    """Config.run with force=True named the namelist file the configuration
+    was read from as its output, and replaced it with HDF5; friction.run
+    refuses that, and so must Config.run, leaving the file as it was."""
+    own = tmp_path / "own.nml"
+    own.write_bytes((DATA / "small.nml").read_bytes())
+    before = own.read_bytes()
+    with friction.Config("afm", files=[INPUTS / "naf.nml", own]) as cfg:
+        with pytest.raises(friction.FrictionError, match="the output is the input file"):
+            cfg.run(own, force=True, progress=False)
+        assert own.read_bytes() == before
+        out = cfg.run(tmp_path / "elsewhere.h5", progress=False)
+    assert out.is_file()

@@ -69,6 +69,8 @@ module friction_capi
    type :: capi_config
       type(job_config) :: job
       type(config_checker) :: origins
+      !> the files read into it: a job's output must not be one of them
+      character(len=4096), allocatable :: files(:)
    end type capi_config
 
    !> One named array of a result: rows x columns, row-major (a series is
@@ -645,6 +647,8 @@ contains
       if (.not. allocated(error)) then
          config%job = work
          config%origins = origins
+         if (.not. allocated(config%files)) allocate (config%files(0))
+         config%files = [config%files, paths(1)]
       end if
       status = report(handle, error)
    end function friction_config_read
@@ -1154,8 +1158,9 @@ contains
       if (.not. allocated(error)) then
          reporter%user = user
          if (c_associated(report_fn)) call c_f_procpointer(report_fn, reporter%call)
+         if (.not. allocated(config%files)) allocate (config%files(0))
          call run_job_config(config%job, c_string(output), iand(flags, job_force) /= 0, &
-            & iand(flags, job_resume) /= 0, comm, reporter, summary, error, config%origins)
+            & iand(flags, job_resume) /= 0, comm, reporter, summary, error, config%origins, config%files)
       end if
       call friction_job_end()
       status = report(handle, error)

@@ -72,7 +72,7 @@ contains
    !> files' would be (`origins`, if given, says where values were set, for
    !> the messages), echoed into the file as its namelist text, then run as
    !> run_job runs it.  Collective over `comm`; `config` is not changed.
-   subroutine run_job_config(config, output, force, resume, comm, reporter, summary, error, origins)
+   subroutine run_job_config(config, output, force, resume, comm, reporter, summary, error, origins, files)
       type(job_config), intent(in) :: config
       character(len=*), intent(in) :: output
       logical, intent(in) :: force, resume
@@ -81,12 +81,15 @@ contains
       character(len=:), allocatable, intent(out) :: summary
       type(error_type), allocatable, intent(out) :: error
       type(config_checker), intent(in), optional :: origins
+      !> the files the configuration was read from (the output must be none of them)
+      character(len=*), intent(in), optional :: files(:)
       type(job_context) :: job
       type(job_config) :: work
       type(config_checker) :: checker
 
       call start_job(comm, output, resume, job)
       allocate (job%files(0))
+      if (present(files)) job%files = files
       if (len_trim(output) == 0) then
          call fatal_error(error, 'no output file given', error_input)
          return
