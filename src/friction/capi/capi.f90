@@ -312,6 +312,7 @@ contains
          return
       end if
       config%job%scene_name = name
+      allocate (config%files(0))
       cfg = c_loc(config)
       status = report(handle, none)
    end function friction_config_new
@@ -647,7 +648,6 @@ contains
       if (.not. allocated(error)) then
          config%job = work
          config%origins = origins
-         if (.not. allocated(config%files)) allocate (config%files(0))
          config%files = [config%files, paths(1)]
       end if
       status = report(handle, error)
@@ -1158,7 +1158,6 @@ contains
       if (.not. allocated(error)) then
          reporter%user = user
          if (c_associated(report_fn)) call c_f_procpointer(report_fn, reporter%call)
-         if (.not. allocated(config%files)) allocate (config%files(0))
          call run_job_config(config%job, c_string(output), iand(flags, job_force) /= 0, &
             & iand(flags, job_resume) /= 0, comm, reporter, summary, error, config%origins, config%files)
       end if

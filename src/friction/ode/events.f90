@@ -124,7 +124,6 @@ module friction_ode_events
       !> Events of the last advance, in time order; a terminal one is last.
       !> (Up to two per function and step: out across zero and back.)
       type(event_hit), allocatable, public :: hits(:)
-      type(event_hit), allocatable :: found(:)   !! advance's work: the events of a step
       integer, public :: n_hits = 0
    contains
       procedure :: init
@@ -199,8 +198,6 @@ contains
       call self%probe%set_time_label(trim(self%time_name), trim(self%time_unit))
       if (allocated(self%hits)) deallocate (self%hits)
       allocate (self%hits(max(1, 2 * self%m)))
-      if (allocated(self%found)) deallocate (self%found)
-      allocate (self%found(max(1, 2 * self%m)))
       if (allocated(self%g)) deallocate (self%last_sign, self%g)
       allocate (self%last_sign(self%m), self%g(self%m))
       self%steps = 0
@@ -248,7 +245,7 @@ contains
       real(wp), intent(in) :: t1
       real(wp), intent(inout) :: y(:)
       type(error_type), allocatable, intent(out) :: error
-      ! (Fixed sizes, and the events found in the locator's own `found`:
+      ! (Fixed sizes, and the events of a step gathered in hits itself:
       ! automatic arrays would be allocated on the heap at every call.)
       real(wp) :: t0, y0(max_state), g0(max_events), f0(max_state)
       real(wp) :: tc, yc(max_state), gc(max_events), theta, h, slope0(max_events), slope1(max_events)
@@ -317,8 +314,8 @@ contains
             if (crossed(near, self%g(k), self%direction(k))) then
                nfound = nfound + 1
                call self%locate(k, t0, y0(1:self%n), g0(k), t, y(1:self%n), -near, &
-                  & self%found(nfound)%t, self%found(nfound)%y(1:self%n), error)
-               call describe(self%found(nfound), k, -near)
+                  & self%hits(nfound)%t, self%hits(nfound)%y(1:self%n), error)
+               call describe(self%hits(nfound), k, -near)
                if (allocated(error)) return
                cycle
             end if
@@ -340,16 +337,16 @@ contains
             if (crossed(near, gc(k), self%direction(k))) then
                nfound = nfound + 1
                call self%locate(k, t0, y0(1:self%n), g0(k), tc, yc(1:self%n), -near, &
-                  & self%found(nfound)%t, self%found(nfound)%y(1:self%n), error)
-               call describe(self%found(nfound), k, -near)
+                  & self%hits(nfound)%t, self%hits(nfound)%y(1:self%n), error)
+               call describe(self%hits(nfound), k, -near)
                if (allocated(error)) return
             end if
             ! ... and back, if that direction counts.
             if (crossed(-near, self%g(k), self%direction(k))) then
                nfound = nfound + 1
                call self%locate(k, tc, yc(1:self%n), gc(k), t, y(1:self%n), near, &
-                  & self%found(nfound)%t, self%found(nfound)%y(1:self%n), error)
-               call describe(self%found(nfound), k, near)
+                  & self%hits(nfound)%t, self%hits(nfound)%y(1:self%n), error)
+               call describe(self%hits(nfound), k, near)
                if (allocated(error)) return
             end if
          end do
@@ -358,33 +355,32 @@ contains
          end do
          if (nfound == 0) cycle
          do i = 1, nfound
-            self%found(i)%terminal = self%terminal(self%found(i)%which)
+            self%hits(i)%terminal = self%terminal(self%hits(i)%which)
          end do
          ! Time order (few events per step: insertion sort).
          do i = 2, nfound
-            swap = self%found(i)
+            swap = self%hits(i)
             j = i - 1
             do while (j >= 1)
-               if (self%found(j)%t <= swap%t) exit
-               self%found(j + 1) = self%found(j)
+               if (self%hits(j)%t <= swap%t) exit
+               self%hits(j + 1) = self%hits(j)
                j = j - 1
             end do
-            self%found(j + 1) = swap
+            self%hits(j + 1) = swap
          end do
          first_terminal = 0
          do i = 1, nfound
-            if (self%found(i)%terminal) then
+            if (self%hits(i)%terminal) then
                first_terminal = i
                exit
             end if
          end do
          if (first_terminal > 0) then
             nfound = first_terminal
-            t = self%found(nfound)%t
-            y(1:self%n) = self%found(nfound)%y(1:self%n)
+            t = self%hits(nfound)%t
+            y(1:self%n) = self%hits(nfound)%y(1:self%n)
             self%ready = .false.
          end if
-         self%hits(1:nfound) = self%found(1:nfound)
          self%n_hits = nfound
          self%located = self%located + nfound
          return
