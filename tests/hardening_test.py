@@ -585,7 +585,7 @@ def case_tolerance_bounds(args):
 
 
 def case_long_line(args):
-    """A namelist line of 100 000 characters reads (no line limit)."""
+    """A namelist line of 100 000 characters reads (the limit is 16 Mi)."""
     write(args, "long.nml", "&scan nx = 16," + " " * 100000 + "ny = 4, velocity = 400.0 /\n")
     friction(args, "-o", "l.h5", inputs(args, "naf.nml"), "long.nml")
     with h5py.File(path(args, "l.h5"), "r") as handle:
@@ -594,6 +594,54 @@ def case_long_line(args):
     # A value list spread over one long line, and a file without a final newline.
     write(args, "nonl.nml", "&scan nx = 16, ny = 4 /")
     friction(args, "-o", "n.h5", inputs(args, "naf.nml"), "nonl.nml")
+
+
+def case_input_not_text(args):
+    """What is not a text file is bad input at once (exit 3, no file), never
+    a read without end: a device (/dev/zero fed the reader forever), a
+    directory (read as an empty namelist), and the same as an XYZ net file;
+    a line without end in a pipe stops at the 16 Mi limit."""
+    write(args, "small.nml", SMALL)
+    for name, word in (("/dev/zero", "device"), ("/dev/null", "device"), (args.workdir, "directory")):
+        result = friction(args, inputs(args, "naf.nml"), name, "small.nml", expect=3, timeout=60)
+        contains(result, name, word)
+        write(args, "net.nml", f"&surface net = 'file', net_file = '{name}' /\n" + GRAPHITE_SMALL)
+        result = friction(args, inputs(args, "graphite.nml"), "net.nml", expect=3, timeout=60)
+        contains(result, name, word)
+    # A pipe of 20 Mi characters without a line end.
+    result = friction(args, inputs(args, "naf.nml"), "/dev/stdin", stdin="&scan nx = 16," + " " * (20 << 20),
+                      expect=3, timeout=60)
+    contains(result, "/dev/stdin:1", "longer than 16 Mi")
+    if [f for f in listing(args.workdir) if f.endswith(".h5")]:
+        fail("bad input wrote a file")
+
+
+def case_input_size(args):
+    """Large inputs take time in proportion to their size: 200 000
+    assignments in one file and a list of 300 000 values read in seconds
+    (the scan and the value lists were quadratic: 20 000 assignments took
+    8 s, 80 000 values 47 s, so these would take minutes; the timeout is
+    60 s).  A repeat count beyond the 10 million values a list holds is bad
+    input, not 16 GB of bounds; and a message shows a long value cut."""
+    write(args, "many.nml", "&scan " + " ".join(["nx = 16,"] * 200000) + " ny = 4 /\n")
+    result = friction(args, "--print-input", inputs(args, "naf.nml"), "many.nml", timeout=60)
+    if "nx = 16" not in result.stdout:
+        fail("the last of many assignments was not read")
+    values = ", ".join(f"{10.0 + 1e-5 * k:.5f}" for k in range(300000))
+    write(args, "list.nml", f"&sweep sweep_variable = 'tip.kx', sweep_values = {values} /\n")
+    result = friction(args, "--print-input", inputs(args, "naf.nml"), "list.nml", timeout=60)
+    if "12.99999" not in result.stdout:
+        fail("the last of the sweep's values was not echoed")
+    write(args, "repeat.nml", "&sweep sweep_variable = 'tip.kx', sweep_values = 2000000000*10.0 /\n")
+    result = friction(args, inputs(args, "naf.nml"), "repeat.nml", expect=3, timeout=60)
+    contains(result, "repeat.nml:1", "sweep_values", "the most a list holds")
+    write(args, "scalar.nml", "&tip kx = " + ", ".join(["10.0"] * 100000) + " /\n")
+    result = friction(args, inputs(args, "naf.nml"), "scalar.nml", expect=3, timeout=60)
+    contains(result, "scalar.nml:1", "kx", "more characters)", "more values than the 1 elements")
+    if len(result.stderr) > 1000:
+        fail(f"the message carries the whole value: {len(result.stderr)} characters")
+    if [f for f in listing(args.workdir) if f.endswith(".h5")]:
+        fail("bad input wrote a file")
 
 
 def case_stdin(args):

@@ -16,7 +16,7 @@ module friction_afm_config
    use friction_kinds, only: ev_per_angstrom_to_nn
    use friction_afm_tip, only: afm_tip, model_inertial, model_overdamped, model_quasistatic, find_height
    use friction_strings, only: itoa, rtoa, quoted, bytes_text
-   use friction_files, only: file_exists
+   use friction_files, only: file_exists, path_kind, kind_regular
    use friction_parameters, only: configurable, parameter_visitor
    use friction_checks, only: config_checker
    use friction_ode_settings, only: visit_integrator, check_integrator, verify_settings, visit_verify, check_verify
@@ -411,6 +411,9 @@ contains
          n = config%side**2
       case default
          n = -1
+         ! Only a regular file: a pipe would be used up, a device read forever
+         ! (the net's reader says what is wrong with such a file).
+         if (path_kind(trim(config%net_file), follow=.true.) /= kind_regular) return
          open (newunit=unit, file=config%net_file, status='old', action='read', iostat=stat)
          if (stat /= 0) return
          read (unit, *, iostat=stat) n

@@ -15,7 +15,8 @@ module friction_files
    public :: rename_file, remove_file, file_exists, process_id, write_text_file, open_for_reading
    public :: path_kind, same_file, publish_file, truncate_file, output_problem, system_error_text, free_bytes
    public :: available_memory, write_bytes, min_free_bytes
-   public :: kind_none, kind_regular, kind_directory, kind_link, kind_other, kind_unknown
+   public :: kind_none, kind_regular, kind_directory, kind_link, kind_other, kind_pipe, kind_unknown
+   public :: read_text_line, max_line_length
 
    !> Free space, bytes, below which no output is written: an HDF5 file that
    !> fails for a full disk can be closed (and so leave no handle open) only
@@ -24,7 +25,13 @@ module friction_files
 
    !> What path_kind finds at a path.
    integer, parameter :: kind_none = 0, kind_regular = 1, kind_directory = 2, kind_link = 3, kind_other = 4, &
-      & kind_unknown = -1
+      & kind_pipe = 5, kind_unknown = -1
+
+   !> The longest line of an input text file (a namelist or an XYZ file):
+   !> a longer one is refused as not text, so that a device or a stream
+   !> without line ends (/dev/zero, a binary file) ends in an error, not in a
+   !> read that fills the memory.
+   integer, parameter :: max_line_length = 16 * 1048576
 
    interface
       function c_rename(from, to) result(stat) bind(c, name='rename')
@@ -116,24 +123,110 @@ module friction_files
 contains
 
    !> Open an existing file to read: a missing file is bad input, one that
-   !> cannot be opened an error of `category` (bad input by default).
-   subroutine open_for_reading(path, unit, error, category)
+   !> cannot be opened an error of `category` (bad input by default).  Only
+   !> a regular file (links followed), or a pipe with `pipe`, is opened: a
+   !> directory, a device (/dev/zero would feed a read forever) or a socket
+   !> is bad input.
+   subroutine open_for_reading(path, unit, error, category, pipe)
       character(len=*), intent(in) :: path
       integer, intent(out) :: unit
       type(error_type), allocatable, intent(out) :: error
       integer, intent(in), optional :: category
+      logical, intent(in), optional :: pipe
       integer :: stat
+      logical :: pipe_ok
 
+      unit = -1
+      pipe_ok = .false.
+      if (present(pipe)) pipe_ok = pipe
       if (.not. file_exists(path)) then
          call fatal_error(error, path//': no such file', error_input)
          return
       end if
+      select case (path_kind(path, follow=.true.))
+      case (kind_directory)
+         call fatal_error(error, path//': is a directory, not a file', error_input)
+         return
+      case (kind_other)
+         if (pipe_ok) then
+            call fatal_error(error, path//': is a device or socket, not a file; give a regular file or a pipe', &
+               & error_input)
+         else
+            call fatal_error(error, path//': is a device or socket, not a file; give a regular file', error_input)
+         end if
+         return
+      case (kind_pipe)
+         if (.not. pipe_ok) then
+            call fatal_error(error, path//': is a pipe, which can be read only once; give a regular file', &
+               & error_input)
+            return
+         end if
+      end select
       open (newunit=unit, file=path, status='old', action='read', iostat=stat)
       if (stat /= 0) then
          call fatal_error(error, path//': cannot open the file', error_input)
          if (present(category)) error%stat = category
       end if
    end subroutine open_for_reading
+
+   !> One line of an input text file, however long (read in pieces without
+   !> advancing), without its end.  stat < 0 at the end of the file, > 0 on
+   !> a read error (`message` says which).  `problem` is set, with stat 0,
+   !> when the line is not text: a control character other than tab, form
+   !> feed and the CR of a CR LF line end (which becomes a blank), or more
+   !> than max_line_length characters; the line is then read no further.  A
+   !> last line without its newline still counts.
+   subroutine read_text_line(unit, got, stat, message, problem)
+      integer, intent(in) :: unit
+      character(len=:), allocatable, intent(out) :: got
+      integer, intent(out) :: stat
+      character(len=*), intent(inout) :: message
+      character(len=:), allocatable, intent(out) :: problem
+      character(len=:), allocatable :: grown
+      character(len=4096) :: piece
+      integer :: size_read, used, i, code
+
+      problem = ''
+      allocate (character(len=4096) :: got)
+      used = 0
+      do
+         read (unit, '(a)', advance='no', iostat=stat, iomsg=message, size=size_read) piece
+         do i = 1, size_read
+            code = iachar(piece(i:i))
+            if (code == 13) then
+               piece(i:i) = ' '
+            else if (code < 32 .and. code /= 9 .and. code /= 12) then
+               problem = 'control character (byte '//itoa(code)//') in column '//itoa(used + i) &
+                  & //': not a text file'
+               got = got(1:used)
+               stat = 0
+               return
+            end if
+         end do
+         if (used + size_read > max_line_length) then
+            problem = 'a line longer than '//itoa(max_line_length / 1048576)//' Mi characters: not a text file'
+            got = got(1:used)
+            stat = 0
+            return
+         end if
+         if (used + size_read > len(got)) then
+            allocate (character(len=max(2 * len(got), used + size_read)) :: grown)
+            grown(1:used) = got(1:used)
+            call move_alloc(grown, got)
+         end if
+         got(used + 1:used + size_read) = piece(1:size_read)
+         used = used + size_read
+         if (is_iostat_eor(stat)) then
+            stat = 0
+            exit
+         end if
+         if (stat /= 0) then
+            if (is_iostat_end(stat) .and. used > 0) stat = 0
+            exit
+         end if
+      end do
+      got = got(1:used)
+   end subroutine read_text_line
 
    logical function file_exists(path)
       character(len=*), intent(in) :: path
@@ -190,7 +283,7 @@ contains
          problem = 'is a symbolic link; friction neither follows nor replaces links, so name the file itself'
       case (kind_directory)
          problem = 'is a directory'
-      case (kind_other)
+      case (kind_other, kind_pipe)
          problem = 'is not a regular file (a device, pipe or socket); friction writes only regular files ' &
             & //'and --force replaces only a regular file'
       case (kind_regular)

@@ -14,8 +14,8 @@
 #include <unistd.h>
 
 /* What is at path, the link itself when follow is 0: 0 nothing, 1 a regular
- * file, 2 a directory, 3 a symbolic link, 4 anything else (a device, pipe or
- * socket), -1 cannot tell (permission, a path too long, ...). */
+ * file, 2 a directory, 3 a symbolic link, 5 a pipe (FIFO), 4 anything else (a
+ * device or socket), -1 cannot tell (permission, a path too long, ...). */
 int friction_path_kind(const char *path, int follow)
 {
     struct stat s;
@@ -24,6 +24,7 @@ int friction_path_kind(const char *path, int follow)
     if (S_ISREG(s.st_mode)) return 1;
     if (S_ISDIR(s.st_mode)) return 2;
     if (S_ISLNK(s.st_mode)) return 3;
+    if (S_ISFIFO(s.st_mode)) return 5;
     return 4;
 }
 

@@ -18,6 +18,11 @@ module friction_parameters
 
    integer, parameter :: mode_list = 1, mode_set = 2, mode_get = 3, mode_write = 4
 
+   !> The most values a list of any length (real_list: a sweep's values)
+   !> takes, repeat counts included: a bound on the memory a value text can
+   !> ask for.
+   integer, parameter, public :: max_list_values = 10000000
+
    !> One variable: where it lives, its kind ('r' real, 'i' integer, 'l'
    !> logical, 'c' text), its number of elements (1 for a scalar) and unit.
    type :: parameter_info
@@ -255,7 +260,7 @@ contains
          if (self%from_number) then
             last = first
          else
-            call value_items(self%text, huge(1), self%first, from, to, self%problem)
+            call value_items(self%text, max_list_values, self%first, from, to, self%problem)
             if (len(self%problem) > 0) return
             last = first + size(from) - 1
          end if
@@ -273,6 +278,12 @@ contains
          end if
          do k = 1, size(from)
             if (to(k) < from(k)) cycle   ! a null value leaves the element
+            if (k > 1) then
+               if (from(k) == from(k - 1) .and. to(k) == to(k - 1)) then   ! a repeat: read once
+                  value(first + k - 1) = value(first + k - 2)
+                  cycle
+               end if
+            end if
             read (self%text(from(k):to(k)), *, iostat=stat) value(first + k - 1)
             if (stat /= 0) then
                self%problem = 'expected '//kind_text('r')
@@ -706,41 +717,55 @@ contains
       write (word, '(a, a, i0)') buffer(1:cut), 'e', stat
    end function shortest
 
-   !> Values joined by ', ', repeats as n*value.
+   !> Values joined by ', ', repeats as n*value (in two passes, the length
+   !> and then the text: time in proportion to the values).
    pure function run_lengths(words) result(text)
       character(len=*), intent(in) :: words(:)
       character(len=:), allocatable :: text
-      integer :: k, n
+      character(len=:), allocatable :: piece
+      integer :: k, n, pass, used
 
-      text = ''
-      k = 1
-      do while (k <= size(words))
-         n = 1
-         do while (k + n <= size(words))
-            if (words(k + n) /= words(k)) exit
-            n = n + 1
+      allocate (character(len=0) :: text)
+      do pass = 1, 2
+         used = 0
+         k = 1
+         do while (k <= size(words))
+            n = 1
+            do while (k + n <= size(words))
+               if (words(k + n) /= words(k)) exit
+               n = n + 1
+            end do
+            piece = trim(words(k))
+            if (n > 1) piece = itoa(n)//'*'//piece
+            if (used > 0) piece = ', '//piece
+            if (pass == 2) text(used + 1:used + len(piece)) = piece
+            used = used + len(piece)
+            k = k + n
          end do
-         if (len(text) > 0) text = text//', '
-         if (n > 1) then
-            text = text//itoa(n)//'*'//trim(words(k))
-         else
-            text = text//trim(words(k))
+         if (pass == 1) then
+            deallocate (text)
+            allocate (character(len=used) :: text)
          end if
-         k = k + n
       end do
    end function run_lengths
 
    pure function quote(text) result(out)
       character(len=*), intent(in) :: text
       character(len=:), allocatable :: out
-      integer :: i
+      character(len=2 * len(text) + 2) :: buffer
+      integer :: i, n
 
-      out = "'"
+      buffer(1:1) = "'"
+      n = 1
       do i = 1, len(text)
-         out = out//text(i:i)
-         if (text(i:i) == "'") out = out//"'"
+         n = n + 1
+         buffer(n:n) = text(i:i)
+         if (text(i:i) == "'") then
+            n = n + 1
+            buffer(n:n) = "'"
+         end if
       end do
-      out = out//"'"
+      out = buffer(1:n)//"'"
    end function quote
 
    pure logical function is_quoted(item)
@@ -755,19 +780,22 @@ contains
    pure function unquote(item) result(text)
       character(len=*), intent(in) :: item
       character(len=:), allocatable :: text
-      integer :: i
+      character(len=max(len(item) - 2, 0)) :: buffer
+      integer :: i, n
       character :: q
 
       q = item(1:1)
-      text = ''
+      n = 0
       i = 2
       do while (i < len(item))
-         text = text//item(i:i)
+         n = n + 1
+         buffer(n:n) = item(i:i)
          if (item(i:i) == q .and. i + 1 < len(item)) then
             if (item(i + 1:i + 1) == q) i = i + 1
          end if
          i = i + 1
       end do
+      text = buffer(1:n)
    end function unquote
 
    !> The items of a value (separated by commas or blanks outside quotes;
@@ -782,12 +810,14 @@ contains
       integer, allocatable, intent(out) :: from(:), to(:)
       character(len=:), allocatable, intent(out) :: problem
       integer, allocatable :: word_from(:), word_to(:)
-      integer :: i, n, star, repeat, stat, k, start
+      integer :: i, n, star, repeat, stat, k, start, words
       character :: q, c
       logical :: comma_last, in_word
 
       problem = ''
-      allocate (word_from(0), word_to(0), from(0), to(0))
+      allocate (word_from(16), word_to(16), from(16), to(16))
+      words = 0
+      n = 0
       q = ' '
       comma_last = .true.
       in_word = .false.
@@ -811,15 +841,11 @@ contains
             cycle
          end if
          if (in_word) then
-            word_from = [word_from, start]
-            word_to = [word_to, i - 1]
+            call push(word_from, word_to, words, start, i - 1)
             in_word = .false.
             comma_last = .false.
          else if (i <= len(text) .and. c == ',') then
-            if (comma_last) then   ! a null value
-               word_from = [word_from, i]
-               word_to = [word_to, i - 1]
-            end if
+            if (comma_last) call push(word_from, word_to, words, i, i - 1)   ! a null value
          end if
          if (i <= len(text) .and. c == ',') comma_last = .true.
       end do
@@ -827,7 +853,7 @@ contains
          problem = 'the quoted text is not closed'
          return
       end if
-      do k = 1, size(word_from)
+      do k = 1, words
          repeat = 1
          if (word_to(k) >= word_from(k)) then
             star = index(text(word_from(k):word_to(k)), '*')
@@ -842,21 +868,46 @@ contains
                end if
             end if
          end if
-         if (size(from) + repeat > room) then
+         if (repeat > room - n) then
             problem = 'more values than the '//itoa(room)//' elements'
+            if (room == max_list_values) problem = 'more than '//itoa(room)//' values, the most a list holds'
             return
          end if
-         do n = 1, repeat
-            from = [from, word_from(k)]
-            to = [to, word_to(k)]
+         do i = 1, repeat
+            call push(from, to, n, word_from(k), word_to(k))
          end do
       end do
-      n = size(from)
+      from = from(1:n)
+      to = to(1:n)
       if (n == 0) then
          problem = 'no value'
          return
       end if
       if (max(1, first) + n - 1 > room) problem = 'more values than the '//itoa(room)//' elements'
+
+   contains
+
+      !> Bounds (a, b) after the first `count` pairs, the room doubled when
+      !> full: time in proportion to the items, however many.
+      pure subroutine push(lower_bounds, upper_bounds, count, a, b)
+         integer, allocatable, intent(inout) :: lower_bounds(:), upper_bounds(:)
+         integer, intent(inout) :: count
+         integer, intent(in) :: a, b
+         integer, allocatable :: grown(:)
+
+         if (count == size(lower_bounds)) then
+            allocate (grown(2 * count))
+            grown(1:count) = lower_bounds(1:count)
+            call move_alloc(grown, lower_bounds)
+            allocate (grown(2 * count))
+            grown(1:count) = upper_bounds(1:count)
+            call move_alloc(grown, upper_bounds)
+         end if
+         count = count + 1
+         lower_bounds(count) = a
+         upper_bounds(count) = b
+      end subroutine push
+
    end subroutine value_items
 
    !> Why a number read from `text` is not the number the text says ('' when
@@ -940,14 +991,17 @@ contains
       real(wp) :: x
       integer(i8) :: m
 
-      call value_items(text, huge(1) - 1, 0, from, to, problem)
+      call value_items(text, max_list_values, 0, from, to, problem)
       ok = .true.
       if (len(problem) > 0) then
-         ok = problem == 'no value' .or. index(problem, 'elements') > 0   ! left to the setter
+         ok = problem == 'no value' .or. index(problem, 'more ') == 1   ! left to the setter
          return
       end if
       do k = 1, size(from)
          if (to(k) < from(k)) cycle
+         if (k > 1) then
+            if (from(k) == from(k - 1) .and. to(k) == to(k - 1)) cycle   ! a repeat, checked already
+         end if
          select case (kind)
          case ('c')
             ok = is_quoted(text(from(k):to(k)))

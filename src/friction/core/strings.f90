@@ -5,7 +5,7 @@ module friction_strings
    implicit none
    private
 
-   public :: itoa, rtoa, join, quoted, lower, text_hash, bytes_text, fixed_text
+   public :: itoa, rtoa, join, quoted, lower, text_hash, bytes_text, fixed_text, one_line
 
    !> An integer as text, without blanks.
    interface itoa
@@ -58,6 +58,25 @@ contains
       end if
       text = buffer(k:)
    end function itoa8
+
+   !> A text on one line, for messages: newlines and carriage returns as
+   !> blanks; with `longest`, a text longer than that is cut to its first
+   !> longest - 20 characters and a count of the rest.
+   pure function one_line(text, longest) result(out)
+      character(len=*), intent(in) :: text
+      integer, intent(in), optional :: longest
+      character(len=:), allocatable :: out
+      integer :: i
+
+      out = text
+      if (present(longest)) then
+         if (len(text) > longest) out = text(1:longest - 20)//' ... ('//itoa(len(text) - longest + 20) &
+            & //' more characters)'
+      end if
+      do i = 1, len(out)
+         if (out(i:i) == new_line('a') .or. out(i:i) == achar(13)) out(i:i) = ' '
+      end do
+   end function one_line
 
    !> A real as text with 7 significant digits.
    pure function rtoa(x) result(text)

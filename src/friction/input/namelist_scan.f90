@@ -6,7 +6,7 @@
 module friction_input_scan
    use friction_strings, only: join, lower, itoa
    use friction_error, only: error_type, fatal_error, error_input
-   use friction_files, only: open_for_reading
+   use friction_files, only: open_for_reading, read_text_line
    implicit none
    private
 
@@ -47,10 +47,11 @@ contains
       character(len=32), allocatable :: seen(:)
       integer, allocatable :: seen_lines(:)
       character :: quote
-      integer :: i, j, k, n, value_from, first, stat
+      integer :: i, j, k, n, value_from, first, stat, count
       logical :: in_group, open_mention
 
-      allocate (mentions(0), seen(0), seen_lines(0))
+      allocate (mentions(16), seen(0), seen_lines(0))
+      count = 0
       if (present(groups)) allocate (groups(0))
       if (present(group_lines)) allocate (group_lines(0))
       call read_text(path, text, line_of, error)
@@ -107,7 +108,10 @@ contains
                first = 0
                if (k >= 1) then
                   if (text(k:k) == ')') then
-                     j = index(text(1:k), '(', back=.true.)
+                     ! An index is short: look no further back than 64 characters (a
+                     ! long text of ')' would make every '=' rescan it).
+                     j = index(text(max(1, k - 64):k), '(', back=.true.)
+                     if (j > 0) j = j + max(1, k - 64) - 1
                      if (j > 0) then
                         read (text(j + 1:k - 1), *, iostat=stat) first
                         if (stat /= 0) first = 0
@@ -122,12 +126,13 @@ contains
                end do
                if (k > j) then
                   call close_value(j)
-                  call grow(mentions)
-                  mentions(size(mentions))%group = group
-                  mentions(size(mentions))%name = lower(text(j + 1:k))
-                  mentions(size(mentions))%first = first
-                  mentions(size(mentions))%line = line_of(j + 1)
-                  mentions(size(mentions))%value = ''
+                  if (count == size(mentions)) call resize(mentions, 2 * count)
+                  count = count + 1
+                  mentions(count)%group = group
+                  mentions(count)%name = lower(text(j + 1:k))
+                  mentions(count)%first = first
+                  mentions(count)%line = line_of(j + 1)
+                  mentions(count)%value = ''
                   open_mention = .true.
                   value_from = i + 1
                end if
@@ -139,6 +144,7 @@ contains
          call fatal_error(error, path//': group &'//group//" is not closed with '/'", error_input)
          return
       end if
+      call resize(mentions, count)
       if (present(groups)) groups = seen
       if (present(group_lines)) group_lines = seen_lines
 
@@ -149,66 +155,77 @@ contains
          integer, intent(in) :: last
 
          if (.not. open_mention) return
-         mentions(size(mentions))%value = trim(adjustl(text(value_from:last)))
+         mentions(count)%value = trim(adjustl(text(value_from:last)))
          open_mention = .false.
       end subroutine close_value
 
    end subroutine scan_namelist_file
 
-   !> One more (empty) mention at the end.  (Element by element: gfortran's
-   !> array constructors mishandle deferred-length character components.)
-   subroutine grow(mentions)
+   !> The first `n` mentions (those beyond the old size empty), moved to an
+   !> array of that size: the scan doubles its room, so that a file of many
+   !> assignments takes time in proportion to them.  (Element by element:
+   !> gfortran's array constructors mishandle deferred-length character
+   !> components.)
+   subroutine resize(mentions, n)
       type(mention), allocatable, intent(inout) :: mentions(:)
-      type(mention), allocatable :: more(:)
+      integer, intent(in) :: n
+      type(mention), allocatable :: moved(:)
       integer :: k
 
-      allocate (more(size(mentions) + 1))
-      do k = 1, size(mentions)
-         more(k)%group = mentions(k)%group
-         more(k)%name = mentions(k)%name
-         more(k)%first = mentions(k)%first
-         more(k)%line = mentions(k)%line
-         if (allocated(mentions(k)%value)) call move_alloc(mentions(k)%value, more(k)%value)
+      allocate (moved(n))
+      do k = 1, min(n, size(mentions))
+         moved(k)%group = mentions(k)%group
+         moved(k)%name = mentions(k)%name
+         moved(k)%first = mentions(k)%first
+         moved(k)%line = mentions(k)%line
+         if (allocated(mentions(k)%value)) call move_alloc(mentions(k)%value, moved(k)%value)
       end do
-      call move_alloc(more, mentions)
-   end subroutine grow
+      call move_alloc(moved, mentions)
+   end subroutine resize
 
    !> The file as one text with newlines, comments blanked, and the line of
-   !> every character.  Lines of any length (read in pieces without
-   !> advancing); a file that is not a regular one (a pipe) is read once, as
-   !> it comes.
+   !> every character.  Lines of any length up to max_line_length; a file
+   !> that is not a regular one (a pipe) is read once, as it comes.  A
+   !> control character or an overlong line (a binary file, a device) is an
+   !> error naming the line, and so is a text beyond max_text_length (a
+   !> pipe that never ends).
    subroutine read_text(path, text, line_of, error)
       character(len=*), intent(in) :: path
       character(len=:), allocatable, intent(out) :: text
       integer, allocatable, intent(out) :: line_of(:)
       type(error_type), allocatable, intent(out) :: error
-      character(len=:), allocatable :: buffer, whole
+      integer, parameter :: max_text_length = 64 * 1048576
+      character(len=:), allocatable :: buffer, problem
+      character(len=:), allocatable :: whole
       character(len=256) :: message
       character :: quote
       integer :: unit, stat, line, i, n, used, filled
 
-      call open_for_reading(path, unit, error)
+      call open_for_reading(path, unit, error, pipe=.true.)
       if (allocated(error)) return
       allocate (character(len=4096) :: whole)
       allocate (line_of(4096))
       used = 0
       line = 0
+      message = ''
       do
-         call read_line(buffer, stat)
+         call read_text_line(unit, buffer, stat, message, problem)
          if (stat /= 0) exit
          line = line + 1
-         n = len_trim(buffer)
          ! A namelist file is text: a control character (a NUL, the bytes of a
          ! binary file given by mistake) is an error, not something to skip.
-         do i = 1, n
-            if (buffer(i:i) == achar(13)) buffer(i:i) = ' '   ! a CR of a CR LF line end
-            if (iachar(buffer(i:i)) < 32 .and. iachar(buffer(i:i)) /= 9 .and. iachar(buffer(i:i)) /= 12) then
-               close (unit)
-               call fatal_error(error, path//':'//itoa(line)//': control character (byte '// &
-                  & itoa(iachar(buffer(i:i)))//') in column '//itoa(i)//': not a namelist text file', error_input)
-               return
-            end if
-         end do
+         if (len(problem) > 0) then
+            close (unit)
+            call fatal_error(error, path//':'//itoa(line)//': '//problem, error_input)
+            return
+         end if
+         if (used + len(buffer) >= max_text_length) then
+            close (unit)
+            call fatal_error(error, path//':'//itoa(line)//': the file is longer than ' &
+               & //itoa(max_text_length / 1048576)//' MiB: not a namelist file', error_input)
+            return
+         end if
+         n = len_trim(buffer)
          quote = ' '
          do i = 1, n
             if (quote /= ' ') then
@@ -232,30 +249,6 @@ contains
       line_of = line_of(1:used)
 
    contains
-
-      !> One whole line, however long, without its end; stat < 0 at the end
-      !> of the file, > 0 on a read error.
-      subroutine read_line(got, stat)
-         character(len=:), allocatable, intent(out) :: got
-         integer, intent(out) :: stat
-         character(len=4096) :: piece
-         integer :: size_read
-
-         got = ''
-         do
-            read (unit, '(a)', advance='no', iostat=stat, iomsg=message, size=size_read) piece
-            got = got//piece(1:size_read)
-            if (is_iostat_eor(stat)) then
-               stat = 0
-               return
-            end if
-            if (stat /= 0) then
-               ! A last line without its newline still counts.
-               if (is_iostat_end(stat) .and. len(got) > 0) stat = 0
-               return
-            end if
-         end do
-      end subroutine read_line
 
       !> Add characters of one line to the text.
       subroutine append(more, line)

@@ -7,7 +7,7 @@
 !> variables (core/parameters.f90); where each value came from is kept for
 !> the messages of the configuration's checks.
 module friction_input_reader
-   use friction_strings, only: itoa, join
+   use friction_strings, only: itoa, join, one_line
    use friction_error, only: error_type, fatal_error, error_input
    use friction_parameters, only: configurable, parameter_info, set_parameter, list_parameters, kind_text, value_has_kind, &
       & split_name
@@ -112,7 +112,7 @@ contains
       character(len=:), allocatable :: group, name
       integer :: equals, first
 
-      source%path = '--set '//trim(text)
+      source%path = '--set '//one_line(trim(text), 100)
       source%override = .true.
       allocate (source%mentions(1), source%groups(0), source%group_lines(0))
       equals = index(text, '=')
@@ -186,7 +186,7 @@ contains
                   return
                end if
                if (.not. value_has_kind(m%value, universe(u)%kind)) then
-                  call fatal_error(error, where//trim(m%name)//' = '//trim(one_line(m%value))//': expected ' &
+                  call fatal_error(error, where//trim(m%name)//' = '//trim(one_line(m%value, 100))//': expected ' &
                      & //kind_text(universe(u)%kind), error_input)
                   return
                end if
@@ -200,7 +200,7 @@ contains
                if (len(problem) > 0) then
                   shown = trim(m%name)
                   if (m%first > 0) shown = shown//'('//itoa(m%first)//')'
-                  call fatal_error(error, where//': &'//trim(m%group)//': '//shown//' = '//trim(one_line(m%value)) &
+                  call fatal_error(error, where//': &'//trim(m%group)//': '//shown//' = '//trim(one_line(m%value, 100)) &
                      & //': '//problem, error_input)
                   return
                end if
@@ -232,17 +232,5 @@ contains
       path = ''
       if (stat == 0) path = trim(buffer)//'/'
    end function working_directory
-
-   !> A value's text on one line, for messages.
-   pure function one_line(text) result(out)
-      character(len=*), intent(in) :: text
-      character(len=len(text)) :: out
-      integer :: i
-
-      out = text
-      do i = 1, len(out)
-         if (out(i:i) == new_line('a')) out(i:i) = ' '
-      end do
-   end function one_line
 
 end module friction_input_reader

@@ -32,7 +32,7 @@ module friction_job_sweep
    use friction_kinds, only: wp, i8
    use friction_clock, only: wall_seconds
    use friction_error, only: error_type, fatal_error, error_interrupted, error_input, error_numerical, error_io
-   use friction_strings, only: itoa, text_hash, bytes_text
+   use friction_strings, only: itoa, text_hash, bytes_text, one_line
    use friction_version, only: version_string
    use friction_ode_solver, only: integrator_statistics, step_type_index, step_type_names, step_type_name_length
    use friction_parameters, only: set_parameter_number, split_name, parameter_info, list_parameters
@@ -255,7 +255,7 @@ contains
          mine%reason = ''
          if (allocated(point_error)) then
             mine%header(2) = status_failed
-            mine%reason = one_line(point_error%message)
+            mine%reason = one_line(trim(point_error%message))
             results(:size(results) - 1) = 0.0_wp   ! (the stepper it ran stays)
             deallocate (point_error)
             if (allocated(series)) deallocate (series)
@@ -424,18 +424,6 @@ contains
       call point%check(checker)
       if (checker%failed()) call move_alloc(checker%error, error)
    end subroutine point_scene
-
-   !> A reason on one line.
-   function one_line(text) result(line)
-      character(len=*), intent(in) :: text
-      character(len=:), allocatable :: line
-      integer :: k
-
-      line = trim(text)
-      do k = 1, len(line)
-         if (line(k:k) == new_line('a') .or. line(k:k) == achar(13)) line(k:k) = ' '
-      end do
-   end function one_line
 
    ! ---- a finished point's way to rank 0 ----
 

@@ -10,8 +10,8 @@
 module friction_surface_net
    use friction_kinds, only: wp
    use friction_error, only: error_type, fatal_error, error_input, error_io
-   use friction_strings, only: itoa, join
-   use friction_files, only: open_for_reading
+   use friction_strings, only: itoa, join, one_line
+   use friction_files, only: open_for_reading, read_text_line
    implicit none
    private
 
@@ -406,25 +406,30 @@ contains
       character(len=*), intent(in) :: species_names(:)
       type(crystal_net), intent(out) :: net
       type(error_type), allocatable, intent(out) :: error
-      character(len=1024) :: line
+      character(len=:), allocatable :: line, problem
+      character(len=256) :: message
       character(len=64) :: label
       real(wp), allocatable :: position(:, :)
       integer, allocatable :: species(:)
       logical, allocatable :: vacant(:)
       integer, allocatable :: kept(:)
       type(crystal_net) :: atoms
-      integer :: unit, stat, n, i, k
+      integer :: unit, stat, n, i, k, number
 
       call open_for_reading(path, unit, error, error_io)
       if (allocated(error)) return
-      read (unit, '(a)', iostat=stat) line
+      message = ''
+      number = 0
+      call next_line()
+      if (allocated(error)) return
       if (stat == 0) read (line, *, iostat=stat) n
       if (stat /= 0 .or. n < 1) then
          call fatal_error(error, path//':1: the first line must hold the number of atoms (>= 1)', error_input)
          close (unit)
          return
       end if
-      read (unit, '(a)', iostat=stat) line   ! comment line
+      call next_line()   ! comment line
+      if (allocated(error)) return
       allocate (position(3, n), species(n), vacant(n), stat=stat)
       if (stat /= 0) then
          call fatal_error(error, path//':1: '//itoa(n)//' atoms announced: more than this machine can hold', &
@@ -433,7 +438,8 @@ contains
          return
       end if
       do i = 1, n
-         read (unit, '(a)', iostat=stat) line
+         call next_line()
+         if (allocated(error)) return
          if (stat /= 0) then
             call fatal_error(error, path//':'//itoa(i + 2)//': the file ends after '//itoa(i - 1) &
                & //' atoms, but its first line announces '//itoa(n), error_input)
@@ -443,7 +449,7 @@ contains
          read (line, *, iostat=stat) label, position(:, i)
          if (stat /= 0 .or. .not. all(abs(position(:, i)) <= huge(1.0_wp))) then
             call fatal_error(error, path//':'//itoa(i + 2)//': expected "species x y z" with numbers, got "' &
-               & //trim(line)//'"', error_input)
+               & //one_line(trim(line), 100)//'"', error_input)
             close (unit)
             return
          end if
@@ -461,7 +467,8 @@ contains
       end do
       ! Anything but blank lines after the announced atoms means a wrong count.
       do
-         read (unit, '(a)', iostat=stat) line
+         call next_line()
+         if (allocated(error)) return
          if (stat /= 0) exit
          if (len_trim(line) > 0) then
             call fatal_error(error, path//':'//itoa(n + 3)//': more atoms than the '//itoa(n) &
@@ -485,6 +492,24 @@ contains
          return
       end if
       call net%remove_sites(vacant)
+
+   contains
+
+      !> The next line in `line` (stat < 0 at the end); a line that is not
+      !> text (a control character, a device's endless bytes) or a read error
+      !> closes the file with an error naming the line.
+      subroutine next_line()
+         call read_text_line(unit, line, stat, message, problem)
+         if (stat > 0) then
+            call fatal_error(error, path//':'//itoa(number + 1)//': cannot read the file ('//trim(message)//')', &
+               & error_io)
+         else if (stat == 0) then
+            number = number + 1
+            if (len(problem) > 0) call fatal_error(error, path//':'//itoa(number)//': '//problem, error_input)
+         end if
+         if (allocated(error)) close (unit)
+      end subroutine next_line
+
    end subroutine read_xyz
 
    !> The indices that put `values` in ascending order (a stable bottom-up
