@@ -222,6 +222,18 @@ typedef void (*friction_report_fn)(const char *message, double fraction, void *u
 int friction_run_job(const char *const *files, int nfiles, const char *output, int flags,
                      friction_report_fn report, void *user, friction_error *err);
 
+/* Ask the job running in this process (friction_run_job, friction_run_config)
+ * to stop at its next safe point: between two scan lines of a map, or two
+ * points of a sweep.  The job then returns FRICTION_INTERRUPTED: a sweep
+ * writes its file with the points done, a map writes no file and keeps the
+ * lines done beside the output; the same job with FRICTION_JOB_RESUME
+ * computes only the rest.  A brake trajectory that is not a sweep runs to
+ * its end.  Callable from any thread, from the job's report callback and
+ * from a signal handler (one atomic store); a request made while no job
+ * runs is forgotten when the next job begins.  Under MPI the request is
+ * rank 0's: the other ranks finish their share first. */
+void friction_job_stop(void);
+
 /* The job of a configuration handle, as friction_run_job runs one read from
  * files: checked, computed (every group: &analysis, &verify, &sweep), and
  * written to `output`, whose `input` attribute is the configuration's text

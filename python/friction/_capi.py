@@ -43,7 +43,9 @@ A library of another C API version is refused.
 import ctypes
 import ctypes.util
 import numbers
+import operator
 import os
+import signal
 import threading
 from pathlib import Path
 
@@ -164,6 +166,7 @@ def _signatures(lib):
         "friction_run_job": (c_int, [ctypes.POINTER(c_char_p), c_int, c_char_p, c_int, _REPORT, c_void_p,
                                      c_void_p]),
         "friction_run_config": (c_int, [c_void_p, c_char_p, c_int, _REPORT, c_void_p, c_void_p]),
+        "friction_job_stop": (None, []),
     }
     for name, (restype, argtypes) in signatures.items():
         function = getattr(lib, name)
@@ -275,10 +278,90 @@ def _item(value):
     return _quote(value)
 
 
-def _callback(report):
-    if report is None:
-        return _REPORT()
-    return _REPORT(lambda message, fraction, user: report(message.decode(errors="replace"), fraction))
+def _c_text(text, what):
+    """Text for a char * argument: a NUL inside would end it there, silently."""
+    data = text if isinstance(text, bytes) else str(text).encode()
+    if b"\0" in data:
+        raise ValueError(f"{what} {text!r} contains a NUL character")
+    return data
+
+
+def _c_path(path, what="path"):
+    return _c_text(os.fsencode(os.fspath(path)), what)
+
+
+def _c_int(value, what):
+    """An integer for an int argument: ctypes would wrap one beyond C's int
+    silently (line 2**40 became line 0)."""
+    value = operator.index(value)
+    if not -2**31 <= value < 2**31:
+        raise ValueError(f"{what} = {value} is beyond a C int")
+    return value
+
+
+class _JobReport:
+    """A job's report callback, and Ctrl-C during the job.
+
+    The user's `report(message, fraction)`, if any, gets the job's progress.
+    An Exception it raises (ctypes would print and drop it) is raised again
+    when the job has ended; the job runs on.  A KeyboardInterrupt or
+    SystemExit raised in it asks the job to stop (friction_job_stop) first.
+    On the main thread SIGINT is the job's for the job's duration: Ctrl-C
+    asks the job to stop at its next scan line or sweep point (Python runs
+    the handler when the job reports, so the callback is installed even
+    without `report`), and once the job has returned, its checkpoints kept,
+    the handler that was there before runs (KeyboardInterrupt)."""
+
+    def __init__(self, lib, report):
+        self.lib, self.report = lib, report
+        self.raised = None
+        self.signalled = None
+        self.function = _REPORT(self._called)
+
+    def _called(self, message, fraction, user):
+        if self.report is None or self.raised is not None:
+            return
+        try:
+            self.report(message.decode(errors="replace"), fraction)
+        except BaseException as error:  # noqa: B902 - raised again after the job
+            self.raised = error
+            if not isinstance(error, Exception):
+                self.lib.friction_job_stop()
+
+    def _on_signal(self, signum, frame):
+        self.signalled = (signum, frame)
+        self.lib.friction_job_stop()
+
+    def run(self, function, *args):
+        """function(*args, report, user, err): the job.  Raises the job's
+        FrictionError, and after it what the report or Ctrl-C raised."""
+        previous = None
+        if threading.current_thread() is threading.main_thread():
+            current = signal.getsignal(signal.SIGINT)
+            if current is not None and current != signal.SIG_IGN:
+                try:
+                    previous = signal.signal(signal.SIGINT, self._on_signal)
+                except ValueError:   # not the main interpreter
+                    previous = None
+        try:
+            try:
+                _call(function, *args, self.function, None)
+            finally:
+                if previous is not None:
+                    signal.signal(signal.SIGINT, previous)
+        except FrictionError:
+            self._raise_pending(previous)
+            raise
+        self._raise_pending(previous)
+
+    def _raise_pending(self, previous):
+        if self.raised is not None:
+            raise self.raised
+        if self.signalled is not None:
+            if callable(previous):
+                previous(*self.signalled)
+            elif previous == signal.SIG_DFL:
+                signal.raise_signal(signal.SIGINT)
 
 
 class Config:
@@ -291,7 +374,7 @@ class Config:
         self._lib = library()
         self._handle = None
         with _ErrorHandle() as err:
-            handle = self._lib.friction_config_new(scene.encode(), err.handle)
+            handle = self._lib.friction_config_new(_c_text(scene, "scene"), err.handle)
             if not handle:
                 err.check(err.status())
         self._handle = handle
@@ -329,14 +412,14 @@ class Config:
     # ---- values ----
     def read(self, path):
         """Apply a namelist file over the current values (all or nothing)."""
-        _call(self._lib.friction_config_read, self.handle, os.fsencode(os.fspath(path)))
+        _call(self._lib.friction_config_read, self.handle, _c_path(path))
         return self
 
     def set(self, name, value):
         """Set "group.variable" (or "group.variable(k)"): a number, True/False, a
         text (quoted for you), or a list of them."""
         if isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_)):
-            _call(self._lib.friction_config_set_real, self.handle, name.encode(), float(value))
+            _call(self._lib.friction_config_set_real, self.handle, _c_text(name, "name"), float(value))
         elif isinstance(value, (list, tuple, np.ndarray)):
             self.set_text(name, ", ".join(_item(v) for v in value))
         else:
@@ -345,13 +428,13 @@ class Config:
 
     def set_text(self, name, text):
         """Set a variable from namelist value text ("5.0", "'hopg'", ".true.", "3*0.0")."""
-        _call(self._lib.friction_config_set, self.handle, name.encode(), text.encode())
+        _call(self._lib.friction_config_set, self.handle, _c_text(name, "name"), _c_text(text, "value"))
         return self
 
     def get(self, name):
         """A variable's value as namelist text ("10.0", "'naf'", ".true.", "2*0.0")."""
         buf = ctypes.create_string_buffer(1 << 16)
-        _call(self._lib.friction_config_get, self.handle, name.encode(), buf, len(buf))
+        _call(self._lib.friction_config_get, self.handle, _c_text(name, "name"), buf, len(buf))
         return buf.value.decode()
 
     def _text(self, function):
@@ -386,7 +469,7 @@ class Config:
         """Line `line` (0-based) of the map, trace or retrace: fx, fy (nN) at scan.nx points."""
         nx = int(self.get("scan.nx")) if self.scene == "afm" else 1
         fx, fy = np.zeros(nx), np.zeros(nx)
-        _call(self._lib.friction_afm_line, self.handle, int(line), int(bool(forward)),
+        _call(self._lib.friction_afm_line, self.handle, _c_int(line, "line"), int(bool(forward)),
               fx.ctypes.data_as(ctypes.c_void_p), fy.ctypes.data_as(ctypes.c_void_p), nx)
         return fx, fy
 
@@ -406,8 +489,8 @@ class Config:
         """The configuration's job to the HDF5 file `output` (friction.h: friction_run_config);
         `report(message, fraction)` as for run_job."""
         flags = (FORCE if force else 0) | (RESUME if resume else 0) | (INIT_MPI if init_mpi else 0)
-        callback = _callback(report)
-        _call(self._lib.friction_run_config, self.handle, os.fsencode(os.fspath(output)), flags, callback, None)
+        _JobReport(self._lib, report).run(self._lib.friction_run_config, self.handle, _c_path(output, "output"),
+                                          flags)
 
 
 def _result_arrays(lib, result, err):
@@ -432,10 +515,14 @@ def run_job(files, output, force=False, resume=False, report=None, init_mpi=Fals
     given receives progress (fraction in [0, 1]) and notes (fraction -1).
     init_mpi: in a process that has not initialised MPI the job runs serially on
     this process without MPI; True has the library initialise MPI first
-    (MPI_THREAD_FUNNELED, for the rest of the process) and run it there.  An interrupted sweep raises
-    FrictionError with status 5."""
-    paths = [os.fsencode(os.fspath(path)) for path in files]
+    (MPI_THREAD_FUNNELED, for the rest of the process) and run it there.
+    Ctrl-C (on the main thread) stops the job at its next scan line or sweep
+    point and then raises KeyboardInterrupt, its context the job's
+    FrictionError with status 5: a sweep's file holds the points done, a
+    map's lines done are kept beside the output, and resume=True computes
+    the rest."""
+    paths = [_c_path(path, "file") for path in files]
     array = (ctypes.c_char_p * max(1, len(paths)))(*paths)
     flags = (FORCE if force else 0) | (RESUME if resume else 0) | (INIT_MPI if init_mpi else 0)
-    callback = _callback(report)
-    _call(library().friction_run_job, array, len(paths), os.fsencode(os.fspath(output)), flags, callback, None)
+    lib = library()
+    _JobReport(lib, report).run(lib.friction_run_job, array, len(paths), _c_path(output, "output"), flags)

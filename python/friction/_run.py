@@ -76,31 +76,15 @@ def _progress(progress, label):
     return _TqdmProgress(tqdm, label)
 
 
-class _Guarded:
-    """A report callback that keeps the first exception the user's callback
-    raised (ctypes would print and drop it) to raise after the job."""
-
-    def __init__(self, report):
-        self.report, self.error = report, None
-
-    def __call__(self, message, fraction):
-        if self.error is None:
-            try:
-                self.report(message, fraction)
-            except BaseException as err:  # noqa: B902 - re-raised after the job
-                self.error = err
-
-
 def _job(start, progress, label):
+    """start(report): a job of the C API, which raises an exception of the
+    report after the job, and takes Ctrl-C (_capi._JobReport)."""
     reporter = _progress(progress, label)
-    guarded = _Guarded(reporter) if reporter is not None else None
     try:
-        start(guarded)
+        start(reporter)
     finally:
         if hasattr(reporter, "close"):
             reporter.close()
-    if guarded is not None and guarded.error is not None:
-        raise guarded.error
 
 
 def _files(files):
@@ -125,8 +109,11 @@ def run(files, output=None, force=False, resume=False, progress=True):
               lines") and -1 for notes (a verify result)
     Returns the output's Path.  Raises FrictionError for bad input (the
     program's message, with file and line), a failed integration or an
-    unwritable file (nothing is written then), and with status 5 for a
-    sweep interrupted by a signal (its file holds the points done).
+    unwritable file (nothing is written then).  Ctrl-C stops the job at its
+    next scan line or sweep point and raises KeyboardInterrupt, its context
+    a FrictionError with status 5: a sweep's file holds the points done, a
+    map keeps the lines done beside the output; resume=True computes only
+    the rest.
 
     MPI: in a process without MPI the job runs serially on this process,
     without starting MPI (the same file as `mpirun -n 1`); under

@@ -1,4 +1,5 @@
 """Jobs: the program's file from Python, with progress."""
+import os
 import sys
 
 import h5py
@@ -11,13 +12,14 @@ NAF = [INPUTS / "naf.nml", DATA / "small.nml"]
 TIMINGS = {"wall_time", "compute_time", "created"}
 
 
-def same_files(a, b):
-    """Every dataset and every attribute but the timings equal."""
+def same_files(a, b, timings=()):
+    """Every dataset and every attribute but the timings (and the datasets
+    `timings`) equal."""
     def items(path):
         found = {}
         with h5py.File(path) as f:
             def visit(name, item):
-                if isinstance(item, h5py.Dataset):
+                if isinstance(item, h5py.Dataset) and name not in timings:
                     found[name] = item[()]
                 for key, value in item.attrs.items():
                     if key not in TIMINGS:
@@ -184,3 +186,111 @@ def test_config_run_never_writes_over_a_file_it_read(friction, tmp_path):
         assert own.read_bytes() == before
         out = cfg.run(tmp_path / "elsewhere.h5", progress=False)
     assert out.is_file()
+
+
+def _interrupted(caught):
+    """The job's FrictionError behind a KeyboardInterrupt raised after it."""
+    context = caught.value.__context__
+    assert isinstance(context, Exception) and getattr(context, "status", None) == 5, repr(context)
+    return context
+
+
+def test_ctrl_c_stops_a_map_and_resume_finishes_it(friction, naf_map, tmp_path):
+    """SIGINT during a job (here sent from the first progress report, on the
+    main thread) stops the map at its next line instead of being swallowed
+    by ctypes until the job ends: KeyboardInterrupt, after the job's status
+    5, no file, the lines done kept; resume computes the rest, and the file
+    equals the uninterrupted run's."""
+    import signal
+    reports = []
+
+    def progress(message, fraction):
+        reports.append(message)
+        if len(reports) == 1:
+            signal.raise_signal(signal.SIGINT)
+
+    out = tmp_path / "stopped.h5"
+    with pytest.raises(KeyboardInterrupt) as caught:
+        friction.run(NAF, output=out, progress=progress)
+    assert "checkpointed" in _interrupted(caught).message
+    assert not out.exists()
+    assert "10 of 10 lines" not in reports and len(reports) < 5, reports
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler   # the handler is back
+    friction.run(NAF, output=out, resume=True, progress=False)
+    same_files(out, naf_map)
+
+
+def test_ctrl_c_in_a_callback_stops_a_sweep(friction, brake_sweep, tmp_path):
+    """A KeyboardInterrupt raised by the report callback itself (as Python
+    raises it off the main thread's handler) stops a sweep between points:
+    its file holds the points done, and resume finishes it to the
+    uninterrupted run's file."""
+    from conftest import DATA as data
+    files = [INPUTS / "brake_sweep.nml", data / "sweep_small.nml"]
+    points = []
+
+    def progress(message, fraction):
+        if "points" in message:
+            points.append(message)
+            raise KeyboardInterrupt
+
+    out = tmp_path / "sweep.h5"
+    with pytest.raises(KeyboardInterrupt) as caught:
+        friction.run(files, output=out, progress=progress)
+    _interrupted(caught)
+    with h5py.File(out) as handle:
+        status = handle["sweep/status"][()]
+    assert 0 < (status == 1).sum() < status.size, status
+    friction.run(files, output=out, force=True, resume=True, progress=False)
+    same_files(out, brake_sweep, timings=("sweep/compute_time", "sweep/computed_by_this_run",
+                                          "sweep/peak_memory_per_rank"))
+
+
+def test_ctrl_c_from_outside_without_a_callback(friction, library, tmp_path):
+    """A real SIGINT from another process, with no progress callback: the
+    job stops within a line, the script ends with KeyboardInterrupt long
+    before the map would have finished, and the lines done are kept."""
+    import signal
+    import subprocess
+    import time
+    # 2000 lines: about 3 s of work on this machine; the signal comes 0.5 s after the start.
+    (tmp_path / "lines.nml").write_text("&scan ny = 2000 /\n")
+    script = tmp_path / "long.py"
+    script.write_text(
+        "import sys\n"
+        f"sys.path.insert(0, {str(INPUTS.parent / 'python')!r})\n"
+        "import friction\n"
+        "friction.library_version()\n"
+        "print('ready', flush=True)\n"
+        f"friction.run([{str(INPUTS / 'naf.nml')!r}, 'lines.nml'], output='long.h5', progress=False)\n"
+        "print('finished', flush=True)\n")
+    env = dict(os.environ, FRICTION_LIBRARY=str(library))
+    child = subprocess.Popen([sys.executable, str(script)], cwd=tmp_path, env=env, stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, text=True)
+    assert child.stdout.readline().strip() == "ready"
+    time.sleep(0.5)
+    child.send_signal(signal.SIGINT)
+    out, err = child.communicate(timeout=120)
+    assert "finished" not in out
+    assert child.returncode != 0 and "KeyboardInterrupt" in err and "(status 5)" in err, err
+    assert not (tmp_path / "long.h5").exists()
+    assert any(path.name.startswith("long.h5") for path in tmp_path.iterdir()), list(tmp_path.iterdir())
+
+
+def test_arguments_that_c_would_cut_are_refused(friction, tmp_path):
+    """An int beyond C's (line 2**40 wrapped to line 0) and text with a NUL
+    (cut there: 'scan.nx\\0junk' set scan.nx) are ValueErrors, not another
+    call than the one asked."""
+    with friction.Config("afm", files=NAF) as cfg:
+        with pytest.raises(ValueError, match="beyond a C int"):
+            cfg.afm_line(2**40)
+        with pytest.raises(ValueError, match="NUL"):
+            cfg.set("scan.nx\0junk", 12)
+        with pytest.raises(ValueError, match="NUL"):
+            cfg.set_text("scan.nx", "12\0 junk")
+        with pytest.raises(ValueError, match="NUL"):
+            cfg.read(str(tmp_path / "a\0b.nml"))
+        assert cfg.get("scan.nx") == "40"
+    with pytest.raises(ValueError, match="NUL"):
+        friction.run(NAF, output=str(tmp_path / "x\0.h5"), progress=False)
+    assert not list(tmp_path.iterdir())

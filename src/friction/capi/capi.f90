@@ -95,6 +95,7 @@ module friction_capi
    contains
       procedure :: progress => callback_progress
       procedure :: note => callback_note
+      procedure :: stop_requested => callback_stop_requested
    end type callback_reporter
 
    abstract interface
@@ -122,6 +123,11 @@ module friction_capi
 
       subroutine friction_job_end() bind(c, name='friction_job_end')
       end subroutine friction_job_end
+
+      function friction_job_stop_asked() bind(c, name='friction_job_stop_asked') result(asked)
+         import :: c_int
+         integer(c_int) :: asked
+      end function friction_job_stop_asked
 
       !> Around friction_config_read's file reading (job_lock.c): 1 if it
       !> took the lock, 0 if this thread holds it for its job.
@@ -1194,5 +1200,12 @@ contains
 
       if (associated(self%call)) call self%call(text//c_null_char, -1.0_c_double, self%user)
    end subroutine callback_note
+
+   !> Whether the host asked the job to stop (friction_job_stop, job_lock.c).
+   logical function callback_stop_requested(self)
+      class(callback_reporter), intent(inout) :: self
+
+      callback_stop_requested = friction_job_stop_asked() /= 0
+   end function callback_stop_requested
 
 end module friction_capi

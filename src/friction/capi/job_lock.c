@@ -14,11 +14,16 @@
  * Fortran runtime's file units are shared by the process, and two threads
  * reading at once got false "cannot open the file" errors and then
  * corrupted the heap.  A read on the thread that runs a job (from its
- * callback) already holds it. */
+ * callback) already holds it.
+ *
+ * A stop request (friction_job_stop) is for the job running now: a flag
+ * that a job clears when it begins and asks between its pieces of work. */
 #include <pthread.h>
+#include <stdatomic.h>
 
 static pthread_mutex_t job_mutex = PTHREAD_MUTEX_INITIALIZER;
 static _Thread_local int job_running = 0;   /* this thread holds job_mutex */
+static atomic_int stop_asked = 0;           /* lock-free: safe in a signal handler */
 
 /* 0: the calling thread may run its job (after waiting for another's);
  * 1: it is running one already, and must not start another. */
@@ -27,6 +32,7 @@ int friction_job_begin(void)
     if (job_running) return 1;
     pthread_mutex_lock(&job_mutex);
     job_running = 1;
+    atomic_store(&stop_asked, 0);
     return 0;
 }
 
@@ -49,4 +55,16 @@ int friction_read_begin(void)
 void friction_read_end(void)
 {
     pthread_mutex_unlock(&job_mutex);
+}
+
+/* friction.h: ask the running job to stop at its next safe point. */
+void friction_job_stop(void)
+{
+    atomic_store(&stop_asked, 1);
+}
+
+/* 1 once friction_job_stop was called during the running job. */
+int friction_job_stop_asked(void)
+{
+    return atomic_load(&stop_asked);
 }
