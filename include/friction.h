@@ -20,7 +20,10 @@
  * "file:line: " when the value came from a file.  The library never prints
  * and never stops the process.  It leaves GSL's error handler and HDF5's
  * automatic error printing as the host set them: each call installs its own
- * for its duration and restores the host's.
+ * for its duration and restores the host's.  Likewise the floating-point
+ * environment: the calls that compute run with no exception trapping and
+ * clear flags, and give the host back its traps and flags on return (a
+ * host that traps overflow gets a status, not SIGFPE).
  *
  * Threads.  Handles are independent, and threads may work at once, each on
  * its own handles (configuration, result, error).  A handle must not be used

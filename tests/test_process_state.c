@@ -13,9 +13,17 @@
  *   test_process_state hdf5 FILE     jobs over the namelist FILE write HDF5 files and leave the
  *                                    automatic error printing as it was: the default, then a
  *                                    function of the program's, which the library never calls
+ *   test_process_state fpe FILE      a program that traps overflow, invalid operations and
+ *                                    division by zero (as -ffpe-trap does): values that overflow
+ *                                    (1e400 as text, 1e308 as a spring) are refused or fail with a
+ *                                    status, not SIGFPE; a map, a brake run and a job over FILE
+ *                                    succeed; after each call the traps and the exception flags
+ *                                    are the program's, as they were before it
  */
+#define _GNU_SOURCE /* feenableexcept, fegetexcept */
 #include <friction.h>
 
+#include <fenv.h>
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_vector.h>
 #include <hdf5.h>
@@ -256,10 +264,84 @@ static int hdf5_mode(const char *namelist) {
   return failures != 0;
 }
 
+/* ---- the floating-point environment ---- */
+
+enum { TRAPPED = FE_INVALID | FE_DIVBYZERO | FE_OVERFLOW };
+
+/* The traps and flags are the program's: TRAPPED trapping, and only the
+ * inexact flag it raised itself before the call. */
+static void environment_kept(const char *call) {
+  CHECK(fegetexcept() == TRAPPED, "after %s the traps are %#x, not %#x", call, fegetexcept(), TRAPPED);
+  CHECK(fetestexcept(FE_ALL_EXCEPT) == FE_INEXACT, "after %s the flags are %#x, not only inexact (%#x)", call,
+        fetestexcept(FE_ALL_EXCEPT), FE_INEXACT);
+}
+
+static void program_flags(void) {
+  feclearexcept(FE_ALL_EXCEPT);
+  feraiseexcept(FE_INEXACT);
+}
+
+static int fpe_mode(const char *namelist) {
+  friction_error *err = friction_error_new();
+  friction_config *cfg;
+  friction_result *res;
+  char message[1024];
+  int status;
+
+  feenableexcept(TRAPPED);
+  program_flags();
+  cfg = friction_config_new("afm", err);
+  environment_kept("friction_config_new");
+  status = friction_config_read(cfg, namelist, err);
+  CHECK(status == FRICTION_OK, "read %s: status %d", namelist, status);
+  environment_kept("friction_config_read");
+
+  /* 1e400 overflows when read as a double: refused as out of range. */
+  status = friction_config_set(cfg, "tip.kx", "1e400", err);
+  message_of(err, message, sizeof message);
+  CHECK(status == FRICTION_ERROR_INPUT && strstr(message, "out of range") != NULL, "1e400: status %d (%s)",
+        status, message);
+  environment_kept("friction_config_set of 1e400");
+
+  /* A map with the paper's tip, then one whose spring (1e308 N/m) overflows the step. */
+  program_flags();
+  res = friction_compute(cfg, err);
+  message_of(err, message, sizeof message);
+  CHECK(res != NULL, "the map failed: %s", message);
+  friction_result_free(res);
+  environment_kept("friction_compute");
+  status = friction_config_set_real(cfg, "tip.kx", 1e308, err);
+  environment_kept("friction_config_set_real");
+  res = status == FRICTION_OK ? friction_compute(cfg, err) : NULL;
+  message_of(err, message, sizeof message);
+  CHECK(res == NULL && friction_error_status(err) != FRICTION_OK, "kx = 1e308 gave a map (%s)", message);
+  printf("kx = 1e308: status %d: %s\n", friction_error_status(err), message);
+  friction_result_free(res);
+  environment_kept("friction_compute with kx = 1e308");
+  friction_config_free(cfg);
+
+  /* A brake run, and a job writing its file. */
+  program_flags();
+  cfg = friction_config_new("brake", err);
+  CHECK(friction_config_set_real(cfg, "brake.t_end", 100.0, err) == FRICTION_OK, "brake.t_end");
+  res = friction_compute(cfg, err);
+  message_of(err, message, sizeof message);
+  CHECK(res != NULL, "the brake run failed: %s", message);
+  friction_result_free(res);
+  environment_kept("friction_compute of the brake");
+  friction_config_free(cfg);
+  program_flags();
+  job(namelist, "process_state_fpe.h5");
+  environment_kept("friction_run_job");
+  friction_error_free(err);
+  return failures != 0;
+}
+
 int main(int argc, char **argv) {
   if (argc >= 3 && strcmp(argv[1], "gsl") == 0) return gsl_mode(argv[2]);
   if (argc >= 2 && strcmp(argv[1], "threads") == 0) return threads_mode();
   if (argc >= 3 && strcmp(argv[1], "hdf5") == 0) return hdf5_mode(argv[2]);
-  fprintf(stderr, "usage: %s gsl NAMELIST | threads | hdf5 NAMELIST\n", argv[0]);
+  if (argc >= 3 && strcmp(argv[1], "fpe") == 0) return fpe_mode(argv[2]);
+  fprintf(stderr, "usage: %s gsl NAMELIST | threads | hdf5 NAMELIST | fpe NAMELIST\n", argv[0]);
   return 2;
 }

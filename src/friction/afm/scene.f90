@@ -6,7 +6,7 @@ module friction_afm_scene
    use friction_kinds, only: wp, i8
    use friction_error, only: error_type, fatal_error, error_input, error_interrupted, error_numerical
    use friction_files, only: available_memory, remove_file
-   use friction_strings, only: itoa, bytes_text, text_hash
+   use friction_strings, only: itoa, bytes_text, text_hash, etoa
    use friction_version, only: version_string
    use friction_parameters, only: parameter_visitor, parameters_text
    use friction_checks, only: config_checker
@@ -311,7 +311,6 @@ contains
          type(integrator_statistics) :: check_stats
          integer :: j, q, stopped
          integer, parameter :: forces(3) = [q_fx, q_fy, q_fz]
-         character(len=300) :: text
 
          associate (c => self%ran)
             check_config = c
@@ -365,16 +364,15 @@ contains
             end if
             associate (d => self%verify)
                if (job%rank == 0) then
-                  write (text, '(a, es8.2, a, es8.2, a, es8.2, a)') 'verify: '//trim(d%method)//' at rtol ', d%rtol, &
-                     & ', atol ', d%atol, ': max |dF| = ', maxval(d%max_difference), ' nN over the map'
-                  call reporter%note(trim(text))
+                  call reporter%note('verify: '//trim(d%method)//' at rtol '//etoa(d%rtol, 2)//', atol ' &
+                     & //etoa(d%atol, 2)//': max |dF| = '//etoa(maxval(d%max_difference), 2)//' nN over the map')
                end if
                if (c%check%max_difference > 0.0_wp .and. .not. (maxval(d%max_difference) <= c%check%max_difference)) &
                   & then
-                  write (text, '(a, es8.2, a, es8.2, a)') 'verify failed: the check run''s forces differ by ', &
-                     & maxval(d%max_difference), ' nN, more than check_limit = ', c%check%max_difference, &
-                     & ' nN (docs/speed.md, which steppers need verify)'
-                  call fatal_error(error, trim(text), error_numerical)
+                  call fatal_error(error, 'verify failed: the check run''s forces differ by ' &
+                     & //etoa(maxval(d%max_difference), 2)//' nN, more than check_limit = ' &
+                     & //etoa(c%check%max_difference, 2)//' nN (docs/speed.md, which steppers need verify)', &
+                     & error_numerical)
                end if
             end associate
          end associate

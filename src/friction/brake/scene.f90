@@ -7,7 +7,7 @@
 module friction_brake_scene
    use mpi_f08
    use friction_kinds, only: wp, i8
-   use friction_strings, only: fixed_text
+   use friction_strings, only: fixed_text, etoa, itoa
    use friction_error, only: error_type, fatal_error, error_numerical
    use friction_version, only: version_string
    use friction_parameters, only: parameter_visitor
@@ -118,7 +118,6 @@ contains
       integer :: check_rank
       real(wp) :: wall, stick_time
       integer(i8) :: counts(4)
-      character(len=240) :: line
 
       self%ran = self%resolved()
       associate (settings => self%ran, check => self%check_record, record => self%record, &
@@ -157,17 +156,15 @@ contains
             check%comparison = compare_runs(main_run, check_run)
             associate (d => check%comparison, c => check_config%solver)
                if (job%rank == 0) then
-                  write (line, '(a, es8.2, a, es8.2, a, es8.2, a, i0, a, i0)') 'verify: '//trim(c%method) &
-                     & //' at rtol ', c%rtol, ', atol ', c%atol, ': max |dx| = ', d%max_difference(1), &
-                     & ' m over the grid; events ', d%events, ' vs ', d%check_events
-                  call reporter%note(trim(line))
+                  call reporter%note('verify: '//trim(c%method)//' at rtol '//etoa(c%rtol, 2)//', atol ' &
+                     & //etoa(c%atol, 2)//': max |dx| = '//etoa(d%max_difference(1), 2)//' m over the grid; events ' &
+                     & //itoa(d%events)//' vs '//itoa(d%check_events))
                end if
                if (settings%check%max_difference > 0.0_wp .and. &
                   & .not. (d%max_difference(1) <= settings%check%max_difference)) then
-                  write (line, '(a, es8.2, a, es8.2, a)') 'verify failed: the check run differs by ', &
-                     & d%max_difference(1), ' m in x, more than check_limit = ', settings%check%max_difference, &
-                     & ' m (docs/speed.md, which steppers need verify)'
-                  call fatal_error(error, trim(line), error_numerical)
+                  call fatal_error(error, 'verify failed: the check run differs by '//etoa(d%max_difference(1), 2) &
+                     & //' m in x, more than check_limit = '//etoa(settings%check%max_difference, 2) &
+                     & //' m (docs/speed.md, which steppers need verify)', error_numerical)
                   return
                end if
             end associate

@@ -297,7 +297,7 @@ contains
 
    !> friction_config *friction_config_new(const char *scene, friction_error *err):
    !> a configuration of the scene with its defaults; NULL on an unknown scene.
-   type(c_ptr) function friction_config_new(scene_name, handle) bind(c, name='friction_config_new') result(cfg)
+   type(c_ptr) function friction_config_new(scene_name, handle) bind(c, name='friction_config_new_body') result(cfg)
       type(c_ptr), value :: scene_name, handle
       type(capi_config), pointer :: config
       character(len=:), allocatable :: name
@@ -396,7 +396,7 @@ contains
 
    !> int friction_config_set(friction_config *cfg, const char *name, const char *value,
    !>                         friction_error *err)
-   integer(c_int) function friction_config_set(cfg, name_c, value_c, handle) bind(c, name='friction_config_set') &
+   integer(c_int) function friction_config_set(cfg, name_c, value_c, handle) bind(c, name='friction_config_set_body') &
       & result(status)
       type(c_ptr), value :: cfg, name_c, value_c, handle
       type(capi_config), pointer :: config
@@ -443,7 +443,7 @@ contains
    !> int friction_config_set_real(friction_config *cfg, const char *name, double x,
    !>                              friction_error *err)
    integer(c_int) function friction_config_set_real(cfg, name_c, x, handle) &
-      & bind(c, name='friction_config_set_real') result(status)
+      & bind(c, name='friction_config_set_real_body') result(status)
       type(c_ptr), value :: cfg, name_c, handle
       real(c_double), value :: x
       type(capi_config), pointer :: config
@@ -482,7 +482,7 @@ contains
 
    !> int friction_config_get(const friction_config *cfg, const char *name, char *buf,
    !>                         size_t len, friction_error *err)
-   integer(c_int) function friction_config_get(cfg, name_c, buf, len, handle) bind(c, name='friction_config_get') &
+   integer(c_int) function friction_config_get(cfg, name_c, buf, len, handle) bind(c, name='friction_config_get_body') &
       & result(status)
       type(c_ptr), value :: cfg, name_c, buf, handle
       integer(c_size_t), value :: len
@@ -521,7 +521,7 @@ contains
    end function friction_config_get
 
    !> int friction_config_text(const friction_config *cfg, char *buf, size_t len, size_t *needed)
-   integer(c_int) function friction_config_text(cfg, buf, len, needed) bind(c, name='friction_config_text') &
+   integer(c_int) function friction_config_text(cfg, buf, len, needed) bind(c, name='friction_config_text_body') &
       & result(status)
       type(c_ptr), value :: cfg, buf, needed
       integer(c_size_t), value :: len
@@ -588,7 +588,7 @@ contains
 
    !> int friction_config_read(friction_config *cfg, const char *path, friction_error *err):
    !> the file's values over the current ones, all or nothing.
-   integer(c_int) function friction_config_read(cfg, path_c, handle) bind(c, name='friction_config_read') &
+   integer(c_int) function friction_config_read(cfg, path_c, handle) bind(c, name='friction_config_read_body') &
       & result(status)
       type(c_ptr), value :: cfg, path_c, handle
       type(capi_config), pointer :: config
@@ -673,7 +673,7 @@ contains
    end subroutine check_config
 
    !> int friction_config_check(const friction_config *cfg, friction_error *err)
-   integer(c_int) function friction_config_check(cfg, handle) bind(c, name='friction_config_check') result(status)
+   integer(c_int) function friction_config_check(cfg, handle) bind(c, name='friction_config_check_body') result(status)
       type(c_ptr), value :: cfg, handle
       type(capi_config), pointer :: config
       type(error_type), allocatable :: error
@@ -688,7 +688,7 @@ contains
    !> int friction_afm_line(const friction_config *cfg, int line, int forward,
    !>                       double *fx, double *fy, size_t n, friction_error *err)
    integer(c_int) function friction_afm_line(cfg, line, forward, fx, fy, n, handle) &
-      & bind(c, name='friction_afm_line') result(status)
+      & bind(c, name='friction_afm_line_body') result(status)
       type(c_ptr), value :: cfg, fx, fy, handle
       integer(c_int), value :: line, forward
       integer(c_size_t), value :: n
@@ -761,7 +761,7 @@ contains
    end function friction_afm_line
 
    !> friction_result *friction_compute(const friction_config *cfg, friction_error *err)
-   type(c_ptr) function friction_compute(cfg, handle) bind(c, name='friction_compute') result(res)
+   type(c_ptr) function friction_compute(cfg, handle) bind(c, name='friction_compute_body') result(res)
       type(c_ptr), value :: cfg, handle
       type(capi_config), pointer :: config
       type(capi_result), pointer :: result
@@ -1086,7 +1086,7 @@ contains
    !> int friction_run_job(const char *const *files, int nfiles, const char *output, int flags,
    !>                      friction_report_fn report, void *user, friction_error *err)
    integer(c_int) function friction_run_job(files, nfiles, output, flags, report_fn, user, handle) &
-      & bind(c, name='friction_run_job') result(status)
+      & bind(c, name='friction_run_job_body') result(status)
       type(c_ptr), value :: files, output, user, handle
       integer(c_int), value :: nfiles, flags
       type(c_funptr), value :: report_fn
@@ -1142,7 +1142,7 @@ contains
    !> int friction_run_config(const friction_config *cfg, const char *output, int flags,
    !>                         friction_report_fn report, void *user, friction_error *err)
    integer(c_int) function friction_run_config(cfg, output, flags, report_fn, user, handle) &
-      & bind(c, name='friction_run_config') result(status)
+      & bind(c, name='friction_run_config_body') result(status)
       type(c_ptr), value :: cfg, output, user, handle
       integer(c_int), value :: flags
       type(c_funptr), value :: report_fn

@@ -5,7 +5,7 @@ module friction_strings
    implicit none
    private
 
-   public :: itoa, rtoa, join, quoted, lower, text_hash, bytes_text, fixed_text, one_line
+   public :: itoa, rtoa, etoa, join, quoted, lower, text_hash, bytes_text, fixed_text, one_line
 
    !> An integer as text, without blanks.
    interface itoa
@@ -77,6 +77,24 @@ contains
          if (out(i:i) == new_line('a') .or. out(i:i) == achar(13)) out(i:i) = ' '
       end do
    end function one_line
+
+   !> A real in scientific notation with `digits` decimals, as the es edit
+   !> descriptor writes it ('1.30E-05'), and with three exponent digits where
+   !> it needs them ('1.30E-152': es alone drops the E there, '1.30-152').
+   pure function etoa(x, digits) result(text)
+      real(wp), intent(in) :: x
+      integer, intent(in) :: digits
+      character(len=:), allocatable :: text
+      character(len=40) :: buffer, edit
+
+      write (edit, '(a, i0, a, i0, a)') '(es', digits + 8, '.', digits, ')'
+      write (buffer, edit) x
+      if (abs(x) <= huge(x) .and. scan(buffer, 'E') == 0) then
+         write (edit, '(a, i0, a, i0, a)') '(es', digits + 9, '.', digits, 'e3)'
+         write (buffer, edit) x
+      end if
+      text = trim(adjustl(buffer))
+   end function etoa
 
    !> A real as text with 7 significant digits.
    pure function rtoa(x) result(text)

@@ -200,8 +200,8 @@ contains
                if (len(problem) > 0) then
                   shown = trim(m%name)
                   if (m%first > 0) shown = shown//'('//itoa(m%first)//')'
-                  call fatal_error(error, where//': &'//trim(m%group)//': '//shown//' = '//trim(one_line(m%value, 100)) &
-                     & //': '//problem, error_input)
+                  call fatal_error(error, where//': &'//trim(m%group)//': '//shown//' = ' &
+                     & //trim(one_line(m%value, 100))//': '//problem, error_input)
                   return
                end if
                call checker%set_origin(trim(m%group), trim(m%name), where)

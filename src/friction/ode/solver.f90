@@ -15,7 +15,7 @@ module friction_ode_solver
    use friction_error, only: error_type, fatal_error, error_numerical, error_input, error_internal
    use friction_strings, only: rtoa
    use friction_ode_system, only: ode_system
-   use friction_strings, only: itoa, rtoa
+   use friction_strings, only: itoa, rtoa, etoa
    implicit none
    private
 
@@ -445,10 +445,8 @@ contains
       class(ode_solver), intent(in) :: self
       real(wp), intent(in) :: t
       character(len=:), allocatable :: text
-      character(len=32) :: buffer
 
-      write (buffer, '(es14.7)') t
-      text = trim(self%time_name)//' = '//trim(adjustl(buffer))//trim(self%time_unit)
+      text = trim(self%time_name)//' = '//etoa(t, 7)//trim(self%time_unit)
    end function time_at
 
    !> Counters summed over all restarts so far.
