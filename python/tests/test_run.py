@@ -294,3 +294,61 @@ def test_arguments_that_c_would_cut_are_refused(friction, tmp_path):
     with pytest.raises(ValueError, match="NUL"):
         friction.run(NAF, output=str(tmp_path / "x\0.h5"), progress=False)
     assert not list(tmp_path.iterdir())
+
+
+def test_a_process_forked_during_a_job_refuses_jobs_and_reads(friction, tmp_path):
+    """fork() while a job runs on another thread (multiprocessing's 'fork'
+    beside a job): the child inherited the job lock held by a thread it does
+    not have, and its first job waited forever.  Its HDF5 and Fortran runtime
+    are the parent's, caught half-way, so the child refuses jobs and file
+    reads with a message; the parent's job finishes; a fork between jobs
+    runs jobs as before."""
+    import threading
+    import time
+    started, release = threading.Event(), threading.Event()
+
+    def progress(message, fraction):
+        started.set()
+        release.wait(60)
+
+    def child(label):
+        """In the forked child: a job and a read; 0 when both behave as `label` says."""
+        code = 1
+        try:
+            refused = []
+            for attempt in (lambda: friction.run(NAF, output=tmp_path / f"{label}.h5", progress=False),
+                            lambda: friction.Config("afm").read(INPUTS / "naf.nml")):
+                try:
+                    attempt()
+                    refused.append(False)
+                except friction.FrictionError as error:
+                    refused.append("forked while a job" in error.message)
+            code = 0 if refused == ([True, True] if label == "mid" else [False, False]) else 2
+        finally:
+            os._exit(code)
+
+    def wait(pid):
+        for _ in range(600):
+            done, status = os.waitpid(pid, os.WNOHANG)
+            if done:
+                return os.waitstatus_to_exitcode(status)
+            time.sleep(0.1)
+        os.kill(pid, 9)
+        os.waitpid(pid, 0)
+        return "hung"
+
+    job = threading.Thread(target=lambda: friction.run(NAF, output=tmp_path / "parent.h5", progress=progress))
+    job.start()
+    assert started.wait(60)
+    pid = os.fork()
+    if pid == 0:
+        child("mid")
+    release.set()
+    job.join(120)
+    assert wait(pid) == 0
+    assert (tmp_path / "parent.h5").is_file() and not (tmp_path / "mid.h5").exists()
+    pid = os.fork()
+    if pid == 0:
+        child("between")
+    assert wait(pid) == 0
+    assert (tmp_path / "between.h5").is_file()

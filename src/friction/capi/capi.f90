@@ -140,6 +140,12 @@ module friction_capi
       end subroutine friction_read_end
    end interface
 
+   !> Why a process forked while its parent ran a job or read a file can
+   !> neither (job_lock.c).
+   character(len=*), parameter :: forked_message = 'this process was forked while a job or a file read ran in ' &
+      & //'its parent: its HDF5 and Fortran runtime are the parent''s, caught half-way; start worker processes ' &
+      & //"with 'spawn' or 'forkserver' (Python's multiprocessing), or fork between jobs"
+
 contains
 
    ! ---- strings, buffers, errors ----
@@ -537,6 +543,7 @@ contains
       ! (The text is formatted by the Fortran runtime's internal writes, which
       ! raced with another thread's file reading: under the read lock.)
       taken = friction_read_begin()
+      if (taken < 0) return   ! (a process forked mid-job: job_lock.c)
       text = job_text(work)
       if (taken /= 0) call friction_read_end()
       status = text_status(text, buf, len, needed)
@@ -619,6 +626,10 @@ contains
       universe = all_parameters()
       ! (One file read and parsed at a time in the process: job_lock.c.)
       taken = friction_read_begin()
+      if (taken < 0) then
+         status = refuse(handle, forked_message)
+         return
+      end if
       call scan_files(paths, parameter_groups(universe), sources, error)
       if (allocated(error)) then
          if (taken /= 0) call friction_read_end()
@@ -1177,8 +1188,13 @@ contains
    subroutine begin_job(error)
       type(error_type), allocatable, intent(out) :: error
 
-      if (friction_job_begin() /= 0) call fatal_error(error, 'a job is already running on this thread ' &
-         & //'(a job cannot be started from its own report callback)', error_input)
+      select case (friction_job_begin())
+      case (1)
+         call fatal_error(error, 'a job is already running on this thread (a job cannot be started from its ' &
+            & //'own report callback)', error_input)
+      case (2)
+         call fatal_error(error, forked_message, error_input)
+      end select
    end subroutine begin_job
 
    subroutine callback_progress(self, done, total, what, last)
