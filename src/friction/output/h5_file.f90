@@ -36,7 +36,7 @@ module friction_output_h5
       end function h5fget_mdc_size
    end interface
 
-   public :: h5_file, h5_status, error_printing, room_to_close, new_text_attribute, new_scalar_attribute
+   public :: h5_file, h5_status, error_printing, room_to_close, new_text_attribute, new_scalar_attribute, open_hdf5
 
    !> H5E_DEFAULT of the C API: the default error stack (hid_t is int64_t
    !> since HDF5 1.10).
@@ -109,6 +109,22 @@ module friction_output_h5
 
 contains
 
+   !> HDF5's Fortran interface, opened once for the process and left open
+   !> (HDF5 closes it at exit).  Each h5open_f copies HDF5's predefined types
+   !> and h5close_f does not release all of the copies: opened and closed
+   !> around every file, it kept 2.6 kB a job in a host that ran jobs in a
+   !> loop (and the checkpoint tables, opened without a close, more).  Jobs
+   !> run one at a time (capi/job_lock.c), so the flag needs no lock.
+   subroutine open_hdf5(stat)
+      integer, intent(out) :: stat
+      logical, save :: opened = .false.
+
+      stat = 0
+      if (opened) return
+      call h5open_f(stat)
+      opened = stat == 0
+   end subroutine open_hdf5
+
    !> Create (truncate) a file for parallel writing on communicator comm;
    !> comm = MPI_COMM_NULL: a serial run without MPI, written by this process
    !> alone with HDF5's default (sec2) driver (the mpio driver needs MPI_Init).
@@ -140,7 +156,7 @@ contains
       end if
       ! The library never prints: failures come back through stat.
       call printing%silence()
-      call h5open_f(stat)
+      call open_hdf5(stat)
       call self%check(stat, 'initialising HDF5')
       call h5pcreate_f(H5P_FILE_ACCESS_F, fapl, stat)
       call self%check(stat, 'creating the file access list')
@@ -548,7 +564,6 @@ contains
          call self%check(stat, 'closing the file')
          self%id = -1
       end if
-      call h5close_f(stat)
       call printing%restore()
       if (self%status /= 0) call fatal_error(error, self%path//': HDF5 failed '//self%failed_at, error_io)
    end subroutine close

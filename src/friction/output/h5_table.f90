@@ -16,7 +16,8 @@ module friction_output_h5_table
    use friction_kinds, only: wp, i8
    use friction_error, only: error_type, fatal_error, error_io
    use friction_files, only: truncate_file
-   use friction_output_h5, only: h5_status, error_printing, room_to_close, new_text_attribute, new_scalar_attribute
+   use friction_output_h5, only: h5_status, error_printing, room_to_close, new_text_attribute, new_scalar_attribute, &
+      & open_hdf5
    implicit none
    private
 
@@ -63,7 +64,7 @@ contains
       self%path = path
       self%status = 0
       call printing%silence()
-      call h5open_f(stat)
+      call open_hdf5(stat)
       call h5fcreate_f(path, H5F_ACC_TRUNC_F, self%id, stat)
       call self%check(stat, 'creating the file')
       call printing%restore()
@@ -81,7 +82,7 @@ contains
       self%path = path
       self%status = 0
       call printing%silence()
-      call h5open_f(stat)
+      call open_hdf5(stat)
       call h5fopen_f(path, H5F_ACC_RDWR_F, self%id, stat)
       if (stat /= 0) self%id = -1
       call self%check(stat, 'opening the file')
