@@ -12,6 +12,8 @@ Measures and prints (this is not a test; nothing fails on a missed target):
   time on one rank, force error and 2-rank speed-up next to the targets
   (< 0.5 s on one core, error < 1e-3 nN; speed-up >= 1.8x on 2 ranks).
 * A tolerance/method ladder for that map: time and error of each setting.
+* A long NaF map (3000 lines of 128 points) with checkpoints every 2 s and
+  without: what a long map pays for being resumable (--no-checkpoints skips it).
 
 Times: "wall" is the file's root attribute wall_time (max over ranks, from
 MPI start-up to just before writing the file); "process" is the wall clock
@@ -52,6 +54,7 @@ INPUTS = ROOT / "inputs"
 
 REF_METHOD, REF_TOL, REF_CHECK_TOL = "rk8pd", 1e-11, 1e-10
 TARGET_TIME_S, TARGET_ERROR_NN, TARGET_SPEEDUP = 0.5, 1e-3, 1.8
+CHECKPOINT_INTERVAL = 2.0   # s: &scan checkpoint_interval of the long map's checkpointed runs
 LADDER = (
     [("rkf45", tol) for tol in (1e-4, 1e-5, 1e-6, 1e-7)]
     + [(m, 1e-6) for m in ("rk4imp", "bsimp", "rk8pd", "rkck")]
@@ -311,6 +314,21 @@ class Benchmark:
                 self.ladder.append(m)
                 self.results["ladder"].append(m.as_dict())
 
+        # 4. the cost of a long map's checkpoints: every CHECKPOINT_INTERVAL s against none
+        self.checkpoints = None
+        if not a.no_checkpoints:
+            lines = 1500 if a.quick else 3000
+            size = (128, lines)
+            pair = []
+            for label, interval in (("no checkpoints", 1e6), ("checkpoints", CHECKPOINT_INTERVAL)):
+                o = self.fr.override(f"checkpoints_{interval:g}", f"&scan checkpoint_interval = {interval:g} /")
+                pair.append(self.measure(f"naf {lines} lines, {label}", "naf", size, 1, [o]))
+            self.checkpoints = tuple(pair)
+            self.results["checkpoints"] = {
+                "interval_s": CHECKPOINT_INTERVAL, "without": pair[0].as_dict(), "with": pair[1].as_dict(),
+                "ratio": pair[1].wall / pair[0].wall,
+                "per_line_ms": 1e3 * (pair[1].wall - pair[0].wall) / lines}
+
     # ---------------------------------------------------------------- output
 
     def report(self, header: dict) -> str:
@@ -394,6 +412,16 @@ class Benchmark:
                   f"{m.runs[-1].steps:>10d} {m.runs[-1].rhs:>10d} {m.error:>9.2e}  {marks}")
             w(f"  (targets: 'time' = under {TARGET_TIME_S:g} s, 'error' = under "
               f"{TARGET_ERROR_NN:g} nN; steps and rhs evals are totals over the map)")
+        if self.checkpoints:
+            without, with_ = self.checkpoints
+            w("")
+            w(f"5. A long map's checkpoints: NaF {with_.ny} lines x {with_.nx} points, 1 rank, "
+              f"median of {a.repeats}")
+            w(f"  without checkpoints            {without.wall:9.3f} s")
+            w(f"  checkpoints every {CHECKPOINT_INTERVAL:g} s         {with_.wall:9.3f} s    "
+              f"{with_.wall / without.wall:.2f} x, "
+              f"{1e3 * (with_.wall - without.wall) / with_.ny:.2f} ms a line "
+              f"(the line itself: {1e3 * without.per_line:.2f} ms)")
         return "\n".join(lines)
 
 
@@ -435,6 +463,8 @@ def main(argv=None) -> int:
     p.add_argument("--quick", action="store_true",
                    help="fewer repeats and smaller maps (64x64 default maps, 128x128 target)")
     p.add_argument("--no-ladder", action="store_true", help="skip the tolerance ladder")
+    p.add_argument("--no-checkpoints", action="store_true",
+                   help="skip the long map with and without checkpoints")
     p.add_argument("--json", metavar="FILE", help="also save the results as JSON to FILE")
     p.add_argument("--binary", default=str(ROOT / "build" / "friction"),
                    help="the friction executable (default: build/friction)")

@@ -7,11 +7,12 @@
 module friction_afm_line_checkpoint
    use friction_kinds, only: wp
    use friction_strings, only: itoa
-   use friction_output_checkpoint, only: save_checkpoint, checkpoint_body, real_line, next_line
+   use friction_output_checkpoint, only: write_checkpoint, publish_checkpoints, discard_checkpoints, &
+      & checkpoint_body, real_line, read_reals, next_line
    implicit none
    private
 
-   public :: line_checkpoint_name, save_line, load_line
+   public :: line_checkpoint_name, save_line, load_line, publish_checkpoints, discard_checkpoints
 
 contains
 
@@ -25,7 +26,9 @@ contains
       name = output//'.line-'//itoa(line + 1)//'.ckpt'
    end function line_checkpoint_name
 
-   !> Write line `line`'s checkpoint.  `trace` and `retrace` are (nx,
+   !> Write line `line`'s checkpoint under its temporary name, to be
+   !> published with the others of the same save (publish_checkpoints: one
+   !> sync for all of them).  `trace` and `retrace` are (nx,
    !> quantities), `retrace` of no columns without a retrace; the `_sem`
    !> arrays likewise, of no rows when not at a temperature; `slips` holds
    !> the line's slips as columns; `counts` the integrator's counts.
@@ -50,7 +53,7 @@ contains
       do k = 1, size(slips, 2)
          text = text//real_line(slips(:, k))
       end do
-      call save_checkpoint(path, input_hash, text, problem)
+      call write_checkpoint(path, input_hash, text, problem)
 
    contains
 
@@ -85,6 +88,7 @@ contains
       character(len=8) :: word
       integer :: shape(9), at, stat, k
       real(wp) :: head(size(counts) + 1)
+      logical :: ok
 
       loaded = .false.
       friction_sem = 0.0_wp
@@ -105,20 +109,18 @@ contains
             & //itoa(shape(2))//' samples)'
          return
       end if
-      text = next_line(body, at)
-      read (text, *, iostat=stat) head
-      if (stat == 0) call columns(trace)
-      if (stat == 0) call columns(retrace)
-      if (stat == 0) call columns(trace_sem)
-      if (stat == 0) call columns(retrace_sem)
+      call read_reals(next_line(body, at), head, ok)
+      if (ok) call columns(trace)
+      if (ok) call columns(retrace)
+      if (ok) call columns(trace_sem)
+      if (ok) call columns(retrace_sem)
       deallocate (slips)
       allocate (slips(shape(7), shape(8)))
       do k = 1, shape(8)
-         if (stat /= 0) exit
-         text = next_line(body, at)
-         read (text, *, iostat=stat) slips(:, k)
+         if (.not. ok) exit
+         call read_reals(next_line(body, at), slips(:, k), ok)
       end do
-      if (stat /= 0) then
+      if (.not. ok) then
          problem = path//': the checkpoint is damaged (its values do not read)'
          return
       end if
@@ -134,9 +136,8 @@ contains
 
          if (size(a, 1) == 0) return
          do q = 1, size(a, 2)
-            if (stat /= 0) return
-            text = next_line(body, at)
-            read (text, *, iostat=stat) a(:, q)
+            if (.not. ok) return
+            call read_reals(next_line(body, at), a(:, q), ok)
          end do
       end subroutine columns
 

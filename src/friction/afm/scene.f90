@@ -25,7 +25,8 @@ module friction_afm_scene
    use friction_afm_output, only: write_afm_file, afm_surface_record, afm_thermal_record, afm_verify_record
    use friction_afm_validity, only: afm_model_warnings, quasistatic_friction_warning
    use friction_afm_netlist, only: afm_netlist
-   use friction_afm_line_checkpoint, only: line_checkpoint_name, save_line, load_line
+   use friction_afm_line_checkpoint, only: line_checkpoint_name, save_line, load_line, publish_checkpoints, &
+      & discard_checkpoints
    implicit none
    private
 
@@ -423,8 +424,11 @@ contains
          type(error_type), allocatable, intent(out) :: error
          real(wp), allocatable :: trace(:, :), retrace(:, :), trace_sem(:, :), retrace_sem(:, :)
          real(wp) :: friction_sem
-         integer :: j, g, k
+         character(len=:), allocatable :: names(:)
+         integer :: j, g, k, n
 
+         allocate (character(len=len(line_checkpoint_name(job%output, self%ran%ny))) :: names(max(0, last - saved)))
+         n = 0
          do j = saved + 1, last
             if (loaded(j)) cycle
             g = self%first + (j - 1) * job%nranks
@@ -435,10 +439,19 @@ contains
                & retrace_sem, friction_sem, local_slips(:, pack([(k, k=1, size(local_slips, 2))], &
                & nint(local_slips(1, :)) == g)), line_counts(:, j), problem)
             if (len(problem) > 0) then
+               call discard_checkpoints(names(1:n))
                call fatal_error(error, problem)
                return
             end if
+            n = n + 1
+            names(n) = line_checkpoint_name(job%output, g)
          end do
+         ! One sync for the lines of this save, then their names.
+         call publish_checkpoints(names(1:n), problem)
+         if (len(problem) > 0) then
+            call fatal_error(error, problem)
+            return
+         end if
          saved = max(saved, last)
          last_saved = wall_seconds()
       end subroutine save_lines

@@ -16,7 +16,7 @@ module friction_files
    public :: path_kind, same_file, publish_file, truncate_file, output_problem, system_error_text, free_bytes
    public :: available_memory, write_bytes, min_free_bytes
    public :: kind_none, kind_regular, kind_directory, kind_link, kind_other, kind_pipe, kind_unknown
-   public :: read_text_line, max_line_length
+   public :: read_text_line, max_line_length, sync_files
 
    !> Free space, bytes, below which no output is written: an HDF5 file that
    !> fails for a full disk can be closed (and so leave no handle open) only
@@ -100,12 +100,19 @@ module friction_files
          real(c_double) :: bytes
       end function c_free_bytes
 
-      function c_write_file(path, data, length) result(code) bind(c, name='friction_write_file')
+      function c_write_file(path, data, length, sync) result(code) bind(c, name='friction_write_file')
          import :: c_int, c_char, c_long
          character(kind=c_char), intent(in) :: path(*), data(*)
          integer(c_long), value :: length
+         integer(c_int), value :: sync
          integer(c_int) :: code
       end function c_write_file
+
+      function c_sync_files(path) result(code) bind(c, name='friction_sync_files')
+         import :: c_int, c_char
+         character(kind=c_char), intent(in) :: path(*)
+         integer(c_int) :: code
+      end function c_sync_files
 
       subroutine c_error_text(code, buffer, size) bind(c, name='friction_error_text')
          import :: c_int, c_char
@@ -399,15 +406,31 @@ contains
    !> file there), every step checked through the C library (gfortran's own
    !> writes report success on a full disk); `problem` says what failed ('' on
    !> success), and a file not written whole is removed.
-   subroutine write_bytes(path, text, problem)
+   subroutine write_bytes(path, text, problem, sync)
       character(len=*), intent(in) :: path, text
       character(len=:), allocatable, intent(out) :: problem
+      logical, intent(in), optional :: sync   !! .false.: no fsync; sync_files after many such writes
       integer :: code
+      integer(c_int) :: flag
 
-      code = int(c_write_file(path//c_null_char, text, int(len(text), c_long)))
+      flag = 1
+      if (present(sync)) flag = merge(1, 0, sync)
+      code = int(c_write_file(path//c_null_char, text, int(len(text), c_long), flag))
       problem = ''
       if (code /= 0) problem = system_error_text(code)
    end subroutine write_bytes
+
+   !> The files written without sync (write_bytes) to the file system that
+   !> holds `path`, on disk at once; `problem` says why not ('' when done).
+   subroutine sync_files(path, problem)
+      character(len=*), intent(in) :: path
+      character(len=:), allocatable, intent(out) :: problem
+      integer :: code
+
+      code = int(c_sync_files(path//c_null_char))
+      problem = ''
+      if (code /= 0) problem = system_error_text(code)
+   end subroutine sync_files
 
    !> Write text to path, complete or not at all (a temporary name beside it,
    !> published when written; see publish_file for `replace`, default true).

@@ -101,18 +101,19 @@ double friction_free_bytes(const char *path)
 }
 
 /* Write `length` bytes to a new file at path (replacing one there), every
- * step checked: open, write, flush, fsync and close.  (gfortran's formatted
- * and stream writes lose ENOSPC: its flush and close report success on a
- * full disk, leaving an empty file.)  On failure the file is removed and
- * the errno returned. */
-int friction_write_file(const char *path, const char *data, long length)
+ * step checked: open, write, flush, fsync (unless `sync` is 0: the caller
+ * syncs many files at once, friction_sync_files) and close.  (gfortran's
+ * formatted and stream writes lose ENOSPC: its flush and close report
+ * success on a full disk, leaving an empty file.)  On failure the file is
+ * removed and the errno returned. */
+int friction_write_file(const char *path, const char *data, long length, int sync)
 {
     int code = 0;
     FILE *file = fopen(path, "wb");
     if (file == NULL) return errno;
     if (length > 0 && fwrite(data, 1, (size_t)length, file) != (size_t)length) code = errno;
     if (code == 0 && fflush(file) != 0) code = errno;
-    if (code == 0 && fsync(fileno(file)) != 0 && errno != EINVAL && errno != EROFS) code = errno;
+    if (code == 0 && sync && fsync(fileno(file)) != 0 && errno != EINVAL && errno != EROFS) code = errno;
     if (fclose(file) != 0 && code == 0) code = errno;
     if (code == 0) return 0;
     if (code == 0) code = EIO;
@@ -125,4 +126,16 @@ void friction_error_text(int code, char *buffer, int size)
 {
     if (size <= 0) return;
     snprintf(buffer, (size_t)size, "%s", strerror(code));
+}
+
+/* Everything written to the file system that holds `path` (an existing
+ * file) on disk: one syncfs(2) for many files written without their own
+ * fsync.  0 or the errno of the failure. */
+int friction_sync_files(const char *path)
+{
+    int fd = open(path, O_RDONLY);
+    if (fd < 0) return errno;
+    int code = syncfs(fd) == 0 ? 0 : errno;
+    close(fd);
+    return code;
 }
