@@ -302,7 +302,7 @@ contains
          & '', &
          & 'exit codes: 0 done, 2 usage, 3 bad input, 4 integration failed, 5 output failed,', &
          & '            6 interrupted (a sweep''s file written with the points done, a map''s', &
-         & '            lines done checkpointed; --resume)'
+         & '            lines done checkpointed, --resume; a brake trajectory: nothing written)'
    end subroutine print_help
 
    integer function exit_code(error)

@@ -230,8 +230,8 @@ int friction_run_job(const char *const *files, int nfiles, const char *output, i
  * points of a sweep.  The job then returns FRICTION_INTERRUPTED: a sweep
  * writes its file with the points done, a map writes no file and keeps the
  * lines done beside the output; the same job with FRICTION_JOB_RESUME
- * computes only the rest.  A brake trajectory that is not a sweep runs to
- * its end.  Callable from any thread, from the job's report callback and
+ * computes only the rest.  A brake trajectory that is not a sweep stops
+ * within a 200th of its τ range and writes nothing.  Callable from any thread, from the job's report callback and
  * from a signal handler (one atomic store); a request made while no job
  * runs is forgotten when the next job begins.  Under MPI the request is
  * rank 0's: the other ranks finish their share first. */

@@ -517,6 +517,28 @@ def case_map_signal(args):
     print(f"{len(kept)} of 400 lines kept at the signal; the resumed map equals the uninterrupted one")
 
 
+def case_brake_signal(args):
+    """SIGINT during a long brake trajectory (not a sweep): it stops within a
+    200th of its range with exit 6 and a message, and writes nothing.
+    Before, the signal's default action killed the program without a word
+    (and in a Python host Ctrl-C waited for the whole trajectory)."""
+    write(args, "long.nml", "&brake t_end = 2000000.0, dt_out = 1.0 /\n" + NO_DIAGNOSTICS)   # about 7 s
+    process = subprocess.Popen([args.binary, "-o", "long.h5", inputs(args, "brake.nml"), "long.nml"],
+                               cwd=args.workdir, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(1.0)
+    started = time.monotonic()
+    process.send_signal(signal.SIGINT)
+    _, stderr = process.communicate(timeout=120)
+    stopped = time.monotonic() - started
+    if process.returncode == 0:
+        raise Skip("the trajectory finished before the signal (a fast machine)")
+    if process.returncode != 6 or "brake run stopped on request" not in stderr or "no file written" not in stderr:
+        fail(f"SIGINT during a brake run: exit {process.returncode}: {stderr}")
+    if [f for f in listing(args.workdir) if f.startswith("long.h5")]:
+        fail(f"a stopped brake run left files: {listing(args.workdir)}")
+    print(f"stopped {stopped:.2f} s after the signal: {stderr.strip().splitlines()[-1]}")
+
+
 def case_sweep_signal_last(args):
     """A stop request after the last point stops nothing: the file says
     complete (status all done, complete = 1) and the run exits 0."""

@@ -352,3 +352,26 @@ def test_a_process_forked_during_a_job_refuses_jobs_and_reads(friction, tmp_path
         child("between")
     assert wait(pid) == 0
     assert (tmp_path / "between.h5").is_file()
+
+
+def test_ctrl_c_stops_a_brake_trajectory(friction, tmp_path):
+    """A brake trajectory (not a sweep) keeps no checkpoints: Ctrl-C stops
+    it within a 200th of its range, and nothing is written; before, the
+    job ran to its end first (2 million τ here, about 7 s)."""
+    import signal
+    long = tmp_path / "long.nml"
+    long.write_text("&brake t_end = 2000000.0, dt_out = 1.0 /\n"
+                    "&analysis spectrum = .false., poincare = .false., lyapunov = .false. /\n")
+    reports = []
+
+    def progress(message, fraction):
+        reports.append(fraction)
+        if len(reports) == 2:
+            signal.raise_signal(signal.SIGINT)
+
+    out = tmp_path / "long.h5"
+    with pytest.raises(KeyboardInterrupt) as caught:
+        friction.run([INPUTS / "brake.nml", long], output=out, progress=progress)
+    assert "brake run stopped on request" in _interrupted(caught).message
+    assert max(reports) < 0.05, reports   # stopped at the third of 200 pieces
+    assert not out.exists() and not list(tmp_path.glob("long.h5*"))

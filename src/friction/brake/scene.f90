@@ -8,7 +8,7 @@ module friction_brake_scene
    use mpi_f08
    use friction_kinds, only: wp, i8
    use friction_strings, only: fixed_text, etoa, itoa
-   use friction_error, only: error_type, fatal_error, error_numerical
+   use friction_error, only: error_type, fatal_error, error_numerical, error_interrupted
    use friction_version, only: version_string
    use friction_parameters, only: parameter_visitor
    use friction_checks, only: config_checker
@@ -322,7 +322,9 @@ contains
       call brake_netlist(self%resolved(), data_file, version, text, note, error)
    end subroutine brake_netlist_text
 
-   !> One brake run, in pieces so that long runs can report progress in τ.
+   !> One brake run, in pieces so that long runs can report progress in τ,
+   !> and stop between them when asked (Ctrl-C, friction_job_stop): a
+   !> trajectory has no checkpoints, so nothing is written then.
    subroutine integrate_brake(run, settings, reporter, error)
       type(brake_run), target, intent(inout) :: run
       type(brake_config), intent(in) :: settings
@@ -338,6 +340,12 @@ contains
          if (allocated(error)) return
          call reporter%progress(run%time_reached() - settings%t_start, settings%t_end - settings%t_start, &
             & 'tau', .false.)
+         if (last < run%n .and. reporter%stop_requested()) then
+            call fatal_error(error, 'brake run stopped on request at τ = '//fixed_text(run%time_reached(), 1) &
+               & //' of '//fixed_text(settings%t_end, 1)//': no file written (a trajectory keeps no ' &
+               & //'checkpoints; run it again)', error_interrupted)
+            return
+         end if
       end do
       call reporter%progress(run%time_reached() - settings%t_start, settings%t_end - settings%t_start, &
          & 'tau', .true.)
