@@ -169,7 +169,10 @@ def _signatures(lib):
         "friction_job_stop": (None, []),
     }
     for name, (restype, argtypes) in signatures.items():
-        function = getattr(lib, name)
+        function = getattr(lib, name, None)
+        if function is None:   # a library of API version 2 built before the function came
+            raise LibraryNotFoundError(f"{lib._name}: libfriction without {name}, older than this package; "
+                                       "build the library of this package's version (scripts/build)")
         function.restype = restype
         function.argtypes = argtypes
 

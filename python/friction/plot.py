@@ -860,15 +860,13 @@ def atlas(data):
     exponent = np.where(done, s["lyapunov"].reshape(n1, n2), np.nan)
     finite = exponent[np.isfinite(exponent)]
     bound = max(float(np.max(np.abs(finite))) if finite.size else 1.0, 1e-12)
-    cmap = colormaps["RdBu_r"].copy()
-    cmap.set_bad("0.7")
+    cmap = colormaps["RdBu_r"].with_extremes(bad="0.7")
     image = top.pcolormesh(_edges(x, xlog), _edges(y, ylog), np.ma.masked_invalid(exponent), cmap=cmap,
                            vmin=-bound, vmax=bound, shading="flat")
     fig.colorbar(image, ax=top, label="Benettin exponent (1/τ)")
     top.set_title("largest Lyapunov exponent: chaos where red")
     stick = np.where(done, s["stick_fraction"].reshape(n1, n2), np.nan)
-    grey = colormaps["viridis"].copy()
-    grey.set_bad("0.7")
+    grey = colormaps["viridis"].with_extremes(bad="0.7")
     image = bottom.pcolormesh(_edges(x, xlog), _edges(y, ylog), np.ma.masked_invalid(stick), cmap=grey,
                               vmin=0.0, vmax=1.0, shading="flat")
     fig.colorbar(image, ax=bottom, label="stick fraction")
