@@ -5,7 +5,8 @@
 !> The bin width 1/(segment length × dt) is reported beside the peak: it is
 !> the resolution; the interpolation only places a single tone within it.
 module friction_analysis_spectrum
-   use, intrinsic :: iso_c_binding, only: c_ptr, c_int, c_double, c_double_complex, c_associated
+   use, intrinsic :: iso_c_binding, only: c_ptr, c_int, c_double, c_double_complex, c_associated, c_loc, &
+      & c_null_ptr
    use friction_kinds, only: wp, pi
    use friction_error, only: error_type, fatal_error, error_input, error_internal
    implicit none
@@ -20,6 +21,16 @@ module friction_analysis_spectrum
    !> input alone.  FFTW's planner is not thread-safe; the program calls it
    !> from one thread per rank.
    integer(c_int), parameter :: fftw_estimate = 64
+
+   !> The last plan, kept for the next transform of the same length: a
+   !> sweep's points all take one, and planning one took 2.6 ms of an atlas
+   !> point's 55 (54 001, a prime length, makes planning dear).  Kept with
+   !> the alignments of the arrays it was made for, as FFTW's new-array
+   !> execute requires.  Jobs run one at a time (capi/job_lock.c), and the
+   !> C API's in-memory computations take no spectrum.
+   type(c_ptr), save :: kept_plan = c_null_ptr
+   integer, save :: kept_length = 0
+   integer(c_int), save :: kept_alignment(2) = -1
 
    !> What the user chooses.
    type :: spectrum_settings
@@ -57,6 +68,12 @@ module friction_analysis_spectrum
          import :: c_ptr
          type(c_ptr), value :: plan
       end subroutine fftw_destroy_plan
+
+      function fftw_alignment_of(p) result(alignment) bind(c, name='fftw_alignment_of')
+         import :: c_ptr, c_int
+         type(c_ptr), value :: p
+         integer(c_int) :: alignment
+      end function fftw_alignment_of
    end interface
 
 contains
@@ -69,10 +86,11 @@ contains
       type(spectrum_settings), intent(in) :: settings
       type(spectrum_result), intent(out) :: result
       type(error_type), allocatable, intent(out) :: error
-      real(c_double), allocatable :: buffer(:)
-      complex(c_double_complex), allocatable :: transform(:)
+      real(c_double), allocatable, target :: buffer(:)
+      complex(c_double_complex), allocatable, target :: transform(:)
       real(wp), allocatable :: window(:), power(:)
       type(c_ptr) :: plan
+      integer(c_int) :: alignment(2)
       integer :: n, length, hop, nbins, s, start, k
       real(wp) :: offset
 
@@ -106,10 +124,20 @@ contains
          return
       end select
       buffer = 0.0_wp
-      plan = fftw_plan_dft_r2c_1d(int(length, c_int), buffer, transform, fftw_estimate)
-      if (.not. c_associated(plan)) then
-         call fatal_error(error, 'spectrum: FFTW could not plan the transform', error_internal)
-         return
+      alignment = [fftw_alignment_of(c_loc(buffer)), fftw_alignment_of(c_loc(transform))]
+      if (c_associated(kept_plan) .and. kept_length == length .and. all(kept_alignment == alignment)) then
+         plan = kept_plan
+      else
+         if (c_associated(kept_plan)) call fftw_destroy_plan(kept_plan)
+         kept_length = 0
+         kept_plan = fftw_plan_dft_r2c_1d(int(length, c_int), buffer, transform, fftw_estimate)
+         if (.not. c_associated(kept_plan)) then
+            call fatal_error(error, 'spectrum: FFTW could not plan the transform', error_internal)
+            return
+         end if
+         kept_length = length
+         kept_alignment = alignment
+         plan = kept_plan
       end if
       power = 0.0_wp
       do s = 1, settings%segments
@@ -119,7 +147,6 @@ contains
          call fftw_execute_dft_r2c(plan, buffer, transform)
          power = power + abs(transform)**2
       end do
-      call fftw_destroy_plan(plan)
       ! One-sided amplitude: a sine of amplitude A gives A at its bin.
       result%amplitude = 2.0_wp * sqrt(power / settings%segments) / sum(window)
       result%amplitude(1) = result%amplitude(1) / 2.0_wp
