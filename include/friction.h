@@ -32,7 +32,8 @@
  * handler is back when the last of them returns, and a lock that runs the
  * job functions one at a time: they use HDF5, FFTW's planner and MPI, which
  * are the whole process's, so a job called while another thread's runs
- * waits for it to end.  A job started from a job's own report callback (the
+ * waits for it to end.  Jobs keep HDF5's Fortran interface open and the
+ * last spectrum's FFT plan from one job to the next.  A job started from a job's own report callback (the
  * same thread) is refused with FRICTION_ERROR_INPUT.
  *
  * Units are those of the namelist input (docs/input.md).
