@@ -525,10 +525,12 @@ def case_brake_signal(args):
     write(args, "long.nml", "&brake t_end = 2000000.0, dt_out = 1.0 /\n" + NO_DIAGNOSTICS)   # about 7 s
     process = subprocess.Popen([args.binary, "-o", "long.h5", inputs(args, "brake.nml"), "long.nml"],
                                cwd=args.workdir, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    time.sleep(1.0)
+    # The first progress line (after 2 s) says the run is integrating: signal then.
+    first = process.stderr.readline()
     started = time.monotonic()
     process.send_signal(signal.SIGINT)
     _, stderr = process.communicate(timeout=120)
+    stderr = first + stderr
     stopped = time.monotonic() - started
     if process.returncode == 0:
         raise Skip("the trajectory finished before the signal (a fast machine)")
