@@ -195,6 +195,21 @@ def _interrupted(caught):
     return context
 
 
+def _sigint_at_report(number):
+    """(reports, progress): a progress callback that keeps its (message,
+    fraction) reports and sends this process SIGINT at report `number`, as
+    Ctrl-C would during the job."""
+    import signal
+    reports = []
+
+    def progress(message, fraction):
+        reports.append((message, fraction))
+        if len(reports) == number:
+            signal.raise_signal(signal.SIGINT)
+
+    return reports, progress
+
+
 def test_ctrl_c_stops_a_map_and_resume_finishes_it(friction, naf_map, tmp_path):
     """SIGINT during a job (here sent from the first progress report, on the
     main thread) stops the map at its next line instead of being swallowed
@@ -202,19 +217,13 @@ def test_ctrl_c_stops_a_map_and_resume_finishes_it(friction, naf_map, tmp_path):
     5, no file, the lines done kept; resume computes the rest, and the file
     equals the uninterrupted run's."""
     import signal
-    reports = []
-
-    def progress(message, fraction):
-        reports.append(message)
-        if len(reports) == 1:
-            signal.raise_signal(signal.SIGINT)
-
+    reports, progress = _sigint_at_report(1)
     out = tmp_path / "stopped.h5"
     with pytest.raises(KeyboardInterrupt) as caught:
         friction.run(NAF, output=out, progress=progress)
     assert "checkpointed" in _interrupted(caught).message
     assert not out.exists()
-    assert "10 of 10 lines" not in reports and len(reports) < 5, reports
+    assert len(reports) < 5 and all(message != "10 of 10 lines" for message, _ in reports), reports
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler   # the handler is back
     friction.run(NAF, output=out, resume=True, progress=False)
     same_files(out, naf_map)
@@ -358,20 +367,13 @@ def test_ctrl_c_stops_a_brake_trajectory(friction, tmp_path):
     """A brake trajectory (not a sweep) keeps no checkpoints: Ctrl-C stops
     it within a 200th of its range, and nothing is written; before, the
     job ran to its end first (2 million τ here, about 7 s)."""
-    import signal
     long = tmp_path / "long.nml"
     long.write_text("&brake t_end = 2000000.0, dt_out = 1.0 /\n"
                     "&analysis spectrum = .false., poincare = .false., lyapunov = .false. /\n")
-    reports = []
-
-    def progress(message, fraction):
-        reports.append(fraction)
-        if len(reports) == 2:
-            signal.raise_signal(signal.SIGINT)
-
+    reports, progress = _sigint_at_report(2)
     out = tmp_path / "long.h5"
     with pytest.raises(KeyboardInterrupt) as caught:
         friction.run([INPUTS / "brake.nml", long], output=out, progress=progress)
     assert "brake run stopped on request" in _interrupted(caught).message
-    assert max(reports) < 0.05, reports   # stopped at the third of 200 pieces
+    assert max(fraction for _, fraction in reports) < 0.05, reports   # stopped at the third of 200 pieces
     assert not out.exists() and not list(tmp_path.glob("long.h5*"))

@@ -16,7 +16,7 @@ module friction_afm_config
    use friction_kinds, only: ev_per_angstrom_to_nn
    use friction_afm_tip, only: afm_tip, model_inertial, model_overdamped, model_quasistatic, find_height
    use friction_strings, only: itoa, rtoa, quoted, bytes_text
-   use friction_files, only: file_exists, path_kind, kind_regular
+   use friction_files, only: file_exists, open_for_reading
    use friction_parameters, only: configurable, parameter_visitor
    use friction_checks, only: config_checker
    use friction_ode_settings, only: visit_integrator, check_integrator, verify_settings, visit_verify, check_verify
@@ -403,6 +403,7 @@ contains
    function net_sites(config) result(n)
       type(afm_config), intent(in) :: config
       integer :: n, unit, stat
+      type(error_type), allocatable :: error
 
       select case (trim(config%net))
       case ('graphite')
@@ -411,11 +412,11 @@ contains
          n = config%side**2
       case default
          n = -1
-         ! Only a regular file: a pipe would be used up, a device read forever
-         ! (the net's reader says what is wrong with such a file).
-         if (path_kind(trim(config%net_file), follow=.true.) /= kind_regular) return
-         open (newunit=unit, file=config%net_file, status='old', action='read', iostat=stat)
-         if (stat /= 0) return
+         ! (A regular file only, as the net's reader opens it, which says
+         ! what is wrong with another: a pipe would be used up, a device read
+         ! forever.)
+         call open_for_reading(trim(config%net_file), unit, error)
+         if (allocated(error)) return
          read (unit, *, iostat=stat) n
          if (stat /= 0) n = -1
          close (unit)

@@ -435,7 +435,8 @@ contains
             call line_arrays(j, trace, retrace, trace_sem, retrace_sem)
             friction_sem = 0.0_wp
             if (scanner%thermal) friction_sem = self%friction_sem(j)
-            call save_line(line_checkpoint_name(job%output, g), input_hash, g, trace, retrace, trace_sem, &
+            names(n + 1) = line_checkpoint_name(job%output, g)
+            call save_line(trim(names(n + 1)), input_hash, g, trace, retrace, trace_sem, &
                & retrace_sem, friction_sem, local_slips(:, pack([(k, k=1, size(local_slips, 2))], &
                & nint(local_slips(1, :)) == g)), line_counts(:, j), problem)
             if (len(problem) > 0) then
@@ -444,7 +445,6 @@ contains
                return
             end if
             n = n + 1
-            names(n) = line_checkpoint_name(job%output, g)
          end do
          ! One sync for the lines of this save, then their names.
          call publish_checkpoints(names(1:n), problem)

@@ -115,7 +115,8 @@ module friction_capi
       end function c_strlen
 
       !> One job at a time in the process (job_lock.c): 0 once the calling
-      !> thread may run its job, 1 if it is running one already.
+      !> thread may run its job, 1 if it is running one already, 2 in a
+      !> process forked while its parent ran one.
       function friction_job_begin() bind(c, name='friction_job_begin') result(busy)
          import :: c_int
          integer(c_int) :: busy
@@ -130,7 +131,8 @@ module friction_capi
       end function friction_job_stop_asked
 
       !> Around friction_config_read's file reading (job_lock.c): 1 if it
-      !> took the lock, 0 if this thread holds it for its job.
+      !> took the lock, 0 if this thread holds it for its job, -1 in a
+      !> process forked while its parent ran a job (no read then).
       function friction_read_begin() bind(c, name='friction_read_begin') result(taken)
          import :: c_int
          integer(c_int) :: taken

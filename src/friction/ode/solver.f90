@@ -13,7 +13,6 @@ module friction_ode_solver
       & c_null_ptr, c_associated, c_loc, c_funloc, c_f_pointer, c_char, c_null_char
    use friction_kinds, only: wp, i8
    use friction_error, only: error_type, fatal_error, error_numerical, error_input, error_internal
-   use friction_strings, only: rtoa
    use friction_ode_system, only: ode_system
    use friction_strings, only: itoa, rtoa, etoa
    implicit none

@@ -21,6 +21,9 @@ module friction_output_checkpoint
    !> The first word of a checkpoint (its format's version).
    character(len=*), parameter :: checkpoint_magic = 'friction-checkpoint-3'
 
+   !> The digits of real_line's numbers.
+   character(len=16), parameter :: hex_digits = '0123456789abcdef'
+
 contains
 
    !> Write `body` (whole lines) as the checkpoint at `path` for the input
@@ -136,9 +139,8 @@ contains
    pure function real_line(values) result(line)
       real(wp), intent(in) :: values(:)
       character(len=:), allocatable :: line
-      character(len=16), parameter :: digits = '0123456789abcdef'
       integer(i8) :: bits
-      integer :: k, d, at
+      integer :: k, d, at, nibble
 
       allocate (character(len=17 * size(values) + 1) :: line)
       at = 0
@@ -146,7 +148,8 @@ contains
          bits = transfer(values(k), bits)
          do d = 15, 0, -1
             at = at + 1
-            line(at:at) = digits(ibits(bits, 4 * d, 4) + 1:ibits(bits, 4 * d, 4) + 1)
+            nibble = int(ibits(bits, 4 * d, 4)) + 1
+            line(at:at) = hex_digits(nibble:nibble)
          end do
          at = at + 1
          line(at:at) = ' '
@@ -171,7 +174,7 @@ contains
          bits = 0_i8
          do d = 1, 16
             at = at + 1
-            nibble = index('0123456789abcdef', line(at:at)) - 1
+            nibble = index(hex_digits, line(at:at)) - 1
             if (nibble < 0) then
                ok = .false.
                return
