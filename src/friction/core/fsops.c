@@ -116,7 +116,6 @@ int friction_write_file(const char *path, const char *data, long length, int syn
     if (code == 0 && sync && fsync(fileno(file)) != 0 && errno != EINVAL && errno != EROFS) code = errno;
     if (fclose(file) != 0 && code == 0) code = errno;
     if (code == 0) return 0;
-    if (code == 0) code = EIO;
     unlink(path);
     return code;
 }
