@@ -27,8 +27,9 @@ contains
 
    pure subroutine rhs(self, t, y, dydt)
       class(crank_in_stick), intent(in) :: self
-      real(wp), intent(in) :: t, y(:)
-      real(wp), intent(out) :: dydt(:)
+      real(wp), intent(in) :: t
+      real(wp), intent(in), contiguous :: y(:)
+      real(wp), intent(out), contiguous :: dydt(:)
       dydt(1) = y(2)
       dydt(2) = (self%x0 + self%v_dr * (t - self%t0) - self%kappa * y(1)) / self%xi
    end subroutine rhs

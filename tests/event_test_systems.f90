@@ -28,8 +28,9 @@ contains
 
    pure subroutine rhs(self, t, y, dydt)
       class(ringing), intent(in) :: self
-      real(wp), intent(in) :: t, y(:)
-      real(wp), intent(out) :: dydt(:)
+      real(wp), intent(in) :: t
+      real(wp), intent(in), contiguous :: y(:)
+      real(wp), intent(out), contiguous :: dydt(:)
       dydt(1) = y(2)
       dydt(2) = -self%omega**2 * y(1)
    end subroutine rhs

@@ -70,8 +70,9 @@ contains
 
    pure subroutine lorenz_rhs(self, t, y, dydt)
       class(lorenz), intent(in) :: self
-      real(wp), intent(in) :: t, y(:)
-      real(wp), intent(out) :: dydt(:)
+      real(wp), intent(in) :: t
+      real(wp), intent(in), contiguous :: y(:)
+      real(wp), intent(out), contiguous :: dydt(:)
       dydt(1) = self%sigma * (y(2) - y(1))
       dydt(2) = y(1) * (self%rho - y(3)) - y(2)
       dydt(3) = y(1) * y(2) - self%beta * y(3)
@@ -94,8 +95,9 @@ contains
 
    pure subroutine oscillator_rhs(self, t, y, dydt)
       class(oscillator), intent(in) :: self
-      real(wp), intent(in) :: t, y(:)
-      real(wp), intent(out) :: dydt(:)
+      real(wp), intent(in) :: t
+      real(wp), intent(in), contiguous :: y(:)
+      real(wp), intent(out), contiguous :: dydt(:)
       dydt(1) = y(2)
       dydt(2) = -self%omega**2 * y(1)
    end subroutine oscillator_rhs
@@ -127,8 +129,9 @@ contains
 
    pure subroutine decay_rhs(self, t, y, dydt)
       class(decay), intent(in) :: self
-      real(wp), intent(in) :: t, y(:)
-      real(wp), intent(out) :: dydt(:)
+      real(wp), intent(in) :: t
+      real(wp), intent(in), contiguous :: y(:)
+      real(wp), intent(out), contiguous :: dydt(:)
       dydt(1) = -self%rate * y(1)
       if (t > self%t_bad) dydt(1) = ieee_value(1.0_wp, ieee_quiet_nan)
    end subroutine decay_rhs
@@ -149,8 +152,9 @@ contains
 
    pure subroutine hopf_rhs(self, t, y, dydt)
       class(hopf), intent(in) :: self
-      real(wp), intent(in) :: t, y(:)
-      real(wp), intent(out) :: dydt(:)
+      real(wp), intent(in) :: t
+      real(wp), intent(in), contiguous :: y(:)
+      real(wp), intent(out), contiguous :: dydt(:)
       real(wp) :: r2
       r2 = y(1)**2 + y(2)**2
       dydt(1) = self%a * y(1) - self%omega * y(2) - y(1) * r2

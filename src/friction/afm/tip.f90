@@ -93,8 +93,8 @@ contains
    pure subroutine rhs(self, t, y, dydt)
       class(afm_tip), intent(in) :: self
       real(wp), intent(in) :: t
-      real(wp), intent(in) :: y(:)
-      real(wp), intent(out) :: dydt(:)
+      real(wp), intent(in), contiguous :: y(:)
+      real(wp), intent(out), contiguous :: dydt(:)
       real(wp) :: r(3), g(3), inverse_mass
       integer :: nd, i
 

@@ -87,8 +87,8 @@ contains
    pure subroutine tangent_rhs(self, t, y, dydt)
       class(tangent_system), intent(in) :: self
       real(wp), intent(in) :: t
-      real(wp), intent(in) :: y(:)
-      real(wp), intent(out) :: dydt(:)
+      real(wp), intent(in), contiguous :: y(:)
+      real(wp), intent(out), contiguous :: dydt(:)
       real(wp) :: dfdy(max_base, max_base), dfdt(max_base)
       integer :: n, i, j, k, c
 

@@ -284,8 +284,8 @@ contains
    pure subroutine hyperplane_rhs(self, t, y, dydt)
       class(hyperplane_system), intent(in) :: self
       real(wp), intent(in) :: t
-      real(wp), intent(in) :: y(:)
-      real(wp), intent(out) :: dydt(:)
+      real(wp), intent(in), contiguous :: y(:)
+      real(wp), intent(out), contiguous :: dydt(:)
 
       call self%base%rhs(t, y, dydt)
    end subroutine hyperplane_rhs

@@ -90,8 +90,8 @@ contains
    pure subroutine rhs(self, t, y, dydt)
       class(brake_regularized), intent(in) :: self
       real(wp), intent(in) :: t
-      real(wp), intent(in) :: y(:)
-      real(wp), intent(out) :: dydt(:)
+      real(wp), intent(in), contiguous :: y(:)
+      real(wp), intent(out), contiguous :: dydt(:)
       real(wp) :: normal
 
       associate (p => self%params)

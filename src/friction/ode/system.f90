@@ -25,13 +25,16 @@ module friction_ode_system
          integer :: n
       end function dimension_interface
 
-      !> dydt = f(t, y).
+      !> dydt = f(t, y).  y and dydt are contiguous (the integrators' state
+      !> vectors always are), so an implementation indexes them without the
+      !> strides of a general array section: the right-hand side is the
+      !> innermost call of every integration.
       pure subroutine rhs_interface(self, t, y, dydt)
          import :: ode_system, wp
          class(ode_system), intent(in) :: self
          real(wp), intent(in) :: t
-         real(wp), intent(in) :: y(:)
-         real(wp), intent(out) :: dydt(:)
+         real(wp), intent(in), contiguous :: y(:)
+         real(wp), intent(out), contiguous :: dydt(:)
       end subroutine rhs_interface
 
       !> dfdy(i, j) = ∂f_i/∂y_j and dfdt(i) = ∂f_i/∂t.
