@@ -12,11 +12,32 @@
 module friction_special
    use, intrinsic :: iso_c_binding, only: c_double
    use, intrinsic :: iso_fortran_env, only: int64
-   use friction_kinds, only: wp
+   use friction_kinds, only: wp, pi
    implicit none
    private
 
    public :: expm1, log1p, sin_cos
+
+   ! sin_cos's table and constants, from π in quadruple precision (folded at
+   ! compile time): the step 2π/256 and the table's angles k 2π/256 exact
+   ! to far below an ulp, so neither the reduction nor the table inherits
+   ! the rounding of 2π/256 to double precision.
+   integer, parameter :: table_size = 256
+   integer, parameter :: qp = selected_real_kind(30)
+   real(qp), parameter :: table_step_qp = 2.0_qp * acos(-1.0_qp) / table_size
+   real(wp), parameter :: steps_per_radian = real(1.0_qp / table_step_qp, wp)
+   real(wp), parameter :: round_shift = 6755399441055744.0_wp   ! 1.5 * 2^52: adding it rounds to an integer
+   ! 2π/256 = step_head + step_tail, step_head with 26 significant bits:
+   ! n step_head is exact for |n| < 2^26, that is |x| < 2^20 rad
+   real(wp), parameter :: step_head = real(int(table_step_qp * 2.0_qp**31, int64), wp) / 2.0_wp**31
+   real(wp), parameter :: step_tail = real(table_step_qp - step_head, wp)
+   integer :: table_index   ! (the implied loops' index below: a name, never a value)
+   real(wp), parameter :: sin_table(0:table_size - 1) = &
+      & [(real(sin(table_step_qp * table_index), wp), table_index = 0, table_size - 1)]
+   real(wp), parameter :: cos_table(0:table_size - 1) = &
+      & [(real(cos(table_step_qp * table_index), wp), table_index = 0, table_size - 1)]
+   real(wp), parameter :: s3 = -1.0_wp / 6.0_wp, s5 = 1.0_wp / 120.0_wp, s7 = -1.0_wp / 5040.0_wp
+   real(wp), parameter :: c2 = -0.5_wp, c4 = 1.0_wp / 24.0_wp, c6 = -1.0_wp / 720.0_wp
 
    interface
       pure function c_expm1(x) result(y) bind(c, name='expm1')
@@ -53,51 +74,40 @@ contains
    !> sin(x) and cos(x) of two arguments at once (a periodic surface's two
    !> phases), written so the compiler evaluates both in one pair of vector
    !> lanes: no branch but the range check.  |x| < 2^20 (a million radians,
-   !> far beyond any scan's phase): x is reduced to r in [-π/4, π/4] by the
-   !> nearest multiple n of π/2, with π/2 split in two (a 33-bit head, so n
-   !> times it is exact, and the rest), and sin r, cos r come from their
-   !> Taylor series through r^17 and r^18, whose remainders are below 1e-19
-   !> there, summed in Estrin's order (short dependency chains).  The result
-   !> is within a few units of the last place of the correctly rounded one
-   !> (tests/test_special.pf: 2 ulp of 1 against the C library's at a
+   !> far beyond any scan's phase): x = a + b with a the nearest multiple
+   !> k 2π/256 and |b| <= π/256, 2π/256 split in two (a 26-bit head, so k
+   !> times it is exact, and the rest); sin a and cos a come from a table of
+   !> 256 correctly rounded pairs (the compiler's, at compile time), sin b
+   !> and cos b - 1 from their Taylor series through b^7 and b^6, whose
+   !> remainders are below 1e-22 there, and
+   !>   sin x = sin a + (sin a (cos b - 1) + cos a sin b),
+   !>   cos x = cos a + (cos a (cos b - 1) - sin a sin b):
+   !> the table's rounding (half an ulp) plus a correction below 0.013.  The
+   !> result is within about an ulp of 1 of the correctly rounded one
+   !> (tests/test_potentials.pf: 2 ulp of 1 against the C library's at a
    !> million points).  Beyond 2^20 the intrinsics answer.
    pure subroutine sin_cos(x, s, c)
       real(wp), intent(in) :: x(2)
       real(wp), intent(out) :: s(2), c(2)
-      real(wp), parameter :: two_over_pi = 0.63661977236758134308_wp
-      real(wp), parameter :: round_shift = 6755399441055744.0_wp   ! 1.5 * 2^52: adding it rounds to an integer
-      real(wp), parameter :: half_pi_head = 1.570796326734125614166259765625_wp   ! 33 significant bits
-      real(wp), parameter :: half_pi_tail = 6.0771005065061926014751442098585e-11_wp
-      real(wp), parameter :: s3 = -1.0_wp / 6.0_wp, s5 = 1.0_wp / 120.0_wp, s7 = -1.0_wp / 5040.0_wp, &
-         & s9 = 1.0_wp / 362880.0_wp, s11 = -1.0_wp / 39916800.0_wp, s13 = 1.0_wp / 6227020800.0_wp, &
-         & s15 = -1.0_wp / 1307674368000.0_wp, s17 = 1.0_wp / 355687428096000.0_wp
-      real(wp), parameter :: c2 = -0.5_wp, c4 = 1.0_wp / 24.0_wp, c6 = -1.0_wp / 720.0_wp, &
-         & c8 = 1.0_wp / 40320.0_wp, c10 = -1.0_wp / 3628800.0_wp, c12 = 1.0_wp / 479001600.0_wp, &
-         & c14 = -1.0_wp / 87178291200.0_wp, c16 = 1.0_wp / 20922789888000.0_wp, &
-         & c18 = -1.0_wp / 6402373705728000.0_wp
-      real(wp) :: shifted(2), n(2), r(2), r2(2), r4(2), r8(2), sr(2), cr(2)
-      integer(int64) :: quadrant(2)
+      real(wp) :: shifted(2), n(2), b(2), b2(2), sin_b(2), cos_b_minus_1(2), sin_a(2), cos_a(2)
+      integer(int64) :: k(2)
 
       if (.not. (abs(x(1)) < 1048576.0_wp .and. abs(x(2)) < 1048576.0_wp)) then
          s = sin(x)
          c = cos(x)
          return
       end if
-      shifted = x * two_over_pi + round_shift
+      shifted = x * steps_per_radian + round_shift
       n = shifted - round_shift
-      quadrant = iand(transfer(shifted, quadrant), 3_int64)   ! n mod 4, from the low bits
-      r = (x - n * half_pi_head) - n * half_pi_tail
-      r2 = r * r
-      r4 = r2 * r2
-      r8 = r4 * r4
-      sr = r + r * r2 * ((s3 + s5 * r2) + r4 * (s7 + s9 * r2) + r8 * ((s11 + s13 * r2) + r4 * (s15 + s17 * r2)))
-      cr = 1.0_wp + r2 * ((c2 + c4 * r2) + r4 * (c6 + c8 * r2) + r8 * ((c10 + c12 * r2) + r4 * (c14 + c16 * r2)) &
-         & + r8 * r8 * c18)
-      ! quadrant 0: (sr, cr), 1: (cr, -sr), 2: (-sr, -cr), 3: (-cr, sr)
-      s = merge(cr, sr, iand(quadrant, 1_int64) == 1_int64)
-      c = merge(sr, cr, iand(quadrant, 1_int64) == 1_int64)
-      s = merge(-s, s, quadrant >= 2_int64)
-      c = merge(-c, c, quadrant == 1_int64 .or. quadrant == 2_int64)
+      k = iand(transfer(shifted, k), int(table_size - 1, int64))   ! n mod 256, from the low bits
+      b = (x - n * step_head) - n * step_tail
+      b2 = b * b
+      sin_b = b + b * b2 * (s3 + b2 * (s5 + b2 * s7))
+      cos_b_minus_1 = b2 * (c2 + b2 * (c4 + b2 * c6))
+      sin_a = [sin_table(k(1)), sin_table(k(2))]
+      cos_a = [cos_table(k(1)), cos_table(k(2))]
+      s = sin_a + (sin_a * cos_b_minus_1 + cos_a * sin_b)
+      c = cos_a + (cos_a * cos_b_minus_1 - sin_a * sin_b)
    end subroutine sin_cos
 
 end module friction_special
