@@ -12,7 +12,7 @@
 module friction_special
    use, intrinsic :: iso_c_binding, only: c_double
    use, intrinsic :: iso_fortran_env, only: int64
-   use friction_kinds, only: wp, pi
+   use friction_kinds, only: wp
    implicit none
    private
 
