@@ -155,8 +155,12 @@ contains
          call fatal_error(error, path//': is a directory, not a file', error_input)
          return
       case (kind_other)
-         call fatal_error(error, path//': is a device or socket, not a file; give a regular file' &
-            & //trim(merge(' or a pipe', '          ', pipe_ok)), error_input)
+         if (pipe_ok) then
+            call fatal_error(error, path//': is a device or socket, not a file; give a regular file or a pipe', &
+               & error_input)
+         else
+            call fatal_error(error, path//': is a device or socket, not a file; give a regular file', error_input)
+         end if
          return
       case (kind_pipe)
          if (.not. pipe_ok) then
