@@ -21,9 +21,11 @@ module friction_surface_lennard_jones
    use friction_surface_potential, only: surface_potential
    use friction_surface_net, only: crystal_net, net_lattice
    use friction_surface_tricubic, only: tricubic_grid, new_tricubic_grid, n_node_values
-   use friction_surface_lj_columns, only: column_sums, difference_terms
+   use friction_surface_table_kernels, only: column_sums, difference_terms
+   use friction_surface_table_kernels_wide, only: column_sums_wide => column_sums
    use friction_strings, only: rtoa, itoa
    use friction_sharing, only: work_sharing
+   use, intrinsic :: iso_c_binding, only: c_int
    implicit none
    private
 
@@ -74,6 +76,9 @@ module friction_surface_lennard_jones
       !> differences are complete within the cutoff of it
       real(wp) :: box(4) = 0.0_wp
       integer :: verify_points = 4096   !! points checked against the direct sum
+      !> build and evaluate through the kernels compiled for AVX2 where the
+      !> processor has it (the same bits: friction_surface_table_kernels)
+      logical :: wide_kernels = .true.
    end type table_settings
 
    !> The tabulated perfect lattice and the net's differences from it.
@@ -95,6 +100,7 @@ module friction_surface_lennard_jones
       real(wp) :: energy_window = 0.0_wp    !! eV
       integer :: points = 0                 !! points the error was measured at
       integer :: difference_count = 0       !! atoms in the differences
+      logical :: wide = .false.             !! built and evaluated by the AVX2 kernels
    end type lj_table
 
    type, extends(surface_potential) :: lj_potential
@@ -114,6 +120,14 @@ module friction_surface_lennard_jones
       procedure :: table_answers
       procedure :: direct_gradient
    end type lj_potential
+
+   interface
+      !> Whether the kernels compiled for AVX2 (x86-64-v3) can run here:
+      !> this build has them and the processor has the instructions (cpu.c).
+      integer(c_int) function friction_wide_kernels() bind(c, name='friction_wide_kernels')
+         import :: c_int
+      end function friction_wide_kernels
+   end interface
 
 contains
 
@@ -557,6 +571,7 @@ contains
       end associate
       t%tolerance = settings%tolerance
       t%energy_window = settings%energy_window
+      t%wide = settings%wide_kernels .and. friction_wide_kernels() /= 0
       t%shift = lj_pair_energy(self%epsilon, self%sigma, self%cutoff)
       t%top = maxval(lattice%basis(3, :)) + self%cutoff
       t%ceiling = max(t%top, maxval(self%atoms%position(3, :)) + self%cutoff)
@@ -591,6 +606,7 @@ contains
             return
          end if
          t%grid = new_tricubic_grid(0.0_wp, 1.0_wp / n1, n1 + 1, 0.0_wp, 1.0_wp / n2, n2 + 1, layers)
+         t%grid%wide = t%wide
          if (present(share)) then
             call fill_grid(ideal, t, centrosymmetric(lattice), swap_symmetric(lattice), share)
          else
@@ -789,7 +805,7 @@ contains
 
    !> The eight node values of the lattice potential at heights z(:) above
    !> the point xy (Å), in the fractional coordinates of the lattice
-   !> (friction_surface_lj_columns' column_sums); the pairs within the
+   !> (friction_surface_table_kernels' column_sums); the pairs within the
    !> cutoff in the plane are gathered once per column.
    pure subroutine column_values(ideal, t, xy, z, values)
       type(lj_potential), intent(in) :: ideal
@@ -833,7 +849,11 @@ contains
             end do
          end do
       end do
-      call column_sums(n, lateral, u1, u2, height, sigma2, e4, shift, c12, rc2, z, values)
+      if (t%wide) then
+         call column_sums_wide(n, lateral, u1, u2, height, sigma2, e4, shift, c12, rc2, z, values)
+      else
+         call column_sums(n, lateral, u1, u2, height, sigma2, e4, shift, c12, rc2, z, values)
+      end if
    end subroutine column_values
 
    !> The Cartesian point of fractional coordinates s.

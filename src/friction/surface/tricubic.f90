@@ -32,6 +32,8 @@
 !> error is about ten times larger at the same spacing.
 module friction_surface_tricubic
    use friction_kinds, only: wp
+   use friction_surface_table_kernels, only: power_polynomial
+   use friction_surface_table_kernels_wide, only: power_polynomial_wide => power_polynomial
    implicit none
    private
 
@@ -65,6 +67,9 @@ module friction_surface_tricubic
       real(wp), allocatable :: cell(:, :)
       integer, allocatable :: slot(:, :), image(:, :)
       integer :: slots = 0
+      !> evaluate through the kernels compiled for AVX2 (the same bits,
+      !> faster; set only where the processor has it: friction_surface_table_kernels)
+      logical :: wide = .false.
    contains
       procedure :: evaluate
       procedure :: set_polynomials
@@ -159,7 +164,7 @@ contains
          associate (op => self%image(i, j))
             call cell_polynomial(self%cell(:, self%slot(i, j) + self%slots * (k - 1)), op, s - i, t - j, &
                & (p(3) - self%z(k)) * self%inverse_dz(k), [self%inverse_hx, self%inverse_hy, self%inverse_dz(k)], &
-               & order, v, g, h)
+               & order, self%wide, v, g, h)
          end associate
          return
       end if
@@ -299,11 +304,13 @@ contains
    !> polynomial is that of cell c at the image point under op (0 none, 1
    !> the reflection: (1 - ξ, 1 - η), 2 the swap: (η, ξ), 3 both:
    !> (1 - η, 1 - ξ); set_polynomials), with inverse(:) the reciprocal cell
-   !> widths.  The image's derivatives come back through the map (odd in
-   !> x, y under the reflection, x and y trading places under the swap).
-   pure subroutine cell_polynomial(c, op, px, py, z, inverse, order, v, g, h)
+   !> widths, through the AVX2 kernel when `wide`.  The image's derivatives
+   !> come back through the map (odd in x, y under the reflection, x and y
+   !> trading places under the swap).
+   pure subroutine cell_polynomial(c, op, px, py, z, inverse, order, wide, v, g, h)
       real(wp), intent(in) :: c(n_cell_coefficients), px, py, z, inverse(3)
       integer, intent(in) :: op, order
+      logical, intent(in) :: wide
       real(wp), intent(out) :: v, g(3), h(3, 3)
       real(wp) :: x, y
 
@@ -321,7 +328,11 @@ contains
          x = 1.0_wp - py
          y = 1.0_wp - px
       end select
-      call power_polynomial(c, x, y, z, inverse, order, v, g, h)
+      if (wide) then
+         call power_polynomial_wide(c, x, y, z, inverse, order, v, g, h)
+      else
+         call power_polynomial(c, x, y, z, inverse, order, v, g, h)
+      end if
       if (op == 0) return
       if (op /= 1) then
          g(1:2) = [g(2), g(1)]
@@ -335,57 +346,6 @@ contains
          end if
       end if
    end subroutine cell_polynomial
-
-   !> The value v, gradient g (order >= 1) and Hessian h (order 2; else
-   !> zero) of one cell's polynomial c (set_polynomials) at local
-   !> coordinates (x, y, z), with inverse(:) the reciprocal cell widths:
-   !> Horner's rule along z (16 cubics at once), then y (4), then x.
-   pure subroutine power_polynomial(c, x, y, z, inverse, order, v, g, h)
-      real(wp), intent(in) :: c(n_cell_coefficients), x, y, z, inverse(3)
-      integer, intent(in) :: order
-      real(wp), intent(out) :: v, g(3), h(3, 3)
-      ! (aN: N-th z derivative, 16 cubics in x, y; bMN: M-th y derivative
-      ! and N-th z derivative, 4 cubics in x.)
-      real(wp) :: a0(16), a1(16), a2(16), b00(4), b10(4), b01(4), b20(4), b11(4), b02(4)
-      integer :: l
-
-      a0 = c(1:16) + z * (c(17:32) + z * (c(33:48) + z * c(49:64)))
-      h = 0.0_wp
-      g = 0.0_wp
-      if (order < 1) then
-         do l = 1, 4
-            b00(l) = a0(l) + y * (a0(l + 4) + y * (a0(l + 8) + y * a0(l + 12)))
-         end do
-         v = b00(1) + x * (b00(2) + x * (b00(3) + x * b00(4)))
-         return
-      end if
-      a1 = c(17:32) + z * (2.0_wp * c(33:48) + 3.0_wp * z * c(49:64))
-      do l = 1, 4
-         b00(l) = a0(l) + y * (a0(l + 4) + y * (a0(l + 8) + y * a0(l + 12)))
-         b10(l) = a0(l + 4) + y * (2.0_wp * a0(l + 8) + 3.0_wp * y * a0(l + 12))
-         b01(l) = a1(l) + y * (a1(l + 4) + y * (a1(l + 8) + y * a1(l + 12)))
-      end do
-      v = b00(1) + x * (b00(2) + x * (b00(3) + x * b00(4)))
-      g(1) = (b00(2) + x * (2.0_wp * b00(3) + 3.0_wp * x * b00(4))) * inverse(1)
-      g(2) = (b10(1) + x * (b10(2) + x * (b10(3) + x * b10(4)))) * inverse(2)
-      g(3) = (b01(1) + x * (b01(2) + x * (b01(3) + x * b01(4)))) * inverse(3)
-      if (order < 2) return
-      a2 = 2.0_wp * c(33:48) + 6.0_wp * z * c(49:64)
-      do l = 1, 4
-         b20(l) = 2.0_wp * a0(l + 8) + 6.0_wp * y * a0(l + 12)
-         b11(l) = a1(l + 4) + y * (2.0_wp * a1(l + 8) + 3.0_wp * y * a1(l + 12))
-         b02(l) = a2(l) + y * (a2(l + 4) + y * (a2(l + 8) + y * a2(l + 12)))
-      end do
-      h(1, 1) = (2.0_wp * b00(3) + 6.0_wp * x * b00(4)) * inverse(1)**2
-      h(2, 2) = (b20(1) + x * (b20(2) + x * (b20(3) + x * b20(4)))) * inverse(2)**2
-      h(3, 3) = (b02(1) + x * (b02(2) + x * (b02(3) + x * b02(4)))) * inverse(3)**2
-      h(1, 2) = (b10(2) + x * (2.0_wp * b10(3) + 3.0_wp * x * b10(4))) * inverse(1) * inverse(2)
-      h(1, 3) = (b01(2) + x * (2.0_wp * b01(3) + 3.0_wp * x * b01(4))) * inverse(1) * inverse(3)
-      h(2, 3) = (b11(1) + x * (b11(2) + x * (b11(3) + x * b11(4)))) * inverse(2) * inverse(3)
-      h(2, 1) = h(1, 2)
-      h(3, 1) = h(1, 3)
-      h(3, 2) = h(2, 3)
-   end subroutine power_polynomial
 
    !> The value and gradient in cell (i, j, k) (0-based lower corner in x
    !> and y, k the layer below) from the axes' basis values: corner by

@@ -1,14 +1,26 @@
-!> The kernels of the surface table (friction_surface_lennard_jones): the
-!> lattice sum's value and derivatives at the nodes of one column of heights
-!> (the table's build), and the pair terms of a list of differences (its
-!> evaluation).  A module of its own so that it can be compiled for
-!> vectorization (CMakeLists.txt) without touching the direct sum's code.
-module friction_surface_lj_columns
+!> The kernels of the surface table (friction_surface_lennard_jones and
+!> friction_surface_tricubic): the lattice sum's value and derivatives at
+!> the nodes of one column of heights (the table's build), the pair terms
+!> of a list of differences, and a cell's polynomial (its evaluation).  A
+!> module of its own so that it can be compiled for vectorization
+!> (CMakeLists.txt) without touching the direct sum's code.
+!>
+!> Compiled twice: as friction_surface_table_kernels for every x86-64
+!> processor, and through table_kernels_wide.F90 as
+!> friction_surface_table_kernels_wide for those with AVX2 (x86-64-v3),
+!> which the table chooses at run time when the processor has it
+!> (lennard_jones.f90, `tabulate`).  The wide copy is compiled without
+!> fused multiply-adds and nothing here reorders a sum, so both give the
+!> same bits: only their speed differs (tests `table`).
+#ifndef TABLE_KERNELS
+#define TABLE_KERNELS friction_surface_table_kernels
+#endif
+module TABLE_KERNELS
    use friction_kinds, only: wp
    implicit none
    private
 
-   public :: column_sums, difference_terms
+   public :: column_sums, difference_terms, power_polynomial
 
 contains
 
@@ -94,4 +106,55 @@ contains
       g = [sum(gx), sum(gy), sum(gz)]
    end subroutine difference_terms
 
-end module friction_surface_lj_columns
+   !> The value v, gradient g (order >= 1) and Hessian h (order 2; else
+   !> zero) of one cell's polynomial c (set_polynomials) at local
+   !> coordinates (x, y, z), with inverse(:) the reciprocal cell widths:
+   !> Horner's rule along z (16 cubics at once), then y (4), then x.
+   pure subroutine power_polynomial(c, x, y, z, inverse, order, v, g, h)
+      real(wp), intent(in) :: c(64), x, y, z, inverse(3)
+      integer, intent(in) :: order
+      real(wp), intent(out) :: v, g(3), h(3, 3)
+      ! (aN: N-th z derivative, 16 cubics in x, y; bMN: M-th y derivative
+      ! and N-th z derivative, 4 cubics in x.)
+      real(wp) :: a0(16), a1(16), a2(16), b00(4), b10(4), b01(4), b20(4), b11(4), b02(4)
+      integer :: l
+
+      a0 = c(1:16) + z * (c(17:32) + z * (c(33:48) + z * c(49:64)))
+      h = 0.0_wp
+      g = 0.0_wp
+      if (order < 1) then
+         do l = 1, 4
+            b00(l) = a0(l) + y * (a0(l + 4) + y * (a0(l + 8) + y * a0(l + 12)))
+         end do
+         v = b00(1) + x * (b00(2) + x * (b00(3) + x * b00(4)))
+         return
+      end if
+      a1 = c(17:32) + z * (2.0_wp * c(33:48) + 3.0_wp * z * c(49:64))
+      do l = 1, 4
+         b00(l) = a0(l) + y * (a0(l + 4) + y * (a0(l + 8) + y * a0(l + 12)))
+         b10(l) = a0(l + 4) + y * (2.0_wp * a0(l + 8) + 3.0_wp * y * a0(l + 12))
+         b01(l) = a1(l) + y * (a1(l + 4) + y * (a1(l + 8) + y * a1(l + 12)))
+      end do
+      v = b00(1) + x * (b00(2) + x * (b00(3) + x * b00(4)))
+      g(1) = (b00(2) + x * (2.0_wp * b00(3) + 3.0_wp * x * b00(4))) * inverse(1)
+      g(2) = (b10(1) + x * (b10(2) + x * (b10(3) + x * b10(4)))) * inverse(2)
+      g(3) = (b01(1) + x * (b01(2) + x * (b01(3) + x * b01(4)))) * inverse(3)
+      if (order < 2) return
+      a2 = 2.0_wp * c(33:48) + 6.0_wp * z * c(49:64)
+      do l = 1, 4
+         b20(l) = 2.0_wp * a0(l + 8) + 6.0_wp * y * a0(l + 12)
+         b11(l) = a1(l + 4) + y * (2.0_wp * a1(l + 8) + 3.0_wp * y * a1(l + 12))
+         b02(l) = a2(l) + y * (a2(l + 4) + y * (a2(l + 8) + y * a2(l + 12)))
+      end do
+      h(1, 1) = (2.0_wp * b00(3) + 6.0_wp * x * b00(4)) * inverse(1)**2
+      h(2, 2) = (b20(1) + x * (b20(2) + x * (b20(3) + x * b20(4)))) * inverse(2)**2
+      h(3, 3) = (b02(1) + x * (b02(2) + x * (b02(3) + x * b02(4)))) * inverse(3)**2
+      h(1, 2) = (b10(2) + x * (2.0_wp * b10(3) + 3.0_wp * x * b10(4))) * inverse(1) * inverse(2)
+      h(1, 3) = (b01(2) + x * (2.0_wp * b01(3) + 3.0_wp * x * b01(4))) * inverse(1) * inverse(3)
+      h(2, 3) = (b11(1) + x * (b11(2) + x * (b11(3) + x * b11(4)))) * inverse(2) * inverse(3)
+      h(2, 1) = h(1, 2)
+      h(3, 1) = h(1, 3)
+      h(3, 2) = h(2, 3)
+   end subroutine power_polynomial
+
+end module TABLE_KERNELS
