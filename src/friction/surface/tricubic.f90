@@ -137,7 +137,10 @@ contains
       last = size(self%z) - 1
       k = self%bin_layer(int(min(real(size(self%bin_layer), wp), max(1.0_wp, &
          & (height - self%z(1)) * self%inverse_bin + 1.0_wp))))
-      ! (A bin is narrower than any layer: at most one layer starts in it.)
+      ! A bin is narrower than any layer: at most one layer starts in it,
+      ! so one step up, without a branch to mispredict as the tip moves
+      ! across the layers (the loop only for rounding at a bin's edge).
+      if (k < last) k = k + merge(1, 0, self%z(k + 1) <= height)
       do while (k < last)
          if (self%z(k + 1) > height) exit
          k = k + 1
