@@ -155,7 +155,11 @@ int friction_config_check(const friction_config *cfg, friction_error *err);
  * (/afm/retrace).  Every tip model, surface and potential; at a temperature
  * (&thermal temperature > 0) the mean over the realizations, as the file
  * holds it.  n is the length of fx and fy: n < scan.nx is
- * FRICTION_ERROR_INPUT and nothing is written. */
+ * FRICTION_ERROR_INPUT and nothing is written.  The configuration keeps
+ * the surface it built (a Lennard-Jones net's table) for its next line or
+ * computation while &surface and the scan's rectangle stay as they were:
+ * a later line of the graphite map costs the line alone.  friction_config_free
+ * releases it. */
 int friction_afm_line(const friction_config *cfg, int line, int forward, double *fx, double *fy, size_t n,
                       friction_error *err);
 
@@ -173,7 +177,8 @@ int friction_afm_line(const friction_config *cfg, int line, int forward, double 
  *          the output grid; the events "events/t", "events/kind", "events/x",
  *          "events/v", "events/y", "events/w".  (&analysis and &verify are
  *          for jobs: friction_run_config.)
- * A configuration with a &sweep is refused: run it with friction_run_config. */
+ * A configuration with a &sweep is refused: run it with friction_run_config.
+ * The afm surface is kept in the configuration as by friction_afm_line. */
 friction_result *friction_compute(const friction_config *cfg, friction_error *err);
 
 /* Copy the array `name` into out[0..n-1] as doubles, maps row-major (ny, nx):

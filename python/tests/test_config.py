@@ -43,6 +43,33 @@ def test_afm_line_is_the_files_line_to_the_last_bit(friction, naf_map):
     assert isinstance(line, friction.Line) and np.array_equal(line.fx, trace[3])
 
 
+GRAPHITE = [INPUTS / "graphite.nml", DATA / "graphite_small.nml"]
+
+
+def test_a_kept_surface_gives_what_a_new_one_gives(friction, files):
+    """A configuration keeps the surface of its last line or computation (the
+    graphite net's table) while &surface and the scan stay: its lines are the
+    program's to the last bit, a changed tip still gets them from the kept
+    table, and a changed surface gets a new one, not the stale one (the
+    oracle: a configuration of its own, which builds its table afresh)."""
+    path = files("graphite_small", GRAPHITE)
+    with h5py.File(path) as f:
+        trace = f["afm/trace/fx"][()]
+    with friction.Config("afm", files=GRAPHITE) as cfg:
+        for j in (0, 2, 1, 2):
+            assert np.array_equal(cfg.afm_line(j).fx, trace[j]), j
+        assert np.array_equal(cfg.compute()["trace/fx"], trace)
+        cfg["tip.kx"] = 0.5
+        softer = cfg.afm_line(1).fx
+        cfg["surface.epsilon"] = 0.9e-2
+        deeper = cfg.afm_line(1).fx
+        assert not np.array_equal(deeper, softer)
+    with friction.Config("afm", files=GRAPHITE, values={"tip.kx": 0.5}) as fresh:
+        assert np.array_equal(fresh.afm_line(1).fx, softer)
+    with friction.Config("afm", files=GRAPHITE, values={"tip.kx": 0.5, "surface.epsilon": 0.9e-2}) as fresh:
+        assert np.array_equal(fresh.afm_line(1).fx, deeper)
+
+
 def test_brake_is_the_programs_run_to_the_last_bit(friction, files):
     override = ("&brake t_end = 40.0, dt_out = 0.5 /\n"
                 "&analysis spectrum = .false., poincare = .false., lyapunov = .false., rosenstein = .false.,"

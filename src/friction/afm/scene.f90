@@ -30,7 +30,7 @@ module friction_afm_scene
    implicit none
    private
 
-   public :: afm_scene, afm_friction
+   public :: afm_scene, afm_friction, take_surface
 
    !> A slip's items: line, realization, trip, support, force, jump, jump_across.
    integer, parameter :: n_slip_items = 7
@@ -675,21 +675,16 @@ contains
       type(afm_scanner), target :: scanner
       class(surface_potential), allocatable :: potential
       type(line_record) :: line
-      character(len=:), allocatable :: key
       real(wp) :: total
       integer :: j
 
       mean_friction = 0.0_wp
       max_force = 0.0_wp
       if (present(memory)) then
-         key = surface_key(c)
-         if (allocated(memory%surface) .and. allocated(memory%surface_key)) then
-            if (memory%surface_key == key) call move_alloc(memory%surface, potential)
-         end if
-         ! (Until it is given back below, memory holds nothing.)
-         if (allocated(memory%surface)) deallocate (memory%surface)
+         call take_surface(c, memory, potential, error)
+      else
+         call new_potential(c, potential, error)
       end if
-      if (.not. allocated(potential)) call new_potential(c, potential, error)
       if (allocated(error)) return
       call scanner%init_owning(c, potential, error)
       if (allocated(error)) return
@@ -705,11 +700,28 @@ contains
          end if
       end do
       mean_friction = total / (real(c%nx, wp) * c%ny * merge(2, 1, c%retrace))
-      if (present(memory)) then
-         call scanner%release_potential(memory%surface)
-         memory%surface_key = key
-      end if
+      if (present(memory)) call scanner%release_potential(memory%surface)
    end subroutine afm_friction
+
+   !> The surface of `c` for a scan: `memory`'s when it was made from the
+   !> same settings (surface_key), else a new one.  Until the scan gives it
+   !> back (afm_scanner's release_potential into memory%surface), memory
+   !> holds no surface, only the key of this one.
+   subroutine take_surface(c, memory, potential, error)
+      type(afm_config), intent(in) :: c
+      type(point_memory), intent(inout) :: memory
+      class(surface_potential), allocatable, intent(out) :: potential
+      type(error_type), allocatable, intent(out) :: error
+      character(len=:), allocatable :: key
+
+      key = surface_key(c)
+      if (allocated(memory%surface) .and. allocated(memory%surface_key)) then
+         if (memory%surface_key == key) call move_alloc(memory%surface, potential)
+      end if
+      if (allocated(memory%surface)) deallocate (memory%surface)
+      memory%surface_key = key
+      if (.not. allocated(potential)) call new_potential(c, potential, error)
+   end subroutine take_surface
 
    !> What the surface new_potential builds depends on: the &surface group
    !> and the scan's rectangle (the lattice sum keeps the atoms near it and

@@ -27,11 +27,12 @@ module friction_capi
    use friction_checks, only: config_checker
    use friction_input_reader, only: namelist_source, scan_files, apply_files, parse_variable_name
    use friction_surface_potential, only: surface_potential
-   use friction_afm_config, only: afm_config, new_potential
+   use friction_afm_config, only: afm_config
    use friction_afm_scan, only: afm_scanner, trip_record, line_record, quantity_names, quantity_count, q_fx, q_fy, &
       & q_jumps, support_along, support_across
    use friction_afm_output, only: line_friction
-   use friction_afm_scene, only: afm_scene
+   use friction_afm_scene, only: afm_scene, take_surface
+   use friction_scene, only: point_memory
    use friction_brake_config, only: brake_config
    use friction_brake_simulate, only: brake_run
    use friction_brake_scene, only: brake_scene
@@ -71,6 +72,10 @@ module friction_capi
       type(config_checker) :: origins
       !> the files read into it: a job's output must not be one of them
       character(len=4096), allocatable :: files(:)
+      !> the surface of the last line or computation (take_surface), for the
+      !> next one while &surface and the scan's rectangle stay as they were:
+      !> a Lennard-Jones net's table is built once, not once per line
+      type(point_memory) :: memory
    end type capi_config
 
    !> One named array of a result: rows x columns, row-major (a series is
@@ -746,7 +751,7 @@ contains
          status = refuse(handle, 'n = '//itoa(int(n))//': fx and fy must hold scan.nx = '//itoa(c%nx)//' values')
          return
       end if
-      call new_potential(c, potential, error)
+      call take_surface(c, config%memory, potential, error)
       if (.not. allocated(error)) call scanner%init_owning(c, potential, error)
       if (allocated(error)) then
          continue
@@ -764,6 +769,7 @@ contains
       else
          call scanner%run_trip(int(line), forward /= 0, trip, error)
       end if
+      call scanner%release_potential(config%memory%surface)
       if (.not. allocated(error)) then
          call c_f_pointer(fx, out, [c%nx])
          out = trip%values(:, q_fx)
@@ -800,7 +806,7 @@ contains
       allocate (result%items(0))
       select type (s => work%scene)
       type is (afm_scene)
-         call compute_afm(s%resolved(), result, error)
+         call compute_afm(s%resolved(), config%memory, result, error)
       type is (brake_scene)
          call compute_brake(s%resolved(), result, error)
       class default
@@ -841,9 +847,11 @@ contains
 
    !> The whole map on this process: every line's trace (and retrace), as
    !> the program's file holds them under /afm; at a temperature the means
-   !> over the realizations, and NAME_sem beside every NAME.
-   subroutine compute_afm(c, result, error)
+   !> over the realizations, and NAME_sem beside every NAME.  The surface
+   !> is memory's when it still holds (take_surface), and left in it.
+   subroutine compute_afm(c, memory, result, error)
       type(afm_config), intent(in) :: c
+      type(point_memory), intent(inout) :: memory
       type(capi_result), intent(inout) :: result
       type(error_type), allocatable, intent(out) :: error
       class(surface_potential), allocatable :: potential
@@ -853,7 +861,7 @@ contains
       real(wp), allocatable :: friction_sem(:)
       integer :: j, q
 
-      call new_potential(c, potential, error)
+      call take_surface(c, memory, potential, error)
       if (allocated(error)) return
       call scanner%init_owning(c, potential, error)
       if (allocated(error)) return
@@ -865,7 +873,7 @@ contains
       allocate (friction_sem(c%ny))
       do j = 1, c%ny
          call scanner%run_line(j - 1, line, error)
-         if (allocated(error)) return
+         if (allocated(error)) exit
          trace(:, j, :) = line%trace
          trace_sem(:, j, :) = line%trace_sem
          if (c%retrace) then
@@ -874,6 +882,8 @@ contains
             friction_sem(j) = line%friction_sem
          end if
       end do
+      call scanner%release_potential(memory%surface)
+      if (allocated(error)) return
       call add_item(result, 'support_x', c%nx, 1, support_along(c))
       call add_item(result, 'support_y', c%ny, 1, support_across(c))
       call add_trips('trace', trace, '')
