@@ -691,7 +691,7 @@ contains
       total = 0.0_wp
       do j = 0, c%ny - 1
          call scanner%run_line(j, line, error)
-         if (allocated(error)) return
+         if (allocated(error)) exit
          total = total + sum(line%trace(:, q_f_along))
          max_force = max(max_force, maxval(hypot(line%trace(:, q_fx), line%trace(:, q_fy))))
          if (c%retrace) then
@@ -699,8 +699,13 @@ contains
             max_force = max(max_force, maxval(hypot(line%retrace(:, q_fx), line%retrace(:, q_fy))))
          end if
       end do
-      mean_friction = total / (real(c%nx, wp) * c%ny * merge(2, 1, c%retrace))
+      ! (The surface goes back also after a failed line: it is not what failed.)
       if (present(memory)) call scanner%release_potential(memory%surface)
+      if (allocated(error)) then
+         max_force = 0.0_wp
+         return
+      end if
+      mean_friction = total / (real(c%nx, wp) * c%ny * merge(2, 1, c%retrace))
    end subroutine afm_friction
 
    !> The surface of `c` for a scan: `memory`'s when it was made from the
