@@ -49,6 +49,11 @@ Measures and prints (this is not a test; nothing fails on a missed target):
       = 1e-10 (floor: the same at 1e-11) the largest |dF| between the two
       maps; the paper's undamped tip is chaotic (part 2a), so its maps
       differ by where the slips fall, printed for completeness.
+   c) lines through the library (friction.Config.afm_line, C API
+      friction_afm_line) of inputs/graphite.nml: the first line of a
+      configuration (it builds the table), the next ones (the configuration
+      keeps the table), and a line of a new configuration each time (median
+      of --repeats + 2 each); the library next to --binary.
 
 Usage (from anywhere; normally through scripts/benchmark_graphite, which builds first):
 
@@ -239,6 +244,7 @@ class Benchmark:
         self.sizes: list[dict] = []
         self.cutoff: list[dict] = []
         self.table: dict = {}
+        self.lines: dict = {}
 
     def flake(self, shells: int) -> Path:
         return self.fr.override(f"shells{shells}", f"&surface shells = {shells} /")
@@ -356,11 +362,43 @@ class Benchmark:
                                    for m in ("table", "direct")),
         }
 
+    def lines_part(self) -> None:
+        """Part 3c: lines of one configuration through the library, the table
+        kept between them, against a new configuration per line."""
+        library = Path(self.args.binary).resolve().parent / "libfriction.so.0"
+        self.lines = {}
+        if not library.is_file():
+            log(f"no {library}: part 3c skipped")
+            return
+        os.environ["FRICTION_LIBRARY"] = str(library)
+        sys.path.insert(0, str(ROOT / "python"))
+        import friction  # the package of this tree, on the library next to the binary
+
+        count = self.args.repeats + 2
+        files = [INPUTS / CASE]
+        kept = []
+        with friction.Config("afm", files=files) as cfg:
+            for j in range(count + 1):
+                log(f"lines through the library, one configuration: line {j}")
+                t0 = time.perf_counter()
+                cfg.afm_line(j)
+                kept.append(time.perf_counter() - t0)
+        new = []
+        for j in range(count):
+            log(f"lines through the library, a new configuration each: line {j}")
+            with friction.Config("afm", files=files) as cfg:
+                t0 = time.perf_counter()
+                cfg.afm_line(j)
+                new.append(time.perf_counter() - t0)
+        self.lines = {"first_s": kept[0], "kept_s": statistics.median(kept[1:]),
+                      "new_configuration_s": statistics.median(new), "lines": count}
+
     def run(self) -> None:
         if not self.args.table_only:
             self.sizes_part()
             self.cutoff_part()
         self.table_part()
+        self.lines_part()
 
     # ---------------------------------------------------------------- output
 
@@ -446,6 +484,12 @@ class Benchmark:
           f"integration floor {t['floor_smooth_nN']:.2e} nN")
         w(f"  the paper's undamped tip (chaotic, part 2a): its maps differ by {t['max_dF_paper_map_nN']:.3f} nN "
           f"(forces span {t['force_range_nN']:.3f} nN): where the slips fall, not the table's error")
+        if self.lines:
+            n = self.lines
+            w(f"  lines through the library (friction_afm_line, inputs/{CASE}, medians of {n['lines']}): "
+              f"the first of a configuration {1e3 * n['first_s']:.1f} ms, the next ones "
+              f"{1e3 * n['kept_s']:.1f} ms (the table kept), a new configuration's "
+              f"{1e3 * n['new_configuration_s']:.1f} ms")
         return "\n".join(lines)
 
 
@@ -525,7 +569,7 @@ def main(argv=None) -> int:
 
     if args.json:
         results = {
-            "sizes": bench.sizes, "cutoff": bench.cutoff, "table": bench.table,
+            "sizes": bench.sizes, "cutoff": bench.cutoff, "table": bench.table, "lines": bench.lines,
             "meta": {"version": version, "source": git_state(), "cpus": cpus,
                      "machine": platform.machine(), "repeats": args.repeats,
                      "quick": args.quick, "scan": bench.scan.read_text().strip(),
