@@ -100,7 +100,6 @@ module friction_surface_lennard_jones
       real(wp) :: energy_window = 0.0_wp    !! eV
       integer :: points = 0                 !! points the error was measured at
       integer :: difference_count = 0       !! atoms in the differences
-      logical :: wide = .false.             !! built and evaluated by the AVX2 kernels
    end type lj_table
 
    type, extends(surface_potential) :: lj_potential
@@ -571,7 +570,9 @@ contains
       end associate
       t%tolerance = settings%tolerance
       t%energy_window = settings%energy_window
-      t%wide = settings%wide_kernels .and. friction_wide_kernels() /= 0
+      ! (The grid's flag also chooses the build's kernels, from before the
+      ! grid has nodes: column_values.)
+      t%grid%wide = settings%wide_kernels .and. friction_wide_kernels() /= 0
       t%shift = lj_pair_energy(self%epsilon, self%sigma, self%cutoff)
       t%top = maxval(lattice%basis(3, :)) + self%cutoff
       t%ceiling = max(t%top, maxval(self%atoms%position(3, :)) + self%cutoff)
@@ -605,8 +606,8 @@ contains
                & //rtoa(settings%max_bytes / 1024.0_wp**2)//' MiB'
             return
          end if
-         t%grid = new_tricubic_grid(0.0_wp, 1.0_wp / n1, n1 + 1, 0.0_wp, 1.0_wp / n2, n2 + 1, layers)
-         t%grid%wide = t%wide
+         t%grid = new_tricubic_grid(0.0_wp, 1.0_wp / n1, n1 + 1, 0.0_wp, 1.0_wp / n2, n2 + 1, layers, &
+            & wide=(t%grid%wide))
          if (present(share)) then
             call fill_grid(ideal, t, centrosymmetric(lattice), swap_symmetric(lattice), share)
          else
@@ -849,7 +850,7 @@ contains
             end do
          end do
       end do
-      if (t%wide) then
+      if (t%grid%wide) then
          call column_sums_wide(n, lateral, u1, u2, height, sigma2, e4, shift, c12, rc2, z, values)
       else
          call column_sums(n, lateral, u1, u2, height, sigma2, e4, shift, c12, rc2, z, values)

@@ -20,7 +20,11 @@ module TABLE_KERNELS
    implicit none
    private
 
-   public :: column_sums, difference_terms, power_polynomial
+   public :: column_sums, difference_terms, power_polynomial, n_cell_coefficients
+
+   !> Coefficients of a cell's polynomial (power_polynomial; the cells of
+   !> friction_surface_tricubic's set_polynomials).
+   integer, parameter :: n_cell_coefficients = 64
 
 contains
 
@@ -111,7 +115,7 @@ contains
    !> coordinates (x, y, z), with inverse(:) the reciprocal cell widths:
    !> Horner's rule along z (16 cubics at once), then y (4), then x.
    pure subroutine power_polynomial(c, x, y, z, inverse, order, v, g, h)
-      real(wp), intent(in) :: c(64), x, y, z, inverse(3)
+      real(wp), intent(in) :: c(n_cell_coefficients), x, y, z, inverse(3)
       integer, intent(in) :: order
       real(wp), intent(out) :: v, g(3), h(3, 3)
       ! (aN: N-th z derivative, 16 cubics in x, y; bMN: M-th y derivative

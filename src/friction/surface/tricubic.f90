@@ -32,7 +32,7 @@
 !> error is about ten times larger at the same spacing.
 module friction_surface_tricubic
    use friction_kinds, only: wp
-   use friction_surface_table_kernels, only: power_polynomial
+   use friction_surface_table_kernels, only: power_polynomial, n_cell_coefficients
    use friction_surface_table_kernels_wide, only: power_polynomial_wide => power_polynomial
    implicit none
    private
@@ -41,8 +41,6 @@ module friction_surface_tricubic
 
    !> Values per node: f, f_x, f_y, f_z, f_xy, f_xz, f_yz, f_xyz.
    integer, parameter :: n_node_values = 8
-   !> Coefficients of a cell's polynomial (set_polynomials).
-   integer, parameter :: n_cell_coefficients = 64
 
    type :: tricubic_grid
       real(wp) :: x0 = 0.0_wp, hx = 1.0_wp   !! first node and spacing along x
@@ -79,13 +77,16 @@ module friction_surface_tricubic
 
 contains
 
-   !> A grid of nx x ny x size(z) nodes, its values zero.
-   pure function new_tricubic_grid(x0, hx, nx, y0, hy, ny, z) result(grid)
+   !> A grid of nx x ny x size(z) nodes, its values zero; `wide` its
+   !> component of that name (default .false.).
+   pure function new_tricubic_grid(x0, hx, nx, y0, hy, ny, z, wide) result(grid)
       real(wp), intent(in) :: x0, hx, y0, hy, z(:)
       integer, intent(in) :: nx, ny
+      logical, intent(in), optional :: wide
       type(tricubic_grid) :: grid
       integer :: b, k, nbins
 
+      if (present(wide)) grid%wide = wide
       grid%x0 = x0
       grid%hx = hx
       grid%nx = nx
