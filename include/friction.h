@@ -6,7 +6,8 @@
  * (friction_config_read) or by name ("tip.kx", friction_config_set), checked
  * by the scene's own checks, the very code that checks the program's input
  * (friction_config_check; every computation runs it first).  Computations on
- * the calling process (friction_afm_line, friction_compute) need no MPI;
+ * the calling process (friction_afm_line, friction_compute,
+ * friction_compute_progress) need no MPI;
  * a friction_result holds a whole computation's arrays.  Jobs
  * (friction_run_job, friction_run_config) run the program's job and write
  * its HDF5 file.
@@ -61,7 +62,8 @@ enum {
   FRICTION_ERROR_NUMERICAL = 2, /* the integration failed */
   FRICTION_ERROR_IO = 3,
   FRICTION_ERROR_INTERNAL = 4,
-  FRICTION_INTERRUPTED = 5      /* a job's sweep stopped early; its file is valid, resumable */
+  FRICTION_INTERRUPTED = 5      /* stopped on request: a job (a sweep's file is valid, resumable) or a
+                                   computation (friction_compute_progress: no result) */
 };
 
 typedef struct friction_error friction_error;   /* opaque: status and message of the last call */
@@ -180,6 +182,24 @@ int friction_afm_line(const friction_config *cfg, int line, int forward, double 
  * A configuration with a &sweep is refused: run it with friction_run_config.
  * The afm surface is kept in the configuration as by friction_afm_line. */
 friction_result *friction_compute(const friction_config *cfg, friction_error *err);
+
+/* Progress of a computation on the calling process: "12 of 48 lines" or
+ * "τ = 120.0 of 1000.0", fraction in [0, 1].  A nonzero return asks the
+ * computation to stop there. */
+typedef int (*friction_progress_fn)(const char *message, double fraction, void *user);
+
+/* friction_compute with progress, and a way to stop it: `progress` (if not
+ * NULL) is called on the calling thread after each scan line of a map and
+ * 200 times along a brake trajectory, with `user` passed through.  When it
+ * returns nonzero before the last report, the computation stops there:
+ * NULL, status FRICTION_INTERRUPTED ("the map stopped on request after 12
+ * of 48 lines: no result"), and the configuration as it was (its kept
+ * surface too).  The request is this call's own: computations on other
+ * threads go on.  To stop from elsewhere (a signal handler, another thread,
+ * a Cancel button) set a flag there and return it from `progress`.  With
+ * progress = NULL it is friction_compute. */
+friction_result *friction_compute_progress(const friction_config *cfg, friction_progress_fn progress, void *user,
+                                           friction_error *err);
 
 /* Copy the array `name` into out[0..n-1] as doubles, maps row-major (ny, nx):
  * out[j * nx + i] is sample i of line j.  *needed (if not NULL) gets its

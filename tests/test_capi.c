@@ -471,6 +471,71 @@ static void check_results(friction_error *err) {
   friction_config_free(cfg);
 }
 
+/* friction_compute_progress: its reports, and a stop asked for by one. */
+struct progress_log {
+  int calls, stop_at;
+  double last;
+  char first[64];
+};
+
+static int log_progress(const char *message, double fraction, void *user) {
+  struct progress_log *log = user;
+  log->calls++;
+  if (log->calls == 1) snprintf(log->first, sizeof log->first, "%s", message);
+  log->last = fraction;
+  return log->calls == log->stop_at;
+}
+
+/* The small map's result `res` (freed here) holds `plain` as its retrace/fx. */
+static void expect_map(friction_result *res, const double plain[48], const char *what, friction_error *err) {
+  double got[48];
+  CHECK(res != NULL, "%s: no result", what);
+  if (res == NULL) return;
+  expect_ok(friction_result_get(res, "retrace/fx", got, 48, NULL, err), err, what);
+  CHECK(memcmp(plain, got, sizeof got) == 0, "%s: the map differs from friction_compute's", what);
+  friction_result_free(res);
+}
+
+static void check_progress(friction_error *err) {
+  friction_config *cfg = small_naf(err), *brake = short_brake(err);
+  struct progress_log log = {0, 0, -1.0, ""};
+  double plain[48];
+  friction_result *res = friction_compute(cfg, err);
+
+  CHECK(res != NULL, "compute the small map");
+  if (res == NULL) return;
+  expect_ok(friction_result_get(res, "retrace/fx", plain, 48, NULL, err), err, "plain retrace/fx");
+  friction_result_free(res);
+  /* a report per line, and the same numbers as without */
+  expect_map(friction_compute_progress(cfg, log_progress, &log, err), plain, "compute with progress", err);
+  CHECK(log.calls == 3 && log.last == 1.0 && strcmp(log.first, "1 of 3 lines") == 0,
+        "progress: %d calls, last fraction %g, first '%s'", log.calls, log.last, log.first);
+  /* NULL progress is friction_compute */
+  expect_map(friction_compute_progress(cfg, NULL, NULL, err), plain, "compute with NULL progress", err);
+  /* a nonzero return stops the map after that line: no result, status 5 */
+  log = (struct progress_log){0, 1, -1.0, ""};
+  CHECK(friction_compute_progress(cfg, log_progress, &log, err) == NULL, "a stopped map gave a result");
+  CHECK(friction_error_status(err) == FRICTION_INTERRUPTED, "stopped map: status %d", friction_error_status(err));
+  friction_error_message(err, last_message, sizeof last_message);
+  CHECK(strstr(last_message, "the map stopped on request after 1 of 3 lines: no result") != NULL, "message: %s",
+        last_message);
+  CHECK(log.calls == 1, "the map went on after the stop: %d reports", log.calls);
+  /* ... and the configuration computes as before */
+  expect_map(friction_compute(cfg, err), plain, "compute after a stop", err);
+  /* the brake reports along τ and stops at the request */
+  log = (struct progress_log){0, 5, -1.0, ""};
+  CHECK(friction_compute_progress(brake, log_progress, &log, err) == NULL, "a stopped brake gave a result");
+  CHECK(friction_error_status(err) == FRICTION_INTERRUPTED, "stopped brake: status %d", friction_error_status(err));
+  friction_error_message(err, last_message, sizeof last_message);
+  CHECK(strstr(last_message, "brake run stopped on request at τ = ") != NULL &&
+            strstr(last_message, "no result") != NULL,
+        "message: %s", last_message);
+  CHECK(log.calls == 5 && strncmp(log.first, "τ = ", strlen("τ = ")) == 0, "brake: %d reports, first '%s'",
+        log.calls, log.first);
+  friction_config_free(brake);
+  friction_config_free(cfg);
+}
+
 /* Jobs: bad arguments; MPI must be initialised by the caller or by request. */
 static void check_jobs(friction_error *err) {
   const char *none[] = {NULL};
@@ -519,6 +584,7 @@ static int checks(void) {
   check_checks(err);
   check_files(err);
   check_results(err);
+  check_progress(err);
   check_jobs(err); /* last: it initialises MPI */
   friction_error_free(err);
   if (failures == 0) printf("checks: all passed\n");

@@ -59,6 +59,8 @@ SONAME = "libfriction.so.0"
 
 # void report(const char *message, double fraction, void *user)
 _REPORT = ctypes.CFUNCTYPE(None, ctypes.c_char_p, ctypes.c_double, ctypes.c_void_p)
+# int progress(const char *message, double fraction, void *user): nonzero stops
+_PROGRESS = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_char_p, ctypes.c_double, ctypes.c_void_p)
 FORCE, RESUME, INIT_MPI = 1, 2, 4
 # Statuses (friction.h)
 OK, ERROR_INPUT, ERROR_NUMERICAL, ERROR_IO, ERROR_INTERNAL, INTERRUPTED = 0, 1, 2, 3, 4, 5
@@ -66,7 +68,7 @@ OK, ERROR_INPUT, ERROR_NUMERICAL, ERROR_IO, ERROR_INTERNAL, INTERRUPTED = 0, 1, 
 
 class FrictionError(RuntimeError):
     """A call the library refused or could not finish; .status is its code
-    (1 input, 2 numerical, 3 I/O, 4 internal, 5 a job's sweep interrupted),
+    (1 input, 2 numerical, 3 I/O, 4 internal, 5 stopped on request),
     .message the library's message."""
 
     def __init__(self, status, message):
@@ -159,6 +161,7 @@ def _signatures(lib):
         "friction_config_check": (c_int, [c_void_p, c_void_p]),
         "friction_afm_line": (c_int, [c_void_p, c_int, c_int, c_void_p, c_void_p, c_size_t, c_void_p]),
         "friction_compute": (c_void_p, [c_void_p, c_void_p]),
+        "friction_compute_progress": (c_void_p, [c_void_p, _PROGRESS, c_void_p, c_void_p]),
         "friction_result_get": (c_int, [c_void_p, c_char_p, c_void_p, c_size_t, size_p, c_void_p]),
         "friction_result_shape": (c_int, [c_void_p, c_char_p, ctypes.POINTER(c_size_t * 2), c_void_p]),
         "friction_result_names": (c_int, [c_void_p, c_char_p, c_size_t]),
@@ -302,42 +305,46 @@ def _c_int(value, what):
     return value
 
 
-class _JobReport:
-    """A job's report callback, and Ctrl-C during the job.
+class _Stoppable:
+    """Progress for the user's `report(message, fraction)`, and Ctrl-C, around
+    one call that reports (a job, or a computation with progress).
 
-    The user's `report(message, fraction)`, if any, gets the job's progress.
-    An Exception it raises (ctypes would print and drop it) is raised again
-    when the job has ended; the job runs on.  A KeyboardInterrupt or
-    SystemExit raised in it asks the job to stop (friction_job_stop) first.
-    On the main thread SIGINT is the job's for the job's duration: Ctrl-C
-    asks the job to stop at its next scan line or sweep point (Python runs
-    the handler when the job reports, so the callback is installed even
-    without `report`), and once the job has returned, its checkpoints kept,
-    the handler that was there before runs (KeyboardInterrupt)."""
+    An exception the report raises (ctypes would print and drop it) is
+    raised again when the call has returned.  On the main thread SIGINT is
+    the call's for its duration: Ctrl-C asks it to stop at its next report
+    (Python runs the handler when the call reports, so the callback is
+    installed even without `report`), and once it has returned, the handler
+    that was there before runs (KeyboardInterrupt).  Subclasses say how a
+    stop is asked for, and which exceptions of the report ask for one."""
 
     def __init__(self, lib, report):
         self.lib, self.report = lib, report
         self.raised = None
         self.signalled = None
-        self.function = _REPORT(self._called)
 
-    def _called(self, message, fraction, user):
+    def _ask_stop(self):
+        raise NotImplementedError
+
+    def _stops_on(self, error):
+        return not isinstance(error, Exception)
+
+    def _deliver(self, message, fraction):
         if self.report is None or self.raised is not None:
             return
         try:
             self.report(message.decode(errors="replace"), fraction)
-        except BaseException as error:  # noqa: B902 - raised again after the job
+        except BaseException as error:  # noqa: B902 - raised again after the call
             self.raised = error
-            if not isinstance(error, Exception):
-                self.lib.friction_job_stop()
+            if self._stops_on(error):
+                self._ask_stop()
 
     def _on_signal(self, signum, frame):
         self.signalled = (signum, frame)
-        self.lib.friction_job_stop()
+        self._ask_stop()
 
-    def run(self, function, *args):
-        """function(*args, report, user, err): the job.  Raises the job's
-        FrictionError, and after it what the report or Ctrl-C raised."""
+    def _guarded(self, call):
+        """call(): the library's call, raising FrictionError on failure; its
+        value.  Raises after it what the report or Ctrl-C raised."""
         previous = None
         if threading.current_thread() is threading.main_thread():
             current = signal.getsignal(signal.SIGINT)
@@ -348,7 +355,7 @@ class _JobReport:
                     previous = None
         try:
             try:
-                _call(function, *args, self.function, None)
+                value = call()
             finally:
                 if previous is not None:
                     signal.signal(signal.SIGINT, previous)
@@ -356,6 +363,7 @@ class _JobReport:
             self._raise_pending(previous)
             raise
         self._raise_pending(previous)
+        return value
 
     def _raise_pending(self, previous):
         if self.raised is not None:
@@ -365,6 +373,49 @@ class _JobReport:
                 previous(*self.signalled)
             elif previous == signal.SIG_DFL:
                 signal.raise_signal(signal.SIGINT)
+
+
+class _JobReport(_Stoppable):
+    """A job's report callback: progress (fraction in [0, 1]) and notes
+    (fraction -1).  The job runs on after an Exception of the report; a
+    KeyboardInterrupt or SystemExit raised in it, or Ctrl-C, asks the job to
+    stop (friction_job_stop) at its next scan line or sweep point."""
+
+    def __init__(self, lib, report):
+        super().__init__(lib, report)
+        self.function = _REPORT(self._called)
+
+    def _called(self, message, fraction, user):
+        self._deliver(message, fraction)
+
+    def _ask_stop(self):
+        self.lib.friction_job_stop()
+
+    def run(self, function, *args):
+        """function(*args, report, user, err): the job.  Raises the job's
+        FrictionError, and after it what the report or Ctrl-C raised."""
+        self._guarded(lambda: _call(function, *args, self.function, None))
+
+
+class _ComputeProgress(_Stoppable):
+    """A computation's progress callback (friction_compute_progress): it
+    returns 1, stopping the computation at its next report, once Ctrl-C came
+    or the report raised anything."""
+
+    def __init__(self, lib, report):
+        super().__init__(lib, report)
+        self.stop = False
+        self.function = _PROGRESS(self._called)
+
+    def _called(self, message, fraction, user):
+        self._deliver(message, fraction)
+        return int(self.stop)
+
+    def _ask_stop(self):
+        self.stop = True
+
+    def _stops_on(self, error):
+        return True
 
 
 class Config:
@@ -476,17 +527,28 @@ class Config:
               fx.ctypes.data_as(ctypes.c_void_p), fy.ctypes.data_as(ctypes.c_void_p), nx)
         return fx, fy
 
-    def compute(self):
+    def compute(self, report=None):
         """The whole scene on this process: a dict of numpy arrays, maps (ny, nx),
-        series 1-D (friction.h: friction_compute)."""
-        with _ErrorHandle() as err:
-            result = self._lib.friction_compute(self.handle, err.handle)
-            if not result:
-                err.check(err.status())
-            try:
-                return _result_arrays(self._lib, result, err)
-            finally:
-                self._lib.friction_result_free(result)
+        series 1-D (friction.h: friction_compute_progress).  `report(message,
+        fraction)` if given receives progress ("12 of 48 lines", fraction in
+        [0, 1]) after each scan line of a map and 200 times along a brake
+        trajectory.  Ctrl-C (on the main thread) stops the computation at its
+        next report and raises KeyboardInterrupt, its context a FrictionError
+        with status 5; so does anything the report raises (raised itself).
+        The Config stays as it was."""
+        progress = _ComputeProgress(self._lib, report)
+
+        def call():
+            with _ErrorHandle() as err:
+                result = self._lib.friction_compute_progress(self.handle, progress.function, None, err.handle)
+                if not result:
+                    err.check(err.status())
+                try:
+                    return _result_arrays(self._lib, result, err)
+                finally:
+                    self._lib.friction_result_free(result)
+
+        return progress._guarded(call)
 
     def run(self, output, force=False, resume=False, report=None, init_mpi=False):
         """The configuration's job to the HDF5 file `output` (friction.h: friction_run_config);

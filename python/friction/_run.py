@@ -77,11 +77,12 @@ def _progress(progress, label):
 
 
 def _job(start, progress, label):
-    """start(report): a job of the C API, which raises an exception of the
-    report after the job, and takes Ctrl-C (_capi._JobReport)."""
+    """start(report): a job or computation of the C API, which raises an
+    exception of the report after it, and takes Ctrl-C (_capi._Stoppable);
+    its value."""
     reporter = _progress(progress, label)
     try:
-        start(reporter)
+        return start(reporter)
     finally:
         if hasattr(reporter, "close"):
             reporter.close()
@@ -238,18 +239,30 @@ class Config(_capi.Config):
              progress, output.name)
         return output
 
+    def compute(self, progress=False):
+        """The whole scene on this process, without a file: a dict of numpy
+        arrays named as in the program's file (compute()).  progress: False
+        (the default: a fit calls this often), True (a tqdm bar or a line on
+        stderr every 2 s), or a callable (message, fraction), called after
+        each scan line of a map ("12 of 48 lines") and 200 times along a
+        brake trajectory.  Ctrl-C stops the computation at its next report
+        and raises KeyboardInterrupt, its context a FrictionError with
+        status 5; the Config stays as it was, ready for the next call."""
+        return _job(lambda report: _capi.Config.compute(self, report=report), progress, self.scene)
+
     def __repr__(self):
         state = "closed" if not self._handle else f"{len(self.names())} variables"
         return f"<friction.Config {self.scene}: {state}>"
 
 
-def compute(scene, files=(), values=None):
+def compute(scene, files=(), values=None, progress=False):
     """The scene's computation on this process, without a file: a dict of
     numpy arrays named as in the program's file ("trace/fx" (ny, nx), ...,
     "support_x"; "t", "x", ..., "events/t").  &analysis, &verify and &sweep
-    are for jobs (run()): a &sweep or &verify check = .true. is refused."""
+    are for jobs (run()): a &sweep or &verify check = .true. is refused.
+    progress and Ctrl-C as Config.compute()."""
     with Config(scene, files, values) as cfg:
-        return cfg.compute()
+        return cfg.compute(progress)
 
 
 def afm_line(files=(), values=None, line=0, forward=True):
@@ -260,10 +273,12 @@ def afm_line(files=(), values=None, line=0, forward=True):
         return cfg.afm_line(line, forward)
 
 
-def brake(files=(), values=None):
+def brake(files=(), values=None, progress=False):
     """A Girling brake run: a dict of numpy arrays, the trajectory "t", "x",
     "v", "y", "w", "stick" on the output grid and the events "events/t",
     "events/kind", "events/x", ... (as /brake of the program's file).
 
-        run = friction.brake(values={"brake.t_end": 300.0})"""
-    return compute("brake", files, values)
+        run = friction.brake(values={"brake.t_end": 300.0})
+
+    progress and Ctrl-C as Config.compute()."""
+    return compute("brake", files, values, progress)

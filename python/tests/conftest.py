@@ -27,6 +27,29 @@ INPUTS = ROOT / "inputs"
 DATA = ROOT / "tests" / "data"
 
 
+def interrupted(caught):
+    """The call's FrictionError (status 5, stopped on request) behind the
+    exception (KeyboardInterrupt) raised after it."""
+    context = caught.value.__context__
+    assert isinstance(context, Exception) and getattr(context, "status", None) == 5, repr(context)
+    return context
+
+
+def sigint_at_report(number):
+    """(reports, progress): a progress callback that keeps its (message,
+    fraction) reports and sends this process SIGINT at report `number`, as
+    Ctrl-C would during a job or computation."""
+    import signal
+    reports = []
+
+    def progress(message, fraction):
+        reports.append((message, fraction))
+        if len(reports) == number:
+            signal.raise_signal(signal.SIGINT)
+
+    return reports, progress
+
+
 @pytest.fixture(scope="session")
 def program():
     path = Path(os.environ.get("FRICTION_PROGRAM", ROOT / "build" / "friction"))

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import helpers
-from conftest import DATA, INPUTS
+from conftest import DATA, INPUTS, interrupted, sigint_at_report
 
 NAF = [INPUTS / "naf.nml", DATA / "small.nml"]
 
@@ -26,6 +26,74 @@ def test_compute_is_the_programs_map_to_the_last_bit(friction, naf_map):
     for name, values in program.items():
         assert computed[name].shape == values.shape, name
         assert np.array_equal(computed[name], values), name
+
+
+def test_compute_reports_each_line_and_computes_the_same_map(friction, naf_map):
+    """compute(progress=...) reports after each of the map's 10 lines, and
+    its numbers are the program's file's, bit for bit, as without it."""
+    reports = []
+    with friction.Config("afm", files=NAF) as cfg:
+        computed = cfg.compute(progress=lambda message, fraction: reports.append((message, fraction)))
+    assert reports == [(f"{j} of 10 lines", j / 10) for j in range(1, 11)]
+    for name, values in file_datasets(naf_map, "afm").items():
+        assert np.array_equal(computed[name], values), name
+
+
+def test_ctrl_c_stops_a_compute_and_the_config_computes_on(friction, naf_map):
+    """SIGINT during compute() (sent from the first report, on the main
+    thread) stops the map after that line: KeyboardInterrupt, after the
+    library's status 5; the SIGINT handler is back, and the same Config's
+    next compute() is the program's map."""
+    import signal
+    reports, progress = sigint_at_report(1)
+    with friction.Config("afm", files=NAF) as cfg:
+        with pytest.raises(KeyboardInterrupt) as caught:
+            cfg.compute(progress=progress)
+        assert "the map stopped on request after 1 of 10 lines: no result" in interrupted(caught).message
+        assert len(reports) == 1
+        assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+        computed = cfg.compute()
+    for name, values in file_datasets(naf_map, "afm").items():
+        assert np.array_equal(computed[name], values), name
+
+
+def test_ctrl_c_from_another_thread_stops_a_long_brake_compute(friction):
+    """A real SIGINT while the main thread is inside the library, no
+    progress asked for: Python's handler runs at the computation's next
+    report (its callback is there for this), so a run of 2 million τ
+    (about 7 s) stops far before its end instead of when it is done."""
+    import os
+    import re
+    import signal
+    import threading
+    timer = threading.Timer(0.5, os.kill, (os.getpid(), signal.SIGINT))
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt) as caught:
+            friction.brake(values={"brake.t_end": 2.0e6, "brake.dt_out": 1.0})
+    finally:
+        timer.cancel()
+    message = interrupted(caught).message
+    reached = re.search(r"at τ = ([0-9.]+) of ([0-9.]+): no result", message)
+    assert reached, message
+    assert float(reached.group(1)) < 0.5 * float(reached.group(2)), message
+
+
+def test_a_report_that_raises_stops_the_computation(friction):
+    """An exception of the progress callback stops the computation at that
+    report (its result would be lost anyway) and is raised after the
+    library's status 5."""
+    reports = []
+
+    def progress(message, fraction):
+        reports.append(message)
+        if len(reports) == 3:
+            raise ValueError("enough")
+
+    with pytest.raises(ValueError, match="enough") as caught:
+        friction.brake(values={"brake.t_end": 40.0, "brake.dt_out": 0.5}, progress=progress)
+    assert "brake run stopped on request at τ = " in interrupted(caught).message
+    assert len(reports) == 3 and reports[0].startswith("τ = "), reports
 
 
 def test_afm_line_is_the_files_line_to_the_last_bit(friction, naf_map):

@@ -6,7 +6,7 @@ import h5py
 import numpy as np
 import pytest
 
-from conftest import DATA, INPUTS
+from conftest import DATA, INPUTS, interrupted, sigint_at_report
 
 NAF = [INPUTS / "naf.nml", DATA / "small.nml"]
 TIMINGS = {"wall_time", "compute_time", "created"}
@@ -188,28 +188,6 @@ def test_config_run_never_writes_over_a_file_it_read(friction, tmp_path):
     assert out.is_file()
 
 
-def _interrupted(caught):
-    """The job's FrictionError behind a KeyboardInterrupt raised after it."""
-    context = caught.value.__context__
-    assert isinstance(context, Exception) and getattr(context, "status", None) == 5, repr(context)
-    return context
-
-
-def _sigint_at_report(number):
-    """(reports, progress): a progress callback that keeps its (message,
-    fraction) reports and sends this process SIGINT at report `number`, as
-    Ctrl-C would during the job."""
-    import signal
-    reports = []
-
-    def progress(message, fraction):
-        reports.append((message, fraction))
-        if len(reports) == number:
-            signal.raise_signal(signal.SIGINT)
-
-    return reports, progress
-
-
 def test_ctrl_c_stops_a_map_and_resume_finishes_it(friction, naf_map, tmp_path):
     """SIGINT during a job (here sent from the first progress report, on the
     main thread) stops the map at its next line instead of being swallowed
@@ -217,11 +195,11 @@ def test_ctrl_c_stops_a_map_and_resume_finishes_it(friction, naf_map, tmp_path):
     5, no file, the lines done kept; resume computes the rest, and the file
     equals the uninterrupted run's."""
     import signal
-    reports, progress = _sigint_at_report(1)
+    reports, progress = sigint_at_report(1)
     out = tmp_path / "stopped.h5"
     with pytest.raises(KeyboardInterrupt) as caught:
         friction.run(NAF, output=out, progress=progress)
-    assert "checkpointed" in _interrupted(caught).message
+    assert "checkpointed" in interrupted(caught).message
     assert not out.exists()
     assert len(reports) < 5 and all(message != "10 of 10 lines" for message, _ in reports), reports
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler   # the handler is back
@@ -246,7 +224,7 @@ def test_ctrl_c_in_a_callback_stops_a_sweep(friction, brake_sweep, tmp_path):
     out = tmp_path / "sweep.h5"
     with pytest.raises(KeyboardInterrupt) as caught:
         friction.run(files, output=out, progress=progress)
-    _interrupted(caught)
+    interrupted(caught)
     with h5py.File(out) as handle:
         status = handle["sweep/status"][()]
     assert 0 < (status == 1).sum() < status.size, status
@@ -370,10 +348,10 @@ def test_ctrl_c_stops_a_brake_trajectory(friction, tmp_path):
     long = tmp_path / "long.nml"
     long.write_text("&brake t_end = 2000000.0, dt_out = 1.0 /\n"
                     "&analysis spectrum = .false., poincare = .false., lyapunov = .false. /\n")
-    reports, progress = _sigint_at_report(2)
+    reports, progress = sigint_at_report(2)
     out = tmp_path / "long.h5"
     with pytest.raises(KeyboardInterrupt) as caught:
         friction.run([INPUTS / "brake.nml", long], output=out, progress=progress)
-    assert "brake run stopped on request" in _interrupted(caught).message
+    assert "brake run stopped on request" in interrupted(caught).message
     assert max(fraction for _, fraction in reports) < 0.05, reports   # stopped at the third of 200 pieces
     assert not out.exists() and not list(tmp_path.glob("long.h5*"))

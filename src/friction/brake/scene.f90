@@ -323,13 +323,17 @@ contains
    end subroutine brake_netlist_text
 
    !> One brake run, in pieces so that long runs can report progress in τ,
-   !> and stop between them when asked (Ctrl-C, friction_job_stop): a
-   !> trajectory has no checkpoints, so nothing is written then.
-   subroutine integrate_brake(run, settings, reporter, error)
+   !> and stop between them when asked (Ctrl-C, friction_job_stop, a C API
+   !> progress function): a trajectory has no checkpoints, so nothing is
+   !> written then.  `lost` ends the message of a stop (default: that no
+   !> file was written).
+   subroutine integrate_brake(run, settings, reporter, error, lost)
       type(brake_run), target, intent(inout) :: run
       type(brake_config), intent(in) :: settings
       class(job_reporter), intent(inout) :: reporter
       type(error_type), allocatable, intent(out) :: error
+      character(len=*), intent(in), optional :: lost
+      character(len=:), allocatable :: tail
       integer :: piece, last
 
       call run%init(settings, error)
@@ -341,9 +345,10 @@ contains
          call reporter%progress(run%time_reached() - settings%t_start, settings%t_end - settings%t_start, &
             & 'tau', .false.)
          if (last < run%n .and. reporter%stop_requested()) then
+            tail = 'no file written (a trajectory keeps no checkpoints; run it again)'
+            if (present(lost)) tail = lost
             call fatal_error(error, 'brake run stopped on request at τ = '//fixed_text(run%time_reached(), 1) &
-               & //' of '//fixed_text(settings%t_end, 1)//': no file written (a trajectory keeps no ' &
-               & //'checkpoints; run it again)', error_interrupted)
+               & //' of '//fixed_text(settings%t_end, 1)//': '//tail, error_interrupted)
             return
          end if
       end do

@@ -19,7 +19,7 @@ module friction_capi
    use mpi_f08, only: MPI_Comm, MPI_Initialized, MPI_Finalized, MPI_Init_thread, MPI_THREAD_FUNNELED, &
       & MPI_COMM_WORLD, MPI_COMM_NULL
    use friction_kinds, only: wp
-   use friction_error, only: error_type, fatal_error, error_input
+   use friction_error, only: error_type, fatal_error, error_input, error_interrupted
    use friction_strings, only: itoa, rtoa, join, quoted
    use friction_version, only: version_string
    use friction_parameters, only: parameter_info, list_parameters, set_parameter, set_parameter_number, &
@@ -35,7 +35,7 @@ module friction_capi
    use friction_scene, only: point_memory
    use friction_brake_config, only: brake_config
    use friction_brake_simulate, only: brake_run
-   use friction_brake_scene, only: brake_scene
+   use friction_brake_scene, only: brake_scene, integrate_brake
    use friction_job_factory, only: scene_names, new_scene
    use friction_job_config, only: job_config, check_job, job_text, all_parameters, parameter_groups, not_in_scene
    use friction_job, only: run_job, run_job_config, job_reporter
@@ -48,8 +48,8 @@ module friction_capi
    public :: friction_config_new, friction_config_free, friction_config_read, friction_config_set, &
       & friction_config_set_real, friction_config_get, friction_config_text, friction_config_names, &
       & friction_config_check
-   public :: friction_afm_line, friction_compute, friction_result_get, friction_result_shape, &
-      & friction_result_names, friction_result_free
+   public :: friction_afm_line, friction_compute, friction_compute_progress, friction_result_get, &
+      & friction_result_shape, friction_result_names, friction_result_free
    public :: friction_run_job, friction_run_config
 
    !> FRICTION_API_VERSION of include/friction.h.
@@ -91,12 +91,19 @@ module friction_capi
       type(result_item), allocatable :: items(:)
    end type capi_result
 
-   !> A job's progress and notes through the caller's C function (if any):
-   !> void report(const char *message, double fraction, void *user), with
-   !> fraction in [0, 1] for progress and -1 for a note.
+   !> A job's or a computation's progress through the caller's C function
+   !> (if any).  A job's: void report(const char *message, double fraction,
+   !> void *user), fraction in [0, 1] for progress and -1 for a note; it
+   !> stops on friction_job_stop.  A computation's (`computation`): int
+   !> progress(const char *message, double fraction, void *user), whose
+   !> nonzero return stops it at its next safe point; the request is that
+   !> call's own, so computations on other threads go on.
    type, extends(job_reporter) :: callback_reporter
       procedure(report_function), pointer, nopass :: call => null()
-      type(c_ptr) :: user
+      procedure(progress_function), pointer, nopass :: ask => null()
+      type(c_ptr) :: user = c_null_ptr
+      logical :: computation = .false.
+      logical :: stop = .false.   !! a computation's `ask` returned nonzero
    contains
       procedure :: progress => callback_progress
       procedure :: note => callback_note
@@ -104,6 +111,13 @@ module friction_capi
    end type callback_reporter
 
    abstract interface
+      integer(c_int) function progress_function(message, fraction, user) bind(c)
+         import :: c_char, c_double, c_ptr, c_int
+         character(kind=c_char), intent(in) :: message(*)
+         real(c_double), value :: fraction
+         type(c_ptr), value :: user
+      end function progress_function
+
       subroutine report_function(message, fraction, user) bind(c)
          import :: c_char, c_double, c_ptr
          character(kind=c_char), intent(in) :: message(*)
@@ -782,6 +796,31 @@ contains
    !> friction_result *friction_compute(const friction_config *cfg, friction_error *err)
    type(c_ptr) function friction_compute(cfg, handle) bind(c, name='friction_compute_body') result(res)
       type(c_ptr), value :: cfg, handle
+      type(callback_reporter) :: silent
+
+      silent%computation = .true.
+      res = compute_scene(cfg, silent, handle)
+   end function friction_compute
+
+   !> friction_result *friction_compute_progress(const friction_config *cfg,
+   !>     friction_progress_fn progress, void *user, friction_error *err)
+   type(c_ptr) function friction_compute_progress(cfg, progress, user, handle) &
+      & bind(c, name='friction_compute_progress_body') result(res)
+      type(c_ptr), value :: cfg, user, handle
+      type(c_funptr), value :: progress
+      type(callback_reporter) :: reporter
+
+      reporter%computation = .true.
+      if (c_associated(progress)) call c_f_procpointer(progress, reporter%ask)
+      reporter%user = user
+      res = compute_scene(cfg, reporter, handle)
+   end function friction_compute_progress
+
+   !> friction_compute's work, with its progress and stop requests through
+   !> `reporter`.
+   type(c_ptr) function compute_scene(cfg, reporter, handle) result(res)
+      type(c_ptr), value :: cfg, handle
+      type(callback_reporter), intent(inout) :: reporter
       type(capi_config), pointer :: config
       type(capi_result), pointer :: result
       type(error_type), allocatable :: error
@@ -806,9 +845,9 @@ contains
       allocate (result%items(0))
       select type (s => work%scene)
       type is (afm_scene)
-         call compute_afm(s%resolved(), config%memory, result, error)
+         call compute_afm(s%resolved(), config%memory, reporter, result, error)
       type is (brake_scene)
-         call compute_brake(s%resolved(), result, error)
+         call compute_brake(s%resolved(), reporter, result, error)
       class default
          call fatal_error(error, "friction_compute: no computation for scene '"//trim(work%scene_name)//"'", &
             & error_input)
@@ -819,7 +858,7 @@ contains
       else
          res = c_loc(result)
       end if
-   end function friction_compute
+   end function compute_scene
 
    !> Append an item of rows x columns values (row-major).
    subroutine add_item(result, name, rows, columns, values)
@@ -849,9 +888,10 @@ contains
    !> the program's file holds them under /afm; at a temperature the means
    !> over the realizations, and NAME_sem beside every NAME.  The surface
    !> is memory's when it still holds (take_surface), and left in it.
-   subroutine compute_afm(c, memory, result, error)
+   subroutine compute_afm(c, memory, reporter, result, error)
       type(afm_config), intent(in) :: c
       type(point_memory), intent(inout) :: memory
+      class(job_reporter), intent(inout) :: reporter
       type(capi_result), intent(inout) :: result
       type(error_type), allocatable, intent(out) :: error
       class(surface_potential), allocatable :: potential
@@ -880,6 +920,12 @@ contains
             retrace(:, j, :) = line%retrace
             retrace_sem(:, j, :) = line%retrace_sem
             friction_sem(j) = line%friction_sem
+         end if
+         call reporter%progress(real(j, wp), real(c%ny, wp), 'lines', j == c%ny)
+         if (j < c%ny .and. reporter%stop_requested()) then
+            call fatal_error(error, 'the map stopped on request after '//itoa(j)//' of '//itoa(c%ny) &
+               & //' lines: no result', error_interrupted)
+            exit
          end if
       end do
       call scanner%release_potential(memory%surface)
@@ -913,16 +959,16 @@ contains
 
    !> The brake's trajectory and events on this process, as the program's
    !> file holds them under /brake.
-   subroutine compute_brake(c, result, error)
+   subroutine compute_brake(c, reporter, result, error)
       type(brake_config), intent(in) :: c
+      class(job_reporter), intent(inout) :: reporter
       type(capi_result), intent(inout) :: result
       type(error_type), allocatable, intent(out) :: error
       type(brake_run), target :: run
       integer :: n, k
 
-      call run%init(c, error)
-      if (allocated(error)) return
-      call run%run_until(run%n, error)
+      call integrate_brake(run, c, reporter, error, &
+         & lost='no result (a trajectory keeps no checkpoints; compute it again)')
       if (allocated(error)) return
       n = run%n
       associate (r => run%trajectory)
@@ -1214,12 +1260,13 @@ contains
       real(wp), intent(in) :: done, total
       character(len=*), intent(in) :: what
       logical, intent(in) :: last
-      character(len=120) :: text
+      character(len=:), allocatable :: text
+      real(c_double) :: fraction
 
-      if (.not. associated(self%call)) return
-      text = progress_text(done, total, what)
-      call self%call(trim(text)//c_null_char, real(max(0.0_wp, min(1.0_wp, done / max(total, tiny(total)))), &
-         & c_double), self%user)
+      text = progress_text(done, total, what)//c_null_char
+      fraction = real(max(0.0_wp, min(1.0_wp, done / max(total, tiny(total)))), c_double)
+      if (associated(self%call)) call self%call(text, fraction, self%user)
+      if (associated(self%ask)) self%stop = self%stop .or. self%ask(text, fraction, self%user) /= 0
    end subroutine callback_progress
 
    subroutine callback_note(self, text)
@@ -1229,11 +1276,16 @@ contains
       if (associated(self%call)) call self%call(text//c_null_char, -1.0_c_double, self%user)
    end subroutine callback_note
 
-   !> Whether the host asked the job to stop (friction_job_stop, job_lock.c).
+   !> Whether the host asked the job to stop (friction_job_stop, job_lock.c),
+   !> or the computation's progress function did (returned nonzero).
    logical function callback_stop_requested(self)
       class(callback_reporter), intent(inout) :: self
 
-      callback_stop_requested = friction_job_stop_asked() /= 0
+      if (self%computation) then
+         callback_stop_requested = self%stop
+      else
+         callback_stop_requested = friction_job_stop_asked() /= 0
+      end if
    end function callback_stop_requested
 
 end module friction_capi

@@ -12,7 +12,8 @@
  * exception trapping and clear flags (feholdexcept), and puts the host's
  * back on return (fesetenv), traps and flags as they were.  The library's
  * failures come back as statuses, as they do for any host.  A job's report
- * callback runs inside the call, in the library's environment.
+ * callback and a computation's progress callback run inside the call, in
+ * the library's environment.
  *
  * The Fortran bodies are the functions of capi.f90 under the names
  * friction_*_body; these wrappers carry the header's names. */
@@ -61,6 +62,10 @@ FP_GUARDED(int, friction_afm_line,
            (cfg, line, forward, fx, fy, n, err))
 
 FP_GUARDED(friction_result *, friction_compute, (const friction_config *cfg, friction_error *err), (cfg, err))
+
+FP_GUARDED(friction_result *, friction_compute_progress,
+           (const friction_config *cfg, friction_progress_fn progress, void *user, friction_error *err),
+           (cfg, progress, user, err))
 
 FP_GUARDED(int, friction_run_job,
            (const char *const *files, int nfiles, const char *output, int flags, friction_report_fn report,
