@@ -15,7 +15,7 @@
 !> different handles.
 module friction_capi
    use, intrinsic :: iso_c_binding, only: c_ptr, c_char, c_int, c_double, c_size_t, c_null_char, c_null_ptr, &
-      & c_associated, c_f_pointer, c_loc, c_funptr, c_f_procpointer
+      & c_associated, c_f_pointer, c_loc, c_funptr, c_f_procpointer, c_null_funptr
    use mpi_f08, only: MPI_Comm, MPI_Initialized, MPI_Finalized, MPI_Init_thread, MPI_THREAD_FUNNELED, &
       & MPI_COMM_WORLD, MPI_COMM_NULL
    use friction_kinds, only: wp
@@ -91,10 +91,10 @@ module friction_capi
       type(result_item), allocatable :: items(:)
    end type capi_result
 
-   !> A job's or a computation's progress through the caller's C function
-   !> (if any).  A job's: void report(const char *message, double fraction,
-   !> void *user), fraction in [0, 1] for progress and -1 for a note; it
-   !> stops on friction_job_stop.  A computation's (`computation`): int
+   !> A job's or a computation's progress through the caller's C function.
+   !> A job's (`call`, if any): void report(const char *message, double
+   !> fraction, void *user), fraction in [0, 1] for progress and -1 for a
+   !> note; it stops on friction_job_stop.  A computation's (`ask`): int
    !> progress(const char *message, double fraction, void *user), whose
    !> nonzero return stops it at its next safe point; the request is that
    !> call's own, so computations on other threads go on.
@@ -102,8 +102,7 @@ module friction_capi
       procedure(report_function), pointer, nopass :: call => null()
       procedure(progress_function), pointer, nopass :: ask => null()
       type(c_ptr) :: user = c_null_ptr
-      logical :: computation = .false.
-      logical :: stop = .false.   !! a computation's `ask` returned nonzero
+      logical :: stop = .false.   !! `ask` returned nonzero
    contains
       procedure :: progress => callback_progress
       procedure :: note => callback_note
@@ -796,10 +795,8 @@ contains
    !> friction_result *friction_compute(const friction_config *cfg, friction_error *err)
    type(c_ptr) function friction_compute(cfg, handle) bind(c, name='friction_compute_body') result(res)
       type(c_ptr), value :: cfg, handle
-      type(callback_reporter) :: silent
 
-      silent%computation = .true.
-      res = compute_scene(cfg, silent, handle)
+      res = friction_compute_progress(cfg, c_null_funptr, c_null_ptr, handle)
    end function friction_compute
 
    !> friction_result *friction_compute_progress(const friction_config *cfg,
@@ -809,9 +806,13 @@ contains
       type(c_ptr), value :: cfg, user, handle
       type(c_funptr), value :: progress
       type(callback_reporter) :: reporter
+      type(job_reporter) :: silent
 
-      reporter%computation = .true.
-      if (c_associated(progress)) call c_f_procpointer(progress, reporter%ask)
+      if (.not. c_associated(progress)) then
+         res = compute_scene(cfg, silent, handle)
+         return
+      end if
+      call c_f_procpointer(progress, reporter%ask)
       reporter%user = user
       res = compute_scene(cfg, reporter, handle)
    end function friction_compute_progress
@@ -820,7 +821,7 @@ contains
    !> `reporter`.
    type(c_ptr) function compute_scene(cfg, reporter, handle) result(res)
       type(c_ptr), value :: cfg, handle
-      type(callback_reporter), intent(inout) :: reporter
+      class(job_reporter), intent(inout) :: reporter
       type(capi_config), pointer :: config
       type(capi_result), pointer :: result
       type(error_type), allocatable :: error
@@ -1276,12 +1277,12 @@ contains
       if (associated(self%call)) call self%call(text//c_null_char, -1.0_c_double, self%user)
    end subroutine callback_note
 
-   !> Whether the host asked the job to stop (friction_job_stop, job_lock.c),
-   !> or the computation's progress function did (returned nonzero).
+   !> Whether the computation's progress function asked to stop (returned
+   !> nonzero), or for a job the host did (friction_job_stop, job_lock.c).
    logical function callback_stop_requested(self)
       class(callback_reporter), intent(inout) :: self
 
-      if (self%computation) then
+      if (associated(self%ask)) then
          callback_stop_requested = self%stop
       else
          callback_stop_requested = friction_job_stop_asked() /= 0
