@@ -21,7 +21,7 @@ module friction_surface_lennard_jones
    use friction_surface_potential, only: surface_potential
    use friction_surface_net, only: crystal_net, net_lattice
    use friction_surface_tricubic, only: tricubic_grid, new_tricubic_grid, n_node_values
-   use friction_surface_table_kernels, only: column_sums, difference_terms
+   use friction_surface_table_kernels, only: column_sums, difference_terms, column_lanes
    use friction_surface_table_kernels_wide, only: column_sums_wide => column_sums
    use friction_strings, only: rtoa, itoa
    use friction_sharing, only: work_sharing
@@ -63,6 +63,14 @@ module friction_surface_lennard_jones
       real(wp) :: origin(2) = 0.0_wp, cell = 1.0_wp
       integer :: ncell(2) = 1
    end type difference_lists
+
+   !> The pairs of one column of the table's build (column_values), kept
+   !> from column to column: one array per quantity, as column_sums wants.
+   type :: column_pairs
+      integer :: n = 0                      !! pairs (padded: gather_pairs)
+      real(wp) :: rc2 = 0.0_wp              !! the cutoff squared, Å²
+      real(wp), allocatable :: u1(:), u2(:), lateral(:), height(:), sigma2(:), e4(:), shift(:)
+   end type column_pairs
 
    !> How to build a table (`tabulate`).
    type :: table_settings
@@ -806,56 +814,109 @@ contains
 
    !> The eight node values of the lattice potential at heights z(:) above
    !> the point xy (Å), in the fractional coordinates of the lattice
-   !> (friction_surface_table_kernels' column_sums); the pairs within the
-   !> cutoff in the plane are gathered once per column.
-   pure subroutine column_values(ideal, t, xy, z, values)
+   !> (friction_surface_table_kernels' column_sums): the pairs within the
+   !> cutoff in the plane gathered once for the column, into `pairs` (kept
+   !> by the caller from column to column: no allocation per column).
+   pure subroutine column_values(ideal, t, xy, z, values, pairs)
       type(lj_potential), intent(in) :: ideal
       type(lj_table), intent(in) :: t
       real(wp), intent(in) :: xy(2), z(:)
       real(wp), intent(out) :: values(:, :)
-      real(wp), allocatable :: u1(:), u2(:), lateral(:), height(:), sigma2(:), e4(:), shift(:)
-      real(wp) :: a1(2), a2(2), c12, rc2, dx, dy
-      integer :: lo(2), hi(2), cx, cy, c, i, n, s, most
+      type(column_pairs), intent(inout) :: pairs
+
+      call gather_pairs(ideal, t, xy, pairs)
+      call pair_sums(t, pairs, z, values)
+   end subroutine column_values
+
+   !> The sites of the lattice within the cutoff of the column above xy in
+   !> the plane, with what the pair terms need of them (u_i = a_i . d does
+   !> not change along the column), padded to whole lanes of column_sums
+   !> with pairs beyond the cutoff, which add zero.
+   pure subroutine gather_pairs(ideal, t, xy, pairs)
+      type(lj_potential), intent(in) :: ideal
+      type(lj_table), intent(in) :: t
+      real(wp), intent(in) :: xy(2)
+      type(column_pairs), intent(inout) :: pairs
+      real(wp) :: a1(2), a2(2), rc2, dx, dy
+      integer :: lo(2), hi(2), cx, cy, c, i, n, s, most, capacity
 
       a1 = t%vectors(:, 1)
       a2 = t%vectors(:, 2)
-      c12 = dot_product(a1, a2)
       rc2 = ideal%cutoff**2
-      ! The sites within the cutoff in the plane, with what the pair terms
-      ! need of them (u_i = a_i . d does not change along the column).
       call cell_range(ideal%atoms, xy, ideal%cutoff, lo, hi)
       most = 0
       do cy = lo(2), hi(2)
          c = lo(1) + cy * ideal%atoms%ncell(1) + 1
          most = most + ideal%atoms%cell_start(c + hi(1) - lo(1) + 1) - ideal%atoms%cell_start(c)
       end do
-      allocate (u1(most), u2(most), lateral(most), height(most), sigma2(most), e4(most), shift(most))
+      most = column_lanes * ((most + column_lanes - 1) / column_lanes)
+      capacity = 0
+      if (allocated(pairs%u1)) capacity = size(pairs%u1)
+      if (capacity < most) then
+         if (allocated(pairs%u1)) deallocate (pairs%u1, pairs%u2, pairs%lateral, pairs%height, pairs%sigma2, &
+            & pairs%e4, pairs%shift)
+         most = max(most, 2 * capacity)
+         allocate (pairs%u1(most), pairs%u2(most), pairs%lateral(most), pairs%height(most), pairs%sigma2(most), &
+            & pairs%e4(most), pairs%shift(most))
+      end if
       n = 0
-      do cy = lo(2), hi(2)
-         do cx = lo(1), hi(1)
-            c = cx + cy * ideal%atoms%ncell(1) + 1
-            do i = ideal%atoms%cell_start(c), ideal%atoms%cell_start(c + 1) - 1
-               dx = xy(1) - ideal%atoms%position(1, i)
-               dy = xy(2) - ideal%atoms%position(2, i)
-               if (dx**2 + dy**2 >= rc2) cycle
-               n = n + 1
-               s = ideal%atoms%species(i)
-               lateral(n) = dx**2 + dy**2
-               u1(n) = a1(1) * dx + a1(2) * dy
-               u2(n) = a2(1) * dx + a2(2) * dy
-               height(n) = ideal%atoms%position(3, i)
-               sigma2(n) = ideal%sigma(s)**2
-               e4(n) = 4.0_wp * ideal%epsilon(s)
-               shift(n) = t%shift(s)
+      associate (u1 => pairs%u1, u2 => pairs%u2, lateral => pairs%lateral, height => pairs%height, &
+         & sigma2 => pairs%sigma2, e4 => pairs%e4, shift => pairs%shift)
+         do cy = lo(2), hi(2)
+            do cx = lo(1), hi(1)
+               c = cx + cy * ideal%atoms%ncell(1) + 1
+               do i = ideal%atoms%cell_start(c), ideal%atoms%cell_start(c + 1) - 1
+                  dx = xy(1) - ideal%atoms%position(1, i)
+                  dy = xy(2) - ideal%atoms%position(2, i)
+                  if (dx**2 + dy**2 >= rc2) cycle
+                  n = n + 1
+                  s = ideal%atoms%species(i)
+                  lateral(n) = dx**2 + dy**2
+                  u1(n) = a1(1) * dx + a1(2) * dy
+                  u2(n) = a2(1) * dx + a2(2) * dy
+                  height(n) = ideal%atoms%position(3, i)
+                  sigma2(n) = ideal%sigma(s)**2
+                  e4(n) = 4.0_wp * ideal%epsilon(s)
+                  shift(n) = t%shift(s)
+               end do
             end do
          end do
-      end do
-      if (t%grid%wide) then
-         call column_sums_wide(n, lateral, u1, u2, height, sigma2, e4, shift, c12, rc2, z, values)
-      else
-         call column_sums(n, lateral, u1, u2, height, sigma2, e4, shift, c12, rc2, z, values)
-      end if
-   end subroutine column_values
+         do while (mod(n, column_lanes) /= 0)
+            n = n + 1
+            lateral(n) = rc2
+            u1(n) = 0.0_wp
+            u2(n) = 0.0_wp
+            height(n) = 0.0_wp
+            sigma2(n) = 0.0_wp
+            e4(n) = 0.0_wp
+            shift(n) = 0.0_wp
+         end do
+      end associate
+      pairs%n = n
+      pairs%rc2 = rc2
+   end subroutine gather_pairs
+
+   !> The eight node values at heights z(:) of the column whose pairs are
+   !> `pairs` (gather_pairs), through the kernels for AVX2 where the table
+   !> uses them.
+   pure subroutine pair_sums(t, pairs, z, values)
+      type(lj_table), intent(in) :: t
+      type(column_pairs), intent(in) :: pairs
+      real(wp), intent(in) :: z(:)
+      real(wp), intent(out) :: values(:, :)
+      real(wp) :: c12
+
+      c12 = dot_product(t%vectors(:, 1), t%vectors(:, 2))
+      associate (n => pairs%n)
+         if (t%grid%wide) then
+            call column_sums_wide(n, pairs%lateral, pairs%u1, pairs%u2, pairs%height, pairs%sigma2, pairs%e4, &
+               & pairs%shift, c12, pairs%rc2, z, values)
+         else
+            call column_sums(n, pairs%lateral, pairs%u1, pairs%u2, pairs%height, pairs%sigma2, pairs%e4, &
+               & pairs%shift, c12, pairs%rc2, z, values)
+         end if
+      end associate
+   end subroutine pair_sums
 
    !> The Cartesian point of fractional coordinates s.
    pure function cartesian(t, s) result(xy)
@@ -865,18 +926,6 @@ contains
 
       xy = s(1) * t%vectors(:, 1) + s(2) * t%vectors(:, 2)
    end function cartesian
-
-   !> The gradient of the lattice potential (direct sum) at r, Cartesian.
-   pure function lattice_gradient(ideal, t, r) result(g)
-      type(lj_potential), intent(in) :: ideal
-      type(lj_table), intent(in) :: t
-      real(wp), intent(in) :: r(3)
-      real(wp) :: g(3)
-      real(wp) :: values(n_node_values, 1)
-
-      call column_values(ideal, t, r(1:2), [r(3)], values)
-      g = cartesian_gradient(t, values(:, 1))
-   end function lattice_gradient
 
    !> The Cartesian gradient from a node's values (V_si = a_i . grad: back
    !> through the inverse).
@@ -906,6 +955,8 @@ contains
       real(wp), parameter :: check_at(3) = [0.2113248654051871_wp, 0.5_wp, 0.7886751345948129_wp]
       real(wp), allocatable :: columns(:, :), upper(:, :), lower(:, :), found(:), checked(:, :, :)
       real(wp) :: step, z, z_new, worst, bottom, ratio, g(3), r(3), v, gi(3), s(2)
+      !> each check column's pairs, gathered once for all the heights tried
+      type(column_pairs), allocatable :: pairs(:)
       integer :: ncol, i, j, k, m
       logical :: all_above
 
@@ -928,8 +979,10 @@ contains
       allocate (upper(n_node_values, ncol), lower(n_node_values, ncol), checked(n_node_values, 4, ncol))
       bottom = minval(ideal%atoms%position(3, :))
       z = t%top
+      allocate (pairs(ncol))
       do m = 1, ncol
-         call column_values(ideal, t, columns(:, m), [z], upper(:, m:m))
+         call gather_pairs(ideal, t, columns(:, m), pairs(m))
+         call pair_sums(t, pairs(m), [z], upper(:, m:m))
       end do
       vmin = minval(upper(1, :))
       found = [z]
@@ -947,7 +1000,7 @@ contains
          if (share%ranks > 1) checked = -0.0_wp
          do m = 1, ncol
             if (mod(m - 1, share%ranks) /= share%rank) cycle
-            call column_values(ideal, t, columns(:, m), [z_new, z_new + check_at * step], checked(:, :, m))
+            call pair_sums(t, pairs(m), [z_new, z_new + check_at * step], checked(:, :, m))
          end do
          if (share%ranks > 1) call share%sum_reals(checked, size(checked))
          lower = checked(:, 1, :)
@@ -1015,9 +1068,12 @@ contains
 
    !> Step 3 of `tabulate`: the lateral spacing (Å) that keeps the error of
    !> the interpolation within the layers under `target`, measured at
-   !> quasi-random points of every layer (energy under the cap) on trial
-   !> spacings: the error goes as the spacing cubed.  The processes share
-   !> the points and take the largest error of all.
+   !> quasi-random points of the layers (energy under the cap) on trial
+   !> spacings: the error goes as the spacing cubed.  Each layer gets
+   !> `per_layer` points; a point (Halton, in the plane) serves every
+   !> `stride`-th layer, so that one gathering of its pairs, and of its
+   !> cell's corners', serves all of them.  The processes share the points
+   !> and take the largest error of all.
    subroutine choose_spacing(ideal, t, layers, target, spacing, reason, share)
       type(lj_potential), intent(in) :: ideal
       type(lj_table), intent(in) :: t
@@ -1026,39 +1082,58 @@ contains
       character(len=:), allocatable, intent(inout) :: reason
       !> the processes sharing the points (each a share, then the largest error)
       class(work_sharing), intent(inout) :: share
-      integer, parameter :: per_layer = 16, trials = 6
-      real(wp) :: worst, s(2), f(2), n(2), corner(n_node_values, 2, 2), v, gi(3), g(3), hi(3, 3)
+      integer, parameter :: per_layer = 16, stride = 6, trials = 6
+      real(wp) :: worst, s(2), f(2), n(2), v, gi(3), hi(3, 3)
+      real(wp), allocatable :: corner(:, :, :, :), exact(:, :, :)
       type(tricubic_grid) :: cell
-      integer :: trial, k, m, i, j, count_halton
+      type(column_pairs) :: pairs
+      integer :: trial, k, j, i, point, first, points, nz
 
+      ! Point j serves layers first(j), first(j) + stride, ...: first(j) =
+      ! 1 + mod(j - 1, stride), so that each layer has per_layer points.
+      points = per_layer * min(stride, size(layers))
+      nz = (size(layers) + stride - 1) / stride
+      allocate (corner(n_node_values, nz, 2, 2), exact(n_node_values, nz, points))
+      ! The lattice at each point's layers: the same for every trial.
+      do point = 1, points
+         if (mod(point - 1, share%ranks) /= share%rank) cycle
+         first = 1 + mod(point - 1, min(stride, size(layers)))
+         associate (z => layers(first::min(stride, size(layers))))
+            call gather_pairs(ideal, t, cartesian(t, [halton(point + 16, 2), halton(point + 16, 3)]), pairs)
+            call pair_sums(t, pairs, z, exact(:, :size(z), point))
+         end associate
+      end do
       spacing = 0.1_wp
       do trial = 1, trials
          n = max(4.0_wp, real(ceiling([norm2(t%vectors(:, 1)), norm2(t%vectors(:, 2))] / spacing), wp))
+         ! One cell of the trial spacing (moved to each point's below), its
+         ! two layers holding the same data: the interpolation in the plane.
+         cell = new_tricubic_grid(0.0_wp, 1.0_wp / n(1), 2, 0.0_wp, 1.0_wp / n(2), 2, [0.0_wp, 1.0_wp])
          worst = 0.0_wp
-         count_halton = 0
-         do k = 1, size(layers)
-            do m = 1, per_layer
-               count_halton = count_halton + 1
-               if (mod(count_halton - 1, share%ranks) /= share%rank) cycle
-               s = [halton(count_halton + 16, 2), halton(count_halton + 16, 3)]
-               ! The cell holding s, its four corners at this layer.
+         do point = 1, points
+            if (mod(point - 1, share%ranks) /= share%rank) cycle
+            s = [halton(point + 16, 2), halton(point + 16, 3)]
+            first = 1 + mod(point - 1, min(stride, size(layers)))
+            associate (z => layers(first::min(stride, size(layers))))
+               ! The cell holding s, its four corners at the point's layers.
                f = floor(s * n)
                do j = 0, 1
                   do i = 0, 1
-                     call column_values(ideal, t, cartesian(t, (f + [i, j]) / n), [layers(k)], &
-                        & corner(:, i + 1:i + 1, j + 1))
+                     call gather_pairs(ideal, t, cartesian(t, (f + [i, j]) / n), pairs)
+                     call pair_sums(t, pairs, z, corner(:, :size(z), i + 1, j + 1))
                   end do
                end do
-               cell = new_tricubic_grid(f(1) / n(1), 1.0_wp / n(1), 2, f(2) / n(2), 1.0_wp / n(2), 2, &
-                  & [layers(k), layers(k) + 1.0_wp])
-               cell%node(:, :, :, 1) = corner
-               cell%node(:, :, :, 2) = corner
-               call cell%evaluate([s(1), s(2), layers(k)], 1, v, gi, hi)
-               if (v > t%energy_cap) cycle
-               gi(1:2) = matmul(transpose(t%to_fraction), gi(1:2))
-               g = lattice_gradient(ideal, t, [cartesian(t, s), layers(k)])
-               worst = max(worst, norm2(gi - g))
-            end do
+               cell%x0 = f(1) / n(1)
+               cell%y0 = f(2) / n(2)
+               do k = 1, size(z)
+                  cell%node(:, :, :, 1) = corner(:, k, :, :)
+                  cell%node(:, :, :, 2) = corner(:, k, :, :)
+                  call cell%evaluate([s(1), s(2), 0.0_wp], 1, v, gi, hi)
+                  if (v > t%energy_cap) cycle
+                  gi(1:2) = matmul(transpose(t%to_fraction), gi(1:2))
+                  worst = max(worst, norm2(gi - cartesian_gradient(t, exact(:, k, point))))
+               end do
+            end associate
          end do
          call share%max_real(worst)
          if (worst <= target .and. trial > 1) return
@@ -1147,6 +1222,7 @@ contains
       !> where each value goes in the image of a column under the swap
       integer, parameter :: swapped(n_node_values) = [1, 3, 2, 4, 5, 7, 6, 8]
       real(wp), allocatable :: packed(:, :, :)
+      type(column_pairs) :: pairs
       integer :: i, j, n1, n2, dealt, op, image(2)
       logical :: used(3)
 
@@ -1159,7 +1235,7 @@ contains
             do i = 1, n1
                if (.not. first_of_orbit(i, j)) cycle
                call column_values(ideal, t, cartesian(t, [real(i - 1, wp) / n1, real(j - 1, wp) / n2]), t%grid%z, &
-                  & t%grid%node(:, i, j, :))
+                  & t%grid%node(:, i, j, :), pairs)
             end do
          end do
       else
@@ -1174,7 +1250,7 @@ contains
                dealt = dealt + 1
                if (mod(dealt - 1, share%ranks) /= share%rank) cycle
                call column_values(ideal, t, cartesian(t, [real(i - 1, wp) / n1, real(j - 1, wp) / n2]), t%grid%z, &
-                  & packed(:, :, dealt))
+                  & packed(:, :, dealt), pairs)
             end do
          end do
          call share%sum_reals(packed, size(packed))

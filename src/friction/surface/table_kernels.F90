@@ -20,11 +20,15 @@ module TABLE_KERNELS
    implicit none
    private
 
-   public :: column_sums, difference_terms, power_polynomial, n_cell_coefficients
+   public :: column_sums, difference_terms, power_polynomial, n_cell_coefficients, column_lanes
 
    !> Coefficients of a cell's polynomial (power_polynomial; the cells of
    !> friction_surface_tricubic's set_polynomials).
    integer, parameter :: n_cell_coefficients = 64
+
+   !> Pairs summed side by side in column_sums (its pair lists are padded to
+   !> a multiple of this).
+   integer, parameter :: column_lanes = 4
 
 contains
 
@@ -38,43 +42,48 @@ contains
    !>   V, V_s1 = 2φ1 u1, V_s2 = 2φ1 u2, V_z = 2φ1 w,
    !>   V_s1s2 = 4φ2 u1 u2 + 2φ1 c12, V_s1z = 4φ2 u1 w, V_s2z = 4φ2 u2 w,
    !>   V_s1s2z = 8φ3 u1 u2 w + 4φ2 c12 w.
+   !> n is a multiple of `column_lanes` (pad with pairs beyond the cutoff:
+   !> lateral(p) >= rc2, e4 = shift = 0, which add exactly zero).
    pure subroutine column_sums(n, lateral, u1, u2, height, sigma2, e4, shift, c12, rc2, z, values)
       integer, intent(in) :: n
-      real(wp), intent(in) :: lateral(:), u1(:), u2(:), height(:), sigma2(:), e4(:), shift(:), c12, rc2, z(:)
+      real(wp), intent(in), dimension(column_lanes, n / column_lanes) :: lateral, u1, u2, height, sigma2, e4, shift
+      real(wp), intent(in) :: c12, rc2, z(:)
       real(wp), intent(out) :: values(:, :)
-      real(wp) :: f0(n), f1(n), f2(n), f3(n), dz(n), acc(8), w, q, inside, iq, s6, s12
-      integer :: k, p
+      real(wp) :: acc(column_lanes, 8), w, q, inside, iq, s6, s12, f0, f1, f2, f3
+      integer :: k, c, l, m
 
       do k = 1, size(z)
-         ! The radial derivatives pair by pair (no branch, so that the loop
-         ! vectorizes: pairs beyond the cutoff get weight 0), then the sums
-         ! in the pairs' order.  (Eight arrays of terms summed by `sum`
-         ! instead took twice as long.)
-         do p = 1, n
-            w = z(k) - height(p)
-            q = lateral(p) + w * w
-            inside = merge(1.0_wp, 0.0_wp, q < rc2)
-            iq = 1.0_wp / q
-            s6 = (sigma2(p) * iq)**3
-            s12 = s6 * s6
-            dz(p) = w
-            f0(p) = inside * (e4(p) * (s12 - s6) - shift(p))
-            f1(p) = inside * e4(p) * (-6.0_wp * s12 + 3.0_wp * s6) * iq
-            f2(p) = inside * e4(p) * (42.0_wp * s12 - 12.0_wp * s6) * iq * iq
-            f3(p) = inside * e4(p) * (-336.0_wp * s12 + 60.0_wp * s6) * iq * iq * iq
-         end do
+         ! The pairs `column_lanes` at a time, each lane with running sums of
+         ! its own, added up in a fixed order at the end: the lanes' loop
+         ! vectorizes without reordering a sum the source does not (so the
+         ! kernels for every processor and for AVX2 give the same bits), and
+         ! without a branch (pairs beyond the cutoff get weight 0).
          acc = 0.0_wp
-         do p = 1, n
-            acc(1) = acc(1) + f0(p)
-            acc(2) = acc(2) + 2.0_wp * f1(p) * u1(p)
-            acc(3) = acc(3) + 2.0_wp * f1(p) * u2(p)
-            acc(4) = acc(4) + 2.0_wp * f1(p) * dz(p)
-            acc(5) = acc(5) + 4.0_wp * f2(p) * u1(p) * u2(p) + 2.0_wp * f1(p) * c12
-            acc(6) = acc(6) + 4.0_wp * f2(p) * u1(p) * dz(p)
-            acc(7) = acc(7) + 4.0_wp * f2(p) * u2(p) * dz(p)
-            acc(8) = acc(8) + (8.0_wp * f3(p) * u1(p) * u2(p) + 4.0_wp * f2(p) * c12) * dz(p)
+         do c = 1, n / column_lanes
+            do l = 1, column_lanes
+               w = z(k) - height(l, c)
+               q = lateral(l, c) + w * w
+               inside = merge(1.0_wp, 0.0_wp, q < rc2)
+               iq = 1.0_wp / q
+               s6 = (sigma2(l, c) * iq)**3
+               s12 = s6 * s6
+               f0 = inside * (e4(l, c) * (s12 - s6) - shift(l, c))
+               f1 = inside * e4(l, c) * (-6.0_wp * s12 + 3.0_wp * s6) * iq
+               f2 = inside * e4(l, c) * (42.0_wp * s12 - 12.0_wp * s6) * iq * iq
+               f3 = inside * e4(l, c) * (-336.0_wp * s12 + 60.0_wp * s6) * iq * iq * iq
+               acc(l, 1) = acc(l, 1) + f0
+               acc(l, 2) = acc(l, 2) + 2.0_wp * f1 * u1(l, c)
+               acc(l, 3) = acc(l, 3) + 2.0_wp * f1 * u2(l, c)
+               acc(l, 4) = acc(l, 4) + 2.0_wp * f1 * w
+               acc(l, 5) = acc(l, 5) + 4.0_wp * f2 * u1(l, c) * u2(l, c) + 2.0_wp * f1 * c12
+               acc(l, 6) = acc(l, 6) + 4.0_wp * f2 * u1(l, c) * w
+               acc(l, 7) = acc(l, 7) + 4.0_wp * f2 * u2(l, c) * w
+               acc(l, 8) = acc(l, 8) + (8.0_wp * f3 * u1(l, c) * u2(l, c) + 4.0_wp * f2 * c12) * w
+            end do
          end do
-         values(:, k) = acc
+         do m = 1, 8
+            values(m, k) = (acc(1, m) + acc(2, m)) + (acc(3, m) + acc(4, m))
+         end do
       end do
    end subroutine column_sums
 
