@@ -69,7 +69,7 @@ module friction_surface_lennard_jones
    type :: column_pairs
       integer :: n = 0                      !! pairs (padded: gather_pairs)
       real(wp) :: rc2 = 0.0_wp              !! the cutoff squared, Å²
-      real(wp), allocatable :: u1(:), u2(:), lateral(:), height(:), sigma2(:), e4(:), shift(:)
+      real(wp), allocatable :: u1(:), u2(:), u12(:), lateral(:), height(:), sigma2(:), e4(:), shift(:)
    end type column_pairs
 
    !> How to build a table (`tabulate`).
@@ -853,15 +853,15 @@ contains
       capacity = 0
       if (allocated(pairs%u1)) capacity = size(pairs%u1)
       if (capacity < most) then
-         if (allocated(pairs%u1)) deallocate (pairs%u1, pairs%u2, pairs%lateral, pairs%height, pairs%sigma2, &
-            & pairs%e4, pairs%shift)
+         if (allocated(pairs%u1)) deallocate (pairs%u1, pairs%u2, pairs%u12, pairs%lateral, pairs%height, &
+            & pairs%sigma2, pairs%e4, pairs%shift)
          most = max(most, 2 * capacity)
-         allocate (pairs%u1(most), pairs%u2(most), pairs%lateral(most), pairs%height(most), pairs%sigma2(most), &
-            & pairs%e4(most), pairs%shift(most))
+         allocate (pairs%u1(most), pairs%u2(most), pairs%u12(most), pairs%lateral(most), pairs%height(most), &
+            & pairs%sigma2(most), pairs%e4(most), pairs%shift(most))
       end if
       n = 0
-      associate (u1 => pairs%u1, u2 => pairs%u2, lateral => pairs%lateral, height => pairs%height, &
-         & sigma2 => pairs%sigma2, e4 => pairs%e4, shift => pairs%shift)
+      associate (u1 => pairs%u1, u2 => pairs%u2, u12 => pairs%u12, lateral => pairs%lateral, &
+         & height => pairs%height, sigma2 => pairs%sigma2, e4 => pairs%e4, shift => pairs%shift)
          do cy = lo(2), hi(2)
             do cx = lo(1), hi(1)
                c = cx + cy * ideal%atoms%ncell(1) + 1
@@ -874,6 +874,7 @@ contains
                   lateral(n) = dx**2 + dy**2
                   u1(n) = a1(1) * dx + a1(2) * dy
                   u2(n) = a2(1) * dx + a2(2) * dy
+                  u12(n) = u1(n) * u2(n)
                   height(n) = ideal%atoms%position(3, i)
                   sigma2(n) = ideal%sigma(s)**2
                   e4(n) = 4.0_wp * ideal%epsilon(s)
@@ -886,6 +887,7 @@ contains
             lateral(n) = rc2
             u1(n) = 0.0_wp
             u2(n) = 0.0_wp
+            u12(n) = 0.0_wp
             height(n) = 0.0_wp
             sigma2(n) = 0.0_wp
             e4(n) = 0.0_wp
@@ -909,11 +911,11 @@ contains
       c12 = dot_product(t%vectors(:, 1), t%vectors(:, 2))
       associate (n => pairs%n)
          if (t%grid%wide) then
-            call column_sums_wide(n, pairs%lateral, pairs%u1, pairs%u2, pairs%height, pairs%sigma2, pairs%e4, &
-               & pairs%shift, c12, pairs%rc2, z, values)
+            call column_sums_wide(n, pairs%lateral, pairs%u1, pairs%u2, pairs%u12, pairs%height, pairs%sigma2, &
+               & pairs%e4, pairs%shift, c12, pairs%rc2, z, values)
          else
-            call column_sums(n, pairs%lateral, pairs%u1, pairs%u2, pairs%height, pairs%sigma2, pairs%e4, &
-               & pairs%shift, c12, pairs%rc2, z, values)
+            call column_sums(n, pairs%lateral, pairs%u1, pairs%u2, pairs%u12, pairs%height, pairs%sigma2, &
+               & pairs%e4, pairs%shift, c12, pairs%rc2, z, values)
          end if
       end associate
    end subroutine pair_sums

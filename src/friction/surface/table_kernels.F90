@@ -35,21 +35,25 @@ contains
    !> The eight node values at heights z(:) of a column, from the n pairs
    !> within the cutoff r_c (rc2 = r_c²) in the plane: for pair p the
    !> lateral distance² lateral(p), u_i(p) = a_i . d (a_i the lattice
-   !> vectors, d the tip less the atom), the atom's height, σ², 4ε and the
-   !> energy shift φ(r_c).  With q = r², φ(q) and its q-derivatives
-   !> φ1, φ2, φ3, w = d_z and c12 = a1 . a2, the values in the fractional
-   !> coordinates of the lattice (d/ds_i = a_i . grad):
+   !> vectors, d the tip less the atom) and u12(p) = u1(p) u2(p), the
+   !> atom's height, σ², 4ε and the energy shift φ(r_c).  With q = r², φ(q)
+   !> and its q-derivatives φ1, φ2, φ3, w = d_z and c12 = a1 . a2, the values
+   !> in the fractional coordinates of the lattice (d/ds_i = a_i . grad):
    !>   V, V_s1 = 2φ1 u1, V_s2 = 2φ1 u2, V_z = 2φ1 w,
    !>   V_s1s2 = 4φ2 u1 u2 + 2φ1 c12, V_s1z = 4φ2 u1 w, V_s2z = 4φ2 u2 w,
-   !>   V_s1s2z = 8φ3 u1 u2 w + 4φ2 c12 w.
+   !>   V_s1s2z = 8φ3 u1 u2 w + 4φ2 c12 w
+   !> (the c12 terms as c12 times the sums of 2φ1 and 4φ2 w).
    !> n is a multiple of `column_lanes` (pad with pairs beyond the cutoff:
    !> lateral(p) >= rc2, e4 = shift = 0, which add exactly zero).
-   pure subroutine column_sums(n, lateral, u1, u2, height, sigma2, e4, shift, c12, rc2, z, values)
+   pure subroutine column_sums(n, lateral, u1, u2, u12, height, sigma2, e4, shift, c12, rc2, z, values)
       integer, intent(in) :: n
-      real(wp), intent(in), dimension(column_lanes, n / column_lanes) :: lateral, u1, u2, height, sigma2, e4, shift
+      real(wp), intent(in), dimension(column_lanes, n / column_lanes) :: lateral, u1, u2, u12, height, sigma2, &
+         & e4, shift
       real(wp), intent(in) :: c12, rc2, z(:)
       real(wp), intent(out) :: values(:, :)
-      real(wp) :: acc(column_lanes, 8), w, q, inside, iq, s6, s12, f0, f1, f2, f3
+      ! (d1 = 2φ1, d2 = 4φ2, d3 = 8φ3: the derivatives as the sums want them.)
+      real(wp) :: acc(column_lanes, 10), w, q, inside, e, iq, s6, s12, t1, t2, d1, d2, d3
+      real(wp) :: total(10)
       integer :: k, c, l, m
 
       do k = 1, size(z)
@@ -64,26 +68,33 @@ contains
                w = z(k) - height(l, c)
                q = lateral(l, c) + w * w
                inside = merge(1.0_wp, 0.0_wp, q < rc2)
+               e = inside * e4(l, c)
                iq = 1.0_wp / q
                s6 = (sigma2(l, c) * iq)**3
                s12 = s6 * s6
-               f0 = inside * (e4(l, c) * (s12 - s6) - shift(l, c))
-               f1 = inside * e4(l, c) * (-6.0_wp * s12 + 3.0_wp * s6) * iq
-               f2 = inside * e4(l, c) * (42.0_wp * s12 - 12.0_wp * s6) * iq * iq
-               f3 = inside * e4(l, c) * (-336.0_wp * s12 + 60.0_wp * s6) * iq * iq * iq
-               acc(l, 1) = acc(l, 1) + f0
-               acc(l, 2) = acc(l, 2) + 2.0_wp * f1 * u1(l, c)
-               acc(l, 3) = acc(l, 3) + 2.0_wp * f1 * u2(l, c)
-               acc(l, 4) = acc(l, 4) + 2.0_wp * f1 * w
-               acc(l, 5) = acc(l, 5) + 4.0_wp * f2 * u1(l, c) * u2(l, c) + 2.0_wp * f1 * c12
-               acc(l, 6) = acc(l, 6) + 4.0_wp * f2 * u1(l, c) * w
-               acc(l, 7) = acc(l, 7) + 4.0_wp * f2 * u2(l, c) * w
-               acc(l, 8) = acc(l, 8) + (8.0_wp * f3 * u1(l, c) * u2(l, c) + 4.0_wp * f2 * c12) * w
+               t1 = e * iq
+               t2 = t1 * iq
+               d1 = t1 * (6.0_wp * s6 - 12.0_wp * s12)
+               d2 = t2 * (168.0_wp * s12 - 48.0_wp * s6)
+               d3 = t2 * iq * (480.0_wp * s6 - 2688.0_wp * s12)
+               acc(l, 1) = acc(l, 1) + (e * (s12 - s6) - inside * shift(l, c))
+               acc(l, 2) = acc(l, 2) + d1 * u1(l, c)
+               acc(l, 3) = acc(l, 3) + d1 * u2(l, c)
+               acc(l, 4) = acc(l, 4) + d1 * w
+               acc(l, 5) = acc(l, 5) + d2 * u12(l, c)
+               acc(l, 6) = acc(l, 6) + d2 * w * u1(l, c)
+               acc(l, 7) = acc(l, 7) + d2 * w * u2(l, c)
+               acc(l, 8) = acc(l, 8) + d3 * w * u12(l, c)
+               acc(l, 9) = acc(l, 9) + d1
+               acc(l, 10) = acc(l, 10) + d2 * w
             end do
          end do
-         do m = 1, 8
-            values(m, k) = (acc(1, m) + acc(2, m)) + (acc(3, m) + acc(4, m))
+         do m = 1, 10
+            total(m) = (acc(1, m) + acc(2, m)) + (acc(3, m) + acc(4, m))
          end do
+         values(:, k) = total(1:8)
+         values(5, k) = total(5) + c12 * total(9)
+         values(8, k) = total(8) + c12 * total(10)
       end do
    end subroutine column_sums
 
