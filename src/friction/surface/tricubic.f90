@@ -198,9 +198,7 @@ contains
    pure subroutine set_polynomials(self, inversion, swap)
       class(tricubic_grid), intent(inout) :: self
       logical, intent(in), optional :: inversion, swap
-      real(wp) :: c(4, 4, 4)
-      real(wp) :: w
-      integer :: i, j, k, a, b, op, n, m, there(2), first
+      integer :: i, j, k, op, n, m, there(2), first
       logical :: used(3)
 
       n = self%nx - 1
@@ -244,24 +242,7 @@ contains
          do j = 0, m - 1
             do i = 0, n - 1
                if (self%image(i, j) /= 0) cycle
-               c = hermite_data(self, i, j, k)
-               w = self%z(k + 1) - self%z(k)
-               do b = 1, 4
-                  do a = 1, 4
-                     call to_power(c(1, a, b), c(2, a, b), c(3, a, b), c(4, a, b), self%hx)
-                  end do
-               end do
-               do b = 1, 4
-                  do a = 1, 4
-                     call to_power(c(a, 1, b), c(a, 2, b), c(a, 3, b), c(a, 4, b), self%hy)
-                  end do
-               end do
-               do b = 1, 4
-                  do a = 1, 4
-                     call to_power(c(a, b, 1), c(a, b, 2), c(a, b, 3), c(a, b, 4), w)
-                  end do
-               end do
-               self%cell(:, self%slot(i, j) + self%slots * (k - 1)) = reshape(c, [n_cell_coefficients])
+               call cell_power(self, i, j, k, self%cell(:, self%slot(i, j) + self%slots * (k - 1)))
             end do
          end do
       end do
@@ -286,22 +267,43 @@ contains
 
    end subroutine set_polynomials
 
-   !> The cubic Hermite data (f0, f1, d0, d1) on an interval of width w
-   !> replaced by the power-basis coefficients (p0, p1, p2, p3) of the same
-   !> cubic (set_polynomials).
-   elemental subroutine to_power(f0, f1, d0, d1, w)
-      real(wp), intent(inout) :: f0, f1, d0, d1
-      real(wp), intent(in) :: w
-      real(wp) :: v0, v1, s0, s1
+   !> The polynomial of cell (i, j, k) (0-based lower corner in x and y, k
+   !> the layer below) in the power basis, c(1 + l + 4m + 16n) the
+   !> coefficient of ξ^l η^m ζ^n (set_polynomials): its Hermite data, then
+   !> along each axis the data (f0, f1, d0, d1) of the 16 cubics replaced by
+   !> their coefficients (p0, p1, p2, p3), p0 = f0, p1 = w d0,
+   !> p2 = 3 (f1 - f0) - 2 w d0 - w d1, p3 = 2 (f0 - f1) + w d0 + w d1.
+   pure subroutine cell_power(self, i, j, k, c)
+      type(tricubic_grid), intent(in) :: self
+      integer, intent(in) :: i, j, k
+      real(wp), intent(out) :: c(4, 4, 4)
+      real(wp), dimension(4, 4) :: v0, v1, s0, s1
 
-      v0 = f0
-      v1 = f1
-      s0 = w * d0
-      s1 = w * d1
-      f1 = s0
-      d0 = 3.0_wp * (v1 - v0) - 2.0_wp * s0 - s1
-      d1 = 2.0_wp * (v0 - v1) + s0 + s1
-   end subroutine to_power
+      c = hermite_data(self, i, j, k)
+      v0 = c(1, :, :)
+      v1 = c(2, :, :)
+      s0 = self%hx * c(3, :, :)
+      s1 = self%hx * c(4, :, :)
+      c(2, :, :) = s0
+      c(3, :, :) = 3.0_wp * (v1 - v0) - 2.0_wp * s0 - s1
+      c(4, :, :) = 2.0_wp * (v0 - v1) + s0 + s1
+      v0 = c(:, 1, :)
+      v1 = c(:, 2, :)
+      s0 = self%hy * c(:, 3, :)
+      s1 = self%hy * c(:, 4, :)
+      c(:, 2, :) = s0
+      c(:, 3, :) = 3.0_wp * (v1 - v0) - 2.0_wp * s0 - s1
+      c(:, 4, :) = 2.0_wp * (v0 - v1) + s0 + s1
+      associate (w => self%z(k + 1) - self%z(k))
+         v0 = c(:, :, 1)
+         v1 = c(:, :, 2)
+         s0 = w * c(:, :, 3)
+         s1 = w * c(:, :, 4)
+      end associate
+      c(:, :, 2) = s0
+      c(:, :, 3) = 3.0_wp * (v1 - v0) - 2.0_wp * s0 - s1
+      c(:, :, 4) = 2.0_wp * (v0 - v1) + s0 + s1
+   end subroutine cell_power
 
    !> The value v, gradient g (order >= 1) and Hessian h (order 2; else
    !> zero) at local coordinates (ξ, η, ζ) = (px, py, z) of a cell whose
