@@ -20,7 +20,8 @@ module TABLE_KERNELS
    implicit none
    private
 
-   public :: column_sums, difference_terms, power_polynomial, n_cell_coefficients, column_lanes
+   public :: column_sums, difference_terms, power_polynomial, power_gradient, image_point, n_cell_coefficients, &
+      & column_lanes
 
    !> Coefficients of a cell's polynomial (power_polynomial; the cells of
    !> friction_surface_tricubic's set_polynomials).
@@ -143,26 +144,17 @@ contains
       real(wp) :: a0(16), a1(16), a2(16), b00(4), b10(4), b01(4), b20(4), b11(4), b02(4)
       integer :: l
 
-      a0 = c(1:16) + z * (c(17:32) + z * (c(33:48) + z * c(49:64)))
       h = 0.0_wp
       g = 0.0_wp
       if (order < 1) then
+         a0 = c(1:16) + z * (c(17:32) + z * (c(33:48) + z * c(49:64)))
          do l = 1, 4
             b00(l) = a0(l) + y * (a0(l + 4) + y * (a0(l + 8) + y * a0(l + 12)))
          end do
          v = b00(1) + x * (b00(2) + x * (b00(3) + x * b00(4)))
          return
       end if
-      a1 = c(17:32) + z * (2.0_wp * c(33:48) + 3.0_wp * z * c(49:64))
-      do l = 1, 4
-         b00(l) = a0(l) + y * (a0(l + 4) + y * (a0(l + 8) + y * a0(l + 12)))
-         b10(l) = a0(l + 4) + y * (2.0_wp * a0(l + 8) + 3.0_wp * y * a0(l + 12))
-         b01(l) = a1(l) + y * (a1(l + 4) + y * (a1(l + 8) + y * a1(l + 12)))
-      end do
-      v = b00(1) + x * (b00(2) + x * (b00(3) + x * b00(4)))
-      g(1) = (b00(2) + x * (2.0_wp * b00(3) + 3.0_wp * x * b00(4))) * inverse(1)
-      g(2) = (b10(1) + x * (b10(2) + x * (b10(3) + x * b10(4)))) * inverse(2)
-      g(3) = (b01(1) + x * (b01(2) + x * (b01(3) + x * b01(4)))) * inverse(3)
+      call horner_gradient(c, x, y, z, inverse(1), inverse(2), inverse(3), a0, a1, b00, b10, b01, v, g)
       if (order < 2) return
       a2 = 2.0_wp * c(33:48) + 6.0_wp * z * c(49:64)
       do l = 1, 4
@@ -180,5 +172,77 @@ contains
       h(3, 1) = h(1, 3)
       h(3, 2) = h(2, 3)
    end subroutine power_polynomial
+
+   !> The value v and gradient g of the cell's polynomial c (power_polynomial,
+   !> order 1; ix, iy, iz the reciprocal widths), and the partial contractions
+   !> the Hessian goes on from.
+   pure subroutine horner_gradient(c, x, y, z, ix, iy, iz, a0, a1, b00, b10, b01, v, g)
+      real(wp), intent(in) :: c(n_cell_coefficients), x, y, z, ix, iy, iz
+      real(wp), intent(out) :: a0(16), a1(16), b00(4), b10(4), b01(4), v, g(3)
+      integer :: l
+
+      a0 = c(1:16) + z * (c(17:32) + z * (c(33:48) + z * c(49:64)))
+      a1 = c(17:32) + z * (2.0_wp * c(33:48) + 3.0_wp * z * c(49:64))
+      do l = 1, 4
+         b00(l) = a0(l) + y * (a0(l + 4) + y * (a0(l + 8) + y * a0(l + 12)))
+         b10(l) = a0(l + 4) + y * (2.0_wp * a0(l + 8) + 3.0_wp * y * a0(l + 12))
+         b01(l) = a1(l) + y * (a1(l + 4) + y * (a1(l + 8) + y * a1(l + 12)))
+      end do
+      v = b00(1) + x * (b00(2) + x * (b00(3) + x * b00(4)))
+      g(1) = (b00(2) + x * (2.0_wp * b00(3) + 3.0_wp * x * b00(4))) * ix
+      g(2) = (b10(1) + x * (b10(2) + x * (b10(3) + x * b10(4)))) * iy
+      g(3) = (b01(1) + x * (b01(2) + x * (b01(3) + x * b01(4)))) * iz
+   end subroutine horner_gradient
+
+   !> The point (x, y) of a cell's local coordinates (px, py) under the map
+   !> `op` that takes a cell to the one whose polynomial it shares (0 none,
+   !> 1 the reflection: (1 - ξ, 1 - η), 2 the swap: (η, ξ), 3 both:
+   !> (1 - η, 1 - ξ); friction_surface_tricubic's set_polynomials).
+   pure subroutine image_point(op, px, py, x, y)
+      integer, intent(in) :: op
+      real(wp), intent(in) :: px, py
+      real(wp), intent(out) :: x, y
+
+      select case (op)
+      case (0)
+         x = px
+         y = py
+      case (1)
+         x = 1.0_wp - px
+         y = 1.0_wp - py
+      case (2)
+         x = py
+         y = px
+      case default
+         x = 1.0_wp - py
+         y = 1.0_wp - px
+      end select
+   end subroutine image_point
+
+   !> The value v and gradient g (no Hessian: the table's hot path) of a cell
+   !> whose polynomial is c at the image point under `op` (image_point), at
+   !> local coordinates (px, py, z); the lateral gradient mapped back (odd
+   !> under the reflection, trading places under the swap).  The same
+   !> operations as power_polynomial's order 1, so the same bits.
+   pure subroutine power_gradient(c, op, px, py, z, ix, iy, iz, v, g)
+      real(wp), intent(in) :: c(n_cell_coefficients), px, py, z, ix, iy, iz
+      integer, intent(in) :: op
+      real(wp), intent(out) :: v, g(3)
+      real(wp) :: a0(16), a1(16), b00(4), b10(4), b01(4), x, y, gi(3)
+
+      call image_point(op, px, py, x, y)
+      call horner_gradient(c, x, y, z, ix, iy, iz, a0, a1, b00, b10, b01, v, gi)
+      g(3) = gi(3)
+      select case (op)
+      case (0)
+         g(1:2) = gi(1:2)
+      case (1)
+         g(1:2) = -gi(1:2)
+      case (2)
+         g(1:2) = [gi(2), gi(1)]
+      case default
+         g(1:2) = -[gi(2), gi(1)]
+      end select
+   end subroutine power_gradient
 
 end module TABLE_KERNELS

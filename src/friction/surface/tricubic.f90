@@ -32,8 +32,9 @@
 !> error is about ten times larger at the same spacing.
 module friction_surface_tricubic
    use friction_kinds, only: wp
-   use friction_surface_table_kernels, only: power_polynomial, n_cell_coefficients
-   use friction_surface_table_kernels_wide, only: power_polynomial_wide => power_polynomial
+   use friction_surface_table_kernels, only: power_polynomial, power_gradient, image_point, n_cell_coefficients
+   use friction_surface_table_kernels_wide, only: power_polynomial_wide => power_polynomial, &
+      & power_gradient_wide => power_gradient
    implicit none
    private
 
@@ -70,6 +71,7 @@ module friction_surface_tricubic
       logical :: wide = .false.
    contains
       procedure :: evaluate
+      procedure :: value_gradient_at
       procedure :: set_polynomials
       procedure :: layer_below
       procedure :: bytes
@@ -183,6 +185,32 @@ contains
          call with_hessian(self, i, j, k, bx, by, bz, v, g, h)
       end if
    end subroutine evaluate
+
+   !> The interpolant's value v and gradient g at (x, y, z) through the
+   !> cells' polynomials, which must be set (set_polynomials): evaluate's
+   !> order 1, the same bits, without its Hessian (the table's hot path).
+   pure subroutine value_gradient_at(self, x, y, z, v, g)
+      class(tricubic_grid), intent(in) :: self
+      real(wp), intent(in) :: x, y, z
+      real(wp), intent(out) :: v, g(3)
+      real(wp) :: s, t
+      integer :: i, j, k
+
+      s = (x - self%x0) * self%inverse_hx
+      t = (y - self%y0) * self%inverse_hy
+      i = int(min(real(self%nx - 2, wp), max(0.0_wp, s)))
+      j = int(min(real(self%ny - 2, wp), max(0.0_wp, t)))
+      k = find_layer(self, z)
+      associate (c => self%cell(:, self%slot(i, j) + self%slots * (k - 1)), op => self%image(i, j), &
+         & zeta => (z - self%z(k)) * self%inverse_dz(k))
+         if (self%wide) then
+            call power_gradient_wide(c, op, s - i, t - j, zeta, self%inverse_hx, self%inverse_hy, &
+               & self%inverse_dz(k), v, g)
+         else
+            call power_gradient(c, op, s - i, t - j, zeta, self%inverse_hx, self%inverse_hy, self%inverse_dz(k), v, g)
+         end if
+      end associate
+   end subroutine value_gradient_at
 
    !> Each cell's polynomial in the power basis of its local coordinates
    !> (the component `cell`), from the nodes' values, which must be set;
@@ -320,20 +348,7 @@ contains
       real(wp), intent(out) :: v, g(3), h(3, 3)
       real(wp) :: x, y
 
-      select case (op)
-      case (0)
-         x = px
-         y = py
-      case (1)
-         x = 1.0_wp - px
-         y = 1.0_wp - py
-      case (2)
-         x = py
-         y = px
-      case default
-         x = 1.0_wp - py
-         y = 1.0_wp - px
-      end select
+      call image_point(op, px, py, x, y)
       if (wide) then
          call power_polynomial_wide(c, x, y, z, inverse, order, v, g, h)
       else
