@@ -311,32 +311,47 @@ contains
       real(wp), intent(in) :: r(3)
       logical, intent(out) :: answered
       real(wp), intent(out) :: g(3)
-      real(wp) :: s1, s2, v, gs(3), h(3, 3)
+      real(wp) :: s(2), v, gs(3), h(3, 3)
 
       g = 0.0_wp
       associate (t => self%table)
          answered = r(3) >= t%ceiling
-         if (answered) return
-         if (r(3) < t%floor .or. r(1) < t%box(1) .or. r(1) > t%box(2) .or. r(2) < t%box(3) &
-            & .or. r(2) > t%box(4)) return
+         if (answered .or. .not. table_holds(t, r)) return
          v = 0.0_wp
          if (r(3) < t%top) then
-            associate (m => t%to_fraction)
-               s1 = m(1, 1) * r(1) + m(1, 2) * r(2)
-               s2 = m(2, 1) * r(1) + m(2, 2) * r(2)
-               s1 = s1 - floor(s1)
-               s2 = s2 - floor(s2)
-               call t%grid%value_gradient_at(s1, s2, r(3), v, gs)
-               if (v > t%energy_cap) return
-               g(1) = m(1, 1) * gs(1) + m(2, 1) * gs(2)
-               g(2) = m(1, 2) * gs(1) + m(2, 2) * gs(2)
-               g(3) = gs(3)
-            end associate
+            s = cell_fraction(t, r)
+            call t%grid%value_gradient_at(s(1), s(2), r(3), v, gs)
+            if (v > t%energy_cap) return
+            g = from_fraction(t, gs)
          end if
          answered = .true.
          call difference_sums(self, r, 1, v, g, h)
       end associate
    end subroutine table_gradient
+
+   !> Whether r lies between the table's floor and its ceiling and within
+   !> its box (elsewhere the direct sum answers).
+   pure logical function table_holds(t, r)
+      type(lj_table), intent(in) :: t
+      real(wp), intent(in) :: r(3)
+
+      table_holds = .not. (r(3) < t%floor .or. r(1) < t%box(1) .or. r(1) > t%box(2) .or. r(2) < t%box(3) &
+         & .or. r(2) > t%box(4))
+   end function table_holds
+
+   !> The fractional coordinates in [0, 1) of r's position in the plane
+   !> within the lattice's cell.
+   pure function cell_fraction(t, r) result(s)
+      type(lj_table), intent(in) :: t
+      real(wp), intent(in) :: r(3)
+      real(wp) :: s(2)
+
+      associate (m => t%to_fraction)
+         s(1) = m(1, 1) * r(1) + m(1, 2) * r(2)
+         s(2) = m(2, 1) * r(1) + m(2, 2) * r(2)
+      end associate
+      s = s - floor(s)
+   end function cell_fraction
 
    pure subroutine hessian(self, r, h)
       class(lj_potential), intent(in) :: self
@@ -445,23 +460,14 @@ contains
       h = 0.0_wp
       associate (t => self%table)
          answered = r(3) >= t%ceiling
-         if (answered) return
-         if (r(3) < t%floor .or. r(1) < t%box(1) .or. r(1) > t%box(2) .or. r(2) < t%box(3) &
-            & .or. r(2) > t%box(4)) return
+         if (answered .or. .not. table_holds(t, r)) return
          if (r(3) < t%top) then
             m = t%to_fraction
-            s(1) = m(1, 1) * r(1) + m(1, 2) * r(2)
-            s(2) = m(2, 1) * r(1) + m(2, 2) * r(2)
-            s = s - floor(s)
+            s = cell_fraction(t, r)
             ! (order 0: the energy alone; the cap needs it in any case)
             call t%grid%evaluate([s(1), s(2), r(3)], order, v, gs, hs)
             if (v > t%energy_cap) return
-            if (order >= 1) then
-               ! dV/dx_j = Σ_i dV/ds_i M_ij: the gradient is Mᵀ g_s.
-               g(1) = m(1, 1) * gs(1) + m(2, 1) * gs(2)
-               g(2) = m(1, 2) * gs(1) + m(2, 2) * gs(2)
-               g(3) = gs(3)
-            end if
+            if (order >= 1) g = from_fraction(t, gs)
             if (order >= 2) then
                h(1:2, 1:2) = matmul(transpose(m), matmul(hs(1:2, 1:2), m))
                h(1:2, 3) = matmul(transpose(m), hs(1:2, 3))
@@ -970,10 +976,21 @@ contains
       real(wp), intent(in) :: values(n_node_values)
       real(wp) :: g(3)
 
-      g(1) = t%to_fraction(1, 1) * values(2) + t%to_fraction(2, 1) * values(3)
-      g(2) = t%to_fraction(1, 2) * values(2) + t%to_fraction(2, 2) * values(3)
-      g(3) = values(4)
+      g = from_fraction(t, values(2:4))
    end function cartesian_gradient
+
+   !> The Cartesian gradient from gs = (V_s1, V_s2, V_z), the gradient in
+   !> the lattice's fractional coordinates: dV/dx_j = Σ_i dV/ds_i M_ij, Mᵀ gs
+   !> in the plane (M = to_fraction).
+   pure function from_fraction(t, gs) result(g)
+      type(lj_table), intent(in) :: t
+      real(wp), intent(in) :: gs(3)
+      real(wp) :: g(3)
+
+      g(1) = t%to_fraction(1, 1) * gs(1) + t%to_fraction(2, 1) * gs(2)
+      g(2) = t%to_fraction(1, 2) * gs(1) + t%to_fraction(2, 2) * gs(2)
+      g(3) = gs(3)
+   end function from_fraction
 
    !> Step 2 of `tabulate`: the heights of the layers, ascending, and the
    !> lowest energy of the lattice met (at the check columns' nodes).  The
