@@ -611,7 +611,8 @@ contains
       ! The surface table's cost, which the file leaves out (it is a timing).
       if (self%three_d .and. allocated(self%surface%evaluation%evaluation)) then
          if (self%surface%evaluation%evaluation == 'table') then
-            write (seconds, '(f12.2)') self%surface%evaluation%build_time
+            ! (Milliseconds: a build takes tens of them.)
+            write (seconds, '(f12.3)') self%surface%evaluation%build_time
             text = text//'; surface table '//bytes_text(self%surface%evaluation%bytes)//', built in ' &
                & //trim(adjustl(seconds))//' s'
          end if
