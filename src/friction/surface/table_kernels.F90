@@ -20,8 +20,8 @@ module TABLE_KERNELS
    implicit none
    private
 
-   public :: column_sums, difference_terms, power_polynomial, power_gradient, image_point, n_cell_coefficients, &
-      & column_lanes
+   public :: column_sums, difference_terms, power_polynomial, power_gradient, image_point, lateral_back, &
+      & n_cell_coefficients, column_lanes
 
    !> Coefficients of a cell's polynomial (power_polynomial; the cells of
    !> friction_surface_tricubic's set_polynomials).
@@ -228,21 +228,23 @@ contains
       real(wp), intent(in) :: c(n_cell_coefficients), px, py, z, ix, iy, iz
       integer, intent(in) :: op
       real(wp), intent(out) :: v, g(3)
-      real(wp) :: a0(16), a1(16), b00(4), b10(4), b01(4), x, y, gi(3)
+      real(wp) :: a0(16), a1(16), b00(4), b10(4), b01(4), x, y
 
       call image_point(op, px, py, x, y)
-      call horner_gradient(c, x, y, z, ix, iy, iz, a0, a1, b00, b10, b01, v, gi)
-      g(3) = gi(3)
-      select case (op)
-      case (0)
-         g(1:2) = gi(1:2)
-      case (1)
-         g(1:2) = -gi(1:2)
-      case (2)
-         g(1:2) = [gi(2), gi(1)]
-      case default
-         g(1:2) = -[gi(2), gi(1)]
-      end select
+      call horner_gradient(c, x, y, z, ix, iy, iz, a0, a1, b00, b10, b01, v, g)
+      call lateral_back(op, g)
    end subroutine power_gradient
+
+   !> The lateral gradient g(1:2) taken at a cell's image point under `op`
+   !> (image_point) mapped back to the cell: odd under the reflection, its
+   !> components trading places under the swap.
+   pure subroutine lateral_back(op, g)
+      integer, intent(in) :: op
+      real(wp), intent(inout) :: g(3)
+
+      if (op == 0) return
+      if (op /= 1) g(1:2) = [g(2), g(1)]
+      if (op /= 2) g(1:2) = -g(1:2)
+   end subroutine lateral_back
 
 end module TABLE_KERNELS

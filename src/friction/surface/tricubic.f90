@@ -32,7 +32,8 @@
 !> error is about ten times larger at the same spacing.
 module friction_surface_tricubic
    use friction_kinds, only: wp
-   use friction_surface_table_kernels, only: power_polynomial, power_gradient, image_point, n_cell_coefficients
+   use friction_surface_table_kernels, only: power_polynomial, power_gradient, image_point, lateral_back, &
+      & n_cell_coefficients
    use friction_surface_table_kernels_wide, only: power_polynomial_wide => power_polynomial, &
       & power_gradient_wide => power_gradient
    implicit none
@@ -298,40 +299,35 @@ contains
    !> The polynomial of cell (i, j, k) (0-based lower corner in x and y, k
    !> the layer below) in the power basis, c(1 + l + 4m + 16n) the
    !> coefficient of ξ^l η^m ζ^n (set_polynomials): its Hermite data, then
-   !> along each axis the data (f0, f1, d0, d1) of the 16 cubics replaced by
-   !> their coefficients (p0, p1, p2, p3), p0 = f0, p1 = w d0,
-   !> p2 = 3 (f1 - f0) - 2 w d0 - w d1, p3 = 2 (f0 - f1) + w d0 + w d1.
+   !> along each axis the 16 cubics' data turned into coefficients (to_power).
    pure subroutine cell_power(self, i, j, k, c)
       type(tricubic_grid), intent(in) :: self
       integer, intent(in) :: i, j, k
       real(wp), intent(out) :: c(4, 4, 4)
-      real(wp), dimension(4, 4) :: v0, v1, s0, s1
 
       c = hermite_data(self, i, j, k)
-      v0 = c(1, :, :)
-      v1 = c(2, :, :)
-      s0 = self%hx * c(3, :, :)
-      s1 = self%hx * c(4, :, :)
-      c(2, :, :) = s0
-      c(3, :, :) = 3.0_wp * (v1 - v0) - 2.0_wp * s0 - s1
-      c(4, :, :) = 2.0_wp * (v0 - v1) + s0 + s1
-      v0 = c(:, 1, :)
-      v1 = c(:, 2, :)
-      s0 = self%hy * c(:, 3, :)
-      s1 = self%hy * c(:, 4, :)
-      c(:, 2, :) = s0
-      c(:, 3, :) = 3.0_wp * (v1 - v0) - 2.0_wp * s0 - s1
-      c(:, 4, :) = 2.0_wp * (v0 - v1) + s0 + s1
-      associate (w => self%z(k + 1) - self%z(k))
-         v0 = c(:, :, 1)
-         v1 = c(:, :, 2)
-         s0 = w * c(:, :, 3)
-         s1 = w * c(:, :, 4)
-      end associate
-      c(:, :, 2) = s0
-      c(:, :, 3) = 3.0_wp * (v1 - v0) - 2.0_wp * s0 - s1
-      c(:, :, 4) = 2.0_wp * (v0 - v1) + s0 + s1
+      call to_power(c(1, :, :), c(2, :, :), c(3, :, :), c(4, :, :), self%hx)
+      call to_power(c(:, 1, :), c(:, 2, :), c(:, 3, :), c(:, 4, :), self%hy)
+      call to_power(c(:, :, 1), c(:, :, 2), c(:, :, 3), c(:, :, 4), self%z(k + 1) - self%z(k))
    end subroutine cell_power
+
+   !> The cubic Hermite data (f0, f1, d0, d1) on an interval of width w
+   !> replaced by the power-basis coefficients (p0, p1, p2, p3) of the same
+   !> cubic: p0 = f0, p1 = w d0, p2 = 3 (f1 - f0) - 2 w d0 - w d1,
+   !> p3 = 2 (f0 - f1) + w d0 + w d1.
+   elemental subroutine to_power(f0, f1, d0, d1, w)
+      real(wp), intent(inout) :: f0, f1, d0, d1
+      real(wp), intent(in) :: w
+      real(wp) :: v0, v1, s0, s1
+
+      v0 = f0
+      v1 = f1
+      s0 = w * d0
+      s1 = w * d1
+      f1 = s0
+      d0 = 3.0_wp * (v1 - v0) - 2.0_wp * s0 - s1
+      d1 = 2.0_wp * (v0 - v1) + s0 + s1
+   end subroutine to_power
 
    !> The value v, gradient g (order >= 1) and Hessian h (order 2; else
    !> zero) at local coordinates (ξ, η, ζ) = (px, py, z) of a cell whose
@@ -354,17 +350,12 @@ contains
       else
          call power_polynomial(c, x, y, z, inverse, order, v, g, h)
       end if
-      if (op == 0) return
-      if (op /= 1) then
-         g(1:2) = [g(2), g(1)]
-         if (order >= 2) h = h([2, 1, 3], [2, 1, 3])
-      end if
+      call lateral_back(op, g)
+      if (order < 2 .or. op == 0) return
+      if (op /= 1) h = h([2, 1, 3], [2, 1, 3])
       if (op /= 2) then
-         g(1:2) = -g(1:2)
-         if (order >= 2) then
-            h(1:2, 3) = -h(1:2, 3)
-            h(3, 1:2) = -h(3, 1:2)
-         end if
+         h(1:2, 3) = -h(1:2, 3)
+         h(3, 1:2) = -h(3, 1:2)
       end if
    end subroutine cell_polynomial
 
