@@ -21,8 +21,10 @@ module friction_surface_lennard_jones
    use friction_surface_potential, only: surface_potential
    use friction_surface_net, only: crystal_net, net_lattice
    use friction_surface_tricubic, only: tricubic_grid, new_tricubic_grid, n_node_values
-   use friction_surface_table_kernels, only: column_sums, difference_terms, column_lanes
-   use friction_surface_table_kernels_wide, only: column_sums_wide => column_sums
+   use friction_surface_table_kernels, only: column_sums, difference_terms, column_lanes, lattice_gradient, &
+      & cell_fraction, from_fraction
+   use friction_surface_table_kernels_wide, only: column_sums_wide => column_sums, &
+      & lattice_gradient_wide => lattice_gradient
    use friction_strings, only: rtoa, itoa
    use friction_sharing, only: work_sharing
    use, intrinsic :: iso_c_binding, only: c_int
@@ -60,7 +62,7 @@ module friction_surface_lennard_jones
       ! 4εw and φ(r_c)w.
       real(wp), allocatable :: x(:), y(:), z(:), sigma2(:), e4w(:), shiftw(:)
       integer, allocatable :: start(:)
-      real(wp) :: origin(2) = 0.0_wp, cell = 1.0_wp
+      real(wp) :: origin(2) = 0.0_wp, cell = 1.0_wp, inverse_cell = 1.0_wp
       integer :: ncell(2) = 1
    end type difference_lists
 
@@ -311,7 +313,8 @@ contains
       real(wp), intent(in) :: r(3)
       logical, intent(out) :: answered
       real(wp), intent(out) :: g(3)
-      real(wp) :: s(2), v, gs(3), h(3, 3)
+      real(wp) :: v, h(3, 3)
+      integer :: c
 
       g = 0.0_wp
       associate (t => self%table)
@@ -319,13 +322,19 @@ contains
          if (answered .or. .not. table_holds(t, r)) return
          v = 0.0_wp
          if (r(3) < t%top) then
-            s = cell_fraction(t, r)
-            call t%grid%value_gradient_at(s(1), s(2), r(3), v, gs)
-            if (v > t%energy_cap) return
-            g = from_fraction(t, gs)
+            if (t%grid%wide) then
+               call lattice_gradient_wide(t%grid%cell_grid, t%to_fraction, r, v, g)
+            else
+               call lattice_gradient(t%grid%cell_grid, t%to_fraction, r, v, g)
+            end if
+            if (v > t%energy_cap) then
+               g = 0.0_wp
+               return
+            end if
          end if
          answered = .true.
-         call difference_sums(self, r, 1, v, g, h)
+         c = difference_cell(t%differences, r(1:2))
+         if (c > 0) call difference_sums(self, r, c, 1, v, g, h)
       end associate
    end subroutine table_gradient
 
@@ -338,20 +347,6 @@ contains
       table_holds = .not. (r(3) < t%floor .or. r(1) < t%box(1) .or. r(1) > t%box(2) .or. r(2) < t%box(3) &
          & .or. r(2) > t%box(4))
    end function table_holds
-
-   !> The fractional coordinates in [0, 1) of r's position in the plane
-   !> within the lattice's cell.
-   pure function cell_fraction(t, r) result(s)
-      type(lj_table), intent(in) :: t
-      real(wp), intent(in) :: r(3)
-      real(wp) :: s(2)
-
-      associate (m => t%to_fraction)
-         s(1) = m(1, 1) * r(1) + m(1, 2) * r(2)
-         s(2) = m(2, 1) * r(1) + m(2, 2) * r(2)
-      end associate
-      s = s - floor(s)
-   end function cell_fraction
 
    pure subroutine hessian(self, r, h)
       class(lj_potential), intent(in) :: self
@@ -454,6 +449,7 @@ contains
       logical, intent(out) :: answered
       real(wp), intent(out) :: v, g(3), h(3, 3)
       real(wp) :: s(2), gs(3), hs(3, 3), m(2, 2)
+      integer :: c
 
       v = 0.0_wp
       g = 0.0_wp
@@ -463,11 +459,11 @@ contains
          if (answered .or. .not. table_holds(t, r)) return
          if (r(3) < t%top) then
             m = t%to_fraction
-            s = cell_fraction(t, r)
+            s = cell_fraction(t%to_fraction, r(1:2))
             ! (order 0: the energy alone; the cap needs it in any case)
             call t%grid%evaluate([s(1), s(2), r(3)], order, v, gs, hs)
             if (v > t%energy_cap) return
-            if (order >= 1) g = from_fraction(t, gs)
+            if (order >= 1) g = from_fraction(t%to_fraction, gs)
             if (order >= 2) then
                h(1:2, 1:2) = matmul(transpose(m), matmul(hs(1:2, 1:2), m))
                h(1:2, 3) = matmul(transpose(m), hs(1:2, 3))
@@ -476,26 +472,37 @@ contains
             end if
          end if
          answered = .true.
-         call difference_sums(self, r, order, v, g, h)
+         c = difference_cell(t%differences, r(1:2))
+         if (c > 0) call difference_sums(self, r, c, order, v, g, h)
       end associate
    end subroutine table_answers
 
+   !> The list (difference_lists' cell) of the differences near xy (Å),
+   !> within the lists' region or at its edge; 0 when that list is empty.
+   pure integer function difference_cell(list, xy) result(c)
+      type(difference_lists), intent(in) :: list
+      real(wp), intent(in) :: xy(2)
+      integer :: ij(2)
+
+      ij = int(min(real(list%ncell - 1, wp), max(0.0_wp, (xy - list%origin) * list%inverse_cell)))
+      c = ij(1) + ij(2) * list%ncell(1) + 1
+      if (list%start(c + 1) == list%start(c)) c = 0
+   end function difference_cell
+
    !> Adds the pair terms of the table's differences within the cutoff of r
    !> (weight +1 an atom the lattice lacks, -1 a site the net lacks), with
-   !> energies shifted by φ(r_c) as the table's.
-   pure subroutine difference_sums(self, r, order, v, g, h)
+   !> energies shifted by φ(r_c) as the table's; c the list near r, not
+   !> empty (difference_cell).
+   pure subroutine difference_sums(self, r, c, order, v, g, h)
       class(lj_potential), intent(in) :: self
       real(wp), intent(in) :: r(3)
-      integer, intent(in) :: order
+      integer, intent(in) :: c, order
       real(wp), intent(inout) :: v, g(3), h(3, 3)
       real(wp) :: d(3), r2, rc2, s6, w, dv, dg(3)
-      integer :: ij(2), i, s, c
+      integer :: i, s
 
       rc2 = self%cutoff**2
       associate (list => self%table%differences)
-         ij = int(min(real(list%ncell - 1, wp), max(0.0_wp, (r(1:2) - list%origin) / list%cell)))
-         c = ij(1) + ij(2) * list%ncell(1) + 1
-         if (list%start(c + 1) == list%start(c)) return
          if (order < 2) then
             associate (from => list%start(c), to => list%start(c + 1) - 1)
                call difference_terms(to - from + 1, list%x(from:to), list%y(from:to), list%z(from:to), &
@@ -796,6 +803,7 @@ contains
       integer :: cx, cy, c, i, total, pass
 
       self%cell = min(2.0_wp, cutoff / 3.0_wp)
+      self%inverse_cell = 1.0_wp / self%cell
       self%origin = [region(1), region(3)]
       self%ncell = max(1, ceiling([region(2) - region(1), region(4) - region(3)] / self%cell))
       reach2 = (cutoff + self%cell / sqrt(2.0_wp))**2
@@ -830,13 +838,13 @@ contains
       type(lj_potential), intent(in) :: self
       type(lj_table), intent(in) :: t
       real(wp) :: middle(2)
-      integer :: ij(2), c, i, lo(2), hi(2), cx, cy, atoms, differences
+      integer :: c, i, lo(2), hi(2), cx, cy, atoms, differences
 
       middle = [0.5_wp * (t%box(1) + t%box(2)), 0.5_wp * (t%box(3) + t%box(4))]
       associate (list => t%differences)
-         ij = int(min(real(list%ncell - 1, wp), max(0.0_wp, (middle - list%origin) / list%cell)))
-         c = ij(1) + ij(2) * list%ncell(1) + 1
-         differences = count([(sum((list%position(1:2, i) - middle)**2) < self%cutoff**2, &
+         c = difference_cell(list, middle)
+         differences = 0
+         if (c > 0) differences = count([(sum((list%position(1:2, i) - middle)**2) < self%cutoff**2, &
             & i = list%start(c), list%start(c + 1) - 1)])
       end associate
       atoms = 0
@@ -976,21 +984,8 @@ contains
       real(wp), intent(in) :: values(n_node_values)
       real(wp) :: g(3)
 
-      g = from_fraction(t, values(2:4))
+      g = from_fraction(t%to_fraction, values(2:4))
    end function cartesian_gradient
-
-   !> The Cartesian gradient from gs = (V_s1, V_s2, V_z), the gradient in
-   !> the lattice's fractional coordinates: dV/dx_j = Σ_i dV/ds_i M_ij, Mᵀ gs
-   !> in the plane (M = to_fraction).
-   pure function from_fraction(t, gs) result(g)
-      type(lj_table), intent(in) :: t
-      real(wp), intent(in) :: gs(3)
-      real(wp) :: g(3)
-
-      g(1) = t%to_fraction(1, 1) * gs(1) + t%to_fraction(2, 1) * gs(2)
-      g(2) = t%to_fraction(1, 2) * gs(1) + t%to_fraction(2, 2) * gs(2)
-      g(3) = gs(3)
-   end function from_fraction
 
    !> Step 2 of `tabulate`: the heights of the layers, ascending, and the
    !> lowest energy of the lattice met (at the check columns' nodes).  The

@@ -17,11 +17,12 @@
 #endif
 module TABLE_KERNELS
    use friction_kinds, only: wp
+   use friction_surface_cell_grid, only: cell_grid
    implicit none
    private
 
-   public :: column_sums, difference_terms, power_polynomial, power_gradient, image_point, lateral_back, &
-      & n_cell_coefficients, column_lanes
+   public :: column_sums, difference_terms, power_polynomial, lattice_gradient, find_layer, image_point, lateral_back, &
+      & cell_fraction, from_fraction, n_cell_coefficients, column_lanes
 
    !> Coefficients of a cell's polynomial (power_polynomial; the cells of
    !> friction_surface_tricubic's set_polynomials).
@@ -134,40 +135,37 @@ contains
    !> The value v, gradient g (order >= 1) and Hessian h (order 2; else
    !> zero) of one cell's polynomial c (set_polynomials) at local
    !> coordinates (x, y, z), with inverse(:) the reciprocal cell widths:
-   !> Horner's rule along z (16 cubics at once), then y (4), then x.
+   !> the cubics along z (16 at once), then y (4), then x (`cubic`).
    pure subroutine power_polynomial(c, x, y, z, inverse, order, v, g, h)
       real(wp), intent(in) :: c(n_cell_coefficients), x, y, z, inverse(3)
       integer, intent(in) :: order
       real(wp), intent(out) :: v, g(3), h(3, 3)
       ! (aN: N-th z derivative, 16 cubics in x, y; bMN: M-th y derivative
       ! and N-th z derivative, 4 cubics in x.)
-      real(wp) :: a0(16), a1(16), a2(16), b00(4), b10(4), b01(4), b20(4), b11(4), b02(4)
-      integer :: l
+      real(wp) :: a0(16), a1(16), a2(16), b00(4), b10(4), b01(4), b20(4), b11(4), b02(4), x2, y2
 
       h = 0.0_wp
       g = 0.0_wp
       if (order < 1) then
-         a0 = c(1:16) + z * (c(17:32) + z * (c(33:48) + z * c(49:64)))
-         do l = 1, 4
-            b00(l) = a0(l) + y * (a0(l + 4) + y * (a0(l + 8) + y * a0(l + 12)))
-         end do
-         v = b00(1) + x * (b00(2) + x * (b00(3) + x * b00(4)))
+         a0 = cubic(c(1:16), c(17:32), c(33:48), c(49:64), z, z * z)
+         b00 = cubic(a0(1:4), a0(5:8), a0(9:12), a0(13:16), y, y * y)
+         v = cubic(b00(1), b00(2), b00(3), b00(4), x, x * x)
          return
       end if
-      call horner_gradient(c, x, y, z, inverse(1), inverse(2), inverse(3), a0, a1, b00, b10, b01, v, g)
+      call cell_gradient(c, x, y, z, inverse(1), inverse(2), inverse(3), a0, a1, b00, b10, b01, v, g)
       if (order < 2) return
+      x2 = x * x
+      y2 = y * y
       a2 = 2.0_wp * c(33:48) + 6.0_wp * z * c(49:64)
-      do l = 1, 4
-         b20(l) = 2.0_wp * a0(l + 8) + 6.0_wp * y * a0(l + 12)
-         b11(l) = a1(l + 4) + y * (2.0_wp * a1(l + 8) + 3.0_wp * y * a1(l + 12))
-         b02(l) = a2(l) + y * (a2(l + 4) + y * (a2(l + 8) + y * a2(l + 12)))
-      end do
+      b20 = 2.0_wp * a0(9:12) + 6.0_wp * y * a0(13:16)
+      b11 = cubic_slope(a1(5:8), a1(9:12), a1(13:16), y, y2)
+      b02 = cubic(a2(1:4), a2(5:8), a2(9:12), a2(13:16), y, y2)
       h(1, 1) = (2.0_wp * b00(3) + 6.0_wp * x * b00(4)) * inverse(1)**2
-      h(2, 2) = (b20(1) + x * (b20(2) + x * (b20(3) + x * b20(4)))) * inverse(2)**2
-      h(3, 3) = (b02(1) + x * (b02(2) + x * (b02(3) + x * b02(4)))) * inverse(3)**2
-      h(1, 2) = (b10(2) + x * (2.0_wp * b10(3) + 3.0_wp * x * b10(4))) * inverse(1) * inverse(2)
-      h(1, 3) = (b01(2) + x * (2.0_wp * b01(3) + 3.0_wp * x * b01(4))) * inverse(1) * inverse(3)
-      h(2, 3) = (b11(1) + x * (b11(2) + x * (b11(3) + x * b11(4)))) * inverse(2) * inverse(3)
+      h(2, 2) = cubic(b20(1), b20(2), b20(3), b20(4), x, x2) * inverse(2)**2
+      h(3, 3) = cubic(b02(1), b02(2), b02(3), b02(4), x, x2) * inverse(3)**2
+      h(1, 2) = cubic_slope(b10(2), b10(3), b10(4), x, x2) * inverse(1) * inverse(2)
+      h(1, 3) = cubic_slope(b01(2), b01(3), b01(4), x, x2) * inverse(1) * inverse(3)
+      h(2, 3) = cubic(b11(1), b11(2), b11(3), b11(4), x, x2) * inverse(2) * inverse(3)
       h(2, 1) = h(1, 2)
       h(3, 1) = h(1, 3)
       h(3, 2) = h(2, 3)
@@ -176,23 +174,39 @@ contains
    !> The value v and gradient g of the cell's polynomial c (power_polynomial,
    !> order 1; ix, iy, iz the reciprocal widths), and the partial contractions
    !> the Hessian goes on from.
-   pure subroutine horner_gradient(c, x, y, z, ix, iy, iz, a0, a1, b00, b10, b01, v, g)
+   pure subroutine cell_gradient(c, x, y, z, ix, iy, iz, a0, a1, b00, b10, b01, v, g)
       real(wp), intent(in) :: c(n_cell_coefficients), x, y, z, ix, iy, iz
       real(wp), intent(out) :: a0(16), a1(16), b00(4), b10(4), b01(4), v, g(3)
-      integer :: l
+      real(wp) :: x2, y2, z2
 
-      a0 = c(1:16) + z * (c(17:32) + z * (c(33:48) + z * c(49:64)))
-      a1 = c(17:32) + z * (2.0_wp * c(33:48) + 3.0_wp * z * c(49:64))
-      do l = 1, 4
-         b00(l) = a0(l) + y * (a0(l + 4) + y * (a0(l + 8) + y * a0(l + 12)))
-         b10(l) = a0(l + 4) + y * (2.0_wp * a0(l + 8) + 3.0_wp * y * a0(l + 12))
-         b01(l) = a1(l) + y * (a1(l + 4) + y * (a1(l + 8) + y * a1(l + 12)))
-      end do
-      v = b00(1) + x * (b00(2) + x * (b00(3) + x * b00(4)))
-      g(1) = (b00(2) + x * (2.0_wp * b00(3) + 3.0_wp * x * b00(4))) * ix
-      g(2) = (b10(1) + x * (b10(2) + x * (b10(3) + x * b10(4)))) * iy
-      g(3) = (b01(1) + x * (b01(2) + x * (b01(3) + x * b01(4)))) * iz
-   end subroutine horner_gradient
+      x2 = x * x
+      y2 = y * y
+      z2 = z * z
+      a0 = cubic(c(1:16), c(17:32), c(33:48), c(49:64), z, z2)
+      a1 = cubic_slope(c(17:32), c(33:48), c(49:64), z, z2)
+      b00 = cubic(a0(1:4), a0(5:8), a0(9:12), a0(13:16), y, y2)
+      b10 = cubic_slope(a0(5:8), a0(9:12), a0(13:16), y, y2)
+      b01 = cubic(a1(1:4), a1(5:8), a1(9:12), a1(13:16), y, y2)
+      v = cubic(b00(1), b00(2), b00(3), b00(4), x, x2)
+      g(1) = cubic_slope(b00(2), b00(3), b00(4), x, x2) * ix
+      g(2) = cubic(b10(1), b10(2), b10(3), b10(4), x, x2) * iy
+      g(3) = cubic(b01(1), b01(2), b01(3), b01(4), x, x2) * iz
+   end subroutine cell_gradient
+
+   !> The cubic c0 + c1 x + c2 x² + c3 x³ by Horner's rule (x2 = x², not
+   !> needed here).
+   pure elemental real(wp) function cubic(c0, c1, c2, c3, x, x2)
+      real(wp), intent(in) :: c0, c1, c2, c3, x, x2
+
+      cubic = c0 + x * (c1 + x * (c2 + x * c3))
+   end function cubic
+
+   !> The cubic's derivative c1 + 2 c2 x + 3 c3 x² (`cubic`).
+   pure elemental real(wp) function cubic_slope(c1, c2, c3, x, x2)
+      real(wp), intent(in) :: c1, c2, c3, x, x2
+
+      cubic_slope = c1 + x * (2.0_wp * c2 + 3.0_wp * x * c3)
+   end function cubic_slope
 
    !> The point (x, y) of a cell's local coordinates (px, py) under the map
    !> `op` that takes a cell to the one whose polynomial it shares (0 none,
@@ -219,21 +233,93 @@ contains
       end select
    end subroutine image_point
 
-   !> The value v and gradient g (no Hessian: the table's hot path) of a cell
-   !> whose polynomial is c at the image point under `op` (image_point), at
-   !> local coordinates (px, py, z); the lateral gradient mapped back (odd
-   !> under the reflection, trading places under the swap).  The same
-   !> operations as power_polynomial's order 1, so the same bits.
-   pure subroutine power_gradient(c, op, px, py, z, ix, iy, iz, v, g)
-      real(wp), intent(in) :: c(n_cell_coefficients), px, py, z, ix, iy, iz
-      integer, intent(in) :: op
-      real(wp), intent(out) :: v, g(3)
-      real(wp) :: a0(16), a1(16), b00(4), b10(4), b01(4), x, y
+   !> The layer k of the grid with z(k) <= height < z(k+1) (1 <= k <= nz - 1;
+   !> the end layers for heights outside: the interpolant continues as a
+   !> cubic).
+   pure integer function find_layer(grid, height) result(k)
+      type(cell_grid), intent(in) :: grid
+      real(wp), intent(in) :: height
+      integer :: last
 
-      call image_point(op, px, py, x, y)
-      call horner_gradient(c, x, y, z, ix, iy, iz, a0, a1, b00, b10, b01, v, g)
+      last = size(grid%z) - 1
+      k = grid%bin_layer(int(min(real(size(grid%bin_layer), wp), max(1.0_wp, &
+         & (height - grid%z(1)) * grid%inverse_bin + 1.0_wp))))
+      ! A bin is narrower than any layer: at most one layer starts in it,
+      ! so one step up, without a branch to mispredict as the tip moves
+      ! across the layers (the loop only for rounding at a bin's edge).
+      if (k < last) k = k + merge(1, 0, grid%z(k + 1) <= height)
+      do while (k < last)
+         if (grid%z(k + 1) > height) exit
+         k = k + 1
+      end do
+   end function find_layer
+
+   !> The value v and Cartesian gradient g at r (Å) of a lattice's table:
+   !> the grid over the fractional coordinates (s1, s2, z) of the lattice's
+   !> cell (grid_gradient), m the map to them (s = m (x, y)).  The table's
+   !> hot path, every step in one routine.
+   pure subroutine lattice_gradient(grid, m, r, v, g)
+      type(cell_grid), intent(in) :: grid
+      real(wp), intent(in) :: m(2, 2), r(3)
+      real(wp), intent(out) :: v, g(3)
+      real(wp) :: s(2), gs(3)
+
+      s = cell_fraction(m, r(1:2))
+      call grid_gradient(grid, s(1), s(2), r(3), v, gs)
+      g = from_fraction(m, gs)
+   end subroutine lattice_gradient
+
+   !> The fractional coordinates in [0, 1) of the point xy (Å) in the plane
+   !> within a lattice's cell, m the map to fractional coordinates.
+   pure function cell_fraction(m, xy) result(s)
+      real(wp), intent(in) :: m(2, 2), xy(2)
+      real(wp) :: s(2)
+
+      s(1) = m(1, 1) * xy(1) + m(1, 2) * xy(2)
+      s(2) = m(2, 1) * xy(1) + m(2, 2) * xy(2)
+      s = s - floor(s)
+   end function cell_fraction
+
+   !> The Cartesian gradient from gs = (V_s1, V_s2, V_z), the gradient in a
+   !> lattice's fractional coordinates, m the map to them: dV/dx_j =
+   !> Σ_i dV/ds_i m_ij, mᵀ gs in the plane.
+   pure function from_fraction(m, gs) result(g)
+      real(wp), intent(in) :: m(2, 2), gs(3)
+      real(wp) :: g(3)
+
+      g(1) = m(1, 1) * gs(1) + m(2, 1) * gs(2)
+      g(2) = m(1, 2) * gs(1) + m(2, 2) * gs(2)
+      g(3) = gs(3)
+   end function from_fraction
+
+   !> The value v and gradient g (no Hessian: the table's hot path) at
+   !> (x, y, z) of the grid's interpolant through its cells' polynomials,
+   !> which must be set: the cell, its layer, its image and the polynomial
+   !> in one routine.  Points outside the grid get the end cells'
+   !> polynomials.  The same operations as power_polynomial's order 1
+   !> (friction_surface_tricubic's evaluate), so the same bits.
+   pure subroutine grid_gradient(grid, x, y, z, v, g)
+      type(cell_grid), intent(in) :: grid
+      real(wp), intent(in) :: x, y, z
+      real(wp), intent(out) :: v, g(3)
+      real(wp) :: s, t, a0(16), a1(16), b00(4), b10(4), b01(4), px, py
+      integer :: i, j, k, op
+
+      s = (x - grid%x0) * grid%inverse_hx
+      t = (y - grid%y0) * grid%inverse_hy
+      i = int(min(real(grid%nx - 2, wp), max(0.0_wp, s)))
+      j = int(min(real(grid%ny - 2, wp), max(0.0_wp, t)))
+      k = find_layer(grid, z)
+      ! The polynomial at the image point under the cell's map, its lateral
+      ! gradient mapped back (odd under the reflection, trading places
+      ! under the swap).
+      op = grid%image(i, j)
+      call image_point(op, s - i, t - j, px, py)
+      call cell_gradient(grid%cell(:, grid%slot(i, j) + grid%slots * (k - 1)), px, py, &
+         & (z - grid%z(k)) * grid%inverse_dz(k), grid%inverse_hx, grid%inverse_hy, grid%inverse_dz(k), &
+         & a0, a1, b00, b10, b01, v, g)
       call lateral_back(op, g)
-   end subroutine power_gradient
+   end subroutine grid_gradient
 
    !> The lateral gradient g(1:2) taken at a cell's image point under `op`
    !> (image_point) mapped back to the cell: odd under the reflection, its

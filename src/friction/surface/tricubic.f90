@@ -32,10 +32,10 @@
 !> error is about ten times larger at the same spacing.
 module friction_surface_tricubic
    use friction_kinds, only: wp
-   use friction_surface_table_kernels, only: power_polynomial, power_gradient, image_point, lateral_back, &
+   use friction_surface_cell_grid, only: cell_grid
+   use friction_surface_table_kernels, only: power_polynomial, find_layer, image_point, lateral_back, &
       & n_cell_coefficients
-   use friction_surface_table_kernels_wide, only: power_polynomial_wide => power_polynomial, &
-      & power_gradient_wide => power_gradient
+   use friction_surface_table_kernels_wide, only: power_polynomial_wide => power_polynomial
    implicit none
    private
 
@@ -44,35 +44,16 @@ module friction_surface_tricubic
    !> Values per node: f, f_x, f_y, f_z, f_xy, f_xz, f_yz, f_xyz.
    integer, parameter :: n_node_values = 8
 
-   type :: tricubic_grid
-      real(wp) :: x0 = 0.0_wp, hx = 1.0_wp   !! first node and spacing along x
-      real(wp) :: y0 = 0.0_wp, hy = 1.0_wp   !! along y
-      integer :: nx = 0, ny = 0              !! nodes along x and y (>= 2)
-      real(wp), allocatable :: z(:)          !! node heights, strictly increasing (>= 2)
-      !> The layer below each of nbins equal bins of [z(1), z(nz)], finer
-      !> than the closest layers, so that layer_below looks at one or two.
-      integer, allocatable :: bin_layer(:)
-      real(wp) :: bin_width = 1.0_wp
-      ! Reciprocals, so that an evaluation divides by nothing.
-      real(wp) :: inverse_hx = 1.0_wp, inverse_hy = 1.0_wp, inverse_bin = 1.0_wp
-      real(wp), allocatable :: inverse_dz(:)
+   !> The grid: its axes, layers and cells' polynomials (cell_grid), and
+   !> the nodes' values.
+   type, extends(cell_grid) :: tricubic_grid
       !> node(:, i, j, k): the eight values of node (x0 + (i-1) hx, y0 + (j-1) hy, z(k))
       real(wp), allocatable :: node(:, :, :, :)
-      !> cell(:, c): when allocated, the polynomial of a cell in its local
-      !> coordinates ξ, η, ζ in [0, 1], coefficient 1 + l + 4m + 16n of
-      !> ξ^l η^m ζ^n; cell (i, j) of layer k (i, j 0-based, k the layer
-      !> below) is c = slot(i, j) + slots (k - 1), evaluated at the point
-      !> mapped by image(i, j) (see `to_image`).  evaluate uses it instead of
-      !> the nodes.
-      real(wp), allocatable :: cell(:, :)
-      integer, allocatable :: slot(:, :), image(:, :)
-      integer :: slots = 0
       !> evaluate through the kernels compiled for AVX2 (the same bits,
       !> faster; set only where the processor has it: friction_surface_table_kernels)
       logical :: wide = .false.
    contains
       procedure :: evaluate
-      procedure :: value_gradient_at
       procedure :: set_polynomials
       procedure :: layer_below
       procedure :: bytes
@@ -129,27 +110,8 @@ contains
       class(tricubic_grid), intent(in) :: self
       real(wp), intent(in) :: height
 
-      k = find_layer(self, height)
+      k = find_layer(self%cell_grid, height)
    end function layer_below
-
-   !> layer_below's work (a plain call, which evaluate can have inlined).
-   pure integer function find_layer(self, height) result(k)
-      type(tricubic_grid), intent(in) :: self
-      real(wp), intent(in) :: height
-      integer :: last
-
-      last = size(self%z) - 1
-      k = self%bin_layer(int(min(real(size(self%bin_layer), wp), max(1.0_wp, &
-         & (height - self%z(1)) * self%inverse_bin + 1.0_wp))))
-      ! A bin is narrower than any layer: at most one layer starts in it,
-      ! so one step up, without a branch to mispredict as the tip moves
-      ! across the layers (the loop only for rounding at a bin's edge).
-      if (k < last) k = k + merge(1, 0, self%z(k + 1) <= height)
-      do while (k < last)
-         if (self%z(k + 1) > height) exit
-         k = k + 1
-      end do
-   end function find_layer
 
    !> The interpolant at p = (x, y, z): its value v, and for order >= 1 its
    !> gradient g, for order 2 also its Hessian h (zero when not asked for).
@@ -166,7 +128,7 @@ contains
       t = (p(2) - self%y0) * self%inverse_hy
       i = int(min(real(self%nx - 2, wp), max(0.0_wp, s)))
       j = int(min(real(self%ny - 2, wp), max(0.0_wp, t)))
-      k = find_layer(self, p(3))
+      k = find_layer(self%cell_grid, p(3))
       if (allocated(self%cell)) then
          associate (op => self%image(i, j))
             call cell_polynomial(self%cell(:, self%slot(i, j) + self%slots * (k - 1)), op, s - i, t - j, &
@@ -186,32 +148,6 @@ contains
          call with_hessian(self, i, j, k, bx, by, bz, v, g, h)
       end if
    end subroutine evaluate
-
-   !> The interpolant's value v and gradient g at (x, y, z) through the
-   !> cells' polynomials, which must be set (set_polynomials): evaluate's
-   !> order 1, the same bits, without its Hessian (the table's hot path).
-   pure subroutine value_gradient_at(self, x, y, z, v, g)
-      class(tricubic_grid), intent(in) :: self
-      real(wp), intent(in) :: x, y, z
-      real(wp), intent(out) :: v, g(3)
-      real(wp) :: s, t
-      integer :: i, j, k
-
-      s = (x - self%x0) * self%inverse_hx
-      t = (y - self%y0) * self%inverse_hy
-      i = int(min(real(self%nx - 2, wp), max(0.0_wp, s)))
-      j = int(min(real(self%ny - 2, wp), max(0.0_wp, t)))
-      k = find_layer(self, z)
-      associate (c => self%cell(:, self%slot(i, j) + self%slots * (k - 1)), op => self%image(i, j), &
-         & zeta => (z - self%z(k)) * self%inverse_dz(k))
-         if (self%wide) then
-            call power_gradient_wide(c, op, s - i, t - j, zeta, self%inverse_hx, self%inverse_hy, &
-               & self%inverse_dz(k), v, g)
-         else
-            call power_gradient(c, op, s - i, t - j, zeta, self%inverse_hx, self%inverse_hy, self%inverse_dz(k), v, g)
-         end if
-      end associate
-   end subroutine value_gradient_at
 
    !> Each cell's polynomial in the power basis of its local coordinates
    !> (the component `cell`), from the nodes' values, which must be set;
