@@ -193,19 +193,22 @@ contains
       g(3) = cubic(b01(1), b01(2), b01(3), b01(4), x, x2) * iz
    end subroutine cell_gradient
 
-   !> The cubic c0 + c1 x + c2 x² + c3 x³ by Horner's rule (x2 = x², not
-   !> needed here).
+   !> The cubic c0 + c1 x + c2 x² + c3 x³, with x2 = x², in Estrin's
+   !> order: its two halves do not wait on each other, so the chain of
+   !> operations that do is shorter than Horner's rule's.  The table's
+   !> evaluation is bound by that chain: each right-hand side waits on the
+   !> one before.
    pure elemental real(wp) function cubic(c0, c1, c2, c3, x, x2)
       real(wp), intent(in) :: c0, c1, c2, c3, x, x2
 
-      cubic = c0 + x * (c1 + x * (c2 + x * c3))
+      cubic = (c0 + c1 * x) + x2 * (c2 + c3 * x)
    end function cubic
 
    !> The cubic's derivative c1 + 2 c2 x + 3 c3 x² (`cubic`).
    pure elemental real(wp) function cubic_slope(c1, c2, c3, x, x2)
       real(wp), intent(in) :: c1, c2, c3, x, x2
 
-      cubic_slope = c1 + x * (2.0_wp * c2 + 3.0_wp * x * c3)
+      cubic_slope = (c1 + (2.0_wp * x) * c2) + (3.0_wp * x2) * c3
    end function cubic_slope
 
    !> The point (x, y) of a cell's local coordinates (px, py) under the map
