@@ -89,6 +89,10 @@ module friction_surface_lennard_jones
       !> build and evaluate through the kernels compiled for AVX2 where the
       !> processor has it (the same bits: friction_surface_table_kernels)
       logical :: wide_kernels = .true.
+      !> compute the nodes of one column in each orbit of the lattice's
+      !> whole point group (graphite: a twelfth), not only under s -> -s and
+      !> the swap (a quarter); the same nodes to rounding (tests `table`)
+      logical :: point_group = .true.
    end type table_settings
 
    !> The tabulated perfect lattice and the net's differences from it.
@@ -595,6 +599,8 @@ contains
       real(wp), allocatable :: layers(:), node(:, :, :, :), cell(:, :)
       real(wp) :: target, spacing, vmin, measured, det
       integer :: attempt, n1, n2
+      integer, allocatable :: group(:, :, :)
+      integer, parameter :: identity(2, 2) = reshape([1, 0, 0, 1], [2, 2]), swap(2, 2) = reshape([0, 1, 1, 0], [2, 2])
 
       reason = ''
       self%tabulated = .false.
@@ -639,6 +645,8 @@ contains
          return
       end if
       target = 0.4_wp * settings%tolerance
+      group = point_group(lattice)
+      if (.not. settings%point_group) group = reflection_and_swap(group)
       do attempt = 1, 3
          if (present(share)) then
             call choose_layers(ideal, t, target, settings%energy_window, layers, vmin, reason, share)
@@ -664,13 +672,13 @@ contains
          t%grid = new_tricubic_grid(0.0_wp, 1.0_wp / n1, n1 + 1, 0.0_wp, 1.0_wp / n2, n2 + 1, layers, &
             & wide=(t%grid%wide))
          if (present(share)) then
-            call fill_grid(ideal, t, centrosymmetric(lattice), swap_symmetric(lattice), share)
+            call fill_grid(ideal, t, group, share)
          else
-            call fill_grid(ideal, t, centrosymmetric(lattice), swap_symmetric(lattice), alone)
+            call fill_grid(ideal, t, group, alone)
          end if
          ! (The table's grid is the cell [0, 1]²: s -> -s is the reflection
          ! through its middle, by periodicity.)
-         call t%grid%set_polynomials(centrosymmetric(lattice), swap_symmetric(lattice))
+         call t%grid%set_polynomials(has_op(group, -identity), has_op(group, swap))
          t%floor = layers(1)
          t%nodes = [n1, n2, size(layers)]
          ! (One copy of the nodes and the cells' polynomials, not two.)
@@ -947,23 +955,26 @@ contains
    end subroutine gather_pairs
 
    !> The eight node values at heights z(:) of the column whose pairs are
-   !> `pairs` (gather_pairs), through the kernels for AVX2 where the table
-   !> uses them.
+   !> `pairs` (gather_pairs), and with values(9:12, :) the four in-plane
+   !> second derivatives too (column_sums), through the kernels for AVX2
+   !> where the table uses them.
    pure subroutine pair_sums(t, pairs, z, values)
       type(lj_table), intent(in) :: t
       type(column_pairs), intent(in) :: pairs
       real(wp), intent(in) :: z(:)
       real(wp), intent(out) :: values(:, :)
-      real(wp) :: c12
+      real(wp) :: metric(3)
 
-      c12 = dot_product(t%vectors(:, 1), t%vectors(:, 2))
+      associate (a => t%vectors)
+         metric = [dot_product(a(:, 1), a(:, 1)), dot_product(a(:, 1), a(:, 2)), dot_product(a(:, 2), a(:, 2))]
+      end associate
       associate (n => pairs%n)
          if (t%grid%wide) then
             call column_sums_wide(n, pairs%lateral, pairs%u1, pairs%u2, pairs%u12, pairs%height, pairs%sigma2, &
-               & pairs%e4, pairs%shift, c12, pairs%rc2, z, values)
+               & pairs%e4, pairs%shift, metric, pairs%rc2, z, values)
          else
             call column_sums(n, pairs%lateral, pairs%u1, pairs%u2, pairs%u12, pairs%height, pairs%sigma2, &
-               & pairs%e4, pairs%shift, c12, pairs%rc2, z, values)
+               & pairs%e4, pairs%shift, metric, pairs%rc2, z, values)
          end if
       end associate
    end subroutine pair_sums
@@ -1195,139 +1206,177 @@ contains
       ! (The last trial's spacing, refined once more, stands: step 5 checks it.)
    end subroutine choose_spacing
 
-   !> Whether the lattice is its own image under r -> -r (in the plane):
-   !> every atom of the cell has an atom of its species and height at minus
-   !> its position, less a lattice vector.
-   pure logical function centrosymmetric(lattice)
+   !> The lattice's point group in fractional coordinates: the integer
+   !> matrices A (entries -1, 0 or 1, determinant ±1) under which s -> A s
+   !> keeps the lattice's metric (AᵀGA = G, G the lattice vectors' dot
+   !> products: a rotation or a mirror through the origin) and takes every
+   !> atom of the cell to an atom of its species and height, less a lattice
+   !> vector; ops(:, :, m) the m-th.  Graphite's
+   !> lattice, centred on a hexagon, has 12: the rotations by multiples of
+   !> 60° and six mirrors.  Should the matrices found not form a group (a
+   !> product with an entry beyond ±1, which a reduced pair of lattice
+   !> vectors does not give), only the identity, s -> -s, the swap
+   !> s -> (s2, s1) and their product are kept, those among them found.
+   pure function point_group(lattice) result(ops)
       type(net_lattice), intent(in) :: lattice
-      real(wp) :: inverse(2, 2), f(2), det
-      integer :: b, c
+      integer, allocatable :: ops(:, :, :)
+      integer :: found(2, 2, 81), a(2, 2), k, n, e(4)
+      real(wp) :: metric(2, 2)
 
-      associate (v => lattice%vectors)
-         det = v(1, 1) * v(2, 2) - v(1, 2) * v(2, 1)
-         inverse = reshape([v(2, 2), -v(2, 1), -v(1, 2), v(1, 1)], [2, 2]) / det
-      end associate
-      centrosymmetric = .true.
-      do b = 1, size(lattice%species)
-         centrosymmetric = .false.
-         do c = 1, size(lattice%species)
-            if (lattice%species(c) /= lattice%species(b)) cycle
-            if (abs(lattice%basis(3, c) - lattice%basis(3, b)) > 1.0e-9_wp) cycle
-            f = matmul(inverse, lattice%basis(1:2, b) + lattice%basis(1:2, c))
-            if (all(abs(f - nint(f)) < 1.0e-9_wp)) centrosymmetric = .true.
-         end do
-         if (.not. centrosymmetric) return
+      metric = matmul(transpose(lattice%vectors), lattice%vectors)
+      n = 0
+      do k = 0, 80
+         e = [mod(k / 27, 3), mod(k / 9, 3), mod(k / 3, 3), mod(k, 3)] - 1
+         a = reshape(e, [2, 2])
+         if (abs(a(1, 1) * a(2, 2) - a(1, 2) * a(2, 1)) /= 1) cycle
+         if (maxval(abs(matmul(transpose(real(a, wp)), matmul(metric, real(a, wp))) - metric)) &
+            & > 1.0e-9_wp * maxval(abs(metric))) cycle
+         if (.not. keeps_atoms(a)) cycle
+         n = n + 1
+         found(:, :, n) = a
       end do
-   end function centrosymmetric
+      ops = found(:, :, 1:n)
+      if (.not. closed(ops)) ops = reflection_and_swap(ops)
 
-   !> Whether the lattice is its own image under the swap of its fractional
-   !> coordinates, s = (s1, s2) -> (s2, s1): a1 and a2 equally long (the
-   !> swap is then the mirror through their bisector), and every atom of the
-   !> cell has an atom of its species and height at its swapped position,
-   !> less a lattice vector (graphite's a1, a2 at 60°).
-   pure logical function swap_symmetric(lattice)
-      type(net_lattice), intent(in) :: lattice
-      real(wp) :: inverse(2, 2), f(2), g(2), det
-      integer :: b, c
+   contains
 
-      associate (v => lattice%vectors)
-         swap_symmetric = abs(norm2(v(:, 1)) - norm2(v(:, 2))) <= 1.0e-12_wp * norm2(v(:, 1))
-         if (.not. swap_symmetric) return
-         det = v(1, 1) * v(2, 2) - v(1, 2) * v(2, 1)
-         inverse = reshape([v(2, 2), -v(2, 1), -v(1, 2), v(1, 1)], [2, 2]) / det
-      end associate
-      do b = 1, size(lattice%species)
-         swap_symmetric = .false.
-         f = matmul(inverse, lattice%basis(1:2, b))
-         do c = 1, size(lattice%species)
-            if (lattice%species(c) /= lattice%species(b)) cycle
-            if (abs(lattice%basis(3, c) - lattice%basis(3, b)) > 1.0e-9_wp) cycle
-            g = matmul(inverse, lattice%basis(1:2, c)) - [f(2), f(1)]
-            if (all(abs(g - nint(g)) < 1.0e-9_wp)) swap_symmetric = .true.
+      !> Whether s -> a s takes every atom of the cell to one of its species
+      !> and height, less a lattice vector.
+      pure logical function keeps_atoms(a)
+         integer, intent(in) :: a(2, 2)
+         real(wp) :: inverse(2, 2), f(2), det
+         integer :: b, c
+
+         associate (v => lattice%vectors)
+            det = v(1, 1) * v(2, 2) - v(1, 2) * v(2, 1)
+            inverse = reshape([v(2, 2), -v(2, 1), -v(1, 2), v(1, 1)], [2, 2]) / det
+         end associate
+         do b = 1, size(lattice%species)
+            keeps_atoms = .false.
+            do c = 1, size(lattice%species)
+               if (lattice%species(c) /= lattice%species(b)) cycle
+               if (abs(lattice%basis(3, c) - lattice%basis(3, b)) > 1.0e-9_wp) cycle
+               f = matmul(real(a, wp), matmul(inverse, lattice%basis(1:2, b))) &
+                  & - matmul(inverse, lattice%basis(1:2, c))
+               if (all(abs(f - nint(f)) < 1.0e-9_wp)) keeps_atoms = .true.
+            end do
+            if (.not. keeps_atoms) return
          end do
-         if (.not. swap_symmetric) return
-      end do
-   end function swap_symmetric
+      end function keeps_atoms
+
+      !> Whether every product of two of ops is among them.
+      pure logical function closed(ops)
+         integer, intent(in) :: ops(:, :, :)
+         integer :: i, j
+
+         closed = .true.
+         do j = 1, size(ops, 3)
+            do i = 1, size(ops, 3)
+               if (.not. has_op(ops, matmul(ops(:, :, i), ops(:, :, j)))) closed = .false.
+            end do
+         end do
+      end function closed
+
+   end function point_group
+
+   !> Those of ops (point_group) among the identity, s -> -s, the swap
+   !> s -> (s2, s1) and their product, which form a group of their own.
+   pure function reflection_and_swap(ops) result(kept)
+      integer, intent(in) :: ops(:, :, :)
+      integer, allocatable :: kept(:, :, :)
+      integer, parameter :: identity(2, 2) = reshape([1, 0, 0, 1], [2, 2]), swap(2, 2) = reshape([0, 1, 1, 0], [2, 2])
+      integer :: m
+
+      kept = ops(:, :, pack([(m, m = 1, size(ops, 3))], [(all(ops(:, :, m) == identity) &
+         & .or. all(ops(:, :, m) == -identity) .or. all(ops(:, :, m) == swap) .or. all(ops(:, :, m) == -swap), &
+         & m = 1, size(ops, 3))]))
+   end function reflection_and_swap
+
+   !> Whether a is among ops (point_group).
+   pure logical function has_op(ops, a)
+      integer, intent(in) :: ops(:, :, :), a(2, 2)
+      integer :: m
+
+      has_op = any([(all(ops(:, :, m) == a), m = 1, size(ops, 3))])
+   end function has_op
 
    !> Step 4 of `tabulate`: every node's values (the last row and column
-   !> repeat the first: the lattice is periodic).  The columns are dealt
-   !> round-robin over the processes of `share`, each its own, and summed.
-   !> The lattice's symmetries among s -> -s (`inversion`, V(-s) = V(s))
-   !> and s -> (s2, s1) (`swap`, with as many nodes along a1 as along a2)
-   !> map columns of nodes onto columns: of each orbit one column is
-   !> computed (the first in the grid's order) and the others are its
-   !> images (the derivatives odd in s1, s2 change sign under the inversion
-   !> and trade places under the swap), which halves the work, or quarters
-   !> it with both (graphite).
-   subroutine fill_grid(ideal, t, inversion, swap, share)
+   !> repeat the first: the lattice is periodic).  The lattice's point group
+   !> `ops` (point_group) takes nodes to nodes (those of its matrices that do
+   !> not mix the axes, unless there are as many nodes along a1 as along
+   !> a2): of each orbit one column is computed, the first in the grid's
+   !> order, with the in-plane second derivatives too, and the others are
+   !> its images.  Where A takes node p to q, V(q) = V(p), and with C = A⁻¹
+   !> the gradient in the plane is Cᵀ ∇V(p) and the in-plane Hessian
+   !> Cᵀ H(p) C (their z-derivatives alike), whose off-diagonal entry is
+   !> the node's cross derivative.  Graphite computes a twelfth of its
+   !> columns.  The columns computed are dealt round-robin over the
+   !> processes of `share`, each its own, and summed.
+   subroutine fill_grid(ideal, t, ops, share)
       type(lj_potential), intent(in) :: ideal
       type(lj_table), intent(inout) :: t
-      logical, intent(in) :: inversion, swap
+      integer, intent(in) :: ops(:, :, :)
       class(work_sharing), intent(inout) :: share
-      !> the sign of each value in the image of a column under s -> -s
-      real(wp), parameter :: parity(n_node_values) = [1.0_wp, -1.0_wp, -1.0_wp, 1.0_wp, 1.0_wp, -1.0_wp, &
-         & -1.0_wp, 1.0_wp]
-      !> where each value goes in the image of a column under the swap
-      integer, parameter :: swapped(n_node_values) = [1, 3, 2, 4, 5, 7, 6, 8]
       real(wp), allocatable :: packed(:, :, :)
       type(column_pairs) :: pairs
-      integer :: i, j, n1, n2, dealt, op, image(2)
-      logical :: used(3)
+      integer :: i, j, k, n1, n2, dealt, m, q(2)
+      logical :: usable(size(ops, 3))
+      !> each node's column (its number in `packed`) and the inverse of the
+      !> element taking the column to it
+      integer, allocatable :: from(:, :), map(:, :, :, :)
+      !> whether a node comes first among its images (it is computed)
+      logical, allocatable :: first(:, :)
 
       n1 = t%grid%nx - 1
       n2 = t%grid%ny - 1
-      ! (op 1: the inversion, 2: the swap, 3: both.)
-      used = [inversion, swap .and. n1 == n2, inversion .and. swap .and. n1 == n2]
-      if (share%ranks == 1) then
-         do j = 1, n2
-            do i = 1, n1
-               if (.not. first_of_orbit(i, j)) cycle
-               call column_values(ideal, t, cartesian(t, [real(i - 1, wp) / n1, real(j - 1, wp) / n2]), t%grid%z, &
-                  & t%grid%node(:, i, j, :), pairs)
-            end do
-         end do
-      else
-         ! The columns computed, packed, dealt round-robin and summed (-0.0
-         ! where this process computes nothing: see work_sharing's sum).
-         allocate (packed(n_node_values, size(t%grid%z), count([((first_of_orbit(i, j), i = 1, n1), j = 1, n2)])), &
-            & source=-0.0_wp)
-         dealt = 0
-         do j = 1, n2
-            do i = 1, n1
-               if (.not. first_of_orbit(i, j)) cycle
-               dealt = dealt + 1
-               if (mod(dealt - 1, share%ranks) /= share%rank) cycle
-               call column_values(ideal, t, cartesian(t, [real(i - 1, wp) / n1, real(j - 1, wp) / n2]), t%grid%z, &
-                  & packed(:, :, dealt), pairs)
-            end do
-         end do
-         call share%sum_reals(packed, size(packed))
-         dealt = 0
-         do j = 1, n2
-            do i = 1, n1
-               if (.not. first_of_orbit(i, j)) cycle
-               dealt = dealt + 1
-               t%grid%node(:, i, j, :) = packed(:, :, dealt)
-            end do
-         end do
-      end if
+      usable = [(n1 == n2 .or. (ops(1, 2, m) == 0 .and. ops(2, 1, m) == 0), m = 1, size(ops, 3))]
+      allocate (first(n1, n2), source=.true.)
       do j = 1, n2
          do i = 1, n1
-            if (.not. first_of_orbit(i, j)) cycle
-            do op = 1, 3
-               if (.not. used(op)) cycle
-               image = mapped(op, i, j)
-               ! (A column its own image, or another op's image, keeps what it has.)
-               if (first_of_orbit(image(1), image(2))) cycle
-               select case (op)
-               case (1)
-                  t%grid%node(:, image(1), image(2), :) = spread(parity, 2, size(t%grid%z)) * t%grid%node(:, i, j, :)
-               case (2)
-                  t%grid%node(:, image(1), image(2), :) = t%grid%node(swapped, i, j, :)
-               case default
-                  t%grid%node(:, image(1), image(2), :) = spread(parity, 2, size(t%grid%z)) &
-                     & * t%grid%node(swapped, i, j, :)
-               end select
+            do m = 1, size(ops, 3)
+               if (.not. usable(m)) cycle
+               q = image(m, i, j)
+               if (q(1) + n1 * q(2) < i + n1 * j) first(i, j) = .false.
+            end do
+         end do
+      end do
+      ! (-0.0 where this process computes nothing: see work_sharing's sum.)
+      allocate (packed(12, size(t%grid%z), count(first)), source=-0.0_wp)
+      dealt = 0
+      do j = 1, n2
+         do i = 1, n1
+            if (.not. first(i, j)) cycle
+            dealt = dealt + 1
+            if (mod(dealt - 1, share%ranks) /= share%rank) cycle
+            call column_values(ideal, t, cartesian(t, [real(i - 1, wp) / n1, real(j - 1, wp) / n2]), t%grid%z, &
+               & packed(:, :, dealt), pairs)
+         end do
+      end do
+      if (share%ranks > 1) call share%sum_reals(packed, size(packed))
+      ! Every node's column and the map from the column computed: first the
+      ! list, then layer by layer (a layer's nodes lie together).
+      allocate (from(n1, n2), map(2, 2, n1, n2))
+      dealt = 0
+      do j = 1, n2
+         do i = 1, n1
+            if (.not. first(i, j)) cycle
+            dealt = dealt + 1
+            from(i, j) = dealt
+            map(:, :, i, j) = reshape([1, 0, 0, 1], [2, 2])
+            do m = 1, size(ops, 3)
+               if (.not. usable(m)) cycle
+               q = image(m, i, j)
+               ! (The column itself, or the image of it under another element.)
+               if (first(q(1), q(2))) cycle
+               from(q(1), q(2)) = dealt
+               map(:, :, q(1), q(2)) = inverse(ops(:, :, m))
+            end do
+         end do
+      end do
+      do k = 1, size(t%grid%z)
+         do j = 1, n2
+            do i = 1, n1
+               call map_values(map(:, :, i, j), packed(:, k, from(i, j)), t%grid%node(:, i, j, k))
             end do
          end do
       end do
@@ -1336,38 +1385,43 @@ contains
 
    contains
 
-      integer function column_index(column)
-         integer, intent(in) :: column(2)
+      !> The node (1-based) that node (i, j) goes to under ops(:, :, m).
+      pure function image(m, i, j) result(node)
+         integer, intent(in) :: m, i, j
+         integer :: node(2)
 
-         column_index = (column(1) - 1) + (column(2) - 1) * n1
-      end function column_index
+         node = modulo(matmul(ops(:, :, m), [i - 1, j - 1]), [n1, n2]) + 1
+      end function image
 
-      !> The column (i, j) is mapped to by op.
-      function mapped(op, i, j) result(column)
-         integer, intent(in) :: op, i, j
-         integer :: column(2)
+      !> The inverse of an integer matrix of determinant ±1.
+      pure function inverse(a) result(b)
+         integer, intent(in) :: a(2, 2)
+         integer :: b(2, 2)
 
-         select case (op)
-         case (1)
-            column = [mod(n1 - (i - 1), n1) + 1, mod(n2 - (j - 1), n2) + 1]
-         case (2)
-            column = [j, i]
-         case default
-            column = [mod(n1 - (j - 1), n1) + 1, mod(n2 - (i - 1), n2) + 1]
-         end select
-      end function mapped
+         b = (a(1, 1) * a(2, 2) - a(1, 2) * a(2, 1)) * reshape([a(2, 2), -a(2, 1), -a(1, 2), a(1, 1)], [2, 2])
+      end function inverse
 
-      !> Whether column (i, j) comes first among its images (it is computed).
-      logical function first_of_orbit(i, j)
-         integer, intent(in) :: i, j
-         integer :: op
+      !> A node's values at the image of a column (`to`, n_node_values of
+      !> them) from the column's values with the in-plane second derivatives
+      !> at that height (`from`, 12: column_sums), c the inverse of the
+      !> element taking the column there (the identity: the column itself).
+      pure subroutine map_values(c, from, to)
+         integer, intent(in) :: c(2, 2)
+         real(wp), intent(in) :: from(12)
+         real(wp), intent(out) :: to(n_node_values)
 
-         first_of_orbit = .true.
-         do op = 1, 3
-            if (.not. used(op)) cycle
-            if (column_index(mapped(op, i, j)) < column_index([i, j])) first_of_orbit = .false.
-         end do
-      end function first_of_orbit
+         to(1) = from(1)
+         to(4) = from(4)
+         to(2) = c(1, 1) * from(2) + c(2, 1) * from(3)
+         to(3) = c(1, 2) * from(2) + c(2, 2) * from(3)
+         to(6) = c(1, 1) * from(6) + c(2, 1) * from(7)
+         to(7) = c(1, 2) * from(6) + c(2, 2) * from(7)
+         ! (Cᵀ H C)_12 = c11 c12 H11 + (c11 c22 + c21 c12) H12 + c21 c22 H22
+         to(5) = c(1, 1) * c(1, 2) * from(9) + (c(1, 1) * c(2, 2) + c(2, 1) * c(1, 2)) * from(5) &
+            & + c(2, 1) * c(2, 2) * from(10)
+         to(8) = c(1, 1) * c(1, 2) * from(11) + (c(1, 1) * c(2, 2) + c(2, 1) * c(1, 2)) * from(8) &
+            & + c(2, 1) * c(2, 2) * from(12)
+      end subroutine map_values
 
    end subroutine fill_grid
 

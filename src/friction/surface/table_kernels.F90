@@ -44,18 +44,44 @@ contains
    !>   V, V_s1 = 2φ1 u1, V_s2 = 2φ1 u2, V_z = 2φ1 w,
    !>   V_s1s2 = 4φ2 u1 u2 + 2φ1 c12, V_s1z = 4φ2 u1 w, V_s2z = 4φ2 u2 w,
    !>   V_s1s2z = 8φ3 u1 u2 w + 4φ2 c12 w
-   !> (the c12 terms as c12 times the sums of 2φ1 and 4φ2 w).
+   !> (the c12 terms as c12 times the sums of 2φ1 and 4φ2 w).  With
+   !> values(9:12, :) too (size(values, 1) = 12), the in-plane second
+   !> derivatives a node's images under the lattice's rotations need
+   !> (c11 = a1 . a1, c22 = a2 . a2):
+   !>   V_s1s1 = 4φ2 u1² + 2φ1 c11, V_s2s2 = 4φ2 u2² + 2φ1 c22,
+   !>   V_s1s1z = 8φ3 u1² w + 4φ2 c11 w, V_s2s2z = 8φ3 u2² w + 4φ2 c22 w.
    !> n is a multiple of `column_lanes` (pad with pairs beyond the cutoff:
    !> lateral(p) >= rc2, e4 = shift = 0, which add exactly zero).
-   pure subroutine column_sums(n, lateral, u1, u2, u12, height, sigma2, e4, shift, c12, rc2, z, values)
+   pure subroutine column_sums(n, lateral, u1, u2, u12, height, sigma2, e4, shift, metric, rc2, z, values)
       integer, intent(in) :: n
       real(wp), intent(in), dimension(column_lanes, n / column_lanes) :: lateral, u1, u2, u12, height, sigma2, &
          & e4, shift
-      real(wp), intent(in) :: c12, rc2, z(:)
+      !> the lattice vectors' products: c11, c12, c22
+      real(wp), intent(in) :: metric(3)
+      real(wp), intent(in) :: rc2, z(:)
+      real(wp), intent(out) :: values(:, :)
+
+      ! (Two calls, each with its flag a constant, so that the compiler makes
+      ! each a loop of its own: the four more sums cost a third more.)
+      if (size(values, 1) >= 12) then
+         call lane_sums(n, lateral, u1, u2, u12, height, sigma2, e4, shift, metric, rc2, z, .true., values)
+      else
+         call lane_sums(n, lateral, u1, u2, u12, height, sigma2, e4, shift, metric, rc2, z, .false., values)
+      end if
+   end subroutine column_sums
+
+   !> column_sums' work, the in-plane second derivatives when `plane`.
+   pure subroutine lane_sums(n, lateral, u1, u2, u12, height, sigma2, e4, shift, metric, rc2, z, plane, values)
+      integer, intent(in) :: n
+      real(wp), intent(in), dimension(column_lanes, n / column_lanes) :: lateral, u1, u2, u12, height, sigma2, &
+         & e4, shift
+      real(wp), intent(in) :: metric(3)
+      real(wp), intent(in) :: rc2, z(:)
+      logical, intent(in) :: plane
       real(wp), intent(out) :: values(:, :)
       ! (d1 = 2φ1, d2 = 4φ2, d3 = 8φ3: the derivatives as the sums want them.)
-      real(wp) :: acc(column_lanes, 10), w, q, inside, e, iq, s6, s12, t1, t2, d1, d2, d3
-      real(wp) :: total(10)
+      real(wp) :: acc(column_lanes, 14), w, q, inside, e, iq, s6, s12, t1, t2, d1, d2, d3
+      real(wp) :: total(14)
       integer :: k, c, l, m
 
       do k = 1, size(z)
@@ -89,16 +115,26 @@ contains
                acc(l, 8) = acc(l, 8) + d3 * w * u12(l, c)
                acc(l, 9) = acc(l, 9) + d1
                acc(l, 10) = acc(l, 10) + d2 * w
+               if (.not. plane) cycle
+               acc(l, 11) = acc(l, 11) + d2 * (u1(l, c) * u1(l, c))
+               acc(l, 12) = acc(l, 12) + d2 * (u2(l, c) * u2(l, c))
+               acc(l, 13) = acc(l, 13) + d3 * w * (u1(l, c) * u1(l, c))
+               acc(l, 14) = acc(l, 14) + d3 * w * (u2(l, c) * u2(l, c))
             end do
          end do
-         do m = 1, 10
+         do m = 1, 14
             total(m) = (acc(1, m) + acc(2, m)) + (acc(3, m) + acc(4, m))
          end do
-         values(:, k) = total(1:8)
-         values(5, k) = total(5) + c12 * total(9)
-         values(8, k) = total(8) + c12 * total(10)
+         values(1:8, k) = total(1:8)
+         values(5, k) = total(5) + metric(2) * total(9)
+         values(8, k) = total(8) + metric(2) * total(10)
+         if (.not. plane) cycle
+         values(9, k) = total(11) + metric(1) * total(9)
+         values(10, k) = total(12) + metric(3) * total(9)
+         values(11, k) = total(13) + metric(1) * total(10)
+         values(12, k) = total(14) + metric(3) * total(10)
       end do
-   end subroutine column_sums
+   end subroutine lane_sums
 
    !> The energy v and gradient g (order 1; energy alone for order 0) at r of
    !> the pairs of a list, as arrays: position (x, y, z), σ², the weighted
