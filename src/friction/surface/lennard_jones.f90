@@ -599,7 +599,7 @@ contains
       real(wp), allocatable :: layers(:), node(:, :, :, :), cell(:, :)
       real(wp) :: target, spacing, vmin, measured, det
       integer :: attempt, n1, n2
-      integer, allocatable :: group(:, :, :)
+      integer, allocatable :: group(:, :, :), nodes_group(:, :, :)
       integer, parameter :: identity(2, 2) = reshape([1, 0, 0, 1], [2, 2]), swap(2, 2) = reshape([0, 1, 1, 0], [2, 2])
 
       reason = ''
@@ -646,12 +646,13 @@ contains
       end if
       target = 0.4_wp * settings%tolerance
       group = point_group(lattice)
-      if (.not. settings%point_group) group = reflection_and_swap(group)
+      nodes_group = group
+      if (.not. settings%point_group) nodes_group = reflection_and_swap(group)
       do attempt = 1, 3
          if (present(share)) then
-            call choose_layers(ideal, t, target, settings%energy_window, layers, vmin, reason, share)
+            call choose_layers(ideal, t, group, target, settings%energy_window, layers, vmin, reason, share)
          else
-            call choose_layers(ideal, t, target, settings%energy_window, layers, vmin, reason, alone)
+            call choose_layers(ideal, t, group, target, settings%energy_window, layers, vmin, reason, alone)
          end if
          if (len(reason) > 0) return
          t%energy_cap = vmin + settings%energy_window
@@ -672,9 +673,9 @@ contains
          t%grid = new_tricubic_grid(0.0_wp, 1.0_wp / n1, n1 + 1, 0.0_wp, 1.0_wp / n2, n2 + 1, layers, &
             & wide=(t%grid%wide))
          if (present(share)) then
-            call fill_grid(ideal, t, group, share)
+            call fill_grid(ideal, t, nodes_group, share)
          else
-            call fill_grid(ideal, t, group, alone)
+            call fill_grid(ideal, t, nodes_group, alone)
          end if
          ! (The table's grid is the cell [0, 1]²: s -> -s is the reflection
          ! through its middle, by periodicity.)
@@ -1001,9 +1002,11 @@ contains
    !> Step 2 of `tabulate`: the heights of the layers, ascending, and the
    !> lowest energy of the lattice met (at the check columns' nodes).  The
    !> processes share the check columns, and all take the same steps.
-   subroutine choose_layers(ideal, t, target, window, layers, vmin, reason, share)
+   subroutine choose_layers(ideal, t, ops, target, window, layers, vmin, reason, share)
       type(lj_potential), intent(in) :: ideal
       type(lj_table), intent(in) :: t
+      !> the lattice's point group (point_group)
+      integer, intent(in) :: ops(:, :, :)
       real(wp), intent(in) :: target, window
       real(wp), allocatable, intent(out) :: layers(:)
       real(wp), intent(out) :: vmin
@@ -1013,6 +1016,8 @@ contains
       integer, parameter :: side = 6, max_layers = 4000
       real(wp), parameter :: check_at(3) = [0.2113248654051871_wp, 0.5_wp, 0.7886751345948129_wp]
       real(wp), allocatable :: columns(:, :), upper(:, :), lower(:, :), found(:), checked(:, :, :)
+      !> the check columns' fractional coordinates
+      real(wp), allocatable :: kept(:, :)
       real(wp) :: step, z, z_new, worst, bottom, ratio, g(3), r(3), v, gi(3), s(2)
       !> each check column's pairs, gathered once for all the heights tried
       type(column_pairs), allocatable :: pairs(:)
@@ -1020,20 +1025,21 @@ contains
       logical :: all_above
 
       ! Check columns: a side x side grid of the cell (its corner, thirds and
-      ! halves among them) and the sites of the atoms in the cell.
-      allocate (columns(2, side * side + size(ideal%atoms%species)))
+      ! halves among them) and the sites of the atoms in the cell, one of
+      ! each orbit of the lattice's point group: along the others the energy
+      ! is the same and the gradient the same rotated, so are the errors
+      ! (graphite: 7 columns of 38, its atoms' sites among the grid's).
+      allocate (columns(2, side * side + size(ideal%atoms%species)), kept(2, side * side + size(ideal%atoms%species)))
       ncol = 0
       do j = 0, side - 1
          do i = 0, side - 1
-            ncol = ncol + 1
-            columns(:, ncol) = cartesian(t, [real(i, wp), real(j, wp)] / side)
+            call add_column([real(i, wp), real(j, wp)] / side)
          end do
       end do
       do i = 1, size(ideal%atoms%species)
          s = matmul(t%to_fraction, ideal%atoms%position(1:2, i))
          if (any(s < 0.0_wp) .or. any(s >= 1.0_wp)) cycle
-         ncol = ncol + 1
-         columns(:, ncol) = ideal%atoms%position(1:2, i)
+         call add_column(s)
       end do
       allocate (upper(n_node_values, ncol), lower(n_node_values, ncol), checked(n_node_values, 4, ncol))
       bottom = minval(ideal%atoms%position(3, :))
@@ -1099,6 +1105,27 @@ contains
          step = step * min(2.0_wp, 0.9_wp * ratio)
       end do
       layers = found(size(found):1:-1)
+
+   contains
+
+      !> Adds the column at fractional coordinates f unless an element of
+      !> ops takes it onto one already there (modulo the lattice).
+      subroutine add_column(f)
+         real(wp), intent(in) :: f(2)
+         real(wp) :: d(2)
+         integer :: m, c
+
+         do m = 1, size(ops, 3)
+            do c = 1, ncol
+               d = matmul(real(ops(:, :, m), wp), f) - kept(:, c)
+               if (all(abs(d - nint(d)) < 1.0e-9_wp)) return
+            end do
+         end do
+         ncol = ncol + 1
+         kept(:, ncol) = f
+         columns(:, ncol) = cartesian(t, f)
+      end subroutine add_column
+
    end subroutine choose_layers
 
    !> The cubic Hermite interpolation along z between two nodes' values
