@@ -808,35 +808,48 @@ contains
       real(wp), intent(in) :: position(:, :), weight(:), cutoff, region(4)
       integer, intent(in) :: species(:)
       type(difference_lists) :: self
-      real(wp) :: centre(2), reach2
-      integer :: cx, cy, c, i, total, pass
+      real(wp) :: centre(2), reach
+      integer :: cx, cy, c, i, total, pass, lo(2), hi(2)
+      integer, allocatable :: next(:)
 
       self%cell = min(2.0_wp, cutoff / 3.0_wp)
       self%inverse_cell = 1.0_wp / self%cell
       self%origin = [region(1), region(3)]
       self%ncell = max(1, ceiling([region(2) - region(1), region(4) - region(3)] / self%cell))
-      reach2 = (cutoff + self%cell / sqrt(2.0_wp))**2
-      allocate (self%start(self%ncell(1) * self%ncell(2) + 1))
-      ! Two passes: the lists' lengths, then their entries.
+      reach = cutoff + self%cell / sqrt(2.0_wp)
+      allocate (self%start(self%ncell(1) * self%ncell(2) + 1), next(self%ncell(1) * self%ncell(2)))
+      ! Two passes over the differences, each to the cells whose centre is
+      ! within reach (a list in the differences' order): the lists'
+      ! lengths, then their entries.
+      self%start = 0
       do pass = 1, 2
-         total = 0
-         self%start(1) = 1
-         do cy = 0, self%ncell(2) - 1
-            do cx = 0, self%ncell(1) - 1
-               c = cx + cy * self%ncell(1) + 1
-               centre = self%origin + ([cx, cy] + 0.5_wp) * self%cell
-               do i = 1, size(species)
-                  if (sum((position(1:2, i) - centre)**2) >= reach2) cycle
-                  total = total + 1
-                  if (pass == 1) cycle
-                  self%position(:, total) = position(:, i)
-                  self%species(total) = species(i)
-                  self%weight(total) = weight(i)
+         do i = 1, size(species)
+            lo = max(0, floor((position(1:2, i) - reach - self%origin) / self%cell - 0.5_wp))
+            hi = min(self%ncell - 1, ceiling((position(1:2, i) + reach - self%origin) / self%cell - 0.5_wp))
+            do cy = lo(2), hi(2)
+               do cx = lo(1), hi(1)
+                  centre = self%origin + ([cx, cy] + 0.5_wp) * self%cell
+                  if (sum((position(1:2, i) - centre)**2) >= reach**2) cycle
+                  c = cx + cy * self%ncell(1) + 1
+                  if (pass == 1) then
+                     self%start(c + 1) = self%start(c + 1) + 1
+                     cycle
+                  end if
+                  self%position(:, next(c)) = position(:, i)
+                  self%species(next(c)) = species(i)
+                  self%weight(next(c)) = weight(i)
+                  next(c) = next(c) + 1
                end do
-               self%start(c + 1) = total + 1
             end do
          end do
-         if (pass == 1) allocate (self%position(3, total), self%species(total), self%weight(total))
+         if (pass == 2) exit
+         self%start(1) = 1
+         do c = 1, size(next)
+            self%start(c + 1) = self%start(c) + self%start(c + 1)
+         end do
+         next = self%start(1:size(next))
+         total = self%start(size(self%start)) - 1
+         allocate (self%position(3, total), self%species(total), self%weight(total))
       end do
    end function new_difference_lists
 
