@@ -62,7 +62,8 @@ contains
       real(wp), intent(out) :: values(:, :)
 
       ! (Two calls, each with its flag a constant, so that the compiler makes
-      ! each a loop of its own: the four more sums cost a third more.)
+      ! each a loop of its own: the columns that need the first eight values
+      ! alone, the checks', do not pay for the four more sums.)
       if (size(values, 1) >= 12) then
          call lane_sums(n, lateral, u1, u2, u12, height, sigma2, e4, shift, metric, rc2, z, .true., values)
       else

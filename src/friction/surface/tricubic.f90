@@ -14,7 +14,7 @@
 !> For speed the grid can also hold each cell's polynomial in the power
 !> basis of its local coordinates (`set_polynomials`, after the nodes are
 !> filled): 64 coefficients per cell, contiguous, so that an evaluation
-!> reads one block and contracts it by Horner's rule along z, y and x
+!> reads one block and contracts it cubic by cubic along z, y and x
 !> instead of gathering and weighting eight corners' data.  It is the same
 !> polynomial, to rounding.  Data symmetric under the point reflection
 !> through the middle of the grid's (x, y) rectangle, or under the swap of
