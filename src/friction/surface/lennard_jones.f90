@@ -95,6 +95,10 @@ module friction_surface_lennard_jones
       logical :: point_group = .true.
    end type table_settings
 
+   !> The identity and the swap of fractional coordinates, s -> (s2, s1),
+   !> as elements of a lattice's point group (point_group).
+   integer, parameter :: identity_op(2, 2) = reshape([1, 0, 0, 1], [2, 2]), swap_op(2, 2) = reshape([0, 1, 1, 0], [2, 2])
+
    !> The tabulated perfect lattice and the net's differences from it.
    type :: lj_table
       type(tricubic_grid) :: grid           !! V over (s1, s2, z): s the fractional coordinates
@@ -600,7 +604,6 @@ contains
       real(wp) :: target, spacing, vmin, measured, det
       integer :: attempt, n1, n2
       integer, allocatable :: group(:, :, :), nodes_group(:, :, :)
-      integer, parameter :: identity(2, 2) = reshape([1, 0, 0, 1], [2, 2]), swap(2, 2) = reshape([0, 1, 1, 0], [2, 2])
 
       reason = ''
       self%tabulated = .false.
@@ -679,7 +682,7 @@ contains
          end if
          ! (The table's grid is the cell [0, 1]²: s -> -s is the reflection
          ! through its middle, by periodicity.)
-         call t%grid%set_polynomials(has_op(group, -identity), has_op(group, swap))
+         call t%grid%set_polynomials(has_op(group, -identity_op), has_op(group, swap_op))
          t%floor = layers(1)
          t%nodes = [n1, n2, size(layers)]
          ! (One copy of the nodes and the cells' polynomials, not two.)
@@ -1092,7 +1095,7 @@ contains
                call hermite_column(lower(:, m), upper(:, m), z_new, z, r(3), v, gi)
                if (v > min(vmin, minval(lower(1, :))) + window) cycle
                g = cartesian_gradient(t, checked(:, 1 + k, m))
-               gi(1:2) = matmul(transpose(t%to_fraction), gi(1:2))
+               gi = from_fraction(t%to_fraction, gi)
                worst = max(worst, norm2(gi - g))
             end do
          end do
@@ -1229,7 +1232,7 @@ contains
                   cell%node(:, :, :, 2) = corner(:, k, :, :)
                   call cell%evaluate([s(1), s(2), 0.0_wp], 1, v, gi, hi)
                   if (v > t%energy_cap) cycle
-                  gi(1:2) = matmul(transpose(t%to_fraction), gi(1:2))
+                  gi = from_fraction(t%to_fraction, gi)
                   worst = max(worst, norm2(gi - cartesian_gradient(t, exact(:, k, point))))
                end do
             end associate
@@ -1261,9 +1264,15 @@ contains
       type(net_lattice), intent(in) :: lattice
       integer, allocatable :: ops(:, :, :)
       integer :: found(2, 2, 81), a(2, 2), k, n, e(4)
-      real(wp) :: metric(2, 2)
+      real(wp) :: metric(2, 2), det
+      !> the basis atoms' fractional coordinates in the plane
+      real(wp) :: fraction(2, size(lattice%species))
 
       metric = matmul(transpose(lattice%vectors), lattice%vectors)
+      associate (v => lattice%vectors)
+         det = v(1, 1) * v(2, 2) - v(1, 2) * v(2, 1)
+         fraction = matmul(reshape([v(2, 2), -v(2, 1), -v(1, 2), v(1, 1)], [2, 2]) / det, lattice%basis(1:2, :))
+      end associate
       n = 0
       do k = 0, 80
          e = [mod(k / 27, 3), mod(k / 9, 3), mod(k / 3, 3), mod(k, 3)] - 1
@@ -1284,20 +1293,15 @@ contains
       !> and height, less a lattice vector.
       pure logical function keeps_atoms(a)
          integer, intent(in) :: a(2, 2)
-         real(wp) :: inverse(2, 2), f(2), det
+         real(wp) :: f(2)
          integer :: b, c
 
-         associate (v => lattice%vectors)
-            det = v(1, 1) * v(2, 2) - v(1, 2) * v(2, 1)
-            inverse = reshape([v(2, 2), -v(2, 1), -v(1, 2), v(1, 1)], [2, 2]) / det
-         end associate
          do b = 1, size(lattice%species)
             keeps_atoms = .false.
             do c = 1, size(lattice%species)
                if (lattice%species(c) /= lattice%species(b)) cycle
                if (abs(lattice%basis(3, c) - lattice%basis(3, b)) > 1.0e-9_wp) cycle
-               f = matmul(real(a, wp), matmul(inverse, lattice%basis(1:2, b))) &
-                  & - matmul(inverse, lattice%basis(1:2, c))
+               f = matmul(real(a, wp), fraction(:, b)) - fraction(:, c)
                if (all(abs(f - nint(f)) < 1.0e-9_wp)) keeps_atoms = .true.
             end do
             if (.not. keeps_atoms) return
@@ -1324,12 +1328,10 @@ contains
    pure function reflection_and_swap(ops) result(kept)
       integer, intent(in) :: ops(:, :, :)
       integer, allocatable :: kept(:, :, :)
-      integer, parameter :: identity(2, 2) = reshape([1, 0, 0, 1], [2, 2]), swap(2, 2) = reshape([0, 1, 1, 0], [2, 2])
-      integer :: m
+      integer :: basic(2, 2, 4), m
 
-      kept = ops(:, :, pack([(m, m = 1, size(ops, 3))], [(all(ops(:, :, m) == identity) &
-         & .or. all(ops(:, :, m) == -identity) .or. all(ops(:, :, m) == swap) .or. all(ops(:, :, m) == -swap), &
-         & m = 1, size(ops, 3))]))
+      basic = reshape([identity_op, -identity_op, swap_op, -swap_op], [2, 2, 4])
+      kept = ops(:, :, pack([(m, m = 1, size(ops, 3))], [(has_op(basic, ops(:, :, m)), m = 1, size(ops, 3))]))
    end function reflection_and_swap
 
    !> Whether a is among ops (point_group).
