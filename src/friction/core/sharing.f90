@@ -3,6 +3,7 @@
 !> the collective sum and maximum the pieces are put together with.  The
 !> base type is a process alone (its sum and maximum leave the values as
 !> they are); friction_scene_context extends it over a job's communicator.
+!> Every procedure is collective: all processes call it, in the same order.
 module friction_sharing
    use friction_kinds, only: wp
    implicit none
@@ -16,6 +17,7 @@ module friction_sharing
    contains
       procedure :: sum_reals
       procedure :: max_real
+      procedure :: every
    end type work_sharing
 
 contains
@@ -34,5 +36,11 @@ contains
       class(work_sharing), intent(inout) :: self
       real(wp), intent(inout) :: x
    end subroutine max_real
+
+   !> Whether `flag` holds on every process (in place).
+   subroutine every(self, flag)
+      class(work_sharing), intent(inout) :: self
+      logical, intent(inout) :: flag
+   end subroutine every
 
 end module friction_sharing

@@ -40,6 +40,7 @@ module friction_scene_context
    contains
       procedure :: sum_reals => mpi_sum_reals
       procedure :: max_real => mpi_max_real
+      procedure :: every => mpi_every
    end type mpi_sharing
 
 contains
@@ -70,6 +71,14 @@ contains
       if (self%comm == MPI_COMM_NULL .or. self%ranks < 2) return
       call MPI_Allreduce(MPI_IN_PLACE, x, 1, MPI_DOUBLE_PRECISION, MPI_MAX, self%comm)
    end subroutine mpi_max_real
+
+   subroutine mpi_every(self, flag)
+      class(mpi_sharing), intent(inout) :: self
+      logical, intent(inout) :: flag
+
+      if (self%comm == MPI_COMM_NULL .or. self%ranks < 2) return
+      call MPI_Allreduce(MPI_IN_PLACE, flag, 1, MPI_LOGICAL, MPI_LAND, self%comm)
+   end subroutine mpi_every
 
    !> Whether the job runs on MPI (false: serial, no MPI call may be made).
    logical function parallel(self)

@@ -87,7 +87,8 @@ module friction_surface_lennard_jones
       real(wp) :: box(4) = 0.0_wp
       integer :: verify_points = 4096   !! points checked against the direct sum
       !> build and evaluate through the kernels compiled for AVX2 where the
-      !> processor has it (the same bits: friction_surface_table_kernels)
+      !> processor of every process sharing the build has it (the same
+      !> values to rounding: friction_surface_table_kernels)
       logical :: wide_kernels = .true.
       !> compute the nodes of one column in each orbit of the lattice's
       !> whole point group (graphite: a twelfth), not only under s -> -s and
@@ -635,8 +636,16 @@ contains
       t%tolerance = settings%tolerance
       t%energy_window = settings%energy_window
       ! (The grid's flag also chooses the build's kernels, from before the
-      ! grid has nodes: column_values.)
-      t%grid%wide = settings%wide_kernels .and. friction_wide_kernels() /= 0
+      ! grid has nodes: column_values.)  The two copies round differently
+      ! (the wide one fuses multiplies and adds), so the processes that
+      ! share the build, and then the lines, take the wide copy only if
+      ! every one of them can: the nodes and the lines' bits must not depend
+      ! on which process computed them.
+      if (present(share)) then
+         t%grid%wide = all_can_go_wide(settings, share)
+      else
+         t%grid%wide = all_can_go_wide(settings, alone)
+      end if
       t%shift = lj_pair_energy(self%epsilon, self%sigma, self%cutoff)
       t%top = maxval(lattice%basis(3, :)) + self%cutoff
       t%ceiling = max(t%top, maxval(self%atoms%position(3, :)) + self%cutoff)
@@ -706,6 +715,16 @@ contains
       reason = 'the table missed the tolerance '//rtoa(settings%tolerance)//' eV/Å by '//rtoa(measured) &
          & //' eV/Å after three refinements'
    end subroutine tabulate
+
+   !> Whether every process of `share` is asked for, and can run, the table's
+   !> kernels for AVX2 (friction_surface_table_kernels).  Collective.
+   logical function all_can_go_wide(settings, share) result(wide)
+      type(table_settings), intent(in) :: settings
+      class(work_sharing), intent(inout) :: share
+
+      wide = settings%wide_kernels .and. friction_wide_kernels() /= 0
+      call share%every(wide)
+   end function all_can_go_wide
 
    !> The perfect lattice's sites within the cutoff (and a margin) of the
    !> cell spanned by its vectors at the origin, as a potential.

@@ -8,10 +8,11 @@
 !> Compiled twice: as friction_surface_table_kernels for every x86-64
 !> processor, and through table_kernels_wide.F90 as
 !> friction_surface_table_kernels_wide for those with AVX2 (x86-64-v3),
-!> which the table chooses at run time when the processor has it
-!> (lennard_jones.f90, `tabulate`).  The wide copy is compiled without
-!> fused multiply-adds and nothing here reorders a sum, so both give the
-!> same bits: only their speed differs (tests `table`).
+!> which the table chooses at run time when the processor of every process
+!> building it has it (lennard_jones.f90, `tabulate`).  The wide copy fuses
+!> multiplies and adds, which shortens the cell's polynomial's chain of
+!> dependent operations (the evaluation's cost), so the two copies agree to
+!> rounding, not bit for bit (tests `table`); nothing here reorders a sum.
 #ifndef TABLE_KERNELS
 #define TABLE_KERNELS friction_surface_table_kernels
 #endif
@@ -89,8 +90,8 @@ contains
          ! The pairs `column_lanes` at a time, each lane with running sums of
          ! its own, added up in a fixed order at the end: the lanes' loop
          ! vectorizes without reordering a sum the source does not (so the
-         ! kernels for every processor and for AVX2 give the same bits), and
-         ! without a branch (pairs beyond the cutoff get weight 0).
+         ! nodes do not depend on the vector width), and without a branch
+         ! (pairs beyond the cutoff get weight 0).
          acc = 0.0_wp
          do c = 1, n / column_lanes
             do l = 1, column_lanes

@@ -49,8 +49,9 @@ module friction_surface_tricubic
    type, extends(cell_grid) :: tricubic_grid
       !> node(:, i, j, k): the eight values of node (x0 + (i-1) hx, y0 + (j-1) hy, z(k))
       real(wp), allocatable :: node(:, :, :, :)
-      !> evaluate through the kernels compiled for AVX2 (the same bits,
-      !> faster; set only where the processor has it: friction_surface_table_kernels)
+      !> evaluate through the kernels compiled for AVX2 (faster, the same
+      !> values to rounding; set only where the processor has it:
+      !> friction_surface_table_kernels)
       logical :: wide = .false.
    contains
       procedure :: evaluate
