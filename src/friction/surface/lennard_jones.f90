@@ -55,11 +55,9 @@ module friction_surface_lennard_jones
    !> (copied, so that a list lies in one piece), entries start(c) ..
    !> start(c+1)-1.  Most of the tip's path has empty lists: no cell walk.
    type :: difference_lists
-      real(wp), allocatable :: position(:, :)
-      integer, allocatable :: species(:)
-      real(wp), allocatable :: weight(:)   !! +1 an atom the lattice lacks, -1 a site the net lacks
-      ! The same, one array per quantity, for difference_terms: x, y, z, σ²,
-      ! 4εw and φ(r_c)w.
+      !> one array per quantity, for difference_terms: the position x, y, z,
+      !> σ², 4εw and φ(r_c)w, with w = +1 an atom the lattice lacks, -1 a
+      !> site the net lacks
       real(wp), allocatable :: x(:), y(:), z(:), sigma2(:), e4w(:), shiftw(:)
       integer, allocatable :: start(:)
       real(wp) :: origin(2) = 0.0_wp, cell = 1.0_wp, inverse_cell = 1.0_wp
@@ -457,34 +455,45 @@ contains
       integer, intent(in) :: order
       logical, intent(out) :: answered
       real(wp), intent(out) :: v, g(3), h(3, 3)
-      real(wp) :: s(2), gs(3), hs(3, 3), m(2, 2)
       integer :: c
+
+      call lattice_answer(self%table, r, order, answered, v, g, h)
+      if (.not. answered) return
+      c = difference_cell(self%table%differences, r(1:2))
+      if (c > 0) call difference_sums(self, r, c, order, v, g, h)
+   end subroutine table_answers
+
+   !> table_answers without the differences: whether the table answers at r,
+   !> and the interpolated lattice's part of the answer.
+   pure subroutine lattice_answer(t, r, order, answered, v, g, h)
+      type(lj_table), intent(in) :: t
+      real(wp), intent(in) :: r(3)
+      integer, intent(in) :: order
+      logical, intent(out) :: answered
+      real(wp), intent(out) :: v, g(3), h(3, 3)
+      real(wp) :: s(2), gs(3), hs(3, 3), m(2, 2)
 
       v = 0.0_wp
       g = 0.0_wp
       h = 0.0_wp
-      associate (t => self%table)
-         answered = r(3) >= t%ceiling
-         if (answered .or. .not. table_holds(t, r)) return
-         if (r(3) < t%top) then
-            m = t%to_fraction
-            s = cell_fraction(t%to_fraction, r(1:2))
-            ! (order 0: the energy alone; the cap needs it in any case)
-            call t%grid%evaluate([s(1), s(2), r(3)], order, v, gs, hs)
-            if (v > t%energy_cap) return
-            if (order >= 1) g = from_fraction(t%to_fraction, gs)
-            if (order >= 2) then
-               h(1:2, 1:2) = matmul(transpose(m), matmul(hs(1:2, 1:2), m))
-               h(1:2, 3) = matmul(transpose(m), hs(1:2, 3))
-               h(3, 1:2) = h(1:2, 3)
-               h(3, 3) = hs(3, 3)
-            end if
+      answered = r(3) >= t%ceiling
+      if (answered .or. .not. table_holds(t, r)) return
+      if (r(3) < t%top) then
+         m = t%to_fraction
+         s = cell_fraction(t%to_fraction, r(1:2))
+         ! (order 0: the energy alone; the cap needs it in any case)
+         call t%grid%evaluate([s(1), s(2), r(3)], order, v, gs, hs)
+         if (v > t%energy_cap) return
+         if (order >= 1) g = from_fraction(t%to_fraction, gs)
+         if (order >= 2) then
+            h(1:2, 1:2) = matmul(transpose(m), matmul(hs(1:2, 1:2), m))
+            h(1:2, 3) = matmul(transpose(m), hs(1:2, 3))
+            h(3, 1:2) = h(1:2, 3)
+            h(3, 3) = hs(3, 3)
          end if
-         answered = .true.
-         c = difference_cell(t%differences, r(1:2))
-         if (c > 0) call difference_sums(self, r, c, order, v, g, h)
-      end associate
-   end subroutine table_answers
+      end if
+      answered = .true.
+   end subroutine lattice_answer
 
    !> The list (difference_lists' cell) of the differences near xy (Å),
    !> within the lists' region or at its edge; 0 when that list is empty.
@@ -507,8 +516,8 @@ contains
       real(wp), intent(in) :: r(3)
       integer, intent(in) :: c, order
       real(wp), intent(inout) :: v, g(3), h(3, 3)
-      real(wp) :: d(3), r2, rc2, s6, w, dv, dg(3)
-      integer :: i, s
+      real(wp) :: d(3), r2, rc2, s6, dv, dg(3)
+      integer :: i
 
       rc2 = self%cutoff**2
       associate (list => self%table%differences)
@@ -521,16 +530,15 @@ contains
             g = g + dg
             return
          end if
+         ! (w ε = 4εw / 4 exactly, and w = ±1 multiplies exactly: the same
+         ! terms as the direct sum's with w applied last.)
          do i = list%start(c), list%start(c + 1) - 1
-            d = r - list%position(:, i)
+            d = r - [list%x(i), list%y(i), list%z(i)]
             r2 = d(1)**2 + d(2)**2 + d(3)**2
             if (r2 >= rc2) cycle
-            s = list%species(i)
-            w = list%weight(i)
-            s6 = (self%sigma(s)**2 / r2)**3
-            v = v + w * (4.0_wp * self%epsilon(s) * (s6 * s6 - s6) - self%table%shift(s))
-            if (order < 1) cycle
-            call add_pair_derivatives(w * self%epsilon(s), s6, r2, d, order, g, h)
+            s6 = (list%sigma2(i) / r2)**3
+            v = v + (list%e4w(i) * (s6 * s6 - s6) - list%shiftw(i))
+            call add_pair_derivatives(0.25_wp * list%e4w(i), s6, r2, d, order, g, h)
          end do
       end associate
    end subroutine difference_sums
@@ -783,15 +791,9 @@ contains
             weight(n) = 1.0_wp
          end do
       end associate
-      t%differences = new_difference_lists(position(:, 1:n), species(1:n), weight(1:n), self%cutoff, region)
-      associate (list => t%differences)
-         list%x = list%position(1, :)
-         list%y = list%position(2, :)
-         list%z = list%position(3, :)
-         list%sigma2 = self%sigma(list%species)**2
-         list%e4w = 4.0_wp * self%epsilon(list%species) * list%weight
-         list%shiftw = t%shift(list%species) * list%weight
-      end associate
+      call fill_difference_lists(position(:, 1:n), self%sigma(species(1:n))**2, &
+         & 4.0_wp * self%epsilon(species(1:n)) * weight(1:n), t%shift(species(1:n)) * weight(1:n), self%cutoff, &
+         & region, t%differences)
       t%difference_count = n
 
    contains
@@ -824,15 +826,15 @@ contains
 
    !> The lists of the differences (see difference_lists) over `region`
    !> (x_min, x_max, y_min, y_max, Å), in cells of 2 Å (or r_c/3 if smaller):
-   !> a list holds the atoms within r_c plus half the cell's diagonal of its
-   !> centre, some 20 % more than the disc of r_c holds.
-   function new_difference_lists(position, species, weight, cutoff, region) result(self)
-      real(wp), intent(in) :: position(:, :), weight(:), cutoff, region(4)
-      integer, intent(in) :: species(:)
-      type(difference_lists) :: self
+   !> a list holds the differences within r_c plus half the cell's diagonal
+   !> of its centre, some 20 % more than the disc of r_c holds.  Difference
+   !> i is at position(:, i), with σ², 4εw and φ(r_c)w of its species.
+   subroutine fill_difference_lists(position, sigma2, e4w, shiftw, cutoff, region, self)
+      real(wp), intent(in) :: position(:, :), sigma2(:), e4w(:), shiftw(:), cutoff, region(4)
+      type(difference_lists), intent(out) :: self
       real(wp) :: centre(2), reach
-      integer :: cx, cy, c, i, total, pass, lo(2), hi(2)
-      integer, allocatable :: next(:)
+      integer :: cx, cy, c, i, pass, lo(2), hi(2)
+      integer, allocatable :: next(:), member(:)
 
       self%cell = min(2.0_wp, cutoff / 3.0_wp)
       self%inverse_cell = 1.0_wp / self%cell
@@ -842,10 +844,10 @@ contains
       allocate (self%start(self%ncell(1) * self%ncell(2) + 1), next(self%ncell(1) * self%ncell(2)))
       ! Two passes over the differences, each to the cells whose centre is
       ! within reach (a list in the differences' order): the lists'
-      ! lengths, then their entries.
+      ! lengths, then which difference each entry is.
       self%start = 0
       do pass = 1, 2
-         do i = 1, size(species)
+         do i = 1, size(sigma2)
             lo = max(0, floor((position(1:2, i) - reach - self%origin) / self%cell - 0.5_wp))
             hi = min(self%ncell - 1, ceiling((position(1:2, i) + reach - self%origin) / self%cell - 0.5_wp))
             do cy = lo(2), hi(2)
@@ -857,9 +859,7 @@ contains
                      self%start(c + 1) = self%start(c + 1) + 1
                      cycle
                   end if
-                  self%position(:, next(c)) = position(:, i)
-                  self%species(next(c)) = species(i)
-                  self%weight(next(c)) = weight(i)
+                  member(next(c)) = i
                   next(c) = next(c) + 1
                end do
             end do
@@ -870,10 +870,15 @@ contains
             self%start(c + 1) = self%start(c) + self%start(c + 1)
          end do
          next = self%start(1:size(next))
-         total = self%start(size(self%start)) - 1
-         allocate (self%position(3, total), self%species(total), self%weight(total))
+         allocate (member(self%start(size(self%start)) - 1))
       end do
-   end function new_difference_lists
+      self%x = position(1, member)
+      self%y = position(2, member)
+      self%z = position(3, member)
+      self%sigma2 = sigma2(member)
+      self%e4w = e4w(member)
+      self%shiftw = shiftw(member)
+   end subroutine fill_difference_lists
 
    !> Whether, within the cutoff of the middle of the table's box, there are
    !> more differences than atoms of the net: then every evaluation would
@@ -888,7 +893,7 @@ contains
       associate (list => t%differences)
          c = difference_cell(list, middle)
          differences = 0
-         if (c > 0) differences = count([(sum((list%position(1:2, i) - middle)**2) < self%cutoff**2, &
+         if (c > 0) differences = count([((list%x(i) - middle(1))**2 + (list%y(i) - middle(2))**2 < self%cutoff**2, &
             & i = list%start(c), list%start(c + 1) - 1)])
       end associate
       atoms = 0
@@ -1512,11 +1517,15 @@ contains
             u = (nz - 1) * halton(tried + 20, 5)
             k = min(nz - 1, int(u) + 1)
             r(3) = t%grid%z(k) + (u - (k - 1)) * (t%grid%z(k + 1) - t%grid%z(k))
-            call self%table_answers(r, 1, answered, v, g, h)
+            ! (Whether the table answers needs the lattice's energy alone;
+            ! the points dealt round-robin over the processes, each its
+            ! points' answers, the differences' sums with them, and direct
+            ! sums; the largest error of all.)
+            call lattice_answer(t, r, 0, answered, v, g, h)
             if (.not. answered) cycle
             counted = counted + 1
-            ! (The points dealt round-robin over the processes; the largest error of all.)
             if (mod(counted - 1, share%ranks) /= share%rank) cycle
+            call self%table_answers(r, 1, answered, v, g, h)
             call sum_pairs(self, r, 1, v, gd, h)
             measured = max(measured, norm2(g - gd))
          end do
