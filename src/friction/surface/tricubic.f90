@@ -36,6 +36,7 @@ module friction_surface_tricubic
    use friction_surface_table_kernels, only: power_polynomial, find_layer, image_point, lateral_back, &
       & n_cell_coefficients
    use friction_surface_table_kernels_wide, only: power_polynomial_wide => power_polynomial
+   use, intrinsic :: iso_c_binding, only: c_size_t
    implicit none
    private
 
@@ -43,6 +44,17 @@ module friction_surface_tricubic
 
    !> Values per node: f, f_x, f_y, f_z, f_xy, f_xz, f_yz, f_xyz.
    integer, parameter :: n_node_values = 8
+
+   interface
+      !> The whole pages of the `bytes` from `p` backed with memory at once
+      !> (pages.c): a trap per page at the first touch costs the table's
+      !> build some 2 µs a page.  Pure: no value the program sees changes.
+      pure subroutine populate(p, bytes) bind(c, name='friction_populate')
+         import :: c_size_t
+         type(*), intent(in) :: p(*)
+         integer(c_size_t), value, intent(in) :: bytes
+      end subroutine populate
+   end interface
 
    !> The grid: its axes, layers and cells' polynomials (cell_grid), and
    !> the nodes' values.
@@ -82,7 +94,9 @@ contains
       grid%inverse_hx = 1.0_wp / hx
       grid%inverse_hy = 1.0_wp / hy
       grid%inverse_dz = 1.0_wp / (z(2:) - z(:size(z) - 1))
-      allocate (grid%node(n_node_values, nx, ny, size(z)), source=0.0_wp)
+      allocate (grid%node(n_node_values, nx, ny, size(z)))
+      call populate(grid%node, storage_size(grid%node, c_size_t) / 8 * size(grid%node, kind=c_size_t))
+      grid%node = 0.0_wp
       nbins = max(1, min(1000000, ceiling((z(size(z)) - z(1)) / minval(z(2:) - z(:size(z) - 1)))))
       grid%bin_width = (z(size(z)) - z(1)) / nbins
       grid%inverse_bin = 1.0_wp / grid%bin_width
@@ -204,6 +218,7 @@ contains
          end do
       end do
       allocate (self%cell(n_cell_coefficients, self%slots * (size(self%z) - 1)))
+      call populate(self%cell, storage_size(self%cell, c_size_t) / 8 * size(self%cell, kind=c_size_t))
       do k = 1, size(self%z) - 1
          do j = 0, m - 1
             do i = 0, n - 1
