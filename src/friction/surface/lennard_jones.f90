@@ -19,7 +19,7 @@
 module friction_surface_lennard_jones
    use friction_kinds, only: wp, pi
    use friction_surface_potential, only: surface_potential
-   use friction_surface_net, only: crystal_net, net_lattice
+   use friction_surface_net, only: crystal_net, net_lattice, fraction_map
    use friction_surface_tricubic, only: tricubic_grid, new_tricubic_grid, n_node_values
    use friction_surface_table_kernels, only: column_sums, difference_terms, column_lanes, lattice_gradient, &
       & cell_fraction, from_fraction
@@ -314,7 +314,9 @@ contains
    end subroutine gradient
 
    !> table_answers' gradient alone (the hot path of a tabulated surface):
-   !> the same answer, the same bits.
+   !> the same answer, bit for bit with the plain kernels and to rounding
+   !> with the AVX2 ones, whose fused multiply-adds may fall differently in
+   !> the two paths (tests `table`).
    pure subroutine table_gradient(self, r, answered, g)
       class(lj_potential), intent(in) :: self
       real(wp), intent(in) :: r(3)
@@ -626,7 +628,7 @@ contains
          reason = 'the lattice vectors are parallel'
          return
       end if
-      t%to_fraction = reshape([t%vectors(2, 2), -t%vectors(2, 1), -t%vectors(1, 2), t%vectors(1, 1)], [2, 2]) / det
+      t%to_fraction = fraction_map(t%vectors)
       t%box = settings%box
       ! A lattice so dense that a node would sum more pairs than this, or a
       ! box holding more sites, costs more to tabulate than it saves.
@@ -1288,15 +1290,12 @@ contains
       type(net_lattice), intent(in) :: lattice
       integer, allocatable :: ops(:, :, :)
       integer :: found(2, 2, 81), a(2, 2), k, n, e(4)
-      real(wp) :: metric(2, 2), det
+      real(wp) :: metric(2, 2)
       !> the basis atoms' fractional coordinates in the plane
       real(wp) :: fraction(2, size(lattice%species))
 
       metric = matmul(transpose(lattice%vectors), lattice%vectors)
-      associate (v => lattice%vectors)
-         det = v(1, 1) * v(2, 2) - v(1, 2) * v(2, 1)
-         fraction = matmul(reshape([v(2, 2), -v(2, 1), -v(1, 2), v(1, 1)], [2, 2]) / det, lattice%basis(1:2, :))
-      end associate
+      fraction = matmul(fraction_map(lattice%vectors), lattice%basis(1:2, :))
       n = 0
       do k = 0, 80
          e = [mod(k / 27, 3), mod(k / 9, 3), mod(k / 3, 3), mod(k, 3)] - 1
@@ -1428,7 +1427,7 @@ contains
             if (.not. first(i, j)) cycle
             dealt = dealt + 1
             from(i, j) = dealt
-            map(:, :, i, j) = reshape([1, 0, 0, 1], [2, 2])
+            map(:, :, i, j) = identity_op
             do m = 1, size(ops, 3)
                if (.not. usable(m)) cycle
                q = image(m, i, j)

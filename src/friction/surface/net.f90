@@ -16,7 +16,7 @@ module friction_surface_net
    private
 
    public :: crystal_net, graphite_net, square_net, read_xyz, write_xyz, vacancy_mark, sort_order, max_local_density, &
-      & first_duplicate, net_lattice, graphite_lattice, square_lattice, detect_lattice
+      & first_duplicate, net_lattice, graphite_lattice, square_lattice, detect_lattice, fraction_map
 
    !> Species label that marks a vacant site in an XYZ file.
    character(len=*), parameter :: vacancy_mark = 'X'
@@ -72,21 +72,30 @@ contains
       lattice%species = [1]
    end function square_lattice
 
+   !> The map from a point (x, y) of the plane to its fractional
+   !> coordinates s in the lattice vectors (vectors(:, i), not parallel):
+   !> s = m (x, y), m the inverse of the matrix whose columns they are.
+   pure function fraction_map(vectors) result(m)
+      real(wp), intent(in) :: vectors(2, 2)
+      real(wp) :: m(2, 2)
+
+      associate (v => vectors)
+         m = reshape([v(2, 2), -v(2, 1), -v(1, 2), v(1, 1)], [2, 2]) / (v(1, 1) * v(2, 2) - v(1, 2) * v(2, 1))
+      end associate
+   end function fraction_map
+
    !> The sites of the lattice whose (x, y) lie in box = (x_min, x_max,
    !> y_min, y_max), Å, with their species, as a net.
    pure function lattice_sites(self, box) result(net)
       class(net_lattice), intent(in) :: self
       real(wp), intent(in) :: box(4)
       type(crystal_net) :: net
-      real(wp) :: inverse(2, 2), corner(2), s(2), lower(2), upper(2), p(2), det
+      real(wp) :: inverse(2, 2), corner(2), s(2), lower(2), upper(2), p(2)
       integer :: i, j, b, k, n, lo(2), hi(2)
       real(wp), allocatable :: position(:, :)
       integer, allocatable :: species(:)
 
-      associate (v => self%vectors)
-         det = v(1, 1) * v(2, 2) - v(1, 2) * v(2, 1)
-         inverse = reshape([v(2, 2), -v(2, 1), -v(1, 2), v(1, 1)], [2, 2]) / det
-      end associate
+      inverse = fraction_map(self%vectors)
       ! The range of cell indices whose cells can reach into the box.
       lower = huge(1.0_wp)
       upper = -huge(1.0_wp)
@@ -173,7 +182,7 @@ contains
          integer, allocatable :: local(:), lengths(:)
          real(wp), allocatable :: candidates(:, :), averaged(:, :)
          logical, allocatable :: accepted(:)
-         real(wp) :: t(3), total(2), inverse(2, 2), det, f(2), cross
+         real(wp) :: t(3), total(2), inverse(2, 2), f(2), cross
          integer :: m, i, j, found, partner, nc, first, second, most
          integer, allocatable :: class_of(:), count_of(:)
          real(wp), allocatable :: class_position(:, :)
@@ -225,10 +234,7 @@ contains
          lattice%vectors(:, 1) = averaged(:, first)
          lattice%vectors(:, 2) = averaged(:, second) * sign(1.0_wp, &
             & averaged(1, first) * averaged(2, second) - averaged(2, first) * averaged(1, second))
-         associate (v => lattice%vectors)
-            det = v(1, 1) * v(2, 2) - v(1, 2) * v(2, 1)
-            inverse = reshape([v(2, 2), -v(2, 1), -v(1, 2), v(1, 1)], [2, 2]) / det
-         end associate
+         inverse = fraction_map(lattice%vectors)
          ! The basis: the atoms' positions in the cell of o, by species.
          allocate (class_of(m), count_of(m), class_position(3, m), class_species(m))
          most = 0

@@ -338,7 +338,8 @@ contains
    !> which must be set: the cell, its layer, its image and the polynomial
    !> in one routine.  Points outside the grid get the end cells'
    !> polynomials.  The same operations as power_polynomial's order 1
-   !> (friction_surface_tricubic's evaluate), so the same bits.
+   !> (friction_surface_tricubic's evaluate): the same bits in the plain
+   !> copy; in the wide one the compiler may fuse them differently.
    pure subroutine grid_gradient(grid, x, y, z, v, g)
       type(cell_grid), intent(in) :: grid
       real(wp), intent(in) :: x, y, z
