@@ -28,7 +28,13 @@
  *
  * Threads.  Handles are independent, and threads may work at once, each on
  * its own handles (configuration, result, error).  A handle must not be used
- * by two threads at once.  The state shared between calls is a
+ * by two threads at once.  Functions that take a `const` handle only read it;
+ * two threads may read one configuration at once only through those.  The
+ * computing functions (friction_afm_line, friction_compute,
+ * friction_compute_progress) take a non-const configuration: they keep the
+ * surface they built in it for the next call, so a configuration shared by
+ * threads that compute needs the caller's lock, or one copy per thread
+ * (friction_config_text and friction_config_read make one).  The state shared between calls is a
  * mutex-guarded count of the threads inside GSL, so that the host's GSL
  * handler is back when the last of them returns, and a lock that runs the
  * job functions one at a time: they use HDF5, FFTW's planner and MPI, which
@@ -162,7 +168,7 @@ int friction_config_check(const friction_config *cfg, friction_error *err);
  * computation while &surface and the scan's rectangle stay as they were:
  * a later line of the graphite map costs the line alone.  friction_config_free
  * releases it. */
-int friction_afm_line(const friction_config *cfg, int line, int forward, double *fx, double *fy, size_t n,
+int friction_afm_line(friction_config *cfg, int line, int forward, double *fx, double *fy, size_t n,
                       friction_error *err);
 
 /* The configuration's whole computation on the calling process, checked
@@ -181,7 +187,7 @@ int friction_afm_line(const friction_config *cfg, int line, int forward, double 
  *          for jobs: friction_run_config.)
  * A configuration with a &sweep is refused: run it with friction_run_config.
  * The afm surface is kept in the configuration as by friction_afm_line. */
-friction_result *friction_compute(const friction_config *cfg, friction_error *err);
+friction_result *friction_compute(friction_config *cfg, friction_error *err);
 
 /* Progress of a computation on the calling process: "12 of 48 lines" or
  * "τ = 120.0 of 1000.0", fraction in [0, 1].  A nonzero return asks the
@@ -198,7 +204,7 @@ typedef int (*friction_progress_fn)(const char *message, double fraction, void *
  * threads go on.  To stop from elsewhere (a signal handler, another thread,
  * a Cancel button) set a flag there and return it from `progress`.  With
  * progress = NULL it is friction_compute. */
-friction_result *friction_compute_progress(const friction_config *cfg, friction_progress_fn progress, void *user,
+friction_result *friction_compute_progress(friction_config *cfg, friction_progress_fn progress, void *user,
                                            friction_error *err);
 
 /* Copy the array `name` into out[0..n-1] as doubles, maps row-major (ny, nx):

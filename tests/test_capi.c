@@ -383,7 +383,7 @@ static void check_results(friction_error *err) {
   expect_input_error(friction_afm_line(cfg, 3, 1, fx, fy, 16, err), err, "line = 3: the map has lines 0 to 2",
                      "line beyond the map");
   expect_input_error(friction_afm_line(cfg, -1, 1, fx, fy, 16, err), err, "line = -1", "negative line");
-  expect_input_error(friction_afm_line(brake, 0, 1, fx, fy, 16, err), err, "scene 'afm', not 'brake'",
+  expect_input_error(friction_afm_line(brake, 0, 1, fx, fy, 16, err), err, "scene 'brake' is not made of scan lines",
                      "afm_line of the brake");
   fx[0] = 12345.0;
   CHECK(friction_afm_line(cfg, 0, 1, fx, fy, 15, err) != FRICTION_OK && fx[0] == 12345.0, "a refused line wrote");

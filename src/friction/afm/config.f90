@@ -22,14 +22,19 @@ module friction_afm_config
    use friction_ode_settings, only: visit_integrator, check_integrator, verify_settings, visit_verify, check_verify
    use friction_afm_thermal, only: thermal_settings
    use friction_afm_langevin, only: langevin_time_step, largest_curvature
-   use friction_ode_auto, only: oscillator_rate
+   use friction_ode_auto, only: oscillator_rate, stiff_choice
    use friction_afm_kramers, only: kmc_barrier_floor
    implicit none
    private
 
    public :: afm_config, potential_names, net_names, tip_model_names, new_potential, new_tip, new_tip_owning, &
       & net_sites, max_species, max_defects, species_count, surface_curvature, thermal_step_limit, tip_stiffness, &
-      & evaluation_names, surface_evaluation, table_energy_window, table_reach, scan_region
+      & evaluation_names, surface_evaluation, table_energy_window, table_reach, scan_region, auto_method
+   public :: surface_naf, surface_hopg, surface_lattice_sum
+
+   !> &surface potential as a kind (afm_config's surface_kind): the analytic
+   !> NaF (Eq. 1) and HOPG (Eq. 2) surfaces, the Lennard-Jones lattice sum (Eq. 3).
+   integer, parameter :: surface_naf = 1, surface_hopg = 2, surface_lattice_sum = 3
 
    character(len=*), parameter :: potential_names(3) = [character(len=4) :: 'naf', 'hopg', 'lj']
    character(len=*), parameter :: net_names(3) = [character(len=8) :: 'graphite', 'square', 'file']
@@ -110,6 +115,9 @@ module friction_afm_config
    contains
       procedure :: visit
       procedure :: validate
+      procedure :: surface_kind
+      procedure :: tip_model
+      procedure :: moves_in_3d
       procedure :: scan_direction
       procedure :: across_direction
    end type afm_config
@@ -666,6 +674,27 @@ contains
       if (allocated(error)) limit = 0.0_wp
    end function thermal_step_limit
 
+   !> The stepper method = 'auto' runs: an implicit one where the tip is stiff
+   !> (friction_ode_auto's rules on tip_stiffness), else the explicit pair the
+   !> surface's work-precision chart shows fastest at this rtol (docs/speed.md).
+   function auto_method(config) result(method)
+      type(afm_config), intent(in) :: config
+      character(len=16) :: method
+      real(wp) :: rtol
+
+      rtol = config%solver%rtol
+      method = stiff_choice(rtol, tip_stiffness(config))
+      if (len_trim(method) > 0) return
+      select case (config%surface_kind())
+      case (surface_hopg)
+         method = merge('rkck ', 'rk8pd', rtol >= 1.0e-6_wp)
+      case (surface_lattice_sum)
+         method = 'rk8pd'
+      case default
+         method = merge('rkck ', 'rk8pd', rtol >= 1.0e-7_wp)
+      end select
+   end function auto_method
+
    !> The stiffness S of the scan for method = 'auto' (friction_ode_auto):
    !> the largest decay rate of the tip linearised anywhere on the surface
    !> times the time between two samples.  Per direction the rate is that of
@@ -684,7 +713,7 @@ contains
       integer :: i
 
       stiffness = 0.0_wp
-      if (config%model == 'quasistatic' .or. config%potential == 'lj') return
+      if (config%tip_model() == model_quasistatic .or. config%moves_in_3d()) return
       if (config%nx < 2 .or. .not. config%velocity > 0.0_wp) return
       call new_potential(config, potential, error)
       if (allocated(error)) return
@@ -725,6 +754,44 @@ contains
       call set_up_tip(config, tip)
    end subroutine new_tip_owning
 
+   !> &surface potential as a kind (surface_naf, surface_hopg or
+   !> surface_lattice_sum); the names are compared here and in the checks only.
+   pure integer function surface_kind(self) result(kind)
+      class(afm_config), intent(in) :: self
+
+      select case (trim(self%potential))
+      case ('hopg')
+         kind = surface_hopg
+      case ('lj')
+         kind = surface_lattice_sum
+      case default
+         kind = surface_naf
+      end select
+   end function surface_kind
+
+   !> &tip model as a kind (friction_afm_tip's model_inertial,
+   !> model_overdamped or model_quasistatic).
+   pure integer function tip_model(self) result(kind)
+      class(afm_config), intent(in) :: self
+
+      select case (trim(self%model))
+      case ('overdamped')
+         kind = model_overdamped
+      case ('quasistatic')
+         kind = model_quasistatic
+      case default
+         kind = model_inertial
+      end select
+   end function tip_model
+
+   !> Whether the surface moves the tip in three dimensions (the lattice sum:
+   !> the tip's height is free), so the tip has a z axis with its spring and damper.
+   pure logical function moves_in_3d(self)
+      class(afm_config), intent(in) :: self
+
+      moves_in_3d = self%surface_kind() == surface_lattice_sum
+   end function moves_in_3d
+
    !> The tip's model and constants around its potential (new_tip).
    subroutine set_up_tip(config, tip)
       type(afm_config), intent(in) :: config
@@ -734,15 +801,9 @@ contains
       tip%mass = config%mass * kg_to_internal
       tip%spring = [config%kx, config%ky, config%kz] * n_per_m_to_internal
       tip%damping = [config%cx, config%cy, config%cz] * ns_per_m_to_internal
-      select case (trim(config%model))
-      case ('overdamped')
-         tip%model = model_overdamped
-      case ('quasistatic')
-         tip%model = model_quasistatic
-         if (.not. all(tip%damping(1:tip%ndim) > 0.0_wp)) tip%damping = 1.0e-3_wp * ns_per_m_to_internal
-      case default
-         tip%model = model_inertial
-      end select
+      tip%model = config%tip_model()
+      if (tip%model == model_quasistatic .and. .not. all(tip%damping(1:tip%ndim) > 0.0_wp)) &
+         & tip%damping = 1.0e-3_wp * ns_per_m_to_internal
    end subroutine set_up_tip
 
 end module friction_afm_config

@@ -8,7 +8,7 @@ module friction_afm_netlist
       & ns_per_m_to_internal
    use friction_error, only: error_type, fatal_error, error_input
    use friction_netlist_spice, only: nl, tolerances, control_end, num
-   use friction_afm_config, only: afm_config
+   use friction_afm_config, only: afm_config, surface_naf, surface_hopg
    use friction_afm_scan, only: line_offset
    implicit none
    private
@@ -28,15 +28,15 @@ contains
       character(len=:), allocatable :: gradient_x, gradient_y, surface
       real(wp) :: along(3), start(3), sample_time, trip_time
 
-      select case (trim(c%potential))
-      case ('naf')
+      select case (c%surface_kind())
+      case (surface_naf)
          surface = '* Surface: NaF(001), Eq. 1: V = -v0 cos(qx x) cos(qy y), qx = 2 pi/ax, qy = 2 pi/ay.'//nl &
             & //'.param v0 = '//num(c%v0)//nl &
             & //'.param qx = '//num(2.0_wp * pi / c%ax)//nl &
             & //'.param qy = '//num(2.0_wp * pi / c%ay)
          gradient_x = 'v0*qx*sin(qx*V(xt))*cos(qy*V(yt))'
          gradient_y = 'v0*qy*cos(qx*V(xt))*sin(qy*V(yt))'
-      case ('hopg')
+      case (surface_hopg)
          surface = '* Surface: HOPG, Eq. 2: V = -v0 [2 cos(qx x) cos(qy y) + cos(2 qy y)],'//nl &
             & //'* qx = 2 pi/a, qy = 2 pi/(a sqrt 3).'//nl &
             & //'.param v0 = '//num(c%v0)//nl &
@@ -44,13 +44,10 @@ contains
             & //'.param qy = '//num(2.0_wp * pi / (c%a * sqrt(3.0_wp)))
          gradient_x = '2*v0*qx*sin(qx*V(xt))*cos(qy*V(yt))'
          gradient_y = '2*v0*qy*(cos(qx*V(xt))*sin(qy*V(yt)) + sin(2*qy*V(yt)))'
-      case ('lj')
-         call fatal_error(error, "--netlist: &surface potential = 'lj' (the graphite Lennard-Jones lattice sum, " &
-            & //'Eq. 3) is not supported: a sum over hundreds of atoms as behavioural sources is impractical ' &
-            & //"in SPICE; the network model covers 'naf' and 'hopg'", error_input)
-         return
       case default
-         call fatal_error(error, "--netlist: unknown potential '"//trim(c%potential)//"'", error_input)
+         call fatal_error(error, "--netlist: &surface potential = '"//trim(c%potential)//"' (the graphite " &
+            & //'Lennard-Jones lattice sum, Eq. 3) is not supported: a sum over hundreds of atoms as behavioural ' &
+            & //"sources is impractical in SPICE; the network model covers 'naf' and 'hopg'", error_input)
          return
       end select
 

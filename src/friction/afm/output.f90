@@ -12,6 +12,7 @@ module friction_afm_output
    use friction_output_parameters, only: write_parameter_attributes
    use friction_output_summary, only: run_summary, write_run_attributes
    use friction_surface_net, only: crystal_net
+   use friction_afm_tip, only: model_quasistatic
    use friction_strings, only: join
    implicit none
    private
@@ -216,7 +217,7 @@ contains
             call file%write_line_block(group//'/'//trim(quantity_names(q))//tail, values(:, :, q), &
                & config%ny, first, stride, trim(quantity_units(q)))
          end do
-         if (config%model == 'quasistatic') call file%write_line_block(group//'/'//trim(quantity_names(q_jumps)) &
+         if (config%tip_model() == model_quasistatic) call file%write_line_block(group//'/'//trim(quantity_names(q_jumps)) &
             & //tail, values(:, :, q_jumps), config%ny, first, stride, trim(quantity_units(q_jumps)))
       end subroutine write_trips
 

@@ -294,7 +294,7 @@ contains
       call self%solver%init(self%tip, config%solver, self%h_start, error)
       if (allocated(error)) return
       self%thermal = config%thermal%enabled()
-      self%kramers = self%thermal .and. config%thermal%model == 'kramers'
+      self%kramers = self%thermal .and. config%thermal%reduced()
       if (self%thermal .and. .not. self%kramers) call init_thermal()
 
    contains

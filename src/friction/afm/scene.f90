@@ -12,17 +12,20 @@ module friction_afm_scene
    use friction_checks, only: config_checker
    use friction_clock, only: wall_seconds
    use friction_ode_solver, only: integrator_statistics
-   use friction_ode_auto, only: auto_name, auto_method
+   use friction_ode_auto, only: auto_name
    use friction_ode_settings, only: verify_solver
    use friction_surface_potential, only: surface_potential
    use friction_output_summary, only: run_summary
-   use friction_scene, only: scene, point_result, point_memory
+   use friction_scene, only: scene, point_result, point_memory, result_sink
    use friction_scene_report, only: job_reporter
    use friction_scene_context, only: job_context, agree_on_error, ranks_text, share_of, job_wall_time, &
       & job_sharing, mpi_sharing
-   use friction_afm_config, only: afm_config, new_potential, species_count, tip_stiffness, scan_region
-   use friction_afm_scan, only: afm_scanner, line_record, slip_list, n_quantities, q_fx, q_fy, q_f_along, q_fz
-   use friction_afm_output, only: write_afm_file, afm_surface_record, afm_thermal_record, afm_verify_record
+   use friction_afm_tip, only: model_overdamped, model_quasistatic
+   use friction_afm_config, only: afm_config, auto_method, new_potential, species_count, scan_region
+   use friction_afm_scan, only: afm_scanner, line_record, trip_record, slip_list, n_quantities, q_fx, q_fy, &
+      & q_f_along, q_fz, q_jumps, quantity_names, quantity_count, support_along, support_across
+   use friction_afm_output, only: write_afm_file, afm_surface_record, afm_thermal_record, afm_verify_record, &
+      & line_friction
    use friction_afm_validity, only: afm_model_warnings, quasistatic_friction_warning
    use friction_afm_netlist, only: afm_netlist
    use friction_afm_line_checkpoint, only: line_checkpoint_name, save_line, load_line, publish_checkpoints, &
@@ -67,6 +70,8 @@ module friction_afm_scene
       procedure :: point_results => afm_point_results
       procedure :: point_series => afm_point_series
       procedure :: run_point => afm_run_point
+      procedure :: compute => afm_compute
+      procedure :: compute_line => afm_compute_line
       procedure :: netlist => afm_netlist_text
       procedure :: verifies => afm_verifies
       procedure :: resolved
@@ -121,8 +126,7 @@ contains
       type(afm_config) :: c
 
       c = self%config
-      if (c%solver%method == auto_name) c%solver%method = auto_method('afm', c%potential, c%solver%rtol, &
-         & tip_stiffness(c))
+      if (c%solver%method == auto_name) c%solver%method = auto_method(c)
    end function resolved
 
    !> The stepper that runs; at a temperature the Langevin scheme.
@@ -142,9 +146,9 @@ contains
       type(afm_config), intent(in) :: c
       character(len=:), allocatable :: name
 
-      if (c%thermal%model == 'kramers') then
+      if (c%thermal%reduced()) then
          name = 'kramers-kmc'
-      else if (c%model == 'overdamped') then
+      else if (c%tip_model() == model_overdamped) then
          name = 'leimkuhler-matthews'
       else
          name = 'baoab'
@@ -185,7 +189,7 @@ contains
          if (allocated(error)) return
          ! A reduced tip model outside where it holds (docs/physics.md, reduced tip models):
          ! one note per reason.
-         if (job%rank == 0 .and. c%potential == 'lj') then
+         if (job%rank == 0 .and. c%moves_in_3d()) then
             if (len(self%surface%evaluation%note) > 0) call reporter%note("note: &surface evaluation = 'table': " &
                & //'the direct sum instead: '//self%surface%evaluation%note)
          end if
@@ -277,7 +281,7 @@ contains
          end if
          if (c%check%enabled) call verify_map(error)
          if (allocated(error)) return
-         if (c%model == 'quasistatic') call check_friction()
+         if (c%tip_model() == model_quasistatic) call check_friction()
          if (scanner%thermal) call gather_slips()
 
          ! The counts of every line, computed now or loaded: a resumed map
@@ -645,6 +649,133 @@ contains
       allocate (series(0))
       call afm_friction(self%resolved(), results(1), results(2), error, memory)
    end subroutine afm_run_point
+
+   !> The whole map on this process: every line's trace (and retrace), as
+   !> the program's file holds them under /afm; at a temperature the means
+   !> over the realizations, and NAME_sem beside every NAME.  The surface
+   !> is memory's when it still holds (take_surface), and left in it.
+   subroutine afm_compute(self, sink, memory, reporter, error)
+      class(afm_scene), intent(inout) :: self
+      class(result_sink), intent(inout) :: sink
+      type(point_memory), intent(inout) :: memory
+      class(job_reporter), intent(inout) :: reporter
+      type(error_type), allocatable, intent(out) :: error
+      type(afm_config) :: c
+      class(surface_potential), allocatable :: potential
+      type(afm_scanner), target :: scanner
+      type(line_record) :: line
+      real(wp), allocatable :: trace(:, :, :), retrace(:, :, :), trace_sem(:, :, :), retrace_sem(:, :, :)
+      real(wp), allocatable :: friction_sem(:)
+      integer :: j, q
+
+      c = self%resolved()
+      call take_surface(c, memory, potential, error)
+      if (allocated(error)) return
+      call scanner%init_owning(c, potential, error)
+      if (allocated(error)) return
+      ! (line j's samples are trace(:, j, q): row-major (ny, nx) as it lies)
+      allocate (trace(c%nx, c%ny, size(quantity_names)), retrace(c%nx, merge(c%ny, 0, c%retrace), &
+         & size(quantity_names)))
+      allocate (trace_sem, mold=trace)
+      allocate (retrace_sem, mold=retrace)
+      allocate (friction_sem(c%ny))
+      do j = 1, c%ny
+         call scanner%run_line(j - 1, line, error)
+         if (allocated(error)) exit
+         trace(:, j, :) = line%trace
+         trace_sem(:, j, :) = line%trace_sem
+         if (c%retrace) then
+            retrace(:, j, :) = line%retrace
+            retrace_sem(:, j, :) = line%retrace_sem
+            friction_sem(j) = line%friction_sem
+         end if
+         call reporter%progress(real(j, wp), real(c%ny, wp), 'lines', j == c%ny)
+         if (j < c%ny .and. reporter%stop_requested()) then
+            call fatal_error(error, 'the map stopped on request after '//itoa(j)//' of '//itoa(c%ny) &
+               & //' lines: no result', error_interrupted)
+            exit
+         end if
+      end do
+      call scanner%release_potential(memory%surface)
+      if (allocated(error)) return
+      call sink%add('support_x', c%nx, 1, support_along(c))
+      call sink%add('support_y', c%ny, 1, support_across(c))
+      call add_trips('trace', trace, '')
+      if (scanner%thermal) call add_trips('trace', trace_sem, '_sem')
+      if (c%retrace) then
+         call add_trips('retrace', retrace, '')
+         if (scanner%thermal) call add_trips('retrace', retrace_sem, '_sem')
+         call sink%add('friction', c%ny, 1, line_friction(trace, retrace))
+         if (scanner%thermal) call sink%add('friction_sem', c%ny, 1, friction_sem)
+      end if
+
+   contains
+
+      subroutine add_trips(trip_name, values, suffix)
+         character(len=*), intent(in) :: trip_name, suffix
+         real(wp), intent(in) :: values(:, :, :)
+
+         do q = 1, quantity_count(scanner%tip%ndim)
+            call sink%add(trip_name//'/'//trim(quantity_names(q))//suffix, c%ny, c%nx, &
+               & reshape(values(:, :, q), [c%nx * c%ny]))
+         end do
+         if (c%tip_model() == model_quasistatic) call sink%add(trip_name//'/'//trim(quantity_names(q_jumps)) &
+            & //suffix, c%ny, c%nx, reshape(values(:, :, q_jumps), [c%nx * c%ny]))
+      end subroutine add_trips
+
+   end subroutine afm_compute
+
+   !> Line `line` (0 to ny - 1) of the map, trace or retrace, on this
+   !> process: 'fx' and 'fy' (nN) over the support's nx positions; at a
+   !> temperature the means over the realizations of whole lines (a trip's
+   !> noise is its own, whatever else is computed).  `capacity` below nx is
+   !> an input error.
+   subroutine afm_compute_line(self, line, forward, capacity, sink, memory, error)
+      class(afm_scene), intent(inout) :: self
+      integer, intent(in) :: line
+      logical, intent(in) :: forward
+      integer(i8), intent(in) :: capacity
+      class(result_sink), intent(inout) :: sink
+      type(point_memory), intent(inout) :: memory
+      type(error_type), allocatable, intent(out) :: error
+      type(afm_config) :: c
+      class(surface_potential), allocatable :: potential
+      type(afm_scanner), target :: scanner
+      type(trip_record) :: trip
+      type(line_record) :: mean
+
+      c = self%resolved()
+      if (line < 0 .or. line >= c%ny) then
+         call fatal_error(error, 'line = '//itoa(line)//': the map has lines 0 to '//itoa(c%ny - 1) &
+            & //' (scan.ny = '//itoa(c%ny)//')', error_input)
+         return
+      end if
+      if (capacity < c%nx) then
+         call fatal_error(error, 'n = '//itoa(capacity)//': fx and fy must hold scan.nx = '//itoa(c%nx) &
+            & //' values', error_input)
+         return
+      end if
+      call take_surface(c, memory, potential, error)
+      if (.not. allocated(error)) call scanner%init_owning(c, potential, error)
+      if (allocated(error)) then
+         continue
+      else if (scanner%thermal) then
+         call scanner%run_line(line, mean, error, with_retrace=.not. forward)
+         if (.not. allocated(error)) then
+            if (forward) then
+               trip%values = mean%trace
+            else
+               trip%values = mean%retrace
+            end if
+         end if
+      else
+         call scanner%run_trip(line, forward, trip, error)
+      end if
+      call scanner%release_potential(memory%surface)
+      if (allocated(error)) return
+      call sink%add('fx', c%nx, 1, trip%values(:, q_fx))
+      call sink%add('fy', c%nx, 1, trip%values(:, q_fy))
+   end subroutine afm_compute_line
 
    subroutine afm_netlist_text(self, data_file, version, text, note, error)
       class(afm_scene), intent(in) :: self

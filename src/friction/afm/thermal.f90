@@ -41,6 +41,7 @@ module friction_afm_thermal
       procedure :: visit
       procedure :: validate
       procedure :: enabled
+      procedure :: reduced
    end type thermal_settings
 
 contains
@@ -57,6 +58,14 @@ contains
       call v%item('time_step', self%time_step, 's')
       call v%end_group()
    end subroutine visit
+
+   !> Whether the thermal model is the reduced one ('kramers': jumps between
+   !> minima at Kramers' rates) rather than the Langevin tip.
+   pure logical function reduced(self)
+      class(thermal_settings), intent(in) :: self
+
+      reduced = trim(self%model) == 'kramers'
+   end function reduced
 
    !> T > 0: the thermal model runs.
    pure logical function enabled(self)
@@ -77,7 +86,7 @@ contains
       if (.not. any(thermal_model_names == self%model)) then
          call c%reject('thermal', 'model', "'"//trim(self%model)//"'", 'unknown thermal model (known: ' &
             & //quoted(thermal_model_names)//')')
-      else if (self%model == 'kramers' .and. self%enabled() .and. self%time_step /= 0.0_wp) then
+      else if (self%reduced() .and. self%enabled() .and. self%time_step /= 0.0_wp) then
          call c%reject('thermal', 'time_step', rtoa(self%time_step), "is not used by model = 'kramers' " &
             & //"(it takes no time steps: the jumps are drawn from the escape rate); leave it 0")
       end if

@@ -5,7 +5,7 @@ module friction_afm_validity
    use friction_kinds, only: wp, ev_per_angstrom_to_nn, deg_to_rad
    use friction_error, only: error_type
    use friction_afm_config, only: afm_config, new_tip
-   use friction_afm_tip, only: afm_tip
+   use friction_afm_tip, only: afm_tip, model_inertial, model_overdamped, model_quasistatic
    use friction_afm_scan, only: find_height, afm_scanner
    use friction_surface_potential, only: surface_potential
    use friction_strings, only: rtoa, itoa, fixed_text
@@ -54,13 +54,13 @@ contains
       real(wp), allocatable :: hazards(:)   !! kramers_note's probe
 
       text = ''
-      if (config%thermal%enabled() .and. config%thermal%model == 'kramers') call kramers_note()
-      if (config%model /= 'quasistatic' .and. config%model /= 'overdamped') return
-      nd = merge(3, 2, config%potential == 'lj')
+      if (config%thermal%enabled() .and. config%thermal%reduced()) call kramers_note()
+      if (config%tip_model() == model_inertial) return
+      nd = merge(3, 2, config%moves_in_3d())
       mass = config%mass
       spring = [config%kx, config%ky, config%kz]
       damping = [config%cx, config%cy, config%cz]
-      if (config%model == 'overdamped') then
+      if (config%tip_model() == model_overdamped) then
          axes = ''
          do i = 1, nd
             if (.not. (damping(i) > 0.0_wp)) cycle
@@ -166,7 +166,7 @@ contains
       real(wp) :: theta, drag
 
       text = ''
-      if (config%model /= 'quasistatic' .or. .not. (friction > 0.0_wp)) return
+      if (config%tip_model() /= model_quasistatic .or. .not. (friction > 0.0_wp)) return
       theta = config%angle * deg_to_rad
       drag = (config%cx * cos(theta)**2 + config%cy * sin(theta)**2) * config%velocity * 0.1_wp  ! nN
       if (drag > drag_share * friction) text = 'quasistatic model: the viscous drag c v = '//fixed(drag, 4) &

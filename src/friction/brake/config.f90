@@ -12,17 +12,22 @@ module friction_brake_config
    use friction_checks, only: config_checker
    use friction_ode_settings, only: visit_integrator, check_integrator, verify_settings, visit_verify, check_verify, &
       & verify_solver
-   use friction_ode_auto, only: rodas4_transition_bound, transition_bound
    implicit none
    private
 
    public :: brake_config, model_names, units_names, brake_solver_defaults
    public :: model_regularized, model_switched, series_names, continuation_names, continuation_config, &
-      & continuation_variable
+      & continuation_variable, rodas4_transition_bound, transition_bound
 
    character(len=*), parameter :: model_names(2) = [character(len=11) :: 'switched', 'regularized']
    character(len=*), parameter :: units_names(2) = [character(len=14) :: 'nondimensional', 'dimensional']
    character(len=*), parameter :: model_switched = 'switched', model_regularized = 'regularized'
+   !> The regularized law's transition in units of its width that a stepper's
+   !> velocity tolerance may span and stay within 100 times the asked tolerance
+   !> (transition_tolerance; docs/speed.md, "The regularized law's steppers"):
+   !> rodas4 up to rodas4_transition_bound, rodas3, rkf45 and rkck up to transition_bound.
+   real(wp), parameter :: rodas4_transition_bound = 3.0_wp
+   real(wp), parameter :: transition_bound = 10.0_wp
    character(len=*), parameter :: series_names(4) = [character(len=1) :: 'x', 'v', 'y', 'w']
    !> The &brake variables a periodic orbit can be continued in (&analysis continuation).
    character(len=*), parameter :: continuation_names(7) = [character(len=11) :: 'mu', 'mu_s', 'xi', 'kappa', &
@@ -58,6 +63,8 @@ module friction_brake_config
       procedure :: visit
       procedure :: validate
       procedure :: resolve
+      procedure :: switched
+      procedure :: auto_method
       procedure :: grid_size
       procedure :: grid_time
       procedure :: check_settings
@@ -304,6 +311,36 @@ contains
       other%solver = verify_solver(self%check, self%solver)
       other%event_tolerance = self%event_tolerance / 1000.0_wp
    end function check_settings
+
+   !> Whether the friction law is the exact stick/slip switching (Fig. 10)
+   !> rather than the regularized law of Eq. 10.
+   pure logical function switched(self)
+      class(brake_config), intent(in) :: self
+
+      switched = trim(self%model) == model_switched
+   end function switched
+
+   !> The stepper method = 'auto' runs (resolved settings): the switched law
+   !> is smooth between its located events, so the high-order rk8pd; the
+   !> regularized law is stiff near v_rel = 0, so by tolerance the L-stable
+   !> rk4imp, rodas4 where its velocity tolerance resolves the arctan's
+   !> transition, else rk8pd (docs/speed.md, "The regularized law's steppers").
+   function auto_method(self) result(method)
+      class(brake_config), intent(in) :: self
+      character(len=16) :: method
+      real(wp) :: rtol
+
+      rtol = self%solver%rtol
+      method = 'rk8pd'
+      if (self%switched()) return
+      if (rtol >= 1.0e-3_wp) then
+         method = 'rk2'
+      else if (rtol >= 1.0e-6_wp) then
+         method = 'rk4imp'
+      else if (rtol >= 1.0e-9_wp .and. .not. self%transition_tolerance() > rodas4_transition_bound) then
+         method = 'rodas4'
+      end if
+   end function auto_method
 
    !> '' or a warning: the regularized model's creep band is narrower than
    !> the integrator can resolve.  In stick x' = v'_dr, and the step control

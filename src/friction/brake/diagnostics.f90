@@ -6,7 +6,7 @@
 module friction_brake_diagnostics
    use friction_kinds, only: wp
    use friction_error, only: error_type, fatal_error, error_input
-   use friction_brake_config, only: brake_config, model_switched, series_names
+   use friction_brake_config, only: brake_config, series_names
    use friction_brake_record, only: brake_trajectory, brake_event_table, event_stick_to_slip
    use friction_brake_simulate, only: initial_state, new_brake_integrator
    use friction_brake_integrator, only: brake_integrator
@@ -136,7 +136,7 @@ contains
             result%exponents = result%qr%exponents()
             result%kaplan_yorke = kaplan_yorke(result%exponents)
          end if
-         if (a%orbit .and. config%model /= model_switched) then
+         if (a%orbit .and. .not. config%switched()) then
             result%orbit%orbit%reason = "the section is the switched model's located slip onsets: model = 'switched'"
          else if (a%orbit) then
             ! Not finding one is a result (orbit%found), not an error.
@@ -188,8 +188,8 @@ contains
             & //'least one interval after lyapunov_transient, lyapunov_d0 > 0', error_input)
          return
       end if
-      call new_brake_integrator(config%model, reference_run)
-      call new_brake_integrator(config%model, perturbed_run)
+      call new_brake_integrator(config, reference_run)
+      call new_brake_integrator(config, perturbed_run)
       t = config%t_start + settings%transient
       reference = initial_state(config)
       call reference_run%start(config, config%t_start, reference, reference_events, error)
@@ -248,7 +248,7 @@ contains
             & //'a duration of at least one interval after lyapunov_spectrum_transient', error_input)
          return
       end if
-      call new_brake_integrator(config%model, run)
+      call new_brake_integrator(config, run)
       run%tangent = .true.
       call run%start(config, config%t_start, initial_state(config), events, error)
       if (allocated(error)) return

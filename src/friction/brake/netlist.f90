@@ -7,7 +7,7 @@ module friction_brake_netlist
    use friction_error, only: error_type, fatal_error, error_input
    use friction_strings, only: rtoa
    use friction_netlist_spice, only: nl, tolerances, control_end, num
-   use friction_brake_config, only: brake_config, model_switched
+   use friction_brake_config, only: brake_config
    implicit none
    private
 
@@ -26,7 +26,7 @@ contains
       note = ''   ! (a note only for the switched model; the caller reads it always)
       associate (p => c%params)
          law = '* Friction law: the regularized arctan law of Eq. 10 (epsilon_prime = '//num(p%epsilon_prime)//').'
-         if (trim(c%model) == model_switched) then
+         if (c%switched()) then
             ! The arctan law carries one friction coefficient: a static one
             ! above the kinetic one has no counterpart in it.
             if (p%mu_s /= p%mu) then

@@ -13,11 +13,11 @@ module friction_brake_scene
    use friction_parameters, only: parameter_visitor
    use friction_checks, only: config_checker
    use friction_ode_solver, only: integrator_statistics
-   use friction_ode_auto, only: auto_name, auto_method
-   use friction_scene, only: scene, point_result, point_memory
+   use friction_ode_auto, only: auto_name
+   use friction_scene, only: scene, point_result, point_memory, result_sink
    use friction_scene_report, only: job_reporter
    use friction_scene_context, only: job_context, agree_on_error, ranks_text, job_wall_time
-   use friction_brake_config, only: brake_config, model_switched
+   use friction_brake_config, only: brake_config
    use friction_brake_simulate, only: brake_run, compare_runs
    use friction_brake_output, only: brake_run_summary, brake_check_summary, write_brake_file
    use friction_brake_diagnostics, only: brake_diagnostics, diagnose_brake
@@ -47,6 +47,7 @@ module friction_brake_scene
       procedure :: point_results => brake_point_results
       procedure :: point_series => brake_point_series
       procedure :: run_point => brake_run_point
+      procedure :: compute => brake_compute
       procedure :: netlist => brake_netlist_text
       procedure :: settings_warning => brake_settings_warning
       procedure :: verifies => brake_verifies
@@ -94,8 +95,7 @@ contains
 
       c = self%config
       call c%resolve(error)   ! (cannot fail on checked settings)
-      if (c%solver%method == auto_name) c%solver%method = auto_method('brake', c%model, c%solver%rtol, &
-         & transition=c%transition_tolerance())
+      if (c%solver%method == auto_name) c%solver%method = c%auto_method()
    end function resolved
 
    function brake_method(self) result(name)
@@ -312,6 +312,46 @@ contains
          text = stepper
       end if
    end function brake_settings_warning
+
+   !> The brake's trajectory and events on this process, as the program's
+   !> file holds them under /brake.
+   subroutine brake_compute(self, sink, memory, reporter, error)
+      class(brake_scene), intent(inout) :: self
+      class(result_sink), intent(inout) :: sink
+      type(point_memory), intent(inout) :: memory
+      class(job_reporter), intent(inout) :: reporter
+      type(error_type), allocatable, intent(out) :: error
+      type(brake_run), target :: run
+      integer :: n, k
+
+      call integrate_brake(run, self%resolved(), reporter, error, &
+         & lost='no result (a trajectory keeps no checkpoints; compute it again)')
+      if (allocated(error)) return
+      n = run%n
+      associate (r => run%trajectory)
+         call sink%add('t', n, 1, r%t(1:n))
+         call sink%add('x', n, 1, r%x(1:n))
+         call sink%add('v', n, 1, r%v(1:n))
+         call sink%add('y', n, 1, r%y(1:n))
+         call sink%add('w', n, 1, r%w(1:n))
+         call sink%add('stick', n, 1, real(r%stick(1:n), wp))
+      end associate
+      n = run%events%n
+      if (n == 0) then
+         ! (The event table's arrays may not exist without events.)
+         call sink%add('events/t', 0, 1, [real(wp) ::])
+         call sink%add('events/kind', 0, 1, [real(wp) ::])
+         do k = 1, 4
+            call sink%add('events/'//'xvyw'(k:k), 0, 1, [real(wp) ::])
+         end do
+         return
+      end if
+      call sink%add('events/t', n, 1, run%events%t(1:n))
+      call sink%add('events/kind', n, 1, real(run%events%kind(1:n), wp))
+      do k = 1, 4
+         call sink%add('events/'//'xvyw'(k:k), n, 1, run%events%state(k, 1:n))
+      end do
+   end subroutine brake_compute
 
    subroutine brake_netlist_text(self, data_file, version, text, note, error)
       class(brake_scene), intent(in) :: self

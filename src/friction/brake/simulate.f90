@@ -6,7 +6,7 @@ module friction_brake_simulate
    use friction_kinds, only: wp, i8
    use friction_error, only: error_type
    use friction_ode_solver, only: integrator_statistics
-   use friction_brake_config, only: brake_config, model_switched
+   use friction_brake_config, only: brake_config
    use friction_brake_record, only: brake_trajectory, brake_event_table
    use friction_brake_integrator, only: brake_integrator
    use friction_brake_switched, only: switched_integrator
@@ -64,7 +64,7 @@ contains
       self%done = 0
       self%compute_time = 0.0_wp
       call self%trajectory%allocate_points(self%n)
-      call new_brake_integrator(config%model, self%integrator)
+      call new_brake_integrator(config, self%integrator)
       call self%integrator%start(config, config%t_start, initial_state(config), self%events, error)
    end subroutine init
 
@@ -126,12 +126,12 @@ contains
       time_reached = self%integrator%t
    end function time_reached
 
-   !> The integrator of a friction model ('switched' or 'regularized').
-   subroutine new_brake_integrator(model, integrator)
-      character(len=*), intent(in) :: model
+   !> The integrator of the configuration's friction model.
+   subroutine new_brake_integrator(config, integrator)
+      type(brake_config), intent(in) :: config
       class(brake_integrator), allocatable, intent(out) :: integrator
 
-      if (trim(model) == model_switched) then
+      if (config%switched()) then
          allocate (switched_integrator :: integrator)
       else
          allocate (regularized_integrator :: integrator)

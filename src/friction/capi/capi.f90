@@ -18,7 +18,7 @@ module friction_capi
       & c_associated, c_f_pointer, c_loc, c_funptr, c_f_procpointer, c_null_funptr
    use mpi_f08, only: MPI_Comm, MPI_Initialized, MPI_Finalized, MPI_Init_thread, MPI_THREAD_FUNNELED, &
       & MPI_COMM_WORLD, MPI_COMM_NULL
-   use friction_kinds, only: wp
+   use friction_kinds, only: wp, i8
    use friction_error, only: error_type, fatal_error, error_input, error_interrupted
    use friction_strings, only: itoa, rtoa, join, quoted
    use friction_version, only: version_string
@@ -26,16 +26,8 @@ module friction_capi
       & get_parameter, kind_text, value_has_kind
    use friction_checks, only: config_checker
    use friction_input_reader, only: namelist_source, scan_files, apply_files, parse_variable_name
-   use friction_surface_potential, only: surface_potential
-   use friction_afm_config, only: afm_config
-   use friction_afm_scan, only: afm_scanner, trip_record, line_record, quantity_names, quantity_count, q_fx, q_fy, &
-      & q_jumps, support_along, support_across
-   use friction_afm_output, only: line_friction
-   use friction_afm_scene, only: afm_scene, take_surface
    use friction_scene, only: point_memory
-   use friction_brake_config, only: brake_config
-   use friction_brake_simulate, only: brake_run
-   use friction_brake_scene, only: brake_scene, integrate_brake
+   use friction_scene_sink, only: array_sink, named_array
    use friction_job_factory, only: scene_names, new_scene
    use friction_job_config, only: job_config, check_job, job_text, all_parameters, parameter_groups, not_in_scene
    use friction_job, only: run_job, run_job_config, job_reporter
@@ -78,17 +70,9 @@ module friction_capi
       type(point_memory) :: memory
    end type capi_config
 
-   !> One named array of a result: rows x columns, row-major (a series is
-   !> one column).
-   type :: result_item
-      character(len=32) :: name = ''
-      integer :: rows = 0, columns = 1
-      real(c_double), allocatable :: values(:)
-   end type result_item
-
-   !> What an opaque `friction_result *` points to.
-   type :: capi_result
-      type(result_item), allocatable :: items(:)
+   !> What an opaque `friction_result *` points to: the named arrays a
+   !> scene computed (scene's compute).
+   type, extends(array_sink) :: capi_result
    end type capi_result
 
    !> A job's or a computation's progress through the caller's C function.
@@ -716,7 +700,7 @@ contains
 
    ! ---- computations on this process ----
 
-   !> int friction_afm_line(const friction_config *cfg, int line, int forward,
+   !> int friction_afm_line(friction_config *cfg, int line, int forward,
    !>                       double *fx, double *fy, size_t n, friction_error *err)
    integer(c_int) function friction_afm_line(cfg, line, forward, fx, fy, n, handle) &
       & bind(c, name='friction_afm_line_body') result(status)
@@ -726,12 +710,9 @@ contains
       type(capi_config), pointer :: config
       type(error_type), allocatable :: error
       type(job_config) :: work
-      type(afm_config) :: c
-      class(surface_potential), allocatable :: potential
-      type(afm_scanner), target :: scanner
-      type(trip_record) :: trip
-      type(line_record) :: mean
+      type(array_sink) :: arrays
       real(c_double), pointer :: out(:)
+      integer :: k, i
 
       if (.not. config_of(cfg, config, error)) then
          status = report(handle, error)
@@ -741,54 +722,18 @@ contains
          status = refuse(handle, 'fx and fy must not be null pointers')
          return
       end if
-      if (config%job%scene_name /= 'afm') then
-         status = refuse(handle, "friction_afm_line needs a configuration of scene 'afm', not '" &
-            & //trim(config%job%scene_name)//"'")
-         return
-      end if
       call check_config(config, work, error)
+      if (.not. allocated(error)) call work%scene%compute_line(int(line), forward /= 0, &
+         & int(n, i8), arrays, config%memory, error)
       if (allocated(error)) then
          status = report(handle, error)
          return
       end if
-      select type (s => work%scene)
-      type is (afm_scene)
-         c = s%resolved()
-      end select
-      if (line < 0 .or. line >= c%ny) then
-         status = refuse(handle, 'line = '//itoa(int(line))//': the map has lines 0 to '//itoa(c%ny - 1) &
-            & //' (scan.ny = '//itoa(c%ny)//')')
-         return
-      end if
-      if (n < c%nx) then
-         status = refuse(handle, 'n = '//itoa(int(n))//': fx and fy must hold scan.nx = '//itoa(c%nx)//' values')
-         return
-      end if
-      call take_surface(c, config%memory, potential, error)
-      if (.not. allocated(error)) call scanner%init_owning(c, potential, error)
-      if (allocated(error)) then
-         continue
-      else if (scanner%thermal) then
-         ! At a temperature: the mean over the realizations (of whole lines:
-         ! a trip's noise is its own, whatever else is computed).
-         call scanner%run_line(int(line), mean, error, with_retrace=forward == 0)
-         if (.not. allocated(error)) then
-            if (forward /= 0) then
-               trip%values = mean%trace
-            else
-               trip%values = mean%retrace
-            end if
-         end if
-      else
-         call scanner%run_trip(int(line), forward /= 0, trip, error)
-      end if
-      call scanner%release_potential(config%memory%surface)
-      if (.not. allocated(error)) then
-         call c_f_pointer(fx, out, [c%nx])
-         out = trip%values(:, q_fx)
-         call c_f_pointer(fy, out, [c%nx])
-         out = trip%values(:, q_fy)
-      end if
+      do k = 1, 2
+         i = arrays%find(trim(merge('fx', 'fy', k == 1)))
+         call c_f_pointer(merge(fx, fy, k == 1), out, [arrays%items(i)%rows])
+         out = arrays%items(i)%values
+      end do
       status = report(handle, error)
    end function friction_afm_line
 
@@ -844,15 +789,7 @@ contains
       end if
       allocate (result)
       allocate (result%items(0))
-      select type (s => work%scene)
-      type is (afm_scene)
-         call compute_afm(s%resolved(), config%memory, reporter, result, error)
-      type is (brake_scene)
-         call compute_brake(s%resolved(), reporter, result, error)
-      class default
-         call fatal_error(error, "friction_compute: no computation for scene '"//trim(work%scene_name)//"'", &
-            & error_input)
-      end select
+      call work%scene%compute(result, config%memory, reporter, error)
       status = report(handle, error)
       if (allocated(error)) then
          deallocate (result)
@@ -860,151 +797,6 @@ contains
          res = c_loc(result)
       end if
    end function compute_scene
-
-   !> Append an item of rows x columns values (row-major).
-   subroutine add_item(result, name, rows, columns, values)
-      type(capi_result), intent(inout) :: result
-      character(len=*), intent(in) :: name
-      integer, intent(in) :: rows, columns
-      real(wp), intent(in) :: values(:)
-      type(result_item), allocatable :: items(:)
-      integer :: k
-
-      allocate (items(size(result%items) + 1))
-      do k = 1, size(result%items)
-         items(k)%name = result%items(k)%name
-         items(k)%rows = result%items(k)%rows
-         items(k)%columns = result%items(k)%columns
-         call move_alloc(result%items(k)%values, items(k)%values)
-      end do
-      k = size(items)
-      items(k)%name = name
-      items(k)%rows = rows
-      items(k)%columns = columns
-      items(k)%values = values
-      call move_alloc(items, result%items)
-   end subroutine add_item
-
-   !> The whole map on this process: every line's trace (and retrace), as
-   !> the program's file holds them under /afm; at a temperature the means
-   !> over the realizations, and NAME_sem beside every NAME.  The surface
-   !> is memory's when it still holds (take_surface), and left in it.
-   subroutine compute_afm(c, memory, reporter, result, error)
-      type(afm_config), intent(in) :: c
-      type(point_memory), intent(inout) :: memory
-      class(job_reporter), intent(inout) :: reporter
-      type(capi_result), intent(inout) :: result
-      type(error_type), allocatable, intent(out) :: error
-      class(surface_potential), allocatable :: potential
-      type(afm_scanner), target :: scanner
-      type(line_record) :: line
-      real(wp), allocatable :: trace(:, :, :), retrace(:, :, :), trace_sem(:, :, :), retrace_sem(:, :, :)
-      real(wp), allocatable :: friction_sem(:)
-      integer :: j, q
-
-      call take_surface(c, memory, potential, error)
-      if (allocated(error)) return
-      call scanner%init_owning(c, potential, error)
-      if (allocated(error)) return
-      ! (line j's samples are trace(:, j, q): row-major (ny, nx) as it lies)
-      allocate (trace(c%nx, c%ny, size(quantity_names)), retrace(c%nx, merge(c%ny, 0, c%retrace), &
-         & size(quantity_names)))
-      allocate (trace_sem, mold=trace)
-      allocate (retrace_sem, mold=retrace)
-      allocate (friction_sem(c%ny))
-      do j = 1, c%ny
-         call scanner%run_line(j - 1, line, error)
-         if (allocated(error)) exit
-         trace(:, j, :) = line%trace
-         trace_sem(:, j, :) = line%trace_sem
-         if (c%retrace) then
-            retrace(:, j, :) = line%retrace
-            retrace_sem(:, j, :) = line%retrace_sem
-            friction_sem(j) = line%friction_sem
-         end if
-         call reporter%progress(real(j, wp), real(c%ny, wp), 'lines', j == c%ny)
-         if (j < c%ny .and. reporter%stop_requested()) then
-            call fatal_error(error, 'the map stopped on request after '//itoa(j)//' of '//itoa(c%ny) &
-               & //' lines: no result', error_interrupted)
-            exit
-         end if
-      end do
-      call scanner%release_potential(memory%surface)
-      if (allocated(error)) return
-      call add_item(result, 'support_x', c%nx, 1, support_along(c))
-      call add_item(result, 'support_y', c%ny, 1, support_across(c))
-      call add_trips('trace', trace, '')
-      if (scanner%thermal) call add_trips('trace', trace_sem, '_sem')
-      if (c%retrace) then
-         call add_trips('retrace', retrace, '')
-         if (scanner%thermal) call add_trips('retrace', retrace_sem, '_sem')
-         call add_item(result, 'friction', c%ny, 1, line_friction(trace, retrace))
-         if (scanner%thermal) call add_item(result, 'friction_sem', c%ny, 1, friction_sem)
-      end if
-
-   contains
-
-      subroutine add_trips(trip_name, values, suffix)
-         character(len=*), intent(in) :: trip_name, suffix
-         real(wp), intent(in) :: values(:, :, :)
-
-         do q = 1, quantity_count(scanner%tip%ndim)
-            call add_item(result, trip_name//'/'//trim(quantity_names(q))//suffix, c%ny, c%nx, &
-               & reshape(values(:, :, q), [c%nx * c%ny]))
-         end do
-         if (c%model == 'quasistatic') call add_item(result, trip_name//'/'//trim(quantity_names(q_jumps)) &
-            & //suffix, c%ny, c%nx, reshape(values(:, :, q_jumps), [c%nx * c%ny]))
-      end subroutine add_trips
-
-   end subroutine compute_afm
-
-   !> The brake's trajectory and events on this process, as the program's
-   !> file holds them under /brake.
-   subroutine compute_brake(c, reporter, result, error)
-      type(brake_config), intent(in) :: c
-      class(job_reporter), intent(inout) :: reporter
-      type(capi_result), intent(inout) :: result
-      type(error_type), allocatable, intent(out) :: error
-      type(brake_run), target :: run
-      integer :: n, k
-
-      call integrate_brake(run, c, reporter, error, &
-         & lost='no result (a trajectory keeps no checkpoints; compute it again)')
-      if (allocated(error)) return
-      n = run%n
-      associate (r => run%trajectory)
-         call add_item(result, 't', n, 1, r%t(1:n))
-         call add_item(result, 'x', n, 1, r%x(1:n))
-         call add_item(result, 'v', n, 1, r%v(1:n))
-         call add_item(result, 'y', n, 1, r%y(1:n))
-         call add_item(result, 'w', n, 1, r%w(1:n))
-         call add_item(result, 'stick', n, 1, real(r%stick(1:n), wp))
-      end associate
-      n = run%events%n
-      if (n == 0) then
-         call add_item(result, 'events/t', 0, 1, [real(wp) ::])
-         call add_item(result, 'events/kind', 0, 1, [real(wp) ::])
-         do k = 1, 4
-            call add_item(result, 'events/'//trim(column(k)), 0, 1, [real(wp) ::])
-         end do
-         return
-      end if
-      call add_item(result, 'events/t', n, 1, run%events%t(1:n))
-      call add_item(result, 'events/kind', n, 1, real(run%events%kind(1:n), wp))
-      do k = 1, 4
-         call add_item(result, 'events/'//trim(column(k)), n, 1, run%events%state(k, 1:n))
-      end do
-
-   contains
-
-      pure function column(k) result(name)
-         integer, intent(in) :: k
-         character(len=1) :: name
-
-         name = 'xvyw'(k:k)
-      end function column
-
-   end subroutine compute_brake
 
    ! ---- results ----
 

@@ -57,14 +57,14 @@ FP_GUARDED(int, friction_config_text, (const friction_config *cfg, char *buf, si
 FP_GUARDED(int, friction_config_check, (const friction_config *cfg, friction_error *err), (cfg, err))
 
 FP_GUARDED(int, friction_afm_line,
-           (const friction_config *cfg, int line, int forward, double *fx, double *fy, size_t n,
+           (friction_config *cfg, int line, int forward, double *fx, double *fy, size_t n,
             friction_error *err),
            (cfg, line, forward, fx, fy, n, err))
 
-FP_GUARDED(friction_result *, friction_compute, (const friction_config *cfg, friction_error *err), (cfg, err))
+FP_GUARDED(friction_result *, friction_compute, (friction_config *cfg, friction_error *err), (cfg, err))
 
 FP_GUARDED(friction_result *, friction_compute_progress,
-           (const friction_config *cfg, friction_progress_fn progress, void *user, friction_error *err),
+           (friction_config *cfg, friction_progress_fn progress, void *user, friction_error *err),
            (cfg, progress, user, err))
 
 FP_GUARDED(int, friction_run_job,

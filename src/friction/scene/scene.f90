@@ -6,17 +6,18 @@
 !> sweep point's named results, and describes itself as a SPICE netlist.
 !> Only the factory (job/factory.f90) knows the concrete types.
 module friction_scene
-   use friction_kinds, only: wp
-   use friction_error, only: error_type
+   use friction_kinds, only: wp, i8
+   use friction_error, only: error_type, fatal_error, error_input
    use friction_parameters, only: configurable, parameter_visitor
    use friction_checks, only: config_checker
    use friction_scene_report, only: job_reporter
    use friction_scene_context, only: job_context
    use friction_surface_potential, only: surface_potential
+   use friction_scene_sink, only: result_sink
    implicit none
    private
 
-   public :: scene, point_result, point_memory
+   public :: scene, point_result, point_memory, result_sink
 
    !> One named result of a sweep point (docs/sweeps.md).
    type :: point_result
@@ -61,6 +62,16 @@ module friction_scene
       !> point_results, and its series; `memory` is what the process kept from its
       !> earlier points (point_memory).
       procedure(point_interface), deferred :: run_point
+      !> The whole scene on this process, into named arrays in `sink` (the
+      !> arrays the output file holds, as the C API returns them), with
+      !> progress and stop requests through `reporter`; `memory` as for
+      !> run_point.  Needs checked settings.
+      procedure(compute_interface), deferred :: compute
+      !> One line of a scene made of lines, trace (`forward`) or retrace, on
+      !> this process: its named arrays in `sink`, each of at most `capacity`
+      !> values (a line longer than that is an input error, found before any
+      !> computation).  By default an error: the scene has no lines.
+      procedure :: compute_line
       !> The scene as a SPICE netlist for ngspice.
       procedure(netlist_interface), deferred :: netlist
       !> '' or a warning that the settings, though valid, make a result
@@ -136,6 +147,15 @@ module friction_scene
          type(error_type), allocatable, intent(out) :: error
       end subroutine point_interface
 
+      subroutine compute_interface(self, sink, memory, reporter, error)
+         import :: scene, result_sink, point_memory, job_reporter, error_type
+         class(scene), intent(inout) :: self
+         class(result_sink), intent(inout) :: sink
+         type(point_memory), intent(inout) :: memory
+         class(job_reporter), intent(inout) :: reporter
+         type(error_type), allocatable, intent(out) :: error
+      end subroutine compute_interface
+
       subroutine netlist_interface(self, data_file, version, text, note, error)
          import :: scene, error_type
          class(scene), intent(in) :: self
@@ -146,6 +166,18 @@ module friction_scene
    end interface
 
 contains
+
+   subroutine compute_line(self, line, forward, capacity, sink, memory, error)
+      class(scene), intent(inout) :: self
+      integer, intent(in) :: line
+      logical, intent(in) :: forward
+      integer(i8), intent(in) :: capacity
+      class(result_sink), intent(inout) :: sink
+      type(point_memory), intent(inout) :: memory
+      type(error_type), allocatable, intent(out) :: error
+
+      call fatal_error(error, "scene '"//self%name()//"' is not made of scan lines: compute it whole", error_input)
+   end subroutine compute_line
 
    function settings_warning(self) result(text)
       class(scene), intent(in) :: self
