@@ -82,9 +82,7 @@ module friction_afm_scan
    !> Slips at a temperature (see check_slips): the support travel between
    !> two quenches, Å (in a stick the force then changes by the stick slope
    !> times 0.05 Å, ~0.04 nN on NaF, below its thermal spread sqrt(k k_B T)
-   !> = 0.2 nN at 300 K; the quenches, ~3 µs each, then add about 10 % to
-   !> the inertial tip's cost and 40 % to the overdamped one's on NaF at
-   !> 400 Å/s); the jump of
+   !> = 0.2 nN at 300 K; the quenches' cost: docs/speed.md); the jump of
    !> the quenched minimum that is a slip, Å (below any well spacing of NaF
    !> or HOPG, above any drift of a minimum between two checks).
    real(wp), parameter :: check_distance = 0.05_wp, slip_distance = 0.5_wp
@@ -977,8 +975,7 @@ contains
             force = tip%lateral_force(y) * ev_per_angstrom_to_nn
             tip_r = tip%tip_position(t, y)
             if (nd == 3) then
-               ! (The message is built only when it is needed: formatting it at
-               ! every sample cost some 5 % of a tabulated graphite map.)
+               ! (The message is built only when it is needed: formatting is dear.)
                if (below_net(tip, tip_r)) call fatal_error(error, 'the tip went below the layer of atoms at (' &
                   & //rtoa(tip_r(1))//', '//rtoa(tip_r(2))//', '//rtoa(tip_r(3))//') Å (line '//itoa(j) &
                   & //trim(merge(' trace  ', ' retrace', forward))//'): off the edge of the net, or pressed ' &

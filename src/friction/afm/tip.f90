@@ -100,10 +100,8 @@ contains
 
       nd = self%ndim
       if (nd == 2) then
-         ! One vector store: the periodic surfaces load (x, y) as one vector,
-         ! and a load that spans two scalar stores cannot take their data
-         ! from the store buffer; it waits until they reach the cache (some
-         ! 12 % of the NaF map's time, the same bits either way).
+         ! One vector store: the surfaces load (x, y) as one vector, which
+         ! two scalar stores could not forward from the store buffer.
          r = [self%support_start(1:2) + self%support_velocity(1:2) * t + y(1:2), 0.0_wp]
       else
          do i = 1, 3

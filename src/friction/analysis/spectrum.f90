@@ -23,8 +23,7 @@ module friction_analysis_spectrum
    integer(c_int), parameter :: fftw_estimate = 64
 
    !> The last plan, kept for the next transform of the same length: a
-   !> sweep's points all take one, and planning one took 2.6 ms of an atlas
-   !> point's 55 (54 001, a prime length, makes planning dear).  Kept with
+   !> sweep's points all take one, and planning is dear (prime lengths).  Kept with
    !> the alignments of the arrays it was made for, as FFTW's new-array
    !> execute requires.  Jobs run one at a time (capi/job_lock.c), and the
    !> C API's in-memory computations take no spectrum.

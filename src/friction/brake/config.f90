@@ -348,10 +348,8 @@ contains
    !> the Rosenbrock steppers share).  When that is not well inside the
    !> band's half-width stick_velocity, the error of x' alone carries |v_rel|
    !> in and out of the band: /brake/events then holds spurious stick and
-   !> slip events, and the stick flags flicker (measured to τ = 1000 with
-   !> rodas3 against a tight reference's 281 events: 3463 at rtol 1e-3,
-   !> atol 1e-5; 56 too many at a velocity tolerance of 1.3 stick_velocity;
-   !> 12 at 0.77; none at 0.38 or below).  The bound is half the band.
+   !> slip events, and the stick flags flicker (docs/speed.md).  The bound
+   !> is half the band, below which none were seen.
    !> Resolved settings (nondimensional parameters).
    function creep_band_warning(self) result(text)
       class(brake_config), intent(in) :: self
@@ -389,23 +387,9 @@ contains
 
    !> '' or a warning: on the regularized law the stepper, at these settings,
    !> falls in a region where it was measured wrong by more than 100 times
-   !> the asked tolerance while reporting success: x over τ in [100, 1000] of
-   !> the paper's brake against rk8pd at rtol 1e-13, epsilon_prime from 1e3
-   !> to 1e10, rtol from 1e-3 to 1e-10 with atol = rtol / 100 (docs/speed.md,
-   !> "The regularized law's steppers").
-   !> - GSL's rk1imp, rk2imp, msadams and msbdf from epsilon_prime = 1e4 on
-   !>   (at the paper's 3.5e7: 480 to 2e5 times at every rtol), bsimp from
-   !>   1e6 on (2000 to 4e7 times); below, they were right or nearly.
-   !> - Where the velocity tolerance does not resolve the arctan's transition
-   !>   (transition_tolerance above a bound, friction_ode_auto's
-   !>   rodas4_transition_bound and transition_bound, with the measurements):
-   !>   rodas4 above 3, rodas3, rkf45 and rkck above 10.
-   !> - rk4 and rk4imp at rtol below 5e-8 with epsilon_prime from 1e7 on:
-   !>   their error grows faster than the tolerance falls (at the paper's
-   !>   epsilon_prime rk4imp 110 to 510 times from rtol 1e-8 on, rk4 180 to
-   !>   750 times; 1e8 and 1e9 alike).
-   !> rk2, rk8pd and rk4imp at rtol 5e-8 and above were within 100 times
-   !> everywhere measured.  Resolved settings.
+   !> the asked tolerance while reporting success (docs/speed.md, "The
+   !> regularized law's steppers", gives the measurements behind each case).
+   !> Resolved settings.
    function stepper_warning(self) result(text)
       class(brake_config), intent(in) :: self
       character(len=:), allocatable :: text

@@ -193,8 +193,7 @@ contains
       ! MPI_Win_allocate (not MPI_Win_create on a Fortran variable) lets Open MPI
       ! pick its shared-memory one-sided component on a node: the fetch is an
       ! atomic in memory and needs no progress from rank 0, which is busy
-      ! computing.  (Measured: with MPI_Win_create a fetch waited for rank 0 to
-      ! finish its point, and the dynamic schedule lost to the static one.)
+      ! computing (with MPI_Win_create a fetch waits for rank 0's point).
       if (dynamic) then
          call MPI_Win_allocate(window_size, 4, MPI_INFO_NULL, job%comm, counter_base, window)
          if (job%rank == 0) then

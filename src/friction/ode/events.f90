@@ -282,7 +282,7 @@ contains
                & error_numerical)
             return
          end if
-         ! (The clock every 16 steps: reading it took 2 % of a sweep point.)
+         ! (The clock every 16 steps: reading it at every step is dear.)
          if (self%max_wall_time > 0.0_wp .and. mod(self%steps, 16_i8) == 0) then
             if (self%elapsed() > self%max_wall_time) then
                call fatal_error(error, trim(self%method)//': max_wall_time = '//rtoa(self%max_wall_time) &

@@ -29,8 +29,7 @@ contains
    !> Write `body` (whole lines) as the checkpoint at `path` for the input
    !> whose hash is `input_hash`, under its temporary name and not yet
    !> synced: publish_checkpoints then syncs many at once and renames them
-   !> (a map's checkpoints, a file a line, took an fsync each: 1 ms a line,
-   !> as long as a NaF line's computation).  `problem` says why it could not
+   !> (an fsync a line costs as much as a short line's computation).  `problem` says why it could not
    !> be written ('' when written); a checkpoint that could not be written
    !> whole (a full disk) is removed, never renamed into place.
    subroutine write_checkpoint(path, input_hash, body, problem)

@@ -100,8 +100,7 @@ contains
    !> A rank's share of n items, dealt round-robin: items first, first +
    !> nranks, ... (0-based), count of them.  Neighbouring lines cost alike
    !> (they cross the same rows of atoms), so dealing them out in turn
-   !> balances uneven maps better than contiguous blocks (HOPG at 7°, rk8pd
-   !> 1e-11: blocks left one rank idle 40 % of the run).  Each rank still
+   !> balances uneven maps better than contiguous blocks.  Each rank still
    !> writes one regular, strided hyperslab.
    pure subroutine share_of(n, nranks, rank, first, count)
       integer, intent(in) :: n, nranks, rank

@@ -35,7 +35,7 @@ module friction_surface_lennard_jones
 
    !> Cells per cutoff length: smaller cells fit the disc of radius r_c more
    !> tightly (visited area (2 + 2/m)² r_c² against π r_c²) at more overhead;
-   !> 3 was 8 % faster than 2 and 4 no faster on the graphite scene.
+   !> 3 is the fastest on graphite (docs/speed.md).
    integer, parameter :: cells_per_cutoff = 3
 
    !> Atoms binned into a grid of square cells in the plane: the atoms of
