@@ -4,7 +4,7 @@ is silently wrong, nothing is lost.  One case per CTest test:
 
     hardening_test.py --binary BIN --mpiexec MPIEXEC --inputs DIR --workdir DIR CASE
 
-Each case reproduces a defect of the issue and asserts the outcome: the exit
+Each case reproduces a defect once found and asserts the outcome: the exit
 code, one `friction: error:` message with the words that explain it, the
 files left (existing ones never damaged), and the output's values.
 """
