@@ -68,7 +68,9 @@ def run(args, cmd, expect=0, env=None, timeout=600, stdin=None):
 
 
 def friction(args, *rest, ranks=None, expect=0, env=None, timeout=600, stdin=None):
-    cmd = [args.binary, "--quiet", *rest]
+    # (An interrupted run: the test build of the program that stops on cue.)
+    binary = args.stop_binary if "FRICTION_TEST_STOP_AFTER" in (env or {}) else args.binary
+    cmd = [binary, "--quiet", *rest]
     if ranks is not None:
         forward = [item for name in (env or {}) for item in ("-x", name)]
         cmd = [args.mpiexec, "-n", str(ranks), *forward, *cmd]
@@ -831,6 +833,7 @@ CASES = {name[len("case_"):].replace("_", "-"): function for name, function in g
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--binary", required=True)
+    parser.add_argument("--stop-binary", required=True, help="the program with a reporter that stops on cue")
     parser.add_argument("--mpiexec", required=True)
     parser.add_argument("--inputs", required=True)
     parser.add_argument("--workdir", required=True)

@@ -13,7 +13,8 @@
 
 set(_fp_work "${CMAKE_CURRENT_BINARY_DIR}/python")
 file(MAKE_DIRECTORY "${_fp_work}")
-set(_fp_env "FRICTION_LIBRARY=$<TARGET_FILE:friction>" "FRICTION_PROGRAM=$<TARGET_FILE:friction_app>")
+set(_fp_env "FRICTION_LIBRARY=$<TARGET_FILE:friction>" "FRICTION_PROGRAM=$<TARGET_FILE:friction_app>"
+  "FRICTION_STOP_PROGRAM=$<TARGET_FILE:friction_stop_after>")
 
 add_test(NAME python-package
   COMMAND ${Python3_EXECUTABLE} -m pytest "${PROJECT_SOURCE_DIR}/python/tests" -q -p no:cacheprovider

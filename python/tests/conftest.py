@@ -51,6 +51,15 @@ def sigint_at_report(number):
 
 
 @pytest.fixture(scope="session")
+def stop_program():
+    """The test build of the program that stops a job on cue (FRICTION_TEST_STOP_AFTER)."""
+    path = Path(os.environ.get("FRICTION_STOP_PROGRAM", ROOT / "build" / "tests" / "friction_stop_after"))
+    if not path.is_file():
+        pytest.fail(f"no program at {path}: build the tests first (scripts/test) or set FRICTION_STOP_PROGRAM")
+    return path
+
+
+@pytest.fixture(scope="session")
 def program():
     path = Path(os.environ.get("FRICTION_PROGRAM", ROOT / "build" / "friction"))
     if not path.is_file():

@@ -108,12 +108,12 @@ def test_a_sweep_job(friction, afm_sweep, tmp_path):
     assert np.array_equal(a["sweep/mean_friction"].values, b["sweep/mean_friction"].values)
 
 
-def test_resume_an_interrupted_sweep(friction, program, brake_sweep, tmp_path):
+def test_resume_an_interrupted_sweep(friction, stop_program, brake_sweep, tmp_path):
     import helpers
     files = [INPUTS / "brake_sweep.nml", DATA / "sweep_small.nml"]
     out = tmp_path / "part.h5"
     # the program stops after 3 of the 6 points as on SIGTERM (exit 6), leaving checkpoints
-    helpers.run([program, "--quiet", "-o", out, *files], expect=6, extra_env={"FRICTION_TEST_STOP_AFTER": "3"})
+    helpers.run([stop_program, "--quiet", "-o", out, *files], expect=6, extra_env={"FRICTION_TEST_STOP_AFTER": "3"})
     part = friction.load(out, scene="sweep")
     assert list(part["sweep/status"].values) == [1, 1, 1, 0, 0, 0]
     assert part.group_attrs["sweep"]["complete"] == 0

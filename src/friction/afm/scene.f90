@@ -236,9 +236,8 @@ contains
          interrupted = .false.
          do j = 1, count
             if (allocated(error)) exit
-            ! Between lines: a stop request (or the test hook, after that many
-            ! lines of this rank computed) ends the map here.
-            if (reporter%stop_requested() .or. (job%stop_after > 0 .and. computed >= job%stop_after)) then
+            ! Between lines: a stop request ends the map here.
+            if (reporter%stop_after(computed)) then
                interrupted = .true.
                exit
             end if
@@ -331,8 +330,8 @@ contains
             stopped = 0
             do j = 1, count
                if (allocated(error)) exit
-               ! (The test hook counts the check's lines after the map's.)
-               if (reporter%stop_requested() .or. (job%stop_after > 0 .and. computed + j - 1 >= job%stop_after)) then
+               ! (The check's lines count after the map's.)
+               if (reporter%stop_after(computed + j - 1)) then
                   stopped = 1
                   exit
                end if

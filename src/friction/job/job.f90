@@ -30,12 +30,10 @@ contains
    !> unless `force`, or `resume` for a sweep (which reuses the checkpoints an
    !> interrupted run left beside it).  `summary` says what was written.
    !> `overrides` ('group.variable=value') apply after the files, in order.
-   subroutine run_job(files, output, force, resume, comm, reporter, summary, error, stop_after, overrides)
+   subroutine run_job(files, output, force, resume, comm, reporter, summary, error, overrides)
       character(len=*), intent(in) :: files(:)
       character(len=*), intent(in) :: output
       logical, intent(in) :: force, resume
-      !> A test hook: > 0 stops a sweep after that point as a stop request would.
-      integer, intent(in), optional :: stop_after
       character(len=*), intent(in), optional :: overrides(:)
       type(MPI_Comm), intent(in) :: comm
       class(job_reporter), intent(inout) :: reporter
@@ -45,7 +43,6 @@ contains
       type(job_config) :: config
 
       call start_job(comm, output, resume, job)
-      if (present(stop_after)) job%stop_after = stop_after
       allocate (job%files(size(files)))
       job%files = files
       if (size(files) == 0) then

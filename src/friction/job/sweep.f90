@@ -113,9 +113,9 @@ module friction_job_sweep
 
 contains
 
-   !> Run the sweep of `config`; a stop request or the stop_after hook of the
-   !> job's options ends it early (the file then marks the points not done as
-   !> pending and the error says so, with stat error_interrupted).
+   !> Run the sweep of `config`; a stop request (the reporter's stop_after)
+   !> ends it early (the file then marks the points not done as pending and
+   !> the error says so, with stat error_interrupted).
    subroutine run_sweep_job(job, config, reporter, summary, error)
       type(job_context), intent(in) :: job
       type(job_config), intent(in) :: config
@@ -215,9 +215,7 @@ contains
       finished = 0
       do
          ! Between points: a stop request ends the sweep here, the point in hand done.
-         ! (The test hook likewise, once this rank has done point stop_after:
-         ! with stop_after = n, a stop request after the last point.)
-         if (reporter%stop_requested() .or. (job%stop_after > 0 .and. last_taken >= job%stop_after)) then
+         if (reporter%stop_after(last_taken)) then
             interrupted = .true.
             exit
          end if
@@ -237,9 +235,12 @@ contains
          i = w
          if (use_todo) read (todo_unit, pos=int(w - 1, i8) * 4 + 1) i
          last_taken = i
-         if (job%stop_after > 0 .and. i > job%stop_after) then
-            interrupted = .true.   ! the test hook: as if a signal came after that point
-            exit
+         ! (A stop after the point before this one, which another rank may have taken.)
+         if (i > 1) then
+            if (reporter%stop_after(i - 1)) then
+               interrupted = .true.
+               exit
+            end if
          end if
          computed = computed + 1
          t0 = wall_seconds()

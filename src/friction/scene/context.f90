@@ -28,7 +28,6 @@ module friction_scene_context
       character(len=4096), allocatable :: files(:)
       logical :: resume = .false.
       logical :: replace = .false.           !! the output may replace a regular file (--force, --resume)
-      integer :: stop_after = 0              !! test hook: > 0 stops a sweep after that point
    contains
       procedure :: parallel
    end type job_context

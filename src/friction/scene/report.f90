@@ -21,6 +21,11 @@ module friction_scene_report
       !> Asked between independent pieces of work (sweep points): true stops
       !> the job there, leaving a valid, resumable file.
       procedure :: stop_requested => never_stop
+      !> Asked once piece `item` is done (a sweep point's number, or how many
+      !> lines of a map this process computed): true stops the job there as
+      !> a stop request would.  By default a stop request alone; a test's
+      !> reporter stops after a given piece.
+      procedure :: stop_after => stop_after_request
    end type job_reporter
 
 contains
@@ -61,5 +66,12 @@ contains
 
       never_stop = .false.
    end function never_stop
+
+   logical function stop_after_request(self, item)
+      class(job_reporter), intent(inout) :: self
+      integer, intent(in) :: item
+
+      stop_after_request = self%stop_requested()
+   end function stop_after_request
 
 end module friction_scene_report
