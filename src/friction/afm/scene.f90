@@ -5,15 +5,12 @@ module friction_afm_scene
    use mpi_f08
    use friction_kinds, only: wp, i8
    use friction_error, only: error_type, fatal_error, error_input, error_interrupted, error_numerical
-   use friction_files, only: available_memory, remove_file
-   use friction_strings, only: itoa, bytes_text, text_hash, etoa
+   use friction_strings, only: itoa, bytes_text
    use friction_version, only: version_string
    use friction_parameters, only: parameter_visitor, parameters_text
    use friction_checks, only: config_checker
-   use friction_clock, only: wall_seconds
    use friction_ode_solver, only: integrator_statistics
    use friction_ode_auto, only: auto_name
-   use friction_ode_settings, only: verify_solver
    use friction_surface_potential, only: surface_potential
    use friction_output_summary, only: run_summary
    use friction_scene, only: scene, point_result, point_memory, result_sink
@@ -28,25 +25,19 @@ module friction_afm_scene
       & line_friction
    use friction_afm_validity, only: afm_model_warnings, quasistatic_friction_warning
    use friction_afm_netlist, only: afm_netlist
-   use friction_afm_line_checkpoint, only: line_checkpoint_name, save_line, load_line, publish_checkpoints, &
-      & discard_checkpoints
+   use friction_afm_line_checkpoint, only: line_checkpoint_name
+   use friction_afm_map_share, only: map_share
+   use friction_afm_map_verify, only: verify_map
    implicit none
    private
 
    public :: afm_scene, afm_friction, take_surface
 
-   !> A slip's items: line, realization, trip, support, force, jump, jump_across.
-   integer, parameter :: n_slip_items = 7
-
    type, extends(scene) :: afm_scene
       type(afm_config) :: config                 !! as the input gives it ('auto' unresolved)
       ! The run's results on this rank
       type(afm_config), private :: ran           !! the settings that ran
-      real(wp), allocatable, private :: trace(:, :, :), retrace(:, :, :)
-      !> At a temperature: standard errors over the realizations of the
-      !> samples and of each line's friction.
-      real(wp), allocatable, private :: trace_sem(:, :, :), retrace_sem(:, :, :)
-      real(wp), allocatable, private :: friction_sem(:)
+      type(map_share), private :: map            !! this rank's lines
       !> The map's slips (all ranks', ordered by line, realization, trip and
       !> time): line, realization, trip, support (Å), force (nN), jump along
       !> and across (Å).
@@ -56,7 +47,6 @@ module friction_afm_scene
       type(afm_surface_record), private :: surface
       type(afm_verify_record), private :: verify
       type(run_summary), private :: record
-      integer, private :: first = 0
       logical, private :: three_d = .false.
    contains
       procedure :: name => afm_name
@@ -165,21 +155,13 @@ contains
       class(surface_potential), allocatable :: potential
       type(mpi_sharing) :: share
       type(line_record) :: line
-      type(integrator_statistics) :: stats
-      real(wp), allocatable :: local_slips(:, :)
       integer(i8) :: counts(4)
-      integer :: count, j, computed, saved, flag
-      real(wp) :: wall, last_saved
-      real(wp), allocatable :: line_counts(:, :)
-      character(len=:), allocatable :: input_hash, problem
+      integer :: j, flag
       logical :: interrupted
-      logical, allocatable :: loaded(:)
-      character(len=:), allocatable :: warnings
-      integer :: start, end
 
       self%ran = self%resolved()
       self%verify = afm_verify_record()
-      associate (c => self%ran)
+      associate (c => self%ran, map => self%map)
          ! The surface first, identically on every rank (its table, if any,
          ! built by all together): a bad net or defect is bad input,
          ! reported before any work.
@@ -187,85 +169,42 @@ contains
          call new_potential(c, potential, error, self%surface%net, self%surface%cutoff, self%surface%evaluation, &
             & share)
          if (allocated(error)) return
-         ! A reduced tip model outside where it holds (docs/physics.md, reduced tip models):
-         ! one note per reason.
-         if (job%rank == 0 .and. c%moves_in_3d()) then
-            if (len(self%surface%evaluation%note) > 0) call reporter%note("note: &surface evaluation = 'table': " &
-               & //'the direct sum instead: '//self%surface%evaluation%note)
-         end if
-         if (job%rank == 0) then
-            warnings = afm_model_warnings(c, potential)
-            start = 1
-            do while (start <= len(warnings))
-               end = index(warnings(start:), new_line('a'))
-               end = merge(len(warnings), start + end - 2, end == 0)
-               call reporter%note('warning: '//warnings(start:end))
-               start = end + 2
-            end do
-         end if
+         if (job%rank == 0) call note_model(potential)
          self%surface%species_names = c%species(1:species_count(c))
-         call share_of(c%ny, job%nranks, job%rank, self%first, count)
-         if (allocated(self%trace)) deallocate (self%trace)
-         if (allocated(self%retrace)) deallocate (self%retrace)
          ! The map's share of this rank, checked before it is allocated.
-         call allocate_share(error)
+         call map%init(c, job, c%thermal%enabled(), error)
          if (.not. allocated(error)) call scanner%init_owning(c, potential, error)
-          if (allocated(self%trace_sem)) deallocate (self%trace_sem)
-          if (allocated(self%retrace_sem)) deallocate (self%retrace_sem)
-          if (allocated(self%friction_sem)) deallocate (self%friction_sem)
-          if (allocated(self%slips)) deallocate (self%slips)
-          allocate (local_slips(n_slip_items, 0))
-          if (.not. allocated(error) .and. scanner%thermal) then
-             allocate (self%trace_sem(c%nx, count, n_quantities))
-             allocate (self%retrace_sem(c%nx, merge(count, 0, c%retrace), n_quantities))
-             allocate (self%friction_sem(count))
-             self%time_step = scanner%time_step()
-             self%scheme = thermal_scheme(c)
-          end if
+         if (.not. allocated(error) .and. scanner%thermal) then
+            self%time_step = scanner%time_step()
+            self%scheme = thermal_scheme(c)
+         end if
          self%surface%contact_height = scanner%contact_height
          self%surface%support_height = scanner%support_height
          if (allocated(scanner%tip)) self%three_d = scanner%tip%ndim == 3
          ! Finished lines go to checkpoints beside the output (every
          ! checkpoint_interval of wall time, and when stopped) for --resume.
-         input_hash = text_hash(job%input_text)
-         allocate (line_counts(4, count), source=0.0_wp)
-         allocate (loaded(count), source=.false.)
-         computed = 0
-         saved = 0
-         last_saved = wall_seconds()
          interrupted = .false.
-         do j = 1, count
+         do j = 1, map%count
             if (allocated(error)) exit
             ! Between lines: a stop request ends the map here.
-            if (reporter%stop_after(computed)) then
+            if (reporter%stop_after(map%computed)) then
                interrupted = .true.
                exit
             end if
-            if (job%resume) call resume_line(j, error)
+            if (job%resume) call map%resume_line(j, error)
             if (allocated(error)) exit
-            if (.not. loaded(j)) then
+            if (.not. map%loaded(j)) then
                counts = scanner_counts()
-               call scanner%run_line(self%first + (j - 1) * job%nranks, line, error)
+               call scanner%run_line(map%global_line(j), line, error)
                if (allocated(error)) exit
-               line_counts(:, j) = real(scanner_counts() - counts, wp)
-               computed = computed + 1
-               self%trace(:, j, :) = line%trace
-               if (c%retrace) self%retrace(:, j, :) = line%retrace
-               if (scanner%thermal) then
-                  self%trace_sem(:, j, :) = line%trace_sem
-                  if (c%retrace) self%retrace_sem(:, j, :) = line%retrace_sem
-                  self%friction_sem(j) = line%friction_sem
-                  call keep_slips(self%first + (j - 1) * job%nranks, line%slips)
-               end if
-               if (wall_seconds() - last_saved >= c%checkpoint_interval) call save_lines(j, error)
+               call map%store(j, line, real(scanner_counts() - counts, wp))
+               if (map%save_due()) call map%save_lines(j, error)
             end if
-            ! Rank 0's share is as large as any other and spread over the whole
-            ! map, so its fraction done is the map's fraction done.
-            if (job%rank == 0) call reporter%progress(real(lines_done(j), wp), real(c%ny, wp), 'lines', .false.)
+            if (job%rank == 0) call reporter%progress(real(map%lines_done(j), wp), real(c%ny, wp), 'lines', .false.)
          end do
-         if (interrupted .and. .not. allocated(error)) call save_lines(j - 1, error)
+         if (interrupted .and. .not. allocated(error)) call map%save_lines(j - 1, error)
          if (job%rank == 0 .and. .not. allocated(error) .and. .not. interrupted) &
-            & call reporter%progress(real(lines_done(count), wp), real(c%ny, wp), 'lines', .true.)
+            & call reporter%progress(real(map%lines_done(map%count), wp), real(c%ny, wp), 'lines', .true.)
 
          ! A failure on any rank stops all of them here, before anything is written.
          call agree_on_error(job, error)
@@ -278,109 +217,49 @@ contains
                & //'compute only the others', error_interrupted)
             return
          end if
-         if (c%check%enabled) call verify_map(error)
-         if (allocated(error)) return
+         if (c%check%enabled) then
+            ! (The surface the map ran on, handed over: a table is not built again.)
+            call scanner%release_potential(potential)
+            call verify_map(map, potential, self%three_d, job, reporter, self%verify, error)
+            if (allocated(error)) return
+         end if
          if (c%tip_model() == model_quasistatic) call check_friction()
-         if (scanner%thermal) call gather_slips()
+         if (scanner%thermal) call map%gather_slips(job, self%slips)
 
          ! The counts of every line, computed now or loaded: a resumed map
          ! records what an uninterrupted one does.
-         counts = nint(sum(line_counts, dim=2), i8)
+         counts = nint(sum(map%line_counts, dim=2), i8)
          if (job%parallel()) call MPI_Allreduce(MPI_IN_PLACE, counts, 4, MPI_INTEGER8, MPI_SUM, job%comm)
-         wall = job_wall_time(job)
-         stats = integrator_statistics(counts(1), counts(2), counts(3), counts(4))
          ! (Component by component: gfortran's structure constructor mis-sizes a
          ! deferred-length component copied from another derived type's.)
          self%record%input_text = job%input_text
          self%record%nranks = job%nranks
-         self%record%wall_time = wall
-         self%record%stats = stats
+         self%record%wall_time = job_wall_time(job)
+         self%record%stats = integrator_statistics(counts(1), counts(2), counts(3), counts(4))
          ! Complete: the checkpoints have served.
-         do j = 1, count
-            call remove_file(line_checkpoint_name(job%output, self%first + (j - 1) * job%nranks))
-         end do
+         call map%remove_checkpoints()
       end associate
 
    contains
 
-      !> &verify: this rank's lines integrated again on the same surface with
-      !> the check's stepper settings, and the largest difference of each
-      !> force component over every rank's samples of both trips; beyond
-      !> check_limit the run fails (nothing written).  Collective.
-      subroutine verify_map(error)
-         type(error_type), allocatable, intent(out) :: error
-         type(afm_scanner) :: checker
-         type(afm_config) :: check_config
-         type(line_record) :: again
-         type(integrator_statistics) :: check_stats
-         integer :: j, q, stopped
-         integer, parameter :: forces(3) = [q_fx, q_fy, q_fz]
+      !> A reduced tip model outside where it holds (docs/physics.md, reduced
+      !> tip models) and a table declined: one note per reason.
+      subroutine note_model(potential)
+         class(surface_potential), intent(in) :: potential
+         character(len=:), allocatable :: warnings
+         integer :: start, end
 
-         associate (c => self%ran)
-            check_config = c
-            check_config%check%enabled = .false.
-            check_config%solver = verify_solver(c%check, c%solver)
-            self%verify%enabled = .true.
-            self%verify%method = check_config%solver%method
-            self%verify%rtol = check_config%solver%rtol
-            self%verify%atol = check_config%solver%atol
-            ! (The surface the map ran on, handed over: a table is not built again.)
-            call scanner%release_potential(potential)
-            call checker%init_owning(check_config, potential, error)
-            stopped = 0
-            do j = 1, count
-               if (allocated(error)) exit
-               ! (The check's lines count after the map's.)
-               if (reporter%stop_after(computed + j - 1)) then
-                  stopped = 1
-                  exit
-               end if
-               call checker%run_line(self%first + (j - 1) * job%nranks, again, error)
-               if (allocated(error)) exit
-               do q = 1, merge(3, 2, self%three_d)
-                  self%verify%max_difference(q) = max(self%verify%max_difference(q), &
-                     & maxval(abs(again%trace(:, forces(q)) - self%trace(:, j, forces(q)))))
-                  if (c%retrace) self%verify%max_difference(q) = max(self%verify%max_difference(q), &
-                     & maxval(abs(again%retrace(:, forces(q)) - self%retrace(:, j, forces(q)))))
-               end do
-               if (job%rank == 0) call reporter%progress(real(lines_done(j), wp), real(c%ny, wp), 'lines (verify)', &
-                  & j == count)
-            end do
-            if (allocated(error)) error%message = 'verify run: '//error%message
-            call agree_on_error(job, error)
-            if (allocated(error)) return
-            if (job%parallel()) call MPI_Allreduce(MPI_IN_PLACE, stopped, 1, MPI_INTEGER, MPI_MAX, job%comm)
-            if (stopped /= 0) then
-               ! Every line of the map is done: --resume then runs the check alone.
-               call save_lines(count, error)
-               if (.not. allocated(error)) call fatal_error(error, 'map interrupted in its &verify run: no file ' &
-                  & //'written; the map''s lines are checkpointed beside the output (' &
-                  & //line_checkpoint_name(job%output, 0)//' ...): run again with --resume to run only the check', &
-                  & error_interrupted)
-               call agree_on_error(job, error)
-               return
-            end if
-            check_stats = checker%statistics()
-            self%verify%rhs_evaluations = check_stats%rhs_evaluations
-            if (job%parallel()) then
-               call MPI_Allreduce(MPI_IN_PLACE, self%verify%max_difference, 3, MPI_DOUBLE_PRECISION, MPI_MAX, job%comm)
-               call MPI_Allreduce(MPI_IN_PLACE, self%verify%rhs_evaluations, 1, MPI_INTEGER8, MPI_SUM, job%comm)
-            end if
-            associate (d => self%verify)
-               if (job%rank == 0) then
-                  call reporter%note('verify: '//trim(d%method)//' at rtol '//etoa(d%rtol, 2)//', atol ' &
-                     & //etoa(d%atol, 2)//': max |dF| = '//etoa(maxval(d%max_difference), 2)//' nN over the map')
-               end if
-               if (c%check%max_difference > 0.0_wp .and. .not. (maxval(d%max_difference) <= c%check%max_difference)) &
-                  & then
-                  call fatal_error(error, 'verify failed: the check run''s forces differ by ' &
-                     & //etoa(maxval(d%max_difference), 2)//' nN, more than check_limit = ' &
-                     & //etoa(c%check%max_difference, 2)//' nN (docs/speed.md, which steppers need verify)', &
-                     & error_numerical)
-               end if
-            end associate
-         end associate
-      end subroutine verify_map
+         if (self%ran%moves_in_3d() .and. len(self%surface%evaluation%note) > 0) call reporter%note( &
+            & "note: &surface evaluation = 'table': the direct sum instead: "//self%surface%evaluation%note)
+         warnings = afm_model_warnings(self%ran, potential)
+         start = 1
+         do while (start <= len(warnings))
+            end = index(warnings(start:), new_line('a'))
+            end = merge(len(warnings), start + end - 2, end == 0)
+            call reporter%note('warning: '//warnings(start:end))
+            start = end + 2
+         end do
+      end subroutine note_model
 
       !> The scanner's integrator counts so far.
       function scanner_counts() result(now)
@@ -391,181 +270,19 @@ contains
          now = [so_far%steps, so_far%failed_steps, so_far%rhs_evaluations, so_far%jacobian_evaluations]
       end function scanner_counts
 
-      !> Line j of this rank from its checkpoint, when there is one for this
-      !> input (then loaded(j)); one that exists but cannot serve is an error.
-      subroutine resume_line(j, error)
-         integer, intent(in) :: j
-         type(error_type), allocatable, intent(out) :: error
-         real(wp), allocatable :: slips(:, :), trace(:, :), retrace(:, :), trace_sem(:, :), retrace_sem(:, :)
-         real(wp) :: friction_sem
-         integer :: g
-
-         g = self%first + (j - 1) * job%nranks
-         call line_arrays(j, trace, retrace, trace_sem, retrace_sem)
-         call load_line(line_checkpoint_name(job%output, g), input_hash, g, trace, retrace, trace_sem, &
-            & retrace_sem, friction_sem, slips, line_counts(:, j), loaded(j), problem)
-         if (len(problem) > 0) then
-            call fatal_error(error, problem//'; --resume reuses only the checkpoints of the same input: remove ' &
-               & //'it, or run without --resume', error_input)
-            return
-         end if
-         if (.not. loaded(j)) return
-         self%trace(:, j, :) = trace
-         if (self%ran%retrace) self%retrace(:, j, :) = retrace
-         if (scanner%thermal) then
-            self%trace_sem(:, j, :) = trace_sem
-            if (self%ran%retrace) self%retrace_sem(:, j, :) = retrace_sem
-            self%friction_sem(j) = friction_sem
-            local_slips = reshape([local_slips, slips], [n_slip_items, size(local_slips, 2) + size(slips, 2)])
-         end if
-      end subroutine resume_line
-
-      !> Checkpoints of this rank's lines after `saved` up to `last` that
-      !> were computed in this run.
-      subroutine save_lines(last, error)
-         integer, intent(in) :: last
-         type(error_type), allocatable, intent(out) :: error
-         real(wp), allocatable :: trace(:, :), retrace(:, :), trace_sem(:, :), retrace_sem(:, :)
-         real(wp) :: friction_sem
-         character(len=:), allocatable :: names(:)
-         integer :: j, g, k, n
-
-         allocate (character(len=len(line_checkpoint_name(job%output, self%ran%ny))) :: names(max(0, last - saved)))
-         n = 0
-         do j = saved + 1, last
-            if (loaded(j)) cycle
-            g = self%first + (j - 1) * job%nranks
-            call line_arrays(j, trace, retrace, trace_sem, retrace_sem)
-            friction_sem = 0.0_wp
-            if (scanner%thermal) friction_sem = self%friction_sem(j)
-            names(n + 1) = line_checkpoint_name(job%output, g)
-            call save_line(trim(names(n + 1)), input_hash, g, trace, retrace, trace_sem, &
-               & retrace_sem, friction_sem, local_slips(:, pack([(k, k=1, size(local_slips, 2))], &
-               & nint(local_slips(1, :)) == g)), line_counts(:, j), problem)
-            if (len(problem) > 0) then
-               call discard_checkpoints(names(1:n))
-               call fatal_error(error, problem)
-               return
-            end if
-            n = n + 1
-         end do
-         ! One sync for the lines of this save, then their names.
-         call publish_checkpoints(names(1:n), problem)
-         if (len(problem) > 0) then
-            call fatal_error(error, problem)
-            return
-         end if
-         saved = max(saved, last)
-         last_saved = wall_seconds()
-      end subroutine save_lines
-
-      !> Line j's samples as save_line and load_line take them: (nx,
-      !> quantities) each, of no rows for what the map does not have.
-      subroutine line_arrays(j, trace, retrace, trace_sem, retrace_sem)
-         integer, intent(in) :: j
-         real(wp), allocatable, intent(out) :: trace(:, :), retrace(:, :), trace_sem(:, :), retrace_sem(:, :)
-         logical :: thermal
-
-         thermal = scanner%thermal
-         trace = self%trace(:, j, :)
-         allocate (retrace(0, 0), trace_sem(0, 0), retrace_sem(0, 0))
-         if (self%ran%retrace) retrace = self%retrace(:, j, :)
-         if (thermal) trace_sem = self%trace_sem(:, j, :)
-         if (thermal .and. self%ran%retrace) retrace_sem = self%retrace_sem(:, j, :)
-      end subroutine line_arrays
-
-      !> trace and retrace for this rank's lines, or an error stating the
-      !> memory they need when this machine has not that much available.
-      subroutine allocate_share(error)
-         type(error_type), allocatable, intent(out) :: error
-         real(wp) :: needed, available
-         integer :: stat
-
-         needed = 8.0_wp * real(self%ran%nx, wp) * real(count, wp) * n_quantities &
-            & * merge(2.0_wp, 1.0_wp, self%ran%retrace)
-         available = available_memory()
-         if (available > 0.0_wp .and. needed > available) then
-            call fatal_error(error, 'the map needs '//bytes_text(needed)//' of memory on each rank (' &
-               & //itoa(self%ran%nx)//' points x '//itoa(count)//' lines x '//itoa(n_quantities) &
-               & //' quantities x 8 bytes'//trim(merge(' x 2 trips', '          ', self%ran%retrace)) &
-               & //'), more than the '//bytes_text(available)//' this machine has available: use fewer ' &
-               & //'points (&scan nx, ny) or more ranks on more machines', error_input)
-            return
-         end if
-         allocate (self%trace(self%ran%nx, count, n_quantities), stat=stat)
-         if (stat == 0) allocate (self%retrace(self%ran%nx, merge(count, 0, self%ran%retrace), n_quantities), &
-            & stat=stat)
-         if (stat /= 0) call fatal_error(error, 'the map needs '//bytes_text(needed)//' of memory on each ' &
-            & //'rank, which could not be allocated: use fewer points (&scan nx, ny) or more ranks', error_input)
-      end subroutine allocate_share
-
-      !> A line's slips onto this rank's list.
-      subroutine keep_slips(global_line, slips)
-         integer, intent(in) :: global_line
-         type(slip_list), intent(in) :: slips
-         real(wp), allocatable :: more(:, :)
-         integer :: k, n
-
-         n = size(local_slips, 2)
-         allocate (more(n_slip_items, n + slips%n))
-         more(:, 1:n) = local_slips
-         do k = 1, slips%n
-            more(:, n + k) = [real(global_line, wp), real(slips%realization(k), wp), real(slips%trip(k), wp), &
-               & slips%support(k), slips%force(k), slips%jump(k), slips%jump_across(k)]
-         end do
-         call move_alloc(more, local_slips)
-      end subroutine keep_slips
-
-      !> Every rank's slips on every rank, in the order of the lines (each
-      !> rank's list is in its lines' order; the lines are dealt round-robin).
-      subroutine gather_slips()
-         integer :: counts(job%nranks), displacements(job%nranks), cursor(job%nranks), n, r, line, k, at
-         real(wp), allocatable :: everything(:, :)
-
-         n = size(local_slips, 2)
-         if (.not. job%parallel()) then
-            call move_alloc(local_slips, self%slips)
-            return
-         end if
-         call MPI_Allgather(n, 1, MPI_INTEGER, counts, 1, MPI_INTEGER, job%comm)
-         displacements(1) = 0
-         do r = 2, job%nranks
-            displacements(r) = displacements(r - 1) + counts(r - 1)
-         end do
-         allocate (everything(n_slip_items, sum(counts)))
-         call MPI_Allgatherv(local_slips, n_slip_items * n, MPI_DOUBLE_PRECISION, everything, &
-            & n_slip_items * counts, n_slip_items * displacements, MPI_DOUBLE_PRECISION, job%comm)
-         allocate (self%slips(n_slip_items, sum(counts)))
-         cursor = displacements
-         at = 0
-         do line = 0, self%ran%ny - 1
-            r = mod(line, job%nranks) + 1
-            do k = cursor(r) + 1, displacements(r) + counts(r)
-               if (nint(everything(1, k)) /= line) exit
-               at = at + 1
-               self%slips(:, at) = everything(:, k)
-               cursor(r) = k
-            end do
-         end do
-      end subroutine gather_slips
-
       !> The quasistatic map's mean friction against the drag it leaves out.
       subroutine check_friction()
          real(wp) :: sums(2)
          character(len=:), allocatable :: warning
 
-         sums = [sum(self%trace(:, :, q_f_along)), real(size(self%trace(:, :, q_f_along)), wp)]
-         if (self%ran%retrace) sums(1) = 0.5_wp * (sums(1) - sum(self%retrace(:, :, q_f_along)))
+         associate (trace => self%map%trace, retrace => self%map%retrace)
+            sums = [sum(trace(:, :, q_f_along)), real(size(trace(:, :, q_f_along)), wp)]
+            if (self%ran%retrace) sums(1) = 0.5_wp * (sums(1) - sum(retrace(:, :, q_f_along)))
+         end associate
          if (job%parallel()) call MPI_Allreduce(MPI_IN_PLACE, sums, 2, MPI_DOUBLE_PRECISION, MPI_SUM, job%comm)
          warning = quasistatic_friction_warning(self%ran, sums(1) / max(1.0_wp, sums(2)))
          if (job%rank == 0 .and. len(warning) > 0) call reporter%note('warning: '//warning)
       end subroutine check_friction
-
-      integer function lines_done(done)
-         integer, intent(in) :: done
-
-         lines_done = min(self%ran%ny, int(real(done, wp) / max(1, count) * self%ran%ny))
-      end function lines_done
 
    end subroutine afm_run
 
@@ -577,27 +294,27 @@ contains
       type(afm_thermal_record) :: thermal
 
       self%record%version = version_string
-      if (allocated(self%trace_sem)) then
+      if (allocated(self%map%trace_sem)) then
          ! (Component by component: gfortran's structure constructor mishandles
          ! deferred-length components.)
-         thermal%trace_sem = self%trace_sem
-         thermal%retrace_sem = self%retrace_sem
-         thermal%friction_sem = self%friction_sem
+         thermal%trace_sem = self%map%trace_sem
+         thermal%retrace_sem = self%map%retrace_sem
+         thermal%friction_sem = self%map%friction_sem
          thermal%time_step = self%time_step
          thermal%scheme = self%scheme
          thermal%slips = self%slips
          if (self%three_d) then
-            call write_afm_file(path, job%comm, self%ran, self%first, job%nranks, self%trace, self%retrace, &
+            call write_afm_file(path, job%comm, self%ran, self%map%first, job%nranks, self%map%trace, self%map%retrace, &
                & self%record, error, self%surface, thermal=thermal, verify=self%verify)
          else
-            call write_afm_file(path, job%comm, self%ran, self%first, job%nranks, self%trace, self%retrace, &
+            call write_afm_file(path, job%comm, self%ran, self%map%first, job%nranks, self%map%trace, self%map%retrace, &
                & self%record, error, thermal=thermal, verify=self%verify)
          end if
       else if (self%three_d) then
-         call write_afm_file(path, job%comm, self%ran, self%first, job%nranks, self%trace, self%retrace, &
+         call write_afm_file(path, job%comm, self%ran, self%map%first, job%nranks, self%map%trace, self%map%retrace, &
             & self%record, error, self%surface, verify=self%verify)
       else
-         call write_afm_file(path, job%comm, self%ran, self%first, job%nranks, self%trace, self%retrace, &
+         call write_afm_file(path, job%comm, self%ran, self%map%first, job%nranks, self%map%trace, self%map%retrace, &
             & self%record, error, verify=self%verify)
       end if
    end subroutine afm_write
