@@ -20,7 +20,7 @@ module friction_app_cli
    use friction_version, only: version_string
    use friction_job, only: run_job, write_netlist, resolve_input, default_output
    use friction_clock, only: wall_seconds
-   use friction_app_terminal, only: terminal_reporter
+   use friction_app_terminal_reporter, only: terminal_reporter
    implicit none
    private
 

@@ -13,7 +13,7 @@
 !> through the same job code, without MPI_Init and its start-up time.
 !> --help, --version, --netlist and usage errors never start MPI.
 program friction_main
-   use friction_app_terminal, only: terminal_reporter
+   use friction_app_terminal_reporter, only: terminal_reporter
    use friction_app_cli, only: run_program
    implicit none
 

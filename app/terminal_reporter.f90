@@ -1,6 +1,6 @@
 !> The command line's reporter: a running job's progress and notes on
 !> stderr, and SIGTERM/SIGINT as a request to stop a sweep.
-module friction_app_terminal
+module friction_app_terminal_reporter
    use, intrinsic :: iso_c_binding, only: c_int
    use, intrinsic :: iso_fortran_env, only: error_unit
    use friction_clock, only: wall_seconds
@@ -103,4 +103,4 @@ contains
       signal_received = friction_interrupted() /= 0
    end function signal_received
 
-end module friction_app_terminal
+end module friction_app_terminal_reporter

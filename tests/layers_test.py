@@ -57,6 +57,21 @@ def main():
                 continue
             if RANK[target] >= RANK[folder]:
                 problems.append(f"{os.path.relpath(path, root)}: {folder}/ uses {used} of {target}/")
+    # Each file is named after its module (docs/layout.md, folders are
+    # namespaces): friction_<folder>_<file>, friction_<file> in core/,
+    # friction_<folder> for the file named as its folder.
+    for path in sources:
+        folder = os.path.relpath(os.path.dirname(path), os.path.join(root, "src", "friction"))
+        folder = "app" if folder.startswith("..") else folder
+        base = os.path.basename(path).split(".")[0]
+        expected = {"friction_" + base if folder in ("core", ".") else f"friction_{folder}_{base}",
+                    f"friction_{folder}"}
+        if folder == "." and base == "friction":
+            expected = {"friction"}
+        for module in re.findall(r"^\s*module\s+(\w+)\s*$", open(path).read(), re.M | re.I):
+            if module.lower() not in expected and not (folder == "core" and base == module.lower()[9:]):
+                problems.append(f"{os.path.relpath(path, root)}: module {module}, not named after its file "
+                                f"({' or '.join(sorted(expected))})")
     if problems:
         print("FAILED: layer violations:\n  " + "\n  ".join(problems))
         sys.exit(1)

@@ -5,7 +5,7 @@
 !> SIGTERM there would.  Unset or not a positive number: never.  The
 !> program `friction` itself reads no such variable.
 module stop_after_reporter
-   use friction_app_terminal, only: terminal_reporter
+   use friction_app_terminal_reporter, only: terminal_reporter
    implicit none
    private
 

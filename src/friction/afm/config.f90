@@ -109,7 +109,7 @@ module friction_afm_config
       ! &integrator
       type(solver_settings) :: solver
       ! &verify: the map integrated again and its forces compared
-      type(verify_settings) :: check
+      type(verify_settings) :: verify
       ! &thermal
       type(thermal_settings) :: thermal
    contains
@@ -192,7 +192,7 @@ contains
       call v%item('checkpoint_interval', self%checkpoint_interval, 's')
       call v%end_group()
       call visit_integrator(self%solver, v, 's')
-      call visit_verify(self%check, v, 'state units', 'nN')
+      call visit_verify(self%verify, v, 'state units', 'nN')
       call self%thermal%visit(v)
    end subroutine visit
 
@@ -240,15 +240,15 @@ contains
          & //' samples, more than 2147483647 per dataset (and '//bytes_text(8.0_wp * n_trip_quantities &
          & * real(self%nx, wp) * self%ny)//' of memory for the trace alone)')
       call check_integrator(self%solver, c)
-      call check_verify(self%check, c, 'nN')
+      call check_verify(self%verify, c, 'nN')
       call self%thermal%validate(c)
       ! (The check is of the stepper's tolerances: the quasi-static tip
       ! follows its equilibrium without them, the Langevin schemes take a
       ! fixed step.)
-      if (self%check%enabled .and. self%model == 'quasistatic') call c%reject('verify', 'check', '.true.', &
+      if (self%verify%enabled .and. self%model == 'quasistatic') call c%reject('verify', 'check', '.true.', &
          & "compares two integrations of the tip: model = 'quasistatic' follows the equilibrium without " &
          & //"integrating (use 'inertial' or 'overdamped')")
-      if (self%check%enabled .and. self%thermal%enabled()) call c%reject('verify', 'check', '.true.', &
+      if (self%verify%enabled .and. self%thermal%enabled()) call c%reject('verify', 'check', '.true.', &
          & 'compares two integrations at two tolerances: at a temperature the Langevin scheme takes a fixed ' &
          & //'time step (compare runs at two &thermal time_step values instead)')
       if (.not. c%failed() .and. self%thermal%enabled()) call check_thermal()

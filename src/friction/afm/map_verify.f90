@@ -46,8 +46,8 @@ contains
 
       associate (c => map%config)
          check_config = c
-         check_config%check%enabled = .false.
-         check_config%solver = verify_solver(c%check, c%solver)
+         check_config%verify%enabled = .false.
+         check_config%solver = verify_solver(c%verify, c%solver)
          record%enabled = .true.
          record%method = check_config%solver%method
          record%rtol = check_config%solver%rtol
@@ -95,11 +95,11 @@ contains
             call reporter%note('verify: '//trim(record%method)//' at rtol '//etoa(record%rtol, 2)//', atol ' &
                & //etoa(record%atol, 2)//': max |dF| = '//etoa(maxval(record%max_difference), 2)//' nN over the map')
          end if
-         if (c%check%max_difference > 0.0_wp .and. .not. (maxval(record%max_difference) <= c%check%max_difference)) &
+         if (c%verify%max_difference > 0.0_wp .and. .not. (maxval(record%max_difference) <= c%verify%max_difference)) &
             & then
             call fatal_error(error, 'verify failed: the check run''s forces differ by ' &
                & //etoa(maxval(record%max_difference), 2)//' nN, more than check_limit = ' &
-               & //etoa(c%check%max_difference, 2)//' nN (docs/speed.md, which steppers need verify)', &
+               & //etoa(c%verify%max_difference, 2)//' nN (docs/speed.md, which steppers need verify)', &
                & error_numerical)
          end if
       end associate

@@ -91,7 +91,7 @@ contains
    logical function afm_verifies(self)
       class(afm_scene), intent(in) :: self
 
-      afm_verifies = self%config%check%enabled
+      afm_verifies = self%config%verify%enabled
    end function afm_verifies
 
    subroutine afm_visit(self, v)
@@ -217,7 +217,7 @@ contains
                & //'compute only the others', error_interrupted)
             return
          end if
-         if (c%check%enabled) then
+         if (c%verify%enabled) then
             ! (The surface the map ran on, handed over: a table is not built again.)
             call scanner%release_potential(potential)
             call verify_map(map, potential, self%three_d, job, reporter, self%verify, error)

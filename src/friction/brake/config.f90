@@ -57,7 +57,7 @@ module friction_brake_config
       real(wp) :: event_tolerance = 1.0e-10_wp  !! bound on located event times, τ
       real(wp) :: stick_velocity = 1.0e-6_wp    !! regularized: |v_rel| below this counts as stick
       type(solver_settings) :: solver = brake_solver_defaults
-      type(verify_settings) :: check   !! &verify: the difference compared is x's
+      type(verify_settings) :: verify   !! &verify: the difference compared is x's
       type(analysis_settings) :: analysis   !! chaos diagnostics (&analysis)
    contains
       procedure :: visit
@@ -121,7 +121,7 @@ contains
          call v%item('v_dr_si', d%v_dr, 'm/s')
       end associate
       call v%end_group()
-      call visit_verify(self%check, v, 'm', 'm')
+      call visit_verify(self%verify, v, 'm', 'm')
       call self%analysis%visit(v, 'tau')
    end subroutine visit
 
@@ -202,7 +202,7 @@ contains
             & "the initial normal force N' = (1 - kappa) y0 + g_prime = "//rtoa(normal) &
             & //' must be > 0 (kappa = '//rtoa(p%kappa)//', g_prime = '//rtoa(p%g_prime)//')')
       end associate
-      call check_verify(self%check, c, 'm')
+      call check_verify(self%verify, c, 'm')
       call self%analysis%validate(c, self%t_start, self%t_end, series_names)
       if (c%failed() .or. len_trim(self%analysis%continuation) == 0) return
       if (self%model /= model_switched) then
@@ -307,8 +307,8 @@ contains
       type(brake_config) :: other
 
       other = self
-      other%check%enabled = .false.
-      other%solver = verify_solver(self%check, self%solver)
+      other%verify%enabled = .false.
+      other%solver = verify_solver(self%verify, self%solver)
       other%event_tolerance = self%event_tolerance / 1000.0_wp
    end function check_settings
 

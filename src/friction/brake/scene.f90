@@ -122,7 +122,7 @@ contains
       self%ran = self%resolved()
       associate (settings => self%ran, check => self%check_record, record => self%record, &
          & main_run => self%main_run)
-         check%enabled = settings%check%enabled
+         check%enabled = settings%verify%enabled
          check_rank = merge(1, 0, job%nranks > 1)
          if (job%rank == 0) call integrate_brake(main_run, settings, reporter, error)
          if (check%enabled) then
@@ -160,10 +160,10 @@ contains
                      & //etoa(c%atol, 2)//': max |dx| = '//etoa(d%max_difference(1), 2)//' m over the grid; events ' &
                      & //itoa(d%events)//' vs '//itoa(d%check_events))
                end if
-               if (settings%check%max_difference > 0.0_wp .and. &
-                  & .not. (d%max_difference(1) <= settings%check%max_difference)) then
+               if (settings%verify%max_difference > 0.0_wp .and. &
+                  & .not. (d%max_difference(1) <= settings%verify%max_difference)) then
                   call fatal_error(error, 'verify failed: the check run differs by '//etoa(d%max_difference(1), 2) &
-                     & //' m in x, more than check_limit = '//etoa(settings%check%max_difference, 2) &
+                     & //' m in x, more than check_limit = '//etoa(settings%verify%max_difference, 2) &
                      & //' m (docs/speed.md, which steppers need verify)', error_numerical)
                   return
                end if
@@ -294,7 +294,7 @@ contains
    logical function brake_verifies(self)
       class(brake_scene), intent(in) :: self
 
-      brake_verifies = self%config%check%enabled
+      brake_verifies = self%config%verify%enabled
    end function brake_verifies
 
    function brake_settings_warning(self) result(text)
