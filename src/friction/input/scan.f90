@@ -99,10 +99,10 @@ contains
                call close_value(i - 1)
                in_group = .false.
             else if (c == '=' .and. in_group) then
-               ! The name before '=': skip blanks and an index like (3) or (1:2).
+               ! The name before '=': skip blanks (tabs too) and an index like (3) or (1:2).
                k = i - 1
                do while (k >= 1)
-                  if (text(k:k) /= ' ' .and. text(k:k) /= new_line('a')) exit
+                  if (text(k:k) /= ' ' .and. text(k:k) /= achar(9) .and. text(k:k) /= new_line('a')) exit
                   k = k - 1
                end do
                first = 0
