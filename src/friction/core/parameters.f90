@@ -459,7 +459,8 @@ contains
       character(len=*), intent(in), optional :: unit
       logical, intent(in), optional :: fold
       integer, allocatable :: from(:), to(:)
-      character(len=len(value) + 2), allocatable :: words(:)
+      ! (Quoted with each quote doubled: up to twice the text and the quotes.)
+      character(len=2 * len(value) + 2), allocatable :: words(:)
       integer :: k
       logical :: folding
 
