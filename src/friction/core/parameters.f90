@@ -677,10 +677,11 @@ contains
       ! ulp of x, closer than any other 15-digit decimal can), so its
       ! significant digits are counted; else 16 or 17.  (Trying 1, 2, ...
       ! digits in turn cost two formatted writes and a read each, most of a
-      ! short run's time spent echoing its input.)
+      ! short run's time spent echoing its input.)  A subnormal's ulp is
+      ! wider than that spacing, so its digits are tried from 1.
       write (buffer, '(es32.14e3)') x
       read (buffer, *, iostat=stat) back
-      if (stat == 0 .and. back == x) then
+      if (stat == 0 .and. back == x .and. abs(x) >= tiny(x)) then
          buffer = adjustl(buffer)
          cut = index(buffer, 'E') - 1
          do while (buffer(cut:cut) == '0')
@@ -690,7 +691,7 @@ contains
          write (form, '(a, i0, a)') '(es32.', digits - 1, 'e3)'
          write (buffer, form) x
       else
-         do digits = 16, 17
+         do digits = merge(16, 1, abs(x) >= tiny(x)), 17
             write (form, '(a, i0, a)') '(es32.', digits - 1, 'e3)'
             write (buffer, form) x
             read (buffer, *, iostat=stat) back
