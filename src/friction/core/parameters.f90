@@ -666,6 +666,7 @@ contains
 
       if (x == 0.0_wp) then
          word = '0.0'
+         if (sign(1.0_wp, x) < 0.0_wp) word = '-0.0'   ! the same bits back
          return
       end if
       if (abs(x) >= 1.0e-3_wp .and. abs(x) < 1.0e15_wp .and. x == anint(x)) then
