@@ -421,6 +421,10 @@ contains
                      exit
                   end if
                end do
+               ! A gap would drop the values after it without a word.
+               if (any(listed(n + 1:) /= huge(1.0_wp))) call c%reject('sweep', 'sweep_values'//suffix, '(none)', &
+                  & 'not given (a null value or a gap), but a later element is: give every value up to the last', &
+                  & index=n + 1)
                if (n == 0) call c%reject('sweep', 'sweep_values'//suffix, '(none)', "give at least one value for " &
                   & //"sweep_spacing"//suffix//" = 'list'")
                if (a == 1) then
