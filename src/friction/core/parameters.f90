@@ -940,13 +940,24 @@ contains
    !> characters other than tab.
    pure logical function is_utf8(text) result(ok)
       character(len=*), intent(in) :: text
-      integer :: i, c, follow, k
+      integer :: i, c, follow, k, low, high
 
       ok = .false.
       i = 1
       do while (i <= len(text))
          c = iachar(text(i:i))
          if (c < 0) c = c + 256
+         ! The second byte's range: narrower after E0, ED, F0 and F4, which
+         ! would else start an overlong form, a surrogate or a code point
+         ! beyond U+10FFFF (not UTF-8; a reader's decoding of the output fails).
+         low = 128
+         high = 191
+         select case (c)
+         case (224); low = 160
+         case (237); high = 159
+         case (240); low = 144
+         case (244); high = 143
+         end select
          if (c < 128) then
             if (c < 32 .and. c /= 9) return
             if (c == 127) return
@@ -965,6 +976,7 @@ contains
             c = iachar(text(i + k:i + k))
             if (c < 0) c = c + 256
             if (c < 128 .or. c > 191) return
+            if (k == 1 .and. (c < low .or. c > high)) return
          end do
          i = i + follow + 1
       end do
