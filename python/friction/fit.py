@@ -1,124 +1,720 @@
-"""Fitting the model of the microscope to a measured scan line: the paper's
-use of the software (adjust the model to a friction image).
+"""Fitting the model of the microscope to a measured friction image: the
+paper's use of the software (determine the microscope's parameters from an
+experimental image), with the uncertainty of each parameter.
 
-    cfg = friction.Config("afm", values=friction.fit.NAF_LINE)
-    result = friction.fit.fit_line(measured_fx, cfg, {"surface.v0": 0.5, ("tip.kx", "tip.ky"): 12.0})
-    result.values      # {"surface.v0": 0.8013..., ("tip.kx", "tip.ky"): 6.0157...}
+    measured = friction.read_image("scan.npz")          # or {"trace/fx": (ny, nx) array, ...}
+    cfg = friction.Config("afm", files=["inputs/naf.nml"], values={"scan.nx": 64, "scan.ny": 64})
+    result = friction.fit.image(measured, cfg, free={"surface.v0": 0.5, "tip.kx=tip.ky": 12.0})
+    result.values["surface.v0"], result.errors["surface.v0"]   # estimate and standard error
+    result.correlation          # (p, p) over result.names
+    result.converged, result.evaluations, result.reason
+    result.fitted, result.residuals                             # {"trace/fx": (ny, nx), ...}
+    result.profile("surface.v0")                                # the profile likelihood on request
+    result.sample(steps=200)                                    # an emcee sample on request
 
-The search is Nelder-Mead over the logarithms of the parameters (positive
-by construction), in numpy: scipy is not needed.  Each evaluation is one
-line of the C API (friction_afm_line) on this process.
+    plan = friction.fit.identifiability(cfg, free=[...], noise=0.02)   # before the experiment
+    plan.errors, plan.correlation, plan.degenerate
+
+The least squares are scipy.optimize.least_squares (trust-region
+reflective, with bounds), positive parameters in log space.  Every model
+evaluation is a set of scan lines of the C API (friction_afm_line), computed
+by a pool of processes, each with its own copy of the configuration; the
+Jacobian's finite differences are computed together, one image per free
+parameter, and its columns for the offset and calibration are exact.
 """
+import concurrent.futures
+import math
+import multiprocessing
+import os
+import re
+import tempfile
+import threading
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from ._run import Config
 
-__all__ = ["fit_line", "nelder_mead", "FitResult", "example", "NAF_LINE"]
+__all__ = ["image", "identifiability", "compare", "fit_line", "FitResult", "ImageFit", "Identifiability",
+           "example", "NAF_LINE", "NUISANCES"]
 
 # One line of a NaF map: the scene's defaults (inputs/naf.nml's values) but these.
 NAF_LINE = {"surface.potential": "naf", "scan.angle": 0.0, "scan.length": 20.0, "scan.nx": 128, "scan.ny": 1,
             "scan.retrace": False, "integrator.method": "rkf45", "integrator.rtol": 1.0e-6,
             "integrator.atol": 1.0e-7}
 
+# The instrument's nuisances fitted alongside the model's parameters, with their starting values:
+# measured = calibration * model + offset, the support's origin drifting drift_x, drift_y angstrom per line.
+NUISANCES = {"offset": 0.0, "calibration": 1.0, "drift_x": 0.0, "drift_y": 0.0}
+# Variables that may be zero or negative: fitted as they are, not through their logarithm.
+_SIGNED = {"scan.angle", "scan.origin_x", "scan.origin_y", "tip.support_z"}
+_CHANNEL = re.compile(r"^(trace|retrace)/(fx|fy|along|across)$")
 
-def nelder_mead(f, x0, step=0.2, tolerance=1e-6, max_evaluations=400):
-    """Minimise f from x0 (standard reflection/expansion/contraction/shrink).
-    Returns (x, f(x), evaluations)."""
-    n = len(x0)
-    simplex = [np.asarray(x0, float)] + [np.asarray(x0, float) + step * np.eye(n)[i] for i in range(n)]
-    values = [f(x) for x in simplex]
-    evaluations = n + 1
-    while evaluations < max_evaluations:
-        order = np.argsort(values)
-        simplex = [simplex[i] for i in order]
-        values = [values[i] for i in order]
-        if abs(values[-1] - values[0]) <= tolerance * (abs(values[0]) + 1e-30) and \
-                max(np.max(np.abs(x - simplex[0])) for x in simplex[1:]) < 1e-6:
-            break
-        centroid = np.mean(simplex[:-1], axis=0)
-        reflected = centroid + (centroid - simplex[-1])
-        f_reflected = f(reflected)
-        evaluations += 1
-        if f_reflected < values[0]:
-            expanded = centroid + 2.0 * (centroid - simplex[-1])
-            f_expanded = f(expanded)
-            evaluations += 1
-            simplex[-1], values[-1] = (expanded, f_expanded) if f_expanded < f_reflected else \
-                (reflected, f_reflected)
-        elif f_reflected < values[-2]:
-            simplex[-1], values[-1] = reflected, f_reflected
-        else:
-            contracted = centroid + 0.5 * (simplex[-1] - centroid)
-            f_contracted = f(contracted)
-            evaluations += 1
-            if f_contracted < values[-1]:
-                simplex[-1], values[-1] = contracted, f_contracted
-            else:
-                for i in range(1, n + 1):
-                    simplex[i] = simplex[0] + 0.5 * (simplex[i] - simplex[0])
-                    values[i] = f(simplex[i])
-                evaluations += n
-    best = int(np.argmin(values))
-    return simplex[best], values[best], evaluations
 
+# ---------------------------------------------------------------- model lines, in worker processes
+
+# Each worker thread's (and process's) own Config: one Config must not compute in two threads at once.
+_worker = threading.local()
+
+
+def _worker_config(text, scene):
+    """This thread's Config for a configuration's text (kept: a fit asks for it again and again)."""
+    key = (scene, text)
+    if getattr(_worker, "key", None) != key:
+        with tempfile.TemporaryDirectory(prefix="friction-fit-") as folder:
+            path = os.path.join(folder, "config.nml")
+            with open(path, "w") as file:
+                file.write(text)
+            _worker.config = Config(scene, files=[path])
+        _worker.key = key
+    return _worker.config
+
+
+def _lines(text, scene, settings, lines, passes, drift, origin):
+    """fx and fy of `lines` for each pass ("trace", "retrace") at `settings`:
+    {pass: (fx (len(lines), nx), fy)}.  Line j's origin moves by j * drift."""
+    cfg = _worker_config(text, scene)
+    for name, value in settings.items():
+        cfg.set(name, float(value))
+    out = {}
+    for trip in passes:
+        fx, fy = [], []
+        for j in lines:
+            cfg.set("scan.origin_x", origin[0] + drift[0] * j).set("scan.origin_y", origin[1] + drift[1] * j)
+            line = cfg.afm_line(int(j), trip == "trace")
+            fx.append(line.fx)
+            fy.append(line.fy)
+        out[trip] = (np.array(fx), np.array(fy))
+    return out
+
+
+class _Lines:
+    """The model's lines for many parameter sets, over a pool of processes
+    (workers > 1) or on this process."""
+
+    def __init__(self, config, lines, passes, workers, executor="processes"):
+        if executor not in ("processes", "threads"):
+            raise ValueError(f"executor must be 'processes' or 'threads', not {executor!r}")
+        self.executor = executor
+        self.text, self.scene = config.text(), config.scene
+        self.lines, self.passes = list(lines), tuple(passes)
+        self.origin = (float(config.value("scan.origin_x")), float(config.value("scan.origin_y")))
+        self.workers = max(1, int(workers))
+        self.pool = None
+        self.images = 0
+        self.line_count = 0
+
+    def _chunks(self):
+        count = min(len(self.lines), 2 * self.workers) if self.workers > 1 else 1
+        return [chunk for chunk in np.array_split(np.asarray(self.lines), count) if chunk.size]
+
+    def evaluate(self, settings_list):
+        """[(settings, drift)] -> [{pass: (fx, fy)}], the lines in self.lines' order."""
+        self.images += len(settings_list)
+        self.line_count += len(settings_list) * len(self.lines) * len(self.passes)
+        chunks = self._chunks()
+        if self.workers == 1:
+            return [_lines(self.text, self.scene, s, self.lines, self.passes, d, self.origin)
+                    for s, d in settings_list]
+        if self.pool is None and self.executor == "threads":
+            # ctypes releases the GIL during each line: threads compute at once, each with its own Config.
+            self.pool = concurrent.futures.ThreadPoolExecutor(self.workers)
+        elif self.pool is None:
+            # spawn: a fresh interpreter per worker, not a fork of one that may hold MPI or threads.
+            self.pool = concurrent.futures.ProcessPoolExecutor(self.workers,
+                                                               mp_context=multiprocessing.get_context("spawn"))
+        futures = [[self.pool.submit(_lines, self.text, self.scene, s, list(c), self.passes, d, self.origin)
+                    for c in chunks] for s, d in settings_list]
+        results = []
+        for parts in futures:
+            parts = [f.result() for f in parts]
+            results.append({trip: (np.concatenate([p[trip][0] for p in parts]),
+                                   np.concatenate([p[trip][1] for p in parts])) for trip in self.passes})
+        return results
+
+    def close(self):
+        if self.pool is not None:
+            self.pool.shutdown()
+            self.pool = None
+
+
+def _default_workers():
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:
+        return os.cpu_count() or 1
+
+
+# ---------------------------------------------------------------- the problem: parameters, data, residuals
+
+def _names(key):
+    if isinstance(key, str):
+        return tuple(part.strip() for part in key.split("="))
+    return tuple(key)
+
+
+def _label(names):
+    return "=".join(names)
+
+
+@dataclass
+class _Parameter:
+    label: str
+    names: tuple       # the configuration's variables set to this value; () for a nuisance
+    start: float
+    log: bool
+    lower: float
+    upper: float
+
+
+def _channels_of(measured, path=""):
+    """{channel: (ny, nx) array} from a MeasuredImage, a dict or an array."""
+    from ._image import ImageError, MeasuredImage
+    if isinstance(measured, MeasuredImage):
+        data = {"trace/along": measured.trace}
+        if measured.retrace is not None:
+            data["retrace/along"] = measured.retrace
+        return data, measured.path or "the measured image"
+    if isinstance(measured, dict):
+        data = {}
+        for key, value in measured.items():
+            if not _CHANNEL.match(key):
+                raise ImageError(f"the measured image: channel {key!r} is not one of trace|retrace / "
+                                 "fx|fy|along|across")
+            data[key] = np.asarray(value, dtype=float)
+        if not data:
+            raise ImageError("the measured image has no channel")
+        return data, "the measured image"
+    array = np.asarray(measured, dtype=float)
+    return {"trace/fx": array if array.ndim == 2 else array[None, :]}, "the measured image"
+
+
+class _Problem:
+    """The residuals and their Jacobian for a configuration, free parameters,
+    nuisances and a (measured or planned) image."""
+
+    def __init__(self, config, free, data, where, lines, nuisances, bounds, workers, step, executor="processes"):
+        from ._image import ImageError
+        if config.scene != "afm":
+            raise ValueError(f"fitting needs a configuration of scene 'afm', not {config.scene!r}")
+        self.config = config
+        self.where = where
+        known = {name for name, *_ in config.names()}
+        nx, ny = int(config.value("scan.nx")), int(config.value("scan.ny"))
+        self.lines = list(range(ny)) if lines is None else [int(j) for j in lines]
+        for j in self.lines:
+            if not 0 <= j < ny:
+                raise ValueError(f"line {j} out of range: the configuration's scan has lines 0 .. {ny - 1}")
+        # ---- free parameters
+        if isinstance(free, str):
+            free = [free]
+        if not isinstance(free, dict):
+            free = {key: None for key in free}
+        if not free:
+            raise ValueError("free names no parameter")
+        bounds = dict(bounds or {})
+        self.parameters = []
+        for key, start in free.items():
+            names = _names(key)
+            for name in names:
+                if name not in known:
+                    raise ValueError(f"unknown free parameter {name!r}: not a variable of scene 'afm' "
+                                     "(group.variable, as Config.names() lists them)")
+                if config.kinds()[name][0] != "real":
+                    raise ValueError(f"free parameter {name!r} is not a real number")
+            label = _label(names)
+            value = float(config.value(names[0]) if start is None else start)
+            log = names[0] not in _SIGNED
+            if log and not value > 0:
+                raise ValueError(f"free parameter {label}: the starting value {value} must be positive "
+                                 "(it is fitted through its logarithm)")
+            low, high = bounds.pop(label, bounds.pop(key, (value / 1e3, value * 1e3) if log else (-np.inf, np.inf)))
+            self.parameters.append(_Parameter(label, names, value, log, float(low), float(high)))
+        nuisances = dict.fromkeys(nuisances) if not isinstance(nuisances, dict) else dict(nuisances)
+        for name, start in nuisances.items():
+            if name not in NUISANCES:
+                raise ValueError(f"unknown nuisance {name!r}: one of {sorted(NUISANCES)}")
+            low, high = bounds.pop(name, (-np.inf, np.inf))
+            self.parameters.append(_Parameter(name, (), float(NUISANCES[name] if start is None else start), False,
+                                              float(low), float(high)))
+        if bounds:
+            raise ValueError(f"bounds for {sorted(bounds)}, which are not free")
+        self.labels = [p.label for p in self.parameters]
+        self.model_parameters = [p for p in self.parameters if p.names or p.label.startswith("drift")]
+        # ---- data
+        self.data = {}
+        for key, array in data.items():
+            if array.ndim != 2 or array.shape[1] != nx or array.shape[0] not in (ny, len(self.lines)):
+                raise ImageError(f"{where}: channel {key!r} is {array.shape[0]} x {array.shape[1]} (lines x samples)"
+                                 f", the configuration's scan {ny} x {nx} (scan.ny x scan.nx)"
+                                 + ("" if lines is None else f" or {len(self.lines)} x {nx} for the lines chosen"))
+            self.data[key] = array[self.lines] if array.shape[0] == ny and len(self.lines) != ny else array
+        self.channels = sorted(self.data)
+        if any(c.startswith("retrace") for c in self.channels) and not bool(config.value("scan.retrace")):
+            raise ImageError(f"{where}: a retrace channel is measured but the configuration has scan.retrace off")
+        self.mask = {c: np.isfinite(self.data[c]) for c in self.channels}
+        self.masked = int(sum(m.size - np.count_nonzero(m) for m in self.mask.values()))
+        if self.masked:
+            warnings.warn(f"{where}: {self.masked} pixels are NaN or infinite: masked, not fitted", stacklevel=3)
+        self.count = int(sum(np.count_nonzero(m) for m in self.mask.values()))
+        if self.count <= len(self.parameters):
+            raise ImageError(f"{where}: {self.count} valid pixels for {len(self.parameters)} parameters")
+        passes = sorted({c.split("/")[0] for c in self.channels}, reverse=True)
+        self.engine = _Lines(config, self.lines, passes, workers, executor)
+        self.step = float(step)
+        self.angle0 = float(config.value("scan.angle"))
+        self._cache = {}
+
+    # ---- parameter vectors
+    def start(self):
+        return np.array([math.log(p.start) if p.log else p.start for p in self.parameters])
+
+    def bounds(self):
+        lower = [math.log(p.lower) if p.log else p.lower for p in self.parameters]
+        upper = [math.log(p.upper) if p.log else p.upper for p in self.parameters]
+        return np.array(lower), np.array(upper)
+
+    def values(self, x):
+        return {p.label: (math.exp(v) if p.log else float(v)) for p, v in zip(self.parameters, x)}
+
+    def _setting(self, x):
+        values = self.values(x)
+        settings = {}
+        for p in self.parameters:
+            for name in p.names:
+                settings[name] = values[p.label]
+        return settings, (values.get("drift_x", 0.0), values.get("drift_y", 0.0))
+
+    def _raw(self, results, settings):
+        """{channel: (lines, nx)} of the model (no offset or calibration) from the lines' fx, fy."""
+        angle = math.radians(settings.get("scan.angle", self.angle0))
+        out = {}
+        for channel in self.channels:
+            trip, component = channel.split("/")
+            fx, fy = results[trip]
+            out[channel] = {"fx": fx, "fy": fy, "along": fx * math.cos(angle) + fy * math.sin(angle),
+                            "across": -fx * math.sin(angle) + fy * math.cos(angle)}[component]
+        return out
+
+    def raw_images(self, xs):
+        """The model's raw images at each parameter vector of xs (cached by vector)."""
+        keys = [np.asarray(x, float).tobytes() for x in xs]
+        todo = [(k, x) for k, x in zip(keys, xs) if k not in self._cache]
+        if todo:
+            settings = [self._setting(x) for _, x in todo]
+            for (k, _), setting, result in zip(todo, settings, self.engine.evaluate(settings)):
+                self._cache[k] = self._raw(result, setting[0])
+        images = [self._cache[k] for k in keys]
+        if len(self._cache) > 64:   # the last iterations' images are all a fit asks for again
+            self._cache = dict(list(self._cache.items())[-32:])
+        return images
+
+    def _affine(self, x):
+        values = self.values(x)
+        return values.get("calibration", 1.0), values.get("offset", 0.0)
+
+    def model(self, x, raw=None):
+        raw = raw or self.raw_images([x])[0]
+        scale, offset = self._affine(x)
+        return {c: scale * raw[c] + offset for c in self.channels}
+
+    def _flat(self, images):
+        return np.concatenate([images[c][self.mask[c]] for c in self.channels])
+
+    def residuals(self, x):
+        model = self.model(x)
+        return self._flat(model) - self._flat(self.data)
+
+    def _delta(self, i, x):
+        p = self.parameters[i]
+        return self.step if p.log else self.step * max(1.0, abs(x[i]))
+
+    def jacobian(self, x):
+        """Forward differences for the model's parameters and the drifts (all
+        their images in one batch), exact columns for offset and calibration."""
+        x = np.asarray(x, float)
+        varied = [i for i, p in enumerate(self.parameters) if p.names or p.label.startswith("drift")]
+        shifted = []
+        for i in varied:
+            y = x.copy()
+            y[i] += self._delta(i, x)
+            shifted.append(y)
+        images = self.raw_images([x] + shifted)
+        base = self._flat(images[0])
+        scale, _ = self._affine(x)
+        columns = np.empty((base.size, len(self.parameters)))
+        for i, image in zip(varied, images[1:]):
+            columns[:, i] = scale * (self._flat(image) - base) / self._delta(i, x)
+        for i, p in enumerate(self.parameters):
+            if p.label == "offset":
+                columns[:, i] = 1.0
+            elif p.label == "calibration":
+                columns[:, i] = base
+        return columns
+
+    def close(self):
+        self.engine.close()
+
+    def unflatten(self, flat):
+        out, at = {}, 0
+        for c in self.channels:
+            image = np.full(self.data[c].shape, np.nan)
+            n = int(np.count_nonzero(self.mask[c]))
+            image[self.mask[c]] = flat[at:at + n]
+            at += n
+            out[c] = image
+        return out
+
+
+def _covariance(jac, sigma):
+    """sigma^2 (J^T J)^-1 in the fitted coordinates, and whether J^T J was singular (pseudo-inverse then)."""
+    _, s, vt = np.linalg.svd(jac, full_matrices=False)
+    singular = s[-1] <= s[0] * 1e-12 if s.size else True
+    inverse = np.where(s > s[0] * 1e-12, 1.0 / np.maximum(s, 1e-300) ** 2, 0.0)
+    return sigma ** 2 * (vt.T * inverse) @ vt, bool(singular)
+
+
+def _correlation(cov):
+    d = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        corr = cov / np.outer(d, d)
+    return np.where(np.isfinite(corr), corr, 0.0)
+
+
+def _degenerate(labels, corr, threshold):
+    return [(labels[i], labels[j], float(corr[i, j])) for i in range(len(labels)) for j in range(i + 1, len(labels))
+            if abs(corr[i, j]) > threshold]
+
+
+def _value_errors(problem, x, cov):
+    """Standard errors of the values: for a log parameter value * SE(log) (the delta method)."""
+    values = problem.values(x)
+    se = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    return {p.label: (values[p.label] * s if p.log else float(s)) for p, s in zip(problem.parameters, se)}
+
+
+# ---------------------------------------------------------------- fitting an image
+
+@dataclass
+class ImageFit:
+    """The fit of an image (friction.fit.image).
+
+    names         the fitted parameters in order: the free ones (ties
+                  joined with "=": "tip.kx=tip.ky") then the nuisances
+    values, errors  {name: estimate}, {name: standard error} (from the
+                  Jacobian at the minimum, scaled by the noise level)
+    correlation   (p, p) correlation matrix over names (of the fitted
+                  coordinates: logarithms for positive parameters)
+    noise         the noise level: the residuals' rms, sqrt(SSR / (N - p))
+    converged, reason, status   scipy's success flag, message and status
+    evaluations   model images computed (each one line per fitted line and pass)
+    lines_computed  scan lines computed
+    fitted, residuals  {channel: (lines, nx)} model and measured - model (NaN where masked)
+    masked        pixels masked (NaN in the measurement) and not fitted
+    degenerate    pairs (a, b, correlation) with |correlation| > 0.9
+    singular      whether J^T J was singular (errors from its pseudo-inverse)"""
+
+    names: list
+    values: dict
+    errors: dict
+    correlation: np.ndarray
+    covariance: np.ndarray = field(repr=False)
+    noise: float = 0.0
+    converged: bool = False
+    reason: str = ""
+    status: int = 0
+    evaluations: int = 0
+    lines_computed: int = 0
+    cost: float = 0.0
+    fitted: dict = field(default_factory=dict, repr=False)
+    residuals: dict = field(default_factory=dict, repr=False)
+    masked: int = 0
+    degenerate: list = field(default_factory=list)
+    singular: bool = False
+    x: np.ndarray = field(default=None, repr=False)
+    jacobian: np.ndarray = field(default=None, repr=False)
+    _problem: object = field(default=None, repr=False)
+
+    def summary(self):
+        """The estimates as a table of text."""
+        rows = [f"{'parameter':<22} {'estimate':>13} {'std. error':>12}"]
+        for name in self.names:
+            rows.append(f"{name:<22} {self.values[name]:>13.6g} {self.errors[name]:>12.3g}")
+        rows.append(f"noise {self.noise:.4g}; {'converged' if self.converged else 'NOT converged'} after "
+                    f"{self.evaluations} images ({self.reason})")
+        if self.degenerate:
+            rows.append("degenerate: " + ", ".join(f"{a} ~ {b} ({c:+.3f})" for a, b, c in self.degenerate))
+        return "\n".join(rows)
+
+    def profile(self, name, points=9, span=3.0, workers=None):
+        """The profile likelihood of one parameter: at `points` values across
+        estimate +- span standard errors (in the fitted coordinate), the
+        others refitted.  Returns (values, delta_chi2), delta_chi2 =
+        (SSR - SSR_min) / noise^2: the 68 % interval is where it is below 1."""
+        problem = self._problem
+        i = self.names.index(name)
+        if workers is not None:
+            problem.engine.workers = workers
+        from scipy.optimize import least_squares
+        sd = math.sqrt(max(self.covariance[i, i], 0.0))
+        grid = self.x[i] + sd * np.linspace(-span, span, points)
+        others = [k for k in range(len(self.names)) if k != i]
+        lower, upper = problem.bounds()
+        out = []
+        try:
+            for g in grid:
+                def fun(y, g=g):
+                    x = self.x.copy()
+                    x[others] = y
+                    x[i] = g
+                    return problem.residuals(x)
+
+                def jac(y, g=g):
+                    x = self.x.copy()
+                    x[others] = y
+                    x[i] = g
+                    return problem.jacobian(x)[:, others]
+                fit = least_squares(fun, self.x[others], jac=jac, bounds=(lower[others], upper[others]),
+                                    x_scale="jac")
+                out.append(2.0 * fit.cost)
+        finally:
+            problem.close()
+        values = [math.exp(g) if problem.parameters[i].log else g for g in grid]
+        return np.array(values), (np.array(out) - 2.0 * self.cost) / self.noise ** 2
+
+    def sample(self, steps=200, walkers=None, seed=0, burn=None):
+        """An MCMC sample of the posterior (emcee's affine-invariant ensemble;
+        flat priors within the bounds in the fitted coordinates, Gaussian
+        noise of the fitted level).  Returns (steps - burn) * walkers rows of
+        the values, columns in the order of names."""
+        try:
+            import emcee
+        except ImportError:
+            raise ImportError("fit's sample() needs the Python package emcee (pip install emcee)") from None
+        problem = self._problem
+        p = len(self.names)
+        walkers = walkers or 2 * p + 2
+        lower, upper = problem.bounds()
+        rng = np.random.default_rng(seed)
+        sd = np.sqrt(np.clip(np.diag(self.covariance), 1e-30, None))
+        start = self.x + 0.1 * sd * rng.standard_normal((walkers, p))
+
+        def log_prob(xs):
+            xs = np.atleast_2d(xs)
+            inside = np.all((xs > lower) & (xs < upper), axis=1)
+            out = np.full(len(xs), -np.inf)
+            good = [x for x, ok in zip(xs, inside) if ok]
+            if good:
+                images = problem.raw_images(good)
+                data = problem._flat(problem.data)
+                values = [-0.5 * np.sum((problem._flat(problem.model(x, raw)) - data) ** 2) / self.noise ** 2
+                          for x, raw in zip(good, images)]
+                out[inside] = values
+            return out
+
+        sampler = emcee.EnsembleSampler(walkers, p, log_prob, vectorize=True,
+                                        seed=int(rng.integers(2**31)))
+        try:
+            sampler.run_mcmc(start, steps)
+        finally:
+            problem.close()
+        chain = sampler.get_chain(discard=steps // 4 if burn is None else burn, flat=True)
+        logs = np.array([q.log for q in problem.parameters])
+        return np.where(logs, np.exp(chain), chain)
+
+
+def image(measured, config, free, lines=None, nuisances=("offset", "calibration", "drift_x", "drift_y"),
+          bounds=None, workers=None, step=1e-6, max_evaluations=None, tolerance=1e-6,
+          executor="processes"):
+    """Fit the configuration's parameters to a measured image by least squares.
+
+    measured    a MeasuredImage (trace and retrace compared with the model's
+                force along the scan, "trace/along", "retrace/along"), a dict
+                {"trace/fx": (ny, nx), "retrace/fy": ..., "trace/along": ...}
+                of any of trace|retrace and fx|fy|along|across, or one
+                (ny, nx) array ("trace/fx"); NaN pixels are masked (warned,
+                counted in .masked)
+    config      a friction.Config of scene "afm" whose scan (scan.nx,
+                scan.ny) the image's shape must match; not changed
+    free        {parameter: start} or a list of parameters (started at the
+                configuration's values); a parameter is "group.variable" or
+                tied variables sharing one value, "tip.kx=tip.ky" or
+                ("tip.kx", "tip.ky"); fitted through their logarithm unless
+                the variable may be signed (scan.angle, scan.origin_*)
+    lines       the lines fitted (default all); measured may hold all the
+                scan's lines or just these
+    nuisances   of NUISANCES, a list (started at 0 offset, calibration 1, no
+                drift) or {name: start}: measured = calibration * model +
+                offset, the support drifting drift_x, drift_y angstrom per
+                line along the lattice's axes; the noise level is always
+                estimated (the residuals' rms)
+    bounds      {parameter: (low, high)} in the parameter's units; positive
+                parameters default to start/1000 .. start*1000
+    workers     processes computing lines (default: the processors this
+                process may use); 1: on this process
+    step        the finite differences' step (in log for positive parameters;
+                1e-6 wants the integrator's rtol at 1e-5 or below)
+    executor    "processes" (spawned: a script must guard its top level with
+                `if __name__ == "__main__":`) or "threads" (the library
+                computes different Configs at once)
+    Returns an ImageFit."""
+    from scipy.optimize import least_squares
+    data, where = _channels_of(measured)
+    problem = _Problem(config, free, data, where, lines, nuisances, bounds, workers or _default_workers(), step,
+                       executor)
+    try:
+        lower, upper = problem.bounds()
+        x0 = np.clip(problem.start(), lower, upper)
+        fit = least_squares(problem.residuals, x0, jac=problem.jacobian, bounds=(lower, upper), method="trf",
+                            x_scale="jac", ftol=tolerance, xtol=tolerance, gtol=tolerance, max_nfev=max_evaluations)
+        jac = problem.jacobian(fit.x)
+        residual = problem.residuals(fit.x)
+    finally:
+        problem.close()
+    dof = max(problem.count - len(problem.parameters), 1)
+    noise = float(np.sqrt(np.sum(residual ** 2) / dof))
+    cov, singular = _covariance(jac, noise)
+    corr = _correlation(cov)
+    fitted = problem.model(fit.x)
+    return ImageFit(problem.labels, problem.values(fit.x), _value_errors(problem, fit.x, cov), corr, cov, noise,
+                    bool(fit.success), str(fit.message), int(fit.status), problem.engine.images,
+                    problem.engine.line_count, float(fit.cost),
+                    {c: np.where(problem.mask[c], fitted[c], np.nan) for c in problem.channels},
+                    {c: np.where(problem.mask[c], problem.data[c] - fitted[c], np.nan) for c in problem.channels},
+                    problem.masked, _degenerate(problem.labels, corr, 0.9), singular, fit.x, jac, problem)
+
+
+# ---------------------------------------------------------------- identifiability before the experiment
+
+@dataclass
+class Identifiability:
+    """What a planned scan would determine (friction.fit.identifiability).
+
+    names, values   the parameters and their planned (true) values
+    errors          {name: standard error} from the Fisher information
+                    J^T J / noise^2 at the planned values
+    relative        {name: error / |value|}
+    correlation     (p, p) over names; degenerate: pairs with |corr| > 0.9
+    pixels          the samples the plan measures"""
+
+    names: list
+    values: dict
+    errors: dict
+    relative: dict
+    correlation: np.ndarray
+    degenerate: list
+    pixels: int
+    singular: bool = False
+    jacobian: np.ndarray = field(default=None, repr=False)
+
+
+def identifiability(config, free, noise, channels=("trace/fx",), lines=None, nuisances=(), workers=None,
+                    step=1e-6, threshold=0.9, executor="processes"):
+    """The Fisher-information standard errors of the free parameters for a
+    planned scan: the configuration (its values are the truth), the
+    channels measured (of trace|retrace / fx|fy|along|across), the noise
+    level (the measured force's standard deviation, nN) and the nuisances
+    fitted alongside (default none).  free and lines as for image().
+    Returns an Identifiability."""
+    nx, ny = int(config.value("scan.nx")), int(config.value("scan.ny"))
+    rows = ny if lines is None else len(list(lines))
+    data = {c: np.zeros((rows, nx)) for c in channels}
+    free = {key: None for key in ([free] if isinstance(free, str) else free)} if not isinstance(free, dict) else free
+    problem = _Problem(config, free, data, "the planned scan", lines, nuisances, None,
+                       workers or _default_workers(), step, executor)
+    try:
+        jac = problem.jacobian(problem.start())
+    finally:
+        problem.close()
+    cov, singular = _covariance(jac, float(noise))
+    corr = _correlation(cov)
+    x = problem.start()
+    errors = _value_errors(problem, x, cov)
+    values = problem.values(x)
+    relative = {k: (errors[k] / abs(values[k]) if values[k] else float("inf")) for k in errors}
+    return Identifiability(problem.labels, values, errors, relative, corr, _degenerate(problem.labels, corr, threshold),
+                           problem.count, singular, jac)
+
+
+def compare(config, scans, free, noise, channels=("trace/fx",), nuisances=(), workers=None, executor="processes"):
+    """Identifiability of several scan choices: scans = {label: {"scan.angle":
+    45.0, ...}} (values set over a copy of config; a "channels" entry
+    replaces the channels measured).  Returns {label: Identifiability}."""
+    out = {}
+    for label, values in scans.items():
+        values = dict(values)
+        chosen = values.pop("channels", channels)
+        with _copy(config) as copy:
+            for name, value in values.items():
+                copy.set(name, value)
+            out[label] = identifiability(copy, free, noise, chosen, None, nuisances, workers, executor=executor)
+    return out
+
+
+def _copy(config):
+    """A new Config with config's values (through its namelist text)."""
+    copy = Config(config.scene)
+    with tempfile.TemporaryDirectory(prefix="friction-fit-") as folder:
+        path = os.path.join(folder, "config.nml")
+        with open(path, "w") as file:
+            file.write(config.text())
+        copy.read(path)
+    return copy
+
+
+# ---------------------------------------------------------------- one line (the first interface)
 
 @dataclass
 class FitResult:
     """values: the fitted parameters, keyed as `start` was; residual: the sum
     of squared differences (nN^2); rms: its root mean square per sample (nN);
-    evaluations: lines computed; line: the fitted model's line."""
+    evaluations: lines computed; line: the fitted model's line; errors:
+    standard errors; converged, reason: scipy's flag and message."""
 
     values: dict
     residual: float
     rms: float
     evaluations: int
     line: np.ndarray = field(repr=False)
+    errors: dict = field(default_factory=dict)
+    converged: bool = True
+    reason: str = ""
 
 
-def _names(key):
-    return (key,) if isinstance(key, str) else tuple(key)
-
-
-def fit_line(measured, config, start, component="fx", line=0, forward=True, step=0.2, tolerance=1e-6,
+def fit_line(measured, config, start, component="fx", line=0, forward=True, step=1e-6, tolerance=1e-10,
              max_evaluations=400):
     """Fit parameters of `config` (a friction.Config of scene "afm") so that
-    its scan line matches `measured` (nN at the scan.nx support positions).
+    its scan line matches `measured` (nN at the scan.nx support positions):
+    image() for one line and no nuisances, on this process.
 
     start      {parameter: starting value}; a parameter is "group.variable"
                or a tuple of them that share one value (("tip.kx", "tip.ky"));
-               values must be positive (the search is over their logarithms)
+               values must be positive (they are fitted through their logarithms)
     component  "fx" or "fy": the force compared
     line, forward  the line of the map and its direction
-    step, tolerance, max_evaluations  of the Nelder-Mead search (nelder_mead)
+    step, tolerance, max_evaluations  of the finite differences and of
+               scipy's least_squares
     The configuration is left at the fitted values.  Returns a FitResult."""
     if component not in ("fx", "fy"):
         raise ValueError(f"component must be 'fx' or 'fy', not {component!r}")
-    keys = list(start)
-    if not keys:
+    if not start:
         raise ValueError("start names no parameter")
-    x0 = [float(start[k]) for k in keys]
-    if min(x0) <= 0:
-        raise ValueError("the starting values must be positive (the search is over their logarithms)")
+    if min(float(v) for v in start.values()) <= 0:
+        raise ValueError("the starting values must be positive (they are fitted through their logarithms)")
     measured = np.asarray(measured, dtype=float)
-
-    def model(p):
-        for key, value in zip(keys, np.exp(p)):
-            for name in _names(key):
-                config.set(name, float(value))
-        return getattr(config.afm_line(line, forward), component)
-
-    def cost(p):
-        values = model(p)
-        if values.shape != measured.shape:
-            raise ValueError(f"the model's line has {values.size} samples, the measured one {measured.size}")
-        return float(np.sum((values - measured) ** 2))
-
-    best, residual, evaluations = nelder_mead(cost, np.log(x0), step, tolerance, max_evaluations)
-    fitted = model(best)
-    return FitResult({k: float(v) for k, v in zip(keys, np.exp(best))}, residual,
-                     float(np.sqrt(residual / measured.size)), evaluations, fitted)
+    channel = ("trace/" if forward else "retrace/") + component
+    free = {(_label(_names(k))): float(v) for k, v in start.items()}
+    result = image({channel: measured[None, :]}, config, free, lines=[line], nuisances=(), workers=1, step=step,
+                   max_evaluations=max_evaluations, tolerance=tolerance)
+    values = {key: result.values[_label(_names(key))] for key in start}
+    for key, value in values.items():
+        for name in _names(key):
+            config.set(name, float(value))
+    residual = 2.0 * result.cost
+    return FitResult(values, residual, float(np.sqrt(residual / measured.size)), result.lines_computed,
+                     result.fitted[channel][0], {key: result.errors[_label(_names(key))] for key in start},
+                     result.converged, result.reason)
 
 
 def example(true=(0.8, 6.0), start=(0.5, 12.0), noise=0.05, seed=8):
