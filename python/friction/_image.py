@@ -185,7 +185,16 @@ def _pick(names, channel, path, kinds="channels"):
     raise ImageError(f"{path}: no channel {channel!r}; the file's {kinds} are {names}")
 
 
+def _signature(path, expected, what):
+    """Refuse a file whose first bytes are not its format's (a reader could loop on one)."""
+    with open(path, "rb") as file:
+        start = file.read(64)
+    if not any(start.startswith(magic) for magic in expected):
+        raise ImageError(f"{path}: not a {what} file (it does not start with {expected[0].decode()!r})")
+
+
 def _read_bruker(path, channel):
+    _signature(path, (b"\\*File list", b"\\*EC File list", b"\\*Force file list"), "Bruker Nanoscope")
     pySPM = _optional("pySPM", "Bruker Nanoscope", path)
     try:
         scan = pySPM.Bruker(str(path))
@@ -232,6 +241,7 @@ def _read_bruker(path, channel):
 
 
 def _read_sxm(path, channel):
+    _signature(path, (b":NANONIS_VERSION:",), "Nanonis .sxm")
     pySPM = _optional("pySPM", "Nanonis", path)
     try:
         scan = pySPM.SXM(str(path))
@@ -259,6 +269,7 @@ def _read_sxm(path, channel):
 
 
 def _read_gwy(path, channel):
+    _signature(path, (b"GWYP",), "Gwyddion .gwy")
     gwyfile = _optional("gwyfile", "Gwyddion", path)
     try:
         container = gwyfile.load(str(path))
