@@ -11,6 +11,8 @@ HOPG, graphite) to the machine scale (the Girling brake), in Python.
     x, fx, fy = cfg.afm_line(0)                     # one line, numpy arrays, no file
     maps = cfg.compute()                            # the whole map: {"trace/fx": (ny, nx), ...}
     run = friction.brake(values={"brake.t_end": 300.0})   # {"t": ..., "x": ..., "events/t": ...}
+    img = friction.read_image("scan.spm")           # a microscope's friction channels, trace and retrace
+    fit = friction.fit.image(img, cfg, free={"surface.v0": 0.5, "tip.kx=tip.ky": 8.0})   # with errors
 
 The computations go through the C API of the shared library libfriction
 (found as friction._capi.find_library says: FRICTION_LIBRARY, the
@@ -21,11 +23,12 @@ Reference: docs/python.md.
 from . import _capi
 from ._capi import FrictionError, LibraryNotFoundError, api_version, library_path
 from ._data import Array, Attributes, Dataset, FileError, load
+from ._image import ImageError, MeasuredImage, read_image
 from ._run import Config, Line, afm_line, brake, compute, run
 from ._version import __version__
 
 __all__ = ["__version__", "library_version", "api_version", "library_path", "FrictionError",
-           "LibraryNotFoundError", "FileError", "Config", "Line", "run", "compute", "afm_line", "brake", "load",
+           "LibraryNotFoundError", "FileError", "read_image", "MeasuredImage", "ImageError", "Config", "Line", "run", "compute", "afm_line", "brake", "load",
            "Dataset", "Array", "Attributes", "plot", "fit"]
 
 

@@ -23,6 +23,7 @@ Jacobian's finite differences are computed together, one image per free
 parameter, and its columns for the offset and calibration are exact.
 """
 import concurrent.futures
+import concurrent.futures.process
 import math
 import multiprocessing
 import os
@@ -34,6 +35,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from . import _capi
 from ._run import Config
 
 __all__ = ["image", "identifiability", "compare", "fit_line", "FitResult", "ImageFit", "Identifiability",
@@ -54,7 +56,8 @@ _CHANNEL = re.compile(r"^(trace|retrace)/(fx|fy|along|across)$")
 
 # ---------------------------------------------------------------- model lines, in worker processes
 
-# Each worker thread's (and process's) own Config: one Config must not compute in two threads at once.
+# The worker process's Config (a process, not a thread, per worker: the library's text calls,
+# friction_config_names among them, are not safe in two threads at once).
 _worker = threading.local()
 
 
@@ -82,9 +85,9 @@ def _lines(text, scene, settings, lines, passes, drift, origin):
         fx, fy = [], []
         for j in lines:
             cfg.set("scan.origin_x", origin[0] + drift[0] * j).set("scan.origin_y", origin[1] + drift[1] * j)
-            line = cfg.afm_line(int(j), trip == "trace")
-            fx.append(line.fx)
-            fy.append(line.fy)
+            line = _capi.Config.afm_line(cfg, int(j), trip == "trace")   # fx, fy without support_x
+            fx.append(line[0])
+            fy.append(line[1])
         out[trip] = (np.array(fx), np.array(fy))
     return out
 
@@ -93,10 +96,7 @@ class _Lines:
     """The model's lines for many parameter sets, over a pool of processes
     (workers > 1) or on this process."""
 
-    def __init__(self, config, lines, passes, workers, executor="processes"):
-        if executor not in ("processes", "threads"):
-            raise ValueError(f"executor must be 'processes' or 'threads', not {executor!r}")
-        self.executor = executor
+    def __init__(self, config, lines, passes, workers):
         self.text, self.scene = config.text(), config.scene
         self.lines, self.passes = list(lines), tuple(passes)
         self.origin = (float(config.value("scan.origin_x")), float(config.value("scan.origin_y")))
@@ -117,10 +117,7 @@ class _Lines:
         if self.workers == 1:
             return [_lines(self.text, self.scene, s, self.lines, self.passes, d, self.origin)
                     for s, d in settings_list]
-        if self.pool is None and self.executor == "threads":
-            # ctypes releases the GIL during each line: threads compute at once, each with its own Config.
-            self.pool = concurrent.futures.ThreadPoolExecutor(self.workers)
-        elif self.pool is None:
+        if self.pool is None:
             # spawn: a fresh interpreter per worker, not a fork of one that may hold MPI or threads.
             self.pool = concurrent.futures.ProcessPoolExecutor(self.workers,
                                                                mp_context=multiprocessing.get_context("spawn"))
@@ -128,7 +125,14 @@ class _Lines:
                     for c in chunks] for s, d in settings_list]
         results = []
         for parts in futures:
-            parts = [f.result() for f in parts]
+            try:
+                parts = [f.result() for f in parts]
+            except concurrent.futures.process.BrokenProcessPool:
+                self.close()
+                raise RuntimeError("friction.fit: a worker process stopped before its lines were computed. "
+                                   "The workers are spawned, each importing the main module again: a script "
+                                   "must call friction.fit under `if __name__ == \"__main__\":` (or pass "
+                                   "workers=1)") from None
             results.append({trip: (np.concatenate([p[trip][0] for p in parts]),
                                    np.concatenate([p[trip][1] for p in parts])) for trip in self.passes})
         return results
@@ -194,7 +198,7 @@ class _Problem:
     """The residuals and their Jacobian for a configuration, free parameters,
     nuisances and a (measured or planned) image."""
 
-    def __init__(self, config, free, data, where, lines, nuisances, bounds, workers, step, executor="processes"):
+    def __init__(self, config, free, data, where, lines, nuisances, bounds, workers, step):
         from ._image import ImageError
         if config.scene != "afm":
             raise ValueError(f"fitting needs a configuration of scene 'afm', not {config.scene!r}")
@@ -261,7 +265,7 @@ class _Problem:
         if self.count <= len(self.parameters):
             raise ImageError(f"{where}: {self.count} valid pixels for {len(self.parameters)} parameters")
         passes = sorted({c.split("/")[0] for c in self.channels}, reverse=True)
-        self.engine = _Lines(config, self.lines, passes, workers, executor)
+        self.engine = _Lines(config, self.lines, passes, workers)
         self.step = float(step)
         self.angle0 = float(config.value("scan.angle"))
         self._cache = {}
@@ -525,8 +529,7 @@ class ImageFit:
 
 
 def image(measured, config, free, lines=None, nuisances=("offset", "calibration", "drift_x", "drift_y"),
-          bounds=None, workers=None, step=1e-6, max_evaluations=None, tolerance=1e-6,
-          executor="processes"):
+          bounds=None, workers=None, step=1e-6, max_evaluations=None, tolerance=1e-6):
     """Fit the configuration's parameters to a measured image by least squares.
 
     measured    a MeasuredImage (trace and retrace compared with the model's
@@ -555,14 +558,12 @@ def image(measured, config, free, lines=None, nuisances=("offset", "calibration"
                 process may use); 1: on this process
     step        the finite differences' step (in log for positive parameters;
                 1e-6 wants the integrator's rtol at 1e-5 or below)
-    executor    "processes" (spawned: a script must guard its top level with
-                `if __name__ == "__main__":`) or "threads" (the library
-                computes different Configs at once)
+                (spawned processes: a script must guard its top level with
+                `if __name__ == "__main__":`, as multiprocessing asks)
     Returns an ImageFit."""
     from scipy.optimize import least_squares
     data, where = _channels_of(measured)
-    problem = _Problem(config, free, data, where, lines, nuisances, bounds, workers or _default_workers(), step,
-                       executor)
+    problem = _Problem(config, free, data, where, lines, nuisances, bounds, workers or _default_workers(), step)
     try:
         lower, upper = problem.bounds()
         x0 = np.clip(problem.start(), lower, upper)
@@ -610,7 +611,7 @@ class Identifiability:
 
 
 def identifiability(config, free, noise, channels=("trace/fx",), lines=None, nuisances=(), workers=None,
-                    step=1e-6, threshold=0.9, executor="processes"):
+                    step=1e-6, threshold=0.9):
     """The Fisher-information standard errors of the free parameters for a
     planned scan: the configuration (its values are the truth), the
     channels measured (of trace|retrace / fx|fy|along|across), the noise
@@ -622,7 +623,7 @@ def identifiability(config, free, noise, channels=("trace/fx",), lines=None, nui
     data = {c: np.zeros((rows, nx)) for c in channels}
     free = {key: None for key in ([free] if isinstance(free, str) else free)} if not isinstance(free, dict) else free
     problem = _Problem(config, free, data, "the planned scan", lines, nuisances, None,
-                       workers or _default_workers(), step, executor)
+                       workers or _default_workers(), step)
     try:
         jac = problem.jacobian(problem.start())
     finally:
@@ -637,7 +638,7 @@ def identifiability(config, free, noise, channels=("trace/fx",), lines=None, nui
                            problem.count, singular, jac)
 
 
-def compare(config, scans, free, noise, channels=("trace/fx",), nuisances=(), workers=None, executor="processes"):
+def compare(config, scans, free, noise, channels=("trace/fx",), nuisances=(), workers=None):
     """Identifiability of several scan choices: scans = {label: {"scan.angle":
     45.0, ...}} (values set over a copy of config; a "channels" entry
     replaces the channels measured).  Returns {label: Identifiability}."""
@@ -648,7 +649,7 @@ def compare(config, scans, free, noise, channels=("trace/fx",), nuisances=(), wo
         with _copy(config) as copy:
             for name, value in values.items():
                 copy.set(name, value)
-            out[label] = identifiability(copy, free, noise, chosen, None, nuisances, workers, executor=executor)
+            out[label] = identifiability(copy, free, noise, chosen, None, nuisances, workers)
     return out
 
 
