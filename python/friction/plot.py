@@ -252,33 +252,17 @@ def nearest_neighbour_distance(xyz):
 
 
 def bonds(xyz, cutoff):
-    """Index pairs (i, j), i < j, of atoms closer than cutoff: a cell list in x, y."""
+    """Index pairs (i, j), i < j, of atoms closer than cutoff (scipy's k-d tree), in lexical order."""
     count = xyz.shape[0]
     if count < 2 or not cutoff or cutoff <= 0:
         return np.empty((0, 2), dtype=int)
-    cell = np.floor((xyz[:, :2] - xyz[:, :2].min(axis=0)) / cutoff).astype(np.int64)
-    stride = int(cell[:, 1].max()) + 3
-    key = (cell[:, 0] + 1) * stride + (cell[:, 1] + 1)
-    order = np.argsort(key, kind="stable")
-    sorted_key = key[order]
-    pairs = []
-    # Half the 3 x 3 neighbourhood (plus the cell itself): each pair once.
-    for dx, dy in ((0, 0), (1, -1), (1, 0), (1, 1), (0, 1)):
-        target = key + dx * stride + dy
-        lo = np.searchsorted(sorted_key, target, side="left")
-        hi = np.searchsorted(sorted_key, target, side="right")
-        counts = hi - lo
-        total = int(counts.sum())
-        if total == 0:
-            continue
-        i = np.repeat(np.arange(count), counts)
-        start = np.repeat(lo - np.concatenate(([0], np.cumsum(counts)[:-1])), counts)
-        j = order[start + np.arange(total)]
-        keep = np.sum((xyz[i] - xyz[j]) ** 2, axis=1) < cutoff ** 2
-        if (dx, dy) == (0, 0):
-            keep &= i < j
-        pairs.append(np.column_stack((i[keep], j[keep])))
-    return np.concatenate(pairs) if pairs else np.empty((0, 2), dtype=int)
+    from scipy.spatial import cKDTree
+    # query_pairs keeps distances <= r: the next float below cutoff keeps the strict "closer than".
+    pairs = cKDTree(np.asarray(xyz, float)).query_pairs(np.nextafter(cutoff, 0.0), output_type="ndarray")
+    if pairs.size == 0:
+        return np.empty((0, 2), dtype=int)
+    pairs = np.sort(pairs.astype(int), axis=1)
+    return pairs[np.lexsort((pairs[:, 1], pairs[:, 0]))]
 
 
 def graphite_net(data, margin=5.0, whole=False, tip_line=0):
@@ -1026,21 +1010,29 @@ def failure_map(data):
 
 def sang_fit(velocity, friction, sem):
     """Sang, Dubé and Grant's law F = F_c - B [ln(v_c/v)]^(2/3) (PRL 87,
-    174301, 2001) fitted by weighted least squares: linear in F_c and B for
-    each v_c, v_c on a grid.  Returns (F_c, B, v_c), v_c in the units of
-    velocity."""
+    174301, 2001) fitted by weighted least squares (scipy's least_squares)
+    over F_c, B and u = ln(ln v_c - ln v_max), which keeps v_c above the
+    fastest point; started from the best of a coarse scan of u, where F_c
+    and B are linear.  Returns (F_c, B, v_c), v_c in the units of velocity."""
+    from scipy.optimize import least_squares
     lv = np.log(np.asarray(velocity, float))
     f = np.asarray(friction, float)
-    w = 1.0 / np.asarray(sem, float) ** 2
-    best = None
-    for lnvc in lv.max() + np.geomspace(0.01, 60.0, 4000):
-        x = (lnvc - lv) ** (2.0 / 3.0)
-        a = np.vstack([np.ones_like(x), -x]).T
-        coef = np.linalg.solve(a.T @ (w[:, None] * a), a.T @ (w * f))
-        chi = float(np.sum(w * (f - a @ coef) ** 2))
-        if best is None or chi < best[0]:
-            best = (chi, coef[0], coef[1], math.exp(lnvc))
-    return best[1], best[2], best[3]
+    sigma = np.asarray(sem, float)
+    top = lv.max()
+
+    def residuals(p):
+        return (f - (p[0] - p[1] * (top + math.exp(p[2]) - lv) ** (2.0 / 3.0))) / sigma
+
+    def linear(u):
+        x = (top + math.exp(u) - lv) ** (2.0 / 3.0)
+        coef = np.linalg.lstsq(np.vstack([np.ones_like(x), -x]).T / sigma[:, None], f / sigma, rcond=None)[0]
+        return np.array([coef[0], coef[1], u])
+
+    # ln v_c - ln v_max from 0.01 to 60 (a decade of v beyond the points to e^60): 13 starts.
+    starts = [linear(u) for u in np.linspace(math.log(0.01), math.log(60.0), 13)]
+    p0 = min(starts, key=lambda p: float(np.sum(residuals(p) ** 2)))
+    p = least_squares(residuals, p0, xtol=1e-12, ftol=1e-12, gtol=1e-12).x
+    return float(p[0]), float(p[1]), float(math.exp(top + math.exp(p[2])))
 
 
 def friction_velocity(rows):
@@ -1085,7 +1077,7 @@ def temperature_fit(rows, below=300.0):
     logarithm's slow change with T left out), fitted by weighted least
     squares through the points with 0 < T < below (K; above, jumps back
     set in); and the free exponent alpha of F_c - C T^alpha with its
-    standard error (the profile of chi^2, Delta chi^2 = 1).  A point whose
+    standard error (scipy's curve_fit, absolute sigma).  A point whose
     realizations all agree (standard error below 1e-9 nN: at low T the jumps scatter
     less than the sample spacing, so no sample tells them apart) gets the
     smallest standard error of the others.  Returns (F_c in nN, C in
@@ -1095,17 +1087,16 @@ def temperature_fit(rows, below=300.0):
     e = np.where(e > 1e-9, e, e[e > 1e-9].min())
     w = 1.0 / e ** 2
 
-    def solve(alpha):
-        a = np.vstack([np.ones_like(t), -t ** alpha]).T
-        coef = np.linalg.solve(a.T @ (w[:, None] * a), a.T @ (w * f))
-        return coef, float(np.sum(w * (f - a @ coef) ** 2))
+    from scipy.optimize import curve_fit
 
-    (fc, c), _ = solve(2.0 / 3.0)
-    alphas = np.linspace(0.2, 2.0, 1801)
-    chi = np.array([solve(a)[1] for a in alphas])
-    best = int(np.argmin(chi))
-    inside = alphas[chi <= chi[best] + 1.0]
-    return float(fc), float(c), float(alphas[best]), float(0.5 * (inside.max() - inside.min()))
+    def law(temperature, fc, c, alpha=2.0 / 3.0):
+        return fc - c * temperature ** alpha
+
+    (fc, c), _ = curve_fit(law, t, f, p0=(f.max(), 0.01), sigma=e, absolute_sigma=True)
+    # The free exponent: its standard error from the covariance of the three (absolute sigma: the
+    # points' own errors, as Delta chi^2 = 1 of the profile).
+    (_, _, alpha), cov = curve_fit(law, t, f, p0=(fc, c, 2.0 / 3.0), sigma=e, absolute_sigma=True)
+    return float(fc), float(c), float(alpha), float(math.sqrt(cov[2, 2]))
 
 
 def friction_temperature(rows):
