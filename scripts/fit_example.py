@@ -4,9 +4,9 @@
 The paper's use of the software: adjust the model of the microscope to a
 measured friction image.  Here the measurement is synthetic: the line the C
 API computes for V0 = 0.8 eV and k = kx = ky = 6 N/m, plus Gaussian noise
-of 0.05 nN (fixed seed).  Starting from V0 = 0.5 eV, k = 12 N/m, a
-Nelder-Mead search over (log V0, log k) minimises the sum of squared
-differences in fx.  scipy is not needed: the search is a few lines of numpy.
+of 0.05 nN (fixed seed).  Starting from V0 = 0.5 eV, k = 12 N/m, scipy's
+least_squares over (log V0, log k) minimises the sum of squared differences
+in fx, and the Jacobian gives each parameter's standard error.
 
     fit_example.py [--check]      --check: exit 1 unless both are within 2 %
 
@@ -44,8 +44,9 @@ def main(argv=None):
     errors = {}
     for key, unit in (("v0", "eV"), ("k", "N/m")):
         errors[key] = abs(fitted[key] - TRUE[key]) / TRUE[key]
+        se = result.errors["surface.v0" if key == "v0" else ("tip.kx", "tip.ky")]
         print(f"{key:>5}: fitted {fitted[key]:.4f} {unit}, true {TRUE[key]:.4f} {unit}, "
-              f"relative error {errors[key]:.2e}")
+              f"relative error {errors[key]:.2e}, standard error {se:.4f} {unit}")
     print(f"rms residual {result.rms:.4f} nN (noise {NOISE} nN), {result.evaluations} line evaluations")
     if args.check and not all(e <= TOLERANCE for e in errors.values()):
         print(f"FAIL: a parameter is off by more than {TOLERANCE:.0%}")
