@@ -412,7 +412,8 @@ class ImageFit:
                   coordinates: logarithms for positive parameters)
     noise         the noise level: the residuals' rms, sqrt(SSR / (N - p))
     converged, reason, status   scipy's success flag, message and status
-    evaluations   model images computed (each one line per fitted line and pass)
+    evaluations   model images computed (each one line per fitted line and
+                  pass; those of the coarse first fit included)
     lines_computed  scan lines computed
     fitted, residuals  {channel: (lines, nx)} model and measured - model (NaN where masked)
     masked        pixels masked (NaN in the measurement) and not fitted
@@ -529,7 +530,7 @@ class ImageFit:
 
 
 def image(measured, config, free, lines=None, nuisances=("offset", "calibration", "drift_x", "drift_y"),
-          bounds=None, workers=None, step=1e-6, max_evaluations=None, tolerance=1e-6):
+          bounds=None, workers=None, step=1e-6, max_evaluations=None, tolerance=1e-6, coarse=8):
     """Fit the configuration's parameters to a measured image by least squares.
 
     measured    a MeasuredImage (trace and retrace compared with the model's
@@ -556,17 +557,38 @@ def image(measured, config, free, lines=None, nuisances=("offset", "calibration"
                 parameters default to start/1000 .. start*1000
     workers     processes computing lines (default: the processors this
                 process may use); 1: on this process
-    step        the finite differences' step (in log for positive parameters;
-                1e-6 wants the integrator's rtol at 1e-5 or below)
                 (spawned processes: a script must guard its top level with
                 `if __name__ == "__main__":`, as multiprocessing asks)
+    step        the finite differences' step (in log for positive parameters;
+                1e-6 wants the integrator's rtol at 1e-4 or below)
+    coarse      when more than twice this many lines are fitted, a first fit
+                on this many evenly spaced lines, from which the fit of all
+                starts (most iterations then cost a few lines); 0: none
     Returns an ImageFit."""
     from scipy.optimize import least_squares
     data, where = _channels_of(measured)
     problem = _Problem(config, free, data, where, lines, nuisances, bounds, workers or _default_workers(), step)
+    images = lines_computed = 0
     try:
         lower, upper = problem.bounds()
         x0 = np.clip(problem.start(), lower, upper)
+        if coarse and len(problem.lines) > 2 * coarse:
+            rows = np.unique(np.linspace(0, len(problem.lines) - 1, int(coarse)).round().astype(int))
+            with warnings.catch_warnings():   # its masked pixels were reported once, above
+                warnings.simplefilter("ignore")
+                first = _Problem(config, {p.label: p.start for p in problem.parameters if p.names},
+                                 {c: problem.data[c][rows] for c in problem.channels}, where,
+                                 [problem.lines[r] for r in rows],
+                                 {p.label: p.start for p in problem.parameters if not p.names}, None,
+                                 problem.engine.workers, step)
+            first.engine.pool, problem.engine.pool = problem.engine.pool, None
+            try:
+                x0 = least_squares(first.residuals, x0, jac=first.jacobian, bounds=(lower, upper), method="trf",
+                                   x_scale="jac", ftol=tolerance, xtol=tolerance, gtol=tolerance,
+                                   max_nfev=max_evaluations).x
+            finally:
+                problem.engine.pool, first.engine.pool = first.engine.pool, None   # the same workers go on
+            images, lines_computed = first.engine.images, first.engine.line_count
         fit = least_squares(problem.residuals, x0, jac=problem.jacobian, bounds=(lower, upper), method="trf",
                             x_scale="jac", ftol=tolerance, xtol=tolerance, gtol=tolerance, max_nfev=max_evaluations)
         jac = problem.jacobian(fit.x)
@@ -579,8 +601,8 @@ def image(measured, config, free, lines=None, nuisances=("offset", "calibration"
     corr = _correlation(cov)
     fitted = problem.model(fit.x)
     return ImageFit(problem.labels, problem.values(fit.x), _value_errors(problem, fit.x, cov), corr, cov, noise,
-                    bool(fit.success), str(fit.message), int(fit.status), problem.engine.images,
-                    problem.engine.line_count, float(fit.cost),
+                    bool(fit.success), str(fit.message), int(fit.status), images + problem.engine.images,
+                    lines_computed + problem.engine.line_count, float(fit.cost),
                     {c: np.where(problem.mask[c], fitted[c], np.nan) for c in problem.channels},
                     {c: np.where(problem.mask[c], problem.data[c] - fitted[c], np.nan) for c in problem.channels},
                     problem.masked, _degenerate(problem.labels, corr, 0.9), singular, fit.x, jac, problem)

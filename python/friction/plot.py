@@ -14,6 +14,8 @@ sweeps:       sweep (every chart of a sweep file), bifurcation, sweep_lyapunov,
 speed:        work_precision, failure_map (files of scripts/work_precision)
 thermal:      friction_velocity (rows of scripts/thermal_velocity.py), sang_fit,
               friction_temperature (rows of scripts/thermal_temperature.py), temperature_fit
+fits:         fit_maps (friction.fit.image's maps), fit_corner (an MCMC sample),
+              friction_load (measured images against their setpoint)
 
 The figures are matplotlib.figure.Figure objects outside pyplot: nothing is
 shown or kept open behind the caller's back, and no display is needed.  In a
@@ -37,7 +39,8 @@ from ._data import FileError, load, reading, require
 __all__ = ["afm_maps", "friction_loop", "graphite_net", "stacked_lines", "brake_phase", "brake_x",
            "brake_spectrum", "poincare", "lyapunov", "floquet", "orbit_branch", "sweep", "bifurcation",
            "sweep_lyapunov", "atlas", "sweep_friction", "work_precision", "failure_map", "friction_velocity",
-           "sang_fit", "friction_temperature", "temperature_fit", "Figure"]
+           "sang_fit", "friction_temperature", "temperature_fit", "fit_maps", "fit_corner", "friction_load",
+           "Figure"]
 
 
 class Figure(_Figure):
@@ -1120,6 +1123,82 @@ def friction_temperature(rows):
     ax.set_xlabel("temperature (K)")
     ax.set_ylabel("mean friction (nN)")
     ax.set_title("NaF, 0.1 Å/s: friction against temperature", fontsize="medium")
+    ax.legend(fontsize="small")
+    fig.tight_layout()
+    return fig
+
+
+# --------------------------------------------------------------------------
+# fits of measured images (friction.fit)
+
+def fit_maps(fit, channel=None):
+    """A fit's measured, fitted and residual maps side by side (one channel of
+    a friction.fit.ImageFit: the first, or `channel`), the residuals on their
+    own colour scale."""
+    channel = channel or sorted(fit.fitted)[0]
+    if channel not in fit.fitted:
+        raise ValueError(f"the fit has no channel {channel!r}: it has {sorted(fit.fitted)}")
+    model, residual = fit.fitted[channel], fit.residuals[channel]
+    measured = model + residual
+    fig = _figure(figsize=(11.0, 3.6))
+    axes = fig.subplots(1, 3)
+    low, high = np.nanmin(measured), np.nanmax(measured)
+    span = np.nanmax(np.abs(residual))
+    for ax, values, title, kwargs in ((axes[0], measured, "measured", {"vmin": low, "vmax": high}),
+                                      (axes[1], model, "fitted model", {"vmin": low, "vmax": high}),
+                                      (axes[2], residual, f"residual (rms {fit.noise:.3g})",
+                                       {"vmin": -span, "vmax": span, "cmap": "RdBu_r"})):
+        image = ax.imshow(values, origin="lower", aspect="auto", interpolation="nearest", **kwargs)
+        ax.set_title(f"{channel}: {title}", fontsize="medium")
+        ax.set_xlabel("sample along the line")
+        fig.colorbar(image, ax=ax, shrink=0.85)
+    axes[0].set_ylabel("line")
+    fig.tight_layout()
+    return fig
+
+
+def fit_corner(sample, names, truths=None):
+    """The corner plot of an MCMC sample (ImageFit.sample(): rows of values in
+    the order of `names`), with the truth marked when known (corner's
+    corner.corner on a Figure of this module)."""
+    try:
+        import corner
+    except ImportError:
+        raise ImportError("fit_corner needs the Python package corner (pip install corner)") from None
+    sample = np.asarray(sample, float)
+    size = 2.2 * sample.shape[1]
+    fig = _figure(figsize=(size, size))
+    corner.corner(sample, fig=fig, labels=list(names), truths=truths, show_titles=True, title_fmt=".4g",
+                  quantiles=(0.16, 0.5, 0.84), title_kwargs={"fontsize": 8}, label_kwargs={"fontsize": 8})
+    return fig
+
+
+def friction_load(images, labels=None):
+    """Friction against load from measured images (friction.read_image): each
+    image's mean (trace - retrace)/2 with the standard error of its lines'
+    means, against its setpoint (metadata["setpoint"]), and the line fitted
+    through them (numpy's polyfit)."""
+    points = []
+    for image in images:
+        if "setpoint" not in image.metadata:
+            raise ValueError(f"{image.path}: no setpoint in the file's header: friction against load needs one")
+        lines = image.line_friction()
+        lines = lines[np.isfinite(lines)]
+        points.append((image.metadata["setpoint"][0], float(np.mean(lines)),
+                       float(np.std(lines, ddof=1) / math.sqrt(lines.size)), image.unit))
+    points.sort()
+    load_v, friction, sem, units = zip(*points)
+    fig = _figure(figsize=(5.6, 4.0))
+    ax = fig.add_subplot()
+    ax.errorbar(load_v, friction, yerr=sem, marker="o", linestyle="none", capsize=3, color="tab:blue",
+                label="mean of (trace - retrace)/2, one standard error of the lines")
+    if len(points) >= 2:
+        slope, intercept = np.polyfit(load_v, friction, 1)
+        grid = np.linspace(min(load_v), max(load_v), 50)
+        ax.plot(grid, slope * grid + intercept, color="tab:orange", linewidth=1,
+                label=f"straight line: slope {slope:.4f} {units[0]}/V")
+    ax.set_xlabel("setpoint (deflection, V): the load")
+    ax.set_ylabel(f"friction ({units[0]})")
     ax.legend(fontsize="small")
     fig.tight_layout()
     return fig
