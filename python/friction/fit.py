@@ -186,7 +186,8 @@ def _channels_of(measured, path=""):
             if not _CHANNEL.match(key):
                 raise ImageError(f"the measured image: channel {key!r} is not one of trace|retrace / "
                                  "fx|fy|along|across")
-            data[key] = np.asarray(value, dtype=float)
+            value = np.asarray(value, dtype=float)
+            data[key] = value[None, :] if value.ndim == 1 else value   # one line
         if not data:
             raise ImageError("the measured image has no channel")
         return data, "the measured image"
@@ -249,7 +250,9 @@ class _Problem:
         # ---- data
         self.data = {}
         for key, array in data.items():
-            if array.ndim != 2 or array.shape[1] != nx or array.shape[0] not in (ny, len(self.lines)):
+            if array.ndim != 2:
+                raise ImageError(f"{where}: channel {key!r} has {array.ndim} dimensions, not 2 (lines x samples)")
+            if array.shape[1] != nx or array.shape[0] not in (ny, len(self.lines)):
                 raise ImageError(f"{where}: channel {key!r} is {array.shape[0]} x {array.shape[1]} (lines x samples)"
                                  f", the configuration's scan {ny} x {nx} (scan.ny x scan.nx)"
                                  + ("" if lines is None else f" or {len(self.lines)} x {nx} for the lines chosen"))
@@ -518,8 +521,8 @@ class ImageFit:
                 out[inside] = values
             return out
 
-        sampler = emcee.EnsembleSampler(walkers, p, log_prob, vectorize=True,
-                                        seed=int(rng.integers(2**31)))
+        sampler = emcee.EnsembleSampler(walkers, p, log_prob, vectorize=True)
+        sampler.random_state = np.random.RandomState(int(rng.integers(2**31))).get_state()   # reproducible
         try:
             sampler.run_mcmc(start, steps)
         finally:

@@ -154,6 +154,10 @@ def test_identifiability_predicts_the_scatter_of_the_estimates(friction):
     assert np.all(np.abs(spread / predicted - 1) < 0.3), (spread, predicted)
     # and each fit's own standard errors (noise estimated from its residuals) agree with the plan's
     assert np.all(np.abs(np.mean(errors, axis=0) / predicted - 1) < 0.3)
+    # Each 95 % interval (1.96 standard errors) holds the truth in at least 16 of the 20 fits: the
+    # lower end of Binomial(20, 0.95)'s central 99 % (scripts/fit_coverage.py counts 60 and more).
+    z = (np.array(estimates) - np.array([0.8, 6.0])) / np.array(errors)
+    assert np.all(np.sum(np.abs(z) < 1.959964, axis=0) >= 16), z
 
 
 def test_profile_likelihood_matches_the_standard_error(friction):
@@ -192,3 +196,43 @@ def test_bad_input_is_refused_clearly(friction):
             fit = friction.fit.image({"trace/fx": holed}, cfg, {"surface.v0": 0.9}, nuisances=(), workers=1)
         assert fit.masked == 1 and np.isnan(fit.residuals["trace/fx"][1, 5])
         assert fit.values["surface.v0"] == pytest.approx(1.0, rel=1e-5)   # the noise-free truth
+
+
+def test_the_mcmc_sample_agrees_with_the_standard_errors(friction):
+    """emcee's sample of one line's posterior (V0, k): its standard deviations against the
+    Jacobian's standard errors, which a near-Gaussian posterior shares.  8 walkers x 150 steps,
+    a quarter dropped: some 40 independent draws (autocorrelation near 20 steps), a deviation's
+    relative standard error near 11 %: 35 % is three of them."""
+    pytest.importorskip("emcee")
+    import friction.fit
+    values = {**friction.fit.NAF_LINE, "scan.nx": 32, **NAF_TRUE}
+    with friction.Config("afm", values=values) as cfg:
+        clean = cfg.afm_line(0).fx
+        measured = clean + 0.05 * np.random.default_rng(9).standard_normal(clean.size)
+        fit = friction.fit.image(measured, cfg, {"surface.v0": 0.8, "tip.kx=tip.ky": 6.0}, nuisances=(), workers=1)
+        sample = fit.sample(steps=150, walkers=8, seed=1)
+    assert sample.shape == (8 * (150 - 150 // 4), 2)
+    ratio = np.std(sample, axis=0) / np.array([fit.errors["surface.v0"], fit.errors["tip.kx=tip.ky"]])
+    assert np.all(np.abs(ratio - 1) < 0.35), ratio
+
+
+def test_the_fit_pictures(friction):
+    import friction.fit
+    import friction.plot
+    from friction._image import image_from_arrays
+    values = {**SMALL, "scan.ny": 2}
+    with friction.Config("afm", files=[INPUTS / "naf.nml"], values=values) as cfg:
+        clean = np.array([cfg.afm_line(j).fx for j in range(2)])
+        fit = friction.fit.image({"trace/fx": clean + 0.01}, cfg, {"surface.v0": 0.9}, nuisances=("offset",),
+                                 workers=1)
+    fig = friction.plot.fit_maps(fit)
+    assert [ax.get_title() for ax in fig.axes[:3]] == ["trace/fx: measured", "trace/fx: fitted model",
+                                                       f"trace/fx: residual (rms {fit.noise:.3g})"]
+    np.testing.assert_allclose(fig.axes[0].images[0].get_array(), clean + 0.01)
+    with pytest.raises(ValueError, match="no channel 'trace/fy'"):
+        friction.plot.fit_maps(fit, "trace/fy")
+    images = [image_from_arrays(np.full((2, 3), 1.0 + s), np.full((2, 3), 1.0 - s), metadata={"setpoint": (s, "V")},
+                                unit="V") for s in (0.1, 0.3, 0.2)]
+    fig = friction.plot.friction_load(images)
+    x, y = fig.axes[0].lines[0].get_data()
+    assert list(x) == [0.1, 0.2, 0.3] and np.allclose(y, [0.1, 0.2, 0.3])   # friction = s by construction
