@@ -195,6 +195,17 @@ def _channels_of(measured, path=""):
     return {"trace/fx": array if array.ndim == 2 else array[None, :]}, "the measured image"
 
 
+def _check_size(measured, config, where):
+    """A measured image's scan size (when its file gives one) must be the configuration's."""
+    from ._image import ImageError, MeasuredImage
+    if not isinstance(measured, MeasuredImage) or not all(math.isfinite(v) for v in measured.size):
+        return
+    planned = (float(config.value("scan.length")), float(config.value("scan.width")))
+    if any(abs(m - p) > 1e-3 * max(abs(p), 1e-12) for m, p in zip(measured.size, planned)):
+        raise ImageError(f"{where}: the image's scan is {measured.size[0]:g} x {measured.size[1]:g} angstrom, the "
+                         f"configuration's {planned[0]:g} x {planned[1]:g} (scan.length x scan.width)")
+
+
 class _Problem:
     """The residuals and their Jacobian for a configuration, free parameters,
     nuisances and a (measured or planned) image."""
@@ -570,6 +581,7 @@ def image(measured, config, free, lines=None, nuisances=("offset", "calibration"
     Returns an ImageFit."""
     from scipy.optimize import least_squares
     data, where = _channels_of(measured)
+    _check_size(measured, config, where)
     problem = _Problem(config, free, data, where, lines, nuisances, bounds, workers or _default_workers(), step)
     images = lines_computed = 0
     try:

@@ -236,3 +236,40 @@ def test_the_fit_pictures(friction):
     fig = friction.plot.friction_load(images)
     x, y = fig.axes[0].lines[0].get_data()
     assert list(x) == [0.1, 0.2, 0.3] and np.allclose(y, [0.1, 0.2, 0.3])   # friction = s by construction
+
+
+def test_a_measured_image_is_fitted_along_the_scan_and_its_size_checked(friction):
+    """A MeasuredImage's trace and retrace are the force along the scan: at 0 degrees fx, so
+    the fit of an image made from fx recovers V0 exactly (noise-free); its size must be the
+    configuration's scan; `lines` chooses the lines fitted."""
+    import friction.fit
+    from friction._image import ImageError, image_from_arrays
+    values = {**SMALL, "scan.ny": 4}
+    with friction.Config("afm", files=[INPUTS / "naf.nml"], values=values) as cfg:
+        trace = np.array([cfg.afm_line(j, True).fx for j in range(4)])
+        retrace = np.array([cfg.afm_line(j, False).fx for j in range(4)])
+        image = image_from_arrays(trace, retrace, size=(20.0, 20.0), unit="nN")
+        fit = friction.fit.image(image, cfg, {"surface.v0": 0.9}, lines=[1, 3], nuisances=(), workers=1)
+        assert sorted(fit.fitted) == ["retrace/along", "trace/along"]
+        assert fit.fitted["trace/along"].shape == (2, 32)
+        assert fit.values["surface.v0"] == pytest.approx(1.0, rel=1e-5)
+        np.testing.assert_allclose(fit.fitted["retrace/along"], retrace[[1, 3]], atol=1e-4)
+        with pytest.raises(ImageError, match=r"scan is 2000 x 2000 angstrom, the configuration's 20 x 20"):
+            friction.fit.image(image_from_arrays(trace, retrace, size=(2000.0, 2000.0)), cfg, ["surface.v0"],
+                               workers=1)
+
+
+def test_compare_is_identifiability_per_scan(friction):
+    import friction.fit
+    line = {"scan.nx": 32, "scan.ny": 1, "scan.retrace": False, "integrator.rtol": 1e-6, "integrator.atol": 1e-7}
+    with friction.Config("afm", files=[INPUTS / "naf.nml"], values=line) as cfg:
+        plans = friction.fit.compare(cfg, {"0": {}, "30": {"scan.angle": 30.0, "channels": ("trace/fy",)}},
+                                     ["surface.v0"], 0.02, workers=1)
+        assert cfg["scan.angle"] == 0.0                       # the configuration is not changed
+        alone = friction.fit.identifiability(cfg, ["surface.v0"], 0.02, workers=1)
+        cfg.set("scan.angle", 30.0)
+        turned = friction.fit.identifiability(cfg, ["surface.v0"], 0.02, channels=("trace/fy",), workers=1)
+    assert plans["0"].errors == alone.errors and plans["30"].errors == turned.errors
+    # One parameter: SE(ln V0) = noise / |dF/d ln V0|, and SE(V0) = V0 SE(ln V0), V0 = 1 eV (naf.nml).
+    jac = alone.jacobian[:, 0]
+    assert alone.errors["surface.v0"] == pytest.approx(1.0 * 0.02 / np.sqrt(np.sum(jac ** 2)), rel=1e-12)
