@@ -18,6 +18,7 @@ The library is found as the package finds it (FRICTION_LIBRARY, the build tree).
 """
 import argparse
 import os
+import resource
 import sys
 import time
 from pathlib import Path
@@ -57,13 +58,19 @@ def measured_image(size):
 def fit(measured, size, workers):
     values = {"scan.nx": size, "scan.ny": size, **TOLERANCES}
     with friction.Config("afm", files=[ROOT / "inputs" / "naf.nml"], values=values) as cfg:
-        start = time.perf_counter()
+        start, cpu = time.perf_counter(), _cpu()
         result = friction.fit.image(measured, cfg, START, nuisances=list(NUISANCES), workers=workers)
-        return result, time.perf_counter() - start
+        return result, time.perf_counter() - start, _cpu() - cpu
 
 
-def report(label, result, wall, truth):
-    print(f"{label}: {wall:.1f} s wall, {result.evaluations} model images, {result.lines_computed} scan lines "
+def _cpu():
+    """CPU seconds of this process and its finished children (the pool's workers, reaped at the fit's end)."""
+    own, children = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+    return own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime
+
+
+def report(label, result, wall, cpu, truth):
+    print(f"{label}: {wall:.1f} s wall, {cpu:.1f} s CPU, load average {os.getloadavg()[0]:.1f}; {result.evaluations} model images, {result.lines_computed} scan lines "
           f"({1e3 * wall / result.lines_computed:.1f} ms of wall per line); "
           f"{'converged' if result.converged else 'NOT converged'} ({result.reason})")
     for name in result.names:
@@ -83,11 +90,11 @@ def main(argv=None):
     measured, sigma = measured_image(args.size)
     print(f"noise {sigma:.4f} nN (2 % of the image's standard deviation)")
     truth = {**TRUE, **NUISANCES}
-    result, wall = fit(measured, args.size, args.workers)
-    report(f"{args.workers} processes", result, wall, truth)
+    result, wall, cpu = fit(measured, args.size, args.workers)
+    report(f"{args.workers} processes", result, wall, cpu, truth)
     if not args.no_serial and args.workers > 1:
-        serial, serial_wall = fit(measured, args.size, 1)
-        report("1 process", serial, serial_wall, truth)
+        serial, serial_wall, serial_cpu = fit(measured, args.size, 1)
+        report("1 process", serial, serial_wall, serial_cpu, truth)
         print(f"speed-up {serial_wall / wall:.2f}x on {args.workers} processes (the same fit: "
               f"{'yes' if serial.values == result.values else 'no'})")
     return 0
