@@ -56,8 +56,8 @@ _CHANNEL = re.compile(r"^(trace|retrace)/(fx|fy|along|across)$")
 
 # ---------------------------------------------------------------- model lines, in worker processes
 
-# The worker process's Config (a process, not a thread, per worker: the library's text calls,
-# friction_config_names among them, are not safe in two threads at once).
+# The worker process's Config (a process, not a thread, per worker: a fit on two threads once got a
+# malformed variable list from friction_config_names; a process keeps its library to itself).
 _worker = threading.local()
 
 
