@@ -106,7 +106,9 @@ class _Lines:
         self.line_count = 0
 
     def _chunks(self):
-        count = min(len(self.lines), 2 * self.workers) if self.workers > 1 else 1
+        # At least 4 lines a task: a task's round trip costs about a line (the images of one batch
+        # are submitted together, so the workers stay busy across them).
+        count = max(1, min(len(self.lines) // 4, 2 * self.workers)) if self.workers > 1 else 1
         return [chunk for chunk in np.array_split(np.asarray(self.lines), count) if chunk.size]
 
     def evaluate(self, settings_list):
