@@ -70,7 +70,8 @@ def _cpu():
 
 
 def report(label, result, wall, cpu, truth):
-    print(f"{label}: {wall:.1f} s wall, {cpu:.1f} s CPU, load average {os.getloadavg()[0]:.1f}; {result.evaluations} model images, {result.lines_computed} scan lines "
+    print(f"{label}: {wall:.1f} s wall, {cpu:.1f} s CPU, load average {os.getloadavg()[0]:.1f}; "
+          f"{result.evaluations} model images, {result.lines_computed} scan lines "
           f"({1e3 * wall / result.lines_computed:.1f} ms of wall per line); "
           f"{'converged' if result.converged else 'NOT converged'} ({result.reason})")
     for name in result.names:
