@@ -15,6 +15,7 @@ import sys
 LAYERS = [
     ["core"],
     ["ode", "surface"],
+    ["law"],
     ["analysis"],
     ["input", "output", "netlist"],
     ["scene"],

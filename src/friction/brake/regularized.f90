@@ -13,12 +13,13 @@
 !> error: the block lifts off); 2., 3. v_rel ∓ stick_velocity, the edges of
 !> the creep band the output counts as stick.
 module friction_brake_regularized
-   use friction_kinds, only: wp, pi
+   use friction_kinds, only: wp
    use friction_error, only: error_type, fatal_error, error_numerical
    use friction_strings, only: rtoa
    use friction_ode_solver, only: solver_settings, is_implicit_step_type
    use friction_ode_events, only: event_system, event_falling, event_either, &
       & event_rising
+   use friction_law_arctan, only: arctan_force, arctan_slope
    use friction_brake_params, only: brake_parameters
    use friction_brake_config, only: brake_config
    use friction_brake_integrator, only: brake_integrator
@@ -56,27 +57,21 @@ module friction_brake_regularized
 
 contains
 
-   !> F/k1 of Eq. 10 (m): the friction force on the block, regularized.
+   !> F/k1 of Eq. 10 (m): the friction force on the block, regularized (the
+   !> law's one formula, friction_law_arctan, in the units of Eq. 10).
    pure real(wp) function regularized_friction(p, normal, v_rel)
       type(brake_parameters), intent(in) :: p
       real(wp), intent(in) :: normal, v_rel
 
-      regularized_friction = -p%mu * normal * (2.0_wp / pi) * atan(p%epsilon_prime * v_rel) &
-         & / (1.0_wp + p%delta_prime * abs(v_rel))
+      regularized_friction = -arctan_force(p%mu, normal, p%epsilon_prime, p%delta_prime, v_rel)
    end function regularized_friction
 
-   !> ∂F/∂v_rel at fixed N'.  The kink of |v_rel| at 0 multiplies
-   !> arctan(0) = 0, so the derivative is continuous.
+   !> ∂F/∂v_rel at fixed N'.
    pure real(wp) function regularized_friction_slope(p, normal, v_rel)
       type(brake_parameters), intent(in) :: p
       real(wp), intent(in) :: normal, v_rel
-      real(wp) :: ev, denominator
 
-      ev = p%epsilon_prime * v_rel
-      denominator = 1.0_wp + p%delta_prime * abs(v_rel)
-      regularized_friction_slope = -p%mu * normal * (2.0_wp / pi) * &
-         & (p%epsilon_prime / (1.0_wp + ev * ev) / denominator &
-         & - atan(ev) * p%delta_prime * sign(1.0_wp, v_rel) / denominator**2)
+      regularized_friction_slope = -arctan_slope(p%mu, normal, p%epsilon_prime, p%delta_prime, v_rel)
    end function regularized_friction_slope
 
    pure function dimension(self) result(n)

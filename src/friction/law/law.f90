@@ -1,0 +1,176 @@
+!> A friction law as one abstract type (docs/laws.md): the force a sliding
+!> contact resists with, from the sliding velocity v (m/s), the normal load
+!> (N), the law's internal states z (a bristle's deflection, a contact's
+!> age) and, where the law is set-valued at v = 0, the force the rest of the
+!> mechanism applies.  The states' derivatives join a mechanism's equations
+!> of motion.  Only the factory (factory.f90) names the concrete laws.
+!>
+!> Sign convention: F resists the motion, it has the sign of v, and the body
+!> obeys m a = applied - F.
+module friction_law
+   use friction_kinds, only: wp
+   use friction_error, only: error_type
+   use friction_checks, only: config_checker
+   use friction_law_settings, only: law_settings
+   implicit none
+   private
+
+   public :: sliding_law, max_law_states
+
+   !> The most internal states a law has (the ODE bridge's room).
+   integer, parameter :: max_law_states = 4
+
+   type, abstract :: sliding_law
+      type(law_settings) :: p   !! the &law parameters the law was made from
+   contains
+      !> Every parameter the law uses, the first bad one to the checker.
+      procedure(check_interface), deferred :: check
+      !> F(v, z, N, applied): the force that resists the motion.
+      procedure(force_interface), deferred :: force
+      !> How many internal states; their rates, names and units.
+      procedure :: state_count
+      procedure :: state_rate
+      procedure :: state_name
+      procedure :: state_unit
+      !> A typical size of each state (the integrators' error scale).
+      procedure :: state_scale
+      !> The states of steady sliding at v.
+      procedure :: steady_state
+      !> The partial derivatives of F and of the states' rates (the implicit
+      !> steppers' Jacobian and the tangent equations); by default from
+      !> central differences, which a law overrides with its exact ones.
+      procedure :: partials
+      !> Set-valued at v = 0 (exact stick): the largest force the contact
+      !> holds in stick, and the force during a slip in direction s = ±1,
+      !> smooth through v = 0 so that an integrator may step a little past
+      !> the end of the slip.
+      procedure :: set_valued
+      procedure :: static_force
+      procedure :: slip_force
+      !> What the law needs before it computes (a table read from its file).
+      procedure :: prepare
+   end type sliding_law
+
+   abstract interface
+      subroutine check_interface(self, c)
+         import :: sliding_law, config_checker
+         class(sliding_law), intent(in) :: self
+         type(config_checker), intent(inout) :: c
+      end subroutine check_interface
+
+      pure real(wp) function force_interface(self, v, z, normal, applied)
+         import :: sliding_law, wp
+         class(sliding_law), intent(in) :: self
+         real(wp), intent(in) :: v, normal, applied
+         real(wp), intent(in) :: z(:)
+      end function force_interface
+   end interface
+
+contains
+
+   pure integer function state_count(self)
+      class(sliding_law), intent(in) :: self
+
+      state_count = 0
+   end function state_count
+
+   pure subroutine state_rate(self, v, z, normal, rate)
+      class(sliding_law), intent(in) :: self
+      real(wp), intent(in) :: v, normal
+      real(wp), intent(in) :: z(:)
+      real(wp), intent(out) :: rate(:)
+
+      rate = 0.0_wp
+   end subroutine state_rate
+
+   function state_name(self, i) result(name)
+      class(sliding_law), intent(in) :: self
+      integer, intent(in) :: i
+      character(len=:), allocatable :: name
+
+      name = 'z'
+   end function state_name
+
+   function state_unit(self, i) result(unit)
+      class(sliding_law), intent(in) :: self
+      integer, intent(in) :: i
+      character(len=:), allocatable :: unit
+
+      unit = 'm'
+   end function state_unit
+
+   pure subroutine state_scale(self, scale)
+      class(sliding_law), intent(in) :: self
+      real(wp), intent(out) :: scale(:)
+
+      scale = 1.0_wp
+   end subroutine state_scale
+
+   pure subroutine steady_state(self, v, normal, z)
+      class(sliding_law), intent(in) :: self
+      real(wp), intent(in) :: v, normal
+      real(wp), intent(out) :: z(:)
+
+      z = 0.0_wp
+   end subroutine steady_state
+
+   !> ∂F/∂v, ∂F/∂z, ∂F/∂applied, ∂ż/∂v, ∂ż/∂z (dgdz(i, j) = ∂ż_i/∂z_j).
+   !> Central differences with steps of 1e-6 of the variable's size (or of
+   !> the state's scale, and of the velocity's largest of |v| and 1e-6 m/s):
+   !> errors of order 1e-12 relative for smooth laws.
+   pure subroutine partials(self, v, z, normal, applied, dfdv, dfdz, dfda, dgdv, dgdz)
+      class(sliding_law), intent(in) :: self
+      real(wp), intent(in) :: v, normal, applied
+      real(wp), intent(in) :: z(:)
+      real(wp), intent(out) :: dfdv, dfdz(:), dfda, dgdv(:), dgdz(:, :)
+      real(wp) :: h, zp(size(z)), zm(size(z)), rp(size(z)), rm(size(z)), scale(size(z))
+      integer :: j
+
+      h = 1.0e-6_wp * max(abs(v), 1.0e-6_wp)
+      dfdv = (self%force(v + h, z, normal, applied) - self%force(v - h, z, normal, applied)) / (2.0_wp * h)
+      call self%state_rate(v + h, z, normal, rp)
+      call self%state_rate(v - h, z, normal, rm)
+      dgdv = (rp - rm) / (2.0_wp * h)
+      h = 1.0e-6_wp * max(abs(applied), 1.0e-6_wp)
+      dfda = (self%force(v, z, normal, applied + h) - self%force(v, z, normal, applied - h)) / (2.0_wp * h)
+      call self%state_scale(scale)
+      do j = 1, size(z)
+         h = 1.0e-6_wp * max(abs(z(j)), scale(j))
+         zp = z
+         zm = z
+         zp(j) = z(j) + h
+         zm(j) = z(j) - h
+         dfdz(j) = (self%force(v, zp, normal, applied) - self%force(v, zm, normal, applied)) / (2.0_wp * h)
+         call self%state_rate(v, zp, normal, rp)
+         call self%state_rate(v, zm, normal, rm)
+         dgdz(:, j) = (rp - rm) / (2.0_wp * h)
+      end do
+   end subroutine partials
+
+   pure logical function set_valued(self)
+      class(sliding_law), intent(in) :: self
+
+      set_valued = .false.
+   end function set_valued
+
+   pure real(wp) function static_force(self, normal)
+      class(sliding_law), intent(in) :: self
+      real(wp), intent(in) :: normal
+
+      static_force = huge(1.0_wp)
+   end function static_force
+
+   pure real(wp) function slip_force(self, v, z, normal, s)
+      class(sliding_law), intent(in) :: self
+      real(wp), intent(in) :: v, normal, s
+      real(wp), intent(in) :: z(:)
+
+      slip_force = self%force(v, z, normal, 0.0_wp)
+   end function slip_force
+
+   subroutine prepare(self, error)
+      class(sliding_law), intent(inout) :: self
+      type(error_type), allocatable, intent(out) :: error
+   end subroutine prepare
+
+end module friction_law
