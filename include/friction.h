@@ -75,6 +75,7 @@ enum {
 typedef struct friction_error friction_error;   /* opaque: status and message of the last call */
 typedef struct friction_config friction_config; /* opaque: a scene's configuration */
 typedef struct friction_result friction_result; /* opaque: the arrays of a computation */
+typedef struct friction_law friction_law;       /* opaque: a friction law with its parameters */
 
 /* ---- versions and errors ---- */
 
@@ -275,6 +276,40 @@ void friction_job_stop(void);
  * (friction_config_text).  MPI and flags as friction_run_job. */
 int friction_run_config(const friction_config *cfg, const char *output, int flags, friction_report_fn report,
                         void *user, friction_error *err);
+
+/* ---- friction laws on their own (docs/laws.md) ---- */
+
+/* A friction law by name ("coulomb", "arctan", "stribeck", "karnopp", "dahl",
+ * "lugre", "elastoplastic", "rate_state", "table") with the &law defaults and
+ * the &integrator of its states' integration (rodas4, rtol 1e-9, atol 1e-11
+ * in units of each state's scale); NULL (and a message) for an unknown name.
+ * Free it with friction_law_free (NULL is ignored). */
+friction_law *friction_law_new(const char *model, friction_error *err);
+void friction_law_free(friction_law *law);
+/* Set, get, check by "group.variable" ("law.sigma0", "law.table_file",
+ * "integrator.rtol"), with namelist value text or a number, as
+ * friction_config_set, friction_config_set_real, friction_config_get and
+ * friction_config_check do for a configuration.  A relative table_file is
+ * relative to the process's working directory. */
+int friction_law_set(friction_law *law, const char *name, const char *value, friction_error *err);
+int friction_law_set_real(friction_law *law, const char *name, double x, friction_error *err);
+int friction_law_get(const friction_law *law, const char *name, char *buf, size_t len, friction_error *err);
+int friction_law_check(const friction_law *law, friction_error *err);
+/* The number of the law's internal states (0, or 1: LuGre's and Dahl's
+ * deflection z in m, rate and state's age theta in s); -1 on an error. */
+int friction_law_state_count(const friction_law *law, friction_error *err);
+/* The law along a prescribed history at the n times t[i] (s, increasing):
+ * u[i] the sliding velocity (m/s; displacement = 0, linear between the
+ * samples) or the displacement (m; displacement = 1, linear between the
+ * samples, so the velocity is constant on each interval).  force[i] (N) gets
+ * the friction force (it resists the motion: the sign of v), and states (if
+ * not NULL, states_len >= n * count) the internal states, states[i * count +
+ * j].  normal is the normal load (N), used by the coefficient laws (coulomb,
+ * arctan, rate_state).  The states start in steady sliding at the first
+ * velocity.  The law is checked first; FRICTION_ERROR_NUMERICAL if the
+ * integration fails. */
+int friction_law_history(const friction_law *law, double normal, const double *t, const double *u, size_t n,
+                         int displacement, double *force, double *states, size_t states_len, friction_error *err);
 
 #ifdef __cplusplus
 }

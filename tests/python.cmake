@@ -46,3 +46,10 @@ foreach(example IN LISTS _fp_examples)
   set_tests_properties(example.${name} PROPERTIES LABELS "python;examples" TIMEOUT 300
     ENVIRONMENT "${_fp_env}")
 endforeach()
+
+# The friction laws from Python alone (friction.law: the C API's laws, SciPy's PCHIP, the fit).
+add_test(NAME python-law
+  COMMAND ${Python3_EXECUTABLE} -m pytest "${PROJECT_SOURCE_DIR}/python/tests/test_law.py" -q -p no:cacheprovider
+          --basetemp "${_fp_work}/pytest-law"
+  WORKING_DIRECTORY "${_fp_work}")
+set_tests_properties(python-law PROPERTIES LABELS "python;capi" TIMEOUT 120 ENVIRONMENT "${_fp_env}")

@@ -29,7 +29,7 @@ from ._version import __version__
 
 __all__ = ["__version__", "library_version", "api_version", "library_path", "FrictionError",
            "LibraryNotFoundError", "FileError", "read_image", "MeasuredImage", "ImageError", "Config", "Line", "run", "compute", "afm_line", "brake", "load",
-           "Dataset", "Array", "Attributes", "plot", "fit"]
+           "Dataset", "Array", "Attributes", "plot", "fit", "law"]
 
 
 def library_version():
@@ -39,8 +39,8 @@ def library_version():
 
 
 def __getattr__(name):
-    # friction.plot and friction.fit on first use: matplotlib only when plotting.
-    if name in ("plot", "fit"):
+    # friction.plot, friction.fit and friction.law on first use: matplotlib only when plotting.
+    if name in ("plot", "fit", "law"):
         import importlib
         module = importlib.import_module(f".{name}", __name__)
         globals()[name] = module

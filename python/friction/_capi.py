@@ -170,6 +170,15 @@ def _signatures(lib):
                                      c_void_p]),
         "friction_run_config": (c_int, [c_void_p, c_char_p, c_int, _REPORT, c_void_p, c_void_p]),
         "friction_job_stop": (None, []),
+        "friction_law_new": (c_void_p, [c_char_p, c_void_p]),
+        "friction_law_free": (None, [c_void_p]),
+        "friction_law_set": (c_int, [c_void_p, c_char_p, c_char_p, c_void_p]),
+        "friction_law_set_real": (c_int, [c_void_p, c_char_p, c_double, c_void_p]),
+        "friction_law_get": (c_int, [c_void_p, c_char_p, c_char_p, c_size_t, c_void_p]),
+        "friction_law_check": (c_int, [c_void_p, c_void_p]),
+        "friction_law_state_count": (c_int, [c_void_p, c_void_p]),
+        "friction_law_history": (c_int, [c_void_p, c_double, c_void_p, c_void_p, c_size_t, c_int, c_void_p,
+                                         c_void_p, c_size_t, c_void_p]),
     }
     for name, (restype, argtypes) in signatures.items():
         function = getattr(lib, name, None)

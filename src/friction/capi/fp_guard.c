@@ -76,3 +76,23 @@ FP_GUARDED(int, friction_run_config,
            (const friction_config *cfg, const char *output, int flags, friction_report_fn report, void *user,
             friction_error *err),
            (cfg, output, flags, report, user, err))
+
+/* The friction laws (capi_law.f90). */
+FP_GUARDED(friction_law *, friction_law_new, (const char *model, friction_error *err), (model, err))
+
+FP_GUARDED(int, friction_law_set, (friction_law *law, const char *name, const char *value, friction_error *err),
+           (law, name, value, err))
+
+FP_GUARDED(int, friction_law_set_real, (friction_law *law, const char *name, double x, friction_error *err),
+           (law, name, x, err))
+
+FP_GUARDED(int, friction_law_get,
+           (const friction_law *law, const char *name, char *buf, size_t len, friction_error *err),
+           (law, name, buf, len, err))
+
+FP_GUARDED(int, friction_law_check, (const friction_law *law, friction_error *err), (law, err))
+
+FP_GUARDED(int, friction_law_history,
+           (const friction_law *law, double normal, const double *t, const double *u, size_t n, int displacement,
+            double *force, double *states, size_t states_len, friction_error *err),
+           (law, normal, t, u, n, displacement, force, states, states_len, err))
