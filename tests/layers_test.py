@@ -19,7 +19,7 @@ LAYERS = [
     ["analysis"],
     ["input", "output", "netlist"],
     ["scene"],
-    ["afm", "brake"],
+    ["afm", "brake", "machine"],
     ["job"],
     ["capi", "."],          # "." is the umbrella module src/friction/friction.f90
     ["app"],

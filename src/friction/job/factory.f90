@@ -3,13 +3,14 @@ module friction_job_factory
    use friction_scene, only: scene
    use friction_afm_scene, only: afm_scene
    use friction_brake_scene, only: brake_scene
+   use friction_machine_scene, only: machine_scene
    implicit none
    private
 
    public :: scene_names, new_scene
 
    !> &job scene = '...' (the first is the default).
-   character(len=*), parameter :: scene_names(2) = [character(len=5) :: 'afm', 'brake']
+   character(len=*), parameter :: scene_names(3) = [character(len=7) :: 'afm', 'brake', 'machine']
 
 contains
 
@@ -23,6 +24,8 @@ contains
          allocate (afm_scene :: s)
       case ('brake')
          allocate (brake_scene :: s)
+      case ('machine')
+         allocate (machine_scene :: s)
       end select
    end subroutine new_scene
 

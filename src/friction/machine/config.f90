@@ -1,0 +1,133 @@
+!> Settings of the machine scene (docs/laws.md, "Mechanisms"): the groups
+!> &machine, &law and &integrator.  One degree of freedom: a block of mass m
+!> on a surface moving at belt_velocity, tied by a spring k and a dashpot c
+!> to a support at u(t) = load_velocity t + support_amplitude sin(2π
+!> support_frequency t), pressed on by the normal load:
+!>
+!>   m x'' = -k (x - u) - c (x' - u') - F(x' - belt_velocity, z),
+!>
+!> F the &law's friction force at the sliding velocity.  The belt oscillator
+!> of Popp and Stelter and of the LuGre paper is load_velocity = 0; the
+!> spring-slider of rate and state is belt_velocity = 0 with the load point
+!> at load_velocity.
+module friction_machine_config
+   use friction_kinds, only: wp, i8
+   use friction_strings, only: rtoa
+   use friction_parameters, only: configurable, parameter_visitor
+   use friction_checks, only: config_checker
+   use friction_ode_solver, only: solver_settings
+   use friction_ode_settings, only: visit_integrator, check_integrator
+   use friction_law_settings, only: law_settings
+   use friction_law_factory, only: check_law
+   implicit none
+   private
+
+   public :: machine_config, machine_solver_defaults
+
+   !> Rodas4 at tight tolerances: the laws with states are stiff (LuGre's
+   !> contact period is 20 ms against seconds of stick-slip).
+   type(solver_settings), parameter :: machine_solver_defaults = solver_settings(method='rodas4', &
+      & rtol=1.0e-9_wp, atol=1.0e-12_wp, h_start=0.0_wp, h_min=0.0_wp, max_steps=100000000_i8, max_wall_time=0.0_wp)
+
+   type, extends(configurable) :: machine_config
+      real(wp) :: mass = 1.0_wp              !! m, kg
+      real(wp) :: stiffness = 2.0_wp         !! k, N/m
+      real(wp) :: damping = 0.0_wp           !! c, N s/m
+      real(wp) :: normal = 1.0_wp            !! normal load N, N
+      real(wp) :: belt_velocity = 0.1_wp     !! the surface's velocity, m/s
+      real(wp) :: load_velocity = 0.0_wp     !! the support's (load point's) velocity, m/s
+      real(wp) :: support_amplitude = 0.0_wp !! m
+      real(wp) :: support_frequency = 0.0_wp !! Hz
+      real(wp) :: x0 = 0.0_wp                !! initial displacement, m
+      real(wp) :: v0 = 0.1_wp                !! initial velocity, m/s
+      logical :: steady_start = .true.       !! the law's states start in steady sliding at v0 - belt_velocity
+      real(wp) :: t_start = 0.0_wp           !! s
+      real(wp) :: t_end = 100.0_wp           !! s
+      real(wp) :: dt_out = 0.01_wp           !! s
+      real(wp) :: event_tolerance = 1.0e-10_wp   !! s: the stick/slip events' times
+      real(wp) :: stick_velocity = 1.0e-6_wp !! m/s: |v - belt_velocity| below this counts as stick (smooth laws)
+      type(law_settings) :: law
+      type(solver_settings) :: solver = machine_solver_defaults
+   contains
+      procedure :: visit
+      procedure :: validate
+      procedure :: grid_size
+      procedure :: grid_time
+   end type machine_config
+
+contains
+
+   subroutine visit(self, v)
+      class(machine_config), intent(inout) :: self
+      type(parameter_visitor), intent(inout) :: v
+
+      call visit_integrator(self%solver, v, 's')
+      call v%begin_group('machine')
+      call v%item('mass', self%mass, 'kg')
+      call v%item('stiffness', self%stiffness, 'N/m')
+      call v%item('damping', self%damping, 'N s/m')
+      call v%item('normal', self%normal, 'N')
+      call v%item('belt_velocity', self%belt_velocity, 'm/s')
+      call v%item('load_velocity', self%load_velocity, 'm/s')
+      call v%item('support_amplitude', self%support_amplitude, 'm')
+      call v%item('support_frequency', self%support_frequency, 'Hz')
+      call v%item('x0', self%x0, 'm')
+      call v%item('v0', self%v0, 'm/s')
+      call v%item('steady_start', self%steady_start)
+      call v%item('t_start', self%t_start, 's')
+      call v%item('t_end', self%t_end, 's')
+      call v%item('dt_out', self%dt_out, 's')
+      call v%item('event_tolerance', self%event_tolerance, 's')
+      call v%item('stick_velocity', self%stick_velocity, 'm/s')
+      call v%end_group()
+      call self%law%visit(v)
+   end subroutine visit
+
+   subroutine validate(self, c)
+      class(machine_config), intent(in) :: self
+      type(config_checker), intent(inout) :: c
+
+      call check_integrator(self%solver, c)
+      call c%positive('machine', 'mass', self%mass, 'kg')
+      call c%finite('machine', 'mass', self%mass)
+      call c%nonnegative('machine', 'stiffness', self%stiffness, 'N/m')
+      call c%finite('machine', 'stiffness', self%stiffness)
+      call c%nonnegative('machine', 'damping', self%damping, 'N s/m')
+      call c%finite('machine', 'damping', self%damping)
+      call c%nonnegative('machine', 'normal', self%normal, 'N')
+      call c%finite('machine', 'normal', self%normal)
+      call c%finite('machine', 'belt_velocity', self%belt_velocity)
+      call c%finite('machine', 'load_velocity', self%load_velocity)
+      call c%nonnegative('machine', 'support_amplitude', self%support_amplitude, 'm')
+      call c%finite('machine', 'support_amplitude', self%support_amplitude)
+      call c%nonnegative('machine', 'support_frequency', self%support_frequency, 'Hz')
+      call c%finite('machine', 'support_frequency', self%support_frequency)
+      call c%finite('machine', 'x0', self%x0)
+      call c%finite('machine', 'v0', self%v0)
+      call c%finite('machine', 't_start', self%t_start)
+      call c%finite('machine', 't_end', self%t_end)
+      if (.not. (self%t_end > self%t_start)) call c%reject('machine', 't_end', rtoa(self%t_end), &
+         & 'must be after t_start = '//rtoa(self%t_start))
+      call c%positive('machine', 'dt_out', self%dt_out, 's')
+      call c%positive('machine', 'event_tolerance', self%event_tolerance, 's')
+      call c%positive('machine', 'stick_velocity', self%stick_velocity, 'm/s')
+      if (c%failed()) return
+      if ((self%t_end - self%t_start) / self%dt_out > 1.0e7_wp) call c%reject('machine', 'dt_out', &
+         & rtoa(self%dt_out), 'gives more than 1e7 output points over [t_start, t_end]')
+      call check_law(self%law, c)
+   end subroutine validate
+
+   pure integer function grid_size(self)
+      class(machine_config), intent(in) :: self
+
+      grid_size = int((self%t_end - self%t_start) / self%dt_out * (1.0_wp + 1.0e-9_wp) + 1.0e-9_wp) + 1
+   end function grid_size
+
+   pure real(wp) function grid_time(self, i)
+      class(machine_config), intent(in) :: self
+      integer, intent(in) :: i
+
+      grid_time = self%t_start + real(i - 1, wp) * self%dt_out
+   end function grid_time
+
+end module friction_machine_config

@@ -1,0 +1,71 @@
+!> The machine's file (docs/laws.md, "Mechanisms"; /machine).  Collective:
+!> every rank calls it with the same run (each computed it: a run is
+!> deterministic), and rank 0 writes the values.
+module friction_machine_output
+   use mpi_f08, only: MPI_Comm
+   use friction_kinds, only: wp
+   use friction_error, only: error_type
+   use friction_strings, only: join
+   use friction_output_h5, only: h5_file
+   use friction_output_parameters, only: write_parameter_attributes
+   use friction_output_summary, only: run_summary, write_run_attributes
+   use friction_machine_config, only: machine_config
+   use friction_machine_run, only: machine_run, event_kind_names
+   implicit none
+   private
+
+   public :: machine_summary, write_machine_file
+
+   type, extends(run_summary) :: machine_summary
+      real(wp) :: compute_time = 0.0_wp   !! s, the integration alone
+   end type machine_summary
+
+contains
+
+   subroutine write_machine_file(path, comm, config, run, summary, error)
+      character(len=*), intent(in) :: path
+      type(MPI_Comm), intent(in) :: comm
+      type(machine_config), intent(in) :: config
+      type(machine_run), intent(in) :: run
+      type(machine_summary), intent(in) :: summary
+      type(error_type), allocatable, intent(out) :: error
+      type(h5_file) :: file
+      type(error_type), allocatable :: close_error
+      type(machine_config) :: copy
+      character(len=32) :: codes(size(event_kind_names))
+      integer :: k, n
+
+      call file%create(path, comm, error)
+      if (allocated(error)) then
+         call file%close(close_error)
+         return
+      end if
+      call write_run_attributes(file, 'machine', trim(config%solver%method), summary)
+      call file%create_group('/machine')
+      call file%write_attribute_text('/machine', 'law', trim(config%law%model))
+      call file%write_attribute_real('/machine', 'compute_time', summary%compute_time, 's')
+      call file%write_attribute_real('/machine', 'stick_time', run%stick_time, 's')
+      call file%write_attribute_real('/machine', 'rtol', config%solver%rtol)
+      call file%write_attribute_real('/machine', 'atol', config%solver%atol)
+      copy = config
+      call write_parameter_attributes(file, '/machine', copy, [character(len=8) :: 'machine', 'law'])
+      call file%write_vector('/machine/t', run%t, 's')
+      call file%write_vector('/machine/x', run%x, 'm')
+      call file%write_vector('/machine/v', run%v, 'm/s')
+      call file%write_vector('/machine/force', run%force, 'N')
+      call file%write_vector_integer('/machine/stick', run%stick, '1')
+      if (run%n_states > 0) call file%write_vector('/machine/'//run%state_name, run%states(1, :), run%state_unit)
+      call file%create_group('/machine/events')
+      do k = 1, size(event_kind_names)
+         write (codes(k), '(i0, a)') k, ' = '//trim(event_kind_names(k))
+      end do
+      call file%write_attribute_text('/machine/events', 'kind_names', join(codes))
+      n = run%n_events
+      call file%write_vector('/machine/events/t', run%event_t(1:n), 's')
+      call file%write_vector_integer('/machine/events/kind', run%event_kind(1:n), '1')
+      call file%write_vector('/machine/events/x', run%event_x(1:n), 'm')
+      call file%write_vector('/machine/events/v', run%event_v(1:n), 'm/s')
+      call file%close(error)
+   end subroutine write_machine_file
+
+end module friction_machine_output

@@ -1,0 +1,257 @@
+!> One run of the machine (docs/laws.md, "Mechanisms"): the trajectory on
+!> the output grid and the stick/slip events.  Set-valued laws switch
+!> exactly between stick and slip as the brake's switched model does
+!> (located events; in stick v = belt_velocity exactly; a slip that ends
+!> beyond the static limit reverses); the other laws are one ODE with the
+!> law's states, and the output counts |w| <= stick_velocity as stick.
+module friction_machine_run
+   use friction_kinds, only: wp
+   use friction_error, only: error_type, fatal_error, error_numerical
+   use friction_strings, only: rtoa
+   use friction_ode_solver, only: ode_solver, integrator_statistics
+   use friction_ode_events, only: event_locator, event_falling
+   use friction_law, only: sliding_law, max_law_states
+   use friction_law_factory, only: make_law
+   use friction_machine_config, only: machine_config
+   use friction_machine_model, only: mechanics, machine_smooth, machine_slip, machine_stick
+   implicit none
+   private
+
+   public :: machine_run, run_machine
+   public :: event_stick_to_slip, event_slip_to_stick, event_slip_reversal, event_kind_names
+
+   integer, parameter :: event_stick_to_slip = 1, event_slip_to_stick = 2, event_slip_reversal = 3
+   character(len=*), parameter :: event_kind_names(3) = [character(len=12) :: 'stick_to_slip', 'slip_to_stick', &
+      & 'reversal']
+
+   type :: machine_run
+      integer :: n = 0                        !! grid points
+      real(wp), allocatable :: t(:), x(:), v(:), force(:), states(:, :)
+      integer, allocatable :: stick(:)
+      integer :: n_states = 0
+      character(len=:), allocatable :: state_name, state_unit
+      integer :: n_events = 0
+      real(wp), allocatable :: event_t(:), event_x(:), event_v(:)
+      integer, allocatable :: event_kind(:)
+      real(wp) :: stick_time = 0.0_wp         !! s in exact stick (set-valued laws)
+      type(integrator_statistics) :: stats
+   contains
+      procedure :: add_event
+   end type machine_run
+
+contains
+
+   subroutine add_event(self, t, kind, x, v)
+      class(machine_run), intent(inout) :: self
+      real(wp), intent(in) :: t, x, v
+      integer, intent(in) :: kind
+      real(wp), allocatable :: rt(:), rx(:), rv(:)
+      integer, allocatable :: rk(:)
+      integer :: n
+
+      n = self%n_events
+      if (n == size(self%event_t)) then
+         allocate (rt(2 * n + 16), rx(2 * n + 16), rv(2 * n + 16), rk(2 * n + 16))
+         rt(1:n) = self%event_t(1:n)
+         rx(1:n) = self%event_x(1:n)
+         rv(1:n) = self%event_v(1:n)
+         rk(1:n) = self%event_kind(1:n)
+         call move_alloc(rt, self%event_t)
+         call move_alloc(rx, self%event_x)
+         call move_alloc(rv, self%event_v)
+         call move_alloc(rk, self%event_kind)
+      end if
+      n = n + 1
+      self%event_t(n) = t
+      self%event_x(n) = x
+      self%event_v(n) = v
+      self%event_kind(n) = kind
+      self%n_events = n
+   end subroutine add_event
+
+   !> The whole run of checked settings c.
+   subroutine run_machine(c, run, error)
+      type(machine_config), intent(in) :: c
+      type(machine_run), intent(out) :: run
+      type(error_type), allocatable, intent(out) :: error
+      class(sliding_law), allocatable :: law
+      type(mechanics) :: m
+      integer :: n
+
+      call make_law(c%law, law, error)
+      if (allocated(error)) return
+      call m%from_config(c)
+      n = c%grid_size()
+      run%n = n
+      run%n_states = law%state_count()
+      allocate (run%t(n), run%x(n), run%v(n), run%force(n), run%states(max(run%n_states, 1), n), run%stick(n))
+      allocate (run%event_t(16), run%event_x(16), run%event_v(16), run%event_kind(16))
+      run%states = 0.0_wp
+      run%stick = 0
+      run%state_name = ''
+      run%state_unit = ''
+      if (run%n_states > 0) then
+         run%state_name = law%state_name(1)
+         run%state_unit = law%state_unit(1)
+      end if
+      if (law%set_valued()) then
+         call run_switched(c, law, m, run, error)
+      else
+         call run_smooth(c, law, m, run, error)
+      end if
+   end subroutine run_machine
+
+   subroutine run_smooth(c, law, m, run, error)
+      type(machine_config), intent(in) :: c
+      class(sliding_law), intent(in) :: law
+      type(mechanics), intent(in) :: m
+      type(machine_run), intent(inout) :: run
+      type(error_type), allocatable, intent(out) :: error
+      type(machine_smooth), target :: system
+      type(ode_solver) :: solver
+      real(wp) :: y(2 + max_law_states), t, z(max_law_states), h
+      integer :: i, k, ns
+
+      ns = law%state_count()
+      system%m = m
+      allocate (system%law, source=law)
+      system%n_states = ns
+      if (ns > 0) call law%state_scale(system%scale(1:ns))
+      h = c%solver%h_start
+      if (.not. (h > 0.0_wp)) h = 1.0e-6_wp * c%dt_out
+      call solver%init(system, c%solver, h, error)
+      if (allocated(error)) return
+      call solver%set_time_label('t', ' s')
+      z = 0.0_wp
+      if (ns > 0 .and. c%steady_start) call law%steady_state(c%v0 - m%belt, m%normal, z(1:ns))
+      y(1) = c%x0
+      y(2) = c%v0
+      y(3:2 + ns) = z(1:ns) / system%scale(1:ns)
+      t = c%t_start
+      do i = 1, run%n
+         if (i > 1) then
+            call solver%advance(t, c%grid_time(i), y(1:2 + ns), error)
+            if (allocated(error)) then
+               error%message = 'machine, '//trim(c%law%model)//' law: '//error%message
+               return
+            end if
+         end if
+         z(1:ns) = y(3:2 + ns) * system%scale(1:ns)
+         run%t(i) = c%grid_time(i)
+         run%x(i) = y(1)
+         run%v(i) = y(2)
+         run%force(i) = law%force(y(2) - m%belt, z(1:ns), m%normal, m%applied(run%t(i), y(1), y(2)))
+         do k = 1, ns
+            run%states(k, i) = z(k)
+         end do
+         if (abs(y(2) - m%belt) <= c%stick_velocity) run%stick(i) = 1
+      end do
+      run%stats = solver%statistics()
+   end subroutine run_smooth
+
+   !> Exact stick and slip for a set-valued law.
+   subroutine run_switched(c, law, m, run, error)
+      type(machine_config), intent(in) :: c
+      class(sliding_law), intent(in) :: law
+      type(mechanics), intent(in) :: m
+      type(machine_run), intent(inout) :: run
+      type(error_type), allocatable, intent(out) :: error
+      type(machine_slip), target :: slip
+      type(machine_stick), target :: stick
+      type(event_locator) :: slipping, sticking
+      real(wp) :: y(2), t, limit, a, h, none(0), t_grid
+      logical :: in_stick
+      integer :: i, which
+
+      limit = law%static_force(m%normal)
+      slip%m = m
+      allocate (slip%law, source=law)
+      stick%m = m
+      stick%limit = limit
+      h = c%solver%h_start
+      if (.not. (h > 0.0_wp)) h = 1.0e-6_wp * c%dt_out
+      call slipping%init(slip, c%solver, [event_falling], [.true.], c%event_tolerance, h, error, 't', ' s')
+      if (allocated(error)) return
+      call sticking%init(stick, c%solver, [event_falling, event_falling], [.true., .true.], c%event_tolerance, h, &
+         & error, 't', ' s')
+      if (allocated(error)) return
+      t = c%t_start
+      y = [c%x0, c%v0]
+      a = m%applied(t, y(1), y(2))
+      in_stick = y(2) == m%belt .and. abs(a) <= limit
+      if (in_stick) then
+         call sticking%restart(t, y, h)
+      else if (y(2) /= m%belt) then
+         call start_slip(sign(1.0_wp, y(2) - m%belt))
+      else
+         call start_slip(sign(1.0_wp, a))
+      end if
+      call record(1)
+      do i = 2, run%n
+         t_grid = c%grid_time(i)
+         do while (t < t_grid)
+            if (in_stick) then
+               block
+                  real(wp) :: t0
+                  t0 = t
+                  call sticking%advance(t, t_grid, y, error)
+                  run%stick_time = run%stick_time + (t - t0)
+               end block
+               if (allocated(error)) exit
+               y(2) = m%belt   ! exact in stick
+               if (sticking%n_hits == 0) cycle
+               which = sticking%hits(sticking%n_hits)%which
+               ! The applied force reached +limit (1) or -limit (2): slip that way.
+               in_stick = .false.
+               call start_slip(merge(1.0_wp, -1.0_wp, which == 1))
+               call run%add_event(t, event_stick_to_slip, y(1), y(2))
+            else
+               call slipping%advance(t, t_grid, y, error)
+               if (allocated(error)) exit
+               if (slipping%n_hits == 0) cycle
+               a = m%applied(t, y(1), m%belt)
+               if (abs(a) <= limit) then
+                  in_stick = .true.
+                  y(2) = m%belt   ! exact: the event left w within the tolerance of 0
+                  call sticking%restart(t, y, h)
+                  call run%add_event(t, event_slip_to_stick, y(1), y(2))
+               else
+                  call start_slip(sign(1.0_wp, a))
+                  call run%add_event(t, event_slip_reversal, y(1), y(2))
+               end if
+            end if
+         end do
+         if (allocated(error)) then
+            error%message = 'machine, '//trim(c%law%model)//' law: '//error%message
+            return
+         end if
+         call record(i)
+      end do
+      run%stats = slipping%statistics()
+      call run%stats%add(sticking%statistics())
+   contains
+      subroutine start_slip(s)
+         real(wp), intent(in) :: s
+
+         slip%direction = s
+         call slipping%restart(t, y, h)
+      end subroutine start_slip
+
+      subroutine record(i)
+         integer, intent(in) :: i
+         real(wp) :: applied
+
+         run%t(i) = t
+         run%x(i) = y(1)
+         run%v(i) = y(2)
+         applied = m%applied(t, y(1), y(2))
+         if (in_stick) then
+            run%force(i) = max(-limit, min(limit, applied))
+            run%stick(i) = 1
+         else
+            run%force(i) = law%slip_force(y(2) - m%belt, none, m%normal, slip%direction)
+         end if
+      end subroutine record
+   end subroutine run_switched
+
+end module friction_machine_run

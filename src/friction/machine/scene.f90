@@ -1,0 +1,181 @@
+!> The machine as a scene (docs/laws.md, "Mechanisms"): one degree of
+!> freedom with any friction law, the belt oscillator and the spring-slider.
+!> Every rank integrates the same run (it is deterministic and short), so
+!> the file does not depend on the number of ranks and nothing is broadcast.
+module friction_machine_scene
+   use friction_kinds, only: wp, i8
+   use friction_strings, only: fixed_text
+   use friction_error, only: error_type, fatal_error, error_input
+   use friction_version, only: version_string
+   use friction_clock, only: wall_seconds
+   use friction_parameters, only: parameter_visitor
+   use friction_checks, only: config_checker
+   use friction_scene, only: scene, point_result, point_memory
+   use friction_scene_report, only: job_reporter
+   use friction_scene_context, only: job_context, agree_on_error, ranks_text, job_wall_time
+   use friction_machine_config, only: machine_config
+   use friction_machine_run, only: machine_run, run_machine
+   use friction_machine_output, only: machine_summary, write_machine_file
+   implicit none
+   private
+
+   public :: machine_scene
+
+   type, extends(scene) :: machine_scene
+      type(machine_config) :: config
+      type(machine_run), private :: result
+      type(machine_summary), private :: record
+   contains
+      procedure :: name => machine_name
+      procedure :: groups => machine_groups
+      procedure :: visit => machine_visit
+      procedure :: check => machine_check
+      procedure :: method => machine_method
+      procedure :: run => machine_run_scene
+      procedure :: write_output => machine_write
+      procedure :: summary => machine_summary_text
+      procedure :: point_results => machine_point_results
+      procedure :: point_series => machine_point_series
+      procedure :: run_point => machine_run_point
+      procedure :: netlist => machine_netlist
+   end type machine_scene
+
+contains
+
+   function machine_name(self) result(name)
+      class(machine_scene), intent(in) :: self
+      character(len=:), allocatable :: name
+
+      name = 'machine'
+   end function machine_name
+
+   subroutine machine_groups(self, names)
+      class(machine_scene), intent(in) :: self
+      character(len=32), allocatable, intent(out) :: names(:)
+
+      names = [character(len=32) :: 'integrator', 'machine', 'law']
+   end subroutine machine_groups
+
+   subroutine machine_visit(self, v)
+      class(machine_scene), intent(inout) :: self
+      type(parameter_visitor), intent(inout) :: v
+
+      call self%config%visit(v)
+   end subroutine machine_visit
+
+   subroutine machine_check(self, checker)
+      class(machine_scene), intent(in) :: self
+      type(config_checker), intent(inout) :: checker
+
+      call self%config%validate(checker)
+   end subroutine machine_check
+
+   function machine_method(self) result(name)
+      class(machine_scene), intent(in) :: self
+      character(len=:), allocatable :: name
+
+      name = trim(self%config%solver%method)
+   end function machine_method
+
+   subroutine machine_run_scene(self, job, reporter, error)
+      class(machine_scene), intent(inout) :: self
+      type(job_context), intent(in) :: job
+      class(job_reporter), intent(inout) :: reporter
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: start
+
+      start = wall_seconds()
+      call run_machine(self%config, self%result, error)
+      self%record%compute_time = wall_seconds() - start
+      call agree_on_error(job, error)
+      if (allocated(error)) return
+      call reporter%progress(self%config%t_end - self%config%t_start, self%config%t_end - self%config%t_start, &
+         & 's', .true.)
+      self%record%stats = self%result%stats
+      self%record%input_text = job%input_text
+      self%record%version = version_string
+      self%record%nranks = job%nranks
+      self%record%wall_time = job_wall_time(job)
+   end subroutine machine_run_scene
+
+   subroutine machine_write(self, path, job, error)
+      class(machine_scene), intent(inout) :: self
+      character(len=*), intent(in) :: path
+      type(job_context), intent(in) :: job
+      type(error_type), allocatable, intent(out) :: error
+
+      call write_machine_file(path, job%comm, self%config, self%result, self%record, error)
+   end subroutine machine_write
+
+   function machine_summary_text(self, job) result(text)
+      class(machine_scene), intent(in) :: self
+      type(job_context), intent(in) :: job
+      character(len=:), allocatable :: text
+      character(len=200) :: line
+
+      write (line, '(a, i0, a, i0, a)') trim(self%config%law%model)//' law, ', self%result%n, &
+         & ' points to t = '//fixed_text(self%config%t_end, 2)//' s, ', self%result%n_events, ' events, ' &
+         & //fixed_text(self%record%wall_time, 3)//' s'
+      text = trim(line)//' '//ranks_text(job%nranks)
+   end function machine_summary_text
+
+   function machine_point_results(self) result(results)
+      class(machine_scene), intent(in) :: self
+      type(point_result), allocatable :: results(:)
+
+      results = [point_result('events', '1', .true.), point_result('stick_fraction', '1', .false.), &
+         & point_result('velocity_range', 'm/s', .false.), point_result('force_mean', 'N', .false.)]
+   end function machine_point_results
+
+   subroutine machine_point_series(self, name, unit)
+      class(machine_scene), intent(in) :: self
+      character(len=:), allocatable, intent(out) :: name, unit
+
+      name = 'maxima'
+      unit = 'm'
+   end subroutine machine_point_series
+
+   !> A sweep point: the run's events, the fraction of the output grid in
+   !> stick, the range of the velocity and the mean friction force over the
+   !> second half of the run (after a transient), and the local maxima of x
+   !> there (the bifurcation diagram).
+   subroutine machine_run_point(self, results, series, memory, error)
+      class(machine_scene), intent(inout) :: self
+      real(wp), intent(out) :: results(:)
+      real(wp), allocatable, intent(out) :: series(:)
+      type(point_memory), intent(inout) :: memory
+      type(error_type), allocatable, intent(out) :: error
+      type(machine_run) :: run
+      logical, allocatable :: peak(:)
+      integer :: j, half
+
+      results = 0.0_wp
+      call run_machine(self%config, run, error)
+      if (allocated(error)) return
+      half = run%n / 2 + 1
+      results(1) = run%n_events
+      results(2) = real(count(run%stick(half:) == 1), wp) / real(run%n - half + 1, wp)
+      results(3) = maxval(run%v(half:)) - minval(run%v(half:))
+      results(4) = sum(run%force(half:)) / real(run%n - half + 1, wp)
+      allocate (peak(run%n), source=.false.)
+      do j = max(2, half), run%n - 1
+         peak(j) = run%x(j) > run%x(j - 1) .and. run%x(j) >= run%x(j + 1)
+      end do
+      series = pack(run%x, peak)
+   end subroutine machine_run_point
+
+   !> No circuit form: the laws with states and the exact stick have no
+   !> SPICE element here.
+   subroutine machine_netlist(self, data_file, version, text, note, error)
+      class(machine_scene), intent(in) :: self
+      character(len=*), intent(in) :: data_file, version
+      character(len=:), allocatable, intent(out) :: text, note
+      type(error_type), allocatable, intent(out) :: error
+
+      text = ''
+      note = ''
+      call fatal_error(error, "scene 'machine': no netlist: the friction laws at the machine scale have no " &
+         & //"circuit form in this program (the brake's has one: &job scene = 'brake')", error_input)
+   end subroutine machine_netlist
+
+end module friction_machine_scene
