@@ -8,6 +8,11 @@ oracles computed here:
   rate-state-critical  a sweep of the spring-slider's stiffness finds the onset
                        of instability at k_c = N (b - a)/D_c (1 + m V^2/(N a D_c)),
                        without and with the inertial correction
+  bad-input            every refused law or machine value: exit code 3, the file,
+                       line, group and variable in the message, no file written
+  table-onset          a tabulated velocity-weakening law on the belt: a sweep of
+                       the damping finds the onset of growth where c = -dF/dv,
+                       the slope of the table's interpolant (SciPy's PCHIP)
 
     machine_oracles.py --binary build/friction --inputs inputs --workdir DIR CASE
 """
@@ -92,15 +97,85 @@ def rate_state_critical(args):
         assert abs(onset / expected - 1.0) < 0.01
 
 
+def table_onset(args):
+    # A table of 41 rows (10 a decade, 1e-3 to 10 m/s) sampled from F = 1 + 0.5 exp(-v/0.1) N; the
+    # block (1 kg, 10 N/m) slides steadily at w = -0.1 m/s on the belt, where the linearized motion
+    # is m x'' + (c + dF/dv) x' + k x = 0: it grows for c < -dF/dv.  The prediction's slope is
+    # SciPy's PchipInterpolator of (ln v, F) differentiated, not the program's.  The disturbance
+    # (1e-5 m) keeps |w - v_b| below 4e-5 m/s, where the slope changes by 1e-3 relative; the growth
+    # rate -(c + dF/dv)/2m is linear in c, and the steps of 2.5 % put the interpolated onset well
+    # inside the 2 % asked.
+    from scipy.interpolate import PchipInterpolator
+
+    work = Path(args.workdir)
+    v = np.logspace(-3.0, 1.0, 41)
+    force = 1.0 + 0.5 * np.exp(-v / 0.1)
+    table = work / "weakening.txt"
+    table.write_text("# v (m/s)  F (N)\n" + "".join(f"{float(a)!r} {float(b)!r}\n" for a, b in zip(v, force)))
+    belt, k, mass = 0.1, 10.0, 1.0
+    curve = PchipInterpolator(np.log(v), force)
+    level = float(curve(np.log(belt)))
+    slope = float(curve.derivative()(np.log(belt))) / belt
+    x_steady = level / k
+    dampings = -slope * np.arange(0.9, 1.11, 0.025)
+    rates = []
+    for c in dampings:
+        got = run(args, "table", ["machine_lugre.nml"],
+                  {"law.model": "'table'", "law.table_file": repr(str(table)), "machine.mass": mass,
+                   "machine.stiffness": k, "machine.damping": c, "machine.belt_velocity": belt,
+                   "machine.x0": x_steady + 1e-5, "machine.v0": 0.0, "machine.t_end": 30.0,
+                   "machine.dt_out": 0.01})
+        dx = got["x"] - x_steady
+        peaks = [i for i in range(1, dx.size - 1) if abs(dx[i]) >= abs(dx[i - 1]) and abs(dx[i]) > abs(dx[i + 1])]
+        rates.append(np.polyfit(got["t"][peaks], np.log(np.abs(dx[peaks])), 1)[0])
+        assert np.max(np.abs(got["v"])) < 1e-3, "the disturbance stays small (linear)"
+    rates = np.array(rates)
+    change = np.nonzero(np.diff(np.sign(rates)))[0]
+    assert change.size == 1 and rates[0] > 0 > rates[-1], rates
+    i = change[0]
+    onset = dampings[i] - rates[i] * (dampings[i + 1] - dampings[i]) / (rates[i + 1] - rates[i])
+    print(f"table-onset: onset at c = {onset:.5f} N s/m, -dF/dv of the table's interpolant {-slope:.5f} N s/m "
+          f"({onset / -slope - 1.0:+.2e}; the sampled law's own slope {0.5 / 0.1 * np.exp(-1.0):.5f})")
+    assert abs(onset / -slope - 1.0) < 0.02
+
+
+def bad_input(args):
+    work = Path(args.workdir)
+    (work / "decreasing.txt").write_text("# v F\n0.1 1.0\n0.05 2.0\n")
+    (work / "nan.txt").write_text("0.1 1.0\n0.2 nan\n")
+    cases = [  # (the group's lines, its line, what the message names, why)
+        ("&law\n  model = 'lugre'\n  sigma0 = -1.0e5\n/\n", 7, "&law: sigma0 = ", "must be > 0"),
+        ("&law\n  model = 'stribeck'\n  fs = 0.5\n/\n", 7, "&law: fs = ", "must be >= fc"),
+        ("&law\n  model = 'lugre'\n  vs = 0.0\n/\n", 7, "&law: vs = ", "must be > 0"),
+        ("&law\n  model = 'rate_state'\n  dc = 0.0\n/\n", 7, "&law: dc = ", "must be > 0"),
+        ("&law\n  model = 'table'\n  table_file = 'decreasing.txt'\n/\n", 7, "&law: table_file = ",
+         str(work / "decreasing.txt") + ":3: velocity"),
+        ("&law\n  model = 'table'\n  table_file = 'nan.txt'\n/\n", 7, "&law: table_file = ",
+         str(work / "nan.txt") + ":2: not a finite number"),
+        ("&machine\n  stiffness = -2.0\n/\n", 6, "&machine: stiffness = ", "must be >= 0"),
+        ("&law\n  model = 'bristles'\n/\n", 6, "&law: model = ", "unknown friction law"),
+    ]
+    for i, (group, line, names, why) in enumerate(cases):
+        path = work / f"bad{i}.nml"
+        path.write_text("! a refused value\n&job\n  scene = 'machine'\n/\n" + group)
+        out = work / f"bad{i}.h5"
+        result = subprocess.run([args.binary, "-o", str(out), str(path)], capture_output=True, text=True)
+        print(f"bad-input: exit {result.returncode}: {result.stderr.strip()}")
+        assert result.returncode == 3, result
+        assert f"{path}:{line}: {names}" in result.stderr and why in result.stderr, result.stderr
+        assert not out.exists()
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--binary", required=True)
     parser.add_argument("--inputs", required=True)
     parser.add_argument("--workdir", required=True)
-    parser.add_argument("case", choices=["lugre-radau", "rate-state-critical"])
+    parser.add_argument("case", choices=["lugre-radau", "rate-state-critical", "table-onset", "bad-input"])
     args = parser.parse_args()
     Path(args.workdir).mkdir(parents=True, exist_ok=True)
-    {"lugre-radau": lugre_radau, "rate-state-critical": rate_state_critical}[args.case](args)
+    {"lugre-radau": lugre_radau, "rate-state-critical": rate_state_critical,
+     "table-onset": table_onset, "bad-input": bad_input}[args.case](args)
     return 0
 
 
