@@ -180,7 +180,7 @@ static void check_set_get(friction_error *err) {
 
   /* unknown scenes, groups and variables; names that are not group.variable */
   CHECK(friction_config_new("gold", err) == NULL, "unknown scene");
-  expect_input_error(friction_error_status(err), err, "unknown scene 'gold' (known: 'afm', 'brake')", "scene");
+  expect_input_error(friction_error_status(err), err, "unknown scene 'gold' (known: 'afm', 'brake', 'machine')", "scene");
   expect_input_error(friction_config_set(cfg, "tip.mas", "1e-8", err), err, "&tip: unknown variable 'mas' (known:",
                      "unknown variable");
   expect_input_error(friction_config_set(cfg, "tips.mass", "1e-8", err), err, "unknown namelist group &tips",

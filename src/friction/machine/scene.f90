@@ -10,7 +10,7 @@ module friction_machine_scene
    use friction_clock, only: wall_seconds
    use friction_parameters, only: parameter_visitor
    use friction_checks, only: config_checker
-   use friction_scene, only: scene, point_result, point_memory
+   use friction_scene, only: scene, point_result, point_memory, result_sink
    use friction_scene_report, only: job_reporter
    use friction_scene_context, only: job_context, agree_on_error, ranks_text, job_wall_time
    use friction_machine_config, only: machine_config
@@ -37,6 +37,7 @@ module friction_machine_scene
       procedure :: point_results => machine_point_results
       procedure :: point_series => machine_point_series
       procedure :: run_point => machine_run_point
+      procedure :: compute => machine_compute
       procedure :: netlist => machine_netlist
    end type machine_scene
 
@@ -163,6 +164,35 @@ contains
       end do
       series = pack(run%x, peak)
    end subroutine machine_run_point
+
+   !> The run on this process into named arrays, as /machine holds them:
+   !> "t", "x", "v", "force", "stick", the law's state ("z", "theta") if it
+   !> has one, and "events/t", "events/kind", "events/x", "events/v".
+   subroutine machine_compute(self, sink, memory, reporter, error)
+      class(machine_scene), intent(inout) :: self
+      class(result_sink), intent(inout) :: sink
+      type(point_memory), intent(inout) :: memory
+      class(job_reporter), intent(inout) :: reporter
+      type(error_type), allocatable, intent(out) :: error
+      type(machine_run) :: run
+      integer :: n
+
+      call run_machine(self%config, run, error)
+      if (allocated(error)) return
+      call reporter%progress(self%config%t_end - self%config%t_start, self%config%t_end - self%config%t_start, &
+         & 's', .true.)
+      call sink%add('t', run%n, 1, run%t)
+      call sink%add('x', run%n, 1, run%x)
+      call sink%add('v', run%n, 1, run%v)
+      call sink%add('force', run%n, 1, run%force)
+      call sink%add('stick', run%n, 1, real(run%stick, wp))
+      if (run%n_states > 0) call sink%add(run%state_name, run%n, 1, run%states(1, :))
+      n = run%n_events
+      call sink%add('events/t', n, 1, run%event_t(1:n))
+      call sink%add('events/kind', n, 1, real(run%event_kind(1:n), wp))
+      call sink%add('events/x', n, 1, run%event_x(1:n))
+      call sink%add('events/v', n, 1, run%event_v(1:n))
+   end subroutine machine_compute
 
    !> No circuit form: the laws with states and the exact stick have no
    !> SPICE element here.
