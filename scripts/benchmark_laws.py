@@ -1,0 +1,142 @@
+#!/usr/bin/env python3
+"""The stiff friction laws as whole processes against SciPy's solve_ivp
+(Radau, LSODA) at equal accuracy: work-precision data, printed as a table.
+Not a test: the machine is shared and noisy, so each time is the median of
+--repeats runs, and the ratios are of medians measured in one run.
+
+  lugre       the LuGre paper's stick-slip (m = 1 kg, k = 2 N/m, belt 0.1 m/s,
+              Table I: sigma0 = 1e5 N/m), 30 s
+  rate_state  the spring-slider at k = 0.2 k_c (aging law, load point at
+              1e-6 m/s), 3000 s: the slip rate spans ten decades
+
+Accuracy: the largest difference in x on the output grid from a reference,
+the program at rtol 1e-12, relative to the range of x.  The program's time
+is its whole process (start, input, integration, HDF5 file); SciPy's is
+solve_ivp alone (the interpreter already running), with the Jacobian
+estimated by differences (its default).
+
+    scripts/benchmark_laws [--repeats N] [--quick]
+"""
+import argparse
+import multiprocessing
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import h5py
+import numpy as np
+from scipy.integrate import solve_ivp
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def program_run(binary, work, name, rtol, sets):
+    out = work / f"{name}.h5"
+    command = [str(binary), "--quiet", "--force", "-o", str(out), str(ROOT / "inputs" / f"machine_{name}.nml"),
+               "--set", f"integrator.rtol={rtol}", "--set", f"integrator.atol={rtol * 1e-3}"]
+    for key, value in sets.items():
+        command += ["--set", f"{key}={value}"]
+    start = time.perf_counter()
+    subprocess.run(command, check=True)
+    elapsed = time.perf_counter() - start
+    with h5py.File(out) as f:
+        return elapsed, f["machine/t"][:], f["machine/x"][:]
+
+
+def lugre_field():
+    m, k, vb, fc, fs, vs, s0, s1, s2 = 1.0, 2.0, 0.1, 1.0, 1.5, 1e-3, 1e5, np.sqrt(1e5), 0.4
+
+    def g(w):
+        return fc + (fs - fc) * np.exp(-(w / vs) ** 2)
+
+    def field(_, y):
+        x, v, z = y
+        w = v - vb
+        zdot = w - s0 * abs(w) * z / g(w)
+        return [v, (-k * x - (s0 * z + s1 * zdot + s2 * w)) / m, zdot]
+
+    return field, [0.0, 0.0, -g(-vb) / s0], 30.0, {}
+
+
+def rate_state_field():
+    mass, normal, a, b, dc, v0, mu0, velocity = 1.0, 1.0, 0.010, 0.015, 1e-5, 1e-6, 0.6, 1e-6
+    k = 0.2 * normal * (b - a) / dc
+
+    def field(t, y):
+        x, v, theta = y
+        psi = mu0 + b * np.log(v0 * max(theta, 1e-300) / dc)
+        big = np.log(max(abs(v), 1e-300) / (2.0 * v0)) + psi / a
+        mu = np.sign(v) * a * (big + np.log(2.0)) if big > 18.0 else a * np.arcsinh(np.sign(v) * np.exp(big))
+        return [v, (-k * (x - velocity * t) - normal * mu) / mass, 1.0 - abs(v) * theta / dc]
+
+    x0 = -mu0 * normal / k
+    sets = {"machine.stiffness": k, "machine.x0": x0, "machine.t_end": 3000.0, "machine.dt_out": 0.1}
+    return field, [x0, 1.01 * velocity, dc / (1.01 * velocity)], 3000.0, sets
+
+
+def _solve(queue, name, method, t, rtol):
+    field, y0, t_end, _ = {"lugre": lugre_field, "rate_state": rate_state_field}[name]()
+    start = time.perf_counter()
+    solution = solve_ivp(field, (0.0, t_end), y0, method=method, t_eval=t, rtol=rtol, atol=rtol * 1e-3)
+    queue.put((time.perf_counter() - start, solution.status, solution.message, solution.y[0]))
+
+
+def scipy_run(name, method, t, rtol, limit):
+    """solve_ivp in a child process, given up after `limit` s (Radau took
+    310 s to fail on the rate-and-state case at rtol 1e-5)."""
+    queue = multiprocessing.Queue()
+    child = multiprocessing.Process(target=_solve, args=(queue, name, method, t, rtol))
+    child.start()
+    try:
+        return queue.get(timeout=limit)
+    except Exception:
+        return limit, -2, f"gave up after {limit:g} s", None
+    finally:
+        child.join(timeout=1)
+        if child.is_alive():
+            child.kill()
+            child.join()
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--quick", action="store_true", help="fewer tolerances")
+    parser.add_argument("--binary", default=str(ROOT / "build" / "friction"))
+    parser.add_argument("--limit", type=float, default=60.0, help="seconds before a SciPy run is given up")
+    args = parser.parse_args()
+    tolerances = [1e-5, 1e-7] if args.quick else [1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9]
+    with tempfile.TemporaryDirectory() as scratch:
+        work = Path(scratch)
+        for name, make in (("lugre", lugre_field), ("rate_state", rate_state_field)):
+            _, _, t_end, sets = make()
+            _, t, reference = program_run(args.binary, work, name, 1e-12, sets)
+            scale = np.ptp(reference)
+            print(f"\n{name}: {t.size} grid points to t = {t_end:g} s; error = max |x - x_ref| / range of x")
+            print(f"{'method':10s} {'rtol':>8s} {'error':>10s} {'time (s)':>10s}")
+            for rtol in tolerances:
+                elapsed = []
+                for _ in range(args.repeats):
+                    seconds, _, x = program_run(args.binary, work, name, rtol, sets)
+                    elapsed.append(seconds)
+                print(f"{'friction':10s} {rtol:8.0e} {np.max(np.abs(x - reference)) / scale:10.2e} "
+                      f"{statistics.median(elapsed):10.4f}")
+            for method in ("Radau", "LSODA"):
+                for rtol in tolerances:
+                    runs = [scipy_run(name, method, t, rtol, args.limit) for _ in range(args.repeats)]
+                    seconds = statistics.median(run[0] for run in runs)
+                    _, status, message, x = runs[-1]
+                    if status != 0 or x is None or x.size != t.size:
+                        print(f"{method:10s} {rtol:8.0e} {'failed':>10s} {seconds:10.4f}  {message}")
+                        continue
+                    error = np.max(np.abs(x - reference)) / scale
+                    print(f"{method:10s} {rtol:8.0e} {error:10.2e} {seconds:10.4f}")
+            sys.stdout.flush()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
