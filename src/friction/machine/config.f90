@@ -18,7 +18,9 @@ module friction_machine_config
    use friction_ode_solver, only: solver_settings
    use friction_ode_settings, only: visit_integrator, check_integrator
    use friction_law_settings, only: law_settings
-   use friction_law_factory, only: check_law
+   use friction_law_factory, only: check_law, new_law
+   use friction_law, only: sliding_law
+   use friction_analysis_settings, only: analysis_settings
    implicit none
    private
 
@@ -48,12 +50,16 @@ module friction_machine_config
       real(wp) :: stick_velocity = 1.0e-6_wp !! m/s: |v - belt_velocity| below this counts as stick (smooth laws)
       type(law_settings) :: law
       type(solver_settings) :: solver = machine_solver_defaults
+      type(analysis_settings) :: analysis   !! &analysis: the spectrum and the Lyapunov exponent
    contains
       procedure :: visit
       procedure :: validate
       procedure :: grid_size
       procedure :: grid_time
    end type machine_config
+
+   character(len=*), parameter :: not_yet = "not computed for scene 'machine' (its &analysis has spectrum " &
+      & //'and lyapunov); the brake has it'
 
 contains
 
@@ -81,6 +87,7 @@ contains
       call v%item('stick_velocity', self%stick_velocity, 'm/s')
       call v%end_group()
       call self%law%visit(v)
+      call self%analysis%visit(v, 's')
    end subroutine visit
 
    subroutine validate(self, c)
@@ -115,6 +122,26 @@ contains
       if ((self%t_end - self%t_start) / self%dt_out > 1.0e7_wp) call c%reject('machine', 'dt_out', &
          & rtoa(self%dt_out), 'gives more than 1e7 output points over [t_start, t_end]')
       call check_law(self%law, c)
+      if (c%failed()) return
+      call self%analysis%validate(c, self%t_start, self%t_end, ['x', 'v'])
+      if (c%failed()) return
+      ! The machine's diagnostics so far: the spectrum, and Benettin's exponent for the laws that
+      ! are one ODE; the others are refused by name rather than ignored.
+      associate (a => self%analysis)
+         if (a%poincare) call c%reject('analysis', 'poincare', '.true.', not_yet)
+         if (a%lyapunov_spectrum) call c%reject('analysis', 'lyapunov_spectrum', '.true.', not_yet)
+         if (a%orbit) call c%reject('analysis', 'orbit', '.true.', not_yet)
+         if (a%rosenstein) call c%reject('analysis', 'rosenstein', '.true.', not_yet)
+         if (a%lyapunov) then
+            block
+               class(sliding_law), allocatable :: law
+               call new_law(self%law, law)
+               if (law%set_valued()) call c%reject('analysis', 'lyapunov', '.true.', "the machine's exponent " &
+                  & //"is computed for the laws that are one ODE; &law model = '"//trim(self%law%model) &
+                  & //"' switches between stick and slip (a smooth law: lugre, elastoplastic, dahl, rate_state, arctan, karnopp)")
+            end block
+         end if
+      end associate
    end subroutine validate
 
    pure integer function grid_size(self)

@@ -11,6 +11,7 @@ module friction_machine_output
    use friction_output_summary, only: run_summary, write_run_attributes
    use friction_machine_config, only: machine_config
    use friction_machine_run, only: machine_run, event_kind_names
+   use friction_machine_diagnostics, only: machine_diagnostics
    implicit none
    private
 
@@ -22,12 +23,13 @@ module friction_machine_output
 
 contains
 
-   subroutine write_machine_file(path, comm, config, run, summary, error)
+   subroutine write_machine_file(path, comm, config, run, summary, diagnostics, error)
       character(len=*), intent(in) :: path
       type(MPI_Comm), intent(in) :: comm
       type(machine_config), intent(in) :: config
       type(machine_run), intent(in) :: run
       type(machine_summary), intent(in) :: summary
+      type(machine_diagnostics), intent(in) :: diagnostics
       type(error_type), allocatable, intent(out) :: error
       type(h5_file) :: file
       type(error_type), allocatable :: close_error
@@ -65,6 +67,29 @@ contains
       call file%write_vector_integer('/machine/events/kind', run%event_kind(1:n), '1')
       call file%write_vector('/machine/events/x', run%event_x(1:n), 'm')
       call file%write_vector('/machine/events/v', run%event_v(1:n), 'm/s')
+      if (diagnostics%spectrum) then
+         associate (p => diagnostics%peak, a => config%analysis)
+            call file%create_group('/machine/spectrum')
+            call file%write_attribute_text('/machine/spectrum', 'series', trim(a%series))
+            call file%write_attribute_text('/machine/spectrum', 'window', trim(a%window))
+            call file%write_attribute_real('/machine/spectrum', 'window_start', a%window_start, 's')
+            call file%write_attribute_real('/machine/spectrum', 'window_end', a%window_end, 's')
+            call file%write_attribute_real('/machine/spectrum', 'peak_frequency', p%peak_frequency, 'Hz')
+            call file%write_attribute_real('/machine/spectrum', 'peak_amplitude', p%peak_amplitude)
+            call file%write_attribute_real('/machine/spectrum', 'resolution', p%resolution, 'Hz')
+            call file%write_vector('/machine/spectrum/frequency', p%frequency, 'Hz')
+            call file%write_vector('/machine/spectrum/amplitude', p%amplitude, merge('m  ', 'm/s', a%series == 'x'))
+         end associate
+      end if
+      if (diagnostics%lyapunov) then
+         associate (f => diagnostics%flow)
+            call file%create_group('/machine/lyapunov')
+            call file%write_attribute_real('/machine/lyapunov', 'exponent', f%current(), '1/s')
+            call file%write_attribute_real('/machine/lyapunov', 'd0', f%d0)
+            call file%write_vector('/machine/lyapunov/time', f%time(1:f%n), 's')
+            call file%write_vector('/machine/lyapunov/estimate', f%estimate(1:f%n), '1/s')
+         end associate
+      end if
       call file%close(error)
    end subroutine write_machine_file
 

@@ -16,6 +16,7 @@ module friction_machine_scene
    use friction_machine_config, only: machine_config
    use friction_machine_run, only: machine_run, run_machine
    use friction_machine_output, only: machine_summary, write_machine_file
+   use friction_machine_diagnostics, only: machine_diagnostics, diagnose_machine
    implicit none
    private
 
@@ -25,6 +26,7 @@ module friction_machine_scene
       type(machine_config) :: config
       type(machine_run), private :: result
       type(machine_summary), private :: record
+      type(machine_diagnostics), private :: diagnostics
    contains
       procedure :: name => machine_name
       procedure :: groups => machine_groups
@@ -54,7 +56,7 @@ contains
       class(machine_scene), intent(in) :: self
       character(len=32), allocatable, intent(out) :: names(:)
 
-      names = [character(len=32) :: 'integrator', 'machine', 'law']
+      names = [character(len=32) :: 'integrator', 'machine', 'law', 'analysis']
    end subroutine machine_groups
 
    subroutine machine_visit(self, v)
@@ -88,6 +90,7 @@ contains
       start = wall_seconds()
       call run_machine(self%config, self%result, error)
       self%record%compute_time = wall_seconds() - start
+      if (.not. allocated(error)) call diagnose_machine(self%config, self%result, self%diagnostics, error)
       call agree_on_error(job, error)
       if (allocated(error)) return
       call reporter%progress(self%config%t_end - self%config%t_start, self%config%t_end - self%config%t_start, &
@@ -105,7 +108,7 @@ contains
       type(job_context), intent(in) :: job
       type(error_type), allocatable, intent(out) :: error
 
-      call write_machine_file(path, job%comm, self%config, self%result, self%record, error)
+      call write_machine_file(path, job%comm, self%config, self%result, self%record, self%diagnostics, error)
    end subroutine machine_write
 
    function machine_summary_text(self, job) result(text)
@@ -125,7 +128,8 @@ contains
       type(point_result), allocatable :: results(:)
 
       results = [point_result('events', '1', .true.), point_result('stick_fraction', '1', .false.), &
-         & point_result('velocity_range', 'm/s', .false.), point_result('force_mean', 'N', .false.)]
+         & point_result('velocity_range', 'm/s', .false.), point_result('force_mean', 'N', .false.), &
+         & point_result('peak_frequency', 'Hz', .false.), point_result('lyapunov', '1/s', .false.)]
    end function machine_point_results
 
    subroutine machine_point_series(self, name, unit)
@@ -147,6 +151,7 @@ contains
       type(point_memory), intent(inout) :: memory
       type(error_type), allocatable, intent(out) :: error
       type(machine_run) :: run
+      type(machine_diagnostics) :: d
       logical, allocatable :: peak(:)
       integer :: j, half
 
@@ -158,6 +163,10 @@ contains
       results(2) = real(count(run%stick(half:) == 1), wp) / real(run%n - half + 1, wp)
       results(3) = maxval(run%v(half:)) - minval(run%v(half:))
       results(4) = sum(run%force(half:)) / real(run%n - half + 1, wp)
+      call diagnose_machine(self%config, run, d, error)
+      if (allocated(error)) return
+      if (d%spectrum) results(5) = d%peak%peak_frequency
+      if (d%lyapunov) results(6) = d%flow%current()
       allocate (peak(run%n), source=.false.)
       do j = max(2, half), run%n - 1
          peak(j) = run%x(j) > run%x(j - 1) .and. run%x(j) >= run%x(j + 1)
