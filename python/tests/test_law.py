@@ -82,3 +82,15 @@ def test_fit_recovers_the_stribeck_curve_of_lugre():
         assert abs(result.values[name] - value) < 4.0 * result.errors[name], (name, result.values, result.errors)
         assert result.errors[name] < 0.05 * value
     assert abs(np.std(result.residuals) / 2e-3 - 1.0) < 0.1
+
+
+def test_machine_scene_computes_through_the_c_api():
+    # The Coulomb belt oscillator (docs/laws.md, Mechanisms) through Config.compute: break-away at
+    # t = 2.5 s + n (1.5π + 2) s, the closed form's cycle, to the event tolerance and the integration's.
+    values = {"machine.stiffness": 1.0, "machine.belt_velocity": 0.2, "machine.v0": 0.2, "machine.t_end": 20.0,
+              "law.model": "coulomb", "law.mu": 0.3, "law.mu_s": 0.5}
+    with friction.Config("machine", values=values) as cfg:
+        run = cfg.compute()
+    breakaway = run["events/t"][run["events/kind"] == 1]
+    np.testing.assert_allclose(breakaway, 2.5 + np.arange(breakaway.size) * (1.5 * np.pi + 2.0), atol=1e-8)
+    assert breakaway.size == 3
