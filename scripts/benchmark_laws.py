@@ -15,7 +15,10 @@ is its whole process (start, input, integration, HDF5 file); SciPy's is
 solve_ivp alone (the interpreter already running), with the Jacobian
 estimated by differences (its default).
 
-    scripts/benchmark_laws [--repeats N] [--quick]
+    scripts/benchmark_laws [--repeats N] [--quick] [--limit S] [--chart FILE.png]
+
+--chart draws the work-precision chart of each case (time against error,
+one line per method) into FILE.png.
 """
 import argparse
 import multiprocessing
@@ -107,8 +110,10 @@ def main():
     parser.add_argument("--quick", action="store_true", help="fewer tolerances")
     parser.add_argument("--binary", default=str(ROOT / "build" / "friction"))
     parser.add_argument("--limit", type=float, default=60.0, help="seconds before a SciPy run is given up")
+    parser.add_argument("--chart", help="draw the work-precision charts into this PNG")
     args = parser.parse_args()
     tolerances = [1e-5, 1e-7] if args.quick else [1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9]
+    points = {}   # (case, method) -> [(error, seconds)]
     with tempfile.TemporaryDirectory() as scratch:
         work = Path(scratch)
         for name, make in (("lugre", lugre_field), ("rate_state", rate_state_field)):
@@ -122,8 +127,9 @@ def main():
                 for _ in range(args.repeats):
                     seconds, _, x = program_run(args.binary, work, name, rtol, sets)
                     elapsed.append(seconds)
-                print(f"{'friction':10s} {rtol:8.0e} {np.max(np.abs(x - reference)) / scale:10.2e} "
-                      f"{statistics.median(elapsed):10.4f}")
+                error = np.max(np.abs(x - reference)) / scale
+                points.setdefault((name, "friction"), []).append((error, statistics.median(elapsed)))
+                print(f"{'friction':10s} {rtol:8.0e} {error:10.2e} {statistics.median(elapsed):10.4f}")
             for method in ("Radau", "LSODA"):
                 for rtol in tolerances:
                     runs = [scipy_run(name, method, t, rtol, args.limit) for _ in range(args.repeats)]
@@ -133,9 +139,32 @@ def main():
                         print(f"{method:10s} {rtol:8.0e} {'failed':>10s} {seconds:10.4f}  {message}")
                         continue
                     error = np.max(np.abs(x - reference)) / scale
+                    points.setdefault((name, method), []).append((error, seconds))
                     print(f"{method:10s} {rtol:8.0e} {error:10.2e} {seconds:10.4f}")
             sys.stdout.flush()
+    if args.chart:
+        chart(points, args.chart)
     return 0
+
+
+def chart(points, path):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4))
+    for ax, (name, title) in zip(axes, (("lugre", "LuGre stick-slip, 30 s"),
+                                        ("rate_state", "rate and state spring-slider, 3000 s"))):
+        for method, style in (("friction", "o-"), ("Radau", "s--"), ("LSODA", "^:")):
+            data = sorted(points.get((name, method), []))
+            if data:
+                ax.loglog([e for e, _ in data], [s for _, s in data], style, label=method)
+        ax.set_xlabel("error in x / range of x")
+        ax.set_ylabel("time (s)")
+        ax.set_title(title)
+        ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
 
 
 if __name__ == "__main__":

@@ -5,7 +5,7 @@
 !> beyond the static limit reverses); the other laws are one ODE with the
 !> law's states, and the output counts |w| <= stick_velocity as stick.
 module friction_machine_run
-   use friction_kinds, only: wp
+   use friction_kinds, only: wp, i8
    use friction_error, only: error_type, fatal_error, error_numerical
    use friction_strings, only: rtoa
    use friction_ode_solver, only: ode_solver, integrator_statistics
@@ -111,6 +111,7 @@ contains
       type(ode_solver) :: solver
       real(wp) :: y(2 + max_law_states), t, z(max_law_states), h
       integer :: i, k, ns
+      integer(i8) :: clock_start, clock_now, clock_rate
 
       ns = law%state_count()
       system%m = m
@@ -128,12 +129,22 @@ contains
       y(2) = c%v0
       y(3:2 + ns) = z(1:ns) / system%scale(1:ns)
       t = c%t_start
+      call system_clock(clock_start, clock_rate)
       do i = 1, run%n
          if (i > 1) then
             call solver%advance(t, c%grid_time(i), y(1:2 + ns), error)
             if (allocated(error)) then
                error%message = 'machine, '//trim(c%law%model)//' law: '//error%message
                return
+            end if
+            ! &integrator max_wall_time, between grid points (the solver counts steps only).
+            if (c%solver%max_wall_time > 0.0_wp) then
+               call system_clock(clock_now)
+               if (real(clock_now - clock_start, wp) / real(clock_rate, wp) > c%solver%max_wall_time) then
+                  call fatal_error(error, 'machine, '//trim(c%law%model)//' law: more than max_wall_time = ' &
+                     & //rtoa(c%solver%max_wall_time)//' s at t = '//rtoa(t)//' s', error_numerical)
+                  return
+               end if
             end if
          end if
          z(1:ns) = y(3:2 + ns) * system%scale(1:ns)
