@@ -43,7 +43,7 @@ module friction_capi
    public :: friction_afm_line, friction_compute, friction_compute_progress, friction_result_get, &
       & friction_result_shape, friction_result_names, friction_result_free
    public :: friction_run_job, friction_run_config
-   !> For the C API's other files (capi_law.f90): the error handle's and the
+   !> For the C API's other files (capi/law.f90): the error handle's and the
    !> strings' helpers.
    public :: report, refuse, c_string, copy_text
 

@@ -77,7 +77,7 @@ FP_GUARDED(int, friction_run_config,
             friction_error *err),
            (cfg, output, flags, report, user, err))
 
-/* The friction laws (capi_law.f90). */
+/* The friction laws (capi/law.f90). */
 FP_GUARDED(friction_law *, friction_law_new, (const char *model, friction_error *err), (model, err))
 
 FP_GUARDED(int, friction_law_set, (friction_law *law, const char *name, const char *value, friction_error *err),
