@@ -85,6 +85,10 @@ module friction_afm_config
       ! &tip
       character(len=16) :: model = 'inertial'   !! 'inertial', 'overdamped' or 'quasistatic'
       real(wp) :: mass = 1.0e-8_wp     !! kg
+      !> whether mass was set (from a file, --set, a sweep or the C API): the
+      !> overdamped model has no mass, and its check of the damping ratio
+      !> uses only a mass given for the tip, never the default
+      logical :: mass_given = .false.
       real(wp) :: kx = 10.0_wp         !! N/m
       real(wp) :: ky = 10.0_wp         !! N/m
       real(wp) :: cx = 1.0e-3_wp       !! N s/m
@@ -145,6 +149,7 @@ contains
    subroutine visit(self, v)
       class(afm_config), intent(inout) :: self
       type(parameter_visitor), intent(inout) :: v
+      logical :: given
 
       call v%begin_group('surface')
       call v%item('potential', self%potential, fold=.true.)
@@ -169,7 +174,9 @@ contains
       call v%end_group()
       call v%begin_group('tip')
       call v%item('model', self%model, fold=.true.)
+      given = v%found
       call v%item('mass', self%mass, 'kg')
+      if (v%setting() .and. v%found .and. .not. given) self%mass_given = .true.
       call v%item('kx', self%kx, 'N/m')
       call v%item('ky', self%ky, 'N/m')
       call v%item('kz', self%kz, 'N/m')

@@ -50,7 +50,7 @@
 !> integrates the Langevin tip.
 module friction_afm_kramers
    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-   use friction_kinds, only: wp, pi
+   use friction_kinds, only: wp, i8, pi
    use friction_error, only: error_type, fatal_error, error_input, error_numerical
    use friction_strings, only: rtoa, itoa
    use friction_symmetric, only: symmetric_eigen, determinant
@@ -63,12 +63,15 @@ module friction_afm_kramers
    public :: landscape_energy, landscape_gradient, landscape_hessian
    public :: find_minimum, find_saddle, unstable_growth_rate, langer_rate, jump_landing
    public :: hazard_path, hazard_start, hazard_advance
-   public :: hazard_running, hazard_jumped, hazard_low_barrier, kmc_barrier_floor
+   public :: hazard_running, hazard_jumped, hazard_low_barrier, hazard_paused, kmc_barrier_floor
 
    !> hazard_advance's outcomes
    integer, parameter :: hazard_running = 0      !! t_end reached, no jump yet
    integer, parameter :: hazard_jumped = 1       !! ∫ r dt reached the target at t_event
    integer, parameter :: hazard_low_barrier = 2  !! the barrier fell to the floor at t_event
+   !> the wall clock passed the caller's `pause_at` between two steps; the
+   !> path is consistent at path%t and a call with the same arguments goes on
+   integer, parameter :: hazard_paused = 3
 
    !> Stationary points are converged when a Newton step is below this, Å.
    real(wp), parameter :: point_tolerance = 1.0e-11_wp
@@ -601,7 +604,12 @@ contains
    !> barrier_floor k_B T (default 3; status hazard_low_barrier, t_event
    !> where it does), or t_end (status hazard_running; call again to go on).
    !> max_log_change (default 0.1) bounds the change of ln r per step.
-   subroutine hazard_advance(tip, path, t_end, target, status, t_event, error, max_log_change, barrier_floor)
+   !> With pause_at (a count of the processor's system_clock), the path
+   !> returns hazard_paused between two steps once the clock has passed it,
+   !> so that its caller can look at its wall-time limit and stop requests:
+   !> a path near a degenerate saddle can take very many short steps.
+   subroutine hazard_advance(tip, path, t_end, target, status, t_event, error, max_log_change, barrier_floor, &
+      & pause_at)
       type(afm_tip), intent(in) :: tip
       type(hazard_path), intent(inout) :: path
       real(wp), intent(in) :: t_end, target
@@ -609,9 +617,11 @@ contains
       real(wp), intent(out) :: t_event
       type(error_type), allocatable, intent(out) :: error
       real(wp), intent(in), optional :: max_log_change, barrier_floor
+      integer(i8), intent(in), optional :: pause_at
       real(wp) :: change, floor, h, t1, u_min(3), u_saddle(3), barrier, log_rate, dh, s, tau
       real(wp) :: t_low, t_high, h_smallest
       logical :: ok, floor_reached
+      integer(i8) :: now
       integer :: n, k
 
       n = tip%ndim
@@ -634,6 +644,14 @@ contains
       end if
       h_smallest = 1.0e-14_wp * max(abs(path%t), abs(t_end), 1.0e-300_wp)
       do while (path%t < t_end)
+         if (present(pause_at)) then
+            call system_clock(now)
+            if (now >= pause_at) then
+               status = hazard_paused
+               t_event = path%t
+               return
+            end if
+         end if
          h = min(path%step, t_end - path%t)
          ! A step that keeps both points on their branches and ln r smooth.
          do

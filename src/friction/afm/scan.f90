@@ -38,16 +38,17 @@
 !> trajectory bit for bit as it is.
 module friction_afm_scan
    use friction_kinds, only: wp, i8, pi, ev_per_angstrom_to_nn
-   use friction_error, only: error_type, fatal_error, error_input, error_numerical
+   use friction_error, only: error_type, fatal_error, error_input, error_numerical, error_interrupted
    use friction_ode_solver, only: ode_solver, integrator_statistics
    use friction_afm_config, only: afm_config, new_tip_owning, surface_curvature
-   use friction_afm_tip, only: afm_tip, model_inertial, model_quasistatic, find_height
+   use friction_afm_tip, only: afm_tip, model_inertial, model_overdamped, model_quasistatic, find_height
    use friction_afm_thermal, only: welford_add, welford_sem
    use friction_afm_langevin, only: langevin_integrator, langevin_state, langevin_time_step, boltzmann
    use friction_afm_kramers, only: find_minimum, hazard_path, hazard_start, hazard_advance, jump_landing, &
-      & hazard_running, hazard_low_barrier, kmc_barrier_floor
+      & hazard_running, hazard_low_barrier, hazard_paused, kmc_barrier_floor
+   use friction_scene_report, only: job_reporter
    use friction_random, only: random_stream
-   use friction_afm_quasistatic, only: newton_equilibrium, equilibrium_tangent
+   use friction_afm_quasistatic, only: newton_equilibrium, equilibrium_tangent, force_imbalance
    use friction_surface_potential, only: surface_potential
    use friction_surface_lennard_jones, only: lj_potential
    use friction_strings, only: rtoa, itoa, bytes_text, fixed_text
@@ -96,6 +97,24 @@ module friction_afm_scan
    integer, parameter :: n_exits = 6
    real(wp), parameter :: exit_angle = 40.0_wp * pi / 180.0_wp, search_distance = 0.1_wp
    real(wp), parameter :: barrier_floor = kmc_barrier_floor
+   !> Wall time, s, between two looks at the stop request within a trip (the
+   !> C API's request is a call into the caller's code), and the Langevin
+   !> steps between two looks at the clock: at ~100 ns a step, ~10 ms.
+   real(wp), parameter :: stop_poll = 0.1_wp
+   !> The overdamped tip's slips at T = 0 (check_overdamped_slip): checked
+   !> where the support travels at most slow_travel Å in the tip's slowest
+   !> spring relaxation time c_i/k_i (then it lags its minimum by about that
+   !> much, and lands where the descent at a fixed support lands: the slow
+   !> limit), and from samples within check_lag Å of their minimum; two
+   !> minima are the same within same_minimum Å (below any well spacing of
+   !> NaF or HOPG); the descent's step, Å.
+   real(wp), parameter :: slow_travel = 2.5e-3_wp, check_lag = 0.05_wp, same_minimum = 0.25_wp
+   !> and how many times the time the slip takes from the fold (the
+   !> passage through the fold's bottleneck and the relaxation into the new
+   !> well, integrated by slip_duration) a tip may take to land
+   real(wp), parameter :: late_factor = 3.0_wp
+   real(wp), parameter :: descent_step = 0.01_wp
+   integer, parameter :: langevin_chunk = 100000
 
    !> One trip's samples: values(i, q) for sample i and quantity q (output units).
    type :: trip_record
@@ -134,6 +153,15 @@ module friction_afm_scan
       type(ode_solver) :: solver
       real(wp) :: h_start = 0.0_wp
       integer(i8) :: clock_start = 0, clock_rate = 1   !! wall clock at init, for max_wall_time
+      integer(i8) :: next_poll = 0                     !! clock count of the next look at `stopper`
+      !> kramers_trip_cost: the clock count at which its sample ends (0: none),
+      !> and the support time the sample reached
+      integer(i8) :: sample_end = 0
+      real(wp) :: reached = 0.0_wp
+      real(wp) :: sample_stop = 0.0_wp     !! and the support time at which it ends
+      !> asked within a trip whether the job should stop (a copy of the job's
+      !> reporter: its request is the process's, not the copy's); none: never
+      class(job_reporter), allocatable :: stopper
       real(wp) :: contact_height = 0.0_wp   !! z0: free tip's equilibrium height at the origin, Å (3D)
       real(wp) :: support_height = 0.0_wp   !! z_M = z0 + support_z, Å (3D)
       ! At a temperature (config%thermal)
@@ -155,9 +183,11 @@ module friction_afm_scan
       procedure :: run_thermal_trip
       procedure :: run_kramers_trip
       procedure :: kramers_escape_hazards
+      procedure :: kramers_trip_cost
       procedure :: run_line
       procedure :: time_step
       procedure :: statistics
+      procedure :: check_halt
       procedure, private :: follow
       procedure, private :: start_thermal_trip
       procedure, private :: start_height
@@ -460,22 +490,28 @@ contains
                      self%force_evaluations = self%force_evaluations + n + 1
                      done = done + n
                      if (.not. allocated(error)) call check_slips()
+                     if (.not. allocated(error) .and. done < self%sample_steps) &
+                        & call self%check_halt('Langevin', self%langevin%time_of(state), error)
                   end do
                else
-                  call self%langevin%advance(tip, self%stream, state, self%sample_steps, error)
-                  self%force_evaluations = self%force_evaluations + self%sample_steps + 1
+                  ! In chunks, the clock looked at between them (the same
+                  ! trajectory bit for bit: the steps do not depend on the calls).
+                  done = 0
+                  do while (done < self%sample_steps .and. .not. allocated(error))
+                     n = min(langevin_chunk, self%sample_steps - done)
+                     call self%langevin%advance(tip, self%stream, state, n, error)
+                     self%force_evaluations = self%force_evaluations + n + 1
+                     done = done + n
+                     if (.not. allocated(error) .and. done < self%sample_steps) &
+                        & call self%check_halt('Langevin', self%langevin%time_of(state), error)
+                  end do
                end if
                self%langevin_steps = self%langevin_steps + self%sample_steps
             else if (k == 1 .and. present(slips)) then
                call check_slips()
             end if
             t = self%langevin%time_of(state)
-            if (.not. allocated(error) .and. c%solver%max_wall_time > 0.0_wp) then
-               call system_clock(now)
-               if (real(now - self%clock_start, wp) / self%clock_rate > c%solver%max_wall_time) &
-                  & call fatal_error(error, 'Langevin: max_wall_time = '//rtoa(c%solver%max_wall_time) &
-                  & //' s reached at t = '//rtoa(t)//' s', error_numerical)
-            end if
+            if (.not. allocated(error)) call self%check_halt('Langevin', t, error)
             if (allocated(error)) then
                write (where, '(a, i0, a, i0, a, f0.4, a)') ' (line ', j, &
                   & trim(merge(' trace  ', ' retrace', forward))//', realization ', realization, &
@@ -648,6 +684,8 @@ contains
       type(hazard_path) :: paths(n_exits)
       real(wp) :: along(3), across(3), s_start, force(3), tip_r(3), t_sample, targets(n_exits), motion(3)
       real(wp) :: u_cur(3), u_next(3), t_cur, t_end, temperature, t_event, t_first, carried
+      !> support time of the last search; of the next, when an exit was dropped
+      real(wp) :: t_search, t_research, u_before(3)
       logical :: active(n_exits), need_search, probing
       integer(i8) :: now
       integer :: i, k, nx, nd, status, searches, p, first
@@ -665,6 +703,8 @@ contains
          t_cur = 0.0_wp
          call find_minimum(tip, t_cur, u_next(1:nd), u_cur(1:nd), error)
          need_search = .true.
+         t_search = t_cur
+         t_research = huge(1.0_wp)
          probing = present(jump_hazards)
          carried = 0.0_wp
          if (probing) allocate (jump_hazards(0))
@@ -682,6 +722,8 @@ contains
                      exit
                   end if
                   call start_exits()
+                  t_search = t_cur
+                  t_research = huge(1.0_wp)
                   need_search = .not. any(active)
                   if (need_search) then
                      t_end = min(t_sample, t_cur + search_distance / c%velocity)
@@ -690,17 +732,49 @@ contains
                      cycle
                   end if
                end if
-               ! Every clock on to the sample or to the first event so far.
-               t_first = t_sample
+               call self%check_halt('kramers', t_cur, error)
+               if (allocated(error)) exit
+               if (.not. any(active)) then
+                  ! Every exit dropped (below): the minimum alone up to the next search.
+                  t_end = min(t_sample, max(t_research, t_cur))
+                  u_before = u_cur
+                  call follow_minimum()
+                  if (allocated(error)) exit
+                  need_search = t_cur < t_sample .or. t_research <= t_sample &
+                     & .or. norm2(u_cur(1:nd) - u_before(1:nd)) > slip_distance
+                  cycle
+               end if
+               if (t_research <= t_cur) then
+                  need_search = .true.
+                  cycle
+               end if
+               ! Every clock on to the sample (or the search due) or to the first event so far.
+               t_first = min(t_sample, t_research)
                first = 0
                do p = 1, n_exits
                   if (.not. active(p)) cycle
-                  call hazard_advance(tip, paths(p), t_first, targets(p), status, t_event, error, &
-                     & barrier_floor=barrier_floor)
-                  self%hazard_steps = self%hazard_steps + paths(p)%steps
-                  paths(p)%steps = 0
+                  do
+                     call system_clock(now)
+                     call hazard_advance(tip, paths(p), t_first, targets(p), status, t_event, error, &
+                        & barrier_floor=barrier_floor, pause_at=now + int(stop_poll * self%clock_rate, i8))
+                     self%hazard_steps = self%hazard_steps + paths(p)%steps
+                     paths(p)%steps = 0
+                     if (allocated(error) .or. status /= hazard_paused) exit
+                     call self%check_halt('kramers', paths(p)%t, error)
+                     if (allocated(error)) exit
+                  end do
                   if (allocated(error)) exit
                   if (status == hazard_running) cycle
+                  if (status == hazard_low_barrier .and. paths(p)%barrier > 1.001_wp * barrier_floor &
+                     & * boltzmann * temperature .and. .not. (paths(p)%t > t_search)) then
+                     ! A saddle lost where it was found: at its own fold, where it
+                     ! merges with the minimum beyond it (a search from here finds
+                     ! it again, lost again at once).  Dropped; the exits are
+                     ! searched again search_distance of support travel on.
+                     active(p) = .false.
+                     t_research = min(t_research, t_search + search_distance / c%velocity)
+                     cycle
+                  end if
                   first = p
                   t_first = t_event
                   ! A saddle lost, not overcome: a new search from there.
@@ -708,6 +782,7 @@ contains
                      & * boltzmann * temperature) first = -p
                end do
                if (allocated(error)) exit
+               if (first == 0 .and. .not. any(active)) cycle
                if (first > 0) then
                   if (probing) call note_jump(sum(paths%hazard, mask=active))
                   call jump(paths(first), t_first)
@@ -718,16 +793,12 @@ contains
                   u_cur = paths(-first)%u_min
                   need_search = .true.
                else
-                  t_cur = t_sample
+                  t_cur = t_first
                   u_cur = paths(findloc(active, .true., 1))%u_min
+                  if (t_first < t_sample) need_search = .true.
                end if
             end do
-            if (.not. allocated(error) .and. c%solver%max_wall_time > 0.0_wp) then
-               call system_clock(now)
-               if (real(now - self%clock_start, wp) / self%clock_rate > c%solver%max_wall_time) &
-                  & call fatal_error(error, 'kramers: max_wall_time = '//rtoa(c%solver%max_wall_time) &
-                  & //' s reached at t = '//rtoa(t_cur)//' s', error_numerical)
-            end if
+            if (.not. allocated(error)) call self%check_halt('kramers', t_cur, error)
             if (allocated(error)) then
                error%message = error%message//' (line '//itoa(j)//trim(merge(' trace  ', ' retrace', forward)) &
                   & //', realization '//itoa(realization)//', support at '//fixed_text(c%velocity * t_cur, 4) &
@@ -859,6 +930,46 @@ contains
       call self%run_kramers_trip(0, .true., 0, record, error, jump_hazards=hazards)
    end subroutine kramers_escape_hazards
 
+   !> The computing time of one trip of the thermal reduced model, s,
+   !> estimated from a sample: line 0's trace (realization 0) over the
+   !> support travel `travel` Å (the lead-in and one period of the surface
+   !> along the scan: the jumps, where the time goes, come once per period),
+   !> its time scaled to the whole trip.  Where the jumps back and forth
+   !> (the thermolubric regime, their number growing as 1/(v c)) make the
+   !> sample longer than `budget` s of wall time, it ends there and the
+   !> estimate, scaled from the travel covered, is a lower bound (`lower`):
+   !> the part of a period before its slip costs least.  0 when the sample
+   !> fails.
+   function kramers_trip_cost(self, travel, budget, lower) result(cost)
+      class(afm_scanner), intent(inout) :: self
+      real(wp), intent(in) :: travel, budget
+      logical, intent(out) :: lower
+      real(wp) :: cost
+      type(trip_record) :: record
+      type(error_type), allocatable :: error
+      integer(i8) :: start, finish
+      real(wp) :: trip
+
+      cost = 0.0_wp
+      lower = .false.
+      trip = (self%config%length + self%config%lead_in) / self%config%velocity
+      call system_clock(start)
+      self%sample_end = start + int(budget * self%clock_rate, i8)
+      self%sample_stop = min(travel / self%config%velocity, trip)
+      self%reached = 0.0_wp
+      call self%run_kramers_trip(0, .true., 0, record, error)
+      self%sample_end = 0
+      call system_clock(finish)
+      cost = real(finish - start, wp) / self%clock_rate
+      if (.not. allocated(error)) return
+      if (error%stat /= error_interrupted .or. .not. (self%reached > 0.0_wp)) then
+         cost = 0.0_wp
+         return
+      end if
+      lower = self%reached < self%sample_stop
+      cost = cost * trip / self%reached
+   end function kramers_trip_cost
+
    subroutine slips_clear(self)
       class(slip_list), intent(inout) :: self
 
@@ -915,9 +1026,9 @@ contains
       type(trip_record), intent(inout) :: record
       type(error_type), allocatable, intent(out) :: error
       real(wp) :: along(3), across(3), line_start(3)
-      real(wp) :: y(6), t, t_sample, s_start, force(3), tip_r(3), u_z
-      integer(i8) :: now
-      integer :: i, k, nx, nd, jumps
+      real(wp) :: y(6), t, t_sample, s_start, force(3), tip_r(3), u_z, t_last, u_last(3), pending
+      integer :: i, k, nx, nd, jumps, i_last
+      logical :: checking
       character(len=96) :: where
 
       associate (c => self%config, tip => self%tip)
@@ -944,6 +1055,13 @@ contains
          end if
          t = 0.0_wp
          jumps = 0
+         ! The overdamped tip in its slow limit: its slips are checked.
+         checking = tip%model == model_overdamped .and. all(tip%spring(1:nd) > 0.0_wp)
+         if (checking) checking = c%velocity * maxval(tip%damping(1:nd) / tip%spring(1:nd)) <= slow_travel
+         t_last = -1.0_wp
+         pending = -1.0_wp
+         u_last = 0.0_wp
+         i_last = 0
          call self%solver%restart(self%h_start)
          if (tip%model == model_quasistatic) call self%relax(t, y(1:nd), error)
          if (.not. allocated(record%values)) then
@@ -960,11 +1078,14 @@ contains
             else
                if (t_sample > t) call self%solver%advance(t, t_sample, y(1:tip%dimension()), error)
             end if
-            if (.not. allocated(error) .and. c%solver%max_wall_time > 0.0_wp) then
-               call system_clock(now)
-               if (real(now - self%clock_start, wp) / self%clock_rate > c%solver%max_wall_time) &
-                  & call fatal_error(error, trim(c%solver%method)//': max_wall_time = ' &
-                  & //rtoa(c%solver%max_wall_time)//' s reached at t = '//rtoa(t)//' s', error_numerical)
+            if (.not. allocated(error)) call self%check_halt(trim(c%solver%method), t, error)
+            if (checking .and. t_last >= 0.0_wp .and. .not. allocated(error)) then
+               call check_overdamped_slip(tip, t_last, u_last(1:nd), t, y(1:nd), pending, error)
+               if (allocated(error)) error%message = 'overdamped tip at T = 0, between the samples at support ' &
+                  & //fixed_text(support_at(c, i_last - 1), 4)//' and '//fixed_text(support_at(c, i - 1), 4) &
+                  & //' Å: '//error%message//': an integration error of '//trim(c%solver%method)//' at rtol = ' &
+                  & //rtoa(c%solver%rtol)//', atol = '//rtoa(c%solver%atol)//" (&integrator): tighten them, or " &
+                  & //"use method = 'rodas4' or 'auto' (docs/physics.md, reduced tip models)"
             end if
             if (allocated(error)) then
                write (where, '(a, i0, a)') ' (line ', j, trim(merge(' trace  ', ' retrace', forward)) &
@@ -972,6 +1093,9 @@ contains
                error%message = error%message//trim(where)
                return
             end if
+            t_last = t
+            u_last(1:nd) = y(1:nd)
+            i_last = i
             force = tip%lateral_force(y) * ev_per_angstrom_to_nn
             tip_r = tip%tip_position(t, y)
             if (nd == 3) then
@@ -996,6 +1120,173 @@ contains
          end do
       end associate
    end subroutine run_trip
+
+   !> The overdamped tip at T = 0 from the sample (t0, u0) to the next, (t1,
+   !> u1), against the slow limit it follows: an error when it slipped
+   !> where that limit does not.  The overdamped tip lags behind its
+   !> minimum of the total energy E, on the side away from the saddle ahead
+   !> (at the minimum u' = -v_M, while the minimum moves forward), so it
+   !> cannot leave the minimum before the minimum ends at its fold; and
+   !> where the support hardly moves during a slip (slow_travel) it lands
+   !> where the descent at the support of the fold lands.  So: the minimum
+   !> of the tip at t0 is followed to t1 as the quasistatic model follows
+   !> it (continuation; at a fold, a push along the motion and the descent
+   !> of the overdamped flow, c u' = -grad E, at that support), and the tip
+   !> at t1 must be in that minimum.  An explicit pair at its stability
+   !> limit on a stiff tip lets the stiff component grow unseen until the
+   !> tip leaves a minimum that still exists; a stepper that steps over a
+   !> slip can land a site too far.  No claim (no error) where the tip is
+   !> mid-slip or lags at t0, or a descent does not settle.  The message
+   !> says what went wrong; the caller says where.
+   subroutine check_overdamped_slip(tip, t0, u0, t1, u1, pending, error)
+      type(afm_tip), intent(in) :: tip
+      real(wp), intent(in) :: t0, u0(:), t1, u1(:)
+      !> the support time by which the tip must have landed from a fold it
+      !> had not yet landed from at t0 (negative: none); on return, at t1
+      real(wp), intent(inout) :: pending
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: m(size(u0)), w(size(u0)), predicted(size(u0)), corrected(size(u0)), dudt(size(u0))
+      real(wp) :: motion(size(u0)), t, h, h_min, speed, deadline, ghost(size(u0))
+      logical :: ok, folded, last
+      integer :: steps, n
+
+      n = size(u0)
+      speed = norm2(tip%support_velocity(1:n))
+      if (.not. (speed > 0.0_wp)) return
+      call newton_equilibrium(tip, t0, u0, m, ok)
+      if (ok) ok = norm2(m - u0) <= check_lag
+      if (.not. ok) then
+         ! Mid-slip (no claim), or still on its way from a fold: the slow
+         ! limit is then where the descent from here lands.
+         if (pending < 0.0_wp) return
+         m = u0
+         call descend(t0, m, ok)
+         if (.not. ok) then
+            pending = -1.0_wp
+            return
+         end if
+      else
+         pending = -1.0_wp
+      end if
+      h_min = fold_resolution / speed
+      t = t0
+      h = t1 - t0
+      folded = pending >= 0.0_wp
+      deadline = merge(pending, huge(1.0_wp), folded)
+      pending = -1.0_wp
+      steps = 0
+      do while (t < t1)
+         steps = steps + 1
+         if (steps > 100000) return
+         last = t + h >= t1
+         if (last) h = t1 - t
+         call equilibrium_tangent(tip, t, m, dudt, ok)
+         if (.not. ok) dudt = 0.0_wp
+         predicted = m + h * dudt
+         call newton_equilibrium(tip, t + h, predicted, corrected, ok)
+         if (ok) ok = norm2(corrected - predicted) <= 0.5_wp * max(norm2(predicted - m), h * speed)
+         if (ok) then
+            t = merge(t1, t + h, last)
+            m = corrected
+            h = 2.0_wp * h
+         else if (h > h_min) then
+            h = 0.25_wp * h
+         else
+            motion = dudt + tip%support_velocity(1:n)
+            ghost = m
+            if (norm2(motion) > 0.0_wp) m = m + jump_push * motion / norm2(motion)
+            t = merge(t1, t + h, last)
+            call descend(t, m, ok)
+            if (.not. ok) return
+            if (.not. folded) deadline = t + late_factor * slip_duration(t, ghost, m)
+            folded = .true.
+            h = t1 - t
+         end if
+      end do
+      w = u1
+      call descend(t1, w, ok)
+      if (.not. ok) return
+      if (norm2(w - m) <= same_minimum) then
+         if (folded .and. norm2(u1 - m) > check_lag) then
+            if (t1 > deadline) then
+               call fatal_error(error, 'the tip had not slipped '//fixed_text(speed * (t1 - deadline), 4) &
+                  & //' Å of support travel after it should have landed from the fold of its minimum of the ' &
+                  & //'total energy ('//rtoa(late_factor)//' times the time the slip takes)', error_numerical)
+            else
+               pending = deadline
+            end if
+         end if
+         return
+      end if
+      if (folded) then
+         call fatal_error(error, 'the tip slipped into the minimum at '//fixed_text(norm2(w - m), 3) &
+            & //' Å from the one its slow limit reaches (a site skipped or a wrong landing)', error_numerical)
+      else
+         call fatal_error(error, 'the tip slipped out of its minimum of the total energy while that minimum ' &
+            & //'still existed (it can slip only where its minimum ends)', error_numerical)
+      end if
+
+   contains
+
+      !> The time the overdamped tip takes from the ghost of its minimum at
+      !> the fold (support time tf) to within check_lag of the minimum it
+      !> lands in (near `landing`), the support moving: explicit Euler on
+      !> the tip's own equation at a tenth of its stability limit (the
+      !> curvature of V from its Hessian at every step); huge when it does
+      !> not land within 1e6 steps (no claim).
+      real(wp) function slip_duration(tf, start, landing) result(duration)
+         real(wp), intent(in) :: tf, start(:), landing(:)
+         real(wp) :: u(size(start)), dudt(size(start)), hess(3, 3), minimum(size(start)), tt, dt
+         integer :: step
+         logical :: settled
+
+         u = start
+         tt = tf
+         duration = huge(1.0_wp)
+         do step = 1, 1000000
+            call tip%potential%hessian(tip%tip_position(tt, u), hess)
+            dt = 0.1_wp * minval(tip%damping(1:n)) / (maxval(tip%spring(1:n)) + norm2(hess(1:n, 1:n)))
+            call tip%rhs(tt, u, dudt)
+            u = u + dt * dudt
+            tt = tt + dt
+            if (mod(step, 64) == 0 .and. norm2(u - landing) <= same_minimum) then
+               call newton_equilibrium(tip, tt, u, minimum, settled)
+               if (settled .and. norm2(minimum - u) <= check_lag) then
+                  duration = tt - tf
+                  return
+               end if
+            end if
+         end do
+      end function slip_duration
+
+      !> u down the overdamped flow c u' = -grad E at the support of time
+      !> ts (normalised steps of descent_step: the flow's path, not its
+      !> time), into the minimum Newton's method then confirms.
+      subroutine descend(ts, u, settled)
+         real(wp), intent(in) :: ts
+         real(wp), intent(inout) :: u(:)
+         logical, intent(out) :: settled
+         real(wp) :: g(size(u)), d(size(u)), minimum(size(u))
+         integer :: iter
+
+         do iter = 0, 20000
+            if (mod(iter, 8) == 0) then
+               call newton_equilibrium(tip, ts, u, minimum, settled)
+               if (settled) settled = norm2(minimum - u) <= landing_distance
+               if (settled) then
+                  u = minimum
+                  return
+               end if
+            end if
+            g = force_imbalance(tip, ts, u)
+            d = -g / tip%damping(1:size(u))
+            if (.not. (norm2(d) > 0.0_wp)) exit
+            u = u + descent_step * d / norm2(d)
+         end do
+         settled = .false.
+      end subroutine descend
+
+   end subroutine check_overdamped_slip
 
    !> For a tip over a lattice sum: whether the tip at `r` is not above the
    !> atoms under it, i.e. less than half the smallest σ above the highest
@@ -1165,5 +1456,36 @@ contains
          stats%rhs_evaluations = stats%rhs_evaluations + self%force_evaluations
       end if
    end function statistics
+
+   !> An error when the trip must end here: the wall time since init has
+   !> passed &integrator max_wall_time (error_numerical, as before), or the
+   !> job's stopper, looked at every stop_poll s, asks to stop
+   !> (error_interrupted).  `what` names the scheme, t the support time.
+   subroutine check_halt(self, what, t, error)
+      class(afm_scanner), intent(inout) :: self
+      character(len=*), intent(in) :: what
+      real(wp), intent(in) :: t
+      type(error_type), allocatable, intent(inout) :: error
+      integer(i8) :: now
+
+      if (allocated(error)) return
+      call system_clock(now)
+      if (self%sample_end > 0 .and. (now >= self%sample_end .or. t >= self%sample_stop)) then
+         self%reached = t
+         call fatal_error(error, what//': the sample of the cost estimate ended', error_interrupted)
+         return
+      end if
+      associate (limit => self%config%solver%max_wall_time)
+         if (limit > 0.0_wp .and. real(now - self%clock_start, wp) / self%clock_rate > limit) then
+            call fatal_error(error, what//': max_wall_time = '//rtoa(limit)//' s reached at t = '//rtoa(t) &
+               & //' s', error_numerical)
+            return
+         end if
+      end associate
+      if (.not. allocated(self%stopper) .or. now < self%next_poll) return
+      self%next_poll = now + int(stop_poll * self%clock_rate, i8)
+      if (self%stopper%stop_requested()) call fatal_error(error, what//': stopped on request at t = '//rtoa(t) &
+         & //' s', error_interrupted)
+   end subroutine check_halt
 
 end module friction_afm_scan

@@ -158,9 +158,11 @@ contains
       integer(i8) :: counts(4)
       integer :: j, flag
       logical :: interrupted
+      integer(i8) :: probe_started
 
       self%ran = self%resolved()
       self%verify = afm_verify_record()
+      probe_started = 0
       associate (c => self%ran, map => self%map)
          ! The surface first, identically on every rank (its table, if any,
          ! built by all together): a bad net or defect is bad input,
@@ -174,6 +176,11 @@ contains
          ! The map's share of this rank, checked before it is allocated.
          call map%init(c, job, c%thermal%enabled(), error)
          if (.not. allocated(error)) call scanner%init_owning(c, potential, error)
+         ! Within a line too (a slow thermal line can take minutes): the
+         ! process's stop request, through a copy of the reporter.
+         if (.not. allocated(error)) allocate (scanner%stopper, source=reporter)
+         ! max_wall_time counts from the reduced model's probe, when there was one.
+         if (probe_started > 0) scanner%clock_start = probe_started
          if (.not. allocated(error) .and. scanner%thermal) then
             self%time_step = scanner%time_step()
             self%scheme = thermal_scheme(c)
@@ -196,7 +203,14 @@ contains
             if (.not. map%loaded(j)) then
                counts = scanner_counts()
                call scanner%run_line(map%global_line(j), line, error)
-               if (allocated(error)) exit
+               if (allocated(error)) then
+                  ! Stopped within the line: as between lines, the lines done kept.
+                  if (error%stat == error_interrupted) then
+                     interrupted = .true.
+                     deallocate (error)
+                  end if
+                  exit
+               end if
                call map%store(j, line, real(scanner_counts() - counts, wp))
                if (map%save_due()) call map%save_lines(j, error)
             end if
@@ -251,7 +265,7 @@ contains
 
          if (self%ran%moves_in_3d() .and. len(self%surface%evaluation%note) > 0) call reporter%note( &
             & "note: &surface evaluation = 'table': the direct sum instead: "//self%surface%evaluation%note)
-         warnings = afm_model_warnings(self%ran, potential)
+         warnings = afm_model_warnings(self%ran, potential, reporter, job%nranks, probe_started)
          start = 1
          do while (start <= len(warnings))
             end = index(warnings(start:), new_line('a'))

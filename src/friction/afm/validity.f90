@@ -2,13 +2,15 @@
 !> program warns, it does not refuse: a reduced model outside its limit
 !> still runs, and docs/speed.md shows what it costs in accuracy.
 module friction_afm_validity
-   use friction_kinds, only: wp, ev_per_angstrom_to_nn, deg_to_rad
+   use friction_kinds, only: wp, i8, ev_per_angstrom_to_nn, deg_to_rad
    use friction_error, only: error_type
-   use friction_afm_config, only: afm_config, new_tip
+   use friction_afm_config, only: afm_config, new_tip, tip_stiffness, surface_hopg
+   use friction_ode_auto, only: stiff_threshold
    use friction_afm_tip, only: afm_tip, model_inertial, model_overdamped, model_quasistatic
    use friction_afm_scan, only: find_height, afm_scanner
    use friction_surface_potential, only: surface_potential
    use friction_strings, only: rtoa, itoa, fixed_text
+   use friction_scene_report, only: job_reporter
    implicit none
    private
 
@@ -28,6 +30,18 @@ module friction_afm_validity
    !> 10 %, and is 12 standard errors low at 100 Å/s, where it is 36 %
    !> (70 % at 300 Å/s); the limit falls at 42 Å/s.
    real(wp), parameter :: forced_share_limit = 0.1_wp
+   !> thermal reduced model: the estimated computing time per process, s,
+   !> above which the program says so before the run (a minute: the
+   !> estimate's error is a factor of about 2, and below a minute a user
+   !> waits without being told)
+   real(wp), parameter :: kramers_cost_limit = 60.0_wp
+   !> the wall time, s, of the sample the estimate scales up (the rest of
+   !> the trip is extrapolated)
+   real(wp), parameter :: cost_sample = 5.0_wp
+   !> GSL's explicit steppers: on a stiff tip their steps are bound by
+   !> stability (docs/physics.md, reduced tip models)
+   character(len=*), parameter :: explicit_steppers(6) = [character(len=7) :: 'rk2', 'rk4', 'rkf45', 'rkck', &
+      & 'rk8pd', 'msadams']
 
 contains
 
@@ -43,9 +57,18 @@ contains
    !>     never settles);
    !>   overdamped: in some moving direction sqrt(m k)/c > 1 (the tip
    !>     overshoots after a slip, which needs inertia).
-   function afm_model_warnings(config, potential) result(text)
+   !>   thermal reduced model: above its velocity range (too many jumps
+   !>     forced at its barrier floor), or an estimated cost above
+   !>     kramers_cost_limit per process.
+   !> The reduced model's probe (a trip of line 0) honours max_wall_time and
+   !> the stop requests of `stopper`; `started` (the clock count at its
+   !> start, 0 without a probe) lets the run count its time from there.
+   function afm_model_warnings(config, potential, stopper, nranks, started) result(text)
       type(afm_config), intent(in) :: config
       class(surface_potential), intent(in) :: potential   !! the run's surface, built from config
+      class(job_reporter), intent(in), optional :: stopper
+      integer, intent(in), optional :: nranks             !! processes sharing the lines (default 1)
+      integer(i8), intent(out), optional :: started
       character(len=:), allocatable :: text
       real(wp) :: mass, spring(3), damping(3), drag, scale, settle, spacing, quality, theta
       integer :: nd, i
@@ -54,13 +77,18 @@ contains
       real(wp), allocatable :: hazards(:)   !! kramers_note's probe
 
       text = ''
+      if (present(started)) started = 0
       if (config%thermal%enabled() .and. config%thermal%reduced()) call kramers_note()
+      if (.not. config%thermal%enabled()) call stiff_note()
       if (config%tip_model() == model_inertial) return
       nd = merge(3, 2, config%moves_in_3d())
       mass = config%mass
       spring = [config%kx, config%ky, config%kz]
       damping = [config%cx, config%cy, config%cz]
       if (config%tip_model() == model_overdamped) then
+         ! (The overdamped model has no mass; the check needs the tip's own,
+         ! not the default of the inertial model.)
+         if (.not. config%mass_given) return
          axes = ''
          do i = 1, nd
             if (.not. (damping(i) > 0.0_wp)) cycle
@@ -69,8 +97,8 @@ contains
                & //fixed(quality, 2)//')'
          end do
          if (len(axes) > 0) call add('overdamped model with an underdamped tip: sqrt(m k)/c > ' &
-            & //fixed(quality_limit, 1)//' along '//axes(3:)//'; it overshoots after a slip, which the ' &
-            & //"overdamped model leaves out (use 'inertial')")
+            & //fixed(quality_limit, 1)//' along '//axes(3:)//' with &tip mass = '//rtoa(mass) &
+            & //" kg; it overshoots after a slip, which the overdamped model leaves out (use 'inertial')")
          return
       end if
       ! Quasistatic: drag against the surface force.
@@ -99,6 +127,24 @@ contains
 
    contains
 
+      !> An explicit stepper on a stiff tip (stiffness S = the largest decay
+      !> rate times the sample interval above stiff_threshold, where
+      !> method = 'auto' picks an implicit one): its steps hover at its
+      !> stability limit, where its error estimate can miss the growth of the
+      !> stiff component until the tip is pushed out of its well (measured
+      !> on the overdamped tip: slips a sample or two early at rtol 1e-3).
+      subroutine stiff_note()
+         real(wp) :: stiffness
+
+         if (config%tip_model() == model_quasistatic .or. .not. any(explicit_steppers == config%solver%method)) return
+         stiffness = tip_stiffness(config)
+         if (stiffness > stiff_threshold) call add("explicit stepper '"//trim(config%solver%method) &
+            & //"' on a stiff tip (stiffness "//speed(stiffness)//': its fastest decay rate times the sample ' &
+            & //'interval, above '//itoa(nint(stiff_threshold))//'): its steps are bound by stability, and at ' &
+            & //'loose tolerances its error control can let the tip slip early; use '//"method = 'auto' " &
+            & //"(rodas4 here) or tighter rtol and atol")
+      end subroutine stiff_note
+
       !> The thermal reduced model above its velocity range: too many of its
       !> jumps come at the floor, forced, instead of by thermal escape
       !> (afm_scanner%kramers_escape_hazards; a jump after hazard H is
@@ -106,11 +152,34 @@ contains
       subroutine kramers_note()
          type(afm_scanner) :: scanner
          type(error_type), allocatable :: error
-         real(wp) :: share, low, high, middle
+         real(wp) :: share, low, high, middle, cost, theta, period
+         logical :: lower
          integer :: k
 
          call scanner%init(config, potential, error)
-         if (.not. allocated(error)) call scanner%kramers_escape_hazards(hazards, error)
+         if (allocated(error)) return
+         if (present(started)) started = scanner%clock_start
+         if (present(stopper)) allocate (scanner%stopper, source=stopper)
+         ! (A probe stopped by max_wall_time or a request says nothing: the
+         ! run, which counts its time from the probe's start, stops at once.)
+         ! The cost first: a sample of one trip, scaled to the map.
+         ! The period along the scan: where the scan line first crosses a
+         ! line of the lattice (HOPG: its longer rectangular period, a√3).
+         theta = config%angle * deg_to_rad
+         if (config%surface_kind() == surface_hopg) then
+            period = sqrt(3.0_wp) * config%a
+         else
+            period = min(config%ax / max(abs(cos(theta)), 1.0e-12_wp), config%ay / max(abs(sin(theta)), 1.0e-12_wp))
+         end if
+         cost = scanner%kramers_trip_cost(config%lead_in + period, cost_sample, lower) * merge(2, 1, config%retrace) &
+            & * config%thermal%realizations * config%ny
+         if (present(nranks)) cost = cost / max(1, nranks)
+         if (cost > kramers_cost_limit) call add("thermal reduced model (&thermal model = 'kramers'): " &
+            & //trim(merge('at least', 'about   ', lower))//' '//itoa(nint(cost, i8))//' s of computing per ' &
+            & //'process for this map (from a sample of line 0): the jumps back and forth between ' &
+            & //'neighbouring minima, whose number grows as 1/(v c) (v the velocity, c the damping) in the ' &
+            & //'thermolubric regime, take the time; fewer realizations or lines, or a higher velocity, cost less')
+         call scanner%kramers_escape_hazards(hazards, error)
          if (allocated(error)) return
          if (size(hazards) == 0) return
          share = forced_share(1.0_wp)
@@ -133,7 +202,7 @@ contains
          call add("thermal reduced model (&thermal model = 'kramers') above its velocity range: " &
             & //itoa(nint(100 * share))//' % of its jumps on line 0 would come where the barrier has ' &
             & //'fallen to its 1 k_B T floor, forced, not by thermal escape (more than ' &
-            & //itoa(nint(100 * forced_share_limit))//' %; it holds below '//fixed(exp(high) * config%velocity, 1) &
+            & //itoa(nint(100 * forced_share_limit))//' %; it holds below '//speed(exp(high) * config%velocity) &
             & //" Å/s): its friction is then too low (use model = 'langevin')")
       end subroutine kramers_note
 
@@ -220,6 +289,23 @@ contains
       end do
       scale = scale * ev_per_angstrom_to_nn
    end function surface_force_scale
+
+   !> A velocity with two significant digits, no padding: 42.0, 3.1, 0.0042
+   !> (a fixed number of decimals gave 0.0 below 0.05 Å/s).
+   function speed(value) result(text)
+      real(wp), intent(in) :: value
+      character(len=:), allocatable :: text
+      character(len=32) :: buffer
+
+      if (value >= 10.0_wp) then
+         text = itoa(nint(value, i8))
+      else if (value >= 1.0_wp) then
+         text = fixed(value, 1)
+      else
+         write (buffer, '(es8.1)') value
+         text = trim(adjustl(buffer))
+      end if
+   end function speed
 
    !> A number with `digits` decimals, no padding.
    function fixed(value, digits) result(text)

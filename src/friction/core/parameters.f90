@@ -58,6 +58,7 @@ module friction_parameters
       !> A real list of any length (allocatable): a list given whole
       !> replaces it; an element past its end lengthens it.
       procedure :: real_list
+      procedure :: setting
       procedure, private :: wants, add_info, add_line, element_ok
    end type parameter_visitor
 
@@ -101,6 +102,14 @@ contains
       self%in_group = .false.
       self%group = ''
    end subroutine end_group
+
+   !> Whether the visitor sets a variable (a configuration that must know
+   !> which of its values were given compares `found` around an item).
+   logical function setting(self)
+      class(parameter_visitor), intent(in) :: self
+
+      setting = self%mode == mode_set
+   end function setting
 
    !> Whether this variable is the one to set or get.
    logical function wants(self, name)
@@ -221,6 +230,11 @@ contains
             read (self%text(from(k):to(k)), *, iostat=stat) value(max(1, self%first) + k - 1)
             if (stat /= 0) then
                self%problem = 'expected '//kind_text('r')
+               ! (A unit in the value, 10 nm/s, is a common slip: say which one counts.)
+               if (present(unit)) then
+                  if (len_trim(unit) > 0 .and. unit /= '1') self%problem = self%problem//' in '//trim(unit) &
+                     & //' (the unit is fixed: write the number alone, converted to it)'
+               end if
                return
             end if
             self%problem = range_problem(self%text(from(k):to(k)), value(max(1, self%first) + k - 1))
