@@ -23,7 +23,7 @@ module friction_capi
    use friction_strings, only: itoa, rtoa, join, quoted
    use friction_version, only: version_string
    use friction_parameters, only: parameter_info, list_parameters, set_parameter, set_parameter_number, &
-      & get_parameter, kind_text, value_has_kind
+      & get_parameter, kind_text, value_has_kind, unit_hint
    use friction_checks, only: config_checker
    use friction_input_reader, only: namelist_source, scan_files, apply_files, parse_variable_name
    use friction_scene, only: point_memory
@@ -433,8 +433,8 @@ contains
       work = config%job
       call resolve_name(work, full, group, name, first, info, error)
       if (.not. allocated(error) .and. .not. value_has_kind(value, info%kind)) &
-         & call fatal_error(error, '&'//group//': '//name//' = '//value//': expected '//kind_text(info%kind), &
-         & error_input)
+         & call fatal_error(error, '&'//group//': '//name//' = '//value//': expected '//kind_text(info%kind) &
+         & //unit_hint(info), error_input)
       if (allocated(error)) then
          status = report(handle, error)
          return

@@ -14,7 +14,7 @@ module friction_parameters
    implicit none
    private
 
-   public :: configurable, parameter_visitor, parameter_info
+   public :: configurable, parameter_visitor, parameter_info, unit_hint
    public :: list_parameters, set_parameter, set_parameter_number, get_parameter, parameters_text
    public :: kind_text, value_has_kind, split_name, max_list_values
 
@@ -102,6 +102,18 @@ contains
       self%in_group = .false.
       self%group = ''
    end subroutine end_group
+
+   !> For a value refused as not of its variable's kind: which unit counts,
+   !> for a real with one (a unit written in the value, `velocity = 10 nm/s`,
+   !> is a common slip and is not read); '' otherwise.
+   pure function unit_hint(info) result(text)
+      type(parameter_info), intent(in) :: info
+      character(len=:), allocatable :: text
+
+      text = ''
+      if (info%kind == 'r' .and. len_trim(info%unit) > 0 .and. info%unit /= '1') text = ' in '//trim(info%unit) &
+         & //' (the unit is fixed: write the number alone, converted to it)'
+   end function unit_hint
 
    !> Whether the visitor sets a variable (a configuration that must know
    !> which of its values were given compares `found` around an item).
@@ -230,11 +242,6 @@ contains
             read (self%text(from(k):to(k)), *, iostat=stat) value(max(1, self%first) + k - 1)
             if (stat /= 0) then
                self%problem = 'expected '//kind_text('r')
-               ! (A unit in the value, 10 nm/s, is a common slip: say which one counts.)
-               if (present(unit)) then
-                  if (len_trim(unit) > 0 .and. unit /= '1') self%problem = self%problem//' in '//trim(unit) &
-                     & //' (the unit is fixed: write the number alone, converted to it)'
-               end if
                return
             end if
             self%problem = range_problem(self%text(from(k):to(k)), value(max(1, self%first) + k - 1))

@@ -10,6 +10,7 @@ module friction_input_reader
    use friction_strings, only: itoa, join, one_line
    use friction_error, only: error_type, fatal_error, error_input
    use friction_parameters, only: configurable, parameter_info, set_parameter, list_parameters, kind_text, value_has_kind, &
+      & unit_hint, &
       & split_name
    use friction_checks, only: config_checker
    use friction_input_scan, only: mention, scan_namelist_file
@@ -187,7 +188,7 @@ contains
                end if
                if (.not. value_has_kind(m%value, universe(u)%kind)) then
                   call fatal_error(error, where//trim(m%name)//' = '//trim(one_line(m%value, 100))//': expected ' &
-                     & //kind_text(universe(u)%kind), error_input)
+                     & //kind_text(universe(u)%kind)//unit_hint(universe(u)), error_input)
                   return
                end if
             end associate
