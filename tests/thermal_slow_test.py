@@ -12,6 +12,8 @@ Cases:
   kramers-stop       SIGTERM ends a single-line reduced-model run within the line (exit 6)
   kramers-cost       the up-front cost estimate warns about that run, and not about a
                      cheap one
+  row                the one-dimensional row surface against NaF on its row of minima, and
+                     its reduced model against its Langevin tip at 300 K
   overdamped-slips   the overdamped tip at T = 0 on a stiff 1-D row: each stepper at its
                      default tolerances either gives the friction of a tight reference or
                      stops with the premature-slip error
@@ -203,6 +205,45 @@ def case_overdamped_slips(args):
             fail(f"{method} was expected to be flagged on this case")
 
 
+def case_row(args):
+    """&surface potential = 'row' (-V0 cos(2 pi x/ax), flat across) against NaF
+    on its row of minima (y = 0, where Eq. 1 is the row exactly and the tip
+    stays on it); at 300 K the reduced model against the Langevin tip on it."""
+    naf = os.path.join(args.inputs, "naf.nml")
+    one = write(args, "one.nml", "&scan ny = 1, width = 0.0 /\n")
+    row = write(args, "row.nml", "&surface potential = 'row' /\n")
+    tight = write(args, "tight.nml", "&integrator method = 'rk8pd', rtol = 1e-10, atol = 1e-10 /\n")
+    for model, extra, bound in (("quasistatic", [], 1e-12), ("inertial", [tight], 1e-9)):
+        files = []
+        for name, surface in (("naf", []), ("row", [row])):
+            out = f"{name}_{model}.h5"
+            run(args, "--quiet", "-o", out, naf, one, *surface, *extra, "--set", f"tip.model='{model}'")
+            files.append(os.path.join(args.workdir, out))
+        with h5py.File(files[0], "r") as a, h5py.File(files[1], "r") as b:
+            worst = max(np.max(np.abs(a[f"afm/{trip}/f_along"][()] - b[f"afm/{trip}/f_along"][()]))
+                        for trip in ("trace", "retrace"))
+            if np.any(b["afm/trace/tip_y"][()] != 0.0) or b["afm"].attrs["potential"] != b"row":
+                fail("the row's tip left y = 0 or the file does not name the row")
+        # The same equations to rounding (sin against the C library's sincos):
+        # 3e-15 nN measured quasistatic, 8.5e-13 nN inertial at rtol = atol = 1e-10.
+        if worst > bound:
+            fail(f"{model}: row and NaF's row of minima differ by {worst} nN (bound {bound})")
+        print(f"{model}: row against NaF's row, largest difference {worst:.1e} nN")
+    base = os.path.join(args.inputs, "naf_thermal_velocity.nml")
+    thermal = write(args, "thermal.nml", "&surface potential = 'row', ax = 2.46 /\n&scan ny = 1, velocity = 30.0 /\n"
+                    "&thermal realizations = 4 /\n")
+    results = {}
+    for model in ("kramers", "langevin"):
+        run(args, "--quiet", "-o", f"{model}.h5", base, thermal, "--set", f"thermal.model='{model}'")
+        with h5py.File(os.path.join(args.workdir, f"{model}.h5"), "r") as f:
+            results[model] = (float(f["afm/friction"][0]), float(f["afm/friction_sem"][0]))
+    (mk, sk), (ml, sl) = results["kramers"], results["langevin"]
+    # Measured 2.314 +- 0.052 against 2.250 +- 0.046 nN: 0.9 combined standard errors.
+    if abs(mk - ml) > 3.0 * np.hypot(sk, sl):
+        fail(f"on the row at 300 K: kramers {mk} +- {sk}, langevin {ml} +- {sl} nN, beyond 3 standard errors")
+    print(f"row at 300 K, 30 A/s: kramers {mk:.4f} +- {sk:.4f}, langevin {ml:.4f} +- {sl:.4f} nN")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--binary", required=True)
@@ -214,7 +255,7 @@ def main():
     os.makedirs(args.workdir)
     {"kramers-hang": case_kramers_hang, "kramers-wall-time": case_kramers_wall_time,
      "kramers-stop": case_kramers_stop, "kramers-cost": case_kramers_cost,
-     "overdamped-slips": case_overdamped_slips}[args.case](args)
+     "overdamped-slips": case_overdamped_slips, "row": case_row}[args.case](args)
     print("1 passed, 0 failed")
 
 

@@ -8,6 +8,7 @@ module friction_afm_config
    use friction_surface_potential, only: surface_potential
    use friction_surface_naf, only: new_naf_potential
    use friction_surface_hopg, only: new_hopg_potential
+   use friction_surface_row, only: new_row_potential
    use friction_surface_net, only: crystal_net, graphite_net, square_net, read_xyz, max_local_density, sort_order, &
       & net_lattice, graphite_lattice, square_lattice, detect_lattice
    use friction_surface_lennard_jones, only: lj_potential, new_lj_potential, cutoff_for_tolerance, table_settings
@@ -30,13 +31,14 @@ module friction_afm_config
    public :: afm_config, potential_names, net_names, tip_model_names, new_potential, new_tip, new_tip_owning, &
       & net_sites, max_species, max_defects, species_count, surface_curvature, thermal_step_limit, tip_stiffness, &
       & evaluation_names, surface_evaluation, table_energy_window, table_reach, scan_region, auto_method
-   public :: surface_naf, surface_hopg, surface_lattice_sum
+   public :: surface_naf, surface_hopg, surface_lattice_sum, surface_row
 
    !> &surface potential as a kind (afm_config's surface_kind): the analytic
-   !> NaF (Eq. 1) and HOPG (Eq. 2) surfaces, the Lennard-Jones lattice sum (Eq. 3).
-   integer, parameter :: surface_naf = 1, surface_hopg = 2, surface_lattice_sum = 3
+   !> NaF (Eq. 1) and HOPG (Eq. 2) surfaces, the Lennard-Jones lattice sum (Eq. 3),
+   !> a one-dimensional row -V0 cos(2πx/ax) (friction_surface_row).
+   integer, parameter :: surface_naf = 1, surface_hopg = 2, surface_lattice_sum = 3, surface_row = 4
 
-   character(len=*), parameter :: potential_names(3) = [character(len=4) :: 'naf', 'hopg', 'lj']
+   character(len=*), parameter :: potential_names(4) = [character(len=4) :: 'naf', 'hopg', 'lj', 'row']
    character(len=*), parameter :: net_names(3) = [character(len=8) :: 'graphite', 'square', 'file']
    !> &surface evaluation of a lattice sum: interpolated from a table of the
    !> perfect lattice (where it meets table_tolerance), or the direct sum.
@@ -533,6 +535,8 @@ contains
          allocate (potential, source=new_naf_potential(config%v0, config%ax, config%ay))
       case ('hopg')
          allocate (potential, source=new_hopg_potential(config%v0, config%a))
+      case ('row')
+         allocate (potential, source=new_row_potential(config%v0, config%ax))
       case ('lj')
          call new_net(config, atoms, error)
          if (allocated(error)) return
@@ -637,6 +641,8 @@ contains
          curvature = largest_curvature(potential, [0.0_wp, 0.0_wp], [config%ax, config%ay], 32)
       case ('hopg')
          curvature = largest_curvature(potential, [0.0_wp, 0.0_wp], [config%a, sqrt(3.0_wp) * config%a], 32)
+      case ('row')
+         curvature = largest_curvature(potential, [0.0_wp, 0.0_wp], [config%ax, config%ax], 32)
       case ('lj')
          curvature = 0.0_wp
          origin = [config%origin_x, config%origin_y, 0.0_wp]
@@ -771,6 +777,8 @@ contains
          kind = surface_hopg
       case ('lj')
          kind = surface_lattice_sum
+      case ('row')
+         kind = surface_row
       case default
          kind = surface_naf
       end select

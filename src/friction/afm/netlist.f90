@@ -8,7 +8,7 @@ module friction_afm_netlist
       & ns_per_m_to_internal
    use friction_error, only: error_type, fatal_error, error_input
    use friction_netlist_spice, only: nl, tolerances, control_end, num
-   use friction_afm_config, only: afm_config, surface_naf, surface_hopg
+   use friction_afm_config, only: afm_config, surface_naf, surface_hopg, surface_row
    use friction_afm_scan, only: line_offset
    implicit none
    private
@@ -36,6 +36,12 @@ contains
             & //'.param qy = '//num(2.0_wp * pi / c%ay)
          gradient_x = 'v0*qx*sin(qx*V(xt))*cos(qy*V(yt))'
          gradient_y = 'v0*qy*cos(qx*V(xt))*sin(qy*V(yt))'
+      case (surface_row)
+         surface = '* Surface: a one-dimensional row, V = -v0 cos(qx x), qx = 2 pi/ax.'//nl &
+            & //'.param v0 = '//num(c%v0)//nl &
+            & //'.param qx = '//num(2.0_wp * pi / c%ax)
+         gradient_x = 'v0*qx*sin(qx*V(xt))'
+         gradient_y = '0'
       case (surface_hopg)
          surface = '* Surface: HOPG, Eq. 2: V = -v0 [2 cos(qx x) cos(qy y) + cos(2 qy y)],'//nl &
             & //'* qx = 2 pi/a, qy = 2 pi/(a sqrt 3).'//nl &
