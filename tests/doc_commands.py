@@ -2,10 +2,11 @@
 """The commands of the documentation run as written (CTest: doc-commands).
 
 Reads README.md and docs/*.md and runs every fenced ```sh block, command by
-command, in a scratch directory set up like the repository root: symbolic
-links to the repository's top-level entries, the build directory as build/,
-and a copy of scripts/ (so that a script that finds the repository from its
-own resolved path finds the scratch directory and its build/).  The blocks of
+command, in a scratch directory set up like a fresh clone: a copy of the
+files git tracks (`git ls-files`; never the user's own outputs such as a
+hopg.h5 left by scripts/run-example) and the build directory linked as
+build/ (a script that finds the repository from its own resolved path finds
+the scratch directory and its build/).  The blocks of
 a page run in order in the page's own scratch directory; each block runs in a
 fresh bash, its commands one after another as typed into one shell.  A
 command that exits non-zero fails the test with the page and line.
@@ -218,16 +219,32 @@ def snapshot(source: Path, build: Path) -> dict[str, tuple[int, float]]:
     return result
 
 
+def tracked_files(source: Path) -> list[str]:
+    """The files of the source tree that git tracks, as they are in the working
+    tree (edits included, deleted files left out); without git (a source
+    archive), every file but hidden entries and build directories."""
+    try:
+        listed = subprocess.run(["git", "-C", str(source), "ls-files", "-z", "--cached"],
+                                capture_output=True, check=True).stdout.decode()
+        names = [n for n in listed.split("\0") if n]
+    except (OSError, subprocess.CalledProcessError):
+        names = []
+        for root, dirs, files in os.walk(source):
+            rel = Path(root).relative_to(source)
+            dirs[:] = [d for d in dirs if not d.startswith(".") and d != "__pycache__"
+                       and not (rel == Path(".") and d.startswith("build"))]
+            names += [str(rel / f) for f in files if not f.startswith(".")]
+    return [n for n in names if (source / n).is_file() or (source / n).is_symlink()]
+
+
 def make_scratch(source: Path, build: Path, parent: Path, name: str) -> Path:
+    """A copy of the tracked files (a file written by a command lands in the
+    copy, whatever the user keeps in the checkout) and build/ -> the build."""
     scratch = Path(tempfile.mkdtemp(prefix=f"{name}-", dir=parent))
-    for entry in source.iterdir():
-        if entry.name.startswith(".") or entry.name.startswith("build"):
-            continue
-        if entry.name == "scripts":
-            shutil.copytree(entry, scratch / "scripts", symlinks=True,
-                            ignore=shutil.ignore_patterns("__pycache__"))
-        else:
-            (scratch / entry.name).symlink_to(entry.resolve())
+    for rel in tracked_files(source):
+        dest = scratch / rel
+        dest.parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy2(source / rel, dest, follow_symlinks=False)
     (scratch / "build").symlink_to(build.resolve())
     return scratch
 
