@@ -13,7 +13,7 @@ endmacro()
 
 find_package(PFUNIT 4.14 QUIET)
 friction_test_tool(PFUNIT_FOUND "pFUnit 4.14" "not packaged by Debian: scripts/install-deps builds it \
-into .deps/pfunit-4.14.0/install; pass -DCMAKE_PREFIX_PATH=${PROJECT_SOURCE_DIR}/.deps/pfunit-4.14.0/install")
+with --tests into a per-user prefix outside the repository (scripts/pfunit-prefix prints it); pass -DCMAKE_PREFIX_PATH=<that prefix>")
 find_program(FRICTION_NGSPICE_EXECUTABLE ngspice DOC "ngspice, for the netlist tests")
 friction_test_tool(FRICTION_NGSPICE_EXECUTABLE "ngspice" "Debian package ngspice")
 find_program(FRICTION_GNUPLOT_EXECUTABLE gnuplot DOC "gnuplot, for the scripts tests")
