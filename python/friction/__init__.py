@@ -3,7 +3,7 @@ HOPG, graphite) to the machine scale (the Girling brake), in Python.
 
     import friction
 
-    path = friction.run("inputs/naf.nml", output="naf.h5", force=True)   # the program's job, with progress
+    path = friction.run(friction.input_file("naf.nml"), output="naf.h5", force=True)   # the job, with progress
     data = friction.load(path)                      # labelled arrays with units
     fig = friction.plot.afm_maps(data)              # the maps as a matplotlib Figure
 
@@ -16,7 +16,8 @@ HOPG, graphite) to the machine scale (the Girling brake), in Python.
 
 The computations go through the C API of the shared library libfriction
 (found as friction._capi.find_library says: FRICTION_LIBRARY, the
-installation, a build tree, the system's loader), loaded on first use:
+installation, the clone it was installed from, a build tree, the system's
+loader), loaded on first use:
 importing the package, load() and the plots need no library.
 Reference: docs/python.md.
 """
@@ -24,11 +25,13 @@ from . import _capi
 from ._capi import FrictionError, LibraryNotFoundError, api_version, library_path
 from ._data import Array, Attributes, Dataset, FileError, load
 from ._image import ImageError, MeasuredImage, read_image
+from ._inputs import input_file
 from ._run import Config, Line, afm_line, brake, compute, run
 from ._version import __version__
 
 __all__ = ["__version__", "library_version", "api_version", "library_path", "FrictionError",
-           "LibraryNotFoundError", "FileError", "read_image", "MeasuredImage", "ImageError", "Config", "Line", "run", "compute", "afm_line", "brake", "load",
+           "LibraryNotFoundError", "FileError", "read_image", "MeasuredImage", "ImageError", "input_file", "Config",
+           "Line", "run", "compute", "afm_line", "brake", "load",
            "Dataset", "Array", "Attributes", "plot", "fit", "law"]
 
 

@@ -34,10 +34,12 @@ from the first of (find_library):
   2. the library of the installation the package was installed into by
      `cmake --install` (PREFIX/share/friction/python/friction ->
      PREFIX/lib/libfriction.so.0, recorded in friction/_installed.py);
-  3. build/libfriction.so.0 of a build tree: the package's folder and each
+  3. the library of the build the package was installed from with pip
+     (the clone's build/libfriction.so.0, recorded in friction/_built.py);
+  4. build/libfriction.so.0 of a build tree: the package's folder and each
      folder above it are searched for build/ (python/friction in the
      repository -> the repository's build/);
-  4. the system's loader (LD_LIBRARY_PATH, ldconfig's cache): libfriction.so.0.
+  5. the system's loader (LD_LIBRARY_PATH, ldconfig's cache): libfriction.so.0.
 A library of another C API version is refused.
 """
 import ctypes
@@ -99,6 +101,16 @@ def _installed_candidates(package_dir):
     return found
 
 
+def _built_candidates(package_dir):
+    """The library of the build the package was installed from by pip (setup.py's record)."""
+    record = package_dir / "_built.py"
+    if not record.is_file():
+        return []
+    namespace = {}
+    exec(compile(record.read_text(), str(record), "exec"), namespace)  # our own generated file
+    return [("the build the package was installed from", namespace["LIBRARY"])] if namespace.get("LIBRARY") else []
+
+
 def library_candidates(environ=None, package_dir=None):
     """Where the library is looked for, in order: a list of (what, path).
 
@@ -108,7 +120,7 @@ def library_candidates(environ=None, package_dir=None):
     package_dir = Path(package_dir or _PACKAGE_DIR).resolve()
     if environ.get("FRICTION_LIBRARY"):
         return [("FRICTION_LIBRARY", environ["FRICTION_LIBRARY"])]
-    found = _installed_candidates(package_dir)
+    found = _installed_candidates(package_dir) + _built_candidates(package_dir)
     for folder in (package_dir, *package_dir.parents):
         found.append(("a build tree", str(folder / "build" / SONAME)))
     found.append(("the system's loader", SONAME))
