@@ -30,7 +30,7 @@ RANK = {folder: rank for rank, folders in enumerate(LAYERS) for folder in folder
 def fortran_files(top):
     for root, _, files in os.walk(top):
         for name in files:
-            if name.endswith((".f90", ".f90.in")):
+            if name.endswith((".f90", ".F90", ".f90.in", ".inc")):
                 yield os.path.join(root, name)
 
 
