@@ -11,9 +11,20 @@ macro(friction_test_tool found what remedy)
   endif()
 endmacro()
 
-find_package(PFUNIT 4.14 QUIET)
+# Besides CMAKE_PREFIX_PATH, where scripts/install-deps --tests puts pFUnit
+# (scripts/pfunit-prefix): FRICTION_PFUNIT_PREFIX, this clone's .deps/ of
+# older versions, and the per-user cache every clone shares, so that a plain
+# `cmake -S . -B build` finds it.
+if(DEFINED ENV{XDG_CACHE_HOME} AND NOT "$ENV{XDG_CACHE_HOME}" STREQUAL "")
+  set(friction_user_cache "$ENV{XDG_CACHE_HOME}")
+else()
+  set(friction_user_cache "$ENV{HOME}/.cache")
+endif()
+find_package(PFUNIT 4.14 QUIET HINTS $ENV{FRICTION_PFUNIT_PREFIX} ${PROJECT_SOURCE_DIR}/.deps/pfunit-4.14.0/install
+  "${friction_user_cache}/friction/pfunit-4.14.0-${CMAKE_Fortran_COMPILER_ID}-${CMAKE_Fortran_COMPILER_VERSION}")
 friction_test_tool(PFUNIT_FOUND "pFUnit 4.14" "not packaged by Debian: scripts/install-deps builds it \
-with --tests into a per-user prefix outside the repository (scripts/pfunit-prefix prints it); pass -DCMAKE_PREFIX_PATH=<that prefix>")
+with --tests into a per-user prefix outside the repository (scripts/pfunit-prefix prints it), where this \
+configuration looks; or configure with -DFRICTION_BUILD_TESTS=OFF for the program and the library alone")
 find_program(FRICTION_NGSPICE_EXECUTABLE ngspice DOC "ngspice, for the netlist tests")
 friction_test_tool(FRICTION_NGSPICE_EXECUTABLE "ngspice" "Debian package ngspice")
 find_program(FRICTION_GNUPLOT_EXECUTABLE gnuplot DOC "gnuplot, for the scripts tests")
