@@ -17,7 +17,8 @@ module friction_app_cli
    use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
    use mpi_f08
    use friction_error, only: error_type, error_input, error_io, error_interrupted
-   use friction_version, only: version_string
+   use friction_version, only: version_string, revision_string, compiler_string, hdf5_version_string, &
+      & gsl_version_string, fftw_version_string, cpu_target_string, table_kernels_string
    use friction_job, only: run_job, write_netlist, resolve_input, default_output
    use friction_clock, only: wall_seconds
    use friction_app_terminal_reporter, only: terminal_reporter
@@ -159,31 +160,84 @@ contains
          end do
       end function launcher_rank
 
+      !> The command line's arguments with bundled short options split, as
+      !> getopt does: -fq is -f -q, and -fqo FILE is -f -q -o FILE.  An
+      !> argument is split only where an option is expected (not the value of
+      !> -o, --output, --netlist or --set).  Returns -1, or the exit code of a
+      !> bundle that puts -o before other letters.
+      integer function split_arguments(argv, n) result(code)
+         character(len=:), allocatable, intent(out) :: argv(:)
+         integer, intent(out) :: n
+         character(len=:), allocatable :: arg
+         integer :: i, k, count, width, length
+         logical :: value_next
+
+         code = -1
+         count = command_argument_count()
+         width = 2
+         n = 0
+         do i = 1, count
+            call get_command_argument(i, length=length)
+            width = max(width, length)
+            n = n + max(1, length - 1)
+         end do
+         allocate (character(len=width) :: arg, argv(max(n, 1)))
+         n = 0
+         value_next = .false.
+         do i = 1, count
+            call get_command_argument(i, arg)
+            if (.not. value_next .and. is_bundle(arg)) then
+               do k = 2, len_trim(arg)
+                  if (arg(k:k) == 'o' .and. k < len_trim(arg)) then
+                     code = usage_error('in '//trim(arg)//', -o must come last (it takes the file name after it)')
+                     return
+                  end if
+                  n = n + 1
+                  argv(n) = '-'//arg(k:k)
+               end do
+               value_next = arg(len_trim(arg):len_trim(arg)) == 'o'
+            else
+               n = n + 1
+               argv(n) = arg
+               value_next = .not. value_next .and. any(trim(arg) == [character(len=9) :: '-o', '--output', &
+                  & '--netlist', '--set'])
+            end if
+         end do
+      end function split_arguments
+
+      !> A bundle of short options: a dash and two or more letters (-fq).
+      logical function is_bundle(arg)
+         character(len=*), intent(in) :: arg
+         integer :: k
+
+         is_bundle = len_trim(arg) > 2 .and. arg(1:1) == '-' .and. arg(2:2) /= '-'
+         do k = 2, len_trim(arg)
+            if (.not. is_bundle) return
+            is_bundle = verify(arg(k:k), 'abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ') == 0
+         end do
+      end function is_bundle
+
       !> Arguments; returns -1 to go on, else the exit code to finish with.
       integer function parse_arguments(opts) result(code)
          type(options), intent(inout) :: opts
-         character(len=:), allocatable :: arg
-         integer :: i, n, width, length
+         character(len=:), allocatable :: arg, argv(:)
+         integer :: i, n
 
-         code = -1
-         n = command_argument_count()
-         width = 1
-         do i = 1, n
-            call get_command_argument(i, length=length)
-            width = max(width, length)
-         end do
-         allocate (character(len=width) :: arg, opts%files(n), opts%sets(n))
+         code = split_arguments(argv, n)
+         if (code >= 0) return
+         allocate (character(len=len(argv)) :: arg)
+         allocate (character(len=len(argv)) :: opts%files(n), opts%sets(n))
          i = 0
          do while (i < n)
             i = i + 1
-            call get_command_argument(i, arg)
+            arg = argv(i)
             select case (trim(arg))
             case ('-h', '--help')
                if (rank == 0) call print_help()
                code = 0
                return
             case ('-V', '--version')
-               if (rank == 0) write (output_unit, '(a)') 'friction '//version_string
+               if (rank == 0) call print_version()
                code = 0
                return
             case ('-o', '--output')
@@ -192,7 +246,7 @@ contains
                   return
                end if
                i = i + 1
-               call get_command_argument(i, arg)
+               arg = argv(i)
                if (len_trim(arg) == 0) then
                   code = usage_error('option -o needs a file name, not an empty one')
                   return
@@ -204,7 +258,7 @@ contains
                   return
                end if
                i = i + 1
-               call get_command_argument(i, arg)
+               arg = argv(i)
                if (len_trim(arg) == 0 .or. arg(1:1) == '-') then
                   code = usage_error('option --netlist needs a file name (the SPICE netlist to write), not "' &
                      & //trim(arg)//'"')
@@ -217,7 +271,7 @@ contains
                   return
                end if
                i = i + 1
-               call get_command_argument(i, arg)
+               arg = argv(i)
                if (index(arg, '=') == 0) then
                   code = usage_error('option --set needs group.variable=value (e.g. --set tip.kx=12.5), not "' &
                      & //trim(arg)//'"')
@@ -295,12 +349,38 @@ contains
             & '                     (arctan law), or line 0 (trace) of a NaF or HOPG map;', &
             & '                     ngspice -b FILE writes FILE.data (docs/netlist.md)', &
             & '  -h, --help         this help', &
-            & '  -V, --version      the version', &
+            & '  -V, --version      the version, the compiler, MPI, HDF5, GSL and FFTW it was', &
+            & '                     built with, the source revision and the kernels chosen', &
+            & 'Short options bundle: -fq is -f -q; -fo FILE is -f -o FILE.', &
             & '', &
             & 'exit codes: 0 done, 2 usage, 3 bad input, 4 integration failed, 5 output failed,', &
             & '            6 interrupted (a sweep''s file written with the points done, a map''s', &
             & '            lines done checkpointed, --resume; a brake trajectory: nothing written)'
       end subroutine print_help
+
+      !> The version's first line as before (scripts read it), then what the
+      !> program was built with and what it chooses on this processor.  MPI's
+      !> is the library's own (MPI_Get_library_version may precede MPI_Init).
+      subroutine print_version()
+         character(len=MPI_MAX_LIBRARY_VERSION_STRING) :: mpi_text
+         character(len=:), allocatable :: cpu
+         integer :: length, cut
+
+         call MPI_Get_library_version(mpi_text, length)
+         mpi_text = mpi_text(1:max(0, min(length, len(mpi_text))))
+         cut = scan(mpi_text, new_line('a')//achar(0))
+         if (cut > 0) mpi_text = mpi_text(1:cut - 1)
+         cpu = cpu_target_string
+         if (len(cpu) == 0) cpu = 'the compiler''s default'
+         write (output_unit, '(a)') 'friction '//version_string, &
+            & '  revision     '//revision_string, &
+            & '  compiler     '//compiler_string//' (processor level: '//cpu//')', &
+            & '  MPI          '//trim(mpi_text), &
+            & '  HDF5         '//hdf5_version_string//' (parallel)', &
+            & '  GSL          '//gsl_version_string, &
+            & '  FFTW         '//fftw_version_string, &
+            & '  kernels      the surface table''s: '//table_kernels_string()
+      end subroutine print_version
 
       integer function exit_code(error)
          type(error_type), intent(in) :: error

@@ -486,7 +486,7 @@ def main(argv=None) -> int:
 
     try:
         version = subprocess.run([str(binary), "--version"], capture_output=True, text=True,
-                                 env=Friction(binary, [], Path()).env, timeout=60).stdout.strip()
+                                 env=Friction(binary, [], Path()).env, timeout=60).stdout.strip().split("\n")[0]
     except (OSError, subprocess.SubprocessError):
         version = "?"
     try:

@@ -536,7 +536,7 @@ def main(argv=None) -> int:
     fr = Friction(snapshot, workdir)
     try:
         version = subprocess.run([str(snapshot), "--version"], capture_output=True, text=True,
-                                 env=fr.env, timeout=60).stdout.strip()
+                                 env=fr.env, timeout=60).stdout.strip().split("\n")[0]
     except (OSError, subprocess.SubprocessError):
         version = "?"
     try:

@@ -33,7 +33,7 @@ TOLERANCE = 0.02      # relative, on each recovered parameter
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--check", action="store_true", help=f"fail unless within {TOLERANCE:.0%}")
+    parser.add_argument("--check", action="store_true", help=f"fail unless within {TOLERANCE:.0%}".replace("%", "%%"))   # argparse formats help with %
     args = parser.parse_args(argv)
 
     result, _ = friction.fit.example((TRUE["v0"], TRUE["k"]), (START["v0"], START["k"]), NOISE)

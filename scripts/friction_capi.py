@@ -9,6 +9,10 @@ library on first use, this module loads it on import, as it always did
 import sys
 from pathlib import Path
 
+if __name__ == "__main__":   # a module to import, not a command: say what it is
+    print(__doc__)
+    sys.exit(0)
+
 # The package beside the scripts: python/ in the repository, share/friction/python when installed.
 _PACKAGE = Path(__file__).resolve().parent.parent / "python"
 if _PACKAGE.is_dir():

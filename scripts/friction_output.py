@@ -7,6 +7,10 @@ friction.FileError (python/friction/_data.py).  InputError is FileError.
 import sys
 from pathlib import Path
 
+if __name__ == "__main__":   # a module to import, not a command: say what it is
+    print(__doc__)
+    sys.exit(0)
+
 _PACKAGE = Path(__file__).resolve().parent.parent / "python"
 if _PACKAGE.is_dir():
     sys.path.insert(0, str(_PACKAGE))

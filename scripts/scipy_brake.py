@@ -62,6 +62,9 @@ for event in (limit_up, limit_down):
 
 
 def main():
+    if len(sys.argv) == 2 and sys.argv[1] in ("-h", "--help"):
+        print(__doc__)
+        return 0
     if len(sys.argv) != 5:
         sys.exit("usage: scipy_brake.py RTOL ATOL T_END OUT.npy")
     rtol, atol, t_end = float(sys.argv[1]), float(sys.argv[2]), float(sys.argv[3])

@@ -2335,7 +2335,15 @@ def case_serial_no_mpi(args):
     with h5py.File(os.path.join(args.workdir, "serial.h5"), "r") as f:
         if f.attrs["nranks"] != 1 or f["brake/x"].size != 1001:
             fail(f"serial.h5: nranks {f.attrs['nranks']}, {f['brake/x'].size} samples (expected 1 and 1001)")
-    if leftovers(args) != ["brake.cir", "serial.h5"]:
+    # Bundled short options: -fqo FILE is -f -q -o FILE (overwrites, says nothing); -o must end a bundle;
+    # a word after -o is its file name even when it looks like a bundle.
+    quiet = program("-fqo", "serial.h5", brake, short, expect=0)
+    if quiet.stderr.strip() or quiet.stdout.strip():
+        fail(f"-fqo: not quiet: {quiet.stderr}{quiet.stdout}")
+    if "-o must come last" not in program("-ofq", "x.h5", brake, short, expect=2).stderr:
+        fail("-ofq: no usage error saying -o must come last")
+    program("-qo", "-fq", brake, short, expect=0)   # writes the file "-fq"
+    if leftovers(args) != ["-fq", "brake.cir", "serial.h5"]:
         fail(f"unexpected files: {leftovers(args)}")
 
 

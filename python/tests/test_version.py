@@ -23,8 +23,13 @@ def test_library_reports_the_packages_version(friction):
 
 
 def test_program_and_its_files_report_it(friction, program, naf_map):
-    out = helpers.run([program, "--version"]).stdout.strip()
-    assert out == f"friction {friction.__version__}"
+    out = helpers.run([program, "--version"]).stdout.strip().split("\n")
+    assert out[0] == f"friction {friction.__version__}"
+    # Then what it was built with and chose, one line each.
+    fields = {line.split()[0]: line.split(None, 1)[1] for line in out[1:]}
+    assert set(fields) == {"revision", "compiler", "MPI", "HDF5", "GSL", "FFTW", "kernels"}, out
+    assert "Fortran" in fields["compiler"] and "parallel" in fields["HDF5"]
+    assert fields["GSL"][0].isdigit() and fields["FFTW"][0].isdigit() and fields["MPI"], out
     with h5py.File(naf_map) as f:
         assert f.attrs["version"].decode() == friction.__version__
     assert friction.load(naf_map).version == friction.__version__

@@ -1,0 +1,78 @@
+#!/usr/bin/env python3
+"""Every script in scripts/ answers --help (and -h) without side effects.
+
+    scripts_help_test.py --scripts DIR --workdir DIR
+
+Each script (shell ones with bash, Python ones with python3; afm_maps.gp
+and C sources are not commands) runs with --help from an empty working
+directory (HOME elsewhere: matplotlib's font cache is not the script's doing), and a PATH whose first folder holds
+stand-ins for the programs a script would use to act: apt-get, sudo,
+dpkg-query, cmake, ninja, make, mpirun, mpiexec, srun, gfortran, ngspice,
+gnuplot, h5dump.  A stand-in records its call and fails.  The script must
+exit 0 within 60 s, print something, call no stand-in and leave the
+working directory empty.
+"""
+import argparse
+import os
+import shutil
+import stat
+import subprocess
+import sys
+from pathlib import Path
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from helpers import fail  # noqa: E402
+
+ACTING = ["apt-get", "sudo", "dpkg-query", "cmake", "ninja", "make", "mpirun", "mpiexec", "srun", "gfortran",
+          "ngspice", "gnuplot", "h5dump"]
+NOT_COMMANDS = {".gp", ".c"}
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--scripts", type=Path, required=True)
+    parser.add_argument("--workdir", type=Path, required=True)
+    args = parser.parse_args()
+    shutil.rmtree(args.workdir, ignore_errors=True)
+    stand_ins = args.workdir / "bin"
+    stand_ins.mkdir(parents=True)
+    calls = args.workdir / "calls.log"
+    for name in ACTING:
+        path = stand_ins / name
+        path.write_text(f"#!/bin/sh\necho \"{name} $*\" >> '{calls}'\nexit 97\n")
+        path.chmod(path.stat().st_mode | stat.S_IXUSR)
+    problems = []
+    scripts = sorted(p for p in args.scripts.iterdir() if p.is_file() and p.suffix not in NOT_COMMANDS)
+    for script in scripts:
+        first = script.read_text(errors="replace").split("\n", 1)[0]
+        interpreter = "python3" if "python" in first or script.suffix == ".py" else "bash"
+        for option in ("--help", "-h"):
+            cwd = args.workdir / "cwd"
+            shutil.rmtree(cwd, ignore_errors=True)
+            cwd.mkdir()
+            calls.unlink(missing_ok=True)
+            env = dict(os.environ, HOME=str(args.workdir / "home"), PATH=f"{stand_ins}{os.pathsep}{os.environ['PATH']}",
+                       MPLBACKEND="Agg", PYTHONDONTWRITEBYTECODE="1")
+            try:
+                result = subprocess.run([interpreter, str(script.resolve()), option], cwd=cwd, env=env,
+                                        capture_output=True, text=True, timeout=60)
+            except subprocess.TimeoutExpired:
+                problems.append(f"{script.name} {option}: still running after 60 s")
+                continue
+            where = f"{script.name} {option}"
+            if result.returncode != 0:
+                problems.append(f"{where}: exit {result.returncode}: {result.stderr.strip()[-300:]}")
+            elif not result.stdout.strip():
+                problems.append(f"{where}: printed nothing on stdout")
+            if calls.exists():
+                problems.append(f"{where}: ran {calls.read_text().strip()!r}")
+            left = sorted(str(p.relative_to(cwd)) for p in cwd.rglob("*"))
+            if left:
+                problems.append(f"{where}: left {left[:5]} in the working directory")
+    if problems:
+        fail(f"{len(problems)} problems:\n  " + "\n  ".join(problems))
+    print(f"{len(scripts)} scripts answer --help and -h without side effects")
+
+
+if __name__ == "__main__":
+    main()
