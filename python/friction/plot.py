@@ -434,6 +434,11 @@ def _describe_brake(run):
 
 
 def _window(run, window):
+    """The time window; None: the run's second half, which leaves out the
+    transient (about 1000 τ of the 3200 at the paper's parameters) so a
+    periodic orbit is drawn as the closed curve it is."""
+    if window is None:
+        window = (run["t"][0] + 0.5 * (run["t"][-1] - run["t"][0]), run["t"][-1])
     t0, t1 = window
     if not t0 < t1:
         raise ValueError("the window (t0, t1) needs t0 < t1")
@@ -442,10 +447,11 @@ def _window(run, window):
     return t0, t1
 
 
-def brake_phase(data, window=(100.0, 1000.0)):
-    """The phase plane (x, x') over the time window (the paper's Fig. 12,
-    tau in [100, 1000]); stick points in their own colour, the belt velocity
-    dashed."""
+def brake_phase(data, window=None):
+    """The phase plane (x, x') over the time window (default: the run's second
+    half, after the transient; the paper's Fig. 12 is tau in [100, 1000],
+    inside the transient); stick points in their own colour, the belt
+    velocity dashed."""
     run = _brake_run(data)
     t0, t1 = _window(run, window)
     inside = (run["t"] >= t0) & (run["t"] <= t1)
@@ -460,12 +466,13 @@ def brake_phase(data, window=(100.0, 1000.0)):
                label=f"belt velocity v'$_{{dr}}$ = {run['v_dr']:g}")
     ax.set_xlabel("x, block displacement (m)")
     ax.set_ylabel("x', block velocity (m per unit τ)")
-    ax.set_title(f"Phase plane, τ ∈ [{t0:g}, {t1:g}] (paper Fig. 12)\n{_describe_brake(run)}")
+    second_half = ", the run's second half: transient left out" if window is None else ""
+    ax.set_title(f"Phase plane, τ ∈ [{t0:g}, {t1:g}] (paper Fig. 12){second_half}\n{_describe_brake(run)}")
     ax.legend(loc="best", fontsize="small")
     return fig
 
 
-def brake_x(data, window=(100.0, 1000.0)):
+def brake_x(data, window=None):
     """x(tau): the whole run above, the last 30 tau of the window below, where
     stick shows as straight stretches of slope v'_dr."""
     run = _brake_run(data)
@@ -722,12 +729,22 @@ def _sweep(data):
         if "sweep_variable2" in data.attrs:
             s["variable2"] = str(data.attrs["sweep_variable2"])
             s["values2"] = np.ravel(data["sweep/values2"].values)
+        # Axis labels with the swept variables' units, which /sweep/values and values2 carry.
+        s["label"] = _with_unit(s["variable"], getattr(data["sweep/values"], "units", None))
+        if "variable2" in s:
+            s["label2"] = _with_unit(s["variable2"], getattr(data["sweep/values2"], "units", None))
     n = s["values"].size
     if any(s[key].size != n for key in keys if key != "maxima"):
         raise FileError("per-point datasets of different lengths")
     if s["scene"] == "brake" and s["maxima_count"].sum() != s["maxima"].size:
         raise FileError("maxima_count does not add up to the maxima")
     return s
+
+
+def _with_unit(name, unit):
+    """'brake.v_dr_prime (m/tau)'; a pure number's unit ('1', none) is not shown."""
+    unit = "" if unit is None else str(unit)
+    return f"{name} ({unit})" if unit and unit != "1" else name
 
 
 def _series(s):
@@ -766,11 +783,11 @@ def bifurcation(data):
         counts = np.where(mask, s["maxima_count"], 0)
         keep = np.repeat(mask, s["maxima_count"])
         parameter = np.repeat(s["values"], counts)
-        ax.plot(parameter, s["maxima"][keep], ",", color="k" if label is None else f"C{k}", alpha=0.6)
+        ax.plot(parameter, s["maxima"][keep], ".", markersize=2, color="k" if label is None else f"C{k}", alpha=0.6)
         if label is not None:
             ax.plot([], [], "o", color=f"C{k}", label=label)
     _mark_failed(ax, s)
-    ax.set_xlabel(s["variable"])
+    ax.set_xlabel(s["label"])
     ax.set_ylabel("local maxima of x after the transient (m)")
     ax.set_title("bifurcation diagram")
     if ax.get_legend_handles_labels()[0]:
@@ -792,7 +809,7 @@ def sweep_lyapunov(data):
         bottom.plot(s["values"][keep], s["stick_fraction"][keep], "o-", ms=3, color=f"C{k}")
     top.set_ylabel("Benettin exponent (1/τ)")
     bottom.set_ylabel("stick fraction")
-    bottom.set_xlabel(s["variable"])
+    bottom.set_xlabel(s["label"])
     if "values2" in s:
         top.legend(fontsize="small")
     fig.tight_layout()
@@ -839,8 +856,8 @@ def atlas(data):
     # The second variable varies fastest (docs/sweeps.md).
     v1 = s["values"].reshape(n1, n2)[:, 0]
     v2 = s["values2"].reshape(n1, n2)[0, :]
-    x, xlabel, xlog = _grid_axis(v2, s["variable2"])
-    y, ylabel, ylog = _grid_axis(v1, s["variable"])
+    x, xlabel, xlog = _grid_axis(v2, s["label2"])
+    y, ylabel, ylog = _grid_axis(v1, s["label"])
     done = (s["status"] == 1).reshape(n1, n2)
     fig = _figure(figsize=(7, 8.5))
     top, bottom = fig.subplots(2, 1, sharex=True)
@@ -890,7 +907,7 @@ def sweep_friction(data):
     top.set_ylabel("mean friction (nN)")
     top.set_title("half the width of the friction loop, over the map")
     bottom.set_ylabel("maximum lateral force (nN)")
-    bottom.set_xlabel(s["variable"])
+    bottom.set_xlabel(s["label"])
     if top.get_legend_handles_labels()[0]:
         top.legend(fontsize="small")
     fig.tight_layout()

@@ -81,6 +81,10 @@ def test_brake_pictures(brake_run, naf_map, tmp_path):
     inside = (t >= 100) & (t <= 300)
     assert np.array_equal(ax.lines[0].get_xdata(), data["brake/x"].values[inside])
     saved(phase, tmp_path / "phase.png")
+    # By default the run's second half: the transient (about 1000 τ of 3200 here) is left out.
+    default = friction.plot.brake_phase(data).axes[0]
+    assert "transient left out" in default.get_title()
+    assert np.array_equal(default.lines[0].get_xdata(), data["brake/x"].values[t >= t[0] + 0.5 * (t[-1] - t[0])])
     x = friction.plot.brake_x(data, window=(100, 300))
     assert f"{data['brake/events/t'].size} stick/slip events" in x.axes[0].get_title()
     saved(x, tmp_path / "x.png")
@@ -124,7 +128,7 @@ def test_sweep_pictures(brake_sweep, afm_sweep, tmp_path):
     figures = friction.plot.sweep(brake_sweep)
     assert set(figures) == {"bifurcation", "lyapunov"}
     bifurcation = figures["bifurcation"].axes[0]
-    assert bifurcation.get_title() == "bifurcation diagram" and bifurcation.get_xlabel() == "brake.v_dr_prime"
+    assert bifurcation.get_title() == "bifurcation diagram" and bifurcation.get_xlabel() == "brake.v_dr_prime (m/tau)"
     maxima = friction.load(brake_sweep)["sweep/maxima"]
     assert np.array_equal(np.sort(bifurcation.lines[0].get_ydata()), np.sort(maxima.values))
     for name, fig in figures.items():
@@ -149,7 +153,7 @@ def test_atlas(brake_atlas, brake_sweep, tmp_path):
     stick = data["sweep/stick_fraction"].values.reshape(3, 4)
     assert np.array_equal(np.asarray(bottom.collections[0].get_array()).reshape(3, 4), stick)
     # Negative log-spaced belt speeds are drawn as magnitudes on a log axis.
-    assert bottom.get_xscale() == "log" and bottom.get_xlabel() == "−brake.v_dr_prime"
+    assert bottom.get_xscale() == "log" and bottom.get_xlabel() == "−brake.v_dr_prime (m/tau)"
     assert top.get_yscale() == "linear" and top.get_ylabel() == "brake.mu"
     assert np.allclose(sorted(bottom.get_xlim()), [0.0005 / 2 ** 0.5, 0.004 * 2 ** 0.5], rtol=1e-9)
     saved(figures["atlas"], tmp_path / "atlas.png")

@@ -4,7 +4,8 @@ Reads one output file and writes two PNGs into the output directory
 (default: the current directory, like `friction` itself):
 
   <stem>_phase.png  the phase plane (x, x') over a time window, as in the
-                    paper's Fig. 12 (default window tau in [100, 1000]); stick
+                    paper's Fig. 12 (default: the run's second half, after the
+                    transient; the paper's window is --window 100 1000); stick
                     shows as the horizontal line x' = v'_dr, drawn in its own
                     colour from the file's stick flag, with the belt velocity
                     as a dashed line
@@ -45,16 +46,17 @@ def parse_args(argv):
         description=__doc__,
         formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("file", type=Path, help="friction output file (HDF5, scene 'brake')")
-    parser.add_argument("--window", type=float, nargs=2, default=(100.0, 1000.0),
+    parser.add_argument("--window", type=float, nargs=2, default=None,
                         metavar=("T0", "T1"),
-                        help="time window of the phase plane (default: 100 1000, as Fig. 12)")
+                        help="time window of the phase plane (default: the run's second half, after the "
+                             "transient; 100 1000 is the paper's Fig. 12)")
     parser.add_argument("-o", "--output-dir", type=Path, default=Path("."), metavar="DIR",
                         help="directory for the PNGs, created if missing (default: .)")
     parser.add_argument("--dpi", type=int, default=150, help="resolution (default: %(default)s)")
     args = parser.parse_args(argv)
     if args.dpi <= 0:
         parser.error("--dpi must be positive")
-    if not args.window[0] < args.window[1]:
+    if args.window is not None and not args.window[0] < args.window[1]:
         parser.error("--window T0 T1 needs T0 < T1")
     return args
 
