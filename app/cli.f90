@@ -93,6 +93,7 @@ contains
             comm = MPI_COMM_WORLD
             call MPI_Comm_rank(comm, rank)
          end if
+         call warn_lone_tasks(comm)
          if (.not. allocated(opts%output)) opts%output = default_output(opts%files(1))
          call run_job(opts%files(1:opts%nfiles), opts%output, opts%force, opts%resume, comm, reporter, summary, &
             & error, overrides=opts%sets(1:opts%nsets))
@@ -131,6 +132,28 @@ contains
             if (stat == 0) launched = .true.
          end do
       end function launched
+
+      !> Slurm started this step with several tasks (SLURM_STEP_NUM_TASKS > 1)
+      !> but they are not one MPI job here (no MPI launch reached the process, or
+      !> MPI_Init made each a job of one: a plain srun where the site's MPI needs
+      !> --mpi=pmix): each task would compute the whole job alone and write the
+      !> same output.  Task 0 says so; the run goes on as asked.
+      subroutine warn_lone_tasks(comm)
+         type(MPI_Comm), intent(in) :: comm
+         character(len=32) :: text
+         integer :: tasks, ranks, length, stat
+
+         call get_environment_variable('SLURM_STEP_NUM_TASKS', text, length, stat)
+         if (stat /= 0 .or. length == 0) return
+         read (text, *, iostat=stat) tasks
+         if (stat /= 0 .or. tasks <= 1) return
+         ranks = 1
+         if (comm /= MPI_COMM_NULL) call MPI_Comm_size(comm, ranks)
+         if (ranks > 1 .or. launcher_rank() /= 0) return
+         write (error_unit, '(a,i0,a)') 'friction: warning: Slurm started ', tasks, ' tasks, but they are not one '// &
+            & 'MPI job: each runs the whole job alone and writes the same output. Launch with srun --mpi=pmix '// &
+            & '(srun --mpi=list shows what the site has) or mpirun; scripts/friction.slurm chooses (docs/cli.md)'
+      end subroutine warn_lone_tasks
 
       !> FRICTION_MPI=1: start MPI even without a launcher (a singleton run,
       !> as `mpirun -n 1` would; docs/cli.md).
