@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Every script in scripts/ answers --help (and -h) without side effects.
+"""Every script in scripts/ answers --help (the shell ones -h too) without side effects.
 
     scripts_help_test.py --scripts DIR --workdir DIR
 
@@ -10,9 +10,11 @@ stand-ins for the programs a script would use to act: apt-get, sudo,
 dpkg-query, cmake, ninja, make, mpirun, mpiexec, srun, gfortran, ngspice,
 gnuplot, h5dump.  A stand-in records its call and fails.  The script must
 exit 0 within 60 s, print something, call no stand-in and leave the
-working directory empty.
+working directory empty.  Four at a time (most of the time is Python
+importing numpy and matplotlib; -h of a Python script is argparse's own).
 """
 import argparse
+import concurrent.futures
 import os
 import shutil
 import stat
@@ -36,42 +38,47 @@ def main():
     shutil.rmtree(args.workdir, ignore_errors=True)
     stand_ins = args.workdir / "bin"
     stand_ins.mkdir(parents=True)
-    calls = args.workdir / "calls.log"
     for name in ACTING:
         path = stand_ins / name
-        path.write_text(f"#!/bin/sh\necho \"{name} $*\" >> '{calls}'\nexit 97\n")
+        path.write_text(f"#!/bin/sh\necho \"{name} $*\" >> \"$STAND_IN_LOG\"\nexit 97\n")
         path.chmod(path.stat().st_mode | stat.S_IXUSR)
-    problems = []
     scripts = sorted(p for p in args.scripts.iterdir() if p.is_file() and p.suffix not in NOT_COMMANDS)
+    runs = []
     for script in scripts:
         first = script.read_text(errors="replace").split("\n", 1)[0]
         interpreter = "python3" if "python" in first or script.suffix == ".py" else "bash"
-        for option in ("--help", "-h"):
-            cwd = args.workdir / "cwd"
-            shutil.rmtree(cwd, ignore_errors=True)
-            cwd.mkdir()
-            calls.unlink(missing_ok=True)
-            env = dict(os.environ, HOME=str(args.workdir / "home"), PATH=f"{stand_ins}{os.pathsep}{os.environ['PATH']}",
-                       MPLBACKEND="Agg", PYTHONDONTWRITEBYTECODE="1")
-            try:
-                result = subprocess.run([interpreter, str(script.resolve()), option], cwd=cwd, env=env,
-                                        capture_output=True, text=True, timeout=60)
-            except subprocess.TimeoutExpired:
-                problems.append(f"{script.name} {option}: still running after 60 s")
-                continue
-            where = f"{script.name} {option}"
-            if result.returncode != 0:
-                problems.append(f"{where}: exit {result.returncode}: {result.stderr.strip()[-300:]}")
-            elif not result.stdout.strip():
-                problems.append(f"{where}: printed nothing on stdout")
-            if calls.exists():
-                problems.append(f"{where}: ran {calls.read_text().strip()!r}")
-            left = sorted(str(p.relative_to(cwd)) for p in cwd.rglob("*"))
-            if left:
-                problems.append(f"{where}: left {left[:5]} in the working directory")
+        for option in ("--help", "-h") if interpreter == "bash" else ("--help",):
+            runs.append((script, interpreter, option))
+
+    def check(number, script, interpreter, option):
+        where = f"{script.name} {option}"
+        cwd = args.workdir / f"cwd{number}"
+        cwd.mkdir()
+        calls = args.workdir / f"calls{number}.log"
+        env = dict(os.environ, HOME=str(args.workdir / "home"), PATH=f"{stand_ins}{os.pathsep}{os.environ['PATH']}",
+                   MPLBACKEND="Agg", PYTHONDONTWRITEBYTECODE="1", STAND_IN_LOG=str(calls))
+        try:
+            result = subprocess.run([interpreter, str(script.resolve()), option], cwd=cwd, env=env,
+                                    capture_output=True, text=True, timeout=60)
+        except subprocess.TimeoutExpired:
+            return [f"{where}: still running after 60 s"]
+        found = []
+        if result.returncode != 0:
+            found.append(f"{where}: exit {result.returncode}: {result.stderr.strip()[-300:]}")
+        elif not result.stdout.strip():
+            found.append(f"{where}: printed nothing on stdout")
+        if calls.exists():
+            found.append(f"{where}: ran {calls.read_text().strip()!r}")
+        left = sorted(str(p.relative_to(cwd)) for p in cwd.rglob("*"))
+        if left:
+            found.append(f"{where}: left {left[:5]} in the working directory")
+        return found
+
+    with concurrent.futures.ThreadPoolExecutor(4) as pool:
+        problems = [p for found in pool.map(lambda item: check(item[0], *item[1]), enumerate(runs)) for p in found]
     if problems:
         fail(f"{len(problems)} problems:\n  " + "\n  ".join(problems))
-    print(f"{len(scripts)} scripts answer --help and -h without side effects")
+    print(f"{len(scripts)} scripts answer --help ({len(runs)} runs) without side effects")
 
 
 if __name__ == "__main__":
