@@ -561,11 +561,15 @@ def poincare(data):
     p = _need(d, "poincare")
     fig = _figure(figsize=(12, 5), layout="constrained")
     strobe, section = fig.subplots(1, 2)
-    strobe.plot(p["strobe_x"], p["strobe_v"], ".", markersize=3)
+    # Coloured by time, so the transient from the initial state and the convergence
+    # (or not) onto the attractor show, rather than one cloud of every point.
+    points = strobe.scatter(p["strobe_x"], p["strobe_v"], c=p["strobe_t"], s=6, cmap="viridis")
     strobe.set_title(f"Stroboscopic map, period {p['period']:.6g} τ (paper Fig. 14)\n{p['strobe_t'].size} points")
     # On the stick-to-slip section x' = v'_dr: (x, y) shows what changes.
-    section.plot(p["section_x"], p["section_y"], ".", markersize=3, color="tab:green")
+    section.scatter(p["section_x"], p["section_y"], c=p["section_t"], s=6, cmap="viridis",
+                    vmin=points.norm.vmin, vmax=points.norm.vmax)
     section.set_title(f"Section: {p['section']} (x, y)\n{p['section_t'].size} points")
+    fig.colorbar(points, ax=[strobe, section], label="τ of the point")
     section.set_ylabel("y, crank arm tip displacement (m)")
     strobe.set_ylabel("x', block velocity (m per unit τ)")
     for ax in (strobe, section):
@@ -596,8 +600,16 @@ def lyapunov(data):
         k0, k1 = int(a["rosenstein_fit_start"]), int(a["rosenstein_fit_end"])
         lam = float(a["rosenstein_exponent"])
         series.plot(t, curve, "-", linewidth=0.8, label="mean ln divergence")
-        series.plot(t[k0:k1 + 1], curve[k0] + lam * (t[k0:k1 + 1] - t[k0]), "--", color="tab:red",
-                    label=f"fit: λ = {lam:.3g} per τ ({float(a['rosenstein_log2_per_sample']):.3g} log2/sample)")
+        # The slope means an exponent only where the curve is straight over the fit range:
+        # R² of a straight line there; below 0.98 (curvature visible by eye) no line is drawn.
+        tk, ck = t[k0:k1 + 1], curve[k0:k1 + 1]
+        r2 = (np.corrcoef(tk, ck)[0, 1] ** 2) if tk.size > 2 and np.ptp(ck) > 0 else 0.0
+        series.axvspan(tk[0], tk[-1], color="0.9", zorder=0, label=f"fit range (R² = {r2:.3f})")
+        if r2 >= 0.98:
+            series.plot(tk, curve[k0] + lam * (tk - t[k0]), "--", color="tab:red",
+                        label=f"fit: λ = {lam:.3g} per τ ({float(a['rosenstein_log2_per_sample']):.3g} log2/sample)")
+        else:
+            series.plot([], [], " ", label=f"no linear region: the fit's slope {lam:.3g} per τ is not an exponent")
         series.set_title(f"Rosenstein: m = {int(a['rosenstein_dimension'])}, delay {int(a['rosenstein_delay'])}, "
                          f"Theiler {int(a['rosenstein_theiler'])} samples of "
                          f"{float(a['rosenstein_sample_spacing']):g} τ")
