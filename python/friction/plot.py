@@ -510,6 +510,7 @@ def _diagnostics(data):
             s = groups["brake/spectrum"]
             d["spectrum"] = {"frequency": data["brake/spectrum/frequency"].values,
                              "amplitude": data["brake/spectrum/amplitude"].values,
+                             "amplitude_units": getattr(data["brake/spectrum/amplitude"], "units", None),
                              "series": str(s["series"]), "window": str(s["window"]),
                              **{k: float(s[k]) for k in ("peak_frequency", "resolution", "window_start",
                                                          "window_end")}}
@@ -547,7 +548,7 @@ def brake_spectrum(data):
     ax.axvline(0.143433, color="0.5", linestyle=":", linewidth=0.8, label="paper: 0.143433")
     ax.set_xlim(0, min(1.0, s["frequency"][-1]))
     ax.set_xlabel("frequency (cycles per unit τ)")
-    ax.set_ylabel(f"amplitude of {s['series']}")
+    ax.set_ylabel(_with_unit(f"amplitude of {s['series']}", s.get("amplitude_units")))
     ax.set_title(f"Spectrum of {s['series']}, τ ∈ [{s['window_start']:g}, {s['window_end']:g}], "
                  f"{s['window']} window (paper Fig. 13)\n{d['model']} model")
     ax.legend(fontsize="small")
