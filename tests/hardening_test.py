@@ -826,6 +826,54 @@ def case_lj_off_edge(args):
         if os.path.exists(path(args, out)):
             fail(f"{out} was written for a scan that failed")
 
+# ---- issue 40: nothing crashes, hangs or lies, round three ----
+
+def case_element_index(args):
+    """An element index that is not a whole number from 1 on (0, -1, 2^31,
+    'a', 1.5, 1:2, 2147483650) was applied to another element: sigma(0) set
+    sigma(1), species(2147483650) replaced 'C'.  Each is now bad input naming
+    the file, line, group and variable, as --set already refused them."""
+    for index in ("0", "-1", "2147483648", "a", "1.5", "1:2", " 0 "):
+        over = write(args, "over.nml", f"&surface\n  sigma({index}) = 5.0\n/\n")
+        result = friction(args, "--print-input", inputs(args, "graphite.nml"), over, expect=3)
+        contains(result, "over.nml:2:", "&surface", f"sigma({index})", "whole number")
+        if result.stdout:
+            fail(f"sigma({index}): --print-input printed an input: {result.stdout[:200]!r}")
+    over = write(args, "over.nml", "&surface species(2147483650) = 'N' /\n")
+    result = friction(args, "--print-input", inputs(args, "graphite.nml"), over, expect=3)
+    contains(result, "over.nml:1:", "&surface", "species(2147483650)")
+    # The oracle for the accepted form: sigma(1) = 5.0 sets the one element.
+    over = write(args, "over.nml", "&surface sigma( 1 ) = 5.0 /\n")
+    result = friction(args, "--print-input", inputs(args, "graphite.nml"), over)
+    if "sigma = 5.0" not in result.stdout.replace("5.00000000000000", "5.0"):
+        line = [text for text in result.stdout.splitlines() if "sigma" in text]
+        fail(f"sigma(1) = 5.0 did not set sigma: {line}")
+
+
+def case_text_outside_group(args):
+    """Text outside a group was dropped without a word, and the default
+    128 x 128 map ran with exit 0: an assignment after the closing '/', a
+    group without its '&', the $scan ... $end form.  Each is bad input
+    naming the line; nothing is written."""
+    texts = {
+        "after": ("&scan nx = 8 /\nny = 3\n", "after.nml:2:", "outside a group"),
+        "no-ampersand": ("scan nx = 8, ny = 3 /\n", "no-ampersand.nml:1:", "outside a group"),
+        "dollar": ("$scan nx = 8, ny = 3 $end\n", "dollar.nml:1:", "$group ... $end"),
+        "quoted": ("&scan nx = 8 / 'ny = 3'\n", "quoted.nml:1:", "outside a group"),
+    }
+    for name, (text, where, words) in texts.items():
+        over = write(args, name + ".nml", text)
+        result = friction(args, "-o", name + ".h5", inputs(args, "naf.nml"), over, expect=3)
+        contains(result, where, words)
+        if os.path.exists(path(args, name + ".h5")):
+            fail(f"{name}: an output was written for bad input")
+    # Comments and blank lines between groups stay allowed.
+    over = write(args, "fine.nml", "! a comment\n\n&scan nx = 8, ny = 2 /   ! after\n\t\n")
+    result = friction(args, "--print-input", inputs(args, "naf.nml"), over)
+    if "nx = 8" not in result.stdout:
+        fail("a comment between groups stopped the reading of &scan")
+
+
 CASES = {name[len("case_"):].replace("_", "-"): function for name, function in globals().items()
          if name.startswith("case_")}
 

@@ -4,6 +4,7 @@
 !> names and kinds and sets the values through the configuration's own
 !> description of its variables (core/parameters.f90).
 module friction_input_scan
+   use friction_kinds, only: i8
    use friction_strings, only: join, lower, itoa
    use friction_error, only: error_type, fatal_error, error_input
    use friction_files, only: open_for_reading, read_text_line
@@ -47,7 +48,7 @@ contains
       character(len=32), allocatable :: seen(:)
       integer, allocatable :: seen_lines(:)
       character :: quote
-      integer :: i, j, k, n, value_from, first, stat, count
+      integer :: i, j, k, n, value_from, first, count
       logical :: in_group, open_mention
 
       allocate (mentions(16), seen(0), seen_lines(0))
@@ -67,6 +68,12 @@ contains
          associate (c => text(i:i))
             if (quote /= ' ') then
                if (c == quote) quote = ' '
+            else if (.not. in_group .and. c /= '&' .and. c /= ' ' .and. c /= new_line('a') &
+               & .and. c /= achar(9)) then
+               ! Outside a group nothing is read: text there would be dropped
+               ! without a word (an assignment after '/', a group without '&').
+               call outside_group_error(i)
+               return
             else if (c == '"' .or. c == "'") then
                quote = c
             else if (c == '&' .and. .not. in_group) then
@@ -113,8 +120,11 @@ contains
                      j = index(text(max(1, k - 64):k), '(', back=.true.)
                      if (j > 0) j = j + max(1, k - 64) - 1
                      if (j > 0) then
-                        read (text(j + 1:k - 1), *, iostat=stat) first
-                        if (stat /= 0) first = 0
+                        call read_index(text(j + 1:k - 1), first)
+                        if (first < 1) then
+                           call index_error(j, k)
+                           return
+                        end if
                         k = j - 1
                      end if
                   end if
@@ -150,6 +160,51 @@ contains
 
    contains
 
+      !> Text outside a group at text(at:): an error naming its line (the
+      !> `$group ... $end` form of old compilers too, which Fortran does not read).
+      subroutine outside_group_error(at)
+         integer, intent(in) :: at
+         integer :: stop_at
+         character(len=:), allocatable :: shown
+
+         stop_at = index(text(at:), new_line('a'))
+         if (stop_at == 0) then
+            stop_at = n
+         else
+            stop_at = at + stop_at - 2
+         end if
+         shown = trim(text(at:min(stop_at, at + 59)))
+         if (text(at:at) == '$') then
+            call fatal_error(error, path//':'//itoa(line_of(at))//": '"//shown//"': the $group ... $end form " &
+               & //"is not read; write &group ... /", error_input)
+         else if (len(group) > 0) then
+            call fatal_error(error, path//':'//itoa(line_of(at))//": '"//shown//"' is outside a group (after " &
+               & //"&"//group//" closed with '/'); it would be ignored: move it into the group or remove it", &
+               & error_input)
+         else
+            call fatal_error(error, path//':'//itoa(line_of(at))//": '"//shown//"' is outside a group; a " &
+               & //"group starts with &name and ends with '/'", error_input)
+         end if
+      end subroutine outside_group_error
+
+      !> An element index that is not a whole number from 1 on, between
+      !> text(open_at) '(' and text(close_at) ')': an error naming the line,
+      !> group and variable (Fortran's own reading would set another element).
+      subroutine index_error(open_at, close_at)
+         integer, intent(in) :: open_at, close_at
+         integer :: b
+
+         b = open_at - 1
+         do while (b >= 1)
+            if (.not. is_name_char(lower(text(b:b)))) exit
+            b = b - 1
+         end do
+         call fatal_error(error, path//':'//itoa(line_of(open_at))//': &'//group//': ' &
+            & //lower(text(b + 1:open_at - 1))//text(open_at:close_at)//': the element is a whole number from 1 ' &
+            & //'to '//itoa(huge(1))//' in parentheses, e.g. sigma(2) (a section such as (1:2) is not read)', &
+            & error_input)
+      end subroutine index_error
+
       !> The open assignment's value ends at `last`.
       subroutine close_value(last)
          integer, intent(in) :: last
@@ -160,6 +215,23 @@ contains
       end subroutine close_value
 
    end subroutine scan_namelist_file
+
+   !> The element index in `digits` (blanks around it allowed): a whole
+   !> number from 1 to huge(1), else 0.
+   subroutine read_index(digits, first)
+      character(len=*), intent(in) :: digits
+      integer, intent(out) :: first
+      character(len=:), allocatable :: t
+      integer(i8) :: wide
+      integer :: stat
+
+      first = 0
+      t = trim(adjustl(digits))
+      if (len(t) == 0 .or. len(t) > 12 .or. verify(t, '0123456789') /= 0) return
+      read (t, *, iostat=stat) wide
+      if (stat /= 0 .or. wide < 1 .or. wide > huge(1)) return
+      first = int(wide)
+   end subroutine read_index
 
    !> The first `n` mentions (those beyond the old size empty), moved to an
    !> array of that size: the scan doubles its room, so that a file of many
