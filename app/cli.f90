@@ -16,12 +16,12 @@ module friction_app_cli
    use, intrinsic :: iso_c_binding, only: c_int
    use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
    use mpi_f08
-   use friction_error, only: error_type, error_input, error_io, error_interrupted
+   use friction_error, only: error_type, error_input, error_io, error_interrupted, fatal_error
    use friction_version, only: version_string, revision_string, compiler_string, hdf5_version_string, &
       & gsl_version_string, fftw_version_string, cpu_target_string, table_kernels_string
    use friction_job, only: run_job, write_netlist, resolve_input, default_output
    use friction_clock, only: wall_seconds
-   use friction_app_terminal_reporter, only: terminal_reporter
+   use friction_app_terminal_reporter, only: terminal_reporter, say, write_fd
    implicit none
    private
 
@@ -33,6 +33,8 @@ module friction_app_cli
          import :: c_int
          integer(c_int), value :: status
       end subroutine c_exit
+      subroutine friction_ignore_write_signals() bind(c)
+      end subroutine friction_ignore_write_signals
    end interface
 
    integer, parameter :: exit_usage = 2, exit_input = 3, exit_numerical = 4, exit_io = 5, exit_interrupted = 6
@@ -61,12 +63,16 @@ contains
       type(options) :: opts
       type(error_type), allocatable :: error
       character(len=:), allocatable :: summary, text
-      integer :: rank, code
+      integer :: rank, code, stat
+      character(len=:), allocatable :: message
       logical :: mpi_started
       type(MPI_Comm) :: comm
 
       mpi_started = .false.
       reporter%t_start = wall_seconds()
+      ! A closed stderr or stdout and a file-size limit fail the write instead
+      ! of killing the program (app/signals.c).
+      call friction_ignore_write_signals()
       ! Until MPI starts (if it does), the launcher's rank says who prints.
       rank = launcher_rank()
 
@@ -78,7 +84,12 @@ contains
          ! One process prints the resolved input, without MPI.
          if (rank /= 0) call finish(0)
          call resolve_input(opts%files(1:opts%nfiles), comm, reporter, text, error, opts%sets(1:opts%nsets))
-         if (.not. allocated(error)) write (output_unit, '(a)', advance='no') text
+         if (.not. allocated(error)) then
+            ! Through the C library: gfortran's write and flush report success on /dev/full.
+            call write_fd(1, text, message)
+            if (len(message) > 0) call fatal_error(error, 'cannot write the input to standard output (' &
+               & //message//')', error_io)
+         end if
          opts%output = ''
       else if (allocated(opts%netlist)) then
          ! One process writes the netlist, without MPI: the others of a launch have nothing to do.
@@ -100,14 +111,14 @@ contains
       end if
       ! An interrupted sweep has written its file: say what it holds, then why it stopped.
       if (rank == 0 .and. .not. opts%quiet .and. allocated(summary)) &
-         & write (error_unit, '(a)') 'friction: wrote '//opts%output//' ('//summary//')'
+         & call say(reporter, 'friction: wrote '//opts%output//' ('//summary//')')
       if (allocated(error)) then
          ! Every rank holds the same error (the library agrees on one): rank 0 says it.
          if (rank == 0) then
             if (error%stat == error_interrupted) then
-               write (error_unit, '(a)') 'friction: '//error%message
+               call say(reporter, 'friction: '//error%message)
             else
-               write (error_unit, '(a)') 'friction: error: '//error%message
+               call say(reporter, 'friction: error: '//error%message)
             end if
          end if
          call finish(exit_code(error))
@@ -260,7 +271,9 @@ contains
                code = 0
                return
             case ('-V', '--version')
-               if (rank == 0) call print_version()
+               stat = 0
+               if (rank == 0) call print_version(stat)
+               if (stat /= 0) reporter%lost = .true.
                code = 0
                return
             case ('-o', '--output')
@@ -327,13 +340,13 @@ contains
       integer function usage_error(message) result(code)
          character(len=*), intent(in) :: message
 
-         if (rank == 0) write (error_unit, '(a)') 'friction: '//message// &
-            & new_line('a')//'usage: friction [options] FILE.nml [MORE.nml ...]  (friction --help)'
+         if (rank == 0) call say(reporter, 'friction: '//message// &
+            & new_line('a')//'usage: friction [options] FILE.nml [MORE.nml ...]  (friction --help)')
          code = exit_usage
       end function usage_error
 
       subroutine print_help()
-         write (output_unit, '(a)') &
+         write (output_unit, '(a)', iostat=stat) &
             & 'usage: [mpirun -n N] friction [options] FILE.nml [MORE.nml ...]', &
             & '', &
             & 'Friction-force maps of a microscope tip dragged over a crystal surface', &
@@ -376,15 +389,18 @@ contains
             & '                     built with, the source revision and the kernels chosen', &
             & 'Short options bundle: -fq is -f -q; -fo FILE is -f -o FILE.', &
             & '', &
-            & 'exit codes: 0 done, 2 usage, 3 bad input, 4 integration failed, 5 output failed,', &
+            & 'exit codes: 0 done, 2 usage, 3 bad input, 4 integration failed, 5 output failed', &
+            & '            (a full disk, ulimit -f, or stderr or stdout closed: 2>&1 | head),', &
             & '            6 interrupted (a sweep''s file written with the points done, a map''s', &
             & '            lines done checkpointed, --resume; a brake trajectory: nothing written)'
+         if (stat /= 0) reporter%lost = .true.
       end subroutine print_help
 
       !> The version's first line as before (scripts read it), then what the
       !> program was built with and what it chooses on this processor.  MPI's
       !> is the library's own (MPI_Get_library_version may precede MPI_Init).
-      subroutine print_version()
+      subroutine print_version(stat)
+         integer, intent(out) :: stat
          character(len=MPI_MAX_LIBRARY_VERSION_STRING) :: mpi_text
          character(len=:), allocatable :: cpu
          integer :: length, cut
@@ -395,7 +411,7 @@ contains
          if (cut > 0) mpi_text = mpi_text(1:cut - 1)
          cpu = cpu_target_string
          if (len(cpu) == 0) cpu = 'the compiler''s default'
-         write (output_unit, '(a)') 'friction '//version_string, &
+         write (output_unit, '(a)', iostat=stat) 'friction '//version_string, &
             & '  revision     '//revision_string, &
             & '  compiler     '//compiler_string//' (processor level: '//cpu//')', &
             & '  MPI          '//trim(mpi_text), &
@@ -415,6 +431,8 @@ contains
             exit_code = exit_io
          case (error_interrupted)
             exit_code = exit_interrupted
+            ! Stopped because stderr was lost (a closed pipe): an I/O error.
+            if (reporter%lost) exit_code = exit_io
          case default
             exit_code = exit_numerical
          end select
@@ -423,13 +441,18 @@ contains
       !> Flush first: what the run said must reach stderr even if finalizing fails.
       subroutine finish(code)
          integer, intent(in) :: code
+         integer :: status
 
-         flush (error_unit)
-         flush (output_unit)
+         flush (error_unit, iostat=stat)
+         flush (output_unit, iostat=stat)
          if (mpi_started) call MPI_Finalize()
-         flush (error_unit)
-         flush (output_unit)
-         call c_exit(int(code, c_int))
+         flush (error_unit, iostat=stat)
+         flush (output_unit, iostat=stat)
+         status = code
+         ! A run whose stderr was lost (its notes and summary unsaid) ends with
+         ! the I/O error's code, even when its file was written.
+         if (reporter%lost .and. (status == 0 .or. status == exit_interrupted)) status = exit_io
+         call c_exit(int(status, c_int))
       end subroutine finish
 
    end subroutine run_program

@@ -874,6 +874,96 @@ def case_text_outside_group(args):
         fail("a comment between groups stopped the reading of &scan")
 
 
+def leftovers(args, prefix):
+    """Temporary files of an output: OUTPUT.tmp-PID, OUTPUT.ckpt.new, *.ckpt.tmp."""
+    return [f for f in listing(args.workdir) if f.startswith(prefix) and (".tmp" in f or f.endswith(".new"))]
+
+
+def case_stderr_closed(args):
+    """A closed stderr (`friction ... 2>&1 | true`) killed the program with
+    SIGPIPE at its first progress line (exit 141, no file).  It is now an
+    I/O error: the map stops at its next line as on a stop request, keeps
+    its lines' checkpoints, leaves no temporary file, and exits 5.  A short
+    run that writes its file and then cannot say so exits 5 too."""
+    write(args, "long.nml", "&scan nx = 64, ny = 8192, checkpoint_interval = 0.0 /\n")
+    reader, writer = os.pipe()
+    os.close(reader)   # the pipe's reader is gone before the run starts, as `| true` leaves it
+    started = time.monotonic()
+    result = subprocess.run([args.binary, "-o", "o.h5", inputs(args, "naf.nml"), "long.nml"], cwd=args.workdir,
+                            stdout=writer, stderr=writer, timeout=120)
+    os.close(writer)
+    seconds = time.monotonic() - started
+    if result.returncode != 5:
+        fail(f"stderr closed: exit {result.returncode}, expected 5 (141 is death by SIGPIPE)")
+    if os.path.exists(path(args, "o.h5")) or leftovers(args, "o.h5"):
+        fail(f"stderr closed: files left {listing(args.workdir)}")
+    kept = [f for f in listing(args.workdir) if f.startswith("o.h5.line-")]
+    print(f"stopped {seconds:.1f} s after the start (its first progress line is due after 2 s), "
+          f"{len(kept)} of 8192 lines kept")
+    reader, writer = os.pipe()
+    os.close(reader)
+    write(args, "short.nml", SMALL)
+    result = subprocess.run([args.binary, "-o", "short.h5", inputs(args, "naf.nml"), "short.nml"],
+                            cwd=args.workdir, stdout=writer, stderr=writer, timeout=120)
+    os.close(writer)
+    if result.returncode != 5 or not os.path.exists(path(args, "short.h5")) or leftovers(args, "short.h5"):
+        fail(f"a short run with stderr closed: exit {result.returncode}, files {listing(args.workdir)}")
+
+
+def limited(kilobytes):
+    import resource
+    return lambda: resource.setrlimit(resource.RLIMIT_FSIZE, (kilobytes * 1024, kilobytes * 1024))
+
+
+def case_file_size_limit(args):
+    """`ulimit -f 40` killed a map with SIGXFSZ and a runtime backtrace and
+    left OUTPUT.tmp-PID; a sweep left OUTPUT.ckpt.new.  A file-size limit is
+    now an I/O error like a full disk: exit 5, one message, nothing left."""
+    write(args, "map.nml", "&scan nx = 64, ny = 64 /\n")
+    result = subprocess.run([args.binary, "--quiet", "-o", "o.h5", inputs(args, "naf.nml"), "map.nml"],
+                            cwd=args.workdir, capture_output=True, text=True, timeout=120, preexec_fn=limited(40))
+    if result.returncode != 5 or [w for w in ABORTS if w in result.stderr]:
+        fail(f"a map under ulimit -f 40: exit {result.returncode}: {result.stderr}")
+    if os.path.exists(path(args, "o.h5")) or leftovers(args, "o.h5"):
+        fail(f"a map under ulimit -f 40 left {listing(args.workdir)}")
+    # A limit above the 1 MB the run asks to spare before computing, below
+    # the 2.4 MB map: the dataset that would pass it is refused before it
+    # is written (a write past the limit left a file HDF5 could not close).
+    result = subprocess.run([args.binary, "--quiet", "-o", "o.h5", inputs(args, "naf.nml")], cwd=args.workdir,
+                            capture_output=True, text=True, timeout=120, preexec_fn=limited(1500))
+    if result.returncode != 5 or [w for w in ABORTS if w in result.stderr] or "ulimit -f" not in result.stderr:
+        fail(f"a 128 x 128 map under ulimit -f 1500: exit {result.returncode}: {result.stderr}")
+    if os.path.exists(path(args, "o.h5")) or leftovers(args, "o.h5"):
+        fail(f"a map under ulimit -f 1500 left {listing(args.workdir)}")
+    write(args, "sweep.nml", SWEEP)
+    result = subprocess.run([args.binary, "--quiet", "-o", "sw.h5", inputs(args, "brake.nml"), "sweep.nml"],
+                            cwd=args.workdir, capture_output=True, text=True, timeout=120, preexec_fn=limited(40))
+    if result.returncode != 5 or [w for w in ABORTS if w in result.stderr]:
+        fail(f"a sweep under ulimit -f 40: exit {result.returncode}: {result.stderr}")
+    if leftovers(args, "sw.h5") or os.path.exists(path(args, "sw.h5")):
+        fail(f"a sweep under ulimit -f 40 left {listing(args.workdir)}")
+    contains(result, "friction: error:")
+
+
+def case_print_input_errors(args):
+    """--print-input ignored write errors: exit 0 with nothing written to a
+    closed stdout or /dev/full.  Both are I/O errors now (exit 5)."""
+    with open("/dev/full", "w") as full:
+        result = subprocess.run([args.binary, "--print-input", inputs(args, "naf.nml")], cwd=args.workdir,
+                                stdout=full, stderr=subprocess.PIPE, text=True, timeout=60)
+    if result.returncode != 5 or "standard output" not in result.stderr:
+        fail(f"--print-input > /dev/full: exit {result.returncode}: {result.stderr}")
+    result = subprocess.run([args.binary, "--print-input", inputs(args, "naf.nml")], cwd=args.workdir,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, timeout=60,
+                            preexec_fn=lambda: os.close(1))
+    if result.returncode != 5 or "standard output" not in result.stderr:
+        fail(f"--print-input >&-: exit {result.returncode}: {result.stderr}")
+    # The oracle: the same with a working stdout exits 0 and prints the groups.
+    result = friction(args, "--print-input", inputs(args, "naf.nml"))
+    if "&scan" not in result.stdout:
+        fail("--print-input printed no &scan")
+
+
 CASES = {name[len("case_"):].replace("_", "-"): function for name, function in globals().items()
          if name.startswith("case_")}
 

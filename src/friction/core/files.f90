@@ -8,13 +8,13 @@
 module friction_files
    use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char, c_double, c_long
    use friction_error, only: error_type, fatal_error, error_io, error_input
-   use friction_strings, only: itoa
+   use friction_strings, only: itoa, bytes_text
    implicit none
    private
 
    public :: rename_file, remove_file, file_exists, process_id, write_text_file, open_for_reading
    public :: path_kind, same_file, publish_file, truncate_file, output_problem, system_error_text, free_bytes
-   public :: available_memory, write_bytes, min_free_bytes
+   public :: available_memory, write_bytes, min_free_bytes, full_text, size_limit_room
    public :: kind_none, kind_regular, kind_directory, kind_link, kind_other, kind_pipe, kind_unknown
    public :: read_text_line, max_line_length, sync_files
 
@@ -94,6 +94,11 @@ module friction_files
          integer(c_int) :: code
       end function c_errno_exists
 
+      function c_size_limit_room(path) result(bytes) bind(c, name='friction_size_limit_room')
+         import :: c_char, c_double
+         character(kind=c_char), intent(in) :: path(*)
+         real(c_double) :: bytes
+      end function c_size_limit_room
       function c_free_bytes(path) result(bytes) bind(c, name='friction_free_bytes')
          import :: c_char, c_double
          character(kind=c_char), intent(in) :: path(*)
@@ -348,6 +353,32 @@ contains
 
       free_bytes = c_free_bytes(path//c_null_char)
    end function free_bytes
+
+   !> Bytes the process's file-size limit (`ulimit -f`) still lets the file
+   !> at path grow by; negative without a limit.
+   real(c_double) function size_limit_room(path)
+      character(len=*), intent(in) :: path
+
+      size_limit_room = c_size_limit_room(path//c_null_char)
+   end function size_limit_room
+
+   !> Why there is no room for the file at path, `free` (free_bytes) being
+   !> too little, for messages: 'the disk is full (X free', or, when the
+   !> process's file-size limit is what leaves so little, 'the file-size
+   !> limit (ulimit -f) is reached (X left'.  The caller closes the bracket.
+   function full_text(path, free) result(text)
+      character(len=*), intent(in) :: path
+      real(c_double), intent(in) :: free
+      character(len=:), allocatable :: text
+      real(c_double) :: limit
+
+      limit = c_size_limit_room(path//c_null_char)
+      if (limit >= 0.0_c_double .and. limit <= free) then
+         text = 'the file-size limit (ulimit -f) is reached ('//bytes_text(free)//' left'
+      else
+         text = 'the disk is full ('//bytes_text(free)//' free'
+      end if
+   end function full_text
 
    !> Memory this machine can still give a process without swapping, bytes
    !> (MemAvailable of /proc/meminfo); negative when unknown.

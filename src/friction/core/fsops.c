@@ -8,6 +8,7 @@
 #include <fcntl.h>
 #include <stdio.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/statvfs.h>
 #include <sys/syscall.h>
@@ -78,9 +79,35 @@ int friction_truncate(const char *path)
     return truncate(path, 0) == 0 ? 0 : errno;
 }
 
+double friction_disk_free_bytes(const char *path);
+
+/* Bytes the process's file-size limit (RLIMIT_FSIZE, `ulimit -f`) still
+ * lets the file at path grow by (its whole size when it does not exist);
+ * -1 without a limit.  A write beyond it fails with EFBIG (SIGXFSZ is
+ * ignored by the program), as a full disk's fails with ENOSPC. */
+double friction_size_limit_room(const char *path)
+{
+    struct rlimit limit;
+    if (getrlimit(RLIMIT_FSIZE, &limit) != 0 || limit.rlim_cur == RLIM_INFINITY) return -1.0;
+    struct stat st;
+    double size = stat(path, &st) == 0 && S_ISREG(st.st_mode) ? (double)st.st_size : 0.0;
+    double room = (double)limit.rlim_cur - size;
+    return room > 0.0 ? room : 0.0;
+}
+
 /* Bytes an unprivileged writer may still write on the file system that
- * holds path (or its directory, when path does not exist yet); -1 unknown. */
+ * holds path (or its directory, when path does not exist yet), or into the
+ * file at path under the file-size limit, whichever is less; -1 unknown. */
 double friction_free_bytes(const char *path)
+{
+    double disk = friction_disk_free_bytes(path);
+    double limit = friction_size_limit_room(path);
+    if (limit >= 0.0 && (disk < 0.0 || limit < disk)) return limit;
+    return disk;
+}
+
+/* The file system's part of friction_free_bytes. */
+double friction_disk_free_bytes(const char *path)
 {
     struct statvfs s;
     if (statvfs(path, &s) != 0) {

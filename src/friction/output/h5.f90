@@ -19,7 +19,7 @@ module friction_output_h5
    use hdf5
    use friction_kinds, only: wp, i8
    use friction_error, only: error_type, fatal_error, error_io
-   use friction_files, only: truncate_file, free_bytes, min_free_bytes
+   use friction_files, only: truncate_file, free_bytes, min_free_bytes, full_text, size_limit_room
    use friction_strings, only: bytes_text
    implicit none
    private
@@ -150,7 +150,7 @@ contains
       if (self%rank == 0) free = free_bytes(path)
       if (self%parallel) call MPI_Bcast(free, 1, MPI_DOUBLE_PRECISION, 0, comm)
       if (free >= 0.0_c_double .and. free < min_free_bytes) then
-         call fatal_error(error, path//': the disk is full ('//bytes_text(real(free, wp))//' free; writing ' &
+         call fatal_error(error, path//': '//full_text(path, free)//'; writing ' &
             & //'the output needs at least '//bytes_text(real(min_free_bytes, wp))//' to spare)', error_io)
          return
       end if
@@ -632,7 +632,7 @@ contains
       if (h5fget_mdc_size(id, max_size, min_clean, cached, entries) < 0) return
       free = free_bytes(path)
       if (free >= 0.0_c_double .and. free < 1.25_c_double * real(cached, c_double) + 8192.0_c_double) &
-         & problem = 'writing the file: the disk is full ('//bytes_text(real(free, wp))//' free, closing needs ' &
+         & problem = 'writing the file: '//full_text(path, free)//', closing needs ' &
          & //'up to '//bytes_text(1.25_wp * real(cached, wp) + 8192.0_wp)//')'
    end function room_to_close
 
@@ -644,8 +644,28 @@ contains
       integer(hid_t), intent(in) :: type, filespace
       integer(hid_t), intent(out) :: dset
       integer :: stat
+      integer(hsize_t) :: points
+      integer(size_t) :: bytes
+      real(c_double) :: room
       logical :: created
 
+      ! Under a file-size limit (ulimit -f) a write past it fails with EFBIG
+      ! at any offset, so a file that failed there cannot be closed (not even
+      ! cut to no bytes, as on a full disk) and HDF5's clean-up at exit
+      ! crashed: the dataset must fit, with min_free_bytes for the metadata.
+      room = -1.0_c_double
+      if (self%rank == 0) room = size_limit_room(self%path)
+      if (self%parallel) call MPI_Bcast(room, 1, MPI_DOUBLE_PRECISION, 0, self%comm)
+      if (room >= 0.0_c_double) then
+         call h5sget_simple_extent_npoints_f(filespace, points, stat)
+         call h5tget_size_f(type, bytes, stat)
+         if (room < real(points, c_double) * real(bytes, c_double) + min_free_bytes) then
+            call self%check(1, 'writing dataset '//name//': '//full_text(self%path, room)//')')
+            call h5sclose_f(filespace, stat)
+            ok = .false.
+            return
+         end if
+      end if
       call h5dcreate_f(self%id, name, type, filespace, dset, stat)
       created = stat == 0
       call self%agree(stat)

@@ -9,7 +9,7 @@ module friction_scene_context
    use friction_clock, only: wall_seconds
    use friction_error, only: error_type, fatal_error, error_io
    use friction_strings, only: itoa, bytes_text
-   use friction_files, only: publish_file, remove_file, process_id, free_bytes, min_free_bytes
+   use friction_files, only: publish_file, remove_file, process_id, free_bytes, min_free_bytes, full_text
    use friction_sharing, only: work_sharing
    implicit none
    private
@@ -215,8 +215,8 @@ contains
       end if
       close (unit, status='delete')
       free = free_bytes(path)
-      if (free >= 0.0_wp .and. free < min_free_bytes) call fatal_error(error, path//': the disk is full (' &
-         & //bytes_text(free)//' free; writing the output needs at least '//bytes_text(min_free_bytes) &
+      if (free >= 0.0_wp .and. free < min_free_bytes) call fatal_error(error, path//': '//full_text(path, free) &
+         & //'; writing the output needs at least '//bytes_text(min_free_bytes) &
          & //' to spare)', error_io)
    end subroutine check_writable
 
