@@ -964,6 +964,72 @@ def case_print_input_errors(args):
         fail("--print-input printed no &scan")
 
 
+def case_sweep_checksum(args):
+    """A sweep checkpoint carries a checksum of each point's row: a status of
+    65537, a result changed to 12345.678 or one flipped bit of a result was
+    resumed into the output with exit 0.  Each is refused as damaged (exit
+    3, naming the point) and the checkpoint is kept as it was; the
+    undamaged checkpoint resumes."""
+    interrupted_sweep(args)
+    name = path(args, "part.h5.ckpt")
+    original = open(name, "rb").read()
+    partial = open(path(args, "part.h5"), "rb").read()   # the interrupted run's file, with its pending points
+
+    def damage(column, change):
+        open(name, "wb").write(original)
+        with h5py.File(name, "r+") as handle:
+            data = handle[column][()]
+            data[0] = change(data[0])
+            handle[column][...] = data
+        damaged = open(name, "rb").read()
+        result = friction(args, "--resume", "-o", "part.h5", inputs(args, "brake.nml"), "sweep.nml", expect=3)
+        contains(result, "part.h5.ckpt", "damaged", "point 1")
+        if "disk" in result.stderr:
+            fail(f"a damaged checkpoint reported as a disk problem: {result.stderr}")
+        if not os.path.exists(name) or open(name, "rb").read() != damaged:
+            fail("a refused checkpoint was removed or changed")
+        if open(path(args, "part.h5"), "rb").read() != partial:
+            fail("a refused resume changed the output")
+
+    damage("status", lambda x: 65537)
+    damage("result1", lambda x: 12345.678)
+    damage("result1", lambda x: np.frombuffer((np.float64(x).view(np.int64) ^ 1).tobytes(), np.float64)[0])
+    open(name, "wb").write(original)
+    friction(args, "--resume", "-o", "part.h5", inputs(args, "brake.nml"), "sweep.nml")
+    with h5py.File(path(args, "part.h5"), "r") as handle:
+        if list(handle["sweep/computed_by_this_run"][()]) != [0, 0, 1, 1, 1]:
+            fail(f"computed {handle['sweep/computed_by_this_run'][()]}")
+
+
+def case_sweep_too_large(args):
+    """sweep_count = 1e8 stopped by SIGTERM filled a disk with 48 MB free
+    with pending rows, lost its computed points and segfaulted at exit;
+    2147483647 did the same.  A sweep whose file cannot fit beside the output
+    is refused before computing (exit 3, naming &sweep and sweep_count),
+    nothing left; on a 48 MB tmpfs (root only), and on this disk for a count
+    too large for it."""
+    write(args, "huge.nml", SWEEP.replace("sweep_count = 5", "sweep_count = 2147483647"))
+    free = shutil.disk_usage(args.workdir).free
+    if free > 8 * 2147483647 * 36:
+        raise Skip(f"the disk has {free} bytes free, room for 2147483647 points")
+    result = friction(args, "-o", "h.h5", inputs(args, "brake.nml"), "huge.nml", expect=3)
+    contains(result, "&sweep", "sweep_count = 2147483647", "free")
+    if [f for f in listing(args.workdir) if f.startswith("h.h5")]:
+        fail(f"a refused sweep left {listing(args.workdir)}")
+    small = small_tmpfs(args, "48m")
+    try:
+        write(args, "huge.nml", SWEEP.replace("sweep_count = 5", "sweep_count = 100000000"))
+        result = friction(args, "-o", "small/h.h5", inputs(args, "brake.nml"), "huge.nml", expect=3)
+        contains(result, "&sweep", "sweep_count = 100000000", "free")
+        if os.listdir(small):
+            fail(f"a refused sweep left {os.listdir(small)}")
+        # The oracle: the 5-point sweep fits there and runs.
+        write(args, "fits.nml", SWEEP)
+        friction(args, "-o", "small/f.h5", inputs(args, "brake.nml"), "fits.nml")
+    finally:
+        unmount(small)
+
+
 CASES = {name[len("case_"):].replace("_", "-"): function for name, function in globals().items()
          if name.startswith("case_")}
 

@@ -5,7 +5,7 @@ module friction_strings
    implicit none
    private
 
-   public :: itoa, rtoa, etoa, join, quoted, lower, text_hash, bytes_text, fixed_text, one_line
+   public :: itoa, rtoa, etoa, join, quoted, lower, text_hash, text_hash_bits, bytes_text, fixed_text, one_line
 
    !> An integer as text, without blanks.
    interface itoa
@@ -161,12 +161,23 @@ contains
 
    !> The 64-bit FNV-1a hash of a text as 16 hex digits: a fingerprint
    !> (not a cryptographic hash) that tells whether two texts are the same,
-   !> e.g. a checkpoint's input and the run's.  Computed in two 32-bit halves
-   !> so no integer arithmetic overflows: h * p mod 2**64 with the prime
-   !> p = 2**40 + 435 is h * 435 + (h * 2**40 mod 2**64).
+   !> e.g. a checkpoint's input and the run's.
    pure function text_hash(text) result(hex)
       character(len=*), intent(in) :: text
       character(len=16) :: hex
+      integer(i8) :: bits
+
+      bits = text_hash_bits(text)
+      write (hex, '(z8.8, z8.8)') shiftr(bits, 32), iand(bits, 4294967295_i8)   ! two non-negative halves
+      hex = lower(hex)
+   end function text_hash
+
+   !> text_hash as its 64 bits.  Computed in two 32-bit halves so no integer
+   !> arithmetic overflows: h * p mod 2**64 with the prime p = 2**40 + 435
+   !> is h * 435 + (h * 2**40 mod 2**64).
+   pure function text_hash_bits(text) result(bits)
+      character(len=*), intent(in) :: text
+      integer(i8) :: bits
       integer(i8), parameter :: mask32 = 4294967295_i8, mask24 = 16777215_i8
       integer(i8) :: hi, lo, t
       integer :: i
@@ -179,9 +190,8 @@ contains
          hi = iand(hi * 435_i8 + shiftr(t, 32) + shiftl(iand(lo, mask24), 8), mask32)
          lo = iand(t, mask32)
       end do
-      write (hex, '(z8.8, z8.8)') hi, lo
-      hex = lower(hex)
-   end function text_hash
+      bits = ior(shiftl(hi, 32), lo)
+   end function text_hash_bits
 
    !> A size in bytes as text for messages: '512 bytes', '3.2 MB', '288.0 GB'.
    pure function bytes_text(bytes) result(text)

@@ -109,6 +109,9 @@ contains
             x = self%from(a)
          else
             x = self%from(a) + (self%to(a) - self%from(a)) * (k - 1) / (self%count(a) - 1)
+            ! Ends of opposite sign near the largest double: to - from overflows.
+            if (abs(self%to(a) - self%from(a)) > huge(x)) x = self%from(a) * (real(self%count(a) - k, wp) &
+               & / (self%count(a) - 1)) + self%to(a) * (real(k - 1, wp) / (self%count(a) - 1))
          end if
       case default
          if (self%count(a) == 1) then

@@ -32,7 +32,8 @@ module friction_job_sweep
    use friction_kinds, only: wp, i8
    use friction_clock, only: wall_seconds
    use friction_error, only: error_type, fatal_error, error_interrupted, error_input, error_numerical, error_io
-   use friction_strings, only: itoa, text_hash, bytes_text, one_line
+   use friction_strings, only: itoa, text_hash, text_hash_bits, bytes_text, one_line
+   use friction_output_checkpoint, only: real_line
    use friction_version, only: version_string
    use friction_ode_solver, only: integrator_statistics, step_type_index, step_type_names, step_type_name_length
    use friction_parameters, only: set_parameter_number, split_name, parameter_info, list_parameters
@@ -42,7 +43,7 @@ module friction_job_sweep
    use friction_output_h5, only: h5_file
    use friction_output_h5_table, only: h5_table
    use friction_output_summary, only: run_summary, write_run_attributes
-   use friction_files, only: remove_file, file_exists, free_bytes, min_free_bytes, rename_file
+   use friction_files, only: remove_file, file_exists, free_bytes, min_free_bytes, rename_file, full_text
    use friction_scene_report, only: job_reporter
    use friction_scene_context, only: job_context, temporary_name, publish, ranks_text, agree_on_error, job_wall_time
    implicit none
@@ -65,7 +66,7 @@ module friction_job_sweep
    integer, parameter :: copy_points = 4096
 
    !> The kinds of the checkpoint's columns of column_names (h5_table's add_column).
-   character(len=7), parameter :: column_kinds = 'iirlili'
+   character(len=8), parameter :: column_kinds = 'iirlilil'
 
    integer, parameter :: tag_header = 7301, tag_numbers = 7302, tag_reason = 7303
 
@@ -160,7 +161,8 @@ contains
       ! nothing is computed (README: Parameter sweeps).  Rank 0 lists the
       ! points still to do in a file every rank reads, so that no rank holds
       ! a list over all points.
-      if (job%rank == 0) then
+      if (job%rank == 0) call check_room(job, config, n, size(names), error)
+      if (job%rank == 0 .and. .not. allocated(error)) then
          if (job%resume .and. file_exists(ckpt%path)) then
             call open_checkpoint(ckpt, input_hash, n, size(names), todo_path, n_work, error)
             use_todo = .not. allocated(error)
@@ -546,9 +548,9 @@ contains
       type(point_result), intent(in) :: names(:)
       logical, intent(in) :: now
       integer, allocatable :: order(:)
-      integer(i8), allocatable :: series_offset(:), reason_offset(:)
+      integer(i8), allocatable :: series_offset(:), reason_offset(:), checksum(:)
       integer(i8) :: s, r
-      integer :: k, a, b, j
+      integer :: k, a, b, j, s_in, r_in
 
       if (batch%n == 0) return
       if (.not. (now .or. batch%n == batch_points .or. batch%n_series >= batch_series .or. ckpt%received == 0 &
@@ -560,8 +562,8 @@ contains
          if (.not. room_for(ckpt%path, 8.0_wp * (batch%n_series + batch%n * (size(names) + 8)) &
             & + len(batch%reasons))) then
             if (ckpt%opened) call ckpt%file%close(ckpt%error)
-            if (.not. allocated(ckpt%error)) call fatal_error(ckpt%error, ckpt%path//': the disk is full (' &
-               & //bytes_text(free_bytes(ckpt%path))//' free)', error_io)
+            if (.not. allocated(ckpt%error)) call fatal_error(ckpt%error, ckpt%path//': ' &
+               & //full_text(ckpt%path, free_bytes(ckpt%path))//')', error_io)
             ckpt%opened = .false.
             call remove_file(ckpt%path)
          else if (.not. ckpt%opened) then
@@ -575,14 +577,21 @@ contains
          return
       end if
       ! Each point's place in the flat lists, in the order they came.
-      allocate (series_offset(batch%n), reason_offset(batch%n))
+      allocate (series_offset(batch%n), reason_offset(batch%n), checksum(batch%n))
       s = ckpt%series_end
       r = ckpt%reason_end
+      s_in = 0
+      r_in = 0
       do k = 1, batch%n
          series_offset(k) = s
          reason_offset(k) = r
+         checksum(k) = point_checksum(batch%status(k), ckpt%run, batch%cost(k), s, batch%series_count(k), r, &
+            & batch%reason_length(k), batch%results(:, k), batch%series(s_in + 1:s_in + batch%series_count(k)), &
+            & batch%reasons(r_in + 1:r_in + batch%reason_length(k)))
          s = s + batch%series_count(k)
          r = r + batch%reason_length(k)
+         s_in = s_in + batch%series_count(k)
+         r_in = r_in + batch%reason_length(k)
       end do
       call ckpt%file%put('series', ckpt%series_end, batch%series(1:batch%n_series))
       call ckpt%file%put('reason', ckpt%reason_end, batch%reasons)
@@ -605,6 +614,7 @@ contains
             call ckpt%file%put('series_count', first, batch%series_count(pick))
             call ckpt%file%put('reason_offset', first, reason_offset(pick))
             call ckpt%file%put('reason_length', first, batch%reason_length(pick))
+            call ckpt%file%put('checksum', first, checksum(pick))
             do j = 1, size(names)
                call ckpt%file%put('result'//itoa(j), first, batch%results(j, pick))
             end do
@@ -625,6 +635,31 @@ contains
       batch%since = wall_seconds()
    end subroutine write_batch
 
+   !> A sweep whose file and checkpoint cannot fit on the output's disk is
+   !> refused before computing: the file holds a row for every point, pending
+   !> ones too.  (sweep_count = 1e8 with 48 MB free computed for seconds,
+   !> filled the disk with pending rows and lost what it had computed.)  Each
+   !> point takes 8 bytes a column: the results, the sweep's own columns
+   !> (about 8) in the file, and as many in the checkpoint.
+   subroutine check_room(job, config, n, n_results, error)
+      type(job_context), intent(in) :: job
+      type(job_config), intent(in) :: config
+      integer, intent(in) :: n, n_results
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: needed, free
+      character(len=:), allocatable :: counts
+
+      needed = 8.0_wp * real(n, wp) * (2 * n_results + 16)
+      free = free_bytes(job%output)
+      if (free < 0.0_wp .or. needed + min_free_bytes <= free) return
+      counts = 'sweep_count = '//itoa(config%sweep%shape(1))
+      if (config%sweep%n_variables == 2) counts = counts//', sweep_count2 = '//itoa(config%sweep%shape(2))
+      call fatal_error(error, '&sweep: '//counts//': '//itoa(n)//' points need about '//bytes_text(needed) &
+         & //' on disk for the sweep''s file and its checkpoint, but beside '//job%output//' ' &
+         & //full_text(job%output, free)//'): sweep fewer points, or write the output where there is room', &
+         & error_input)
+   end subroutine check_room
+
    !> Whether the disk at path has room for `bytes` more and min_free_bytes
    !> to spare (true where it cannot tell).
    logical function room_for(path, bytes)
@@ -636,18 +671,27 @@ contains
       room_for = free < 0.0_wp .or. free >= bytes + min_free_bytes
    end function room_for
 
-   !> Why the run failed when its checkpoint could not be written.
+   !> Why the run failed when its checkpoint could not be written: a full
+   !> disk only when the disk is full (a damaged checkpoint that HDF5 cannot
+   !> write into is not one).
    function checkpoint_lost(ckpt) result(message)
       type(checkpoint), intent(in) :: ckpt
       character(len=:), allocatable :: message
       real(wp) :: free
+      logical :: full
 
       message = ckpt%error%message
       free = free_bytes(ckpt%path)
-      if (free >= 0.0_wp .and. free < min_free_bytes) message = message//' (the disk is full: ' &
-         & //bytes_text(free)//' free)'
+      full = free >= 0.0_wp .and. free < min_free_bytes
+      if (full .and. index(message, ' free') == 0 .and. index(message, ' left') == 0) &
+         & message = message//' ('//full_text(ckpt%path, free)//')'
       message = message//'; the checkpoint could not be written and was removed (a failed write leaves it ' &
-         & //'untrustworthy), and the points of this run are lost with it: run again when there is room'
+         & //'untrustworthy), and the points of this run are lost with it'
+      if (full) then
+         message = message//': run again when there is room'
+      else
+         message = message//' (the disk has room: a damaged checkpoint, or a file-size limit)'
+      end if
    end function checkpoint_lost
 
    !> The permutation that sorts `keys` (a batch: insertion sort, as the
@@ -692,7 +736,7 @@ contains
       call ckpt%file%set_integer('/', 'points', n)
       call ckpt%file%set_integer('/', 'results', int(size(names), i8))
       call ckpt%file%set_integer('/', 'runs', int(ckpt%run, i8))
-      do j = 1, 7
+      do j = 1, len(column_kinds)
          call ckpt%file%add_column(trim(column_names(j)), column_kinds(j:j), n, '')
       end do
       do j = 1, size(names)
@@ -723,6 +767,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(error_type), allocatable :: ignored
       integer, allocatable :: status(:)
+      character(len=:), allocatable :: problem
       integer :: unit, stat, first, count, k, j
       logical :: whole
 
@@ -748,7 +793,7 @@ contains
       end if
       whole = ckpt%file%integer('/', 'points') == n .and. ckpt%file%integer('/', 'results') == n_results &
          & .and. ckpt%file%integer('/', 'runs') >= 1
-      do k = 1, 7
+      do k = 1, len(column_kinds)
          whole = whole .and. ckpt%file%length(trim(column_names(k))) == n
       end do
       do j = 1, n_results
@@ -759,6 +804,13 @@ contains
          call ckpt%file%close(ignored)
          call fatal_error(error, ckpt%path//': the checkpoint is damaged (its columns are not those of this ' &
             & //'sweep); remove it, and --resume computes every point again', error_input)
+         return
+      end if
+      problem = damaged_rows(ckpt, n, n_results)
+      if (len(problem) > 0) then
+         call ckpt%file%close(ignored)
+         call fatal_error(error, ckpt%path//': the checkpoint is damaged ('//problem//'); remove it, and ' &
+            & //'--resume computes every point again', error_input)
          return
       end if
       ckpt%opened = .true.
@@ -790,12 +842,94 @@ contains
       end if
    end subroutine open_checkpoint
 
+   !> The checksum of a point's row of the checkpoint: the 64-bit FNV-1a
+   !> hash (text_hash_bits) of its numbers' bits as a map's line checkpoints
+   !> write them (real_line), and of its reason.  A flipped bit or a changed
+   !> value anywhere in the row, its series or its reason changes it.
+   function point_checksum(status, run, cost, series_offset, series_count, reason_offset, reason_length, results, &
+      & series, reason) result(bits)
+      integer, intent(in) :: status, run, series_count, reason_length
+      real(wp), intent(in) :: cost, results(:), series(:)
+      integer(i8), intent(in) :: series_offset, reason_offset
+      character(len=*), intent(in) :: reason
+      integer(i8) :: bits
+
+      bits = text_hash_bits(real_line([real(status, wp), real(run, wp), cost, real(series_offset, wp), &
+         & real(series_count, wp), real(reason_offset, wp), real(reason_length, wp), results, series])//reason)
+   end function point_checksum
+
+   !> --resume: every point's row of the checkpoint against its checksum, a
+   !> piece of copy_points points at a time; '' when all agree, else what
+   !> is damaged (a status that is none of the three, a row that does not
+   !> match its checksum, a row that points outside the flat lists).
+   function damaged_rows(ckpt, n, n_results) result(problem)
+      type(checkpoint), intent(inout) :: ckpt
+      integer, intent(in) :: n, n_results
+      character(len=:), allocatable :: problem
+      integer, allocatable :: status(:), run(:), series_count(:), reason_length(:)
+      integer(i8), allocatable :: series_offset(:), reason_offset(:), checksum(:)
+      real(wp), allocatable :: cost(:), results(:, :), series(:)
+      character(len=:), allocatable :: reason
+      integer(i8) :: series_end, reason_end
+      integer :: first, piece, k, j
+
+      problem = ''
+      series_end = ckpt%file%length('series')
+      reason_end = ckpt%file%length('reason')
+      allocate (status(copy_points), run(copy_points), series_count(copy_points), reason_length(copy_points))
+      allocate (series_offset(copy_points), reason_offset(copy_points), checksum(copy_points))
+      allocate (cost(copy_points), results(copy_points, n_results))
+      do first = 1, n, copy_points
+         piece = min(copy_points, n - first + 1)
+         associate (at => int(first - 1, i8), c => piece)
+            call ckpt%file%get('status', at, status(1:c))
+            call ckpt%file%get('run', at, run(1:c))
+            call ckpt%file%get('compute_time', at, cost(1:c))
+            call ckpt%file%get('series_offset', at, series_offset(1:c))
+            call ckpt%file%get('series_count', at, series_count(1:c))
+            call ckpt%file%get('reason_offset', at, reason_offset(1:c))
+            call ckpt%file%get('reason_length', at, reason_length(1:c))
+            call ckpt%file%get('checksum', at, checksum(1:c))
+            do j = 1, n_results
+               call ckpt%file%get('result'//itoa(j), at, results(1:c, j))
+            end do
+         end associate
+         if (ckpt%file%failed()) then
+            problem = 'its columns do not read'
+            return
+         end if
+         do k = 1, piece
+            if (status(k) == status_pending) cycle
+            if (status(k) /= status_done .and. status(k) /= status_failed) then
+               problem = 'point '//itoa(first + k - 1)//' has the status '//itoa(status(k))//', none of 0, 1, 2'
+               return
+            end if
+            if (series_count(k) < 0 .or. reason_length(k) < 0 .or. series_offset(k) < 0 .or. reason_offset(k) < 0 &
+               & .or. series_offset(k) + series_count(k) > series_end &
+               & .or. reason_offset(k) + reason_length(k) > reason_end) then
+               problem = 'point '//itoa(first + k - 1)//' points outside its series or reasons'
+               return
+            end if
+            allocate (series(series_count(k)))
+            allocate (character(len=reason_length(k)) :: reason)
+            if (series_count(k) > 0) call ckpt%file%get('series', series_offset(k), series)
+            if (reason_length(k) > 0) call ckpt%file%get('reason', reason_offset(k), reason)
+            if (point_checksum(status(k), run(k), cost(k), series_offset(k), series_count(k), reason_offset(k), &
+               & reason_length(k), results(k, :), series, reason) /= checksum(k) .or. ckpt%file%failed()) then
+               problem = 'point '//itoa(first + k - 1)//'''s values do not match their checksum'
+               return
+            end if
+            deallocate (series, reason)
+         end do
+      end do
+   end function damaged_rows
+
    !> The checkpoint's per-point columns besides the results.
    pure function column_names(k) result(name)
       integer, intent(in) :: k
       character(len=16) :: name
-      character(len=16), parameter :: names(7) = [character(len=16) :: 'status', 'run', 'compute_time', &
-         & 'series_offset', 'series_count', 'reason_offset', 'reason_length']
+      character(len=16), parameter :: names(8) = [character(len=16) :: 'status', 'run', 'compute_time', &
+         & 'series_offset', 'series_count', 'reason_offset', 'reason_length', 'checksum']
 
       name = names(k)
    end function column_names
