@@ -1030,6 +1030,95 @@ def case_sweep_too_large(args):
         unmount(small)
 
 
+def case_runtime_aborts(args):
+    """Accepted values that aborted in the runtime: continuation_points =
+    2147483647 (allocating 64 GB) is bad input; a linear sweep of tip.kx from
+    -1.7e308 to 1.7e308 ("Nonnegative width required in format") runs its
+    points (the middle one is 0, exactly) without an abort or a checkpoint
+    left."""
+    result = friction(args, "-o", "o.h5", inputs(args, "brake.nml"), "--set", "brake.t_end=400",
+                      "--set", "analysis.orbit=.true.", "--set", "analysis.continuation='mu'",
+                      "--set", "analysis.continuation_end=0.5", "--set", "analysis.continuation_points=2147483647",
+                      expect=3)
+    contains(result, "&analysis", "continuation_points")
+    write(args, "kx.nml", "&sweep sweep_variable = 'tip.kx', sweep_spacing = 'linear', sweep_from = -1.7e308,"
+          " sweep_to = 1.7e308, sweep_count = 3 /\n&scan nx = 8, ny = 1 /\n")
+    result = friction(args, "-o", "s.h5", inputs(args, "naf.nml"), "kx.nml", expect=None)
+    if result.returncode not in (0, 4):
+        fail(f"the kx sweep: exit {result.returncode}: {result.stderr}")
+    if [f for f in listing(args.workdir) if ".ckpt" in f or ".tmp" in f]:
+        fail(f"the kx sweep left {listing(args.workdir)}")
+    with h5py.File(path(args, "s.h5"), "r") as handle:
+        values = handle["sweep/values"][()]
+        if list(values) != [-1.7e308, 0.0, 1.7e308]:
+            fail(f"the sweep's values {values}, expected -1.7e308, 0, 1.7e308")
+
+
+def case_endless_loops(args):
+    """lyapunov_spectrum_renormalise = 1e-300 with max_wall_time = 3 never
+    ended and ignored SIGTERM; 1e-13 and lyapunov_renormalise = 1e-300 (an
+    exponent of 0.0 from zero samples) were accepted.  Each is bad input now,
+    naming the variable."""
+    for name in ("lyapunov_spectrum_renormalise", "lyapunov_renormalise"):
+        for value in ("1e-300", "1e-13"):
+            result = friction(args, "--print-input", inputs(args, "brake.nml"), "--set", f"analysis.{name}={value}",
+                              "--set", "analysis.lyapunov_spectrum=.true.", "--set", "analysis.lyapunov=.true.",
+                              expect=3)
+            contains(result, f"&analysis: {name}", "renormalisation intervals")
+
+
+def signalled(args, command, words, delay, limit):
+    """Run command, send SIGTERM after `delay` seconds (inside its long
+    loop), and check it ends within `limit` seconds of the signal with exit
+    6 and `words` in its message; returns the seconds it took."""
+    process = subprocess.Popen(command, cwd=args.workdir, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(delay)
+    if process.poll() is not None:
+        fail(f"{command}: ended (exit {process.returncode}) before the signal: the loop is not long enough "
+             f"to test: {process.stderr.read()}")
+    sent = time.monotonic()
+    process.send_signal(signal.SIGTERM)
+    try:
+        _, stderr = process.communicate(timeout=120)
+    except subprocess.TimeoutExpired:
+        process.kill()
+        fail(f"{command}: no end 120 s after SIGTERM")
+    took = time.monotonic() - sent
+    if process.returncode != 6 or any(word not in stderr for word in words):
+        fail(f"SIGTERM: exit {process.returncode}, expected 6 with {words}: {stderr}")
+    if took > limit:
+        fail(f"SIGTERM: ended {took:.2f} s after the signal, more than {limit} s")
+    return took
+
+
+def case_stop_long_loops(args):
+    """A stop request ends each long loop of a brake run within one of its
+    pieces: the Lyapunov spectrum's renormalisations, Benettin's intervals,
+    the continuation's points.  Each run integrates a short trajectory
+    (0.1 s), then spends its time in the loop (tens of seconds to its end);
+    SIGTERM comes 3 s after the start, and the run must end with exit 6
+    within 5 s (a piece takes milliseconds; the margin is the machine's
+    load).  Before, the loops ran to their end (837 s for the spectrum of
+    the issue)."""
+    quiet = ("&analysis spectrum = .false., poincare = .false., rosenstein = .false., lyapunov = .false.,"
+             " lyapunov_spectrum = .false., orbit = .false.,\n")
+    runs = {
+        "spectrum": ("lyapunov_spectrum = .true., lyapunov_spectrum_renormalise = 0.0002,"
+                     " lyapunov_spectrum_transient = 0.0 /\n", "the Lyapunov spectrum"),
+        "benettin": ("lyapunov = .true., lyapunov_renormalise = 0.0002, lyapunov_transient = 0.0 /\n",
+                     "the Lyapunov exponent"),
+        "continuation": ("orbit = .true., continuation = 'mu', continuation_end = 0.3,"
+                         " continuation_points = 20000 /\n", "the continuation"),
+    }
+    for name, (text, words) in runs.items():
+        write(args, name + ".nml", "&brake t_end = 1000.0, dt_out = 0.5 /\n" + quiet + text)
+        took = signalled(args, [args.binary, "-o", name + ".h5", inputs(args, "brake.nml"), name + ".nml"],
+                         ["stopped on request", words], 3.0, 5.0)
+        if [f for f in listing(args.workdir) if f.startswith(name + ".h5")]:
+            fail(f"{name}: a stopped run left {listing(args.workdir)}")
+        print(f"{name}: ended {took:.2f} s after SIGTERM")
+
+
 CASES = {name[len("case_"):].replace("_", "-"): function for name, function in globals().items()
          if name.startswith("case_")}
 

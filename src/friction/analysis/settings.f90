@@ -12,6 +12,11 @@ module friction_analysis_settings
 
    public :: analysis_settings, section_names
 
+   !> The most renormalisation intervals a Lyapunov estimate may take, and
+   !> the most points a continuation may follow (both: hours to days of work).
+   real(wp), parameter :: max_renormalisations = 1.0e7_wp
+   integer, parameter :: max_continuation_points = 100000
+
    character(len=*), parameter :: section_names(3) = [character(len=13) :: 'none', 'stick_to_slip', 'w_zero_up']
 
    type :: analysis_settings
@@ -152,6 +157,12 @@ contains
          & call c%reject('analysis', 'lyapunov_spectrum_duration', rtoa(self%lyapunov_spectrum_duration), &
          & 'shorter than one renormalisation interval, lyapunov_spectrum_renormalise = ' &
          & //rtoa(self%lyapunov_spectrum_renormalise))
+      ! Each renormalisation is an integration of its own: a tiny interval
+      ! makes the loop endless in practice (1e-300 ran for hours, 1e-13 too).
+      if (self%lyapunov) call check_intervals('lyapunov_renormalise', self%lyapunov_renormalise, &
+         & self%lyapunov_duration, self%lyapunov_transient)
+      if (self%lyapunov_spectrum) call check_intervals('lyapunov_spectrum_renormalise', &
+         & self%lyapunov_spectrum_renormalise, self%lyapunov_spectrum_duration, self%lyapunov_spectrum_transient)
       call c%nonnegative('analysis', 'orbit_transient', self%orbit_transient, 'τ')
       call c%positive('analysis', 'orbit_tolerance', self%orbit_tolerance, 'm and m per unit time')
       if (self%orbit_max_iterations < 1) call c%reject('analysis', 'orbit_max_iterations', &
@@ -159,6 +170,11 @@ contains
       call c%finite('analysis', 'continuation_end', self%continuation_end)
       if (self%continuation_points < 2) call c%reject('analysis', 'continuation_points', &
          & itoa(self%continuation_points), 'must be >= 2 (both ends of the line)')
+      ! Each point is a periodic orbit found by Newton shooting: more than
+      ! max_continuation_points would run for years (2**31 - 1 asked 64 GB).
+      if (self%continuation_points > max_continuation_points) call c%reject('analysis', 'continuation_points', &
+         & itoa(self%continuation_points), 'must be <= '//itoa(max_continuation_points) &
+         & //' (each point is a periodic orbit of its own)')
       if (len_trim(self%continuation) > 0 .and. .not. self%orbit) call c%reject('analysis', 'continuation', &
          & "'"//trim(self%continuation)//"'", 'follows the periodic orbit: needs orbit = .true.')
       if (self%rosenstein_stride < 1) call c%reject('analysis', 'rosenstein_stride', &
@@ -176,6 +192,23 @@ contains
       if (self%rosenstein_fit_end <= self%rosenstein_fit_start .or. &
          & self%rosenstein_fit_end > self%rosenstein_horizon) call c%reject('analysis', 'rosenstein_fit_end', &
          & itoa(self%rosenstein_fit_end), 'must be in (rosenstein_fit_start, rosenstein_horizon]')
+   contains
+
+      !> The renormalisation interval `name` over its span (duration, or the
+      !> run after the transient) gives at most max_renormalisations intervals.
+      subroutine check_intervals(name, interval, duration, transient)
+         character(len=*), intent(in) :: name
+         real(wp), intent(in) :: interval, duration, transient
+         real(wp) :: span
+
+         if (.not. (interval > 0.0_wp)) return   ! refused above
+         span = duration
+         if (span == 0.0_wp) span = t_end - t_start - transient
+         if (.not. (span / interval <= max_renormalisations)) call c%reject('analysis', name, rtoa(interval), &
+            & 'gives '//rtoa(span / interval)//' renormalisation intervals over '//rtoa(span)//' τ; at most ' &
+            & //rtoa(max_renormalisations)//' (each is an integration of its own): give a longer interval')
+      end subroutine check_intervals
+
    end subroutine validate
 
 end module friction_analysis_settings

@@ -19,6 +19,8 @@ module friction_brake_diagnostics
    use friction_analysis_lyapunov_series, only: rosenstein_settings, rosenstein_result, rosenstein_exponent
    use friction_analysis_periodic_orbit, only: orbit_settings
    use friction_brake_orbit, only: brake_orbit, brake_periodic_orbit, orbit_branch, follow_branch
+   use friction_scene_report, only: job_reporter, loop_guard
+   use friction_clock, only: wall_seconds
    implicit none
    private
 
@@ -45,16 +47,23 @@ module friction_brake_diagnostics
 
 contains
 
-   !> Everything the settings switch on, from a finished run.
-   subroutine diagnose_brake(config, trajectory, events, result, error)
+   !> Everything the settings switch on, from a finished run.  The long
+   !> loops (the Lyapunov estimates' intervals, the continuation's points)
+   !> end on a stop request of `reporter` (if given) and at the integrator's
+   !> max_wall_time since the diagnostics began.
+   subroutine diagnose_brake(config, trajectory, events, result, error, reporter)
       type(brake_config), intent(in) :: config
       type(brake_trajectory), intent(in) :: trajectory
       type(brake_event_table), intent(in) :: events
       type(brake_diagnostics), intent(out) :: result
       type(error_type), allocatable, intent(out) :: error
+      class(job_reporter), intent(inout), optional :: reporter
       real(wp), allocatable :: states(:, :), window_series(:)
       integer :: first, last, k, column
       real(wp) :: t_end
+      type(loop_guard) :: guard
+
+      guard = loop_guard(started=wall_seconds(), limit=config%solver%max_wall_time)
 
       associate (a => config%analysis)
          result%settings = a
@@ -122,7 +131,7 @@ contains
                & result%benettin%duration = config%t_end - config%t_start - a%lyapunov_transient
             result%benettin%renormalise = a%lyapunov_renormalise
             result%benettin%d0 = a%lyapunov_d0
-            call brake_benettin(config, result%benettin, result%flow, error)
+            call brake_benettin(config, result%benettin, result%flow, error, guard, reporter)
             if (allocated(error)) return
          end if
          if (a%lyapunov_spectrum) then
@@ -131,7 +140,7 @@ contains
             if (result%tangent%duration == 0.0_wp) &
                & result%tangent%duration = config%t_end - config%t_start - a%lyapunov_spectrum_transient
             result%tangent%renormalise = a%lyapunov_spectrum_renormalise
-            call brake_lyapunov_spectrum(config, result%tangent, result%qr, error)
+            call brake_lyapunov_spectrum(config, result%tangent, result%qr, error, guard, reporter)
             if (allocated(error)) return
             result%exponents = result%qr%exponents()
             result%kaplan_yorke = kaplan_yorke(result%exponents)
@@ -147,7 +156,7 @@ contains
             if (len_trim(a%continuation) > 0) then
                call follow_branch(config, result%orbit, a%continuation_end, a%continuation_points, &
                   & a%orbit_transient, orbit_settings(tolerance=a%orbit_tolerance, &
-                  & max_iterations=a%orbit_max_iterations), result%branch, error)
+                  & max_iterations=a%orbit_max_iterations), result%branch, error, guard, reporter)
                if (allocated(error)) return
             end if
          end if
@@ -172,11 +181,13 @@ contains
    !> back to d0.  In stick the perturbation is put on the positions only so
    !> that both runs start in the same phase; a separation with a velocity
    !> part restarts the perturbed run in slip, as the logic decides.
-   subroutine brake_benettin(config, settings, result, error)
+   subroutine brake_benettin(config, settings, result, error, guard, reporter)
       type(brake_config), intent(in) :: config
       type(benettin_settings), intent(in) :: settings
       type(benettin_accumulator), intent(out) :: result
       type(error_type), allocatable, intent(out) :: error
+      type(loop_guard), intent(in), optional :: guard   !! a stop request and max_wall_time, checked each interval
+      class(job_reporter), intent(inout), optional :: reporter
       class(brake_integrator), allocatable, target :: reference_run, perturbed_run
       type(brake_event_table) :: reference_events, perturbed_events
       real(wp) :: t, reference(4), perturbed(4), direction(4)
@@ -212,6 +223,10 @@ contains
          call result%renormalise(reference, perturbed, settings%renormalise)
          ! Long runs: keep the event tables from growing without bound.
          call reference_events%clear()
+         if (present(guard)) then
+            call guard%check(reporter, '&analysis: the Lyapunov exponent (Benettin)', t, 'τ', error)
+            if (allocated(error)) return
+         end if
       end do
 
    contains
@@ -232,11 +247,13 @@ contains
    !> tangent matrix (the switched model applies the saltation matrices at
    !> its events and the stick flow, which forgets the block's velocity);
    !> after the transient, a QR step every renormalisation interval.
-   subroutine brake_lyapunov_spectrum(config, settings, result, error)
+   subroutine brake_lyapunov_spectrum(config, settings, result, error, guard, reporter)
       type(brake_config), intent(in) :: config
       type(tangent_settings), intent(in) :: settings
       type(spectrum_accumulator), intent(out) :: result
       type(error_type), allocatable, intent(out) :: error
+      type(loop_guard), intent(in), optional :: guard   !! a stop request and max_wall_time, checked each interval
+      class(job_reporter), intent(inout), optional :: reporter
       class(brake_integrator), allocatable, target :: run
       type(brake_event_table) :: events
       real(wp) :: phi(4, 4), t0
@@ -260,6 +277,8 @@ contains
          if (allocated(error)) return
          call events%clear()
          call run%reset_tangent(phi)
+         call check_guard()
+         if (allocated(error)) return
       end do
       intervals = int(settings%duration / settings%renormalise + 1.0e-9_wp)
       call result%start(4, intervals)
@@ -271,7 +290,16 @@ contains
          phi = run%phi
          call result%renormalise(phi, settings%renormalise, run%lost)
          call run%reset_tangent(phi)
+         call check_guard()
+         if (allocated(error)) return
       end do
+
+   contains
+
+      subroutine check_guard()
+         if (present(guard)) call guard%check(reporter, '&analysis: the Lyapunov spectrum', run%t, 'τ', error)
+      end subroutine check_guard
+
    end subroutine brake_lyapunov_spectrum
 
 end module friction_brake_diagnostics

@@ -26,6 +26,7 @@ module friction_brake_orbit
    use friction_brake_params, only: brake_parameters
    use friction_brake_record, only: brake_event_table, event_stick_to_slip, event_kind_names
    use friction_brake_switched, only: switched_integrator, brake_slip
+   use friction_scene_report, only: job_reporter, loop_guard
    use friction_analysis_periodic_orbit, only: section_map, orbit_settings, periodic_orbit, &
       & find_periodic_orbit, floquet_multipliers, floquet_exponents
    implicit none
@@ -235,7 +236,7 @@ contains
    !> that fails, from the first slip onset after `transient` of a run at
    !> the point.  Every point's run also gives the attractor's slip onsets.
    !> Sequential: the result does not depend on ranks.
-   subroutine follow_branch(config, first, last, n, transient, settings, branch, error)
+   subroutine follow_branch(config, first, last, n, transient, settings, branch, error, guard, reporter)
       type(brake_config), intent(in) :: config
       type(brake_orbit), intent(in) :: first
       real(wp), intent(in) :: last, transient
@@ -243,6 +244,8 @@ contains
       type(orbit_settings), intent(in) :: settings
       type(orbit_branch), intent(out) :: branch
       type(error_type), allocatable, intent(out) :: error
+      type(loop_guard), intent(in), optional :: guard   !! a stop request and max_wall_time, checked each point
+      class(job_reporter), intent(inout), optional :: reporter
       type(brake_orbit) :: previous, current
       type(brake_config) :: point
       real(wp) :: start
@@ -281,6 +284,11 @@ contains
          branch%section_x = [branch%section_x, onsets]
          call record(k, current)
          previous = current
+         if (present(guard) .and. k < n) then
+            call guard%check(reporter, '&analysis: the continuation of the orbit', branch%parameter(k), &
+               & trim(branch%variable), error)
+            if (allocated(error)) return
+         end if
       end do
       call detect_bifurcations(config, branch)
 

@@ -178,7 +178,10 @@ contains
                & .or. a%orbit
          end associate
          if (self%analysing) then
-            call diagnose_brake(settings, main_run%trajectory, main_run%events, self%diagnostics, error)
+            ! A stop request or max_wall_time may end the long loops on some
+            ! ranks sooner than on others: they agree before going on.
+            call diagnose_brake(settings, main_run%trajectory, main_run%events, self%diagnostics, error, reporter)
+            call agree_on_error(job, error)
             if (allocated(error)) return
          end if
 

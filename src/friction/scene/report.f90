@@ -4,11 +4,13 @@
 !> (app/) and the C API extend it.
 module friction_scene_report
    use friction_kinds, only: wp
-   use friction_strings, only: fixed_text
+   use friction_strings, only: fixed_text, rtoa
+   use friction_error, only: error_type, fatal_error, error_interrupted, error_numerical
+   use friction_clock, only: wall_seconds
    implicit none
    private
 
-   public :: job_reporter, progress_text
+   public :: job_reporter, progress_text, loop_guard
 
    type :: job_reporter
    contains
@@ -28,7 +30,43 @@ module friction_scene_report
       procedure :: stop_after => stop_after_request
    end type job_reporter
 
+   !> What a long loop inside a run asks between its pieces (a Lyapunov
+   !> estimate's renormalisations, a continuation's points): whether a stop
+   !> was requested, and whether the integrator's max_wall_time has passed
+   !> since the loop's work began.  Each piece is short and bounded, so the
+   !> loop ends within one piece of the request or the limit.
+   type :: loop_guard
+      real(wp) :: started = 0.0_wp   !! wall_seconds() when the work began
+      real(wp) :: limit = 0.0_wp     !! s; 0 for none
+   contains
+      procedure :: check => guard_check
+   end type loop_guard
+
 contains
+
+   !> An error when the loop must end: stopped on request (`reporter`, if
+   !> given, asked), or max_wall_time reached; `what` names the work and
+   !> `t` (in `unit`) how far it came, in the message.
+   subroutine guard_check(self, reporter, what, t, unit, error)
+      class(loop_guard), intent(in) :: self
+      class(job_reporter), intent(inout), optional :: reporter
+      character(len=*), intent(in) :: what, unit
+      real(wp), intent(in) :: t
+      type(error_type), allocatable, intent(inout) :: error
+
+      if (allocated(error)) return
+      if (present(reporter)) then
+         if (reporter%stop_requested()) then
+            call fatal_error(error, what//' stopped on request at '//unit//' = '//rtoa(t) &
+               & //': no file written (run it again)', error_interrupted)
+            return
+         end if
+      end if
+      if (self%limit > 0.0_wp) then
+         if (wall_seconds() - self%started > self%limit) call fatal_error(error, what//': max_wall_time = ' &
+            & //rtoa(self%limit)//' s reached at '//unit//' = '//rtoa(t), error_numerical)
+      end if
+   end subroutine guard_check
 
    !> What a progress report says, for any reporter: "τ = 120.0 of 3200.0",
    !> "12 of 64 lines", "20 of 48 points started" (rank 0 knows the index of
