@@ -160,9 +160,11 @@ contains
       ! Each renormalisation is an integration of its own: a tiny interval
       ! makes the loop endless in practice (1e-300 ran for hours, 1e-13 too).
       if (self%lyapunov) call check_intervals('lyapunov_renormalise', self%lyapunov_renormalise, &
-         & self%lyapunov_duration, self%lyapunov_transient)
+         & self%lyapunov_duration, self%lyapunov_transient, .false.)
+      ! (The spectrum's transient is integrated in renormalisation intervals too.)
       if (self%lyapunov_spectrum) call check_intervals('lyapunov_spectrum_renormalise', &
-         & self%lyapunov_spectrum_renormalise, self%lyapunov_spectrum_duration, self%lyapunov_spectrum_transient)
+         & self%lyapunov_spectrum_renormalise, self%lyapunov_spectrum_duration, self%lyapunov_spectrum_transient, &
+         & .true.)
       call c%nonnegative('analysis', 'orbit_transient', self%orbit_transient, 'τ')
       call c%positive('analysis', 'orbit_tolerance', self%orbit_tolerance, 'm and m per unit time')
       if (self%orbit_max_iterations < 1) call c%reject('analysis', 'orbit_max_iterations', &
@@ -195,15 +197,18 @@ contains
    contains
 
       !> The renormalisation interval `name` over its span (duration, or the
-      !> run after the transient) gives at most max_renormalisations intervals.
-      subroutine check_intervals(name, interval, duration, transient)
+      !> run after the transient; the transient too when `stepped`) gives at
+      !> most max_renormalisations intervals.
+      subroutine check_intervals(name, interval, duration, transient, stepped)
          character(len=*), intent(in) :: name
          real(wp), intent(in) :: interval, duration, transient
+         logical, intent(in) :: stepped
          real(wp) :: span
 
          if (.not. (interval > 0.0_wp)) return   ! refused above
          span = duration
          if (span == 0.0_wp) span = t_end - t_start - transient
+         if (stepped) span = span + transient
          if (.not. (span / interval <= max_renormalisations)) call c%reject('analysis', name, rtoa(interval), &
             & 'gives '//rtoa(span / interval)//' renormalisation intervals over '//rtoa(span)//' τ; at most ' &
             & //rtoa(max_renormalisations)//' (each is an integration of its own): give a longer interval')
