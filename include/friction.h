@@ -43,6 +43,16 @@
  * last spectrum's FFT plan from one job to the next.  A job started from a job's own report callback (the
  * same thread) is refused with FRICTION_ERROR_INPUT.
  *
+ * Freed handles.  The library keeps a table of the handles it gave out and
+ * the host has not freed.  Freeing a handle twice, or passing one after
+ * freeing it (or a pointer the library never gave out, or a handle of
+ * another kind), is detected and harmless: the free functions ignore it,
+ * the others return FRICTION_ERROR_INPUT with "... handle is not live"
+ * (friction_error_status returns -1 for such an error handle, and an error
+ * handle that is not live gets no message).  The one case it cannot tell:
+ * a freed handle whose memory the allocator has given to a new handle of
+ * the same kind is that new handle, so using it is undefined behaviour.
+ *
  * Units are those of the namelist input (docs/input.md).
  */
 #ifndef FRICTION_H

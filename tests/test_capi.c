@@ -173,6 +173,43 @@ static void check_null_handles(friction_error *err) {
   friction_config_free(cfg);
 }
 
+/* A host that frees a handle twice or uses one after freeing it (issue 40):
+ * the frees ignore it and the other calls refuse it, without touching the
+ * freed memory (under valgrind or ASan this runs clean). */
+static void check_freed_handles(friction_error *err) {
+  char buf[256];
+  double x[16];
+  size_t shape[2], needed;
+  friction_config *cfg = small_naf(err);
+  friction_result *res = friction_compute(cfg, err);
+  CHECK(res != NULL, "compute for the freed-handle checks");
+  friction_config_free(cfg);
+  friction_config_free(cfg); /* a double free */
+  expect_input_error(friction_config_set(cfg, "tip.kx", "1.0", err), err, "not live", "set(freed cfg)");
+  expect_input_error(friction_config_get(cfg, "tip.kx", buf, sizeof buf, err), err, "not live", "get(freed cfg)");
+  expect_input_error(friction_config_check(cfg, err), err, "not live", "check(freed cfg)");
+  CHECK(friction_config_text(cfg, buf, sizeof buf, &needed) == FRICTION_ERROR_INPUT, "text(freed cfg)");
+  CHECK(friction_config_names(cfg, buf, sizeof buf, &needed) == FRICTION_ERROR_INPUT, "names(freed cfg)");
+  CHECK(friction_compute(cfg, err) == NULL, "compute(freed cfg)");
+  expect_input_error(friction_error_status(err), err, "not live", "compute(freed cfg)");
+  friction_result_free(res);
+  friction_result_free(res);
+  expect_input_error(friction_result_get(res, "fx", x, 16, &needed, err), err, "not live", "result_get(freed)");
+  expect_input_error(friction_result_shape(res, "fx", shape, err), err, "not live", "result_shape(freed)");
+  CHECK(friction_result_names(res, buf, sizeof buf) == FRICTION_ERROR_INPUT, "result_names(freed)");
+  /* A handle of another kind is not taken for this one. */
+  expect_input_error(friction_config_check((friction_config *)err, err), err, "not live", "check(error as cfg)");
+  friction_error *gone = friction_error_new();
+  friction_error_free(gone);
+  friction_error_free(gone);
+  CHECK(friction_error_status(gone) == -1, "status of a freed error handle");
+  CHECK(friction_error_message(gone, buf, sizeof buf) != FRICTION_OK && strstr(buf, "not live") != NULL,
+        "message of a freed error handle: '%s'", buf);
+  cfg = small_naf(err);
+  CHECK(friction_config_set(cfg, "tip.kx", "1.0", gone) == FRICTION_OK, "a call with a freed error handle");
+  friction_config_free(cfg);
+}
+
 /* Names, kinds and values through set, set_real and get. */
 static void check_set_get(friction_error *err) {
   char buf[512];
@@ -580,6 +617,7 @@ static int checks(void) {
   check_versions();
   check_error_handles();
   check_null_handles(err);
+  check_freed_handles(err);
   check_set_get(err);
   check_checks(err);
   check_files(err);

@@ -19,7 +19,7 @@ module friction_capi
    use mpi_f08, only: MPI_Comm, MPI_Initialized, MPI_Finalized, MPI_Init_thread, MPI_THREAD_FUNNELED, &
       & MPI_COMM_WORLD, MPI_COMM_NULL
    use friction_kinds, only: wp, i8
-   use friction_error, only: error_type, fatal_error, error_input, error_interrupted
+   use friction_error, only: error_type, fatal_error, error_input, error_interrupted, error_internal
    use friction_strings, only: itoa, rtoa, join, quoted
    use friction_version, only: version_string
    use friction_parameters, only: parameter_info, list_parameters, set_parameter, set_parameter_number, &
@@ -52,6 +52,9 @@ module friction_capi
 
    !> friction_run_job / friction_run_config flags.
    integer(c_int), parameter :: job_force = 1, job_resume = 2, job_init_mpi = 4
+
+   !> The kinds of handle in the table of live ones (handles.c).
+   integer(c_int), parameter :: kind_error = 1, kind_config = 2, kind_result = 3
 
    !> What an opaque `friction_error *` points to.
    type :: capi_error
@@ -130,6 +133,23 @@ module friction_capi
       subroutine friction_job_end() bind(c, name='friction_job_end')
       end subroutine friction_job_end
 
+      !> The live handles (handles.c): recorded when made, taken out when
+      !> freed; a handle not live (freed, or never given out) is refused.
+      integer(c_int) function friction_handle_add(handle, kind) bind(c, name='friction_handle_add')
+         import :: c_ptr, c_int
+         type(c_ptr), value :: handle
+         integer(c_int), value :: kind
+      end function friction_handle_add
+      integer(c_int) function friction_handle_remove(handle, kind) bind(c, name='friction_handle_remove')
+         import :: c_ptr, c_int
+         type(c_ptr), value :: handle
+         integer(c_int), value :: kind
+      end function friction_handle_remove
+      integer(c_int) function friction_handle_live(handle, kind) bind(c, name='friction_handle_live')
+         import :: c_ptr, c_int
+         type(c_ptr), value :: handle
+         integer(c_int), value :: kind
+      end function friction_handle_live
       function friction_job_stop_asked() bind(c, name='friction_job_stop_asked') result(asked)
          import :: c_int
          integer(c_int) :: asked
@@ -223,6 +243,7 @@ contains
       status = 0
       if (allocated(error)) status = int(error%stat, c_int)
       if (.not. c_associated(handle)) return
+      if (friction_handle_live(handle, kind_error) == 0) return   ! freed: nowhere to say it
       call c_f_pointer(handle, err)
       err%status = status
       if (allocated(error)) then
@@ -265,6 +286,10 @@ contains
       allocate (err)
       err%message = ''
       handle = c_loc(err)
+      if (friction_handle_add(handle, kind_error) == 0) then
+         deallocate (err)
+         handle = c_null_ptr
+      end if
    end function friction_error_new
 
    !> void friction_error_free(friction_error *err); null is ignored.
@@ -273,6 +298,7 @@ contains
       type(capi_error), pointer :: err
 
       if (.not. c_associated(handle)) return
+      if (friction_handle_remove(handle, kind_error) == 0) return   ! freed already, or not an error handle
       call c_f_pointer(handle, err)
       deallocate (err)
    end subroutine friction_error_free
@@ -284,6 +310,7 @@ contains
 
       status = -1
       if (.not. c_associated(handle)) return
+      if (friction_handle_live(handle, kind_error) == 0) return
       call c_f_pointer(handle, err)
       status = err%status
    end function friction_error_status
@@ -300,6 +327,10 @@ contains
       status = error_input
       if (.not. c_associated(handle)) then
          copied = copy_text('', buf, len)   ! an empty message, still a failure
+         return
+      end if
+      if (friction_handle_live(handle, kind_error) == 0) then
+         copied = copy_text('the error handle is not live (freed already, or not from friction_error_new)', buf, len)
          return
       end if
       call c_f_pointer(handle, err)
@@ -333,6 +364,12 @@ contains
       config%job%scene_name = name
       allocate (config%files(0))
       cfg = c_loc(config)
+      if (friction_handle_add(cfg, kind_config) == 0) then
+         deallocate (config)
+         cfg = c_null_ptr
+         status = refuse(handle, 'out of memory for a new configuration handle')
+         return
+      end if
       status = report(handle, none)
    end function friction_config_new
 
@@ -342,6 +379,7 @@ contains
       type(capi_config), pointer :: config
 
       if (.not. c_associated(cfg)) return
+      if (friction_handle_remove(cfg, kind_config) == 0) return   ! freed already, or not a configuration
       call c_f_pointer(cfg, config)
       deallocate (config)
    end subroutine friction_config_free
@@ -355,10 +393,14 @@ contains
 
       ok = c_associated(cfg)
       nullify (config)
-      if (ok) then
-         call c_f_pointer(cfg, config)
-      else
+      if (.not. ok) then
          call fatal_error(error, 'the configuration is a null pointer', error_input)
+      else if (friction_handle_live(cfg, kind_config) == 0) then
+         ok = .false.
+         call fatal_error(error, 'the configuration handle is not live (freed already, or not from ' &
+            & //'friction_config_new)', error_input)
+      else
+         call c_f_pointer(cfg, config)
       end if
    end function config_of
 
@@ -545,6 +587,7 @@ contains
 
       status = error_input
       if (.not. c_associated(cfg)) return
+      if (friction_handle_live(cfg, kind_config) == 0) return
       call c_f_pointer(cfg, config)
       work = config%job
       ! (The text is formatted by the Fortran runtime's internal writes, which
@@ -583,6 +626,7 @@ contains
 
       status = error_input
       if (.not. c_associated(cfg)) return
+      if (friction_handle_live(cfg, kind_config) == 0) return
       call c_f_pointer(cfg, config)
       work = config%job
       list = list_parameters(work)
@@ -793,6 +837,10 @@ contains
       allocate (result)
       allocate (result%items(0))
       call work%scene%compute(result, config%memory, reporter, error)
+      if (.not. allocated(error)) then
+         if (friction_handle_add(c_loc(result), kind_result) == 0) call fatal_error(error, &
+            & 'out of memory for a new result handle', error_internal)
+      end if
       status = report(handle, error)
       if (allocated(error)) then
          deallocate (result)
@@ -815,6 +863,11 @@ contains
       nullify (result)
       if (.not. c_associated(res)) then
          call fatal_error(error, 'the result is a null pointer', error_input)
+         return
+      end if
+      if (friction_handle_live(res, kind_result) == 0) then
+         call fatal_error(error, 'the result handle is not live (freed already, or not from friction_compute)', &
+            & error_input)
          return
       end if
       call c_f_pointer(res, result)
@@ -896,6 +949,7 @@ contains
 
       status = error_input
       if (.not. c_associated(res)) return
+      if (friction_handle_live(res, kind_result) == 0) return
       call c_f_pointer(res, result)
       if (copy_text(join(result%items%name, new_line('a')), buf, len)) status = 0
    end function friction_result_names
@@ -906,6 +960,7 @@ contains
       type(capi_result), pointer :: result
 
       if (.not. c_associated(res)) return
+      if (friction_handle_remove(res, kind_result) == 0) return   ! freed already, or not a result
       call c_f_pointer(res, result)
       deallocate (result)
    end subroutine friction_result_free
