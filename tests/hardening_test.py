@@ -1119,6 +1119,34 @@ def case_stop_long_loops(args):
         print(f"{name}: ended {took:.2f} s after SIGTERM")
 
 
+def case_misleading_messages(args):
+    """Messages that named no variable or blamed the wrong thing: ax =
+    1e-300 failed as a NaN at t = 0; a tiny Langevin time_step, welch_segments
+    and lyapunov_d0 = 1e300 (blamed on the pad lifting off) named no file,
+    line or variable; thermal.temperature = 1e300 ran (forces of 1e148 nN).
+    Each is bad input naming the file, line, group and variable now.  Two
+    ranks reading a pipe were told to give 'a regular file or a pipe'."""
+    cases = [
+        ("naf.nml", "&surface ax = 1e-300 /\n", "&surface: ax"),
+        ("naf_thermal_temperature.nml", "&thermal model = 'langevin', time_step = 1e-30 /\n", "&thermal: time_step"),
+        ("naf_thermal_temperature.nml", "&thermal temperature = 1e300 /\n", "&thermal: temperature"),
+        ("brake.nml", "&analysis welch_segments = 100000 /\n", "&analysis: welch_segments"),
+        ("brake.nml", "&analysis lyapunov_d0 = 1e300 /\n", "&analysis: lyapunov_d0"),
+    ]
+    for base, text, words in cases:
+        write(args, "bad.nml", text)
+        result = friction(args, "-o", "bad.h5", inputs(args, base), "bad.nml", expect=3)
+        contains(result, "bad.nml:1:", words)
+        if os.path.exists(path(args, "bad.h5")):
+            fail(f"{text.strip()}: an output was written")
+    write(args, "small.nml", SMALL)
+    result = friction(args, "-o", "pipe.h5", inputs(args, "naf.nml"), "/dev/stdin", ranks=2, expect=3,
+                      stdin=open(path(args, "small.nml")).read())
+    contains(result, "/dev/stdin", "rank 0", "regular file")
+    if "or a pipe" in result.stderr:
+        fail(f"two ranks reading a pipe were told to give a pipe: {result.stderr}")
+
+
 CASES = {name[len("case_"):].replace("_", "-"): function for name, function in globals().items()
          if name.startswith("case_")}
 

@@ -369,6 +369,10 @@ def load(path, scene=None):
             f.visititems(visit)
     except OSError as err:
         raise FileError(f"cannot read as HDF5 ({err})") from None
+    except (RuntimeError, KeyError, ValueError, TypeError) as err:
+        # A damaged file opens and then fails inside: h5py's own errors
+        # (RuntimeError, KeyError, ValueError) said nothing of the file.
+        raise FileError(f"the HDF5 file is damaged ({type(err).__name__}: {err})") from None
     arrays = _label(raw, root, group_attrs)
     return Dataset(path, arrays, root, group_attrs)
 

@@ -123,6 +123,30 @@ def test_files_it_cannot_read(tmp_path, naf_map):
         friction.load(naf_map)["afm/trace/nothing"]
 
 
+def test_a_damaged_file(tmp_path, brake_run):
+    """A file damaged inside (bits flipped past its superblock) raised
+    h5py's RuntimeError, KeyError or ValueError; every damage is the
+    package's FileError, or loads (a flip in the data's own bytes)."""
+    import random
+    data = bytes(open(brake_run, "rb").read())
+    raised = set()
+    for seed in range(40):
+        rng = random.Random(seed)
+        damaged = bytearray(data)
+        for _ in range(20):
+            at = rng.randrange(len(damaged))
+            damaged[at] ^= 1 << rng.randrange(8)
+        path = tmp_path / f"damaged-{seed}.h5"
+        path.write_bytes(bytes(damaged))
+        try:
+            friction.load(path)
+        except friction.FileError as err:
+            raised.add(str(err).split(" (")[0])
+    # The 40 fixed seeds reach a file that opens and fails inside (any other
+    # exception fails the test where it is raised).
+    assert "the HDF5 file is damaged" in raised, raised
+
+
 def test_to_xarray(naf_map, brake_sweep):
     xr = pytest.importorskip("xarray")
     data = friction.load(naf_map)

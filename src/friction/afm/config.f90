@@ -213,9 +213,11 @@ contains
       if (.not. any(potential_names == self%potential)) call c%reject('surface', 'potential', &
          & "'"//trim(self%potential)//"'", 'unknown potential (known: '//quoted(potential_names)//')')
       call c%nonnegative('surface', 'v0', self%v0, 'eV')
-      call c%positive('surface', 'ax', self%ax, 'angstrom')
-      call c%positive('surface', 'ay', self%ay, 'angstrom')
-      call c%positive('surface', 'a', self%a, 'angstrom')
+      ! Lattice constants of crystals are angstroms; ax = 1e-300 overflowed the
+      ! surface's forces and failed as a NaN at t = 0 naming no variable.
+      call lattice_constant('ax', self%ax)
+      call lattice_constant('ay', self%ay)
+      call lattice_constant('a', self%a)
       call c%positive('tip', 'mass', self%mass, 'kg')
       call c%nonnegative('tip', 'kx', self%kx, 'N/m')
       call c%nonnegative('tip', 'ky', self%ky, 'N/m')
@@ -264,6 +266,14 @@ contains
 
    contains
 
+      subroutine lattice_constant(name, value)
+         character(len=*), intent(in) :: name
+         real(wp), intent(in) :: value
+
+         if (.not. (value >= 0.01_wp)) call c%reject('surface', name, rtoa(value), &
+            & 'must be >= 0.01 angstrom (a lattice constant: crystals have 2 to 6 angstrom)')
+      end subroutine lattice_constant
+
       !> At T > 0: a tip model with thermal motion, a heat bath on every
       !> moving axis, a surface the thermal scan supports, and a step below
       !> the Langevin integrator's stability limit.
@@ -292,6 +302,14 @@ contains
             & //'an undamped axis has none')
          if (.not. c%failed() .and. self%thermal%model == 'kramers') call check_kramers()
          if (c%failed() .or. self%thermal%time_step == 0.0_wp) return
+         ! (The scan's own check said this at run time, naming no variable.)
+         if (self%nx > 1 .and. self%velocity > 0.0_wp) then
+            if (max(self%length / real(self%nx - 1, wp), self%lead_in) / self%velocity / self%thermal%time_step &
+               & > 1.0e9_wp) call c%reject('thermal', 'time_step', rtoa(self%thermal%time_step), 'makes more ' &
+               & //'than 1e9 Langevin steps between two samples (or over the lead-in): give a longer step, or 0 ' &
+               & //'to choose one')
+            if (c%failed()) return
+         end if
          limit = thermal_step_limit(self)
          if (limit > 0.0_wp .and. self%thermal%time_step >= limit) call c%reject('thermal', 'time_step', &
             & rtoa(self%thermal%time_step), 'is at or above the stability limit '//rtoa(limit)//' s of the ' &

@@ -27,6 +27,9 @@ module friction_afm_thermal
 
    public :: thermal_settings, thermal_model_names, welford_add, welford_sem
 
+   !> The highest temperature accepted, K.
+   real(wp), parameter :: max_temperature = 1.0e5_wp
+
    !> &thermal model: the Langevin tip, or the thermal reduced model (Kramers
    !> rates and kinetic Monte Carlo, friction_afm_kramers).
    character(len=*), parameter :: thermal_model_names(2) = [character(len=8) :: 'langevin', 'kramers']
@@ -81,6 +84,9 @@ contains
 
       call c%finite('thermal', 'temperature', self%temperature)
       call c%nonnegative('thermal', 'temperature', self%temperature, 'K; 0 for the deterministic tip')
+      ! Every crystal has melted long before (1e300 K ran, with forces of 1e148 nN).
+      if (self%temperature > max_temperature) call c%reject('thermal', 'temperature', rtoa(self%temperature), &
+         & 'must be <= '//rtoa(max_temperature)//' K (a tip over a crystal: every crystal melts below 5000 K)')
       if (self%realizations < 1) call c%reject('thermal', 'realizations', itoa(self%realizations), &
          & 'must be >= 1 (independent repetitions of every line)')
       if (.not. any(thermal_model_names == self%model)) then

@@ -16,6 +16,8 @@ module friction_analysis_settings
    !> the most points a continuation may follow (both: hours to days of work).
    real(wp), parameter :: max_renormalisations = 1.0e7_wp
    integer, parameter :: max_continuation_points = 100000
+   !> The largest separation Benettin's two runs may start at.
+   real(wp), parameter :: max_separation = 1.0e-3_wp
 
    character(len=*), parameter :: section_names(3) = [character(len=13) :: 'none', 'stick_to_slip', 'w_zero_up']
 
@@ -114,13 +116,16 @@ contains
       call v%end_group()
    end subroutine visit
 
-   !> The diagnostics' settings over a run from t_start to t_end; `series`
-   !> names the scene's variables that can be analysed.
-   subroutine validate(self, c, t_start, t_end, series)
+   !> The diagnostics' settings over a run from t_start to t_end sampled
+   !> every `dt` (if given); `series` names the scene's variables that can
+   !> be analysed.
+   subroutine validate(self, c, t_start, t_end, series, dt)
       class(analysis_settings), intent(in) :: self
       type(config_checker), intent(inout) :: c
       real(wp), intent(in) :: t_start, t_end
       character(len=*), intent(in) :: series(:)
+      real(wp), intent(in), optional :: dt
+      real(wp) :: samples
 
       if (.not. any(series == self%series)) call c%reject('analysis', 'series', "'"//trim(self%series)//"'", &
          & 'unknown variable (known: '//quoted(series)//')')
@@ -133,6 +138,15 @@ contains
          & rtoa(self%window_end), 'must be after window_start = '//rtoa(self%window_start))
       if (self%welch_segments < 1) call c%reject('analysis', 'welch_segments', itoa(self%welch_segments), &
          & 'must be >= 1')
+      ! K half-overlapping segments of the window's samples: each needs 8 (the
+      ! spectrum's own check, which named no variable).
+      if (present(dt) .and. self%welch_segments > 1 .and. (self%spectrum .or. self%poincare)) then
+         samples = (min(self%window_end, t_end) - max(self%window_start, t_start)) / dt + 1.0_wp
+         if (samples > 0.0_wp .and. 2.0_wp * samples / (self%welch_segments + 1.0_wp) < 8.0_wp) &
+            & call c%reject('analysis', 'welch_segments', itoa(self%welch_segments), 'leaves fewer than 8 ' &
+            & //'samples a segment of the window [window_start, window_end] ('//itoa(int(samples)) &
+            & //' samples); at most '//itoa(max(1, int(samples) / 4 - 1)))
+      end if
       call c%nonnegative('analysis', 'strobe_period', self%strobe_period, 'τ; 0 for 1 / peak frequency')
       call c%finite('analysis', 'strobe_start', self%strobe_start)
       call c%nonnegative('analysis', 'strobe_end', self%strobe_end, 'τ; 0 for the end of the run')
@@ -140,6 +154,11 @@ contains
       call c%nonnegative('analysis', 'lyapunov_duration', self%lyapunov_duration, 'τ; 0 for the rest of the run')
       call c%positive('analysis', 'lyapunov_renormalise', self%lyapunov_renormalise, 'τ')
       call c%positive('analysis', 'lyapunov_d0', self%lyapunov_d0, 'initial separation')
+      ! Benettin's separation is infinitesimal; 1e300 overflowed the perturbed
+      ! run, which was then reported as the pad lifting off.
+      if (self%lyapunov_d0 > max_separation) call c%reject('analysis', 'lyapunov_d0', rtoa(self%lyapunov_d0), &
+         & 'must be <= '//rtoa(max_separation)//' (a small separation of the two runs; the motion itself is of ' &
+         & //'order 1e-2)')
       if (self%lyapunov .and. self%lyapunov_duration == 0.0_wp .and. &
          & .not. (t_end - t_start - self%lyapunov_transient >= self%lyapunov_renormalise)) &
          & call c%reject('analysis', 'lyapunov_transient', rtoa(self%lyapunov_transient), &

@@ -203,7 +203,7 @@ contains
             & //' must be > 0 (kappa = '//rtoa(p%kappa)//', g_prime = '//rtoa(p%g_prime)//')')
       end associate
       call check_verify(self%verify, c, 'm')
-      call self%analysis%validate(c, self%t_start, self%t_end, series_names)
+      call self%analysis%validate(c, self%t_start, self%t_end, series_names, self%dt_out)
       if (c%failed() .or. len_trim(self%analysis%continuation) == 0) return
       if (self%model /= model_switched) then
          call c%reject('analysis', 'continuation', "'"//trim(self%analysis%continuation)//"'", &

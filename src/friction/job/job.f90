@@ -139,6 +139,7 @@ contains
       integer :: k
 
       call read_input(files, config, job%input_text, error, overrides, notes)
+      call name_unread_pipe(job, files, error)
       call agree_on_error(job, error)
       if (allocated(error)) return
       if (job%rank == 0) then
@@ -209,6 +210,30 @@ contains
       if (allocated(error)) return
       summary = config%scene%summary(job)
    end subroutine run_configured
+
+   !> A rank other than 0 that cannot read an input file that is not a
+   !> regular one, while rank 0 could: a pipe given to a job of many ranks
+   !> reaches rank 0 alone (the others see /dev/null as /dev/stdin, and were
+   !> told to 'give a regular file or a pipe').  The error says so instead.
+   subroutine name_unread_pipe(job, files, error)
+      type(job_context), intent(in) :: job
+      character(len=*), intent(in) :: files(:)
+      type(error_type), allocatable, intent(inout) :: error
+      integer :: rank0_failed, k
+
+      if (.not. job%parallel()) return
+      rank0_failed = merge(1, 0, allocated(error))
+      call MPI_Bcast(rank0_failed, 1, MPI_INTEGER, 0, job%comm)
+      if (job%rank == 0 .or. rank0_failed /= 0 .or. .not. allocated(error)) return
+      do k = 1, size(files)
+         if (path_kind(trim(files(k)), follow=.true.) /= kind_regular) then
+            call fatal_error(error, trim(files(k))//': not a regular file (a pipe or a device?): rank 0 read ' &
+               & //'it, but on more than one rank every rank reads the input itself, and a pipe reaches rank 0 ' &
+               & //'alone; give a regular file, or run on one rank', error_input)
+            return
+         end if
+      end do
+   end subroutine name_unread_pipe
 
    !> Every rank must have read the same input: compare the hash of each
    !> rank's resolved input with rank 0's.  When they differ, name an input
