@@ -69,12 +69,12 @@ class Contract:
         return directory
 
     def run(self, directory, arguments, ranks=None, stdin=None, replaced=(), output=None, shapes=None,
-            allowed=DOCUMENTED, timeout=120, env=None):
+            allowed=DOCUMENTED, timeout=120, env=None, binary=None):
         """Run `friction --quiet ARGUMENTS` in directory and check the
         contract; `replaced` may change (the output with --force), `output`
         is checked when the run succeeds; returns the completed process."""
         before = snapshot(directory)
-        cmd = [self.args.binary, "--quiet", *arguments]
+        cmd = [binary or self.args.binary, "--quiet", *arguments]
         extra = dict(env or {})
         env = dict(os.environ)
         env.update(extra)
@@ -675,8 +675,11 @@ def newer_groups(contract, p):
             text += "&thermal temperature = 300.0, realizations = 2, seed = 5 /\n"
         write("run.nml", text)
         files = [os.path.join(inputs, "naf.nml"), "run.nml"]
+        # (The test build of the program stops on cue, as SIGTERM after that many lines would.)
+        stop = contract.args.stop_binary
         stopped = contract.run(directory, ["-o", "out.h5", *files], ranks=p["ranks"], allowed={0, 6}, timeout=90,
-                               env={"FRICTION_TEST_STOP_AFTER": str(p["stop_after"])})
+                               env={"FRICTION_TEST_STOP_AFTER": str(p["stop_after"])} if stop else None,
+                               binary=stop)
         kept = [f for f in os.listdir(directory) if f.startswith("out.h5.line-")]
         assert stopped.returncode == 0 or (kept and not os.path.exists(os.path.join(directory, "out.h5"))), \
             f"a stopped map: exit {stopped.returncode}, checkpoints {kept}"
@@ -768,6 +771,9 @@ def run_class(args, name, examples, derandomize):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--binary", required=True)
+    parser.add_argument("--stop-binary", default=None,
+                        help="the program with a reporter that stops on cue (FRICTION_TEST_STOP_AFTER), for the "
+                             "map checkpoints of newer-groups; without it those maps run uninterrupted")
     parser.add_argument("--mpiexec", required=True)
     parser.add_argument("--inputs", required=True)
     parser.add_argument("--library", default=None, help="libfriction, for the C API class")
@@ -779,6 +785,8 @@ def main():
     # (Absolute: the cases run in directories of their own, and a relative
     # path, as scripts/fuzz gives, would name nothing there.)
     args.binary = os.path.abspath(args.binary)
+    if args.stop_binary:
+        args.stop_binary = os.path.abspath(args.stop_binary)
     args.inputs = os.path.abspath(args.inputs)
     args.workdir = os.path.abspath(args.workdir)
     if "capi-values" in args.classes or "all" in args.classes:
