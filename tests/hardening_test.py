@@ -1065,6 +1065,10 @@ def case_endless_loops(args):
                               "--set", "analysis.lyapunov_spectrum=.true.", "--set", "analysis.lyapunov=.true.",
                               expect=3)
             contains(result, f"&analysis: {name}", "renormalisation intervals")
+    # Newton's steps are each a run to the section: 2**31 - 1 of them is refused too.
+    result = friction(args, "--print-input", inputs(args, "brake.nml"), "--set",
+                      "analysis.orbit_max_iterations=2147483647", expect=3)
+    contains(result, "&analysis: orbit_max_iterations", "<= 1000")
 
 
 def signalled(args, command, words, delay, limit):

@@ -16,6 +16,8 @@ module friction_analysis_settings
    !> the most points a continuation may follow (both: hours to days of work).
    real(wp), parameter :: max_renormalisations = 1.0e7_wp
    integer, parameter :: max_continuation_points = 100000
+   !> The most Newton steps a periodic orbit may take.
+   integer, parameter :: max_newton_steps = 1000
    !> The largest separation Benettin's two runs may start at.
    real(wp), parameter :: max_separation = 1.0e-3_wp
 
@@ -188,6 +190,11 @@ contains
       call c%positive('analysis', 'orbit_tolerance', self%orbit_tolerance, 'm and m per unit time')
       if (self%orbit_max_iterations < 1) call c%reject('analysis', 'orbit_max_iterations', &
          & itoa(self%orbit_max_iterations), 'must be >= 1')
+      ! Each Newton step is a return to the section, up to the whole run long:
+      ! Newton converges in tens where it converges at all.
+      if (self%orbit_max_iterations > max_newton_steps) call c%reject('analysis', 'orbit_max_iterations', &
+         & itoa(self%orbit_max_iterations), 'must be <= '//itoa(max_newton_steps)//' (Newton converges in ' &
+         & //'tens of steps where it converges at all; each is a run to the section)')
       call c%finite('analysis', 'continuation_end', self%continuation_end)
       if (self%continuation_points < 2) call c%reject('analysis', 'continuation_points', &
          & itoa(self%continuation_points), 'must be >= 2 (both ends of the line)')
