@@ -69,7 +69,7 @@ contains
             if (quote /= ' ') then
                if (c == quote) quote = ' '
             else if (.not. in_group .and. c /= '&' .and. c /= ' ' .and. c /= new_line('a') &
-               & .and. c /= achar(9)) then
+               & .and. c /= achar(9) .and. c /= achar(13)) then
                ! Outside a group nothing is read: text there would be dropped
                ! without a word (an assignment after '/', a group without '&').
                call outside_group_error(i)
