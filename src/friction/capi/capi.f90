@@ -22,8 +22,8 @@ module friction_capi
    use friction_error, only: error_type, fatal_error, error_input, error_interrupted, error_internal
    use friction_strings, only: itoa, rtoa, join, quoted
    use friction_version, only: version_string
-   use friction_parameters, only: parameter_info, list_parameters, set_parameter, set_parameter_number, &
-      & get_parameter, kind_text, value_has_kind, unit_hint
+   use friction_parameters, only: configurable, parameter_info, list_parameters, set_parameter, &
+      & set_parameter_number, get_parameter, kind_text, value_has_kind, unit_hint
    use friction_checks, only: config_checker
    use friction_input_reader, only: namelist_source, scan_files, apply_files, parse_variable_name
    use friction_scene, only: point_memory
@@ -45,7 +45,7 @@ module friction_capi
    public :: friction_run_job, friction_run_config
    !> For the C API's other files (capi/law.f90): the error handle's and the
    !> strings' helpers.
-   public :: report, refuse, c_string, copy_text
+   public :: report, refuse, c_string, copy_text, set_checked_text, set_checked_number
 
    !> FRICTION_API_VERSION of include/friction.h.
    integer(c_int), parameter :: api_version = 2
@@ -458,7 +458,7 @@ contains
       type(error_type), allocatable :: error
       type(job_config) :: work
       type(parameter_info) :: info
-      character(len=:), allocatable :: full, value, group, name, problem, shown
+      character(len=:), allocatable :: full, value, group, name
       integer :: first
 
       if (.not. config_of(cfg, config, error)) then
@@ -474,18 +474,10 @@ contains
       ! On a copy: a value refused changes nothing.
       work = config%job
       call resolve_name(work, full, group, name, first, info, error)
-      if (.not. allocated(error) .and. .not. value_has_kind(value, info%kind)) &
-         & call fatal_error(error, '&'//group//': '//name//' = '//value//': expected '//kind_text(info%kind) &
-         & //unit_hint(info), error_input)
+      if (.not. allocated(error)) call set_checked_text(work, group, name, first, info, value, error)
       if (allocated(error)) then
          status = report(handle, error)
          return
-      end if
-      call set_parameter(work, group, name, value, first, '', problem)
-      if (len(problem) > 0) then
-         shown = name
-         if (first > 0) shown = shown//'('//itoa(first)//')'
-         call fatal_error(error, '&'//group//': '//shown//' = '//value//': '//problem, error_input)
       end if
       call check_scene_kept(config, work, value, error)
       if (.not. allocated(error)) then
@@ -494,6 +486,50 @@ contains
       end if
       status = report(handle, error)
    end function friction_config_set
+
+   !> Set group.name (element `first`, 0 for all) of `obj` from namelist
+   !> text after checking its kind (`info`): the C API's message when refused.
+   subroutine set_checked_text(obj, group, name, first, info, value, error)
+      class(configurable), intent(inout) :: obj
+      character(len=*), intent(in) :: group, name, value
+      integer, intent(in) :: first
+      type(parameter_info), intent(in) :: info
+      type(error_type), allocatable, intent(inout) :: error
+      character(len=:), allocatable :: problem
+
+      if (.not. value_has_kind(value, info%kind)) then
+         call fatal_error(error, '&'//group//': '//name//' = '//value//': expected '//kind_text(info%kind) &
+            & //unit_hint(info), error_input)
+         return
+      end if
+      call set_parameter(obj, group, name, value, first, '', problem)
+      if (len(problem) > 0) call fatal_error(error, '&'//group//': '//element_name(name, first)//' = '//value &
+         & //': '//problem, error_input)
+   end subroutine set_checked_text
+
+   !> Set group.name (element `first`) of `obj` to the number x, checked.
+   subroutine set_checked_number(obj, group, name, first, x, error)
+      class(configurable), intent(inout) :: obj
+      character(len=*), intent(in) :: group, name
+      integer, intent(in) :: first
+      real(wp), intent(in) :: x
+      type(error_type), allocatable, intent(inout) :: error
+      character(len=:), allocatable :: problem
+
+      call set_parameter_number(obj, group, name, x, problem, first)
+      if (len(problem) > 0) call fatal_error(error, '&'//group//': '//element_name(name, first)//' = '//rtoa(x) &
+         & //': '//problem, error_input)
+   end subroutine set_checked_number
+
+   !> name, or name(first) for one element.
+   pure function element_name(name, first) result(shown)
+      character(len=*), intent(in) :: name
+      integer, intent(in) :: first
+      character(len=:), allocatable :: shown
+
+      shown = name
+      if (first > 0) shown = shown//'('//itoa(first)//')'
+   end function element_name
 
    !> int friction_config_set_real(friction_config *cfg, const char *name, double x,
    !>                              friction_error *err)
@@ -505,7 +541,7 @@ contains
       type(error_type), allocatable :: error
       type(job_config) :: work
       type(parameter_info) :: info
-      character(len=:), allocatable :: full, group, name, problem, shown
+      character(len=:), allocatable :: full, group, name
       integer :: first
 
       if (.not. config_of(cfg, config, error)) then
@@ -523,12 +559,8 @@ contains
          status = report(handle, error)
          return
       end if
-      call set_parameter_number(work, group, name, real(x, wp), problem, first)
-      if (len(problem) > 0) then
-         shown = name
-         if (first > 0) shown = shown//'('//itoa(first)//')'
-         call fatal_error(error, '&'//group//': '//shown//' = '//rtoa(real(x, wp))//': '//problem, error_input)
-      else
+      call set_checked_number(work, group, name, first, real(x, wp), error)
+      if (.not. allocated(error)) then
          config%job = work
          call config%origins%set_origin(group, name, '')
       end if

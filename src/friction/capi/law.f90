@@ -11,8 +11,7 @@ module friction_capi_law
    use friction_kinds, only: wp
    use friction_error, only: error_type, fatal_error, error_input
    use friction_strings, only: itoa, rtoa, join
-   use friction_parameters, only: configurable, parameter_visitor, parameter_info, list_parameters, set_parameter, &
-      & set_parameter_number, get_parameter, kind_text, value_has_kind
+   use friction_parameters, only: configurable, parameter_visitor, parameter_info, list_parameters, get_parameter
    use friction_checks, only: config_checker
    use friction_input_reader, only: parse_variable_name
    use friction_ode_solver, only: solver_settings
@@ -21,7 +20,7 @@ module friction_capi_law
    use friction_law_settings, only: law_settings
    use friction_law_factory, only: new_law, check_law, make_law, law_names
    use friction_law_history, only: law_history, history_velocity, history_displacement, history_solver_defaults
-   use friction_capi, only: report, refuse, c_string, copy_text
+   use friction_capi, only: report, refuse, c_string, copy_text, set_checked_text, set_checked_number
    implicit none
    private
 
@@ -131,7 +130,7 @@ contains
       type(capi_law) :: work
       type(error_type), allocatable :: error
       type(parameter_info) :: info
-      character(len=:), allocatable :: group, name, value, problem
+      character(len=:), allocatable :: group, name, value
       integer :: first
 
       if (.not. law_of(handle, law, error)) then
@@ -145,13 +144,7 @@ contains
       value = c_string(value_c)
       work = law   ! a value refused changes nothing
       call resolve(work, c_string(name_c), group, name, first, info, error)
-      if (.not. allocated(error) .and. .not. value_has_kind(value, info%kind)) &
-         & call fatal_error(error, '&'//group//': '//name//' = '//value//': expected '//kind_text(info%kind), &
-         & error_input)
-      if (.not. allocated(error)) then
-         call set_parameter(work, group, name, value, first, '', problem)
-         if (len(problem) > 0) call fatal_error(error, '&'//group//': '//name//' = '//value//': '//problem, error_input)
-      end if
+      if (.not. allocated(error)) call set_checked_text(work, group, name, first, info, value, error)
       if (.not. allocated(error)) law = work
       status = report(err, error)
    end function friction_law_set
@@ -165,7 +158,7 @@ contains
       type(capi_law) :: work
       type(error_type), allocatable :: error
       type(parameter_info) :: info
-      character(len=:), allocatable :: group, name, problem
+      character(len=:), allocatable :: group, name
       integer :: first
 
       if (.not. law_of(handle, law, error)) then
@@ -178,11 +171,7 @@ contains
       end if
       work = law
       call resolve(work, c_string(name_c), group, name, first, info, error)
-      if (.not. allocated(error)) then
-         call set_parameter_number(work, group, name, real(x, wp), problem, first)
-         if (len(problem) > 0) call fatal_error(error, '&'//group//': '//name//' = '//rtoa(real(x, wp))//': ' &
-            & //problem, error_input)
-      end if
+      if (.not. allocated(error)) call set_checked_number(work, group, name, first, real(x, wp), error)
       if (.not. allocated(error)) law = work
       status = report(err, error)
    end function friction_law_set_real

@@ -12,22 +12,22 @@ module friction_law_elastoplastic
    use friction_kinds, only: wp, pi
    use friction_strings, only: rtoa
    use friction_checks, only: config_checker
-   use friction_law, only: sliding_law
+   use friction_law, only: difference_partials
+   use friction_law_lugre, only: lugre_law
    use friction_law_settings, only: law_group
-   use friction_law_stribeck, only: stribeck_curve, check_stribeck
+   use friction_law_stribeck, only: stribeck_curve
    implicit none
    private
 
    public :: elastoplastic_law
 
-   type, extends(sliding_law) :: elastoplastic_law
+   !> LuGre's force, state, scale and steady state; its own ż and checks,
+   !> and the abstract law's difference partials for ż's switching share.
+   type, extends(lugre_law) :: elastoplastic_law
    contains
       procedure :: check
-      procedure :: force
-      procedure :: state_count
       procedure :: state_rate
-      procedure :: state_scale
-      procedure :: steady_state
+      procedure :: partials
    end type elastoplastic_law
 
 contains
@@ -36,12 +36,7 @@ contains
       class(elastoplastic_law), intent(in) :: self
       type(config_checker), intent(inout) :: c
 
-      call c%positive(law_group, 'sigma0', self%p%sigma0, 'N/m')
-      call c%finite(law_group, 'sigma0', self%p%sigma0)
-      call c%nonnegative(law_group, 'sigma1', self%p%sigma1, 'N s/m')
-      call c%finite(law_group, 'sigma1', self%p%sigma1)
-      call c%positive(law_group, 'fc', self%p%fc, 'N')
-      call check_stribeck(self%p, c)
+      call self%lugre_law%check(c)
       if (c%failed()) return
       if (.not. (self%p%z_ba >= 0.0_wp .and. self%p%z_ba < self%p%fc / self%p%sigma0)) &
          & call c%reject(law_group, 'z_ba', rtoa(self%p%z_ba), 'must be >= 0 and below fc/sigma0 = ' &
@@ -66,22 +61,6 @@ contains
       end if
    end function plastic_share
 
-   pure real(wp) function force(self, v, z, normal, applied)
-      class(elastoplastic_law), intent(in) :: self
-      real(wp), intent(in) :: v, normal, applied
-      real(wp), intent(in) :: z(:)
-      real(wp) :: rate(1)
-
-      call self%state_rate(v, z, normal, rate)
-      force = self%p%sigma0 * z(1) + self%p%sigma1 * rate(1) + self%p%sigma2 * v
-   end function force
-
-   pure integer function state_count(self)
-      class(elastoplastic_law), intent(in) :: self
-
-      state_count = 1
-   end function state_count
-
    pure subroutine state_rate(self, v, z, normal, rate)
       class(elastoplastic_law), intent(in) :: self
       real(wp), intent(in) :: v, normal
@@ -91,20 +70,13 @@ contains
       rate(1) = v * (1.0_wp - plastic_share(self, v, z(1)) * self%p%sigma0 * abs(z(1)) / stribeck_curve(self%p, v))
    end subroutine state_rate
 
-   pure subroutine state_scale(self, scale)
+   pure subroutine partials(self, v, z, normal, applied, dfdv, dfdz, dfda, dgdv, dgdz)
       class(elastoplastic_law), intent(in) :: self
-      real(wp), intent(out) :: scale(:)
+      real(wp), intent(in) :: v, normal, applied
+      real(wp), intent(in) :: z(:)
+      real(wp), intent(out) :: dfdv, dfdz(:), dfda, dgdv(:), dgdz(:, :)
 
-      scale(1) = self%p%fs / self%p%sigma0
-   end subroutine state_scale
-
-   pure subroutine steady_state(self, v, normal, z)
-      class(elastoplastic_law), intent(in) :: self
-      real(wp), intent(in) :: v, normal
-      real(wp), intent(out) :: z(:)
-
-      z(1) = 0.0_wp
-      if (v /= 0.0_wp) z(1) = sign(stribeck_curve(self%p, v) / self%p%sigma0, v)
-   end subroutine steady_state
+      call difference_partials(self, v, z, normal, applied, dfdv, dfdz, dfda, dgdv, dgdz)
+   end subroutine partials
 
 end module friction_law_elastoplastic

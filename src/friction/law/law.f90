@@ -15,7 +15,7 @@ module friction_law
    implicit none
    private
 
-   public :: sliding_law, max_law_states
+   public :: sliding_law, max_law_states, difference_partials
 
    !> The most internal states a law has (the ODE bridge's room).
    integer, parameter :: max_law_states = 4
@@ -39,7 +39,7 @@ module friction_law
       !> The partial derivatives of F and of the states' rates (the implicit
       !> steppers' Jacobian and the tangent equations); by default from
       !> central differences, which a law overrides with its exact ones.
-      procedure :: partials
+      procedure :: partials => difference_partials
       !> Set-valued at v = 0 (exact stick): the largest force the contact
       !> holds in stick, and the force during a slip in direction s = ±1,
       !> smooth through v = 0 so that an integrator may step a little past
@@ -117,8 +117,9 @@ contains
    !> ∂F/∂v, ∂F/∂z, ∂F/∂applied, ∂ż/∂v, ∂ż/∂z (dgdz(i, j) = ∂ż_i/∂z_j).
    !> Central differences with steps of 1e-6 of the variable's size (or of
    !> the state's scale, and of the velocity's largest of |v| and 1e-6 m/s):
-   !> errors of order 1e-12 relative for smooth laws.
-   pure subroutine partials(self, v, z, normal, applied, dfdv, dfdz, dfda, dgdv, dgdz)
+   !> errors of order 1e-12 relative for smooth laws.  Public, so that a law
+   !> extending one with analytic partials can fall back on these.
+   pure subroutine difference_partials(self, v, z, normal, applied, dfdv, dfdz, dfda, dgdv, dgdz)
       class(sliding_law), intent(in) :: self
       real(wp), intent(in) :: v, normal, applied
       real(wp), intent(in) :: z(:)
@@ -145,7 +146,7 @@ contains
          call self%state_rate(v, zm, normal, rm)
          dgdz(:, j) = (rp - rm) / (2.0_wp * h)
       end do
-   end subroutine partials
+   end subroutine difference_partials
 
    pure logical function set_valued(self)
       class(sliding_law), intent(in) :: self
