@@ -15,7 +15,7 @@ module friction_law
    implicit none
    private
 
-   public :: sliding_law, max_law_states, difference_partials
+   public :: sliding_law, max_law_states, difference_partials, exact_stick_force
 
    !> The most internal states a law has (the ODE bridge's room).
    integer, parameter :: max_law_states = 4
@@ -153,6 +153,22 @@ contains
 
       set_valued = .false.
    end function set_valued
+
+   !> The force of a set-valued law with exact stick: at rest the applied
+   !> force, up to the static limit; sliding, the slip force.
+   pure real(wp) function exact_stick_force(self, v, z, normal, applied) result(force)
+      class(sliding_law), intent(in) :: self
+      real(wp), intent(in) :: v, normal, applied
+      real(wp), intent(in) :: z(:)
+      real(wp) :: limit
+
+      if (v == 0.0_wp) then
+         limit = self%static_force(normal)
+         force = max(-limit, min(limit, applied))
+      else
+         force = self%slip_force(v, z, normal, sign(1.0_wp, v))
+      end if
+   end function exact_stick_force
 
    pure real(wp) function static_force(self, normal)
       class(sliding_law), intent(in) :: self

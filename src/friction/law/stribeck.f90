@@ -9,7 +9,7 @@ module friction_law_stribeck
    use friction_kinds, only: wp
    use friction_strings, only: rtoa
    use friction_checks, only: config_checker
-   use friction_law, only: sliding_law
+   use friction_law, only: sliding_law, exact_stick_force
    use friction_law_settings, only: law_settings, law_group
    implicit none
    private
@@ -80,11 +80,7 @@ contains
       real(wp), intent(in) :: v, normal, applied
       real(wp), intent(in) :: z(:)
 
-      if (v == 0.0_wp) then
-         force = max(-self%p%fs, min(self%p%fs, applied))
-      else
-         force = self%slip_force(v, z, normal, sign(1.0_wp, v))
-      end if
+      force = exact_stick_force(self, v, z, normal, applied)
    end function force
 
    pure subroutine partials(self, v, z, normal, applied, dfdv, dfdz, dfda, dgdv, dgdz)

@@ -18,7 +18,7 @@ module friction_law_table
    use friction_strings, only: rtoa, itoa
    use friction_files, only: open_for_reading, read_text_line
    use friction_checks, only: config_checker
-   use friction_law, only: sliding_law
+   use friction_law, only: sliding_law, exact_stick_force
    use friction_law_settings, only: law_group
    use friction_law_pchip, only: pchip_curve
    implicit none
@@ -216,14 +216,8 @@ contains
       class(table_law), intent(in) :: self
       real(wp), intent(in) :: v, normal, applied
       real(wp), intent(in) :: z(:)
-      real(wp) :: limit
 
-      if (v == 0.0_wp) then
-         limit = self%static_force(normal)
-         force = max(-limit, min(limit, applied))
-      else
-         force = self%slip_force(v, z, normal, sign(1.0_wp, v))
-      end if
+      force = exact_stick_force(self, v, z, normal, applied)
    end function force
 
    pure subroutine partials(self, v, z, normal, applied, dfdv, dfdz, dfda, dgdv, dgdz)
