@@ -40,6 +40,7 @@ from pathlib import Path
 
 
 import friction
+from friction.commands import save_figures
 import friction.plot
 
 # As the user typed it: plot_chaos.py (scripts/ in the repository) or friction-plot-chaos
@@ -79,16 +80,7 @@ def main(argv=None):
     except friction.FileError as err:
         print(f"{PROG}: {args.file}: {err}", file=sys.stderr)
         return 2
-    try:
-        args.output_dir.mkdir(parents=True, exist_ok=True)
-        for name, figure in figures.items():
-            out = args.output_dir / f"{args.file.stem}_{name}.png"
-            figure.savefig(out, dpi=args.dpi)
-            print(f"wrote {out}")
-    except OSError as err:
-        print(f"{PROG}: cannot write into {args.output_dir}: {err}", file=sys.stderr)
-        return 1
-    return 0
+    return save_figures(PROG, figures, args.output_dir, args.file.stem, args.dpi)
 
 
 if __name__ == "__main__":
