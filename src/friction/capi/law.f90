@@ -20,7 +20,9 @@ module friction_capi_law
    use friction_law_settings, only: law_settings
    use friction_law_factory, only: new_law, check_law, make_law, law_names
    use friction_law_history, only: law_history, history_velocity, history_displacement, history_solver_defaults
-   use friction_capi, only: report, refuse, c_string, copy_text, set_checked_text, set_checked_number
+   use friction_capi_text, only: c_string, copy_text
+   use friction_capi_handles, only: report, refuse
+   use friction_capi_config, only: set_checked_text, set_checked_number
    implicit none
    private
 
