@@ -1,14 +1,15 @@
-!> One microscope scan line (line 0, trace) over NaF (Eq. 1) or HOPG
-!> (Eq. 2) as a SPICE netlist for ngspice (docs: netlist); the conventions
-!> shared by every scene's netlist are in netlist/spice.f90.  A
-!> Lennard-Jones lattice sum (Eq. 3) is refused: hundreds of pair terms in
-!> behavioural sources, re-derived at every Newton iteration, are impractical.
+!> One microscope scan line (line 0, trace) as a SPICE netlist for ngspice
+!> (docs: netlist); the conventions shared by every scene's netlist are in
+!> netlist/spice.f90.  The surface's potential writes its own part
+!> (surface_potential's spice): NaF (Eq. 1), HOPG (Eq. 2) and the row have
+!> one; a Lennard-Jones lattice sum (Eq. 3) has none and is refused.
 module friction_afm_netlist
    use friction_kinds, only: wp, pi, ev_per_angstrom_to_nn, kg_to_internal, n_per_m_to_internal, &
       & ns_per_m_to_internal
    use friction_error, only: error_type, fatal_error, error_input
    use friction_netlist_spice, only: nl, tolerances, control_end, num
-   use friction_afm_config, only: afm_config, surface_naf, surface_hopg, surface_row
+   use friction_surface_potential, only: surface_potential, spice_form
+   use friction_afm_config, only: afm_config, new_potential
    use friction_afm_scan, only: line_offset
    implicit none
    private
@@ -25,37 +26,32 @@ contains
       character(len=*), intent(in) :: data_file, version
       character(len=:), allocatable, intent(out) :: text
       type(error_type), allocatable, intent(out) :: error
-      character(len=:), allocatable :: gradient_x, gradient_y, surface
+      character(len=:), allocatable :: surface
+      type(afm_config) :: direct
+      class(surface_potential), allocatable :: potential
+      type(spice_form) :: form
       real(wp) :: along(3), start(3), sample_time, trip_time
+      integer :: k
 
-      select case (c%surface_kind())
-      case (surface_naf)
-         surface = '* Surface: NaF(001), Eq. 1: V = -v0 cos(qx x) cos(qy y), qx = 2 pi/ax, qy = 2 pi/ay.'//nl &
-            & //'.param v0 = '//num(c%v0)//nl &
-            & //'.param qx = '//num(2.0_wp * pi / c%ax)//nl &
-            & //'.param qy = '//num(2.0_wp * pi / c%ay)
-         gradient_x = 'v0*qx*sin(qx*V(xt))*cos(qy*V(yt))'
-         gradient_y = 'v0*qy*cos(qx*V(xt))*sin(qy*V(yt))'
-      case (surface_row)
-         surface = '* Surface: a one-dimensional row, V = -v0 cos(qx x), qx = 2 pi/ax.'//nl &
-            & //'.param v0 = '//num(c%v0)//nl &
-            & //'.param qx = '//num(2.0_wp * pi / c%ax)
-         gradient_x = 'v0*qx*sin(qx*V(xt))'
-         gradient_y = '0'
-      case (surface_hopg)
-         surface = '* Surface: HOPG, Eq. 2: V = -v0 [2 cos(qx x) cos(qy y) + cos(2 qy y)],'//nl &
-            & //'* qx = 2 pi/a, qy = 2 pi/(a sqrt 3).'//nl &
-            & //'.param v0 = '//num(c%v0)//nl &
-            & //'.param qx = '//num(2.0_wp * pi / c%a)//nl &
-            & //'.param qy = '//num(2.0_wp * pi / (c%a * sqrt(3.0_wp)))
-         gradient_x = '2*v0*qx*sin(qx*V(xt))*cos(qy*V(yt))'
-         gradient_y = '2*v0*qy*(cos(qx*V(xt))*sin(qy*V(yt)) + sin(2*qy*V(yt)))'
-      case default
-         call fatal_error(error, "--netlist: &surface potential = '"//trim(c%potential)//"' (the graphite " &
-            & //'Lennard-Jones lattice sum, Eq. 3) is not supported: a sum over hundreds of atoms as behavioural ' &
-            & //"sources is impractical in SPICE; the network model covers 'naf' and 'hopg'", error_input)
+      ! (The form only: a lattice sum is built direct, without its table.)
+      direct = c
+      direct%evaluation = 'direct'
+      call new_potential(direct, potential, error)
+      if (allocated(error)) return
+      call potential%spice(form)
+      if (len(form%why) > 0) then
+         call fatal_error(error, "--netlist: &surface potential = '"//trim(c%potential)//"' is not supported: " &
+            & //form%why, error_input)
          return
-      end select
+      end if
+      surface = ''
+      do k = 1, size(form%comment)
+         surface = surface//'* '//trim(form%comment(k))//nl
+      end do
+      do k = 1, size(form%names)
+         surface = surface//'.param '//trim(form%names(k))//' = '//num(form%values(k))//nl
+      end do
+      surface = surface(1:len(surface) - len(nl))
 
       along = c%scan_direction()
       ! Line 0 starts lead_in before its first sample, as the kernel's trace.
@@ -101,8 +97,8 @@ contains
          & //'Bxt 0 xt I=V(vx)'//nl &
          & //'Byt 0 yt I=V(vy)'//nl &
          & //'* v_x'' = (k_x (x_M - x_t) - dV/dx - c_x v_x)/m (E2, E1 and the damping of Fig. 4a), same in y'//nl &
-         & //'Bvx 0 vx I=(kx*(xs + vmx*time - V(xt)) - '//gradient_x//' - cx*V(vx))/mass'//nl &
-         & //'Bvy 0 vy I=(ky*(ys + vmy*time - V(yt)) - '//gradient_y//' - cy*V(vy))/mass'//nl &
+         & //'Bvx 0 vx I=(kx*(xs + vmx*time - V(xt)) - '//form%gradient_x//' - cx*V(vx))/mass'//nl &
+         & //'Bvy 0 vy I=(ky*(ys + vmy*time - V(yt)) - '//form%gradient_y//' - cy*V(vy))/mass'//nl &
          & //tolerances(c%solver%rtol, c%solver%atol)//nl &
          & //'.tran '//num(sample_time)//' '//num(trip_time)//' 0 '//num(sample_time)//' uic'//nl &
          & //'.control'//nl &

@@ -4,7 +4,7 @@
 !> Periodic under (a, 0) and (a/2, a√3/2): a hexagonal lattice.
 module friction_surface_hopg
    use friction_kinds, only: wp, pi
-   use friction_surface_potential, only: surface_potential
+   use friction_surface_potential, only: surface_potential, spice_form
    use friction_special, only: sin_cos
    implicit none
    private
@@ -20,6 +20,7 @@ module friction_surface_hopg
       procedure :: gradient
       procedure :: hessian
       procedure :: dimensions
+      procedure :: spice
    end type hopg_potential
 
 contains
@@ -81,5 +82,19 @@ contains
 
       n = 2
    end function dimensions
+
+   !> Eq. 2 with the netlist's names for its constants.
+   pure subroutine spice(self, form)
+      class(hopg_potential), intent(in) :: self
+      type(spice_form), intent(out) :: form
+
+      form%comment = [character(len=100) :: 'Surface: HOPG, Eq. 2: V = -v0 [2 cos(qx x) cos(qy y) + cos(2 qy y)],', &
+         & 'qx = 2 pi/a, qy = 2 pi/(a sqrt 3).']
+      form%names = [character(len=8) :: 'v0', 'qx', 'qy']
+      form%values = [self%v0, self%qx, self%qy]
+      form%gradient_x = '2*v0*qx*sin(qx*V(xt))*cos(qy*V(yt))'
+      form%gradient_y = '2*v0*qy*(cos(qx*V(xt))*sin(qy*V(yt)) + sin(2*qy*V(yt)))'
+      form%why = ''
+   end subroutine spice
 
 end module friction_surface_hopg

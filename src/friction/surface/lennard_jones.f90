@@ -23,7 +23,7 @@
 !> friction_surface_differences.
 module friction_surface_lennard_jones
    use friction_kinds, only: wp, pi
-   use friction_surface_potential, only: surface_potential
+   use friction_surface_potential, only: surface_potential, spice_form
    use friction_surface_net, only: crystal_net, net_lattice, fraction_map
    use friction_surface_tricubic, only: new_tricubic_grid
    use friction_surface_table_kernels, only: difference_terms, lattice_gradient, cell_fraction, from_fraction
@@ -56,6 +56,7 @@ module friction_surface_lennard_jones
       procedure :: tabulate
       procedure :: table_answers
       procedure :: direct_gradient
+      procedure :: spice
    end type lj_potential
 
 contains
@@ -553,5 +554,18 @@ contains
       end associate
       call share%max_real(measured)
    end subroutine verify
+
+   !> No SPICE form: the sum over the net's atoms would be one pair term per
+   !> atom in a behavioural source, re-derived at every Newton iteration.
+   pure subroutine spice(self, form)
+      class(lj_potential), intent(in) :: self
+      type(spice_form), intent(out) :: form
+
+      allocate (form%comment(0), form%names(0), form%values(0))
+      form%gradient_x = ''
+      form%gradient_y = ''
+      form%why = 'the Lennard-Jones lattice sum (Eq. 3) over hundreds of atoms would be hundreds of pair terms ' &
+         & //'in behavioural sources, re-derived at every Newton iteration: impractical in SPICE'
+   end subroutine spice
 
 end module friction_surface_lennard_jones

@@ -2,7 +2,7 @@
 !> V = -V0 cos(2πx/ax) cos(2πy/ay).
 module friction_surface_naf
    use friction_kinds, only: wp, pi
-   use friction_surface_potential, only: surface_potential
+   use friction_surface_potential, only: surface_potential, spice_form
    use friction_special, only: sin_cos
    implicit none
    private
@@ -18,6 +18,7 @@ module friction_surface_naf
       procedure :: gradient
       procedure :: hessian
       procedure :: dimensions
+      procedure :: spice
    end type naf_potential
 
 contains
@@ -76,5 +77,19 @@ contains
 
       n = 2
    end function dimensions
+
+   !> Eq. 1 with the netlist's names for its constants.
+   pure subroutine spice(self, form)
+      class(naf_potential), intent(in) :: self
+      type(spice_form), intent(out) :: form
+
+      form%comment = [character(len=100) :: &
+         & 'Surface: NaF(001), Eq. 1: V = -v0 cos(qx x) cos(qy y), qx = 2 pi/ax, qy = 2 pi/ay.']
+      form%names = [character(len=8) :: 'v0', 'qx', 'qy']
+      form%values = [self%v0, self%qx, self%qy]
+      form%gradient_x = 'v0*qx*sin(qx*V(xt))*cos(qy*V(yt))'
+      form%gradient_y = 'v0*qy*cos(qx*V(xt))*sin(qy*V(yt))'
+      form%why = ''
+   end subroutine spice
 
 end module friction_surface_naf

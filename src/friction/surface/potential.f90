@@ -9,7 +9,19 @@ module friction_surface_potential
    implicit none
    private
 
-   public :: surface_potential
+   public :: surface_potential, spice_form
+
+   !> A potential as a SPICE netlist writes it (afm/netlist.f90): comment
+   !> lines, its constants (.param name = value) and dV/dx, dV/dy as
+   !> behavioural expressions of the tip's nodes V(xt) and V(yt), in Å and
+   !> eV.  A potential without one says why in `why` ('' when it has one).
+   type :: spice_form
+      character(len=100), allocatable :: comment(:)
+      character(len=8), allocatable :: names(:)
+      real(wp), allocatable :: values(:)
+      character(len=:), allocatable :: gradient_x, gradient_y
+      character(len=:), allocatable :: why
+   end type spice_form
 
    type, abstract :: surface_potential
    contains
@@ -17,6 +29,7 @@ module friction_surface_potential
       procedure(gradient_interface), deferred :: gradient
       procedure(hessian_interface), deferred :: hessian
       procedure(dimensions_interface), deferred :: dimensions
+      procedure :: spice
    end type surface_potential
 
    abstract interface
@@ -51,5 +64,18 @@ module friction_surface_potential
          integer :: n
       end function dimensions_interface
    end interface
+
+contains
+
+   !> The potential's SPICE form; a potential without a closed form has none.
+   pure subroutine spice(self, form)
+      class(surface_potential), intent(in) :: self
+      type(spice_form), intent(out) :: form
+
+      allocate (form%comment(0), form%names(0), form%values(0))
+      form%gradient_x = ''
+      form%gradient_y = ''
+      form%why = 'it has no closed form for a behavioural source'
+   end subroutine spice
 
 end module friction_surface_potential

@@ -6,7 +6,7 @@
 !> is this potential exactly.
 module friction_surface_row
    use friction_kinds, only: wp, pi
-   use friction_surface_potential, only: surface_potential
+   use friction_surface_potential, only: surface_potential, spice_form
    implicit none
    private
 
@@ -20,6 +20,7 @@ module friction_surface_row
       procedure :: gradient
       procedure :: hessian
       procedure :: dimensions
+      procedure :: spice
    end type row_potential
 
 contains
@@ -64,5 +65,18 @@ contains
 
       n = 2
    end function dimensions
+
+   !> The row, flat across: no force in y.
+   pure subroutine spice(self, form)
+      class(row_potential), intent(in) :: self
+      type(spice_form), intent(out) :: form
+
+      form%comment = [character(len=100) :: 'Surface: a one-dimensional row, V = -v0 cos(qx x), qx = 2 pi/ax.']
+      form%names = [character(len=8) :: 'v0', 'qx']
+      form%values = [self%v0, self%q]
+      form%gradient_x = 'v0*qx*sin(qx*V(xt))'
+      form%gradient_y = '0'
+      form%why = ''
+   end subroutine spice
 
 end module friction_surface_row
