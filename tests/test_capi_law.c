@@ -1,7 +1,8 @@
 /* The C API's friction laws (include/friction.h, "friction laws on their own")
  * from C: Dahl's law along a triangle wave of displacement against its closed
  * form, LuGre's state count and steady force, and every refusal (an unknown
- * law or variable, a bad value, short or NULL arrays, a NULL handle). */
+ * law or variable, a bad value, short or NULL arrays, a NULL handle, a freed
+ * one). */
 #include <friction.h>
 
 #include <math.h>
@@ -81,6 +82,24 @@ int main(void) {
   CHECK(fabs(f[1] - steady) < 1e-12, "LuGre steady %.17g vs %.17g", f[1], steady);
   friction_law_free(lugre);
   friction_law_free(NULL);
+
+  /* A host that frees a law twice or uses it after its free (issue 40): the free ignores it and
+   * every call refuses it with FRICTION_ERROR_INPUT, without touching the freed memory; so is a
+   * handle of another kind passed as a law. */
+  friction_law *gone = friction_law_new("coulomb", err);
+  CHECK(gone != NULL, "friction_law_new(coulomb)");
+  friction_law_free(gone);
+  friction_law_free(gone);
+  expect_refusal(friction_law_set(gone, "law.mu", "0.2", err), err, "law handle is not live");
+  expect_refusal(friction_law_set_real(gone, "law.mu", 0.2, err), err, "law handle is not live");
+  expect_refusal(friction_law_get(gone, "law.mu", value, sizeof value, err), err, "law handle is not live");
+  expect_refusal(friction_law_check(gone, err), err, "law handle is not live");
+  CHECK(friction_law_state_count(gone, err) == -1, "state count of a freed law");
+  expect_refusal(friction_error_status(err), err, "law handle is not live");
+  expect_refusal(friction_law_history(gone, 1.0, tt, v, 2, 0, f, NULL, 0, err), err, "law handle is not live");
+  expect_refusal(friction_law_check((friction_law *)err, err), err, "law handle is not live");
+  friction_law_free((friction_law *)err); /* not a law: ignored, the error handle stays */
+  CHECK(friction_error_status(err) == FRICTION_ERROR_INPUT, "the error handle survives a law free of it");
 
   friction_error_free(err);
   if (failures) fprintf(stderr, "%d failures\n", failures);

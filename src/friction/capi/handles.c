@@ -1,5 +1,5 @@
-/* The C API's live handles: every configuration, result and error handle
- * the library gave out and the host has not freed, with its kind.
+/* The C API's live handles: every configuration, result, error and law
+ * handle the library gave out and the host has not freed, with its kind.
  *
  * A host that frees a handle twice, or uses one after freeing it, used to
  * kill itself inside the library (the second free corrupted the heap).  A

@@ -18,14 +18,14 @@ module friction_capi_handles
    private
 
    public :: capi_error, capi_config, capi_result
-   public :: kind_error, kind_config, kind_result
+   public :: kind_error, kind_config, kind_result, kind_law
    public :: friction_handle_add, friction_handle_remove, friction_handle_live
    public :: report, refuse, config_of
    public :: friction_error_new, friction_error_free, friction_error_status, friction_error_message
    public :: friction_config_new, friction_config_free, friction_result_free
 
    !> The kinds of handle in the table of live ones (handles.c).
-   integer(c_int), parameter :: kind_error = 1, kind_config = 2, kind_result = 3
+   integer(c_int), parameter :: kind_error = 1, kind_config = 2, kind_result = 3, kind_law = 4
 
    !> What an opaque `friction_error *` points to.
    type :: capi_error

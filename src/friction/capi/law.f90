@@ -4,7 +4,8 @@
 !> variables and checked by the law's own checks; and the law along a
 !> prescribed velocity or displacement history into the caller's arrays
 !> (friction_law_history).  No module variables: the state lives in the
-!> handles.
+!> handles, which the table of live handles (handles.c) records as the
+!> configurations: a law freed twice, or used after its free, is refused.
 module friction_capi_law
    use, intrinsic :: iso_c_binding, only: c_ptr, c_int, c_double, c_size_t, c_associated, c_f_pointer, c_loc, &
       & c_null_ptr
@@ -21,7 +22,8 @@ module friction_capi_law
    use friction_law_factory, only: new_law, check_law, make_law, law_names
    use friction_law_history, only: law_history, history_velocity, history_displacement, history_solver_defaults
    use friction_capi_text, only: c_string, copy_text
-   use friction_capi_handles, only: report, refuse
+   use friction_capi_handles, only: report, refuse, kind_law, friction_handle_add, friction_handle_remove, &
+      & friction_handle_live
    use friction_capi_config, only: set_checked_text, set_checked_number
    implicit none
    private
@@ -54,8 +56,15 @@ contains
       type(error_type), allocatable, intent(out) :: error
 
       ok = c_associated(handle)
+      nullify (law)
       if (.not. ok) then
          call fatal_error(error, 'the law handle is a null pointer', error_input)
+         return
+      end if
+      ok = friction_handle_live(handle, kind_law) /= 0
+      if (.not. ok) then
+         call fatal_error(error, 'the law handle is not live (freed already, or not from friction_law_new)', &
+            & error_input)
          return
       end if
       call c_f_pointer(handle, law)
@@ -108,6 +117,12 @@ contains
       allocate (law)
       law%p = p
       res = c_loc(law)
+      if (friction_handle_add(res, kind_law) == 0) then
+         deallocate (law)
+         res = c_null_ptr
+         status = refuse(handle, 'out of memory for a new law handle')
+         return
+      end if
       block
          type(error_type), allocatable :: none
          status = report(handle, none)
@@ -120,6 +135,7 @@ contains
       type(capi_law), pointer :: law
 
       if (.not. c_associated(handle)) return
+      if (friction_handle_remove(handle, kind_law) == 0) return   ! freed already, or not a law
       call c_f_pointer(handle, law)
       deallocate (law)
    end subroutine friction_law_free
