@@ -33,6 +33,7 @@ SWEEP = ("&brake mu = 0.5, mu_s = 0.59, t_end = 300.0, dt_out = 0.1 /\n"
          " sweep_from = -0.004, sweep_to = -0.001, sweep_count = 5 /\n")
 GRAPHITE_SMALL = "&scan nx = 12, ny = 3, length = 2.0 /\n"
 ABORTS = ("Fortran runtime error", "Error allocating", "Backtrace", "Segmentation fault", "SIGSEGV",
+          "infinite loop closing library",
           "Error termination", "Program received signal")
 
 

@@ -3,7 +3,15 @@
 !> Every column is chunked, so a column of a million points is written in
 !> pieces as they come and the writer holds only the piece in hand; a
 !> column made with n < 0 is extendible (a flat list that grows by appends).
-!> Columns are filled with zeros where nothing was written yet.
+!>
+!> A column takes all its space when it is made (or extended), filled with
+!> zeros, and only after the disk and the file-size limit were found to
+!> have room for it with min_free_bytes to spare: its writes then land in
+!> space the file already holds and cannot fail for room.  A chunk write
+!> that fails (a full disk, EFBIG past `ulimit -f`) makes HDF5 1.10 keep
+!> the chunk's buffer: at exit it cannot close its library and prints
+!> "infinite loop closing library" with a dump, or crashes; a column whose
+!> making fails leaves nothing behind.
 !>
 !> One process, no MPI-IO: the file is opened with HDF5's default driver
 !> (the parallel library serves that too).  Failures are kept, as h5_file
@@ -11,11 +19,12 @@
 !> switched off around each call and restored.
 module friction_output_h5_table
    use, intrinsic :: iso_fortran_env, only: int8, int32, int64
-   use, intrinsic :: iso_c_binding, only: c_ptr, c_loc, c_null_ptr
+   use, intrinsic :: iso_c_binding, only: c_ptr, c_loc, c_null_ptr, c_double
    use hdf5
    use friction_kinds, only: wp, i8
    use friction_error, only: error_type, fatal_error, error_io
-   use friction_files, only: truncate_file
+   use friction_files, only: truncate_file, free_bytes, min_free_bytes, full_text
+   use friction_strings, only: bytes_text
    use friction_output_h5, only: h5_status, error_printing, room_to_close, new_text_attribute, new_scalar_attribute, &
       & open_hdf5
    implicit none
@@ -143,6 +152,28 @@ contains
       if (self%status /= 0) call fatal_error(error, self%path//': HDF5 failed '//self%failed_at, error_io)
    end subroutine table_close
 
+   !> Whether the disk and the file-size limit leave room for a column
+   !> growing from `from` to `to` elements of `type` in chunks of `chunk`,
+   !> with min_free_bytes to spare for what HDF5 writes at its close; if not,
+   !> the failure of `what` is kept.
+   logical function has_room(self, what, type, chunk, from, to)
+      class(h5_table), intent(inout) :: self
+      character(len=*), intent(in) :: what
+      integer(hid_t), intent(in) :: type
+      integer(hsize_t), intent(in) :: chunk, from, to
+      integer(size_t) :: bytes
+      integer :: stat
+      real(c_double) :: free, needed
+
+      call h5tget_size_f(type, bytes, stat)
+      needed = real((to + chunk - 1) / chunk - (from + chunk - 1) / chunk, c_double) * real(chunk, c_double) &
+         & * real(bytes, c_double)
+      free = free_bytes(self%path)
+      has_room = free < 0.0_c_double .or. free >= needed + min_free_bytes
+      if (.not. has_room) call self%check(1, what//': '//full_text(self%path, free)//'; it needs ' &
+         & //bytes_text(needed)//' and '//bytes_text(min_free_bytes)//' to spare)')
+   end function has_room
+
    !> The HDF5 type of a column kind: 'r' double, 'i' 32-bit integer, 'l'
    !> 64-bit integer, 'b' byte (text as bytes).
    integer(hid_t) function kind_type(kind) result(type)
@@ -198,15 +229,17 @@ contains
       type(error_printing) :: printing
 
       if (self%status /= 0) return
-      call printing%silence()
       dims = int(max(0_i8, n), hsize_t)
       maxdims = dims
       if (n < 0) maxdims = H5S_UNLIMITED_F
       chunk = max(1_hsize_t, min(chunk_points, dims))
       if (n < 0) chunk = chunk_points
+      if (.not. has_room(self, 'creating dataset '//name, type, chunk(1), 0_hsize_t, dims(1))) return
+      call printing%silence()
       call h5screate_simple_f(1, dims, space, stat, maxdims)
       call h5pcreate_f(H5P_DATASET_CREATE_F, plist, stat)
       call h5pset_chunk_f(plist, 1, chunk, stat)
+      call h5pset_alloc_time_f(plist, H5D_ALLOC_TIME_EARLY_F, stat)
       call h5dcreate_f(self%id, name, type, space, dset, stat, dcpl_id=plist)
       call self%check(stat, 'creating dataset '//name)
       if (stat == 0) then
@@ -279,15 +312,18 @@ contains
          counts = int(count, hsize_t)
          call h5dget_space_f(dset, filespace, stat)
          call h5sget_simple_extent_dims_f(filespace, dims, maxdims, stat)
-         if (write .and. offset(1) + counts(1) > dims(1)) then
-            call h5sclose_f(filespace, stat)
-            call h5dset_extent_f(dset, offset + counts, stat)
-            call self%check(stat, 'extending dataset '//name)
-            call h5dget_space_f(dset, filespace, stat)
-         end if
          ! A text column's type is its own (its width); numbers convert.
          file_type = type
          if (type == -1) call h5dget_type_f(dset, file_type, stat)
+         if (write .and. offset(1) + counts(1) > dims(1)) then
+            call h5sclose_f(filespace, stat)
+            if (has_room(self, 'extending dataset '//name, file_type, chunk_points, dims(1), offset(1) + counts(1))) &
+               & then
+               call h5dset_extent_f(dset, offset + counts, stat)
+               call self%check(stat, 'extending dataset '//name)
+            end if
+            call h5dget_space_f(dset, filespace, stat)
+         end if
          call h5sselect_hyperslab_f(filespace, H5S_SELECT_SET_F, offset, counts, stat)
          call h5screate_simple_f(1, counts, memspace, stat)
          if (self%status == 0) then
