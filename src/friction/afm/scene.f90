@@ -368,16 +368,16 @@ contains
       unit = ''
    end subroutine afm_point_series
 
-   subroutine afm_run_point(self, results, series, memory, error)
+   subroutine afm_run_point(self, sink, memory, error)
       class(afm_scene), intent(inout) :: self
-      real(wp), intent(out) :: results(:)
-      real(wp), allocatable, intent(out) :: series(:)
+      class(result_sink), intent(inout) :: sink
       type(point_memory), intent(inout) :: memory
       type(error_type), allocatable, intent(out) :: error
+      real(wp) :: results(2)
 
       results = 0.0_wp
-      allocate (series(0))
       call afm_friction(self%resolved(), results(1), results(2), error, memory)
+      if (.not. allocated(error)) call self%put_point(sink, results, [real(wp) ::])
    end subroutine afm_run_point
 
    !> The whole map on this process: every line's trace (and retrace), as

@@ -245,12 +245,12 @@ contains
    !> period, the largest |μ| and the critical μ; 0 when none or off) and the
    !> local maxima of x after the transient (the bifurcation diagram).  (A
    !> brake point keeps nothing in `memory`: its set-up costs nothing.)
-   subroutine brake_run_point(self, results, series, memory, error)
+   subroutine brake_run_point(self, sink, memory, error)
       class(brake_scene), intent(inout) :: self
-      real(wp), intent(out) :: results(:)
-      real(wp), allocatable, intent(out) :: series(:)
+      class(result_sink), intent(inout) :: sink
       type(point_memory), intent(inout) :: memory
       type(error_type), allocatable, intent(out) :: error
+      real(wp) :: results(9)
       type(brake_config) :: point
       type(brake_run), target :: run
       type(brake_diagnostics) :: diagnostics
@@ -287,7 +287,7 @@ contains
             do j = 2, run%n - 1
                peak(j) = t(j) >= a%window_start .and. x(j) > x(j - 1) .and. x(j) >= x(j + 1)
             end do
-            series = pack(x(1:run%n), peak)
+            call self%put_point(sink, results, pack(x(1:run%n), peak))
          end associate
       end associate
    end subroutine brake_run_point

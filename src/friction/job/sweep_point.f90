@@ -12,7 +12,7 @@ module friction_job_sweep_point
    use friction_ode_solver, only: step_type_index
    use friction_parameters, only: set_parameter_number, split_name
    use friction_checks, only: config_checker
-   use friction_scene, only: scene, point_result, point_memory
+   use friction_scene, only: scene, point_result, point_memory, result_sink
    use friction_job_config, only: job_config
    implicit none
    private
@@ -38,6 +38,16 @@ module friction_job_sweep_point
       real(wp), allocatable :: numbers(:)   !! results, cost, series
       character(len=:), allocatable :: reason
    end type finished_point
+
+   !> Where a point's scene puts its results (run_point): each named result
+   !> in its place among the scene's point_results, the series whole.
+   type, extends(result_sink) :: point_sink
+      type(point_result), allocatable :: names(:)
+      character(len=:), allocatable :: series_name
+      real(wp), allocatable :: results(:), series(:)
+   contains
+      procedure :: add => point_sink_add
+   end type point_sink
 
 contains
 
@@ -94,6 +104,8 @@ contains
       character(len=:), allocatable, intent(out) :: warning
       type(error_type), allocatable, intent(out) :: error
       class(scene), allocatable :: point
+      type(point_sink) :: sink
+      character(len=:), allocatable :: unit
 
       results = 0.0_wp
       warning = ''
@@ -102,9 +114,30 @@ contains
       if (allocated(error)) return
       warning = point%settings_warning()
       results(size(results)) = real(step_type_index(point%method()), wp)
-      deallocate (series)
-      call point%run_point(results(:size(results) - 1), series, kept, error)
+      sink%names = point%point_results()
+      call point%point_series(sink%series_name, unit)
+      allocate (sink%results(size(sink%names)), source=0.0_wp)
+      allocate (sink%series(0))
+      call point%run_point(sink, kept, error)
+      results(:size(results) - 1) = sink%results
+      call move_alloc(sink%series, series)
    end subroutine run_point
+
+   subroutine point_sink_add(self, name, rows, columns, values)
+      class(point_sink), intent(inout) :: self
+      character(len=*), intent(in) :: name
+      integer, intent(in) :: rows, columns
+      real(wp), intent(in) :: values(:)
+      integer :: j
+
+      if (len(self%series_name) > 0 .and. name == self%series_name) then
+         self%series = values
+         return
+      end if
+      do j = 1, size(self%names)
+         if (self%names(j)%name == name .and. size(values) > 0) self%results(j) = values(1)
+      end do
+   end subroutine point_sink_add
 
    !> The scene's warning about point i's settings ('' for none or a point
    !> that fails its check).

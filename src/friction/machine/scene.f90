@@ -144,12 +144,12 @@ contains
    !> stick, the range of the velocity and the mean friction force over the
    !> second half of the run (after a transient), and the local maxima of x
    !> there (the bifurcation diagram).
-   subroutine machine_run_point(self, results, series, memory, error)
+   subroutine machine_run_point(self, sink, memory, error)
       class(machine_scene), intent(inout) :: self
-      real(wp), intent(out) :: results(:)
-      real(wp), allocatable, intent(out) :: series(:)
+      class(result_sink), intent(inout) :: sink
       type(point_memory), intent(inout) :: memory
       type(error_type), allocatable, intent(out) :: error
+      real(wp) :: results(6)
       type(machine_run) :: run
       type(machine_diagnostics) :: d
       logical, allocatable :: peak(:)
@@ -171,7 +171,7 @@ contains
       do j = max(2, half), run%n - 1
          peak(j) = run%x(j) > run%x(j - 1) .and. run%x(j) >= run%x(j + 1)
       end do
-      series = pack(run%x, peak)
+      call self%put_point(sink, results, pack(run%x, peak))
    end subroutine machine_run_point
 
    !> The run on this process into named arrays, as /machine holds them:

@@ -58,10 +58,14 @@ module friction_scene
       !> variable-length series ('' when it has none).
       procedure(results_interface), deferred :: point_results
       procedure(series_interface), deferred :: point_series
-      !> One sweep point on this process alone: its results, in the order of
-      !> point_results, and its series; `memory` is what the process kept from its
-      !> earlier points (point_memory).
+      !> One sweep point on this process alone, into `sink` as compute's
+      !> arrays go: each of point_results as a 1 x 1 array, and the series
+      !> (point_series) as one column; nothing on an error.  `memory` is what
+      !> the process kept from its earlier points (point_memory).
       procedure(point_interface), deferred :: run_point
+      !> Give `sink` a point's results, in the order of point_results, and
+      !> its series: what run_point does once the point is computed.
+      procedure, non_overridable :: put_point
       !> The whole scene on this process, into named arrays in `sink` (the
       !> arrays the output file holds, as the C API returns them), with
       !> progress and stop requests through `reporter`; `memory` as for
@@ -138,11 +142,10 @@ module friction_scene
          character(len=:), allocatable, intent(out) :: name, unit
       end subroutine series_interface
 
-      subroutine point_interface(self, results, series, memory, error)
-         import :: scene, wp, error_type, point_memory
+      subroutine point_interface(self, sink, memory, error)
+         import :: scene, result_sink, error_type, point_memory
          class(scene), intent(inout) :: self
-         real(wp), intent(out) :: results(:)
-         real(wp), allocatable, intent(out) :: series(:)
+         class(result_sink), intent(inout) :: sink
          type(point_memory), intent(inout) :: memory
          type(error_type), allocatable, intent(out) :: error
       end subroutine point_interface
@@ -166,6 +169,22 @@ module friction_scene
    end interface
 
 contains
+
+   subroutine put_point(self, sink, results, series)
+      class(scene), intent(in) :: self
+      class(result_sink), intent(inout) :: sink
+      real(wp), intent(in) :: results(:), series(:)
+      type(point_result), allocatable :: names(:)
+      character(len=:), allocatable :: series_name, series_unit
+      integer :: j
+
+      names = self%point_results()
+      do j = 1, size(names)
+         call sink%add(trim(names(j)%name), 1, 1, results(j:j))
+      end do
+      call self%point_series(series_name, series_unit)
+      if (len(series_name) > 0) call sink%add(series_name, size(series), 1, series)
+   end subroutine put_point
 
    subroutine compute_line(self, line, forward, capacity, sink, memory, error)
       class(scene), intent(inout) :: self
