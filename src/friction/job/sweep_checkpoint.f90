@@ -49,18 +49,19 @@ module friction_job_sweep_checkpoint
    end type point_batch
 
    !> Rank 0's checkpoint: the file, this run's number, where its flat lists
-   !> end, and the batch of points not yet in it.
+   !> end, and the batch of points not yet in it.  The file, its path and
+   !> the run are what the output's copy reads; the rest is its own.
    type :: sweep_checkpoint
       type(h5_table) :: file
       character(len=:), allocatable :: path
-      character(len=:), allocatable :: hash   !! of the input it belongs to
-      integer :: points = 0
-      integer :: results = 0   !! per point, the sweep's own included
-      logical :: opened = .false.
       integer :: run = 1
-      integer(i8) :: series_end = 0, reason_end = 0
-      integer :: received = 0   !! points done in this run
-      type(error_type), allocatable :: error   !! the first failure to write it
+      character(len=:), allocatable, private :: hash   !! of the input it belongs to
+      integer, private :: points = 0
+      integer, private :: results = 0   !! per point, the sweep's own included
+      logical, private :: opened = .false.
+      integer(i8), private :: series_end = 0, reason_end = 0
+      integer, private :: received = 0   !! points done in this run
+      type(error_type), allocatable, private :: error   !! the first failure to write it
       type(point_batch), private :: batch
    contains
       procedure :: init => checkpoint_init
