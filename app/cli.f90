@@ -376,7 +376,8 @@ contains
             & '                     --set "integrator.method=''rk8pd''", --set surface.sigma(2)=3.4)', &
             & '      --print-input  print the resolved input (files and --set applied,', &
             & '                     defaults filled) as a namelist that reads back to the', &
-            & '                     same run, and exit without computing or writing', &
+            & '                     same run, each variable''s unit a comment after it, and', &
+            & '                     exit without computing or writing', &
             & '      --resume       reuse the sweep points or map lines an interrupted run', &
             & '                     completed (its checkpoints beside the output); a sweep''s', &
             & '                     output is overwritten', &

@@ -263,15 +263,50 @@ contains
          & 'compares two integrations at two tolerances: at a temperature the Langevin scheme takes a fixed ' &
          & //'time step (compare runs at two &thermal time_step values instead)')
       if (.not. c%failed() .and. self%thermal%enabled()) call check_thermal()
+      if (.not. c%failed()) call warn_other_units()
 
    contains
+
+      !> Values every check accepts that look like numbers in another unit
+      !> (docs/input.md, Units): warnings, the run goes on.
+      subroutine warn_other_units()
+         real(wp), parameter :: day = 86400.0_wp
+         real(wp) :: line_time
+
+         ! Cantilevers and contacts span about 0.01 to 100 N/m.
+         call spring('kx', self%kx)
+         call spring('ky', self%ky)
+         if (self%moves_in_3d()) call spring('kz', self%kz)
+         ! A line's duration sets the cost of a tip whose motion is
+         ! integrated; the quasi-static and Kramers models step from sample
+         ! to sample or from jump to jump, and slow scans are what they are for.
+         if (self%model == 'quasistatic' .or. (self%thermal%enabled() .and. self%thermal%reduced())) return
+         line_time = (self%length + self%lead_in) / self%velocity
+         if (line_time > day) call c%warn('scan', 'velocity', rtoa(self%velocity), 'a line of ' &
+            & //rtoa(self%length + self%lead_in)//' angstrom takes '//rtoa(line_time)//' s of scan time at this ' &
+            & //'velocity, more than a day: the unit is angstrom/s (' &
+            & //rtoa(self%velocity)//' m/s = '//rtoa(self%velocity * 1.0e10_wp)//' angstrom/s)')
+      end subroutine warn_other_units
+
+      subroutine spring(name, value)
+         character(len=*), intent(in) :: name
+         real(wp), intent(in) :: value
+
+         if (value > 0.0_wp .and. (value < 1.0e-3_wp .or. value > 1.0e3_wp)) call c%warn('tip', name, rtoa(value), &
+            & 'far outside the springs of AFM tips, 1e-3 to 1e3 N/m: the unit is N/m (1 nN/angstrom = 10 N/m, ' &
+            & //'1 eV/angstrom^2 = 16.02 N/m)')
+      end subroutine spring
 
       subroutine lattice_constant(name, value)
          character(len=*), intent(in) :: name
          real(wp), intent(in) :: value
+         character(len=:), allocatable :: hint
 
+         hint = ''
+         if (value > 0.0_wp .and. value < 1.0e-6_wp) hint = '; it looks like metres: '//rtoa(value)//' m = ' &
+            & //rtoa(value * 1.0e10_wp)//' angstrom'
          if (.not. (value >= 0.01_wp)) call c%reject('surface', name, rtoa(value), &
-            & 'must be >= 0.01 angstrom (a lattice constant: crystals have 2 to 6 angstrom)')
+            & 'must be >= 0.01 angstrom (a lattice constant: crystals have 2 to 6 angstrom'//hint//')')
       end subroutine lattice_constant
 
       !> At T > 0: a tip model with thermal motion, a heat bath on every

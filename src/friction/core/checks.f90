@@ -3,7 +3,9 @@
 !> point, or nothing for the C API), the group, the variable, the value and
 !> the reason.  Every configuration type checks itself through a checker,
 !> so the namelist, the sweep and the C API reject the same values with the
-!> same words.
+!> same words.  A value that is allowed but looks like a slip (a number in
+!> another unit) gives a warning in the same words instead, kept beside the
+!> error for the caller to pass on.
 module friction_checks
    use friction_kinds, only: wp
    use friction_error, only: error_type, fatal_error, error_input
@@ -20,16 +22,19 @@ module friction_checks
       character(len=:), allocatable :: where   !! 'file.nml:3', 'sweep point 2', or '' (set in memory)
    end type origin_entry
 
-   !> The first rejected value (later ones are not reported: one message).
+   !> The first rejected value (later ones are not reported: one message),
+   !> and every warning in the order given.
    type :: config_checker
       type(error_type), allocatable :: error
       type(origin_entry), allocatable :: origins(:)
+      character(len=1024), allocatable :: warnings(:)
    contains
       procedure :: set_origin
       procedure :: origin
       procedure :: is_set
       procedure :: failed
       procedure :: reject
+      procedure :: warn
       procedure :: positive
       procedure :: nonnegative
       procedure :: finite
@@ -110,6 +115,23 @@ contains
       if (len(where) > 0) where = where//': '
       call fatal_error(self%error, where//'&'//group//': '//shown//' = '//value//': '//reason, error_input)
    end subroutine reject
+
+   !> A value that is allowed but implausible: the same words as `reject`
+   !> (where it was set, group, variable, value, reason), kept in `warnings`.
+   subroutine warn(self, group, name, value, reason, index)
+      class(config_checker), intent(inout) :: self
+      character(len=*), intent(in) :: group, name, value, reason
+      integer, intent(in), optional :: index
+      character(len=:), allocatable :: shown, where
+
+      if (.not. allocated(self%warnings)) allocate (self%warnings(0))
+      shown = name
+      if (present(index)) shown = name//'('//itoa(index)//')'
+      where = self%origin(group, name)
+      if (len(where) > 0) where = where//': '
+      self%warnings = [character(len=1024) :: self%warnings, where//'&'//group//': '//shown//' = '//value//': ' &
+         & //reason]
+   end subroutine warn
 
    subroutine positive(self, group, name, value, unit_text)
       class(config_checker), intent(inout) :: self

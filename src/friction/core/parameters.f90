@@ -9,16 +9,18 @@
 module friction_parameters
    use friction_kinds, only: wp, i8
    use friction_strings, only: lower, itoa
+   use friction_plausibility, only: unit_plausibility
    use friction_value_text, only: split_name, real_words, run_lengths, quote, is_quoted, unquote, value_items, &
       & range_problem, is_utf8, kind_text, value_has_kind, max_list_values
    implicit none
    private
 
-   public :: configurable, parameter_visitor, parameter_info, unit_hint
+   public :: configurable, parameter_visitor, parameter_info, unit_hint, parameter_finding
    public :: list_parameters, set_parameter, set_parameter_number, get_parameter, parameters_text
+   public :: implausible_values
    public :: kind_text, value_has_kind, split_name, max_list_values
 
-   integer, parameter :: mode_list = 1, mode_set = 2, mode_get = 3, mode_write = 4
+   integer, parameter :: mode_list = 1, mode_set = 2, mode_get = 3, mode_write = 4, mode_inspect = 5
 
    !> One variable: where it lives, its kind ('r' real, 'i' integer, 'l'
    !> logical, 'c' text), its number of elements (1 for a scalar) and unit.
@@ -29,6 +31,16 @@ module friction_parameters
       integer :: size = 1
       character(len=40) :: unit = ''
    end type parameter_info
+
+   !> A real value that looks like a number in another unit than its
+   !> variable's (friction_plausibility): which element, and why.
+   type :: parameter_finding
+      character(len=32) :: group = ''
+      character(len=32) :: name = ''
+      integer :: index = 0                      !! the element of an array; 0 for a scalar
+      character(len=64) :: value = ''           !! the value as namelist text
+      character(len=512) :: reason = ''
+   end type parameter_finding
 
    type :: parameter_visitor
       integer :: mode = mode_list
@@ -48,6 +60,8 @@ module friction_parameters
       integer :: listed = 0
       character(len=32), allocatable :: only(:)  !! write: the groups to write (all when unallocated)
       logical :: in_group = .false.
+      logical :: units = .false.                 !! write: each variable's unit as a comment after it
+      type(parameter_finding), allocatable :: findings(:)  !! inspect: the implausible values
    contains
       procedure :: begin_group
       procedure :: end_group
@@ -59,7 +73,7 @@ module friction_parameters
       !> replaces it; an element past its end lengthens it.
       procedure :: real_list
       procedure :: setting
-      procedure, private :: wants, add_info, add_line, element_ok
+      procedure, private :: wants, add_info, add_line, element_ok, inspect_reals
    end type parameter_visitor
 
    !> A type whose variables can be visited.
@@ -171,12 +185,49 @@ contains
       self%list(self%listed) = info
    end subroutine add_info
 
-   subroutine add_line(self, name, value)
+   !> One assignment of the namelist being written; with `units`, the
+   !> variable's unit follows as a comment (none for '1', a pure number).
+   subroutine add_line(self, name, value, unit)
       class(parameter_visitor), intent(inout) :: self
       character(len=*), intent(in) :: name, value
+      character(len=*), intent(in), optional :: unit
+      character(len=:), allocatable :: line
 
-      if (self%in_group) self%text = self%text//'  '//name//' = '//value//new_line('a')
+      if (.not. self%in_group) return
+      line = '  '//name//' = '//value
+      if (self%units .and. present(unit)) then
+         if (len_trim(unit) > 0 .and. unit /= '1') line = line//repeat(' ', max(2, 32 - len(line)))//'! ' &
+            & //trim(unit)
+      end if
+      self%text = self%text//line//new_line('a')
    end subroutine add_line
+
+   !> Inspect: the elements of a real variable that look like numbers in
+   !> another unit than `unit`.
+   subroutine inspect_reals(self, name, value, unit)
+      class(parameter_visitor), intent(inout) :: self
+      character(len=*), intent(in) :: name
+      real(wp), intent(in) :: value(:)
+      character(len=*), intent(in), optional :: unit
+      type(parameter_finding) :: finding
+      character(len=:), allocatable :: reason
+      character(len=26) :: words(1)
+      integer :: k
+
+      if (.not. present(unit)) return
+      if (.not. allocated(self%findings)) allocate (self%findings(0))
+      do k = 1, size(value)
+         reason = unit_plausibility(unit, value(k))
+         if (len(reason) == 0) cycle
+         finding%group = self%group
+         finding%name = name
+         finding%index = merge(k, 0, size(value) > 1)
+         words = real_words(value(k:k))
+         finding%value = words(1)
+         finding%reason = reason
+         self%findings = [self%findings, finding]
+      end do
+   end subroutine inspect_reals
 
    subroutine real_scalar(self, name, value, unit)
       class(parameter_visitor), intent(inout) :: self
@@ -204,6 +255,8 @@ contains
       select case (self%mode)
       case (mode_list)
          call self%add_info(name, 'r', size(value), unit)
+      case (mode_inspect)
+         if (.not. present(fill)) call self%inspect_reals(name, value, unit)
       case (mode_write)
          if (present(fill)) then
             n = size(value)
@@ -211,9 +264,9 @@ contains
                if (value(n) /= fill) exit
                n = n - 1
             end do
-            if (n > 0) call self%add_line(name, run_lengths(real_words(value(1:n))))
+            if (n > 0) call self%add_line(name, run_lengths(real_words(value(1:n))), unit)
          else
-            call self%add_line(name, run_lengths(real_words(value)))
+            call self%add_line(name, run_lengths(real_words(value)), unit)
          end if
       case default
          if (.not. self%wants(name)) return
@@ -265,7 +318,7 @@ contains
 
       if (.not. allocated(value)) allocate (value(0))
       select case (self%mode)
-      case (mode_list, mode_write)
+      case (mode_list, mode_write, mode_inspect)
          call self%real_array(name, value, unit, fill)
       case default
          if (.not. self%wants(name)) return
@@ -381,7 +434,7 @@ contains
                self%text = run_lengths(words)
             end if
          else
-            call self%add_line(name, run_lengths(words))
+            call self%add_line(name, run_lengths(words), unit)
          end if
       case default
          if (.not. self%wants(name)) return
@@ -504,7 +557,7 @@ contains
                self%text = run_lengths(words)
             end if
          else
-            call self%add_line(name, run_lengths(words))
+            call self%add_line(name, run_lengths(words), unit)
          end if
       case default
          if (.not. self%wants(name)) return
@@ -632,15 +685,17 @@ contains
 
    !> All variables as namelist text (the groups in `only` when present),
    !> reals with 17 significant digits so the text reads back to the same
-   !> doubles.
-   function parameters_text(obj, only) result(text)
+   !> doubles; with `units`, each variable's unit as a comment after it.
+   function parameters_text(obj, only, units) result(text)
       class(configurable), intent(inout) :: obj
       character(len=*), intent(in), optional :: only(:)
+      logical, intent(in), optional :: units
       character(len=:), allocatable :: text
       type(parameter_visitor) :: v
 
       v%mode = mode_write
       v%text = ''
+      if (present(units)) v%units = units
       if (present(only)) then
          allocate (v%only(size(only)))
          v%only = only
@@ -648,5 +703,18 @@ contains
       call obj%visit(v)
       text = v%text
    end function parameters_text
+
+   !> The real values of `obj` that look like numbers in another unit than
+   !> their variable's (friction_plausibility), in the order visited.
+   function implausible_values(obj) result(findings)
+      class(configurable), intent(inout) :: obj
+      type(parameter_finding), allocatable :: findings(:)
+      type(parameter_visitor) :: v
+
+      v%mode = mode_inspect
+      allocate (v%findings(0))
+      call obj%visit(v)
+      call move_alloc(v%findings, findings)
+   end function implausible_values
 
 end module friction_parameters

@@ -6,7 +6,7 @@ module friction_job_config
    use friction_strings, only: itoa, rtoa, join, quoted, lower
    use friction_error, only: error_type, fatal_error, error_input
    use friction_parameters, only: configurable, parameter_visitor, parameter_info, list_parameters, &
-      & parameters_text, split_name
+      & parameters_text, split_name, parameter_finding, implausible_values
    use friction_checks, only: config_checker
    use friction_input_reader, only: namelist_source, scan_files, apply_files, override_source, source_place, last_text
    use friction_scene, only: scene
@@ -230,8 +230,36 @@ contains
          call move_alloc(checker%error, error)
          return
       end if
+      call warn_implausible(config, checker)
+      if (present(notes) .and. allocated(checker%warnings)) then
+         do k = 1, size(checker%warnings)
+            notes = [character(len=1024) :: notes, 'warning: '//trim(checker%warnings(k))]
+         end do
+      end if
       input_text = job_text(config)
    end subroutine read_input
+
+   !> Warnings for the values the input gives that look like numbers in
+   !> another unit than their variable's (friction_plausibility), each naming
+   !> where it was set; defaults are not the input's slips.
+   subroutine warn_implausible(config, checker)
+      type(job_config), intent(inout) :: config
+      type(config_checker), intent(inout) :: checker
+      type(parameter_finding), allocatable :: findings(:)
+      integer :: k
+
+      findings = implausible_values(config)
+      do k = 1, size(findings)
+         associate (f => findings(k))
+            if (.not. checker%is_set(trim(f%group), trim(f%name))) cycle
+            if (f%index > 0) then
+               call checker%warn(trim(f%group), trim(f%name), trim(f%value), trim(f%reason), f%index)
+            else
+               call checker%warn(trim(f%group), trim(f%name), trim(f%value), trim(f%reason))
+            end if
+         end associate
+      end do
+   end subroutine warn_implausible
 
    !> Groups of the sources that are not part of the job's scene: in an
    !> override (--set), an error with the C API's message; in a file, a
@@ -304,9 +332,11 @@ contains
       end do
    end function scenes_with
 
-   !> The groups the job reads as namelist text.
-   function job_text(config) result(text)
+   !> The groups the job reads as namelist text; with `units`, each
+   !> variable's unit as a comment after it (--print-input).
+   function job_text(config, units) result(text)
       type(job_config), intent(inout) :: config
+      logical, intent(in), optional :: units
       character(len=:), allocatable :: text
       character(len=32), allocatable :: groups(:), own(:)
 
@@ -315,7 +345,7 @@ contains
       groups(1) = 'job'
       groups(2:) = own
       if (config%sweep%enabled()) groups = [character(len=32) :: groups, 'sweep']
-      text = parameters_text(config, groups)
+      text = parameters_text(config, groups, units)
    end function job_text
 
    !> The scene's checks, then the sweep's: one or two known numeric

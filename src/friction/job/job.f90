@@ -108,7 +108,8 @@ contains
 
    !> The resolved input of `files` and `overrides` (all applied, defaults
    !> filled, checked) as the namelist text a run echoes into its output,
-   !> which reads back to the same run; nothing is computed or written.
+   !> which reads back to the same run, each variable's unit a comment after
+   !> it; nothing is computed or written.
    !> Collective over `comm`; warnings go to the reporter.
    subroutine resolve_input(files, comm, reporter, text, error, overrides)
       character(len=*), intent(in) :: files(:)
@@ -123,7 +124,8 @@ contains
       call set_comm(comm, job)
       call read_job_input(job, files, overrides, reporter, config, error)
       if (allocated(error)) return
-      text = job%input_text
+      ! The run's own echo, with each variable's unit as a comment.
+      text = job_text(config, units=.true.)
    end subroutine resolve_input
 
    !> Read the input into `config` and `job%input_text` on every rank, the
