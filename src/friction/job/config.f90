@@ -183,14 +183,16 @@ contains
    !> back to the same run.  A file's group of another scene is ignored with
    !> a warning in `notes` if the input names the scene (&job scene), and is
    !> an error if the scene is the default one: the input then most likely
-   !> forgot its &job (docs/cli.md, Groups of another scene).
-   subroutine read_input(paths, config, input_text, error, overrides, notes)
+   !> forgot its &job (docs/cli.md, Groups of another scene).  With `units`,
+   !> input_text has each variable's unit as a comment (--print-input).
+   subroutine read_input(paths, config, input_text, error, overrides, notes, units)
       character(len=*), intent(in) :: paths(:)
       type(job_config), intent(out) :: config
       character(len=:), allocatable, intent(out) :: input_text
       type(error_type), allocatable, intent(out) :: error
       character(len=*), intent(in), optional :: overrides(:)
       character(len=1024), allocatable, intent(out), optional :: notes(:)
+      logical, intent(in), optional :: units
       type(namelist_source), allocatable :: sources(:), files(:)
       type(parameter_info), allocatable :: universe(:)
       type(config_checker) :: checker
@@ -236,7 +238,7 @@ contains
             notes = [character(len=1024) :: notes, 'warning: '//trim(checker%warnings(k))]
          end do
       end if
-      input_text = job_text(config)
+      input_text = job_text(config, units)
    end subroutine read_input
 
    !> Warnings for the values the input gives that look like numbers in

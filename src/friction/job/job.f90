@@ -122,25 +122,26 @@ contains
       type(job_config) :: config
 
       call set_comm(comm, job)
-      call read_job_input(job, files, overrides, reporter, config, error)
+      call read_job_input(job, files, overrides, reporter, config, error, units=.true.)
       if (allocated(error)) return
-      ! The run's own echo, with each variable's unit as a comment.
-      text = job_text(config, units=.true.)
+      text = job%input_text
    end subroutine resolve_input
 
    !> Read the input into `config` and `job%input_text` on every rank, the
    !> ranks agreeing on an error; rank 0 passes the reader's warnings on.
-   subroutine read_job_input(job, files, overrides, reporter, config, error)
+   !> With `units`, the text has each variable's unit as a comment.
+   subroutine read_job_input(job, files, overrides, reporter, config, error, units)
       type(job_context), intent(inout) :: job
       character(len=*), intent(in) :: files(:)
       character(len=*), intent(in), optional :: overrides(:)
       class(job_reporter), intent(inout) :: reporter
       type(job_config), intent(out) :: config
       type(error_type), allocatable, intent(out) :: error
+      logical, intent(in), optional :: units
       character(len=1024), allocatable :: notes(:)
       integer :: k
 
-      call read_input(files, config, job%input_text, error, overrides, notes)
+      call read_input(files, config, job%input_text, error, overrides, notes, units)
       call name_unread_pipe(job, files, error)
       call agree_on_error(job, error)
       if (allocated(error)) return
