@@ -24,25 +24,25 @@ contains
       character(len=*), intent(in) :: unit
       real(wp), intent(in) :: value
       character(len=:), allocatable :: reason
-      real(wp) :: size
+      real(wp) :: magnitude
 
       reason = ''
-      size = abs(value)
-      if (.not. (size > 0.0_wp .and. size <= huge(size))) return
+      magnitude = abs(value)
+      if (.not. (magnitude > 0.0_wp .and. magnitude <= huge(magnitude))) return
       select case (trim(unit))
       case ('degree')
          ! Angles users give in degrees are whole or half degrees; pi/4,
          ! 0.122 or 1.5708 are radians.
-         if (size < two_pi .and. modulo(2.0_wp * size, 1.0_wp) /= 0.0_wp) reason = 'below 2 pi and not a whole ' &
+         if (magnitude < two_pi .and. modulo(2.0_wp * magnitude, 1.0_wp) /= 0.0_wp) reason = 'below 2 pi and not a whole ' &
             & //'or half degree: it looks like radians, and the unit is degrees ('//rtoa(value)//' rad = ' &
             & //rtoa(value * 180.0_wp / (two_pi / 2.0_wp))//' degrees)'
       case ('eV')
          ! Surface energies are meV to eV; 1e-19 is a value in joules.
-         if (size < 1.0e-10_wp) reason = 'below 1e-10 eV: it looks like joules, and the unit is eV (' &
+         if (magnitude < 1.0e-10_wp) reason = 'below 1e-10 eV: it looks like joules, and the unit is eV (' &
             & //rtoa(value)//' J = '//rtoa(value / electronvolt)//' eV)'
       case ('angstrom')
          ! Atomic lengths are tenths to hundreds of angstroms; 1e-10 is metres.
-         if (size < 1.0e-6_wp) reason = 'below 1e-6 angstrom: it looks like metres, and the unit is angstrom (' &
+         if (magnitude < 1.0e-6_wp) reason = 'below 1e-6 angstrom: it looks like metres, and the unit is angstrom (' &
             & //rtoa(value)//' m = '//rtoa(value * 1.0e10_wp)//' angstrom)'
       end select
    end function unit_plausibility
