@@ -4,7 +4,7 @@ HOPG, graphite) to the machine scale (the Girling brake), in Python.
     import friction
 
     path = friction.run(friction.input_file("naf.nml"), output="naf.h5", force=True)   # the job, with progress
-    data = friction.load(path)                      # labelled arrays with units
+    data = friction.load(path)                      # an xarray.DataTree: coordinates, units
     fig = friction.plot.afm_maps(data)              # the maps as a matplotlib Figure
 
     cfg = friction.Config("afm", files=["inputs/naf.nml"], values={"scan.nx": 64})
@@ -23,7 +23,7 @@ Reference: docs/python.md.
 """
 from . import _capi
 from ._capi import FrictionError, LibraryNotFoundError, api_version, library_path
-from ._data import Array, Attributes, Dataset, FileError, load
+from ._data import FileError, groups, load, paths
 from ._image import ImageError, MeasuredImage, read_image
 from ._inputs import input_file
 from ._run import Config, Line, afm_line, brake, compute, run
@@ -31,8 +31,8 @@ from ._version import __version__
 
 __all__ = ["__version__", "library_version", "api_version", "library_path", "FrictionError",
            "LibraryNotFoundError", "FileError", "read_image", "MeasuredImage", "ImageError", "input_file", "Config",
-           "Line", "run", "compute", "afm_line", "brake", "load",
-           "Dataset", "Array", "Attributes", "plot", "fit", "law"]
+           "Line", "run", "compute", "afm_line", "brake", "load", "paths", "groups",
+           "plot", "fit", "law"]
 
 
 def library_version():

@@ -1,27 +1,25 @@
-"""Reading the program's HDF5 files as labelled arrays with units.
+"""Reading the program's HDF5 files as xarray trees with units.
 
-    data = friction.load("naf.h5")
-    fx = data["afm/trace/fx"]          # an Array: values (ny, nx), dims ("support_y", "support_x")
-    fx.units                           # 'nN'
-    fx.coords["support_x"].units       # 'angstrom'
-    fx.sel(support_y=2.0)              # the line nearest 2 Å across the scan, an Array over support_x
-    data.attrs["wall_time"], data.attrs.units["wall_time"]     # 0.047, 's'
-    data.group_attrs["afm"]["angle"], data.group_attrs["afm"].units["angle"]
-    data.to_xarray()                   # an xarray.Dataset, when xarray is installed
+    data = friction.load("naf.h5")          # an xarray.DataTree
+    fx = data["afm/trace/fx"]               # a DataArray over ("support_y", "support_x")
+    fx.attrs["units"]                       # 'nN'
+    fx["support_x"].attrs["units"]          # 'angstrom'
+    fx.sel(support_y=2.0, method="nearest") # the line nearest 2 Å across the scan
+    data.attrs["wall_time"], data.attrs["wall_time_units"]     # 0.047, 's'
+    data["afm"].attrs["angle"], data["afm"].attrs["angle_units"]
 
-The package's own small labelled-array type rather than xarray (docs/python.md,
-"Why not xarray"): load() gives the same objects whatever is installed, with
-no dependency beyond numpy and h5py, and to_xarray() hands them to xarray for
-those who use it.
+The files' layouts (which dataset runs along which other) are the program's
+own, so load() names the dimensions and coordinates that the files do not
+yet mark themselves; xarray does the rest.
 """
 import contextlib
-from collections.abc import Mapping
 from pathlib import Path
 
 import h5py
 import numpy as np
+import xarray as xr
 
-__all__ = ["Array", "Attributes", "Dataset", "FileError", "load", "open_output", "text"]
+__all__ = ["FileError", "groups", "load", "open_output", "paths", "text"]
 
 
 class FileError(ValueError):
@@ -56,259 +54,27 @@ def _python(value):
     return value
 
 
-class Attributes(dict):
-    """The attributes of a group: {name: value}, with the units of those that
-    have one in .units ({name: unit}, from the file's NAME_units attributes,
-    which are not repeated among the values)."""
-
-    def __init__(self, raw=None):
-        super().__init__()
-        self.units = {}
-        raw = dict(raw or {})
-        for name, value in raw.items():
-            if name.endswith("_units") and name[:-len("_units")] in raw:
-                self.units[name[:-len("_units")]] = text(value)
-            else:
-                self[name] = _python(value)
-
-    def flat(self):
-        """The attributes as the file has them: NAME_units beside NAME."""
-        out = dict(self)
-        out.update({f"{name}_units": unit for name, unit in self.units.items()})
-        return out
+def _attrs(raw):
+    """An HDF5 object's attributes as plain Python values (text decoded);
+    an attribute's unit stays beside it as NAME_units, as in the file."""
+    return {name: _python(value) for name, value in dict(raw or {}).items()}
 
 
-class Array:
-    """A numpy array with named dimensions, coordinates and units.
-
-    values  the numpy array
-    dims    a name per dimension ("support_y", "support_x"; "t"; a swept variable)
-    coords  {name: Array}: the coordinate of a dimension has the dimension's
-            name; others ("brake.mu" of a sweep's maxima) name the dimension
-            they run along in their own dims
-    units   the dataset's `units` attribute ('nN', 'angstrom', 'm per unit tau'), or None
-    name    the dataset's path in the file ("afm/trace/fx")
-    attrs   the dataset's other attributes
-
-    numpy functions take it as an array (np.mean(a), np.asarray(a)); a[...]
-    indexes the values.  isel() and sel() keep the labels."""
-
-    def __init__(self, values, dims, coords=None, units=None, name=None, attrs=None):
-        self.values = np.asarray(values)
-        self.dims = tuple(dims)
-        if len(self.dims) != self.values.ndim:
-            raise ValueError(f"{name}: {len(self.dims)} dimension names for an array of {self.values.ndim}")
-        self.coords = dict(coords or {})
-        for key, coord in self.coords.items():
-            for dim, size in zip(coord.dims, coord.shape):
-                if dim in self.dims and self.values.shape[self.dims.index(dim)] != size:
-                    raise ValueError(f"{name}: coordinate {key} has {size} values along {dim}, the array "
-                                     f"{self.values.shape[self.dims.index(dim)]}")
-        self.units = units
-        self.name = name
-        self.attrs = dict(attrs or {})
-
-    # ---- as an array ----
-    def __array__(self, dtype=None, copy=None):
-        if dtype is None:
-            return self.values
-        return self.values.astype(dtype)
-
-    @property
-    def shape(self):
-        return self.values.shape
-
-    @property
-    def ndim(self):
-        return self.values.ndim
-
-    @property
-    def size(self):
-        return self.values.size
-
-    @property
-    def dtype(self):
-        return self.values.dtype
-
-    def __len__(self):
-        return len(self.values)
-
-    def __getitem__(self, key):
-        return self.values[key]
-
-    def __iter__(self):
-        return iter(self.values)
-
-    @property
-    def label(self):
-        """"name (units)" for an axis: the last part of the name."""
-        short = (self.name or "").rsplit("/", 1)[-1]
-        return f"{short} ({self.units})" if self.units else short
-
-    def coord(self, dim):
-        """The coordinate of dimension `dim` (an Array), or its indices when it has none."""
-        if dim not in self.dims:
-            raise KeyError(f"{self.name}: no dimension {dim!r} (dimensions: {', '.join(self.dims)})")
-        if dim in self.coords:
-            return self.coords[dim]
-        return Array(np.arange(self.shape[self.dims.index(dim)]), (dim,), name=dim)
-
-    # ---- selection ----
-    def isel(self, indexers=None, **more):
-        """By position: isel(support_y=3), isel(t=slice(0, 100)); an integer
-        drops its dimension.  indexers: a dict, for names that are not Python
-        identifiers ({"brake.mu": 2})."""
-        indexers = dict(indexers or {}, **more)
-        for dim in indexers:
-            if dim not in self.dims:
-                raise KeyError(f"{self.name}: no dimension {dim!r} (dimensions: {', '.join(self.dims)})")
-        key = tuple(indexers.get(dim, slice(None)) for dim in self.dims)
-        dims = tuple(dim for dim, k in zip(self.dims, key) if not isinstance(k, (int, np.integer)))
-        coords = {}
-        for cname, coord in self.coords.items():
-            ckey = tuple(indexers.get(dim, slice(None)) for dim in coord.dims)
-            if any(isinstance(k, (int, np.integer)) for k in ckey):
-                continue
-            coords[cname] = Array(coord.values[ckey], coord.dims, units=coord.units, name=coord.name,
-                                  attrs=coord.attrs)
-        return Array(self.values[key], dims, coords, self.units, self.name, self.attrs)
-
-    def sel(self, indexers=None, **more):
-        """By coordinate value, the nearest: sel(support_y=2.0), sel(t=150.0);
-        a pair (low, high) selects the range low <= c <= high."""
-        indexers = dict(indexers or {}, **more)
-        positions = {}
-        for dim, value in indexers.items():
-            c = np.asarray(self.coord(dim).values, dtype=float)
-            if isinstance(value, tuple) and len(value) == 2:
-                inside = np.flatnonzero((c >= value[0]) & (c <= value[1]))
-                if inside.size == 0:
-                    raise KeyError(f"{self.name}: no {dim} in [{value[0]}, {value[1]}]")
-                positions[dim] = slice(int(inside[0]), int(inside[-1]) + 1)
-            else:
-                positions[dim] = int(np.nanargmin(np.abs(c - float(value))))
-        return self.isel(positions)
-
-    # ---- other forms ----
-    def to_xarray(self):
-        """An xarray.DataArray (needs xarray)."""
-        xr = _xarray()
-        return xr.DataArray(self.values, dims=self.dims, coords=_xarray_coords(self.coords, self.dims),
-                            name=self.name, attrs=_variable_attrs(self))
-
-    def __repr__(self):
-        dims = ", ".join(f"{d}: {n}" for d, n in zip(self.dims, self.shape))
-        lines = [f"<friction.Array {self.name or ''} ({dims}) {self.dtype}"
-                 + (f" [{self.units}]" if self.units else "") + ">"]
-        for cname, coord in self.coords.items():
-            values = coord.values
-            span = f"{values.min():g} .. {values.max():g}" if values.size and values.dtype.kind in "fiu" else ""
-            lines.append(f"  {cname} ({', '.join(coord.dims)}): {span}" + (f" [{coord.units}]" if coord.units else ""))
-        return "\n".join(lines)
+def paths(tree):
+    """The path of every array in a loaded file ("afm/trace/fx", "brake/t"),
+    coordinates included, in the file's order of groups."""
+    out = []
+    for node in tree.subtree:
+        prefix = node.path.strip("/")
+        own = node.to_dataset(inherit=False)
+        out += [f"{prefix}/{name}" if prefix else str(name) for name in own.variables]
+    return out
 
 
-def _xarray():
-    try:
-        import xarray
-    except ImportError:
-        raise ImportError("to_xarray() needs xarray: python3 -m pip install xarray "
-                          "(friction.load itself does not)") from None
-    return xarray
-
-
-def _variable_attrs(array):
-    attrs = {k: v for k, v in array.attrs.items() if not isinstance(v, np.ndarray) or v.dtype != object}
-    if array.units is not None:
-        attrs["units"] = array.units
-    return attrs
-
-
-def _xarray_name(name, coord, all_dims):
-    """A coordinate that runs along another dimension than the one it is named
-    after (a sweep's maxima: "brake.v_dr_prime" along "maximum") is renamed
-    "<its dimension>_<name>" ("maximum_brake.v_dr_prime"): in xarray a name is
-    either a dimension's coordinate or not."""
-    if name in all_dims and coord.dims != (name,):
-        return f"{coord.dims[0]}_{name}"
-    return name
-
-
-def _xarray_coords(coords, dims, all_dims=None):
-    all_dims = set(dims) | set(all_dims or ())
-    return {_xarray_name(name, coord, all_dims): (coord.dims, coord.values, _variable_attrs(coord))
-            for name, coord in coords.items() if set(coord.dims) <= set(dims)}
-
-
-class Dataset(Mapping):
-    """The contents of one HDF5 file, read whole (the file is closed again).
-
-    data["afm/trace/fx"]   an Array by the dataset's path
-    list(data)             the paths of every dataset
-    data.attrs             the root's Attributes (program, version, scene, input, ...)
-    data.group_attrs       {group path: Attributes} of every group ("afm", "brake/spectrum")
-    data.scene, data.version, data.path
-    data.to_xarray()       an xarray.Dataset (needs xarray)
-    """
-
-    def __init__(self, path, arrays, attrs, group_attrs):
-        self.path = Path(path)
-        self._arrays = dict(arrays)
-        self.attrs = attrs
-        self.group_attrs = group_attrs
-
-    def __getitem__(self, name):
-        try:
-            return self._arrays[name.strip("/")]
-        except KeyError:
-            raise KeyError(f"{name} (not in {self.path.name})") from None
-
-    def __iter__(self):
-        return iter(self._arrays)
-
-    def __len__(self):
-        return len(self._arrays)
-
-    @property
-    def scene(self):
-        """'afm', 'brake' or 'sweep' for the program's files, else None."""
-        return self.attrs.get("scene")
-
-    @property
-    def version(self):
-        """The version of the program that wrote the file."""
-        return self.attrs.get("version")
-
-    @property
-    def is_friction(self):
-        """True for a file the program wrote."""
-        return self.attrs.get("program") == "friction"
-
-    def to_xarray(self):
-        """Every dataset as a variable of one xarray.Dataset (named by its path),
-        with its dimensions, coordinates and units; the root's attributes as the
-        dataset's, a group's as "group/name" (NAME_units beside NAME, as in the
-        file).  A sweep's maxima have their swept values as the coordinate
-        "maximum_<variable>"."""
-        xr = _xarray()
-        variables, coords = {}, {}
-        all_dims = {dim for array in self._arrays.values() for dim in array.dims}
-        for name, array in self._arrays.items():
-            variables[name] = (array.dims, array.values, _variable_attrs(array))
-            coords.update(_xarray_coords(array.coords, array.dims, all_dims))
-        for name in coords:
-            variables.pop(name, None)
-        attrs = self.attrs.flat()
-        for group, group_attrs in self.group_attrs.items():
-            attrs.update({f"{group}/{k}": v for k, v in group_attrs.flat().items()})
-        return xr.Dataset(variables, coords=coords, attrs=attrs)
-
-    def __repr__(self):
-        lines = [f"<friction.Dataset {self.path.name}: " + (
-            f"friction {self.version}, scene {self.scene}" if self.is_friction else "an HDF5 file") + ">"]
-        for name, array in self._arrays.items():
-            dims = ", ".join(f"{d}: {n}" for d, n in zip(array.dims, array.shape))
-            lines.append(f"  {name} ({dims})" + (f" [{array.units}]" if array.units else ""))
-        return "\n".join(lines)
+def groups(tree):
+    """{group path: its attributes} of every group of a loaded file ("afm",
+    "brake/spectrum"); the root's are tree.attrs."""
+    return {node.path.strip("/"): node.attrs for node in tree.subtree if node.path != "/"}
 
 
 def _check_path(path):
@@ -330,42 +96,46 @@ def _read_values(dataset):
 
 
 def load(path, scene=None):
-    """Read a friction output file (any HDF5 file) into a Dataset of labelled arrays.
+    """Read a friction output file (any HDF5 file) into an xarray.DataTree:
+    a node per group, a variable per dataset (named by the dataset), the
+    root's and each group's attributes as the node's attrs.
 
     The program's layouts get their dimensions and coordinates:
       afm     maps (ny, nx) over ("support_y", "support_x"), the line offset
-              across the scan and the support position along it (angstrom);
-              /afm/friction over support_y; /surface/atoms over ("atom", "xyz")
-      brake   the trajectory over "t"; the events over "event" (their times);
-              the spectrum over "frequency"; the Poincare points over "strobe"
-              and "section" (their times); the Lyapunov curves over
-              "benettin_time" and "rosenstein_time"
+              across the scan and the support position along it (angstrom),
+              coordinates of /afm that /afm/trace and /afm/retrace inherit;
+              /afm/friction over support_y; /afm/slips over "slip";
+              /surface/atoms over ("atom", "xyz")
+      brake   the trajectory over "t"; the events over "event" with their
+              times t as coordinate; the spectrum over "frequency"; the
+              Poincare points over "strobe" and "section" with strobe_t and
+              section_t; the Lyapunov curves over "benettin_time",
+              "rosenstein_time" and "exponents_time"
       sweep   per point over the swept variable ("brake.v_dr_prime"), or over
               both variables (a grid, the second varying fastest); the brake's
               maxima over "maximum", with the swept values of their point as
-              coordinates
-    Datasets of other files, or of unknown shape, get dims "<path>_dim_<k>".
-    Units come from each dataset's `units` attribute; attributes' units
-    (NAME_units) go into Attributes.units.
+              the coordinates "maximum_<variable>"
+    Other datasets get dims "<path>_dim_<k>".  Units are each variable's
+    attrs["units"]; an attribute's unit is the attribute NAME_units.
 
     scene: 'afm', 'brake' or 'sweep' to require a file the program wrote for
     that scene.  Raises FileError for a missing file, one that is not HDF5,
     or not of the scene asked for."""
     if scene is not None:
         return require(path, scene)
-    if isinstance(path, Dataset):
+    if isinstance(path, xr.DataTree):
         return path
     path = _check_path(path)
-    raw, group_attrs = {}, {}
+    raw, group_attrs = {}, {"": {}}
     try:
         with h5py.File(path, "r") as f:
-            root = Attributes(f.attrs)
+            group_attrs[""] = _attrs(f.attrs)
 
             def visit(name, item):
                 if isinstance(item, h5py.Dataset):
-                    raw[name] = (_read_values(item), dict(item.attrs))
+                    raw[name] = (_read_values(item), _attrs(item.attrs))
                 else:
-                    group_attrs[name] = Attributes(item.attrs)
+                    group_attrs[name] = _attrs(item.attrs)
             f.visititems(visit)
     except OSError as err:
         raise FileError(f"cannot read as HDF5 ({err})") from None
@@ -373,101 +143,100 @@ def load(path, scene=None):
         # A damaged file opens and then fails inside: h5py's own errors
         # (RuntimeError, KeyError, ValueError) said nothing of the file.
         raise FileError(f"the HDF5 file is damaged ({type(err).__name__}: {err})") from None
-    arrays = _label(raw, root, group_attrs)
-    return Dataset(path, arrays, root, group_attrs)
-
-
-def _plain(name, values, attrs, dims=None, coords=None):
-    attrs = {k: _python(v) for k, v in attrs.items()}
-    units = attrs.pop("units", None)
-    if dims is None:
-        dims = tuple(f"{name}_dim_{k}" for k in range(values.ndim))
-    return Array(values, dims, coords, units, name, attrs)
+    labels = _label(raw, group_attrs[""], group_attrs)
+    nodes = {name: {"data": {}, "coords": {}} for name in group_attrs}
+    for name, (values, attrs) in raw.items():
+        group, _, short = name.rpartition("/")
+        nodes.setdefault(group, {"data": {}, "coords": {}})
+        dims, role = labels.get(name, (tuple(f"{name}_dim_{k}" for k in range(values.ndim)), "data"))
+        reshaped = values.reshape([n for n in labels.get(name + "#shape", values.shape)])
+        nodes[group][role][short] = xr.Variable(dims, reshaped, attrs)
+    for name, (dims, values, attrs) in labels.get("#extra", {}).items():
+        group, _, short = name.rpartition("/")
+        nodes[group]["coords"][short] = xr.Variable(dims, values, attrs)
+    datasets = {"/" + group: xr.Dataset(node["data"], coords=node["coords"], attrs=group_attrs.get(group, {}))
+                for group, node in nodes.items()}
+    try:
+        return xr.DataTree.from_dict(datasets)
+    except ValueError as err:
+        raise FileError(f"unexpected data in the file ({err})") from None
 
 
 def _label(raw, root, group_attrs):
-    """Arrays with the dimensions and coordinates of the program's layouts."""
-    arrays = {}
-    layouts = []
+    """{dataset path: (dims, "data" or "coords")} of the program's layouts;
+    "<path>#shape" where a dataset is reshaped and "#extra" for coordinates
+    the file does not hold as datasets."""
+    labels = {}
     if root.get("program") == "friction":
-        if "afm/support_x" in raw:
-            layouts.append(_afm_layout)
+        if "afm/support_x" in raw and "afm/support_y" in raw:
+            _afm_layout(raw, labels)
         if "brake/t" in raw:
-            layouts.append(_brake_layout)
+            _brake_layout(raw, labels)
         if "sweep/values" in raw:
-            layouts.append(_sweep_layout)
+            _sweep_layout(raw, root, group_attrs, labels)
         if "surface/atoms" in raw:
-            layouts.append(_surface_layout)
-    for layout in layouts:
-        arrays.update(layout(raw, root, group_attrs))
-    for name, (values, attrs) in raw.items():
-        if name not in arrays:
-            arrays[name] = _plain(name, values, attrs)
-    return arrays
+            _surface_layout(raw, labels)
+    return labels
 
 
-def _coordinate(raw, name, dim):
-    values, attrs = raw[name]
-    return _plain(name, values, attrs, dims=(dim,))
-
-
-def _along(raw, arrays, prefix, coord_name, dim, members):
-    """Label the 1-D datasets `members` under prefix with the coordinate `coord_name`."""
+def _along(raw, labels, prefix, coord_name, dim, members):
+    """The 1-D datasets `members` under prefix run along dim, whose
+    coordinate is the dataset coord_name."""
     if coord_name not in raw or raw[coord_name][0].ndim != 1:
         return
-    coord = _coordinate(raw, coord_name, dim)
-    n = coord.size
-    for name, (values, attrs) in raw.items():
-        if name.startswith(prefix) and members(name[len(prefix):]) and values.shape == (n,):
-            arrays[name] = _plain(name, values, attrs, (dim,), {dim: coord})
+    n = raw[coord_name][0].size
+    for name, (values, _) in raw.items():
+        rest = name[len(prefix):]
+        if name.startswith(prefix) and "/" not in rest and members(rest) and values.shape == (n,):
+            labels[name] = ((dim,), "data")
+    labels[coord_name] = ((dim,), "coords")
 
 
-def _afm_layout(raw, root, group_attrs):
-    arrays = {}
-    x = _coordinate(raw, "afm/support_x", "support_x")
-    y = _coordinate(raw, "afm/support_y", "support_y")
-    arrays["afm/support_x"] = Array(x.values, x.dims, {"support_x": x}, x.units, x.name, x.attrs)
-    arrays["afm/support_y"] = Array(y.values, y.dims, {"support_y": y}, y.units, y.name, y.attrs)
-    for name, (values, attrs) in raw.items():
-        if name.startswith(("afm/trace/", "afm/retrace/")) and values.shape == (y.size, x.size):
-            arrays[name] = _plain(name, values, attrs, ("support_y", "support_x"),
-                                  {"support_y": y, "support_x": x})
-    if "afm/friction" in raw and raw["afm/friction"][0].shape == (y.size,):
-        values, attrs = raw["afm/friction"]
-        arrays["afm/friction"] = _plain("afm/friction", values, attrs, ("support_y",), {"support_y": y})
-    return arrays
+def _afm_layout(raw, labels):
+    ny, nx = raw["afm/support_y"][0].size, raw["afm/support_x"][0].size
+    labels["afm/support_x"] = (("support_x",), "coords")
+    labels["afm/support_y"] = (("support_y",), "coords")
+    for name, (values, _) in raw.items():
+        if name.startswith(("afm/trace/", "afm/retrace/")) and values.shape == (ny, nx):
+            labels[name] = (("support_y", "support_x"), "data")
+    for name in ("afm/friction", "afm/friction_sem"):
+        if name in raw and raw[name][0].shape == (ny,):
+            labels[name] = (("support_y",), "data")
+    slips = [name for name in raw if name.startswith("afm/slips/") and raw[name][0].ndim == 1]
+    if slips and len({raw[name][0].size for name in slips}) == 1:
+        labels.update({name: (("slip",), "data") for name in slips})
 
 
-def _surface_layout(raw, root, group_attrs):
-    arrays = {}
-    values, attrs = raw["surface/atoms"]
+def _surface_layout(raw, labels):
+    values = raw["surface/atoms"][0]
     if values.ndim == 2 and values.shape[1] in (2, 3):
-        xyz = Array(np.array(["x", "y", "z"][:values.shape[1]], dtype=object), ("xyz",), name="xyz")
-        arrays["surface/atoms"] = _plain("surface/atoms", values, attrs, ("atom", "xyz"), {"xyz": xyz})
+        labels["surface/atoms"] = (("atom", "xyz"), "data")
+        labels.setdefault("#extra", {})["surface/xyz"] = (
+            ("xyz",), np.array(["x", "y", "z"][:values.shape[1]], dtype=object), {})
         if "surface/species" in raw and raw["surface/species"][0].shape == (values.shape[0],):
-            species, sattrs = raw["surface/species"]
-            arrays["surface/species"] = _plain("surface/species", species, sattrs, ("atom",))
-    return arrays
+            labels["surface/species"] = (("atom",), "data")
 
 
-def _brake_layout(raw, root, group_attrs):
-    arrays = {}
-    _along(raw, arrays, "brake/", "brake/t", "t", lambda rest: "/" not in rest)
-    _along(raw, arrays, "brake/events/", "brake/events/t", "event", lambda rest: True)
-    _along(raw, arrays, "brake/spectrum/", "brake/spectrum/frequency", "frequency", lambda rest: True)
-    _along(raw, arrays, "brake/poincare/", "brake/poincare/strobe_t", "strobe",
+def _brake_layout(raw, labels):
+    _along(raw, labels, "brake/", "brake/t", "t", lambda rest: True)
+    _along(raw, labels, "brake/events/", "brake/events/t", "event", lambda rest: True)
+    _along(raw, labels, "brake/spectrum/", "brake/spectrum/frequency", "frequency", lambda rest: True)
+    _along(raw, labels, "brake/poincare/", "brake/poincare/strobe_t", "strobe",
            lambda rest: rest.startswith("strobe_"))
-    _along(raw, arrays, "brake/poincare/", "brake/poincare/section_t", "section",
+    _along(raw, labels, "brake/poincare/", "brake/poincare/section_t", "section",
            lambda rest: rest.startswith("section_"))
-    _along(raw, arrays, "brake/lyapunov/", "brake/lyapunov/benettin_time", "benettin_time",
-           lambda rest: rest.startswith("benettin_"))
-    _along(raw, arrays, "brake/lyapunov/", "brake/lyapunov/rosenstein_time", "rosenstein_time",
-           lambda rest: rest.startswith("rosenstein_"))
-    return arrays
+    for curve in ("benettin", "rosenstein"):
+        _along(raw, labels, "brake/lyapunov/", f"brake/lyapunov/{curve}_time", f"{curve}_time",
+               lambda rest, curve=curve: rest.startswith(f"{curve}_"))
+    history = "brake/lyapunov/exponents_history"
+    if "brake/lyapunov/exponents_time" in raw and history in raw:
+        n = raw["brake/lyapunov/exponents_time"][0].size
+        if raw[history][0].ndim == 2 and raw[history][0].shape[0] == n:
+            labels["brake/lyapunov/exponents_time"] = (("exponents_time",), "coords")
+            labels[history] = (("exponents_time", "exponent"), "data")
 
 
-def _sweep_layout(raw, root, group_attrs):
-    arrays = {}
+def _sweep_layout(raw, root, group_attrs, labels):
     values, vattrs = raw["sweep/values"]
     n = values.size
     var1 = root.get("sweep_variable") or "values"
@@ -475,33 +244,32 @@ def _sweep_layout(raw, root, group_attrs):
     sweep = group_attrs.get("sweep", {})
     shape1, shape2 = int(sweep.get("shape", n)), int(sweep.get("shape2", 1))
     two = bool(var2) and "sweep/values2" in raw and shape1 * shape2 == n and shape2 > 0
+    extra = labels.setdefault("#extra", {})
+    if var1 == "values":
+        return
     if two:
         values2, v2attrs = raw["sweep/values2"]
-        c1 = _plain("sweep/values", values[::shape2], vattrs, (var1,))
-        c2 = _plain("sweep/values2", values2[:shape2], v2attrs, (var2,))
-        dims, coords, shape = (var1, var2), {var1: c1, var2: c2}, (shape1, shape2)
-        # every point's values, for the maxima
-        point_coords = {var1: _plain("sweep/values", values, vattrs, ("point",)),
-                        var2: _plain("sweep/values2", values2, v2attrs, ("point",))}
+        dims, shape = (var1, var2), (shape1, shape2)
+        extra[f"sweep/{var1}"] = ((var1,), values[::shape2], vattrs)
+        extra[f"sweep/{var2}"] = ((var2,), values2[:shape2], v2attrs)
+        per_point = {var1: (values, vattrs), var2: (values2, v2attrs)}
     else:
-        c1 = _plain("sweep/values", values, vattrs, (var1,))
-        dims, coords, shape = (var1,), {var1: c1}, (n,)
-        point_coords = {var1: _plain("sweep/values", values, vattrs, ("point",))}
-    for name, (data, attrs) in raw.items():
+        dims, shape = (var1,), (n,)
+        extra[f"sweep/{var1}"] = ((var1,), values, vattrs)
+        per_point = {var1: (values, vattrs)}
+    for name, (data, _) in raw.items():
         if name.startswith("sweep/") and data.shape == (n,):
-            arrays[name] = _plain(name, data.reshape(shape), attrs, dims, coords)
+            labels[name] = (dims, "data")
+            labels[name + "#shape"] = shape
     if "sweep/maxima" in raw and "sweep/maxima_count" in raw:
         counts = np.asarray(raw["sweep/maxima_count"][0]).astype(int).ravel()
-        maxima, mattrs = raw["sweep/maxima"]
+        maxima = raw["sweep/maxima"][0]
         if counts.size == n and counts.sum() == maxima.size and (counts >= 0).all():
-            mcoords = {key: Array(np.repeat(c.values, counts), ("maximum",), units=c.units, name=c.name,
-                                  attrs=c.attrs) for key, c in point_coords.items()}
-            arrays["sweep/maxima"] = _plain("sweep/maxima", maxima, mattrs, ("maximum",), mcoords)
-    if "sweep/peak_memory_per_rank" in raw:
-        data, attrs = raw["sweep/peak_memory_per_rank"]
-        if data.ndim == 1:
-            arrays["sweep/peak_memory_per_rank"] = _plain("sweep/peak_memory_per_rank", data, attrs, ("rank",))
-    return arrays
+            labels["sweep/maxima"] = (("maximum",), "data")
+            for key, (point_values, attrs) in per_point.items():
+                extra[f"sweep/maximum_{key}"] = (("maximum",), np.repeat(point_values, counts), attrs)
+    if "sweep/peak_memory_per_rank" in raw and raw["sweep/peak_memory_per_rank"][0].ndim == 1:
+        labels["sweep/peak_memory_per_rank"] = (("rank",), "data")
 
 
 @contextlib.contextmanager
@@ -535,11 +303,12 @@ WHAT = {"afm": "force-map", "brake": "brake", "sweep": "sweep"}
 
 
 def require(data, scene, what=None):
-    """`data` (a Dataset or a file name) loaded, and a friction file of `scene`;
+    """`data` (a loaded file or a file name) loaded, and a friction file of `scene`;
     FileError otherwise, as open_output words it."""
     what = what or WHAT.get(scene, scene)
     data = load(data)
-    if not data.is_friction or data.scene != scene or scene not in data.group_attrs:
+    if (data.attrs.get("program") != "friction" or data.attrs.get("scene") != scene
+            or scene not in data.children):
         raise FileError(f"not a friction {what} file "
                         f"(needs program = 'friction', scene = '{scene}', group /{scene})")
     return data

@@ -1,5 +1,5 @@
-"""The project's pictures as functions: each takes a file's data (a Dataset
-from friction.load, or a file name) and returns a matplotlib Figure.
+"""The project's pictures as functions: each takes a file's data (the
+xarray.DataTree of friction.load, or a file name) and returns a matplotlib Figure.
 
     data = friction.load("naf.h5")
     fig = friction.plot.afm_maps(data)          # Fx and Fy maps (the paper's Fig. 7b/8b)
@@ -34,7 +34,7 @@ from matplotlib.colors import ListedColormap, Normalize
 from matplotlib.figure import Figure as _Figure
 from matplotlib.patches import Polygon, Rectangle
 
-from ._data import FileError, load, reading, require
+from ._data import FileError, groups, load, paths, reading, require
 
 __all__ = ["afm_maps", "friction_loop", "graphite_net", "stacked_lines", "brake_phase", "brake_x",
            "brake_spectrum", "poincare", "lyapunov", "floquet", "orbit_branch", "sweep", "bifurcation",
@@ -73,12 +73,12 @@ def _scan(data):
     """The map, its axes and the line friction of an AFM file, checked."""
     data = require(data, "afm", "force-map")
     with reading("force-map"):
-        afm = data.group_attrs["afm"]
+        afm = groups(data)["afm"]
         scan = {"potential": str(afm["potential"]), "angle": float(afm["angle"]),
                 "x": data["afm/support_x"].values, "y": data["afm/support_y"].values,
-                "friction": data["afm/friction"].values if "afm/friction" in data else None}
+                "friction": data["afm/friction"].values if "afm/friction" in paths(data) else None}
         for trip in ("trace", "retrace"):
-            if f"afm/{trip}/fx" in data:
+            if f"afm/{trip}/fx" in paths(data):
                 scan[trip] = {q: data[f"afm/{trip}/{q}"].values for q in ("fx", "fy", "f_along")}
     if "trace" not in scan:
         raise FileError("no /afm/trace group")
@@ -169,11 +169,11 @@ NN_SAMPLE = 400  # atoms whose nearest neighbour sets the nearest-neighbour dist
 def _lattice(data):
     """The scan, the tip path and the net of a lattice-sum file, checked."""
     data = require(data, "afm", "force-map")
-    if "surface/atoms" not in data:
+    if "surface/atoms" not in paths(data):
         raise FileError("not a lattice-sum scene: no /surface/atoms (for NaF/HOPG maps use plot_afm.py)")
     with reading("force-map"):
-        afm = data.group_attrs["afm"]
-        surface = data.group_attrs.get("surface", {})
+        afm = groups(data)["afm"]
+        surface = groups(data).get("surface", {})
         lattice = {
             "potential": str(afm.get("potential", "?")),
             "angle": float(afm["angle"]),
@@ -182,14 +182,14 @@ def _lattice(data):
             "y": np.asarray(data["afm/support_y"].values, dtype=float),
             "atoms": np.asarray(data["surface/atoms"].values, dtype=float),
             "species": (np.asarray(data["surface/species"].values, dtype=int)
-                        if "surface/species" in data else None),
+                        if "surface/species" in paths(data) else None),
             "species_names": [s.strip() for s in str(surface.get("species_names", "")).split(",")],
             "cutoff": float(surface["cutoff"]) if "cutoff" in surface else None,
             "trips": {},
         }
         for trip in ("trace", "retrace"):
             quantities = {q: np.asarray(data[f"afm/{trip}/{q}"].values, dtype=float)
-                          for q in (*COMPONENTS, "tip_x", "tip_y") if f"afm/{trip}/{q}" in data}
+                          for q in (*COMPONENTS, "tip_x", "tip_y") if f"afm/{trip}/{q}" in paths(data)}
             if quantities:
                 lattice["trips"][trip] = quantities
 
@@ -414,7 +414,7 @@ def _brake_run(data):
     data = require(data, "brake", "brake")
     with reading("brake"):
         run = {name: data[f"brake/{name}"].values for name in ("t", "x", "v", "y", "w", "stick")}
-        brake = data.group_attrs["brake"]
+        brake = groups(data)["brake"]
         run["model"] = str(brake["model"])
         run["v_dr"] = float(brake["v_dr_prime"])
         run["method"] = str(data.attrs.get("method", "?"))
@@ -502,28 +502,28 @@ def _diagnostics(data):
     data = require(data, "brake", "brake")
     d = {}
     with reading("brake"):
-        brake = data.group_attrs["brake"]
+        brake = groups(data)["brake"]
         d["model"] = str(brake["model"])
         d["v_dr"] = float(brake["v_dr_prime"])
-        groups = data.group_attrs
-        if "brake/spectrum" in groups:
-            s = groups["brake/spectrum"]
+        present = groups(data)
+        if "brake/spectrum" in present:
+            s = present["brake/spectrum"]
             d["spectrum"] = {"frequency": data["brake/spectrum/frequency"].values,
                              "amplitude": data["brake/spectrum/amplitude"].values,
-                             "amplitude_units": getattr(data["brake/spectrum/amplitude"], "units", None),
+                             "amplitude_units": data["brake/spectrum/amplitude"].attrs.get("units"),
                              "series": str(s["series"]), "window": str(s["window"]),
                              **{k: float(s[k]) for k in ("peak_frequency", "resolution", "window_start",
                                                          "window_end")}}
-        if "brake/poincare" in groups:
-            p = groups["brake/poincare"]
-            d["poincare"] = {name.rsplit("/", 1)[1]: data[name].values for name in data
+        if "brake/poincare" in present:
+            p = present["brake/poincare"]
+            d["poincare"] = {name.rsplit("/", 1)[1]: data[name].values for name in paths(data)
                              if name.startswith("brake/poincare/")}
             d["poincare"]["period"] = float(p["strobe_period"])
             d["poincare"]["section"] = str(p["section"])
-        if "brake/lyapunov" in groups:
-            d["lyapunov"] = {name.rsplit("/", 1)[1]: data[name].values for name in data
+        if "brake/lyapunov" in present:
+            d["lyapunov"] = {name.rsplit("/", 1)[1]: data[name].values for name in paths(data)
                              if name.startswith("brake/lyapunov/")}
-            d["lyapunov"]["attrs"] = groups["brake/lyapunov"]
+            d["lyapunov"]["attrs"] = present["brake/lyapunov"]
     if not any(k in d for k in ("spectrum", "poincare", "lyapunov")):
         raise FileError("no chaos diagnostics in the file (run friction with an &analysis group)")
     return d
@@ -626,13 +626,13 @@ def _orbit(data):
     """The /brake/orbit group: attributes and datasets (branch ones under 'branch/')."""
     data = require(data, "brake", "brake")
     with reading("brake"):
-        if "brake/orbit" not in data.group_attrs:
+        if "brake/orbit" not in groups(data):
             raise FileError("no /brake/orbit in the file (run friction with &analysis orbit = .true.)")
-        o = {name[len("brake/orbit/"):]: data[name].values for name in data if name.startswith("brake/orbit/")}
-        o["attrs"] = data.group_attrs["brake/orbit"]
-        if "brake/orbit/branch" in data.group_attrs:
-            o["variable"] = str(data.group_attrs["brake/orbit/branch"]["variable"])
-            names = str(data.group_attrs["brake/orbit/bifurcations"]["kind_names"])
+        o = {name[len("brake/orbit/"):]: data[name].values for name in paths(data) if name.startswith("brake/orbit/")}
+        o["attrs"] = groups(data)["brake/orbit"]
+        if "brake/orbit/branch" in groups(data):
+            o["variable"] = str(groups(data)["brake/orbit/branch"]["variable"])
+            names = str(groups(data)["brake/orbit/bifurcations"]["kind_names"])
             o["kind_names"] = {int(code): name.strip() for code, name in
                                (item.split("=") for item in names.split(","))}
     return o
@@ -735,7 +735,7 @@ def _sweep(data):
             keys += ["maxima", "maxima_offset", "maxima_count", "lyapunov", "stick_fraction"]
         else:
             keys += ["mean_friction", "max_force"]
-        missing = [key for key in keys if f"sweep/{key}" not in data]
+        missing = [key for key in keys if f"sweep/{key}" not in paths(data)]
         if missing:
             raise FileError("/sweep lacks " + ", ".join(missing))
         s.update({key: np.ravel(data[f"sweep/{key}"].values) for key in keys})
@@ -743,9 +743,9 @@ def _sweep(data):
             s["variable2"] = str(data.attrs["sweep_variable2"])
             s["values2"] = np.ravel(data["sweep/values2"].values)
         # Axis labels with the swept variables' units, which /sweep/values and values2 carry.
-        s["label"] = _with_unit(s["variable"], getattr(data["sweep/values"], "units", None))
+        s["label"] = _with_unit(s["variable"], data["sweep/values"].attrs.get("units"))
         if "variable2" in s:
-            s["label2"] = _with_unit(s["variable2"], getattr(data["sweep/values2"], "units", None))
+            s["label2"] = _with_unit(s["variable2"], data["sweep/values2"].attrs.get("units"))
     n = s["values"].size
     if any(s[key].size != n for key in keys if key != "maxima"):
         raise FileError("per-point datasets of different lengths")
@@ -960,12 +960,12 @@ def work_precision(data, scene):
     against CPU time, log-log, a line per method (its 'ok' points), the
     series measured elsewhere dashed, the reference's own check dotted."""
     data = load(data)
-    if scene not in data.group_attrs:
-        known = sorted(g for g in data.group_attrs if "/" not in g)
+    if scene not in groups(data):
+        known = sorted(g for g in groups(data) if "/" not in g)
         raise FileError(f"no scene {scene!r} in the file (scenes: {', '.join(known)})")
     with reading("work-precision"):
-        attrs = data.group_attrs[scene]
-        methods = sorted({name.split("/")[1] for name in data
+        attrs = groups(data)[scene]
+        methods = sorted({name.split("/")[1] for name in paths(data)
                           if name.startswith(f"{scene}/") and name.count("/") == 2 and name.split("/")[1] != "extra"},
                          key=lambda m: list(STYLE).index(m) if m in STYLE else len(STYLE))
         check = float(attrs["reference_check"])
@@ -980,7 +980,7 @@ def work_precision(data, scene):
             color, marker = STYLE.get(method, ("k", "."))
             ax.loglog(data[f"{scene}/{method}/error"].values[ok], data[f"{scene}/{method}/cpu_time"].values[ok],
                       marker=marker, color=color, label=method, lw=1.2, ms=5)
-        extras = sorted({name.split("/")[2] for name in data if name.startswith(f"{scene}/extra/")})
+        extras = sorted({name.split("/")[2] for name in paths(data) if name.startswith(f"{scene}/extra/")})
         for label in extras:
             ax.loglog(data[f"{scene}/extra/{label}/error"].values, data[f"{scene}/extra/{label}/cpu_time"].values,
                       "k--", marker="+", label=label)
@@ -1005,7 +1005,7 @@ def failure_map(data):
     setting of a parameter, ok, slow, failed or silently wrong, with the CPU
     time in ms."""
     data = load(data)
-    maps = [g for g in data.group_attrs if "/" not in g]
+    maps = [g for g in groups(data) if "/" not in g]
     if not maps:
         raise FileError("no failure maps in the file")
     with reading("failure-map"):
@@ -1015,8 +1015,8 @@ def failure_map(data):
         axes = np.atleast_1d(fig.subplots(1, len(maps)))
         cmap = ListedColormap(FAILURE_COLOURS)
         for ax, name in zip(axes, maps):
-            attrs = data.group_attrs[name]
-            parameter = next(p for p in PARAMETER_LABELS if f"{name}/{p}" in data)
+            attrs = groups(data)[name]
+            parameter = next(p for p in PARAMETER_LABELS if f"{name}/{p}" in paths(data))
             values = data[f"{name}/{parameter}"].values
             labels = [PARAMETER_LABELS[parameter](v) for v in values]
             category = np.asarray(data[f"{name}/category"].values, dtype=int)

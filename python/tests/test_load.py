@@ -1,9 +1,9 @@
 """load(): the datasets with their coordinates and units, read independently with h5py."""
-import sys
 
 import h5py
 import numpy as np
 import pytest
+import xarray as xr
 
 import friction
 from conftest import DATA, ROOT
@@ -16,67 +16,69 @@ def raw(path, name):
 
 def test_a_map(naf_map):
     data = friction.load(naf_map)
-    assert data.scene == "afm" and data.is_friction and data.path == naf_map
+    assert isinstance(data, xr.DataTree)
+    assert data.attrs["scene"] == "afm" and data.attrs["program"] == "friction"
     fx = data["afm/trace/fx"]
     values, attrs = raw(naf_map, "afm/trace/fx")
-    assert np.array_equal(fx.values, values) and fx.units == attrs["units"].decode() == "nN"
+    assert np.array_equal(fx.values, values) and fx.attrs["units"] == attrs["units"].decode() == "nN"
     assert fx.dims == ("support_y", "support_x") and fx.shape == (10, 40)
     x, _ = raw(naf_map, "afm/support_x")
     y, _ = raw(naf_map, "afm/support_y")
-    assert np.array_equal(fx.coords["support_x"].values, x) and fx.coords["support_x"].units == "angstrom"
-    assert np.array_equal(fx.coords["support_y"].values, y) and fx.coords["support_y"].units == "angstrom"
+    # the map's coordinates are /afm's, inherited by /afm/trace
+    assert np.array_equal(fx["support_x"].values, x) and fx["support_x"].attrs["units"] == "angstrom"
+    assert np.array_equal(fx["support_y"].values, y) and fx["support_y"].attrs["units"] == "angstrom"
     assert data["afm/friction"].dims == ("support_y",)
-    assert data["afm/trace/tip_x"].units == "angstrom"
-    # selection keeps the labels
-    line = fx.sel(support_y=y[3] + 0.1)
+    assert data["afm/trace/tip_x"].attrs["units"] == "angstrom"
+    # xarray's selection by coordinate
+    line = fx.sel(support_y=y[3] + 0.1, method="nearest")
     assert line.dims == ("support_x",) and np.array_equal(line.values, values[3])
-    part = fx.sel(support_x=(5.0, 10.0))
-    assert np.array_equal(part.coords["support_x"].values, x[(x >= 5.0) & (x <= 10.0)])
+    part = fx.sel(support_x=slice(5.0, 10.0))
+    assert np.array_equal(part["support_x"].values, x[(x >= 5.0) & (x <= 10.0)])
     assert np.array_equal(fx.isel(support_y=2, support_x=slice(0, 4)).values, values[2, :4])
-    assert np.mean(fx) == pytest.approx(values.mean()) and np.asarray(fx) is fx.values
-    assert fx.label == "fx (nN)"
-    # attributes and their units (NAME_units), the root's and a group's
-    assert data.attrs["program"] == "friction" and data.attrs.units["wall_time"] == "s"
-    assert "wall_time_units" not in data.attrs and isinstance(data.attrs["nranks"], int)
-    afm = data.group_attrs["afm"]
-    assert afm["angle"] == 0.0 and afm.units["angle"] == "degree" and afm.units["kx"] == "N/m"
+    # attributes as in the file, a unit beside its value (NAME_units)
+    assert data.attrs["wall_time_units"] == "s" and isinstance(data.attrs["nranks"], int)
+    afm = data["afm"].attrs
+    assert afm["angle"] == 0.0 and afm["angle_units"] == "degree" and afm["kx_units"] == "N/m"
     assert afm["potential"] == "naf"
-    assert "afm/trace/fx" in repr(data) and "[nN]" in repr(fx)
+    assert "afm/trace/fx" in friction.paths(data) and "afm/support_x" in friction.paths(data)
+    assert friction.groups(data)["afm/trace"] == {}
 
 
 def test_a_brake_run(brake_run):
     data = friction.load(brake_run, scene="brake")
     t, _ = raw(brake_run, "brake/t")
     x = data["brake/x"]
-    assert x.dims == ("t",) and np.array_equal(x.coords["t"].values, t) and x.units == "m"
-    assert data["brake/v"].units == "m per unit tau" and data["brake/stick"].dims == ("t",)
+    assert x.dims == ("t",) and np.array_equal(x["t"].values, t) and x.attrs["units"] == "m"
+    assert data["brake/v"].attrs["units"] == "m per unit tau" and data["brake/stick"].dims == ("t",)
     events = data["brake/events/kind"]
     et, _ = raw(brake_run, "brake/events/t")
-    assert events.dims == ("event",) and np.array_equal(events.coords["event"].values, et)
+    assert events.dims == ("event",) and np.array_equal(events["t"].values, et)
     spectrum = data["brake/spectrum/amplitude"]
     f, _ = raw(brake_run, "brake/spectrum/frequency")
-    assert spectrum.dims == ("frequency",) and np.array_equal(spectrum.coords["frequency"].values, f)
-    assert spectrum.coords["frequency"].units == "cycles per unit tau"
+    assert spectrum.dims == ("frequency",) and np.array_equal(spectrum["frequency"].values, f)
+    assert spectrum["frequency"].attrs["units"] == "cycles per unit tau"
     assert data["brake/poincare/strobe_x"].dims == ("strobe",)
+    st, _ = raw(brake_run, "brake/poincare/strobe_t")
+    assert np.array_equal(data["brake/poincare/strobe_x"]["strobe_t"].values, st)
     assert data["brake/poincare/section_y"].dims == ("section",)
     assert data["brake/lyapunov/benettin_estimate"].dims == ("benettin_time",)
     assert data["brake/lyapunov/rosenstein_divergence"].dims == ("rosenstein_time",)
-    brake = data.group_attrs["brake"]
-    assert brake["v_dr_prime"] == -0.002788 and brake.units["v_dr_prime"] == "m/tau"
-    assert data.group_attrs["brake/spectrum"].units["peak_frequency"] == "1/tau"
+    brake = data["brake"].attrs
+    assert brake["v_dr_prime"] == -0.002788 and brake["v_dr_prime_units"] == "m/tau"
+    assert data["brake/spectrum"].attrs["peak_frequency_units"] == "1/tau"
 
 
 def test_a_brake_sweep(brake_sweep):
     data = friction.load(brake_sweep, scene="sweep")
     values, vattrs = raw(brake_sweep, "sweep/values")
     lyap = data["sweep/lyapunov"]
-    assert lyap.dims == ("brake.v_dr_prime",) and lyap.units == "1/tau"
-    assert np.array_equal(lyap.coords["brake.v_dr_prime"].values, values)
-    assert lyap.coords["brake.v_dr_prime"].units == vattrs["units"].decode() == "m/tau"
+    assert lyap.dims == ("brake.v_dr_prime",) and lyap.attrs["units"] == "1/tau"
+    assert np.array_equal(lyap["brake.v_dr_prime"].values, values)
+    assert lyap["brake.v_dr_prime"].attrs["units"] == vattrs["units"].decode() == "m/tau"
     maxima = data["sweep/maxima"]
     counts, _ = raw(brake_sweep, "sweep/maxima_count")
     assert maxima.dims == ("maximum",) and maxima.size == counts.sum()
-    assert np.array_equal(maxima.coords["brake.v_dr_prime"].values, np.repeat(values, counts))
+    assert np.array_equal(maxima["maximum_brake.v_dr_prime"].values, np.repeat(values, counts))
 
 
 def test_an_afm_sweep_is_a_grid(afm_sweep):
@@ -89,27 +91,27 @@ def test_an_afm_sweep_is_a_grid(afm_sweep):
     for i in range(5):
         for j in range(2):
             assert grid.values[i, j] == friction_values[i * 2 + j]
-            assert grid.coords["surface.v0"].values[i] == v0[i * 2 + j]
-            assert grid.coords["scan.velocity"].values[j] == velocity[i * 2 + j]
-    assert grid.coords["surface.v0"].units == "eV" and grid.coords["scan.velocity"].units == "angstrom/s"
+            assert grid["surface.v0"].values[i] == v0[i * 2 + j]
+            assert grid["scan.velocity"].values[j] == velocity[i * 2 + j]
+    assert grid["surface.v0"].attrs["units"] == "eV" and grid["scan.velocity"].attrs["units"] == "angstrom/s"
     assert grid.sel({"scan.velocity": 100.0}).dims == ("surface.v0",)
 
 
 def test_a_lattice_sum_map(graphite_map):
     data = friction.load(graphite_map)
     atoms = data["surface/atoms"]
-    assert atoms.dims == ("atom", "xyz") and list(atoms.coords["xyz"].values) == ["x", "y", "z"]
+    assert atoms.dims == ("atom", "xyz") and list(atoms["xyz"].values) == ["x", "y", "z"]
     assert data["surface/species"].dims == ("atom",)
     assert data["afm/trace/fz"].dims == ("support_y", "support_x")
-    assert data.group_attrs["surface"]["species_names"] == "C"
+    assert data["surface"].attrs["species_names"] == "C"
 
 
 def test_other_hdf5_files():
     data = friction.load(ROOT / "docs" / "work_precision.h5")
-    assert not data.is_friction and data.scene is None
+    assert data.attrs["program"] != "friction"
     status = data["naf/rkf45/status"]
     assert status.dims == ("naf/rkf45/status_dim_0",) and status.values[0] in ("ok", "unresolved", "capped")
-    assert data.group_attrs["naf"]["unit"] == "nN"
+    assert data["naf"].attrs["unit"] == "nN"
 
 
 def test_files_it_cannot_read(tmp_path, naf_map):
@@ -147,30 +149,6 @@ def test_a_damaged_file(tmp_path, brake_run):
     assert "the HDF5 file is damaged" in raised, raised
 
 
-def test_to_xarray(naf_map, brake_sweep):
-    xr = pytest.importorskip("xarray")
+def test_a_tree_is_loaded_once(naf_map):
     data = friction.load(naf_map)
-    ds = data.to_xarray()
-    assert isinstance(ds, xr.Dataset)
-    fx = ds["afm/trace/fx"]
-    assert fx.dims == ("support_y", "support_x") and fx.attrs["units"] == "nN"
-    assert ds["support_x"].attrs["units"] == "angstrom"
-    assert np.array_equal(fx.sel(support_y=data["afm/support_y"].values[4]).values, data["afm/trace/fx"].values[4])
-    assert ds.attrs["wall_time_units"] == "s" and ds.attrs["afm/angle_units"] == "degree"
-    one = data["afm/friction"].to_xarray()
-    assert one.dims == ("support_y",) and one.attrs["units"] == "nN"
-    sweep = friction.load(brake_sweep)
-    values, _ = raw(brake_sweep, "sweep/values")
-    counts, _ = raw(brake_sweep, "sweep/maxima_count")
-    converted = sweep.to_xarray()
-    assert np.array_equal(converted["brake.v_dr_prime"].values, values)
-    assert converted["sweep/lyapunov"].dims == ("brake.v_dr_prime",)
-    along = converted["sweep/maxima"].coords["maximum_brake.v_dr_prime"]
-    assert along.dims == ("maximum",) and np.array_equal(along.values, np.repeat(values, counts))
-    assert sweep["sweep/maxima"].to_xarray().coords["brake.v_dr_prime"].dims == ("maximum",)
-
-
-def test_to_xarray_without_xarray(naf_map, monkeypatch):
-    monkeypatch.setitem(sys.modules, "xarray", None)
-    with pytest.raises(ImportError, match="pip install xarray"):
-        friction.load(naf_map).to_xarray()
+    assert friction.load(data) is data

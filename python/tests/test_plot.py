@@ -89,7 +89,7 @@ def test_brake_pictures(brake_run, naf_map, tmp_path):
     assert f"{data['brake/events/t'].size} stick/slip events" in x.axes[0].get_title()
     saved(x, tmp_path / "x.png")
     spectrum = friction.plot.brake_spectrum(data)
-    peak = data.group_attrs["brake/spectrum"]["peak_frequency"]
+    peak = data["brake/spectrum"].attrs["peak_frequency"]
     assert spectrum.axes[0].lines[1].get_xdata()[0] == peak
     assert "(paper Fig. 13)" in spectrum.axes[0].get_title()
     saved(spectrum, tmp_path / "spectrum.png")
@@ -97,7 +97,7 @@ def test_brake_pictures(brake_run, naf_map, tmp_path):
     assert f"{data['brake/poincare/strobe_t'].size} points" in poincare.axes[0].get_title()
     saved(poincare, tmp_path / "poincare.png")
     lyapunov = friction.plot.lyapunov(data)
-    exponent = data.group_attrs["brake/lyapunov"]["benettin_exponent"]
+    exponent = data["brake/lyapunov"].attrs["benettin_exponent"]
     assert f"Benettin running estimate: {exponent:.3g} per τ" in lyapunov.axes[0].get_title()
     saved(lyapunov, tmp_path / "lyapunov.png")
     with pytest.raises(ValueError, match="window 5000 6000 is outside the run"):

@@ -116,11 +116,11 @@ def test_resume_an_interrupted_sweep(friction, stop_program, brake_sweep, tmp_pa
     helpers.run([stop_program, "--quiet", "-o", out, *files], expect=6, extra_env={"FRICTION_TEST_STOP_AFTER": "3"})
     part = friction.load(out, scene="sweep")
     assert list(part["sweep/status"].values) == [1, 1, 1, 0, 0, 0]
-    assert part.group_attrs["sweep"]["complete"] == 0
+    assert part["sweep"].attrs["complete"] == 0
     friction.run(files, output=out, resume=True, progress=False)
     resumed, full = friction.load(out), friction.load(brake_sweep)
     assert list(resumed["sweep/computed_by_this_run"].values) == [0, 0, 0, 1, 1, 1]
-    assert resumed.group_attrs["sweep"]["complete"] == 1
+    assert resumed["sweep"].attrs["complete"] == 1
     for name in ("sweep/maxima", "sweep/lyapunov", "sweep/stick_fraction", "sweep/status"):
         assert np.array_equal(resumed[name].values, full[name].values), name
 

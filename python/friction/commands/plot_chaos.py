@@ -73,7 +73,7 @@ def main(argv=None):
     args = parse_args(argv)
     try:
         data = friction.load(args.file, scene="brake")
-        present = [(name, draw) for name, group, draw in PLOTS if group in data.group_attrs]
+        present = [(name, draw) for name, group, draw in PLOTS if group in friction.groups(data)]
         if not present:
             raise friction.FileError("no chaos diagnostics in the file (run friction with an &analysis group)")
         figures = {name: draw(data) for name, draw in present}
