@@ -32,7 +32,7 @@ from ._version import __version__
 __all__ = ["__version__", "library_version", "api_version", "library_path", "FrictionError",
            "LibraryNotFoundError", "FileError", "read_image", "MeasuredImage", "ImageError", "input_file", "Config",
            "Line", "run", "compute", "afm_line", "brake", "load", "paths", "groups",
-           "plot", "fit", "law"]
+           "plot", "fit", "law", "thermal"]
 
 
 def library_version():
@@ -42,8 +42,8 @@ def library_version():
 
 
 def __getattr__(name):
-    # friction.plot, friction.fit and friction.law on first use: matplotlib only when plotting.
-    if name in ("plot", "fit", "law"):
+    # friction.plot, fit, law and thermal on first use: matplotlib only when plotting.
+    if name in ("plot", "fit", "law", "thermal"):
         import importlib
         module = importlib.import_module(f".{name}", __name__)
         globals()[name] = module

@@ -1041,31 +1041,16 @@ def failure_map(data):
     return fig
 
 
-def sang_fit(velocity, friction, sem):
-    """Sang, Dubé and Grant's law F = F_c - B [ln(v_c/v)]^(2/3) (PRL 87,
-    174301, 2001) fitted by weighted least squares (scipy's least_squares)
-    over F_c, B and u = ln(ln v_c - ln v_max), which keeps v_c above the
-    fastest point; started from the best of a coarse scan of u, where F_c
-    and B are linear.  Returns (F_c, B, v_c), v_c in the units of velocity."""
-    from scipy.optimize import least_squares
-    lv = np.log(np.asarray(velocity, float))
-    f = np.asarray(friction, float)
-    sigma = np.asarray(sem, float)
-    top = lv.max()
-
-    def residuals(p):
-        return (f - (p[0] - p[1] * (top + math.exp(p[2]) - lv) ** (2.0 / 3.0))) / sigma
-
-    def linear(u):
-        x = (top + math.exp(u) - lv) ** (2.0 / 3.0)
-        coef = np.linalg.lstsq(np.vstack([np.ones_like(x), -x]).T / sigma[:, None], f / sigma, rcond=None)[0]
-        return np.array([coef[0], coef[1], u])
-
-    # ln v_c - ln v_max from 0.01 to 60 (a decade of v beyond the points to e^60): 13 starts.
-    starts = [linear(u) for u in np.linspace(math.log(0.01), math.log(60.0), 13)]
-    p0 = min(starts, key=lambda p: float(np.sum(residuals(p) ** 2)))
-    p = least_squares(residuals, p0, xtol=1e-12, ftol=1e-12, gtol=1e-12).x
-    return float(p[0]), float(p[1]), float(math.exp(top + math.exp(p[2])))
+def sang_fit(velocity, friction, sem, temperature=300.0):
+    """Sang, Dube and Grant's law F = F_c - B [ln(v_c/v)]^(2/3) (PRL 87,
+    174301, 2001) through the points, weighted by their standard errors
+    (friction.thermal.fit_sang at one temperature, where only
+    B = (beta k_B T)^(2/3) is determined).  Returns (F_c, B, v_c), v_c in
+    the units of velocity."""
+    from . import thermal
+    fit = thermal.fit_sang(velocity, friction, temperature, sem)
+    b = (fit.values["beta"] * thermal.K_B * temperature) ** (2.0 / 3.0)
+    return fit.values["F_c"], float(b), fit.values["v_c"]
 
 
 def friction_velocity(rows):
