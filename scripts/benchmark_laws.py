@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """The stiff friction laws as whole processes against SciPy's solve_ivp
-(Radau, LSODA) at equal accuracy: work-precision data, printed as a table.
+(Radau, LSODA) and SUNDIALS CVODE (BDF) at equal accuracy: work-precision
+data, printed as a table.
 Not a test: the machine is shared and noisy, so each time is the median of
 --repeats runs, and the ratios are of medians measured in one run.
 
@@ -13,7 +14,9 @@ Accuracy: the largest difference in x on the output grid from a reference,
 the program at rtol 1e-12, relative to the range of x.  The program's time
 is its whole process (start, input, integration, HDF5 file); SciPy's is
 solve_ivp alone (the interpreter already running), with the Jacobian
-estimated by differences (its default).
+estimated by differences (its default).  CVODE's is its whole process too
+(scripts/cvode_laws.c, compiled here: BDF, dense solver, the analytic
+Jacobian; Debian: libsundials-dev, without which its rows are skipped).
 
     scripts/benchmark_laws [--repeats N] [--quick] [--limit S] [--chart FILE.png]
 
@@ -21,7 +24,10 @@ estimated by differences (its default).
 one line per method) into FILE.png.
 """
 import argparse
+import json
 import multiprocessing
+import os
+import shutil
 import statistics
 import subprocess
 import sys
@@ -104,6 +110,36 @@ def scipy_run(name, method, t, rtol, limit):
             child.join()
 
 
+SUNDIALS_LIBS = ["-lsundials_cvode", "-lsundials_nvecserial", "-lsundials_sunmatrixdense",
+                 "-lsundials_sunlinsoldense", "-lm"]
+
+
+def build_cvode(work):
+    """Compile scripts/cvode_laws.c: (the program, None) or (None, why not)."""
+    cc = os.environ.get("CC", "cc")
+    if shutil.which(cc) is None:
+        return None, f"no C compiler ({cc})"
+    exe = work / "cvode_laws"
+    result = subprocess.run([cc, "-O2", "-o", str(exe), str(ROOT / "scripts" / "cvode_laws.c"), *SUNDIALS_LIBS],
+                            capture_output=True, text=True)
+    if result.returncode != 0:
+        return None, "could not build the CVODE peer (Debian: apt-get install libsundials-dev)"
+    return exe, None
+
+
+def cvode_run(exe, work, name, rtol, dt_out):
+    """(seconds of the whole process, x on the grid) or (seconds, why it failed)."""
+    out = work / f"cvode_{name}.bin"
+    start = time.perf_counter()
+    result = subprocess.run([str(exe), name, f"{rtol:.17g}", f"{rtol * 1e-3:.17g}", f"{dt_out:.17g}", str(out)],
+                            capture_output=True, text=True)
+    elapsed = time.perf_counter() - start
+    if result.returncode != 0:
+        return elapsed, result.stderr.strip().splitlines()[-1]
+    json.loads(result.stdout)
+    return elapsed, np.fromfile(out)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--repeats", type=int, default=3)
@@ -116,6 +152,9 @@ def main():
     points = {}   # (case, method) -> [(error, seconds)]
     with tempfile.TemporaryDirectory() as scratch:
         work = Path(scratch)
+        cvode, why_not = build_cvode(work)
+        if why_not:
+            print(f"CVODE rows skipped: {why_not}")
         for name, make in (("lugre", lugre_field), ("rate_state", rate_state_field)):
             _, _, t_end, sets = make()
             _, t, reference = program_run(args.binary, work, name, 1e-12, sets)
@@ -141,6 +180,16 @@ def main():
                     error = np.max(np.abs(x - reference)) / scale
                     points.setdefault((name, method), []).append((error, seconds))
                     print(f"{method:10s} {rtol:8.0e} {error:10.2e} {seconds:10.4f}")
+            for rtol in tolerances if cvode else []:
+                runs = [cvode_run(cvode, work, name, rtol, float(t[1] - t[0])) for _ in range(args.repeats)]
+                seconds = statistics.median(run[0] for run in runs)
+                x = runs[-1][1]
+                if isinstance(x, str) or x.size != t.size:
+                    print(f"{'CVODE':10s} {rtol:8.0e} {'failed':>10s} {seconds:10.4f}  {x if isinstance(x, str) else ''}")
+                    continue
+                error = np.max(np.abs(x - reference)) / scale
+                points.setdefault((name, "CVODE"), []).append((error, seconds))
+                print(f"{'CVODE':10s} {rtol:8.0e} {error:10.2e} {seconds:10.4f}")
             sys.stdout.flush()
     if args.chart:
         chart(points, args.chart)
@@ -155,7 +204,7 @@ def chart(points, path):
     fig, axes = plt.subplots(1, 2, figsize=(10, 4))
     for ax, (name, title) in zip(axes, (("lugre", "LuGre stick-slip, 30 s"),
                                         ("rate_state", "rate and state spring-slider, 3000 s"))):
-        for method, style in (("friction", "o-"), ("Radau", "s--"), ("LSODA", "^:")):
+        for method, style in (("friction", "o-"), ("Radau", "s--"), ("LSODA", "^:"), ("CVODE", "D-.")):
             data = sorted(points.get((name, method), []))
             if data:
                 ax.loglog([e for e, _ in data], [s for _, s in data], style, label=method)

@@ -1,0 +1,195 @@
+/* The machine scene's stiff friction laws integrated by SUNDIALS CVODE: the
+ * peer of `friction` in scripts/benchmark_laws.py.
+ *
+ * The same two cases as the benchmark's SciPy runs (and as the program's
+ * inputs/machine_lugre.nml and machine_rate_state.nml with the benchmark's
+ * settings), in the state (x, v, z) of a block of mass m on a spring:
+ *   lugre       LuGre (Table I of its paper: sigma0 = 1e5 N/m, sigma1 =
+ *               sqrt(1e5) N s/m, sigma2 = 0.4 N s/m, F_c = 1 N, F_s = 1.5 N,
+ *               v_s = 1e-3 m/s) on a belt at 0.1 m/s, m = 1 kg, k = 2 N/m,
+ *               30 s; z the bristles' deflection
+ *   rate_state  Dieterich-Ruina with the aging law and the regularized
+ *               friction a asinh(v/(2 V0) e^(psi/a)), a spring-slider at
+ *               k = 0.2 k_c pulled at 1e-6 m/s, 3000 s; z the state theta
+ * CVODE as a C user sets it up for a stiff problem: BDF with a dense direct
+ * linear solver and the analytic Jacobian (with CVODE's own difference
+ * quotients the Newton iteration fails on the rate-and-state slips at every
+ * tolerance from 1e-4 to 1e-8, flag -4), scalar tolerances
+ * (atol = rtol x 1e-3, as the benchmark's other runs), CV_NORMAL output at
+ * each grid point (CVODE interpolates there).
+ *
+ * Usage: cvode_laws CASE RTOL ATOL DT_OUT OUT.bin
+ *   OUT.bin  x on the grid t = 0, DT_OUT, ..., t_end as raw doubles
+ * Prints one line of JSON: steps, rhs_evaluations, jacobian_evaluations.
+ * Exit 1 on bad arguments, 2 on a CVODE failure, 3 on an output failure. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cvode/cvode.h>
+#include <nvector/nvector_serial.h>
+#include <sundials/sundials_context.h>
+#include <sunlinsol/sunlinsol_dense.h>
+#include <sunmatrix/sunmatrix_dense.h>
+
+typedef struct {
+    int rate_state;
+    /* LuGre */
+    double m, k, belt, fc, fs, vs, s0, s1, s2;
+    /* rate and state */
+    double normal, a, b, dc, v0, mu0, pull, stiffness;
+} case_t;
+
+static double stribeck(const case_t *p, double w)
+{
+    return p->fc + (p->fs - p->fc) * exp(-(w / p->vs) * (w / p->vs));
+}
+
+static int rhs(double t, N_Vector yv, N_Vector dv, void *data)
+{
+    const case_t *p = data;
+    const double *y = N_VGetArrayPointer(yv);
+    double *d = N_VGetArrayPointer(dv);
+    if (!p->rate_state) {
+        double w = y[1] - p->belt;
+        double zdot = w - p->s0 * fabs(w) * y[2] / stribeck(p, w);
+        d[0] = y[1];
+        d[1] = (-p->k * y[0] - (p->s0 * y[2] + p->s1 * zdot + p->s2 * w)) / p->m;
+        d[2] = zdot;
+    } else {
+        double theta = y[2] > 1e-300 ? y[2] : 1e-300;
+        double speed = fabs(y[1]) > 1e-300 ? fabs(y[1]) : 1e-300;
+        double psi = p->mu0 + p->b * log(p->v0 * theta / p->dc);
+        double big = log(speed / (2.0 * p->v0)) + psi / p->a;
+        double sign = (y[1] > 0) - (y[1] < 0);
+        /* asinh(s e^big) for large big is s (big + ln 2): no overflow of the exponential */
+        double mu = big > 18.0 ? sign * p->a * (big + log(2.0)) : p->a * asinh(sign * exp(big));
+        d[0] = y[1];
+        d[1] = (-p->stiffness * (y[0] - p->pull * t) - p->normal * mu) / p->m;
+        d[2] = 1.0 - fabs(y[1]) * y[2] / p->dc;
+    }
+    return 0;
+}
+
+static int jacobian(double t, N_Vector yv, N_Vector fy, SUNMatrix jm, void *data, N_Vector t1, N_Vector t2,
+                    N_Vector t3)
+{
+    (void)t; (void)fy; (void)t1; (void)t2; (void)t3;
+    const case_t *p = data;
+    const double *y = N_VGetArrayPointer(yv);
+    SUNMatZero(jm);
+    SM_ELEMENT_D(jm, 0, 1) = 1.0;
+    if (!p->rate_state) {
+        double w = y[1] - p->belt, g = stribeck(p, w);
+        double dg = (p->fs - p->fc) * exp(-(w / p->vs) * (w / p->vs)) * (-2.0 * w / (p->vs * p->vs));
+        double sign = (w > 0) - (w < 0);
+        double dzdot_dv = 1.0 - p->s0 * y[2] * (sign * g - fabs(w) * dg) / (g * g);
+        double dzdot_dz = -p->s0 * fabs(w) / g;
+        SM_ELEMENT_D(jm, 1, 0) = -p->k / p->m;
+        SM_ELEMENT_D(jm, 1, 1) = -(p->s1 * dzdot_dv + p->s2) / p->m;
+        SM_ELEMENT_D(jm, 1, 2) = -(p->s0 + p->s1 * dzdot_dz) / p->m;
+        SM_ELEMENT_D(jm, 2, 1) = dzdot_dv;
+        SM_ELEMENT_D(jm, 2, 2) = dzdot_dz;
+    } else {
+        double theta = y[2] > 1e-300 ? y[2] : 1e-300;
+        double speed = fabs(y[1]) > 1e-300 ? fabs(y[1]) : 1e-300;
+        double psi = p->mu0 + p->b * log(p->v0 * theta / p->dc);
+        double big = log(speed / (2.0 * p->v0)) + psi / p->a;
+        double sign = (y[1] > 0) - (y[1] < 0);
+        double dmu_dv, dmu_dtheta;
+        if (big > 18.0) { /* mu = s a (big + ln 2) */
+            dmu_dv = p->a / speed;
+            dmu_dtheta = sign * p->b / theta;
+        } else {
+            double e = exp(psi / p->a) / (2.0 * p->v0), s = y[1] * e, root = sqrt(1.0 + s * s);
+            dmu_dv = p->a * e / root;
+            dmu_dtheta = p->b * s / (theta * root);
+        }
+        SM_ELEMENT_D(jm, 1, 0) = -p->stiffness / p->m;
+        SM_ELEMENT_D(jm, 1, 1) = -p->normal * dmu_dv / p->m;
+        SM_ELEMENT_D(jm, 1, 2) = -p->normal * dmu_dtheta / p->m;
+        SM_ELEMENT_D(jm, 2, 1) = -sign * y[2] / p->dc;
+        SM_ELEMENT_D(jm, 2, 2) = -fabs(y[1]) / p->dc;
+    }
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc != 6) {
+        fprintf(stderr, "usage: cvode_laws lugre|rate_state RTOL ATOL DT_OUT OUT.bin\n");
+        return 1;
+    }
+    case_t p = {0};
+    double y0[3], t_end;
+    if (strcmp(argv[1], "lugre") == 0) {
+        p = (case_t){.m = 1.0, .k = 2.0, .belt = 0.1, .fc = 1.0, .fs = 1.5, .vs = 1e-3, .s0 = 1e5,
+                     .s1 = sqrt(1e5), .s2 = 0.4};
+        y0[0] = 0.0;
+        y0[1] = 0.0;
+        y0[2] = -stribeck(&p, -p.belt) / p.s0;
+        t_end = 30.0;
+    } else if (strcmp(argv[1], "rate_state") == 0) {
+        p = (case_t){.rate_state = 1, .m = 1.0, .normal = 1.0, .a = 0.010, .b = 0.015, .dc = 1e-5, .v0 = 1e-6,
+                     .mu0 = 0.6, .pull = 1e-6};
+        p.stiffness = 0.2 * p.normal * (p.b - p.a) / p.dc;
+        y0[0] = -p.mu0 * p.normal / p.stiffness;
+        y0[1] = 1.01 * p.pull;
+        y0[2] = p.dc / (1.01 * p.pull);
+        t_end = 3000.0;
+    } else {
+        fprintf(stderr, "cvode_laws: unknown case %s (lugre or rate_state)\n", argv[1]);
+        return 1;
+    }
+    char *end;
+    double rtol = strtod(argv[2], &end), atol = strtod(argv[3], &end), dt = strtod(argv[4], &end);
+    if (!(rtol > 0) || !(atol > 0) || !(dt > 0)) {
+        fprintf(stderr, "cvode_laws: RTOL, ATOL and DT_OUT must be positive\n");
+        return 1;
+    }
+    long n = lround(t_end / dt) + 1;
+    double *x = malloc(sizeof(double) * (size_t)n);
+    SUNContext context;
+    if (x == NULL || SUNContext_Create(NULL, &context) != 0) return 2;
+    N_Vector y = N_VNew_Serial(3, context);
+    for (int i = 0; i < 3; ++i) NV_Ith_S(y, i) = y0[i];
+    void *mem = CVodeCreate(CV_BDF, context);
+    SUNMatrix matrix = SUNDenseMatrix(3, 3, context);
+    SUNLinearSolver solver = SUNLinSol_Dense(y, matrix, context);
+    int status = CVodeInit(mem, rhs, 0.0, y);
+    status = status ? status : CVodeSStolerances(mem, rtol, atol);
+    status = status ? status : CVodeSetUserData(mem, &p);
+    status = status ? status : CVodeSetLinearSolver(mem, solver, matrix);
+    status = status ? status : CVodeSetJacFn(mem, jacobian);
+    status = status ? status : CVodeSetMaxNumSteps(mem, 100000000L);
+    x[0] = y0[0];
+    double t = 0.0;
+    for (long i = 1; i < n && status >= 0; ++i) {
+        status = CVode(mem, (double)i * dt, y, &t, CV_NORMAL);
+        x[i] = NV_Ith_S(y, 0);
+    }
+    if (status < 0) {
+        fprintf(stderr, "cvode_laws: CVODE failed at t = %g with flag %d\n", t, status);
+        return 2;
+    }
+    long steps = 0, rhs_evaluations = 0, jacobians = 0, rhs_for_jacobian = 0;
+    CVodeGetNumSteps(mem, &steps);
+    CVodeGetNumRhsEvals(mem, &rhs_evaluations);
+    CVodeGetNumJacEvals(mem, &jacobians);
+    CVodeGetNumLinRhsEvals(mem, &rhs_for_jacobian);
+    FILE *out = fopen(argv[5], "wb");
+    if (out == NULL || fwrite(x, sizeof(double), (size_t)n, out) != (size_t)n || fclose(out) != 0) {
+        fprintf(stderr, "cvode_laws: cannot write %s\n", argv[5]);
+        return 3;
+    }
+    printf("{\"steps\": %ld, \"rhs_evaluations\": %ld, \"jacobian_evaluations\": %ld}\n", steps,
+           rhs_evaluations + rhs_for_jacobian, jacobians);
+    CVodeFree(&mem);
+    SUNLinSolFree(solver);
+    SUNMatDestroy(matrix);
+    N_VDestroy(y);
+    SUNContext_Free(&context);
+    free(x);
+    return 0;
+}
