@@ -21,7 +21,7 @@ module friction_machine_run
    public :: event_stick_to_slip, event_slip_to_stick, event_slip_reversal, event_kind_names
 
    integer, parameter :: event_stick_to_slip = 1, event_slip_to_stick = 2, event_slip_reversal = 3
-   character(len=*), parameter :: event_kind_names(3) = [character(len=12) :: 'stick_to_slip', 'slip_to_stick', &
+   character(len=*), parameter :: event_kind_names(3) = [character(len=13) :: 'stick_to_slip', 'slip_to_stick', &
       & 'reversal']
 
    type :: machine_run
