@@ -26,10 +26,11 @@ friction_require(PKG_CONFIG_FOUND "pkg-config" "pkg-config")
 pkg_check_modules(FFTW3 QUIET IMPORTED_TARGET fftw3)
 friction_require(FFTW3_FOUND "FFTW3" "libfftw3-dev")
 
-# Parallel HDF5 with its Fortran interface.  FindHDF5 asks the h5pfc wrapper.
+# Parallel HDF5 with its Fortran interface, and its high-level library (the
+# dimension scales).  FindHDF5 asks the h5pfc wrapper.
 set(HDF5_PREFER_PARALLEL TRUE)
-find_package(HDF5 QUIET COMPONENTS Fortran)
-friction_require(HDF5_FOUND "HDF5 with Fortran support" "libhdf5-openmpi-dev")
+find_package(HDF5 QUIET COMPONENTS Fortran HL)
+friction_require(HDF5_FOUND "HDF5 with Fortran support and its high-level library" "libhdf5-openmpi-dev")
 if(NOT HDF5_IS_PARALLEL)
   message(FATAL_ERROR "friction needs the parallel (MPI) build of HDF5, found a serial one.\n"
     "On Debian/Ubuntu: sudo apt-get install libhdf5-openmpi-dev")
@@ -39,7 +40,7 @@ target_include_directories(friction::hdf5_headers INTERFACE ${HDF5_Fortran_INCLU
 target_compile_definitions(friction::hdf5_headers INTERFACE ${HDF5_Fortran_DEFINITIONS})
 add_library(friction::hdf5 INTERFACE IMPORTED)
 target_link_libraries(friction::hdf5 INTERFACE friction::hdf5_headers
-  ${HDF5_Fortran_LIBRARIES} ${HDF5_LIBRARIES})
+  ${HDF5_HL_LIBRARIES} ${HDF5_Fortran_LIBRARIES} ${HDF5_LIBRARIES})
 
 # The program's HDF5: each of HDF5's own shared libraries replaced by the
 # static archive beside it, when there is one (Debian's libhdf5-*-dev ship
@@ -47,7 +48,7 @@ target_link_libraries(friction::hdf5 INTERFACE friction::hdf5_headers
 # archives, or with -DFRICTION_STATIC_HDF5=OFF, the shared ones.
 option(FRICTION_STATIC_HDF5 "Link the friction program with HDF5's static archives" ON)
 set(friction_hdf5_program_libraries)
-foreach(library IN LISTS HDF5_Fortran_LIBRARIES HDF5_LIBRARIES)
+foreach(library IN LISTS HDF5_HL_LIBRARIES HDF5_Fortran_LIBRARIES HDF5_LIBRARIES)
   get_filename_component(library_name "${library}" NAME)
   string(REGEX REPLACE "\\.so$" ".a" archive "${library}")
   if(FRICTION_STATIC_HDF5 AND library_name MATCHES "^libhdf5.*\\.so$" AND EXISTS "${archive}")
@@ -77,7 +78,7 @@ if(friction_hdf5_program_libraries MATCHES "libhdf5[^;]*\\.a(;|$)")
   if(FRICTION_HDF5_ARCHIVES_LINK)
     set(FRICTION_PROGRAM_STATIC_HDF5 ON)
   else()
-    set(friction_hdf5_program_libraries ${HDF5_Fortran_LIBRARIES} ${HDF5_LIBRARIES})
+    set(friction_hdf5_program_libraries ${HDF5_HL_LIBRARIES} ${HDF5_Fortran_LIBRARIES} ${HDF5_LIBRARIES})
   endif()
 endif()
 message(STATUS "friction: the program links HDF5's static archives: ${FRICTION_PROGRAM_STATIC_HDF5}")

@@ -25,7 +25,6 @@ import os
 import shutil
 import sys
 
-import h5py
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -68,15 +67,6 @@ def printed_arrays(text):
     return arrays
 
 
-def datasets(path, group):
-    """The datasets under a group of an HDF5 file, by name relative to it."""
-    found = {}
-    with h5py.File(path, "r") as f:
-        f[group].visititems(lambda name, item: found.__setitem__(name, item[()])
-                            if isinstance(item, h5py.Dataset) else None)
-    return found
-
-
 def same(name, expected, actual):
     expected, actual = np.asarray(expected), np.asarray(actual)
     if expected.shape != actual.shape:
@@ -90,7 +80,7 @@ def compare_scene(args, scene_name, scene, group):
     files = inputs(args, scene, scene_name)
     out = os.path.join(args.workdir, f"{scene_name}.h5")
     run([args.binary, "-q", "-f", "-o", out] + files, args.workdir)
-    program = datasets(out, group)
+    program = helpers.group_datasets(out, group)
     capi = printed_arrays(run([args.capi, group] + files, args.workdir))
     computed = {name: value for name, value in capi.items() if not name.startswith("line/")}
     if sorted(computed) != sorted(program):

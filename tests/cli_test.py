@@ -658,7 +658,7 @@ def comparable(path):
     with h5py.File(path, "r") as f:
         def visit(name, obj):
             for key, value in obj.attrs.items():
-                items[f"{name}@{key}"] = value
+                items[f"{name}@{key}"] = helpers.attribute_value(f, value)
             if isinstance(obj, h5py.Dataset):
                 items[name] = obj[()]
         f.visititems(visit)

@@ -96,6 +96,44 @@ def friction_package(library=None):
 TIMINGS = {"wall_time", "compute_time", "check_compute_time", "created"}
 
 
+def attribute_value(f, value):
+    """An attribute's value, comparable between files: the object references
+    of the dimension scales (DIMENSION_LIST, REFERENCE_LIST) become the
+    paths they point to, which two files of the same results share."""
+    import h5py
+    import numpy as np
+
+    def name(ref):
+        return f[ref].name if ref else ""
+
+    if isinstance(value, np.ndarray) and value.dtype.names:          # REFERENCE_LIST: (dataset, axis)
+        return tuple((name(row[0]), int(row[1])) for row in value)
+    if isinstance(value, np.ndarray) and value.dtype == object:      # DIMENSION_LIST: refs per axis
+        flat = [tuple(name(r) for r in np.ravel(axis)) if isinstance(axis, np.ndarray)
+                else name(axis) if isinstance(axis, h5py.Reference) else axis for axis in value.ravel()]
+        if any(isinstance(x, tuple) for x in flat) or any(isinstance(v, h5py.Reference) for v in value.ravel()):
+            return tuple(flat)
+    return value
+
+
+#: Datasets a file holds as an axis for netCDF readers, not as a result: the
+#: events' numbers 1 to n (a computation in memory has no such array).
+AXES_ONLY = {"events/event"}
+
+
+def group_datasets(path, group):
+    """The results under a group of an HDF5 file, by name relative to it
+    ("x", "events/t"), without the AXES_ONLY datasets: what a computation in
+    memory (the C API's friction_compute, Config.compute) returns."""
+    import h5py
+
+    found = {}
+    with h5py.File(path, "r") as f:
+        f[group].visititems(lambda name, item: found.__setitem__(name, item[()])
+                            if isinstance(item, h5py.Dataset) and name not in AXES_ONLY else None)
+    return found
+
+
 def file_contents(path, ignore=TIMINGS):
     """Every dataset and attribute of an HDF5 file by name ("group/name",
     "group/name@attribute"), but the attributes in `ignore` (the timings):
@@ -109,7 +147,7 @@ def file_contents(path, ignore=TIMINGS):
             contents[name] = item[()]
         for key, value in item.attrs.items():
             if key not in ignore:
-                contents[f"{name}@{key}"] = value
+                contents[f"{name}@{key}"] = attribute_value(f, value)
 
     with h5py.File(path, "r") as f:
         for key, value in f.attrs.items():

@@ -100,7 +100,9 @@ def load(path, scene=None):
     a node per group, a variable per dataset (named by the dataset), the
     root's and each group's attributes as the node's attrs.
 
-    The program's layouts get their dimensions and coordinates:
+    The file's own HDF5 dimension scales name the dimensions and coordinates
+    (docs/output.md); where a file has none (a sweep's, an older version's),
+    the program's layouts give them:
       afm     maps (ny, nx) over ("support_y", "support_x"), the line offset
               across the scan and the support position along it (angstrom),
               coordinates of /afm that /afm/trace and /afm/retrace inherit;
@@ -108,9 +110,9 @@ def load(path, scene=None):
               /surface/atoms over ("atom", "xyz")
       brake   the trajectory over "t"; the events over "event" with their
               times t as coordinate; the spectrum over "frequency"; the
-              Poincare points over "strobe" and "section" with strobe_t and
-              section_t; the Lyapunov curves over "benettin_time",
-              "rosenstein_time" and "exponents_time"
+              Poincare points over "strobe_t" and "section_t"; the Lyapunov
+              curves over "benettin_time", "rosenstein_time" and
+              "exponents_time"
       sweep   per point over the swept variable ("brake.v_dr_prime"), or over
               both variables (a grid, the second varying fastest); the brake's
               maxima over "maximum", with the swept values of their point as
@@ -126,7 +128,7 @@ def load(path, scene=None):
     if isinstance(path, xr.DataTree):
         return path
     path = _check_path(path)
-    raw, group_attrs = {}, {"": {}}
+    raw, group_attrs, scales = {}, {"": {}}, {}
     try:
         with h5py.File(path, "r") as f:
             group_attrs[""] = _attrs(f.attrs)
@@ -134,6 +136,10 @@ def load(path, scene=None):
             def visit(name, item):
                 if isinstance(item, h5py.Dataset):
                     raw[name] = (_read_values(item), _attrs(item.attrs))
+                    axes = [item.dims[k][0].name.strip("/") if len(item.dims[k]) else None
+                            for k in range(item.ndim)]
+                    if axes and all(axes):
+                        scales[name] = axes
                 else:
                     group_attrs[name] = _attrs(item.attrs)
             f.visititems(visit)
@@ -144,10 +150,12 @@ def load(path, scene=None):
         # (RuntimeError, KeyError, ValueError) said nothing of the file.
         raise FileError(f"the HDF5 file is damaged ({type(err).__name__}: {err})") from None
     labels = _label(raw, group_attrs[""], group_attrs)
+    labels.update(_scales(raw, scales))
     nodes = {name: {"data": {}, "coords": {}} for name in group_attrs}
     for name, (values, attrs) in raw.items():
         group, _, short = name.rpartition("/")
         nodes.setdefault(group, {"data": {}, "coords": {}})
+        attrs = {k: v for k, v in attrs.items() if k not in SCALE_ATTRIBUTES}
         dims, role = labels.get(name, (tuple(f"{name}_dim_{k}" for k in range(values.ndim)), "data"))
         reshaped = values.reshape([n for n in labels.get(name + "#shape", values.shape)])
         nodes[group][role][short] = xr.Variable(dims, reshaped, attrs)
@@ -160,6 +168,29 @@ def load(path, scene=None):
         return xr.DataTree.from_dict(datasets)
     except ValueError as err:
         raise FileError(f"unexpected data in the file ({err})") from None
+
+
+#: HDF5's bookkeeping of dimension scales: the dimensions and coordinates say it.
+SCALE_ATTRIBUTES = {"CLASS", "NAME", "DIMENSION_LIST", "REFERENCE_LIST", "coordinates"}
+
+
+def _scales(raw, scales):
+    """The dimensions and coordinates the file states itself: a dataset whose
+    every axis has an HDF5 dimension scale runs along the scales' names, a
+    scale is the coordinate of its dimension, and the datasets a `coordinates`
+    attribute names (in the same group) are coordinates too."""
+    labels = {name: (tuple(axis.rsplit("/", 1)[-1] for axis in axes), "data") for name, axes in scales.items()}
+    for name in scales:
+        group = name.rpartition("/")[0]
+        for word in str(raw[name][1].get("coordinates", "")).split():
+            other = f"{group}/{word}"
+            if other in raw:
+                labels[other] = (labels.get(other, labels[name])[0], "coords")
+    for axes in scales.values():
+        for axis in axes:
+            if axis in raw:
+                labels[axis] = ((axis.rsplit("/", 1)[-1],), "coords")
+    return labels
 
 
 def _label(raw, root, group_attrs):
@@ -221,9 +252,9 @@ def _brake_layout(raw, labels):
     _along(raw, labels, "brake/", "brake/t", "t", lambda rest: True)
     _along(raw, labels, "brake/events/", "brake/events/t", "event", lambda rest: True)
     _along(raw, labels, "brake/spectrum/", "brake/spectrum/frequency", "frequency", lambda rest: True)
-    _along(raw, labels, "brake/poincare/", "brake/poincare/strobe_t", "strobe",
+    _along(raw, labels, "brake/poincare/", "brake/poincare/strobe_t", "strobe_t",
            lambda rest: rest.startswith("strobe_"))
-    _along(raw, labels, "brake/poincare/", "brake/poincare/section_t", "section",
+    _along(raw, labels, "brake/poincare/", "brake/poincare/section_t", "section_t",
            lambda rest: rest.startswith("section_"))
     for curve in ("benettin", "rosenstein"):
         _along(raw, labels, "brake/lyapunov/", f"brake/lyapunov/{curve}_time", f"{curve}_time",

@@ -10,18 +10,10 @@ from conftest import DATA, INPUTS, interrupted, sigint_at_report
 NAF = [INPUTS / "naf.nml", DATA / "small.nml"]
 
 
-def file_datasets(path, group):
-    found = {}
-    with h5py.File(path) as f:
-        f[group].visititems(lambda name, item: found.__setitem__(name, item[()])
-                            if isinstance(item, h5py.Dataset) else None)
-    return found
-
-
 def test_compute_is_the_programs_map_to_the_last_bit(friction, naf_map):
     with friction.Config("afm", files=NAF) as cfg:
         computed = cfg.compute()
-    program = file_datasets(naf_map, "afm")
+    program = helpers.group_datasets(naf_map, "afm")
     assert sorted(computed) == sorted(program)
     for name, values in program.items():
         assert computed[name].shape == values.shape, name
@@ -35,7 +27,7 @@ def test_compute_reports_each_line_and_computes_the_same_map(friction, naf_map):
     with friction.Config("afm", files=NAF) as cfg:
         computed = cfg.compute(progress=lambda message, fraction: reports.append((message, fraction)))
     assert reports == [(f"{j} of 10 lines", j / 10) for j in range(1, 11)]
-    for name, values in file_datasets(naf_map, "afm").items():
+    for name, values in helpers.group_datasets(naf_map, "afm").items():
         assert np.array_equal(computed[name], values), name
 
 
@@ -53,7 +45,7 @@ def test_ctrl_c_stops_a_compute_and_the_config_computes_on(friction, naf_map):
         assert len(reports) == 1
         assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
         computed = cfg.compute()
-    for name, values in file_datasets(naf_map, "afm").items():
+    for name, values in helpers.group_datasets(naf_map, "afm").items():
         assert np.array_equal(computed[name], values), name
 
 
@@ -144,7 +136,7 @@ def test_brake_is_the_programs_run_to_the_last_bit(friction, files):
                 " lyapunov_spectrum = .false., orbit = .false. /\n")
     path = files("brake_40", [INPUTS / "brake.nml"], override)
     run = friction.brake([INPUTS / "brake.nml", path.parent / "brake_40_override.nml"])
-    program = file_datasets(path, "brake")
+    program = helpers.group_datasets(path, "brake")
     trajectory = {k: v for k, v in program.items() if k.count("/") == 0 or k.startswith("events/")}
     assert set(trajectory) == set(run)
     for name, values in trajectory.items():

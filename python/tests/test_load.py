@@ -57,10 +57,10 @@ def test_a_brake_run(brake_run):
     f, _ = raw(brake_run, "brake/spectrum/frequency")
     assert spectrum.dims == ("frequency",) and np.array_equal(spectrum["frequency"].values, f)
     assert spectrum["frequency"].attrs["units"] == "cycles per unit tau"
-    assert data["brake/poincare/strobe_x"].dims == ("strobe",)
+    assert data["brake/poincare/strobe_x"].dims == ("strobe_t",)
     st, _ = raw(brake_run, "brake/poincare/strobe_t")
     assert np.array_equal(data["brake/poincare/strobe_x"]["strobe_t"].values, st)
-    assert data["brake/poincare/section_y"].dims == ("section",)
+    assert data["brake/poincare/section_y"].dims == ("section_t",)
     assert data["brake/lyapunov/benettin_estimate"].dims == ("benettin_time",)
     assert data["brake/lyapunov/rosenstein_divergence"].dims == ("rosenstein_time",)
     brake = data["brake"].attrs
@@ -152,3 +152,30 @@ def test_a_damaged_file(tmp_path, brake_run):
 def test_a_tree_is_loaded_once(naf_map):
     data = friction.load(naf_map)
     assert friction.load(data) is data
+
+
+def test_xarray_opens_the_files_themselves(naf_map, brake_run):
+    """The files carry their coordinates as HDF5 dimension scales, so xarray
+    opens them without this package (engine h5netcdf): a map's axes, the
+    trajectory's time, the spectrum's frequencies, the events' numbers and
+    times, with the values h5py reads."""
+    import h5netcdf  # noqa: F401  (xarray's engine; scripts/install-deps installs it)
+    tree = xr.open_datatree(naf_map, engine="h5netcdf", phony_dims="sort")
+    fx = tree["afm/trace/fx"]
+    values, _ = raw(naf_map, "afm/trace/fx")
+    x, _ = raw(naf_map, "afm/support_x")
+    y, _ = raw(naf_map, "afm/support_y")
+    assert fx.dims == ("support_y", "support_x") and np.array_equal(fx.values, values)
+    assert np.array_equal(fx["support_x"].values, x) and np.array_equal(fx["support_y"].values, y)
+    assert fx.attrs["units"] == "nN" and fx["support_x"].attrs["units"] == "angstrom"
+    assert tree["afm/friction"].dims == ("support_y",)
+    brake = xr.open_datatree(brake_run, engine="h5netcdf", phony_dims="sort")
+    t, _ = raw(brake_run, "brake/t")
+    assert brake["brake/x"].dims == ("t",) and np.array_equal(brake["brake/x"]["t"].values, t)
+    f, _ = raw(brake_run, "brake/spectrum/frequency")
+    assert np.array_equal(brake["brake/spectrum/amplitude"]["frequency"].values, f)
+    kind = brake["brake/events/kind"]
+    et, _ = raw(brake_run, "brake/events/t")
+    assert kind.dims == ("event",) and np.array_equal(kind["t"].values, et)
+    assert np.array_equal(kind["event"].values, np.arange(1, et.size + 1))
+    assert brake["brake/poincare/strobe_x"].dims == ("strobe_t",)

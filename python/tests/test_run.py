@@ -3,6 +3,7 @@ import os
 import sys
 
 import h5py
+import helpers
 import numpy as np
 import pytest
 
@@ -23,7 +24,7 @@ def same_files(a, b, timings=()):
                     found[name] = item[()]
                 for key, value in item.attrs.items():
                     if key not in TIMINGS:
-                        found[f"{name}@{key}"] = value
+                        found[f"{name}@{key}"] = helpers.attribute_value(f, value)
             visit("/", f)
             f.visititems(visit)
         return found

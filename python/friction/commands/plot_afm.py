@@ -72,10 +72,10 @@ def main(argv=None):
         line = ny // 2 if args.line is None else args.line
         if not 0 <= line < ny:
             raise friction.FileError(f"--line {line} out of range: the file has lines 0 .. {ny - 1}")
-        if f"afm/{args.trip}/fx" not in data:
+        if f"afm/{args.trip}/fx" not in friction.paths(data):
             raise friction.FileError(f"no /afm/{args.trip}: the run had retrace off")
         maps_figure = friction.plot.afm_maps(data, args.trip, args.cmap)
-        has_loop = "afm/retrace/f_along" in data and "afm/friction" in data
+        has_loop = "afm/retrace/f_along" in friction.paths(data) and "afm/friction" in friction.paths(data)
         loop_figure = friction.plot.friction_loop(data, line) if has_loop else None
     except friction.FileError as err:
         print(f"{PROG}: {args.file}: {err}", file=sys.stderr)

@@ -88,13 +88,13 @@ def main(argv=None):
     args = parse_args(argv)
     try:
         data = friction.load(args.file, scene="afm")
-        if "surface/atoms" not in data:
+        if "surface/atoms" not in friction.paths(data):
             raise friction.FileError("not a lattice-sum scene: no /surface/atoms "
                                      "(for NaF/HOPG maps use plot_afm.py)")
         ny = data["afm/support_y"].size
-        if f"afm/{args.trip}/fx" not in data:
+        if f"afm/{args.trip}/fx" not in friction.paths(data):
             raise friction.FileError(f"no /afm/{args.trip}: the run had retrace off")
-        if f"afm/{args.trip}/{args.component}" not in data:
+        if f"afm/{args.trip}/{args.component}" not in friction.paths(data):
             raise friction.FileError(f"no /afm/{args.trip}/{args.component} in the file")
         tip_line = None if args.no_tip else args.tip_line
         if tip_line is not None and not 0 <= tip_line < ny:

@@ -99,6 +99,8 @@ contains
       type(error_type), allocatable :: close_error
       type(afm_config) :: copy
       integer :: q, nq
+      !> a map's axes: across the scan (its lines), along it
+      character(len=*), parameter :: map_axes(2) = [character(len=14) :: '/afm/support_y', '/afm/support_x']
 
       call file%create(path, comm, error)
       if (allocated(error)) then
@@ -148,6 +150,8 @@ contains
             & config%ny, first, stride, 'nN')
          if (present(thermal)) call file%write_vector_block('/afm/friction_sem', thermal%friction_sem, &
             & config%ny, first, stride, 'nN')
+         call file%attach_scales('/afm/friction', map_axes(1:1))
+         if (present(thermal)) call file%attach_scales('/afm/friction_sem', map_axes(1:1))
       end if
       if (present(thermal)) then
          call file%create_group('/afm/slips')
@@ -216,9 +220,13 @@ contains
          do q = 1, nq
             call file%write_line_block(group//'/'//trim(quantity_names(q))//tail, values(:, :, q), &
                & config%ny, first, stride, trim(quantity_units(q)))
+            call file%attach_scales(group//'/'//trim(quantity_names(q))//tail, map_axes)
          end do
-         if (config%tip_model() == model_quasistatic) call file%write_line_block(group//'/'//trim(quantity_names(q_jumps)) &
-            & //tail, values(:, :, q_jumps), config%ny, first, stride, trim(quantity_units(q_jumps)))
+         if (config%tip_model() == model_quasistatic) then
+            call file%write_line_block(group//'/'//trim(quantity_names(q_jumps))//tail, values(:, :, q_jumps), &
+               & config%ny, first, stride, trim(quantity_units(q_jumps)))
+            call file%attach_scales(group//'/'//trim(quantity_names(q_jumps))//tail, map_axes)
+         end if
       end subroutine write_trips
 
    end subroutine write_afm_file

@@ -52,8 +52,11 @@ contains
       type(error_type), allocatable :: close_error
       type(brake_config) :: copy
       real(wp) :: f(2)
-      integer :: n
+      integer :: n, k
       character(len=32) :: codes(size(event_kind_names))
+      !> the trajectory's series, along /brake/t
+      character(len=*), parameter :: along_t(5) = [character(len=5) :: 'x', 'v', 'y', 'w', 'stick']
+      character(len=*), parameter :: event_series(6) = [character(len=4) :: 't', 'kind', 'x', 'v', 'y', 'w']
 
       call file%create(path, comm, error)
       if (allocated(error)) then
@@ -103,6 +106,9 @@ contains
       call file%write_vector('/brake/y', trajectory%y, 'm')
       call file%write_vector('/brake/w', trajectory%w, 'm per unit tau')
       call file%write_vector_integer('/brake/stick', trajectory%stick, '1')
+      do k = 1, 5
+         call file%attach_scales('/brake/'//trim(along_t(k)), ['/brake/t'])
+      end do
 
       n = events%n
       call file%create_group('/brake/events')
@@ -117,6 +123,14 @@ contains
       call file%write_vector('/brake/events/v', event_column(2), 'm per unit tau')
       call file%write_vector('/brake/events/y', event_column(3), 'm')
       call file%write_vector('/brake/events/w', event_column(4), 'm per unit tau')
+      ! The events' own axis: their number, the coordinate every /brake/events dataset runs along
+      ! (their time t cannot be: a child's dimension named t would clash with the trajectory's).
+      call file%write_vector_integer('/brake/events/event', [(k, k = 1, n)], '1')
+      do k = 1, size(event_series)
+         call file%attach_scales('/brake/events/'//trim(event_series(k)), ['/brake/events/event'])
+         ! t as each event's time coordinate (CF's auxiliary coordinates), as netCDF readers take it
+         if (k > 1) call file%write_attribute_text('/brake/events/'//trim(event_series(k)), 'coordinates', 't')
+      end do
 
       if (check%enabled) then
          call file%create_group('/brake/verify')
@@ -191,6 +205,7 @@ contains
             call file%write_vector('/brake/spectrum/frequency', d%spectrum%frequency, frequency_unit)
             k = findloc(names, trim(a%series), 1)
             call file%write_vector('/brake/spectrum/amplitude', d%spectrum%amplitude, trim(units(max(k, 1))))
+            call file%attach_scales('/brake/spectrum/amplitude', ['/brake/spectrum/frequency'])
          end if
          if (a%poincare) then
             call file%create_group('/brake/poincare')
@@ -203,6 +218,8 @@ contains
             do k = 1, 4
                call file%write_vector('/brake/poincare/strobe_'//names(k), d%strobe_points(k, :), trim(units(k)))
                call file%write_vector('/brake/poincare/section_'//names(k), d%section_points(k, :), trim(units(k)))
+               call file%attach_scales('/brake/poincare/strobe_'//names(k), ['/brake/poincare/strobe_t '])
+               call file%attach_scales('/brake/poincare/section_'//names(k), ['/brake/poincare/section_t'])
             end do
          end if
          if (a%lyapunov .or. a%rosenstein .or. a%lyapunov_spectrum) call file%create_group('/brake/lyapunov')
@@ -224,6 +241,7 @@ contains
             call file%write_attribute_real('/brake/lyapunov', 'benettin_d0', d%benettin%d0)
             call file%write_vector('/brake/lyapunov/benettin_time', d%flow%time(1:d%flow%n), 'tau')
             call file%write_vector('/brake/lyapunov/benettin_estimate', d%flow%estimate(1:d%flow%n), '1/tau')
+            call file%attach_scales('/brake/lyapunov/benettin_estimate', ['/brake/lyapunov/benettin_time'])
          end if
          if (a%orbit) call write_orbit(file, d)
          if (a%rosenstein) then
@@ -244,6 +262,7 @@ contains
             call file%write_attribute_integer('/brake/lyapunov', 'rosenstein_fit_end', int(a%rosenstein_fit_end, i8))
             call file%write_vector('/brake/lyapunov/rosenstein_time', d%series%time, '1')
             call file%write_vector('/brake/lyapunov/rosenstein_divergence', d%series%divergence, 'ln of the series unit')
+            call file%attach_scales('/brake/lyapunov/rosenstein_divergence', ['/brake/lyapunov/rosenstein_time'])
          end if
       end associate
    end subroutine write_diagnostics
@@ -289,6 +308,10 @@ contains
       type(h5_file), intent(inout) :: file
       type(orbit_branch), intent(in) :: b
       character(len=*), parameter :: group = '/brake/orbit/branch'
+      !> the branch's series along its points, whose coordinate is the parameter (a coordinate is on
+      !> every axis of a dataset or on none: netCDF's readers refuse a mix)
+      character(len=*), parameter :: along_branch(4) = [character(len=11) :: 'found', 'source', 'period', &
+         & 'max_modulus']
       character(len=32) :: codes(size(bifurcation_names))
       integer :: k
 
@@ -306,6 +329,10 @@ contains
       call file%write_matrix(group//'/events_per_period', real(b%pattern, wp), '1')
       call file%write_vector(group//'/section_parameter', b%section_parameter, b%unit)
       call file%write_vector(group//'/section_x', b%section_x, 'm')
+      call file%attach_scales(group//'/section_x', [group//'/section_parameter'])
+      do k = 1, size(along_branch)
+         call file%attach_scales(group//'/'//trim(along_branch(k)), [group//'/parameter'])
+      end do
       call file%create_group('/brake/orbit/bifurcations')
       do k = 1, size(bifurcation_names)
          write (codes(k), '(i0, a)') k, ' = '//trim(bifurcation_names(k))

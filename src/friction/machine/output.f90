@@ -36,6 +36,9 @@ contains
       type(machine_config) :: copy
       character(len=32) :: codes(size(event_kind_names))
       integer :: k, n
+      !> the run's series, along /machine/t
+      character(len=*), parameter :: along_t(4) = [character(len=5) :: 'x', 'v', 'force', 'stick']
+      character(len=*), parameter :: event_series(4) = [character(len=4) :: 't', 'kind', 'x', 'v']
 
       call file%create(path, comm, error)
       if (allocated(error)) then
@@ -57,6 +60,10 @@ contains
       call file%write_vector('/machine/force', run%force, 'N')
       call file%write_vector_integer('/machine/stick', run%stick, '1')
       if (run%n_states > 0) call file%write_vector('/machine/'//run%state_name, run%states(1, :), run%state_unit)
+      do k = 1, size(along_t)
+         call file%attach_scales('/machine/'//trim(along_t(k)), ['/machine/t'])
+      end do
+      if (run%n_states > 0) call file%attach_scales('/machine/'//run%state_name, ['/machine/t'])
       call file%create_group('/machine/events')
       do k = 1, size(event_kind_names)
          write (codes(k), '(i0, a)') k, ' = '//trim(event_kind_names(k))
@@ -67,6 +74,13 @@ contains
       call file%write_vector_integer('/machine/events/kind', run%event_kind(1:n), '1')
       call file%write_vector('/machine/events/x', run%event_x(1:n), 'm')
       call file%write_vector('/machine/events/v', run%event_v(1:n), 'm/s')
+      ! The events' own axis (their time t cannot be: a child's dimension t would clash with the run's).
+      call file%write_vector_integer('/machine/events/event', [(k, k = 1, n)], '1')
+      do k = 1, size(event_series)
+         call file%attach_scales('/machine/events/'//trim(event_series(k)), ['/machine/events/event'])
+         ! t as each event's time coordinate (CF's auxiliary coordinates), as netCDF readers take it
+         if (k > 1) call file%write_attribute_text('/machine/events/'//trim(event_series(k)), 'coordinates', 't')
+      end do
       if (diagnostics%spectrum) then
          associate (p => diagnostics%peak, a => config%analysis)
             call file%create_group('/machine/spectrum')
@@ -79,6 +93,7 @@ contains
             call file%write_attribute_real('/machine/spectrum', 'resolution', p%resolution, 'Hz')
             call file%write_vector('/machine/spectrum/frequency', p%frequency, 'Hz')
             call file%write_vector('/machine/spectrum/amplitude', p%amplitude, merge('m  ', 'm/s', a%series == 'x'))
+            call file%attach_scales('/machine/spectrum/amplitude', ['/machine/spectrum/frequency'])
          end associate
       end if
       if (diagnostics%lyapunov) then
@@ -88,6 +103,7 @@ contains
             call file%write_attribute_real('/machine/lyapunov', 'd0', f%d0)
             call file%write_vector('/machine/lyapunov/time', f%time(1:f%n), 's')
             call file%write_vector('/machine/lyapunov/estimate', f%estimate(1:f%n), '1/s')
+            call file%attach_scales('/machine/lyapunov/estimate', ['/machine/lyapunov/time'])
          end associate
       end if
       call file%close(error)

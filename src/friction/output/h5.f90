@@ -13,7 +13,7 @@
 module friction_output_h5
    use, intrinsic :: iso_fortran_env, only: int64
    use, intrinsic :: iso_c_binding, only: c_ptr, c_loc, c_funptr, c_int, c_int64_t, c_null_ptr, c_null_funptr, &
-      & c_size_t, c_double
+      & c_size_t, c_double, c_char, c_null_char
    use mpi_f08, only: MPI_Comm, MPI_INFO_NULL, MPI_Comm_rank, MPI_Allreduce, MPI_Barrier, MPI_IN_PLACE, &
       & MPI_INTEGER, MPI_MAX, MPI_Bcast, MPI_DOUBLE_PRECISION, MPI_COMM_NULL, operator(==)
    use hdf5
@@ -34,6 +34,28 @@ module friction_output_h5
          integer(c_int), intent(out) :: cur_num_entries
          integer(c_int) :: status
       end function h5fget_mdc_size
+   end interface
+
+   interface
+      !> HDF5's dimension scales (the high-level library): what netCDF and
+      !> xarray read as a dataset's coordinates.
+      function h5ds_set_scale(dataset, name) result(status) bind(c, name='H5DSset_scale')
+         import :: c_int64_t, c_char, c_int
+         integer(c_int64_t), value :: dataset
+         character(kind=c_char), intent(in) :: name(*)
+         integer(c_int) :: status
+      end function h5ds_set_scale
+      function h5ds_is_scale(dataset) result(status) bind(c, name='H5DSis_scale')
+         import :: c_int64_t, c_int
+         integer(c_int64_t), value :: dataset
+         integer(c_int) :: status
+      end function h5ds_is_scale
+      function h5ds_attach_scale(dataset, scale, axis) result(status) bind(c, name='H5DSattach_scale')
+         import :: c_int64_t, c_int
+         integer(c_int64_t), value :: dataset, scale
+         integer(c_int), value :: axis
+         integer(c_int) :: status
+      end function h5ds_attach_scale
    end interface
 
    public :: h5_file, h5_status, error_printing, room_to_close, new_text_attribute, new_scalar_attribute, open_hdf5
@@ -101,6 +123,7 @@ module friction_output_h5
       procedure :: write_attribute_text
       procedure :: write_attribute_real
       procedure :: write_attribute_integer
+      procedure :: attach_scales
       procedure :: has_attribute
       procedure :: close
       procedure, private :: agree
@@ -318,6 +341,38 @@ contains
       if (len_trim(units) > 0) call attribute_text(self, dset, 'units', units)
       call h5dclose_f(dset, stat)
    end subroutine write_block_silently
+
+   !> The coordinates of a dataset's axes: scales(k) (a dataset's path, or
+   !> blank for none) becomes a dimension scale named by its last path
+   !> element and is attached to axis k of dataset name, the axes in the
+   !> file's order (slowest first, as h5py and xarray show them).
+   subroutine attach_scales(self, name, scales)
+      class(h5_file), intent(inout) :: self
+      character(len=*), intent(in) :: name, scales(:)
+      integer(hid_t) :: dset, scale
+      integer :: stat, k
+      character(len=:), allocatable :: path
+      type(error_printing) :: printing
+
+      if (self%status /= 0) return
+      call printing%silence()
+      call h5dopen_f(self%id, name, dset, stat)
+      call self%check(stat, 'opening dataset '//name//' for its coordinates')
+      do k = 1, size(scales)
+         path = trim(scales(k))
+         if (self%status /= 0 .or. len(path) == 0) cycle
+         call h5dopen_f(self%id, path, scale, stat)
+         call self%check(stat, 'opening coordinate '//path)
+         if (stat /= 0) cycle
+         if (h5ds_is_scale(scale) <= 0) call self%check(int(h5ds_set_scale(scale, &
+            & path(index(path, '/', back=.true.) + 1:)//c_null_char)), 'making '//path//' a dimension scale')
+         call self%check(int(h5ds_attach_scale(dset, scale, int(k - 1, c_int))), &
+            & 'attaching coordinate '//path//' to '//name)
+         call h5dclose_f(scale, stat)
+      end do
+      if (self%status == 0) call h5dclose_f(dset, stat)
+      call printing%restore()
+   end subroutine attach_scales
 
    !> A 1-D integer dataset that every rank holds whole; rank 0 writes it
    !> (flags, codes).  Collective like the others.
