@@ -91,6 +91,41 @@ def test_a_synthetic_image_is_recovered_within_three_standard_errors(friction, s
     assert result.correlation.shape == (p, p) and np.allclose(np.diag(result.correlation), 1.0)
 
 
+# Graphite under the Lennard-Jones tip (the lattice sum through its table): the paper's scene with
+# damping (ringing after every slip makes the sampled force jump with the parameters) at the paper's
+# stiff end, kx = ky = 2.5 N/m, where the tip slides without slips between samples; 4 lines of 32
+# samples, tolerances tight enough for the finite differences' step (docs/fitting.md).
+GRAPHITE = [INPUTS / "graphite.nml", INPUTS / "graphite_damped.nml", INPUTS / "graphite_stiff.nml"]
+GRAPHITE_SMALL = {"scan.nx": 32, "scan.ny": 4, "integrator.rtol": 1e-6, "integrator.atol": 1e-6}
+
+
+def test_a_graphite_image_through_the_table_is_recovered_within_three_standard_errors(friction, files):
+    """The measurement is the program's map (a job on its own process, building its own table),
+    plus an offset of 0.01 nN and Gaussian noise of 2 % of the map's spread (seed 3); the fit's
+    model is the C API's lines on the workers, each keeping its table across the evaluations.
+    From k 30 % off and the support 1 angstrom high, k, the support's height and the offset
+    come back within 3 standard errors of the truth."""
+    import h5py
+    import friction.fit
+    override = "&scan nx = 32, ny = 4 /\n&integrator rtol = 1e-6, atol = 1e-6 /\n"
+    with h5py.File(files("graphite_fit", GRAPHITE, override)) as f:
+        clean = {c: f[f"afm/{c}"][()] for c in ("trace/fx", "retrace/fx")}
+        assert f["surface"].attrs["evaluation"] == b"table"     # the lattice sum through its table
+    sigma = 0.02 * np.std(np.concatenate([v.ravel() for v in clean.values()]))
+    rng = np.random.default_rng(3)
+    measured = {c: v + 0.01 + sigma * rng.standard_normal(v.shape) for c, v in clean.items()}
+    with friction.Config("afm", files=GRAPHITE, values=GRAPHITE_SMALL) as cfg:
+        result = friction.fit.image(measured, cfg, {"tip.kx=tip.ky": 3.25, "tip.support_z": -5.0},
+                                    nuisances=("offset",), workers=2)
+    assert result.converged, result.reason
+    truth = {"tip.kx=tip.ky": 2.5, "tip.support_z": -6.0, "offset": 0.01}
+    for name in result.names:
+        # 3 standard errors: a 0.3 % chance per parameter for a Gaussian estimate.
+        assert abs(result.values[name] - truth[name]) < 3 * result.errors[name], (name, result.summary())
+    # The noise level within 13 %: three of its relative standard errors, 1/sqrt(2 x 256) = 4.4 %.
+    assert result.noise == pytest.approx(sigma, rel=0.13)
+
+
 def test_one_process_and_a_pool_give_the_same_fit(friction):
     import friction.fit
     values = {**SMALL, **NAF_TRUE, "scan.ny": 2}
