@@ -52,6 +52,7 @@ NUISANCES = {"offset": 0.0, "calibration": 1.0, "drift_x": 0.0, "drift_y": 0.0}
 # Variables that may be zero or negative: fitted as they are, not through their logarithm.
 _SIGNED = {"scan.angle", "scan.origin_x", "scan.origin_y", "tip.support_z"}
 _CHANNEL = re.compile(r"^(trace|retrace)/(fx|fy|along|across)$")
+_ELEMENT = re.compile(r"^([a-z_]+\.[a-z_0-9]+)\((\d+)\)$")   # one element of a list: surface.epsilon(2)
 
 
 # ---------------------------------------------------------------- model lines, in worker processes
@@ -74,21 +75,22 @@ def _worker_config(text, scene):
     return _worker.config
 
 
-def _lines(text, scene, settings, lines, passes, drift, origin):
-    """fx and fy of `lines` for each pass ("trace", "retrace") at `settings`:
-    {pass: (fx (len(lines), nx), fy)}.  Line j's origin moves by j * drift."""
+# What a built surface depends on besides the &surface group: the scan's rectangle (a lattice
+# sum's table covers it; a configuration keeps its surface while both stay as they were).
+_RECTANGLE = ("scan.origin_x", "scan.origin_y", "scan.angle", "scan.length", "scan.width", "scan.lead_in")
+
+
+def _lines(text, scene, items, passes):
+    """The lines of `items`, [(settings, line, origin)], in their order: [{pass: (fx, fy)}] for
+    each pass ("trace", "retrace").  The line is computed with the map's origin at `origin`."""
     cfg = _worker_config(text, scene)
-    for name, value in settings.items():
-        cfg.set(name, float(value))
-    out = {}
-    for trip in passes:
-        fx, fy = [], []
-        for j in lines:
-            cfg.set("scan.origin_x", origin[0] + drift[0] * j).set("scan.origin_y", origin[1] + drift[1] * j)
-            line = _capi.Config.afm_line(cfg, int(j), trip == "trace")   # fx, fy without support_x
-            fx.append(line[0])
-            fy.append(line[1])
-        out[trip] = (np.array(fx), np.array(fy))
+    out = []
+    for settings, j, origin in items:
+        for name, value in settings.items():
+            cfg.set(name, float(value))
+        cfg.set("scan.origin_x", origin[0]).set("scan.origin_y", origin[1])
+        out.append({trip: _capi.Config.afm_line(cfg, int(j), trip == "trace")[:2]   # fx, fy
+                    for trip in passes})
     return out
 
 
@@ -105,38 +107,60 @@ class _Lines:
         self.images = 0
         self.line_count = 0
 
-    def _chunks(self):
-        # At least 4 lines a task: a task's round trip costs about a line (the images of one batch
-        # are submitted together, so the workers stay busy across them).
-        count = max(1, min(len(self.lines) // 4, 2 * self.workers)) if self.workers > 1 else 1
-        return [chunk for chunk in np.array_split(np.asarray(self.lines), count) if chunk.size]
+    def _items(self, settings_list):
+        """(settings, line, origin) for every line of every image, in the order they are computed:
+        sorted by what the surface depends on (the &surface values and the line's scan), so that
+        the lines one built surface serves follow each other.  The images of a Jacobian that move
+        neither the surface nor the scan (a spring constant, the tip's height) then share the
+        table of their base image, line by line, when a drift moves each line's scan."""
+        items, keys = [], []
+        for settings, drift in settings_list:
+            start = (settings.get("scan.origin_x", self.origin[0]), settings.get("scan.origin_y", self.origin[1]))
+            surface = tuple(sorted((k, v) for k, v in settings.items()
+                                   if k.startswith("surface.") or (k in _RECTANGLE and not k.startswith("scan.origin"))))
+            for j in self.lines:
+                origin = (start[0] + drift[0] * j, start[1] + drift[1] * j)   # line j's origin moves by j * drift
+                items.append((settings, j, origin))
+                keys.append((surface, origin))
+        order = sorted(range(len(items)), key=keys.__getitem__)   # stable: in a group, as given
+        return items, order
 
     def evaluate(self, settings_list):
         """[(settings, drift)] -> [{pass: (fx, fy)}], the lines in self.lines' order."""
         self.images += len(settings_list)
         self.line_count += len(settings_list) * len(self.lines) * len(self.passes)
-        chunks = self._chunks()
+        items, order = self._items(settings_list)
+        ordered = [items[n] for n in order]
         if self.workers == 1:
-            return [_lines(self.text, self.scene, s, self.lines, self.passes, d, self.origin)
-                    for s, d in settings_list]
-        if self.pool is None:
-            # spawn: a fresh interpreter per worker, not a fork of one that may hold MPI or threads.
-            self.pool = concurrent.futures.ProcessPoolExecutor(self.workers,
-                                                               mp_context=multiprocessing.get_context("spawn"))
-        futures = [[self.pool.submit(_lines, self.text, self.scene, s, list(c), self.passes, d, self.origin)
-                    for c in chunks] for s, d in settings_list]
-        results = []
-        for parts in futures:
+            done = _lines(self.text, self.scene, ordered, self.passes)
+        else:
+            if self.pool is None:
+                # spawn: a fresh interpreter per worker, not a fork of one that may hold MPI or threads.
+                self.pool = concurrent.futures.ProcessPoolExecutor(self.workers,
+                                                                   mp_context=multiprocessing.get_context("spawn"))
+            # At least 4 lines a task: a task's round trip costs about a line.  Two tasks a worker: the
+            # pool stays busy while the last ones finish.
+            count = max(1, min(len(ordered) // 4, 2 * self.workers))
+            bounds = np.linspace(0, len(ordered), count + 1).round().astype(int)
+            futures = [self.pool.submit(_lines, self.text, self.scene, ordered[lo:hi], self.passes)
+                       for lo, hi in zip(bounds[:-1], bounds[1:]) if hi > lo]
             try:
-                parts = [f.result() for f in parts]
+                done = [line for future in futures for line in future.result()]
             except concurrent.futures.process.BrokenProcessPool:
                 self.close()
                 raise RuntimeError("friction.fit: a worker process stopped before its lines were computed. "
                                    "The workers are spawned, each importing the main module again: a script "
                                    "must call friction.fit under `if __name__ == \"__main__\":` (or pass "
                                    "workers=1)") from None
-            results.append({trip: (np.concatenate([p[trip][0] for p in parts]),
-                                   np.concatenate([p[trip][1] for p in parts])) for trip in self.passes})
+        lines = [None] * len(items)
+        for n, line in zip(order, done):
+            lines[n] = line
+        per = len(self.lines)
+        results = []
+        for i in range(len(settings_list)):
+            mine = lines[i * per:(i + 1) * per]
+            results.append({trip: (np.array([line[trip][0] for line in mine]),
+                                   np.array([line[trip][1] for line in mine])) for trip in self.passes})
         return results
 
     def close(self):
@@ -235,12 +259,21 @@ class _Problem:
         self.parameters = []
         for key, start in free.items():
             names = _names(key)
+            kinds = config.kinds()
             for name in names:
-                if name not in known:
+                match = _ELEMENT.match(name)
+                base, index = (match.group(1), int(match.group(2))) if match else (name, None)
+                if base not in known:
                     raise ValueError(f"unknown free parameter {name!r}: not a variable of scene 'afm' "
                                      "(group.variable, as Config.names() lists them)")
-                if config.kinds()[name][0] != "real":
+                kind, size = kinds[base][0], kinds[base][1]
+                if kind != "real":
                     raise ValueError(f"free parameter {name!r} is not a real number")
+                if index is None and size > 1:
+                    raise ValueError(f"free parameter {name!r} holds {size} values (a species table): name "
+                                     f"one, {name}(1) .. {name}({size})")
+                if index is not None and not 1 <= index <= size:
+                    raise ValueError(f"free parameter {name!r}: {base} has elements 1 .. {size}")
             label = _label(names)
             value = float(config.value(names[0]) if start is None else start)
             log = names[0] not in _SIGNED

@@ -126,6 +126,20 @@ def test_a_graphite_image_through_the_table_is_recovered_within_three_standard_e
     assert result.noise == pytest.approx(sigma, rel=0.13)
 
 
+def test_the_scan_origin_is_fitted_with_a_drift(friction):
+    """scan.origin_x free beside drift_x: line j starts at the fitted origin plus j x drift (the
+    lines were once computed from the configuration's origin, whatever the fit's).  Noise-free,
+    from 0.4 angstrom off: the truth to 1e-4 angstrom (the integrator's rtol 1e-6 on a 1 nN force)."""
+    import friction.fit
+    values = {**SMALL, **NAF_TRUE, "scan.ny": 3}
+    with friction.Config("afm", files=[INPUTS / "naf.nml"], values={**values, "scan.origin_x": 0.5}) as cfg:
+        measured = np.array([cfg.afm_line(j).fx for j in range(3)])
+    with friction.Config("afm", files=[INPUTS / "naf.nml"], values=values) as cfg:
+        fit = friction.fit.image(measured, cfg, {"scan.origin_x": 0.9}, nuisances=("drift_x",), workers=1)
+    assert fit.values["scan.origin_x"] == pytest.approx(0.5, abs=1e-4)
+    assert fit.values["drift_x"] == pytest.approx(0.0, abs=1e-4)
+
+
 def test_one_process_and_a_pool_give_the_same_fit(friction):
     import friction.fit
     values = {**SMALL, **NAF_TRUE, "scan.ny": 2}
@@ -219,6 +233,10 @@ def test_bad_input_is_refused_clearly(friction):
             friction.fit.image({"trace/fx": np.zeros((3, 32))}, cfg, ["surface.v0"], workers=1)
         with pytest.raises(ValueError, match=r"unknown free parameter 'tip.kk'"):
             friction.fit.image({"trace/fx": np.zeros((2, 32))}, cfg, ["tip.kk"], workers=1)
+        with pytest.raises(ValueError, match=r"'surface.epsilon' holds 8 values .*: name one, surface.epsilon\(1\)"):
+            friction.fit.image({"trace/fx": np.zeros((2, 32))}, cfg, {"surface.epsilon": 0.01}, workers=1)
+        with pytest.raises(ValueError, match=r"'surface.sigma\(9\)': surface.sigma has elements 1 .. 8"):
+            friction.fit.image({"trace/fx": np.zeros((2, 32))}, cfg, ["surface.sigma(9)"], workers=1)
         with pytest.raises(ValueError, match=r"unknown nuisance 'tilt'"):
             friction.fit.image({"trace/fx": np.zeros((2, 32))}, cfg, ["surface.v0"], nuisances=["tilt"], workers=1)
         with pytest.raises(ImageError, match=r"channel 'trace/fz' is not one of"):
