@@ -18,8 +18,8 @@ Measures and prints (this is not a test; nothing fails on a missed target):
   medians of 5; then the fit of k and the support's height with the offset, from k = 3.25 N/m
   and support_z = -5 angstrom, repeated (--repeats, default 3): the median wall time, the model
   images to converge, the time per image and per line; with --drift the same with a drift of
-  0.01 angstrom per line in the image and drift_x fitted, once (a drift moves each line's scan:
-  the table is built again for every line).
+  0.01 angstrom per line in the image and drift_x fitted (a drift moves each line's scan: the
+  table is built again for every line).
 
     python3 scripts/benchmark_fit.py [--workers N] [--size N] [--no-serial] [--scene naf|graphite]
                                      [--graphite-size N] [--repeats N] [--drift]
@@ -180,7 +180,7 @@ def graphite(size, workers, repeats, drift):
           f"{1e3 * kept:.1f} ms with it kept ({built / kept:.0f}x), {1e3 * moved:.0f} ms with the scan moved")
     cases = [("k, support_z and the offset", 0.0, ("offset",), repeats)]
     if drift:
-        cases.append(("the same and drift_x", GRAPHITE_DRIFT, ("offset", "drift_x"), 1))
+        cases.append(("the same and drift_x", GRAPHITE_DRIFT, ("offset", "drift_x"), repeats))
     for label, shift, nuisances, count in cases:
         measured, sigma = graphite_image(size, shift)
         runs = []

@@ -123,27 +123,53 @@ class _Lines:
                 items.append((settings, j, origin))
                 keys.append((surface, origin))
         order = sorted(range(len(items)), key=keys.__getitem__)   # stable: in a group, as given
-        return items, order
+        groups = []   # runs of one key in that order: the lines one surface serves
+        for n in order:
+            if groups and keys[groups[-1][-1]] == keys[n]:
+                groups[-1].append(n)
+            else:
+                groups.append([n])
+        return items, groups
+
+    def _tasks(self, groups, images):
+        """The groups packed into tasks in their order: about two a worker per image, of at least
+        4 lines (a task's round trip costs about a line), a group split only when it is larger
+        than a task (its surface then built once more)."""
+        total = sum(len(g) for g in groups)
+        size = math.ceil(total / max(1, min(total // 4, 2 * self.workers * images)))
+        tasks, current = [], []
+        for group in groups:
+            while len(group) > size:
+                if current:
+                    tasks.append(current)
+                    current = []
+                tasks.append(group[:size])
+                group = group[size:]
+            if current and len(current) + len(group) > size:
+                tasks.append(current)
+                current = []
+            current = current + group
+        if current:
+            tasks.append(current)
+        return tasks
 
     def evaluate(self, settings_list):
         """[(settings, drift)] -> [{pass: (fx, fy)}], the lines in self.lines' order."""
         self.images += len(settings_list)
         self.line_count += len(settings_list) * len(self.lines) * len(self.passes)
-        items, order = self._items(settings_list)
-        ordered = [items[n] for n in order]
+        items, groups = self._items(settings_list)
+        order = [n for group in groups for n in group]
         if self.workers == 1:
-            done = _lines(self.text, self.scene, ordered, self.passes)
+            done = _lines(self.text, self.scene, [items[n] for n in order], self.passes)
         else:
             if self.pool is None:
                 # spawn: a fresh interpreter per worker, not a fork of one that may hold MPI or threads.
                 self.pool = concurrent.futures.ProcessPoolExecutor(self.workers,
                                                                    mp_context=multiprocessing.get_context("spawn"))
-            # At least 4 lines a task: a task's round trip costs about a line.  Two tasks a worker: the
-            # pool stays busy while the last ones finish.
-            count = max(1, min(len(ordered) // 4, 2 * self.workers))
-            bounds = np.linspace(0, len(ordered), count + 1).round().astype(int)
-            futures = [self.pool.submit(_lines, self.text, self.scene, ordered[lo:hi], self.passes)
-                       for lo, hi in zip(bounds[:-1], bounds[1:]) if hi > lo]
+            tasks = self._tasks(groups, len(settings_list))
+            order = [n for task in tasks for n in task]
+            futures = [self.pool.submit(_lines, self.text, self.scene, [items[n] for n in task], self.passes)
+                       for task in tasks]
             try:
                 done = [line for future in futures for line in future.result()]
             except concurrent.futures.process.BrokenProcessPool:
