@@ -16,7 +16,12 @@ gives 19 times in 20.  The fits are shared among processes (one fit each).  --sc
             of fx, k = 2.5 N/m, support_z = -6 angstrom, an offset of 0.01 nN, no drift; from
             k = 3.25 N/m, support_z = -5 angstrom with the offset.
 
-    python3 scripts/fit_coverage.py [--scene naf|hopg|graphite] [--count N] [--workers N] [--seed S]
+--start truth starts each fit at the truth (the nuisances too): the intervals of the minimum
+around the truth, apart from whether a fit from afar finds it.  A fit whose noise estimate is
+more than 1.5 times the noise added has stopped in another minimum: those are counted.
+
+    python3 scripts/fit_coverage.py [--scene naf|hopg|graphite] [--start given|truth] [--count N]
+                                    [--workers N] [--seed S]
 
 Prints the counts, the band and the median |estimate - truth| / standard error; exits 0 (it
 measures, it is not a test).
@@ -68,7 +73,7 @@ def clean_image(scene):
 
 
 def one_fit(args):
-    scene, clean, sigma, seed = args
+    scene, clean, sigma, seed, from_truth = args
     import friction
     import friction.fit
     files, values, truth, start, nuisances, channels, _ = SCENES[scene]
@@ -77,13 +82,18 @@ def one_fit(args):
     # The configuration's own values of the free parameters are not the truth: only the start counts.
     values = {k: v for k, v in values.items() if k not in ("surface.v0", "tip.kx", "tip.ky", "tip.support_z")}
     with friction.Config("afm", files=files, values=values) as cfg:
+        if from_truth:
+            start = {n: truth[n] for n in start}
+            nuisances = {n: truth.get(n, 0.0) for n in nuisances}
         fit = friction.fit.image(measured, cfg, start, nuisances=nuisances, workers=1)
-    return fit.converged, {n: (fit.values[n], fit.errors[n]) for n in truth}
+    return fit.converged, {n: (fit.values[n], fit.errors[n]) for n in truth}, fit.noise
 
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--scene", choices=sorted(SCENES), default="naf", help="the image (default naf)")
+    parser.add_argument("--start", choices=("given", "truth"), default="given",
+                        help="the fits' start: the scene's (default) or the truth")
     parser.add_argument("--count", type=int, default=100, help="noise realizations (default 100)")
     parser.add_argument("--workers", type=int, default=2, help="processes (default 2)")
     parser.add_argument("--seed", type=int, default=1000, help="the first seed (default 1000)")
@@ -92,17 +102,19 @@ def main(argv=None):
     clean = clean_image(args.scene)
     sigma = 0.02 * float(np.std(np.concatenate([v.ravel() for v in clean.values()])))
     start = time.perf_counter()
-    jobs = [(args.scene, clean, sigma, args.seed + i) for i in range(args.count)]
+    jobs = [(args.scene, clean, sigma, args.seed + i, args.start == "truth") for i in range(args.count)]
     with concurrent.futures.ProcessPoolExecutor(args.workers, mp_context=multiprocessing.get_context("spawn")) as pool:
         results = list(pool.map(one_fit, jobs))
     wall = time.perf_counter() - start
     low, high = binom.interval(0.95, args.count, 0.95)
-    converged = sum(ok for ok, _ in results)
+    converged = sum(ok for ok, _, _ in results)
+    elsewhere = sum(noise > 1.5 * sigma for _, _, noise in results)
     print(f"{args.scene}: {args.count} noise realizations (seeds {args.seed}..{args.seed + args.count - 1}), noise {sigma:.4f} nN,"
-          f" {converged} converged, {wall:.0f} s on {args.workers} processes")
+          f" {converged} converged, {elsewhere} in another minimum (noise estimate over 1.5 times the noise),"
+          f" from {'the truth' if args.start == 'truth' else 'the scene start'}; {wall:.0f} s on {args.workers} processes")
     print(f"binomial band (central 95 % of Binomial({args.count}, 0.95)): {int(low)} to {int(high)}")
     for name, truth in SCENES[args.scene][2].items():
-        z = np.array([(values[name][0] - truth) / values[name][1] for _, values in results])
+        z = np.array([(values[name][0] - truth) / values[name][1] for _, values, _ in results])
         covered = int(np.sum(np.abs(z) < 1.959964))
         inside = "inside" if low <= covered <= high else "OUTSIDE"
         print(f"  {name:<16} covered {covered:>4} of {args.count} ({inside} the band); median |z| "

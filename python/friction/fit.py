@@ -72,6 +72,7 @@ def _worker_config(text, scene):
                 file.write(text)
             _worker.config = Config(scene, files=[path])
         _worker.key = key
+        _worker.values = {}   # what this process set last: a call per line for each costs (measured)
     return _worker.config
 
 
@@ -84,11 +85,14 @@ def _lines(text, scene, items, passes):
     """The lines of `items`, [(settings, line, origin)], in their order: [{pass: (fx, fy)}] for
     each pass ("trace", "retrace").  The line is computed with the map's origin at `origin`."""
     cfg = _worker_config(text, scene)
+    last = _worker.values
     out = []
     for settings, j, origin in items:
-        for name, value in settings.items():
-            cfg.set(name, float(value))
-        cfg.set("scan.origin_x", origin[0]).set("scan.origin_y", origin[1])
+        values = {**settings, "scan.origin_x": origin[0], "scan.origin_y": origin[1]}   # the line's origin
+        for name, value in values.items():
+            if last.get(name) != float(value):
+                cfg.set(name, float(value))
+                last[name] = float(value)
         out.append({trip: _capi.Config.afm_line(cfg, int(j), trip == "trace")[:2]   # fx, fy
                     for trip in passes})
     return out
@@ -103,6 +107,9 @@ class _Lines:
         self.lines, self.passes = list(lines), tuple(passes)
         self.origin = (float(config.value("scan.origin_x")), float(config.value("scan.origin_y")))
         self.workers = max(1, int(workers))
+        # Only a Lennard-Jones net builds a surface worth keeping (its table); the other potentials'
+        # lines are computed image by image, each image's settings set once a task.
+        self.lattice_sum = str(config.value("surface.potential")).strip().lower() == "lj"
         self.pool = None
         self.images = 0
         self.line_count = 0
@@ -114,14 +121,14 @@ class _Lines:
         neither the surface nor the scan (a spring constant, the tip's height) then share the
         table of their base image, line by line, when a drift moves each line's scan."""
         items, keys = [], []
-        for settings, drift in settings_list:
+        for image, (settings, drift) in enumerate(settings_list):
             start = (settings.get("scan.origin_x", self.origin[0]), settings.get("scan.origin_y", self.origin[1]))
             surface = tuple(sorted((k, v) for k, v in settings.items()
                                    if k.startswith("surface.") or (k in _RECTANGLE and not k.startswith("scan.origin"))))
             for j in self.lines:
                 origin = (start[0] + drift[0] * j, start[1] + drift[1] * j)   # line j's origin moves by j * drift
                 items.append((settings, j, origin))
-                keys.append((surface, origin))
+                keys.append((surface, origin) if self.lattice_sum else image)
         order = sorted(range(len(items)), key=keys.__getitem__)   # stable: in a group, as given
         groups = []   # runs of one key in that order: the lines one surface serves
         for n in order:
