@@ -109,9 +109,11 @@ def main(argv=None):
     low, high = binom.interval(0.95, args.count, 0.95)
     converged = sum(ok for ok, _, _ in results)
     elsewhere = sum(noise > 1.5 * sigma for _, _, noise in results)
-    print(f"{args.scene}: {args.count} noise realizations (seeds {args.seed}..{args.seed + args.count - 1}), noise {sigma:.4f} nN,"
-          f" {converged} converged, {elsewhere} in another minimum (noise estimate over 1.5 times the noise),"
-          f" from {'the truth' if args.start == 'truth' else 'the scene start'}; {wall:.0f} s on {args.workers} processes")
+    seeds = f"{args.seed}..{args.seed + args.count - 1}"
+    origin = "the truth" if args.start == "truth" else "the scene's start"
+    print(f"{args.scene}: {args.count} noise realizations (seeds {seeds}), noise {sigma:.4f} nN, {converged} "
+          f"converged, {elsewhere} in another minimum (noise estimate over 1.5 times the noise), from {origin}; "
+          f"{wall:.0f} s on {args.workers} processes")
     print(f"binomial band (central 95 % of Binomial({args.count}, 0.95)): {int(low)} to {int(high)}")
     for name, truth in SCENES[args.scene][2].items():
         z = np.array([(values[name][0] - truth) / values[name][1] for _, values, _ in results])

@@ -115,16 +115,17 @@ class _Lines:
         self.line_count = 0
 
     def _items(self, settings_list):
-        """(settings, line, origin) for every line of every image, in the order they are computed:
-        sorted by what the surface depends on (the &surface values and the line's scan), so that
-        the lines one built surface serves follow each other.  The images of a Jacobian that move
-        neither the surface nor the scan (a spring constant, the tip's height) then share the
-        table of their base image, line by line, when a drift moves each line's scan."""
+        """(settings, line, origin) for every line of every image, and their groups in the order
+        they are computed: for a lattice sum by what its surface depends on (the &surface values
+        and the line's scan), so that the lines one built table serves follow each other (the
+        images of a Jacobian that move neither the surface nor the scan, a spring constant or
+        the tip's height, then share their base image's table line by line when a drift moves
+        each line's scan); for the other potentials image by image."""
         items, keys = [], []
         for image, (settings, drift) in enumerate(settings_list):
             start = (settings.get("scan.origin_x", self.origin[0]), settings.get("scan.origin_y", self.origin[1]))
-            surface = tuple(sorted((k, v) for k, v in settings.items()
-                                   if k.startswith("surface.") or (k in _RECTANGLE and not k.startswith("scan.origin"))))
+            surface = tuple(sorted((k, v) for k, v in settings.items() if k.startswith("surface.")
+                                   or (k in _RECTANGLE and not k.startswith("scan.origin"))))
             for j in self.lines:
                 origin = (start[0] + drift[0] * j, start[1] + drift[1] * j)   # line j's origin moves by j * drift
                 items.append((settings, j, origin))
