@@ -3,7 +3,7 @@
  *
  * The same equations as the program (src/friction/afm/tip.f90, Eq. 4 in the
  * state y = (u, r'), u = r - r_M the tip's displacement from the support,
- * internal units Å, eV, s), the same scan (src/friction/afm/scan.f90: lines
+ * internal units Å, eV, s), the same scan (src/friction/afm/trip.f90: lines
  * along x at angle 0, every trip started at rest at the support, trace and
  * retrace) and the same samples, so the forces can be set side by side
  * with the program's.  CVODE runs as a C user would set it up for a stiff

@@ -25,6 +25,17 @@ LAYERS = [
     ["app"],
 ]
 RANK = {folder: rank for rank, folders in enumerate(LAYERS) for folder in folders}
+# Inside a folder, modules that are layered among themselves (docs/layout.md,
+# The AFM scan): lowest first, files on one line beside each other.  A module
+# of these may use another of these only from a lower line.
+SUBLAYERS = {
+    "afm": [
+        ["trip", "guard"],
+        ["slow_limit"],
+        ["deterministic_trip", "langevin_trip", "kramers_trip"],
+        ["scan"],
+    ],
+}
 
 
 def fortran_files(top):
@@ -58,6 +69,22 @@ def main():
                 continue
             if RANK[target] >= RANK[folder]:
                 problems.append(f"{os.path.relpath(path, root)}: {folder}/ uses {used} of {target}/")
+    for folder, rows in SUBLAYERS.items():
+        sub_rank = {f"friction_{folder}_{base}": rank for rank, bases in enumerate(rows) for base in bases}
+        for path in sources:
+            here = os.path.relpath(os.path.dirname(path), os.path.join(root, "src", "friction"))
+            base = os.path.basename(path).split(".")[0]
+            module = f"friction_{folder}_{base}"
+            if here != folder or module not in sub_rank:
+                continue
+            for _, used in re.findall(r"^(\s*use\s+(friction\w*))", open(path).read(), re.M | re.I):
+                target = sub_rank.get(used.lower())
+                if target is not None and used.lower() != module and target >= sub_rank[module]:
+                    problems.append(f"{os.path.relpath(path, root)}: {module} uses {used}, on its own line "
+                                    f"or above it in {folder}/")
+        for base in (base for bases in rows for base in bases):
+            if not os.path.exists(os.path.join(root, "src", "friction", folder, base + ".f90")):
+                problems.append(f"src/friction/{folder}/{base}.f90: layered in this test but missing")
     # Each file is named after its module (docs/layout.md, folders are
     # namespaces): friction_<folder>_<file>, friction_<file> in core/,
     # friction_<folder> for the file named as its folder.

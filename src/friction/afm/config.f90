@@ -57,7 +57,7 @@ module friction_afm_config
    character(len=*), parameter :: tip_model_names(3) = [character(len=11) :: 'inertial', 'overdamped', &
       & 'quasistatic']
    integer, parameter :: max_species = 8, max_defects = 64
-   !> Quantities a trip records (friction_afm_scan's n_quantities), for sizes in messages.
+   !> Quantities a trip records (friction_afm_trip's n_quantities), for sizes in messages.
    integer, parameter :: n_trip_quantities = 9
 
    type, extends(configurable) :: afm_config
@@ -796,7 +796,7 @@ contains
 
    !> The tip model in internal units around a potential; the support path
    !> is set per trip.  The quasistatic model uses the damping only to relax
-   !> the tip into a new minimum after a jump (friction_afm_scan): with
+   !> the tip into a new minimum after a jump (friction_afm_deterministic_trip): with
    !> damping in every moving direction that is the overdamped motion at a
    !> fixed support; with none in some direction, plain steepest descent of
    !> the total energy (the same damping, 1e-3 N s/m, in every direction).

@@ -85,7 +85,7 @@ module friction_afm_kramers
    real(wp), parameter :: default_log_change = 0.1_wp, default_floor = 3.0_wp
    integer, parameter :: max_iterations = 500
    !> The barrier, in k_B T, below which the reduced model of the scan
-   !> (friction_afm_scan) fires an exit at once.  Near the fold where the
+   !> (friction_afm_kramers_trip) fires an exit at once.  Near the fold where the
    !> jumps come the barrier is cubic, and there the escape rate of a well
    !> in equilibrium (the lowest eigenvalue of the Smoluchowski operator,
    !> absorbing past the saddle) is Kramers' within 10 % down to 1 k_B T:

@@ -12,7 +12,7 @@ module friction_afm_map_share
    use friction_clock, only: wall_seconds
    use friction_scene_context, only: job_context, share_of
    use friction_afm_config, only: afm_config
-   use friction_afm_scan, only: line_record, slip_list, n_quantities
+   use friction_afm_trip, only: line_record, slip_list, n_quantities
    use friction_afm_line_checkpoint, only: line_checkpoint_name, save_line, load_line, publish_checkpoints, &
       & discard_checkpoints
    implicit none

@@ -14,7 +14,8 @@ module friction_afm_map_verify
    use friction_scene_report, only: job_reporter
    use friction_scene_context, only: job_context, agree_on_error
    use friction_afm_config, only: afm_config
-   use friction_afm_scan, only: afm_scanner, line_record, q_fx, q_fy, q_fz
+   use friction_afm_scan, only: afm_scanner
+   use friction_afm_trip, only: line_record, q_fx, q_fy, q_fz
    use friction_afm_output, only: afm_verify_record
    use friction_afm_map_share, only: map_share
    use friction_afm_line_checkpoint, only: line_checkpoint_name

@@ -10,7 +10,7 @@ module friction_afm_netlist
    use friction_netlist_spice, only: nl, tolerances, control_end, num
    use friction_surface_potential, only: surface_potential, spice_form
    use friction_afm_config, only: afm_config, new_potential
-   use friction_afm_scan, only: line_offset
+   use friction_afm_trip, only: line_offset
    implicit none
    private
 

@@ -6,7 +6,7 @@ module friction_afm_output
    use friction_error, only: error_type
    use friction_ode_solver, only: integrator_statistics
    use friction_afm_config, only: afm_config, surface_evaluation
-   use friction_afm_scan, only: quantity_names, quantity_units, quantity_count, q_f_along, q_jumps, &
+   use friction_afm_trip, only: quantity_names, quantity_units, quantity_count, q_f_along, q_jumps, &
       & support_along, support_across
    use friction_output_h5, only: h5_file
    use friction_output_parameters, only: write_parameter_attributes

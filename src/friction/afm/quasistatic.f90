@@ -5,16 +5,28 @@
 !> E = V(r) + ½ Σ k_i (r_i - r_M,i)².  A minimum of E has J positive
 !> definite; the tip follows such a minimum as the support moves, and the
 !> minimum ends at a fold, where J becomes singular (docs/physics.md, Prandtl–Tomlinson: the slip of
-!> the Prandtl–Tomlinson model).  The tracking loop and the jump at a fold
-!> live in friction_afm_scan; here are the pure pieces: Newton's method
-!> kept inside the convex region, and the tangent of the branch.
+!> the Prandtl–Tomlinson model).  The trips that follow a minimum
+!> (friction_afm_deterministic_trip, friction_afm_slow_limit) land the tip
+!> after a fold each their own way; here are the pure pieces: Newton's
+!> method kept inside the convex region, the tangent of the branch, and one
+!> step of the continuation along it up to a fold.
 module friction_afm_quasistatic
    use friction_kinds, only: wp
    use friction_afm_tip, only: afm_tip
    implicit none
    private
 
-   public :: newton_equilibrium, equilibrium_tangent, force_imbalance
+   public :: newton_equilibrium, equilibrium_tangent, force_imbalance, continuation_step, landing_distance
+
+   !> The continuation (continuation_step): the support travel, Å, to which a
+   !> fold is located (the force near a fold varies like the square root of
+   !> the distance to it: ~1e-4 nN here); the push, Å, that starts the tip
+   !> off the vanished minimum (small against any lattice period, large
+   !> against the ~sqrt(fold_resolution) ghost of the minimum).
+   real(wp), parameter :: fold_resolution = 1.0e-9_wp, jump_push = 0.05_wp
+   !> How close, Å, a relaxed or descended state must be to the minimum
+   !> Newton's method finds from it to count as landed there.
+   real(wp), parameter :: landing_distance = 0.05_wp
 
    !> Newton's method stops when the update is below this, Å: far below
    !> any tolerance a map is integrated to (atol 1e-4 Å), and well above
@@ -123,5 +135,51 @@ contains
       call cholesky_solve(total_hessian(tip, t, u), tip%spring(1:n) * tip%support_velocity(1:n), dudt, ok)
       dudt = dudt - tip%support_velocity(1:n)
    end subroutine equilibrium_tangent
+
+   !> One step of the continuation of a minimum u of E from support time t
+   !> towards t1, support speed `speed` (Å/s), trying the step h: a
+   !> tangent predictor (equilibrium_tangent) and Newton's method as
+   !> corrector.  The step is accepted only when Newton converges with J
+   !> positive definite at every iterate and lands within half a step (the
+   !> larger of the predicted move and the support's travel) of the
+   !> prediction: the minimum cannot then have been left for another well;
+   !> t and u advance and h doubles.  Otherwise h is quartered; once it is
+   !> below fold_resolution of support travel the minimum has ended at a
+   !> fold: `folded`, t goes past the fold and u is pushed jump_push along
+   !> the tip's motion dr/dt = du/dt + v_M (the direction in which the
+   !> minimum vanished) off the ghost of the minimum, kept in `ghost`.  The
+   !> caller lands the tip from there and sets h.
+   pure subroutine continuation_step(tip, t, t1, h, speed, u, folded, ghost)
+      type(afm_tip), intent(in) :: tip
+      real(wp), intent(inout) :: t, h
+      real(wp), intent(in) :: t1, speed
+      real(wp), intent(inout) :: u(:)
+      logical, intent(out) :: folded
+      real(wp), intent(out) :: ghost(:)
+      real(wp) :: dudt(size(u)), predicted(size(u)), corrected(size(u)), motion(size(u))
+      logical :: ok, last
+
+      folded = .false.
+      last = t + h >= t1
+      if (last) h = t1 - t
+      call equilibrium_tangent(tip, t, u, dudt, ok)
+      if (.not. ok) dudt = 0.0_wp
+      predicted = u + h * dudt
+      call newton_equilibrium(tip, t + h, predicted, corrected, ok)
+      if (ok) ok = norm2(corrected - predicted) <= 0.5_wp * max(norm2(predicted - u), h * speed)
+      if (ok) then
+         t = merge(t1, t + h, last)
+         u = corrected
+         h = 2.0_wp * h
+      else if (h > fold_resolution / speed) then
+         h = 0.25_wp * h
+      else
+         folded = .true.
+         motion = dudt + tip%support_velocity(1:size(u))
+         ghost = u
+         if (norm2(motion) > 0.0_wp) u = u + jump_push * motion / norm2(motion)
+         t = merge(t1, t + h, last)
+      end if
+   end subroutine continuation_step
 
 end module friction_afm_quasistatic

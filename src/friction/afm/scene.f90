@@ -19,8 +19,9 @@ module friction_afm_scene
       & job_sharing, mpi_sharing
    use friction_afm_tip, only: model_overdamped, model_quasistatic
    use friction_afm_config, only: afm_config, auto_method, new_potential, species_count, scan_region
-   use friction_afm_scan, only: afm_scanner, line_record, trip_record, slip_list, n_quantities, q_fx, q_fy, &
-      & q_f_along, q_fz, q_jumps, quantity_names, quantity_count, support_along, support_across
+   use friction_afm_scan, only: afm_scanner
+   use friction_afm_trip, only: line_record, trip_record, slip_list, n_quantities, q_fx, q_fy, q_f_along, q_fz, &
+      & q_jumps, quantity_names, quantity_count, support_along, support_across
    use friction_afm_output, only: write_afm_file, afm_surface_record, afm_thermal_record, afm_verify_record, &
       & line_friction
    use friction_afm_validity, only: afm_model_warnings, quasistatic_friction_warning
@@ -178,9 +179,9 @@ contains
          if (.not. allocated(error)) call scanner%init_owning(c, potential, error)
          ! Within a line too (a slow thermal line can take minutes): the
          ! process's stop request, through a copy of the reporter.
-         if (.not. allocated(error)) allocate (scanner%stopper, source=reporter)
+         if (.not. allocated(error)) allocate (scanner%guard%stopper, source=reporter)
          ! max_wall_time counts from the reduced model's probe, when there was one.
-         if (probe_started > 0) scanner%clock_start = probe_started
+         if (probe_started > 0) scanner%guard%clock_start = probe_started
          if (.not. allocated(error) .and. scanner%thermal) then
             self%time_step = scanner%time_step()
             self%scheme = thermal_scheme(c)

@@ -7,8 +7,8 @@
 !> Langevin tip, friction_afm_langevin, at a fixed step) or 'kramers' (the
 !> thermal reduced model: the tip in a minimum of its energy, jumping over
 !> the saddle ahead at Kramers–Langer rates by kinetic Monte Carlo,
-!> friction_afm_kramers and friction_afm_scan); the output is the mean of
-!> every sample over the realizations with its standard error.
+!> friction_afm_kramers_trip); the output is the mean of every sample
+!> over the realizations with its standard error.
 !>
 !> This module holds the group's variables and the checks that need no
 !> other group; the checks against the tip and the surface (an undamped

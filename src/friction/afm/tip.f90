@@ -9,7 +9,7 @@
 !>
 !> Reduced models (docs/physics.md, reduced tip models): `model_overdamped` drops the
 !> inertia, c_i r_i' = k_i (r_M,i - r_i) - dV/dr_i, state y = u only;
-!> `model_quasistatic` follows the equilibrium (friction_afm_scan) and uses
+!> `model_quasistatic` follows the equilibrium (friction_afm_deterministic_trip) and uses
 !> the same first-order system, at a fixed support, only to relax the tip
 !> into a new minimum after a jump.
 module friction_afm_tip

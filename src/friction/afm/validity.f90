@@ -6,8 +6,8 @@ module friction_afm_validity
    use friction_error, only: error_type
    use friction_afm_config, only: afm_config, new_tip, tip_stiffness, surface_hopg, surface_row
    use friction_ode_auto, only: stiff_threshold
-   use friction_afm_tip, only: afm_tip, model_inertial, model_overdamped, model_quasistatic
-   use friction_afm_scan, only: find_height, afm_scanner
+   use friction_afm_tip, only: afm_tip, model_inertial, model_overdamped, model_quasistatic, find_height
+   use friction_afm_scan, only: afm_scanner
    use friction_surface_potential, only: surface_potential
    use friction_strings, only: rtoa, itoa, fixed_text
    use friction_scene_report, only: job_reporter
@@ -158,8 +158,8 @@ contains
 
          call scanner%init(config, potential, error)
          if (allocated(error)) return
-         if (present(started)) started = scanner%clock_start
-         if (present(stopper)) allocate (scanner%stopper, source=stopper)
+         if (present(started)) started = scanner%guard%clock_start
+         if (present(stopper)) allocate (scanner%guard%stopper, source=stopper)
          ! (A probe stopped by max_wall_time or a request says nothing: the
          ! run, which counts its time from the probe's start, stops at once.)
          ! The cost first: a sample of one trip, scaled to the map.
