@@ -85,7 +85,7 @@ def main():
         for base in (base for bases in rows for base in bases):
             if not os.path.exists(os.path.join(root, "src", "friction", folder, base + ".f90")):
                 problems.append(f"src/friction/{folder}/{base}.f90: layered in this test but missing")
-    # Each file is named after its module (docs/layout.md, folders are
+    # Each file is named after its module or submodule (docs/layout.md, folders are
     # namespaces): friction_<folder>_<file>, friction_<file> in core/,
     # friction_<folder> for the file named as its folder.
     for path in sources:
@@ -96,7 +96,10 @@ def main():
                     f"friction_{folder}"}
         if folder == "." and base == "friction":
             expected = {"friction"}
-        for module in re.findall(r"^\s*module\s+(\w+)\s*$", open(path).read(), re.M | re.I):
+        text = open(path).read()
+        modules = re.findall(r"^\s*module\s+(\w+)\s*$", text, re.M | re.I) + \
+            re.findall(r"^\s*submodule\s*\(\s*\w+\s*\)\s*(\w+)\s*$", text, re.M | re.I)
+        for module in modules:
             if module.lower() not in expected and not (folder == "core" and base == module.lower()[9:]):
                 problems.append(f"{os.path.relpath(path, root)}: module {module}, not named after its file "
                                 f"({' or '.join(sorted(expected))})")

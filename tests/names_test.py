@@ -6,7 +6,8 @@ scene factory and the configurations (docs/layout.md).
 How it finds them.  The names are read from the source, not listed here:
 the scene names from `scene_names` in src/friction/job/factory.f90, and the
 model and potential names from every `*model_names` or `potential_names`
-parameter array of the configuration modules (the files that declare them).
+parameter array of the configuration modules (the files that declare them,
+and their submodules).
 A named text constant whose value is one of those names (`model_switched =
 'switched'`) counts as the name.  In every other Fortran file of src/ and
 app/, with comments removed, it fails on
@@ -64,6 +65,13 @@ def main():
             if found:
                 names.update(found)
                 owners.add(path)
+    # A configuration's submodule (its checks) is part of the configuration.
+    owner_modules = {m.lower() for path in owners
+                     for m in re.findall(r"^\s*module\s+(\w+)\s*$", open(path, encoding="utf-8").read(), re.M | re.I)}
+    for path in sources:
+        parent = re.search(r"^\s*submodule\s*\(\s*(\w+)", open(path, encoding="utf-8").read(), re.M | re.I)
+        if parent and parent.group(1).lower() in owner_modules:
+            owners.add(path)
     factory = os.path.join(root, "src", "friction", "job", "factory.f90")
     if "afm" not in names or "switched" not in names or "lj" not in names or factory not in owners:
         print(f"FAILED: the name lists were not found (names {sorted(names)}): has their declaration changed?")
