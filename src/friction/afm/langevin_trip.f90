@@ -38,7 +38,7 @@ module friction_afm_langevin_trip
    !> thermal spread sqrt(k k_B T) = 0.2 nN at 300 K (the quenches' cost:
    !> docs/speed.md).
    real(wp), parameter :: check_distance = 0.05_wp
-   !> Langevin steps between two looks at the clock: at ~100 ns a step, ~10 ms.
+   !> Langevin steps between two looks at the clock: a stop is seen within a small part of a second.
    integer, parameter :: langevin_chunk = 100000
 
    !> The Langevin trips of one tip: the steps and their counts.

@@ -385,18 +385,21 @@ contains
       class(slip_list), intent(inout) :: self
       integer, intent(in) :: realization, trip
       real(wp), intent(in) :: support, force, jump, jump_across
+      integer :: room
 
       if (.not. allocated(self%realization)) then
          allocate (self%realization(16), self%trip(16), self%support(16), self%force(16), self%jump(16), &
             & self%jump_across(16))
       end if
       if (self%n == size(self%realization)) then
-         call grow_integers(self%realization)
-         call grow_integers(self%trip)
-         call grow_reals(self%support)
-         call grow_reals(self%force)
-         call grow_reals(self%jump)
-         call grow_reals(self%jump_across)
+         ! Twice the room, the entries kept.
+         room = size(self%realization)
+         self%realization = [self%realization, spread(0, 1, room)]
+         self%trip = [self%trip, spread(0, 1, room)]
+         self%support = [self%support, spread(0.0_wp, 1, room)]
+         self%force = [self%force, spread(0.0_wp, 1, room)]
+         self%jump = [self%jump, spread(0.0_wp, 1, room)]
+         self%jump_across = [self%jump_across, spread(0.0_wp, 1, room)]
       end if
       self%n = self%n + 1
       self%realization(self%n) = realization
@@ -405,28 +408,6 @@ contains
       self%force(self%n) = force
       self%jump(self%n) = jump
       self%jump_across(self%n) = jump_across
-
-   contains
-
-      !> Twice the room, the entries kept.
-      subroutine grow_integers(list)
-         integer, allocatable, intent(inout) :: list(:)
-         integer, allocatable :: longer(:)
-
-         allocate (longer(2 * size(list)))
-         longer(1:size(list)) = list
-         call move_alloc(longer, list)
-      end subroutine grow_integers
-
-      subroutine grow_reals(list)
-         real(wp), allocatable, intent(inout) :: list(:)
-         real(wp), allocatable :: longer(:)
-
-         allocate (longer(2 * size(list)))
-         longer(1:size(list)) = list
-         call move_alloc(longer, list)
-      end subroutine grow_reals
-
    end subroutine slips_add
 
 end module friction_afm_trip
