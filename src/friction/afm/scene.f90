@@ -20,8 +20,8 @@ module friction_afm_scene
    use friction_afm_tip, only: model_overdamped, model_quasistatic
    use friction_afm_config, only: afm_config, auto_method, new_potential, species_count, scan_region
    use friction_afm_scan, only: afm_scanner
-   use friction_afm_trip, only: line_record, trip_record, slip_list, n_quantities, q_fx, q_fy, q_f_along, q_fz, &
-      & q_jumps, quantity_names, quantity_count, support_along, support_across
+   use friction_afm_trip, only: line_record, trip_record, q_fx, q_fy, q_f_along, q_jumps, quantity_names, &
+      & quantity_count, support_along, support_across
    use friction_afm_output, only: write_afm_file, afm_surface_record, afm_thermal_record, afm_verify_record, &
       & line_friction
    use friction_afm_validity, only: afm_model_warnings, quasistatic_friction_warning
