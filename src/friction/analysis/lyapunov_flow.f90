@@ -10,6 +10,7 @@ module friction_analysis_lyapunov_flow
    use friction_error, only: error_type, fatal_error, error_input
    use friction_ode_system, only: ode_system
    use friction_ode_solver, only: ode_solver, solver_settings
+   use friction_ode_watch, only: step_watch
    implicit none
    private
 
@@ -81,14 +82,17 @@ contains
    end function current_exponent
 
    !> The exponent of a smooth system from y0 at t0; the perturbation starts
-   !> along (1, 1, ..., 1)/√n after the transient.
-   subroutine benettin_exponent(system, solver, y0, t0, settings, result, error)
+   !> along (1, 1, ..., 1)/√n after the transient.  A watch, if given, is
+   !> asked inside every integration and after every interval: its error
+   !> (a stop request, a wall-clock limit) ends the estimate there.
+   subroutine benettin_exponent(system, solver, y0, t0, settings, result, error, watch)
       class(ode_system), target, intent(in) :: system
       type(solver_settings), intent(in) :: solver
       real(wp), intent(in) :: y0(:), t0
       type(benettin_settings), intent(in) :: settings
       type(benettin_accumulator), intent(out) :: result
       type(error_type), allocatable, intent(out) :: error
+      class(step_watch), intent(inout), optional :: watch
       type(ode_solver) :: first, second
       real(wp) :: t, t1, t2, reference(size(y0)), perturbed(size(y0)), h
       integer :: k, intervals
@@ -108,7 +112,7 @@ contains
       reference = y0
       t = t0
       if (settings%transient > 0.0_wp) then
-         call first%advance(t, t0 + settings%transient, reference, error)
+         call first%advance(t, t0 + settings%transient, reference, error, watch)
          if (allocated(error)) return
       end if
       perturbed = reference + settings%d0 / sqrt(real(size(y0), wp))
@@ -118,13 +122,17 @@ contains
       do k = 1, intervals
          t1 = t
          t2 = t
-         call first%advance(t1, t + settings%renormalise, reference, error)
+         call first%advance(t1, t + settings%renormalise, reference, error, watch)
          if (allocated(error)) return
          call second%restart(h)
-         call second%advance(t2, t + settings%renormalise, perturbed, error)
+         call second%advance(t2, t + settings%renormalise, perturbed, error, watch)
          if (allocated(error)) return
          t = t + settings%renormalise
          call result%renormalise(reference, perturbed, settings%renormalise)
+         if (present(watch)) then
+            call watch%check(t, error)
+            if (allocated(error)) return
+         end if
       end do
       call first%destroy()
       call second%destroy()

@@ -5,13 +5,14 @@
 module friction_machine_diagnostics
    use friction_kinds, only: wp
    use friction_error, only: error_type
+   use friction_ode_watch, only: step_watch
    use friction_analysis_spectrum, only: spectrum_settings, spectrum_result, amplitude_spectrum
    use friction_analysis_lyapunov_flow, only: benettin_settings, benettin_accumulator, benettin_exponent
    use friction_law, only: sliding_law, max_law_states
    use friction_law_factory, only: make_law
    use friction_machine_config, only: machine_config
    use friction_machine_model, only: machine_smooth
-   use friction_machine_run, only: machine_run
+   use friction_machine_run, only: machine_run, machine_watch
    implicit none
    private
 
@@ -25,11 +26,14 @@ module friction_machine_diagnostics
 
 contains
 
-   subroutine diagnose_machine(c, run, d, error)
+   !> `watch` (by default max_wall_time alone, from now) is asked inside
+   !> Benettin's integrations and after each of its intervals.
+   subroutine diagnose_machine(c, run, d, error, watch)
       type(machine_config), intent(in) :: c
       type(machine_run), intent(in) :: run
       type(machine_diagnostics), intent(out) :: d
       type(error_type), allocatable, intent(out) :: error
+      class(step_watch), intent(inout), optional :: watch
 
       associate (a => c%analysis)
          d%spectrum = a%spectrum
@@ -80,7 +84,15 @@ contains
          if (b%duration == 0.0_wp) b%duration = c%t_end - c%t_start - b%transient
          b%renormalise = c%analysis%lyapunov_renormalise
          b%d0 = c%analysis%lyapunov_d0
-         call benettin_exponent(system, c%solver, y(1:2 + ns), c%t_start, b, d%flow, error)
+         if (present(watch)) then
+            call benettin_exponent(system, c%solver, y(1:2 + ns), c%t_start, b, d%flow, error, watch)
+         else
+            block
+               class(step_watch), allocatable :: own
+               allocate (own, source=machine_watch(c, "&analysis: the Lyapunov exponent (Benettin)"))
+               call benettin_exponent(system, c%solver, y(1:2 + ns), c%t_start, b, d%flow, error, own)
+            end block
+         end if
       end subroutine lyapunov
 
    end subroutine diagnose_machine

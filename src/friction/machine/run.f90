@@ -5,10 +5,11 @@
 !> beyond the static limit reverses); the other laws are one ODE with the
 !> law's states, and the output counts |w| <= stick_velocity as stick.
 module friction_machine_run
-   use friction_kinds, only: wp, i8
-   use friction_error, only: error_type, fatal_error, error_numerical
-   use friction_strings, only: rtoa
+   use friction_kinds, only: wp
+   use friction_error, only: error_type
    use friction_ode_solver, only: ode_solver, integrator_statistics
+   use friction_ode_watch, only: step_watch
+   use friction_scene_report, only: job_reporter, new_job_watch
    use friction_ode_events, only: event_locator, event_falling
    use friction_law, only: sliding_law, max_law_states
    use friction_law_factory, only: make_law
@@ -17,7 +18,7 @@ module friction_machine_run
    implicit none
    private
 
-   public :: machine_run, run_machine
+   public :: machine_run, run_machine, machine_watch
    public :: event_stick_to_slip, event_slip_to_stick, event_slip_reversal, event_kind_names
 
    integer, parameter :: event_stick_to_slip = 1, event_slip_to_stick = 2, event_slip_reversal = 3
@@ -69,12 +70,29 @@ contains
       self%n_events = n
    end subroutine add_event
 
-   !> The whole run of checked settings c.
-   subroutine run_machine(c, run, error)
+   !> A watch over the machine's work from now on: max_wall_time, and the
+   !> stop requests of `reporter` if given.
+   function machine_watch(c, what, reporter) result(watch)
+      type(machine_config), intent(in) :: c
+      character(len=*), intent(in) :: what
+      class(job_reporter), intent(in), optional :: reporter
+      class(step_watch), allocatable :: watch
+
+      allocate (watch, source=new_job_watch('machine, '//trim(c%law%model)//' law: '//what, 't', &
+         & c%solver%max_wall_time, reporter))
+   end function machine_watch
+
+   !> The whole run of checked settings c.  The integration asks `watch`
+   !> every few steps and at every output point (by default a watch of
+   !> max_wall_time alone): a stop request or the limit ends the run there
+   !> with an error, and nothing of it is kept.
+   subroutine run_machine(c, run, error, watch)
       type(machine_config), intent(in) :: c
       type(machine_run), intent(out) :: run
       type(error_type), allocatable, intent(out) :: error
+      class(step_watch), intent(inout), optional :: watch
       class(sliding_law), allocatable :: law
+      class(step_watch), allocatable :: own
       type(mechanics) :: m
       integer :: n
 
@@ -94,24 +112,37 @@ contains
          run%state_name = law%state_name(1)
          run%state_unit = law%state_unit(1)
       end if
-      if (law%set_valued()) then
-         call run_switched(c, law, m, run, error)
+      if (present(watch)) then
+         call integrate(watch)
       else
-         call run_smooth(c, law, m, run, error)
+         allocate (own, source=machine_watch(c, 'the run'))
+         call integrate(own)
       end if
+
+   contains
+
+      subroutine integrate(watch)
+         class(step_watch), intent(inout) :: watch
+
+         if (law%set_valued()) then
+            call run_switched(c, law, m, run, watch, error)
+         else
+            call run_smooth(c, law, m, run, watch, error)
+         end if
+      end subroutine integrate
    end subroutine run_machine
 
-   subroutine run_smooth(c, law, m, run, error)
+   subroutine run_smooth(c, law, m, run, watch, error)
       type(machine_config), intent(in) :: c
       class(sliding_law), intent(in) :: law
       type(mechanics), intent(in) :: m
       type(machine_run), intent(inout) :: run
+      class(step_watch), intent(inout) :: watch
       type(error_type), allocatable, intent(out) :: error
       type(machine_smooth), target :: system
       type(ode_solver) :: solver
       real(wp) :: y(2 + max_law_states), t, z(max_law_states), h
       integer :: i, k, ns
-      integer(i8) :: clock_start, clock_now, clock_rate
 
       ns = law%state_count()
       system%m = m
@@ -129,23 +160,16 @@ contains
       y(2) = c%v0
       y(3:2 + ns) = z(1:ns) / system%scale(1:ns)
       t = c%t_start
-      call system_clock(clock_start, clock_rate)
       do i = 1, run%n
          if (i > 1) then
-            call solver%advance(t, c%grid_time(i), y(1:2 + ns), error)
+            call solver%advance(t, c%grid_time(i), y(1:2 + ns), error, watch)
             if (allocated(error)) then
-               error%message = 'machine, '//trim(c%law%model)//' law: '//error%message
+               call label(c, error)
                return
             end if
-            ! &integrator max_wall_time, between grid points (the solver counts steps only).
-            if (c%solver%max_wall_time > 0.0_wp) then
-               call system_clock(clock_now)
-               if (real(clock_now - clock_start, wp) / real(clock_rate, wp) > c%solver%max_wall_time) then
-                  call fatal_error(error, 'machine, '//trim(c%law%model)//' law: more than max_wall_time = ' &
-                     & //rtoa(c%solver%max_wall_time)//' s at t = '//rtoa(t)//' s', error_numerical)
-                  return
-               end if
-            end if
+            ! (Also here: a trip of a few steps never reaches the solver's look.)
+            call watch%check(t, error)
+            if (allocated(error)) return
          end if
          z(1:ns) = y(3:2 + ns) * system%scale(1:ns)
          run%t(i) = c%grid_time(i)
@@ -161,11 +185,12 @@ contains
    end subroutine run_smooth
 
    !> Exact stick and slip for a set-valued law.
-   subroutine run_switched(c, law, m, run, error)
+   subroutine run_switched(c, law, m, run, watch, error)
       type(machine_config), intent(in) :: c
       class(sliding_law), intent(in) :: law
       type(mechanics), intent(in) :: m
       type(machine_run), intent(inout) :: run
+      class(step_watch), intent(inout) :: watch
       type(error_type), allocatable, intent(out) :: error
       type(machine_slip), target :: slip
       type(machine_stick), target :: stick
@@ -205,7 +230,7 @@ contains
                block
                   real(wp) :: t0
                   t0 = t
-                  call sticking%advance(t, t_grid, y, error)
+                  call sticking%advance(t, t_grid, y, error, watch)
                   run%stick_time = run%stick_time + (t - t0)
                end block
                if (allocated(error)) exit
@@ -217,7 +242,7 @@ contains
                call start_slip(merge(1.0_wp, -1.0_wp, which == 1))
                call run%add_event(t, event_stick_to_slip, y(1), y(2))
             else
-               call slipping%advance(t, t_grid, y, error)
+               call slipping%advance(t, t_grid, y, error, watch)
                if (allocated(error)) exit
                if (slipping%n_hits == 0) cycle
                a = m%applied(t, y(1), m%belt)
@@ -233,9 +258,11 @@ contains
             end if
          end do
          if (allocated(error)) then
-            error%message = 'machine, '//trim(c%law%model)//' law: '//error%message
+            call label(c, error)
             return
          end if
+         call watch%check(t, error)
+         if (allocated(error)) return
          call record(i)
       end do
       run%stats = slipping%statistics()
@@ -264,5 +291,14 @@ contains
          end if
       end subroutine record
    end subroutine run_switched
+
+   !> The law's name before an integrator's message (a watch's names it already).
+   subroutine label(c, error)
+      type(machine_config), intent(in) :: c
+      type(error_type), intent(inout) :: error
+
+      if (index(error%message, 'machine, ') /= 1) error%message = 'machine, '//trim(c%law%model)//' law: ' &
+         & //error%message
+   end subroutine label
 
 end module friction_machine_run

@@ -14,7 +14,8 @@ module friction_machine_scene
    use friction_scene_report, only: job_reporter
    use friction_scene_context, only: job_context, agree_on_error, ranks_text, job_wall_time
    use friction_machine_config, only: machine_config
-   use friction_machine_run, only: machine_run, run_machine
+   use friction_machine_run, only: machine_run, run_machine, machine_watch
+   use friction_ode_watch, only: step_watch
    use friction_machine_output, only: machine_summary, write_machine_file
    use friction_machine_diagnostics, only: machine_diagnostics, diagnose_machine
    implicit none
@@ -86,11 +87,20 @@ contains
       class(job_reporter), intent(inout) :: reporter
       type(error_type), allocatable, intent(out) :: error
       real(wp) :: start
+      class(step_watch), allocatable :: watch
 
       start = wall_seconds()
-      call run_machine(self%config, self%result, error)
+      ! Stop requests and max_wall_time reach the integration between its steps (a stiff law
+      ! can crawl through one output interval), and the diagnostics' from their start.
+      allocate (watch, source=machine_watch(self%config, 'the run', reporter))
+      call run_machine(self%config, self%result, error, watch)
       self%record%compute_time = wall_seconds() - start
-      if (.not. allocated(error)) call diagnose_machine(self%config, self%result, self%diagnostics, error)
+      if (.not. allocated(error)) then
+         deallocate (watch)
+         allocate (watch, source=machine_watch(self%config, '&analysis: the Lyapunov exponent (Benettin)', &
+            & reporter))
+         call diagnose_machine(self%config, self%result, self%diagnostics, error, watch)
+      end if
       call agree_on_error(job, error)
       if (allocated(error)) return
       call reporter%progress(self%config%t_end - self%config%t_start, self%config%t_end - self%config%t_start, &
@@ -184,9 +194,11 @@ contains
       class(job_reporter), intent(inout) :: reporter
       type(error_type), allocatable, intent(out) :: error
       type(machine_run) :: run
+      class(step_watch), allocatable :: watch
       integer :: n
 
-      call run_machine(self%config, run, error)
+      allocate (watch, source=machine_watch(self%config, 'the run', reporter))
+      call run_machine(self%config, run, error, watch)
       if (allocated(error)) return
       call reporter%progress(self%config%t_end - self%config%t_start, self%config%t_end - self%config%t_start, &
          & 's', .true.)

@@ -46,6 +46,7 @@ module friction_ode_events
    use friction_strings, only: itoa, rtoa
    use friction_ode_system, only: ode_system
    use friction_ode_solver, only: ode_solver, solver_settings, integrator_statistics
+   use friction_ode_watch, only: step_watch
    implicit none
    private
 
@@ -238,13 +239,16 @@ contains
    !> first step in which events happened: those are in hits(1:n_hits) in
    !> time order.  If one of them is terminal it is the last, and (t, y) is
    !> its state: call restart before going on.  Otherwise (t, y) is the end
-   !> of that step and advance may simply be called again.
-   subroutine advance(self, t, t1, y, error)
+   !> of that step and advance may simply be called again.  A watch, if
+   !> given, is asked every 16 steps (with the wall-clock limit): its error
+   !> ends the advance there.
+   subroutine advance(self, t, t1, y, error, watch)
       class(event_locator), intent(inout) :: self
       real(wp), intent(inout) :: t
       real(wp), intent(in) :: t1
       real(wp), intent(inout) :: y(:)
       type(error_type), allocatable, intent(out) :: error
+      class(step_watch), intent(inout), optional :: watch
       ! (Fixed sizes, and the events of a step gathered in hits itself:
       ! automatic arrays would be allocated on the heap at every call.)
       real(wp) :: t0, y0(max_state), g0(max_events), f0(max_state)
@@ -290,6 +294,10 @@ contains
                   & error_numerical)
                return
             end if
+         end if
+         if (present(watch) .and. mod(self%steps, 16_i8) == 0) then
+            call watch%check(t, error)
+            if (allocated(error)) return
          end if
          call self%system%rhs(t, y(1:self%n), self%f(1:self%n))
          self%extra_rhs = self%extra_rhs + 1

@@ -275,6 +275,35 @@ int friction_gsl_driver_apply(gsl_odeiv2_driver *d, double *t, double t1, double
     return quiet_end(gsl_odeiv2_driver_apply(d, t, t1, y));
 }
 
+/* gsl_odeiv2_driver_apply in parts: from *t towards t1 for at most `steps`
+ * steps, with the same checks in the same order (the step budget of the
+ * trip, h_max, h_min), so that the steps are the same, bit for bit, as one
+ * apply; `first` starts the trip (its step count at 0).  *done is 1 once t1
+ * is reached.  Between parts the caller may look at the clock or a stop
+ * request: one apply gives it no chance until t1. */
+int friction_gsl_driver_apply_part(gsl_odeiv2_driver *d, double *t, double t1, double y[], long steps,
+                                   int first, int *done)
+{
+    int status = GSL_SUCCESS;
+    long taken;
+
+    *done = 0;
+    if (first) d->n = 0;
+    quiet_begin();
+    if (first && !(t1 >= *t)) status = GSL_EINVAL;   /* (as apply: a step forwards, t1 behind) */
+    for (taken = 0; status == GSL_SUCCESS && *t < t1 && taken < steps; taken++) {
+        status = gsl_odeiv2_evolve_apply(d->e, d->c, d->s, d->sys, t, t1, &d->h, y);
+        if (status != GSL_SUCCESS) break;
+        if (d->nmax > 0 && d->n > d->nmax) status = GSL_EMAXITER;
+        else if (fabs(d->h) > d->hmax) d->h = copysign(d->hmax, d->h);
+        if (status == GSL_SUCCESS && fabs(d->h) < d->hmin) status = GSL_ENOPROG;
+        if (status == GSL_SUCCESS) d->n++;
+    }
+    status = quiet_end(status);
+    if (status == GSL_SUCCESS && !(*t < t1)) *done = 1;
+    return status;
+}
+
 /* One accepted step from *t towards t1 (never past it), with the checks of
  * gsl_odeiv2_driver_apply (h_max, h_min) but without its step budget, which
  * a caller that looks at every step counts itself.  h_min applies to the

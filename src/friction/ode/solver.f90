@@ -14,6 +14,7 @@ module friction_ode_solver
    use friction_kinds, only: wp, i8
    use friction_error, only: error_type, fatal_error, error_numerical, error_input, error_internal
    use friction_ode_system, only: ode_system
+   use friction_ode_watch, only: step_watch
    use friction_strings, only: itoa, rtoa, etoa
    implicit none
    private
@@ -165,6 +166,19 @@ module friction_ode_solver
          real(c_double), intent(inout) :: y(*)
          integer(c_int) :: status
       end function friction_gsl_driver_apply
+
+      function friction_gsl_driver_apply_part(driver, t, t1, y, steps, first, done) result(status) &
+         & bind(c, name='friction_gsl_driver_apply_part')
+         import :: c_ptr, c_int, c_double, c_long
+         type(c_ptr), value :: driver
+         real(c_double), intent(inout) :: t
+         real(c_double), value :: t1
+         real(c_double), intent(inout) :: y(*)
+         integer(c_long), value :: steps
+         integer(c_int), value :: first
+         integer(c_int), intent(out) :: done
+         integer(c_int) :: status
+      end function friction_gsl_driver_apply_part
 
       function friction_gsl_driver_step_once(driver, t, t1, y) result(status) &
          & bind(c, name='friction_gsl_driver_step_once')
@@ -362,19 +376,37 @@ contains
       deallocate (self%failed_restart)
    end subroutine report_failed_restart
 
-   !> Advance y from t to t1.  On failure t holds the time reached.
-   subroutine advance(self, t, t1, y, error)
+   !> Advance y from t to t1.  On failure t holds the time reached.  With a
+   !> watch, the trip goes in parts of watch_steps steps (the same steps as
+   !> one piece, bit for bit) and the watch is asked after each: its error
+   !> ends the trip there.
+   subroutine advance(self, t, t1, y, error, watch)
       class(ode_solver), intent(inout) :: self
       real(wp), intent(inout) :: t
       real(wp), intent(in) :: t1
       real(wp), intent(inout) :: y(:)
       type(error_type), allocatable, intent(out) :: error
-      integer(c_int) :: status
+      class(step_watch), intent(inout), optional :: watch
+      integer(c_int) :: status, done, first
       integer(c_long) :: steps, failed
+      !> Steps between two looks of the watch: a few microseconds of the
+      !> cheapest systems, so a look (a clock read) costs nothing in comparison.
+      integer(c_long), parameter :: watch_steps = 16
 
       call self%report_failed_restart(error)
       if (allocated(error)) return
-      status = friction_gsl_driver_apply(self%driver, t, t1, y)
+      if (present(watch)) then
+         first = 1
+         do
+            status = friction_gsl_driver_apply_part(self%driver, t, t1, y, watch_steps, first, done)
+            first = 0
+            if (status /= gsl_success .or. done /= 0) exit
+            call watch%check(t, error)
+            if (allocated(error)) return
+         end do
+      else
+         status = friction_gsl_driver_apply(self%driver, t, t1, y)
+      end if
       call friction_gsl_driver_counts(self%driver, steps, failed)
       if (status /= gsl_success) then
          if (status == gsl_ebadfunc) then

@@ -7,10 +7,11 @@ module friction_scene_report
    use friction_strings, only: fixed_text, rtoa
    use friction_error, only: error_type, fatal_error, error_interrupted, error_numerical
    use friction_clock, only: wall_seconds
+   use friction_ode_watch, only: step_watch
    implicit none
    private
 
-   public :: job_reporter, progress_text, loop_guard
+   public :: job_reporter, progress_text, loop_guard, job_watch, new_job_watch
 
    type :: job_reporter
    contains
@@ -42,7 +43,54 @@ module friction_scene_report
       procedure :: check => guard_check
    end type loop_guard
 
+   !> A loop guard asked from inside an integration (the ode layer's watch):
+   !> a trip that crawls through one output interval (a stiff law near a
+   !> singular point takes steps of 1e-20 s) still ends on a stop request
+   !> and at max_wall_time.  It holds a copy of the job's reporter (the
+   !> request is the process's, not the copy's), asked at most every
+   !> poll_interval s: a C API caller's stop function may be dear.
+   type, extends(step_watch) :: job_watch
+      type(loop_guard) :: guard
+      class(job_reporter), allocatable :: stopper   !! none: max_wall_time alone
+      character(len=:), allocatable :: what, unit
+      real(wp) :: next_poll = -huge(1.0_wp)   !! wall_seconds() of the next look at stopper
+   contains
+      procedure :: check => watch_check
+   end type job_watch
+
+   !> Seconds between two looks at a watch's stopper.
+   real(wp), parameter :: poll_interval = 0.05_wp
+
 contains
+
+   !> A watch over work that begins now: `what` and `unit` name the work and
+   !> its time in the messages, `limit` is max_wall_time (0 for none).
+   function new_job_watch(what, unit, limit, reporter) result(watch)
+      character(len=*), intent(in) :: what, unit
+      real(wp), intent(in) :: limit
+      class(job_reporter), intent(in), optional :: reporter
+      type(job_watch) :: watch
+
+      watch%guard = loop_guard(started=wall_seconds(), limit=limit)
+      watch%what = what
+      watch%unit = unit
+      if (present(reporter)) allocate (watch%stopper, source=reporter)
+   end function new_job_watch
+
+   subroutine watch_check(self, t, error)
+      class(job_watch), intent(inout) :: self
+      real(wp), intent(in) :: t
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: now
+
+      now = wall_seconds()
+      if (allocated(self%stopper) .and. now >= self%next_poll) then
+         self%next_poll = now + poll_interval
+         call self%guard%check(self%stopper, self%what, t, self%unit, error)
+      else
+         call self%guard%check(what=self%what, t=t, unit=self%unit, error=error)
+      end if
+   end subroutine watch_check
 
    !> An error when the loop must end: stopped on request (`reporter`, if
    !> given, asked), or max_wall_time reached; `what` names the work and
