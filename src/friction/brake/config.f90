@@ -12,16 +12,19 @@ module friction_brake_config
    use friction_checks, only: config_checker
    use friction_ode_settings, only: visit_integrator, check_integrator, verify_settings, visit_verify, check_verify, &
       & verify_solver
+   use friction_law_settings, only: law_settings, law_group
+   use friction_law_factory, only: check_law, new_law
+   use friction_law, only: sliding_law
    implicit none
    private
 
    public :: brake_config, model_names, units_names, brake_solver_defaults
-   public :: model_regularized, model_switched, series_names, continuation_names, continuation_config, &
+   public :: model_regularized, model_switched, model_law, series_names, continuation_names, continuation_config, &
       & continuation_variable, rodas4_transition_bound, transition_bound
 
-   character(len=*), parameter :: model_names(2) = [character(len=11) :: 'switched', 'regularized']
+   character(len=*), parameter :: model_names(3) = [character(len=11) :: 'switched', 'regularized', 'law']
    character(len=*), parameter :: units_names(2) = [character(len=14) :: 'nondimensional', 'dimensional']
-   character(len=*), parameter :: model_switched = 'switched', model_regularized = 'regularized'
+   character(len=*), parameter :: model_switched = 'switched', model_regularized = 'regularized', model_law = 'law'
    !> The regularized law's transition in units of its width that a stepper's
    !> velocity tolerance may span and stay within 100 times the asked tolerance
    !> (transition_tolerance; docs/speed.md, "The regularized law's steppers"):
@@ -40,7 +43,7 @@ module friction_brake_config
       & max_wall_time=0.0_wp)
 
    type, extends(configurable) :: brake_config
-      character(len=16) :: model = model_switched      !! 'switched' (Fig. 10) or 'regularized' (Eq. 10)
+      character(len=16) :: model = model_switched      !! 'switched' (Fig. 10), 'regularized' (Eq. 10) or 'law' (&law)
       character(len=16) :: units = 'nondimensional'    !! which parameter set is read
       type(brake_parameters) :: params                 !! Eq. 10 (given, or derived from dimensional)
       type(brake_dimensional) :: dimensional           !! §6.2 data, used when units = 'dimensional'
@@ -59,8 +62,11 @@ module friction_brake_config
       type(solver_settings) :: solver = brake_solver_defaults
       type(verify_settings) :: verify   !! &verify: the difference compared is x's
       type(analysis_settings) :: analysis   !! chaos diagnostics (&analysis)
+      type(law_settings) :: law             !! &law: the friction law of model = 'law'
    contains
       procedure :: visit
+      procedure :: uses_law
+      procedure :: law_units
       procedure :: validate
       procedure :: resolve
       procedure :: switched
@@ -123,7 +129,34 @@ contains
       call v%end_group()
       call visit_verify(self%verify, v, 'm', 'm')
       call self%analysis%visit(v, 'tau')
+      call self%law%visit(v)
    end subroutine visit
+
+   !> Whether the friction is the &law group's law (model = 'law').
+   pure logical function uses_law(self)
+      class(brake_config), intent(in) :: self
+
+      uses_law = trim(self%model) == model_law
+   end function uses_law
+
+   !> The brake's units in the law's (docs/laws.md, "The brake with any
+   !> law"): a force of the brake's (over k1, in m) is `force` N, a velocity
+   !> (m per unit τ) `velocity` m/s, a unit τ `time` s.  With units =
+   !> 'dimensional' the law's parameters are SI (k1, 1/√(m/k1), √(m/k1));
+   !> else the law works in the brake's own units (all three 1, exactly).
+   !> Resolved settings.
+   pure subroutine law_units(self, force, velocity, time)
+      class(brake_config), intent(in) :: self
+      real(wp), intent(out) :: force, velocity, time
+
+      force = 1.0_wp
+      velocity = 1.0_wp
+      time = 1.0_wp
+      if (trim(self%units) /= 'dimensional') return
+      time = sqrt(self%dimensional%block_mass / self%dimensional%k1)
+      force = self%dimensional%k1
+      velocity = 1.0_wp / time
+   end subroutine law_units
 
    !> Every value of the brake's groups, or the first bad one to `c`.
    subroutine validate(self, c)
@@ -145,7 +178,7 @@ contains
       associate (p => self%params, d => self%dimensional)
          call c%nonnegative('brake', 'mu', p%mu, 'kinetic friction coefficient')
          call c%nonnegative('brake', 'mu_s', p%mu_s, 'static friction coefficient')
-         if (.not. regularized .and. p%mu > p%mu_s) call c%reject('brake', 'mu', rtoa(p%mu), &
+         if (self%model == model_switched .and. p%mu > p%mu_s) call c%reject('brake', 'mu', rtoa(p%mu), &
             & 'the switched model needs mu <= mu_s = '//rtoa(p%mu_s)//' (a kinetic coefficient above the ' &
             & //'static one makes every slip stop at once: use the regularized model)')
          if (dimensional) then
@@ -204,6 +237,8 @@ contains
       end associate
       call check_verify(self%verify, c, 'm')
       call self%analysis%validate(c, self%t_start, self%t_end, series_names, self%dt_out)
+      if (c%failed()) return
+      call check_law_choice(self, c)
       if (c%failed() .or. len_trim(self%analysis%continuation) == 0) return
       if (self%model /= model_switched) then
          call c%reject('analysis', 'continuation', "'"//trim(self%analysis%continuation)//"'", &
@@ -236,6 +271,58 @@ contains
          end if
       end block
    end subroutine validate
+
+   !> &law with model = 'law': the law's own checks, and the tools that need
+   !> more than this model gives refused by name.  &law without it: refused
+   !> (it would be ignored), at the first variable the input set.
+   subroutine check_law_choice(self, c)
+      type(brake_config), intent(in) :: self
+      type(config_checker), intent(inout) :: c
+      class(sliding_law), allocatable :: law
+      character(len=:), allocatable :: why
+      integer :: k
+
+      if (.not. self%uses_law()) then
+         if (.not. allocated(c%origins)) return
+         do k = 1, size(c%origins)
+            if (c%origins(k)%group /= law_group) cycle
+            block
+               type(brake_config) :: copy
+               character(len=:), allocatable :: text, problem
+               copy = self   ! (the visitor takes its object inout)
+               call get_parameter(copy, law_group, trim(c%origins(k)%name), 0, text, problem)
+               call c%reject(law_group, trim(c%origins(k)%name), text, "is read only with &brake model = 'law' " &
+               & //"(here model = '"//trim(self%model)//"', whose friction is &brake's mu, mu_s, epsilon_prime " &
+               & //'and delta_prime)')
+            end block
+            return
+         end do
+         return
+      end if
+      call check_law(self%law, c)
+      if (c%failed()) return
+      why = "is not computed for &brake model = 'law' (the state has the law's own variables and no tangent " &
+         & //'equations here): use the switched or the regularized model'
+      associate (a => self%analysis)
+         if (a%lyapunov) call c%reject('analysis', 'lyapunov', '.true.', why)
+         if (a%lyapunov_spectrum) call c%reject('analysis', 'lyapunov_spectrum', '.true.', why)
+         if (a%orbit) call c%reject('analysis', 'orbit', '.true.', why)
+      end associate
+      if (c%failed()) return
+      call new_law(self%law, law)
+      ! Exact stick holds the closed-form stick phase, whose end needs a static limit affine in N'.
+      if (law%set_valued()) then
+         block
+            real(wp) :: f0, f1, f2
+            f0 = law%static_force(0.0_wp)
+            f1 = law%static_force(1.0_wp)
+            f2 = law%static_force(2.0_wp)
+            if (abs(f2 - 2.0_wp * f1 + f0) > 1.0e-12_wp * max(abs(f2), abs(f1), abs(f0), tiny(1.0_wp))) &
+               & call c%reject(law_group, 'model', "'"//trim(self%law%model)//"'", 'its static limit is not ' &
+               & //"affine in the normal load, which the brake's exact stick needs")
+         end block
+      end if
+   end subroutine check_law_choice
 
    !> The configuration with the continuation variable set to `value` (and no
    !> continuation of its own).
@@ -333,6 +420,16 @@ contains
       rtol = self%solver%rtol
       method = 'rk8pd'
       if (self%switched()) return
+      if (self%uses_law()) then
+         ! Set-valued laws switch like the switched model; the others have stiff states (LuGre,
+         ! rate and state) or a stiff transition (the arctan law): the L-stable Rosenbrock stepper.
+         block
+            class(sliding_law), allocatable :: law
+            call new_law(self%law, law)
+            if (.not. law%set_valued()) method = 'rodas4'
+         end block
+         return
+      end if
       if (rtol >= 1.0e-3_wp) then
          method = 'rk2'
       else if (rtol >= 1.0e-6_wp) then

@@ -24,6 +24,13 @@ contains
       character(len=:), allocatable :: law
 
       note = ''   ! (a note only for the switched model; the caller reads it always)
+      if (c%uses_law()) then
+         ! The network is Eq. 10's; a law's states and exact stick have no element in it.
+         call fatal_error(error, "--netlist: &brake model = 'law' (&law model = '"//trim(c%law%model) &
+            & //"'): no netlist: the network is written for the arctan law of Eq. 10 only; use &brake " &
+            & //"model = 'regularized' (its mu, epsilon_prime and delta_prime) for one", error_input)
+         return
+      end if
       associate (p => c%params)
          law = '* Friction law: the regularized arctan law of Eq. 10 (epsilon_prime = '//num(p%epsilon_prime)//').'
          if (c%switched()) then

@@ -99,6 +99,12 @@ contains
       else
          call write_parameter_attributes(file, '/brake', copy, [character(len=17) :: 'brake'])
       end if
+      if (config%uses_law()) then
+         ! The law's parameters in its own group (names such as mu and delta are &brake's too).
+         call file%create_group('/brake/law')
+         call file%write_attribute_text('/brake/law', 'model', trim(config%law%model))
+         call write_parameter_attributes(file, '/brake/law', copy, [character(len=17) :: 'law'])
+      end if
 
       call file%write_vector('/brake/t', trajectory%t, 'tau')
       call file%write_vector('/brake/x', trajectory%x, 'm')

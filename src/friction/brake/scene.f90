@@ -68,6 +68,8 @@ contains
       character(len=32), allocatable, intent(out) :: names(:)
 
       names = [character(len=32) :: 'integrator', 'brake', 'brake_dimensional', 'verify', 'analysis']
+      ! &law is the friction of model = 'law' only (the others' files are as before).
+      if (self%config%uses_law()) names = [character(len=32) :: names, 'law']
    end subroutine brake_groups
 
    subroutine brake_visit(self, v)

@@ -11,6 +11,7 @@ module friction_brake_simulate
    use friction_brake_integrator, only: brake_integrator
    use friction_brake_switched, only: switched_integrator
    use friction_brake_regularized, only: regularized_integrator
+   use friction_brake_law_model, only: law_integrator
    implicit none
    private
 
@@ -133,6 +134,8 @@ contains
 
       if (config%switched()) then
          allocate (switched_integrator :: integrator)
+      else if (config%uses_law()) then
+         allocate (law_integrator :: integrator)
       else
          allocate (regularized_integrator :: integrator)
       end if

@@ -10,7 +10,8 @@
 !> since x'' = 0 makes x/κ a particular solution.  No integrator is
 !> involved, so the stick phase costs nothing and has no truncation error.
 !>
-!> Stick ends when the elastic force |2x - y| reaches μs N' (Eq. 5), and
+!> Stick ends when the elastic force |2x - y| reaches μs N' (Eq. 5; with
+!> a law of &law, its static limit slope N' + level), and
 !> N' must stay positive.  Each of the three functions
 !>   h1 = μs N' - (2x - y),  h2 = μs N' + (2x - y),  h3 = N'
 !> is c0 + c1 u + (trigonometric part of amplitude a_k) along the stick, so
@@ -37,6 +38,8 @@ module friction_brake_stick
       real(wp) :: t0 = 0.0_wp, x0 = 0.0_wp
       real(wp) :: a = 0.0_wp, b = 0.0_wp     !! A, B of the crank's free oscillation
       real(wp) :: omega = 1.0_wp
+      !> The static limit slope N' + level: μs N' unless start is told otherwise.
+      real(wp) :: slope = 0.0_wp, level = 0.0_wp
    contains
       procedure :: start
       procedure :: state_at
@@ -47,12 +50,18 @@ module friction_brake_stick
 contains
 
    !> Stick from time t0 and state y = (x, v, y, w); v is taken as v'_dr.
-   pure subroutine start(self, p, t0, y)
+   !> The static limit is μs N', or slope N' + level when given.
+   pure subroutine start(self, p, t0, y, slope, level)
       class(stick_motion), intent(inout) :: self
       type(brake_parameters), intent(in) :: p
       real(wp), intent(in) :: t0, y(4)
+      real(wp), intent(in), optional :: slope, level
 
       self%p = p
+      self%slope = p%mu_s
+      self%level = 0.0_wp
+      if (present(slope)) self%slope = slope
+      if (present(level)) self%level = level
       self%t0 = t0
       self%x0 = y(1)
       self%omega = sqrt(p%kappa / p%xi)
@@ -113,13 +122,22 @@ contains
          force = 2.0_wp * y(1) - y(3)
          d_normal = (1.0_wp - p%kappa) * y(4)
          d_force = 2.0_wp * y(2) - y(4)
+         ! (The level apart when it is 0: the switched model's limit as it always was, bit for bit.)
          select case (k)
          case (stick_end_force_positive)
-            h = p%mu_s * normal - force
-            dh = p%mu_s * d_normal - d_force
+            if (self%level == 0.0_wp) then
+               h = self%slope * normal - force
+            else
+               h = self%slope * normal + (self%level - force)
+            end if
+            dh = self%slope * d_normal - d_force
          case (stick_end_force_negative)
-            h = p%mu_s * normal + force
-            dh = p%mu_s * d_normal + d_force
+            if (self%level == 0.0_wp) then
+               h = self%slope * normal + force
+            else
+               h = self%slope * normal + (self%level + force)
+            end if
+            dh = self%slope * d_normal + d_force
          case default
             h = normal
             dh = d_normal
@@ -151,9 +169,9 @@ contains
          associate (p => self%p)
             select case (k)
             case (stick_end_force_positive)
-               curvature = abs(1.0_wp + p%mu_s * (1.0_wp - p%kappa)) * amplitude
+               curvature = abs(1.0_wp + self%slope * (1.0_wp - p%kappa)) * amplitude
             case (stick_end_force_negative)
-               curvature = abs(p%mu_s * (1.0_wp - p%kappa) - 1.0_wp) * amplitude
+               curvature = abs(self%slope * (1.0_wp - p%kappa) - 1.0_wp) * amplitude
             case default
                curvature = abs(1.0_wp - p%kappa) * amplitude
             end select
