@@ -143,6 +143,13 @@ def bad_input(args):
     work = Path(args.workdir)
     (work / "decreasing.txt").write_text("# v F\n0.1 1.0\n0.05 2.0\n")
     (work / "nan.txt").write_text("0.1 1.0\n0.2 nan\n")
+    with h5py.File(work / "other.h5", "w") as f:   # a microscope sweep of another variable than scan.velocity
+        f["sweep/values"] = np.array([1.0, 2.0])
+        f["sweep/values"].attrs["units"] = np.bytes_("eV")
+        f["sweep/values"].attrs["variable"] = np.bytes_("surface.v0")
+        f["sweep/mean_friction"] = np.array([0.1, 0.2])
+        f["sweep/mean_friction"].attrs["units"] = np.bytes_("nN")
+        f["sweep/status"] = np.array([1, 1], dtype=np.int32)
     cases = [  # (the group's lines, its line, what the message names, why)
         ("&law\n  model = 'lugre'\n  sigma0 = -1.0e5\n/\n", 7, "&law: sigma0 = ", "must be > 0"),
         ("&law\n  model = 'stribeck'\n  fs = 0.5\n/\n", 7, "&law: fs = ", "must be >= fc"),
@@ -152,6 +159,8 @@ def bad_input(args):
          str(work / "decreasing.txt") + ":3: velocity"),
         ("&law\n  model = 'table'\n  table_file = 'nan.txt'\n/\n", 7, "&law: table_file = ",
          str(work / "nan.txt") + ":2: not a finite number"),
+        ("&law\n  model = 'table'\n  table_file = 'other.h5'\n/\n", 7, "&law: table_file = ",
+         str(work / "other.h5") + ": a sweep of 'surface.v0'; the table needs one of scan.velocity"),
         ("&machine\n  stiffness = -2.0\n/\n", 6, "&machine: stiffness = ", "must be >= 0"),
         ("&law\n  model = 'bristles'\n/\n", 6, "&law: model = ", "unknown friction law"),
     ]

@@ -1,6 +1,9 @@
 """friction.law: the C API's friction laws from Python, against oracles that
 are not the library's output: closed forms, SciPy's PchipInterpolator, and a
 fit that recovers the parameters it was simulated with."""
+from pathlib import Path
+
+import h5py
 import numpy as np
 import pytest
 from scipy.interpolate import PchipInterpolator
@@ -51,6 +54,82 @@ def test_table_law_is_scipys_pchip_in_log_velocity(tmp_path):
     np.testing.assert_allclose(force[inside], expected, rtol=1e-13)
     np.testing.assert_allclose(force[probe <= v[0]], 3.0 * f[0], rtol=1e-15)
     np.testing.assert_allclose(force[probe >= v[-1]], 3.0 * f[-1], rtol=1e-15)
+
+
+SWEEP = Path(__file__).resolve().parents[2] / "tests" / "data" / "naf_thermal_velocity_sweep.h5"
+
+
+def write_sweep(path, values, friction, status, variable="scan.velocity"):
+    """A file in the layout of the program's sweeps (docs/sweeps.md)."""
+    with h5py.File(path, "w") as f:
+        f["sweep/values"] = np.asarray(values, dtype=float)
+        f["sweep/values"].attrs["units"] = np.bytes_("angstrom/s")
+        f["sweep/values"].attrs["variable"] = np.bytes_(variable)
+        f["sweep/mean_friction"] = np.asarray(friction, dtype=float)
+        f["sweep/mean_friction"].attrs["units"] = np.bytes_("nN")
+        f["sweep/status"] = np.asarray(status, dtype=np.int32)
+
+
+def test_table_from_the_microscopes_sweep_file():
+    # A sweep of scan.velocity over inputs/naf_thermal_velocity.nml (NaF at 300 K, the thermal
+    # reduced model, 4 velocities from 0.01 to 10 angstrom/s, made by the program): its rows are
+    # the velocities in m/s and the mean friction in N, times the scale, interpolated as a text
+    # table's (SciPy's PchipInterpolator in ln v).
+    with h5py.File(SWEEP) as f:
+        v = f["sweep/values"][:] * 1e-10
+        fr = f["sweep/mean_friction"][:] * 1e-9
+    contacts = 1.0e6
+    probe = np.logspace(np.log10(v[0]) - 1, np.log10(v[-1]) + 1, 301)
+    with Law("table", table_file=str(SWEEP), scale=contacts) as law:
+        law.check()
+        force, _ = law.history(probe, probe)
+        at_rows, _ = law.history(v, v)
+    inside = (probe > v[0]) & (probe < v[-1])
+    np.testing.assert_allclose(force[inside], contacts * PchipInterpolator(np.log(v), fr)(np.log(probe[inside])),
+                               rtol=1e-13)
+    np.testing.assert_allclose(at_rows, contacts * fr, rtol=1e-13)
+    np.testing.assert_allclose(force[probe <= v[0]], contacts * fr[0], rtol=1e-15)
+
+
+def test_sweep_table_reproduces_a_closed_form_law(tmp_path):
+    # F(v) = F0 + F1 ln(1 + v/v1), the shape of thermally activated friction, sampled at 4 velocities
+    # a decade from 1e-3 to 1e3 angstrom/s, given as a sweep's list in a shuffled order with one
+    # failed point: the table reproduces the law (scaled) to the interpolation's error.  That error
+    # is the monotone cubic's on these rows, which SciPy's PchipInterpolator of the same rows has
+    # too (measured: 5.1e-5 of F at most, where the curve bends; the law and SciPy 3e-16 apart); the
+    # bound is it, plus rounding.
+    f0, f1, v1 = 0.2, 0.05, 0.3                      # nN, nN, angstrom/s
+    grid = np.logspace(-3, 3, 25)
+    closed = lambda a: f0 + f1 * np.log1p(a / v1)    # noqa: E731 (angstrom/s -> nN)
+    order = np.random.default_rng(3).permutation(grid.size)
+    values = np.append(grid[order], 5.0)
+    friction_nn = np.append(closed(grid[order]), np.nan)
+    status = np.append(np.ones(grid.size, dtype=np.int32), 2)
+    path = tmp_path / "curve.h5"
+    write_sweep(path, values, friction_nn, status)
+    probe = np.logspace(-3, 3, 601)[1:-1] * 1e-10     # m/s, inside the rows
+    with Law("table", table_file=str(path), scale=200.0) as law:
+        law.check()
+        force, _ = law.history(probe, probe)
+    exact = 200.0 * closed(probe * 1e10) * 1e-9
+    pchip = 200.0 * PchipInterpolator(np.log(grid * 1e-10), closed(grid) * 1e-9)(np.log(probe))
+    bound = np.max(np.abs(pchip - exact))
+    error = np.max(np.abs(force - exact))
+    assert error <= bound * (1 + 1e-9) + 1e-15 * np.max(exact), (error, bound)
+    assert bound < 1e-4 * np.max(exact)
+
+
+def test_sweep_table_refusals(tmp_path):
+    other = tmp_path / "other.h5"
+    write_sweep(other, [1.0, 2.0], [0.1, 0.2], [1, 1], variable="surface.v0")
+    with Law("table", table_file=str(other)) as law:
+        with pytest.raises(friction.FrictionError, match=r"&law: table_file = .*a sweep of 'surface.v0'"):
+            law.check()
+    few = tmp_path / "few.h5"
+    write_sweep(few, [1.0, 2.0], [0.1, 0.2], [1, 2])
+    with Law("table", table_file=str(few)) as law:
+        with pytest.raises(friction.FrictionError, match="1 points done; a table needs at least 2"):
+            law.check()
 
 
 def test_bad_values_are_refused_by_name():

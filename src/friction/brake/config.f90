@@ -14,6 +14,7 @@ module friction_brake_config
       & verify_solver
    use friction_law_settings, only: law_settings, law_group
    use friction_law_factory, only: check_law, new_law
+   use friction_output_law_files, only: law_with_files
    use friction_law, only: sliding_law
    implicit none
    private
@@ -299,7 +300,7 @@ contains
          end do
          return
       end if
-      call check_law(self%law, c)
+      call check_law(law_with_files(self%law), c)
       if (c%failed()) return
       why = "is not computed for &brake model = 'law' (the state has the law's own variables and no tangent " &
          & //'equations here): use the switched or the regularized model'

@@ -27,6 +27,7 @@ module friction_brake_law_model
    use friction_ode_events, only: event_system, event_falling, event_either, event_rising
    use friction_law, only: sliding_law, max_law_states
    use friction_law_factory, only: make_law
+   use friction_output_law_files, only: law_with_files
    use friction_brake_params, only: brake_parameters
    use friction_brake_config, only: brake_config
    use friction_brake_integrator, only: brake_integrator
@@ -301,7 +302,7 @@ contains
       integer :: ns
 
       if (allocated(self%law)) deallocate (self%law)
-      call make_law(config%law, self%law, error)
+      call make_law(law_with_files(config%law), self%law, error)
       if (allocated(error)) return
       self%p = config%params
       call config%law_units(self%units%force, self%units%velocity, self%units%time)

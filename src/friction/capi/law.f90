@@ -20,6 +20,7 @@ module friction_capi_law
    use friction_law, only: sliding_law
    use friction_law_settings, only: law_settings
    use friction_law_factory, only: new_law, check_law, make_law, law_names
+   use friction_output_law_files, only: law_with_files
    use friction_law_history, only: law_history, history_velocity, history_displacement, history_solver_defaults
    use friction_capi_text, only: c_string, copy_text
    use friction_capi_handles, only: report, refuse, kind_law, friction_handle_add, friction_handle_remove, &
@@ -243,7 +244,7 @@ contains
       do k = 1, size(listed)
          call c%set_origin(listed(k)%group, listed(k)%name, '')
       end do
-      call check_law(law%p, c)
+      call check_law(law_with_files(law%p), c)
       if (.not. c%failed()) call check_integrator(law%solver, c)
       if (c%failed()) call move_alloc(c%error, error)
    end subroutine check_all
@@ -312,7 +313,7 @@ contains
          return
       end if
       call check_all(law, error)
-      if (.not. allocated(error)) call make_law(law%p, made, error)
+      if (.not. allocated(error)) call make_law(law_with_files(law%p), made, error)
       if (allocated(error)) then
          status = report(err, error)
          return

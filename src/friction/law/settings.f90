@@ -7,6 +7,7 @@
 module friction_law_settings
    use friction_kinds, only: wp
    use friction_parameters, only: parameter_visitor
+   use friction_law_table_reader, only: table_read
    implicit none
    private
 
@@ -46,6 +47,11 @@ module friction_law_settings
       character(len=law_path_length) :: table_file = ''   !! two columns: v (m/s), F (N)
       real(wp) :: scale = 1.0_wp        !! the table's force times this (number of contacts)
       character(len=12) :: extrapolation = 'constant'   !! above the last velocity: 'constant' or 'logarithmic'
+      !> Reads table files other than text (a microscope sweep's HDF5 file),
+      !> given by the layer that has the means; none: text only.  (A
+      !> procedure pointer: settings are copied freely, a pointer to a module
+      !> routine with them.)
+      procedure(table_read), pointer, nopass :: reader => null()
    contains
       procedure :: visit
    end type law_settings

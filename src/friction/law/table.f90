@@ -11,7 +11,9 @@
 !>   'logarithmic' continues along the end slope dF/d(ln v), as thermally
 !>   activated friction does.
 !> F is odd in v.  A table computed at the atomic scale (the microscope
-!> scene's friction against velocity) used at the machine scale.
+!> scene's friction against velocity) used at the machine scale: the rows
+!> may also come from a microscope sweep's HDF5 file, through the reading
+!> routine the settings carry (law/table_reader.f90).
 module friction_law_table
    use friction_kinds, only: wp
    use friction_error, only: error_type, fatal_error, error_input
@@ -21,6 +23,7 @@ module friction_law_table
    use friction_law, only: sliding_law, exact_stick_force
    use friction_law_settings, only: law_group
    use friction_law_pchip, only: pchip_curve
+   use friction_law_table_reader, only: table_read
    implicit none
    private
 
@@ -45,11 +48,14 @@ module friction_law_table
 
 contains
 
-   !> The rows of `path`, or '' and a problem naming the file and line.
-   subroutine read_table(path, v, f, problem)
+   !> The rows of `path`, or '' and a problem naming the file and line; a
+   !> file the reader takes (a sweep's HDF5 file) by the reader.
+   subroutine read_table(path, v, f, problem, reader)
       character(len=*), intent(in) :: path
       real(wp), allocatable, intent(out) :: v(:), f(:)
       character(len=:), allocatable, intent(out) :: problem
+      procedure(table_read), optional :: reader
+      logical :: handled
       type(error_type), allocatable :: error
       character(len=:), allocatable :: line, bad
       character(len=256) :: message
@@ -59,7 +65,13 @@ contains
       integer :: unit, stat, number, n, extra
       character(len=1) :: probe
 
+      if (present(reader)) then
+         call reader(trim(path), v, f, problem, handled)
+         if (handled) return
+      end if
       problem = ''
+      if (allocated(v)) deallocate (v)
+      if (allocated(f)) deallocate (f)
       allocate (v(0), f(0))
       call open_for_reading(trim(path), unit, error)
       if (allocated(error)) then
@@ -152,7 +164,11 @@ contains
          call c%reject(law_group, 'table_file', "''", 'the tabulated law needs a file of v (m/s), F (N) rows')
          return
       end if
-      call read_table(self%p%table_file, v, f, problem)
+      if (associated(self%p%reader)) then
+         call read_table(self%p%table_file, v, f, problem, self%p%reader)
+      else
+         call read_table(self%p%table_file, v, f, problem)
+      end if
       if (len(problem) > 0) call c%reject(law_group, 'table_file', "'"//trim(self%p%table_file)//"'", problem)
    end subroutine check
 
@@ -162,7 +178,11 @@ contains
       real(wp), allocatable :: v(:), f(:)
       character(len=:), allocatable :: problem
 
-      call read_table(self%p%table_file, v, f, problem)
+      if (associated(self%p%reader)) then
+         call read_table(self%p%table_file, v, f, problem, self%p%reader)
+      else
+         call read_table(self%p%table_file, v, f, problem)
+      end if
       if (len(problem) > 0) then
          call fatal_error(error, '&'//law_group//': table_file: '//problem, error_input)
          return

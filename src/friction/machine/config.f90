@@ -19,6 +19,7 @@ module friction_machine_config
    use friction_ode_settings, only: visit_integrator, check_integrator
    use friction_law_settings, only: law_settings
    use friction_law_factory, only: check_law, new_law
+   use friction_output_law_files, only: law_with_files
    use friction_law, only: sliding_law
    use friction_analysis_settings, only: analysis_settings
    implicit none
@@ -121,7 +122,7 @@ contains
       if (c%failed()) return
       if ((self%t_end - self%t_start) / self%dt_out > 1.0e7_wp) call c%reject('machine', 'dt_out', &
          & rtoa(self%dt_out), 'gives more than 1e7 output points over [t_start, t_end]')
-      call check_law(self%law, c)
+      call check_law(law_with_files(self%law), c)
       if (c%failed()) return
       call self%analysis%validate(c, self%t_start, self%t_end, ['x', 'v'])
       if (c%failed()) return

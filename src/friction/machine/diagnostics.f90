@@ -10,6 +10,7 @@ module friction_machine_diagnostics
    use friction_analysis_lyapunov_flow, only: benettin_settings, benettin_accumulator, benettin_exponent
    use friction_law, only: sliding_law, max_law_states
    use friction_law_factory, only: make_law
+   use friction_output_law_files, only: law_with_files
    use friction_machine_config, only: machine_config
    use friction_machine_model, only: machine_smooth
    use friction_machine_run, only: machine_run, machine_watch
@@ -68,7 +69,7 @@ contains
          real(wp) :: y(2 + max_law_states), z(max_law_states)
          integer :: ns
 
-         call make_law(c%law, law, error)
+         call make_law(law_with_files(c%law), law, error)
          if (allocated(error)) return
          ns = law%state_count()
          call system%m%from_config(c)

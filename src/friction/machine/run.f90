@@ -13,6 +13,7 @@ module friction_machine_run
    use friction_ode_events, only: event_locator, event_falling
    use friction_law, only: sliding_law, max_law_states
    use friction_law_factory, only: make_law
+   use friction_output_law_files, only: law_with_files
    use friction_machine_config, only: machine_config
    use friction_machine_model, only: mechanics, machine_smooth, machine_slip, machine_stick
    implicit none
@@ -96,7 +97,7 @@ contains
       type(mechanics) :: m
       integer :: n
 
-      call make_law(c%law, law, error)
+      call make_law(law_with_files(c%law), law, error)
       if (allocated(error)) return
       call m%from_config(c)
       n = c%grid_size()

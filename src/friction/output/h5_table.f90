@@ -40,6 +40,7 @@ module friction_output_h5_table
       private
       integer(hid_t) :: id = -1
       character(len=:), allocatable :: path
+      logical :: read_only = .false.   !! opened to read another program's file: never cut, never written
    contains
       procedure :: create => table_create
       procedure :: open => table_open
@@ -80,19 +81,28 @@ contains
       if (self%status /= 0) call fatal_error(error, path//': HDF5 failed '//self%failed_at, error_io)
    end subroutine table_create
 
-   !> Open an existing file at path for reading and writing.
-   subroutine table_open(self, path, error)
+   !> Open an existing file at path for reading and writing, or for reading
+   !> only (read_only: a file this program did not make, left as it is
+   !> whatever fails).
+   subroutine table_open(self, path, error, read_only)
       class(h5_table), intent(inout) :: self
       character(len=*), intent(in) :: path
       type(error_type), allocatable, intent(out) :: error
+      logical, intent(in), optional :: read_only
       type(error_printing) :: printing
       integer :: stat
 
       self%path = path
       self%status = 0
+      self%read_only = .false.
+      if (present(read_only)) self%read_only = read_only
       call printing%silence()
       call open_hdf5(stat)
-      call h5fopen_f(path, H5F_ACC_RDWR_F, self%id, stat)
+      if (self%read_only) then
+         call h5fopen_f(path, H5F_ACC_RDONLY_F, self%id, stat)
+      else
+         call h5fopen_f(path, H5F_ACC_RDWR_F, self%id, stat)
+      end if
       if (stat /= 0) self%id = -1
       call self%check(stat, 'opening the file')
       call printing%restore()
@@ -133,7 +143,7 @@ contains
       type(error_printing) :: printing
       integer :: stat
 
-      if (self%id >= 0 .and. self%status == 0) then
+      if (self%id >= 0 .and. self%status == 0 .and. .not. self%read_only) then
          problem = room_to_close(self%id, self%path)
          if (len(problem) > 0) call self%check(1, problem)
       end if
@@ -143,7 +153,7 @@ contains
          ! first: that gives its space back, so closing, which writes what
          ! HDF5 still holds, succeeds and leaves no handle open (HDF5's
          ! clean-up at exit would crash on one).  Such a file is for removal.
-         if (self%status /= 0) call truncate_file(self%path)
+         if (self%status /= 0 .and. .not. self%read_only) call truncate_file(self%path)
          call h5fclose_f(self%id, stat)
          call self%check(stat, 'closing the file')
          self%id = -1
