@@ -61,13 +61,30 @@ def stall_wall_time(args):
     assert not out.exists(), "a file was written"
 
 
+def catches_sigterm(pid):
+    """Whether process pid has a handler for SIGTERM (Linux: SigCgt of /proc/PID/status)."""
+    try:
+        for line in Path(f"/proc/{pid}/status").read_text().splitlines():
+            if line.startswith("SigCgt:"):
+                return bool(int(line.split()[1], 16) >> (signal.SIGTERM - 1) & 1)
+    except OSError:
+        return False
+    return False
+
+
 def stall_signal(args):
     out = Path(args.workdir) / "kept.h5"
     out.write_bytes(b"an existing file the stopped run must leave as it was\n")
     before = out.read_bytes()
     process = subprocess.Popen(command(args, out, STALL + ["--force"]), stdout=subprocess.PIPE,
                                stderr=subprocess.PIPE, text=True)
-    time.sleep(1.0)   # well into the stall (it begins within 0.1 s of the start)
+    # Signal once the program catches SIGTERM (its handler goes in at the run's first look at a stop
+    # request, within 16 steps of the start): no timing assumption; then the run is in the stall
+    # (it begins 0.1 s in) or soon will be.
+    deadline = time.monotonic() + 60
+    while not catches_sigterm(process.pid) and process.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.02)
+    time.sleep(0.5)
     assert process.poll() is None, "the stalled run ended by itself"
     sent = time.monotonic()
     process.send_signal(signal.SIGTERM)
