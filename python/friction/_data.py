@@ -54,10 +54,19 @@ def _python(value):
     return value
 
 
+#: HDF5's bookkeeping of dimension scales: the dimensions and coordinates say it.
+SCALE_ATTRIBUTES = {"CLASS", "NAME", "DIMENSION_LIST", "REFERENCE_LIST", "coordinates"}
+
+
 def _attrs(raw):
     """An HDF5 object's attributes as plain Python values (text decoded);
-    an attribute's unit stays beside it as NAME_units, as in the file."""
-    return {name: _python(value) for name, value in dict(raw or {}).items()}
+    an attribute's unit stays beside it as NAME_units, as in the file.  The
+    dimension scales' bookkeeping (SCALE_ATTRIBUTES) is not read: its object
+    references, when damaged, can keep HDF5 reading for ever, and the
+    layouts below name the same dimensions."""
+    if raw is None:
+        return {}
+    return {name: _python(raw[name]) for name in raw.keys() if name not in SCALE_ATTRIBUTES}
 
 
 def paths(tree):
@@ -100,9 +109,9 @@ def load(path, scene=None):
     a node per group, a variable per dataset (named by the dataset), the
     root's and each group's attributes as the node's attrs.
 
-    The file's own HDF5 dimension scales name the dimensions and coordinates
-    (docs/output.md); where a file has none (a sweep's, an older version's),
-    the program's layouts give them:
+    The program's layouts name the dimensions and coordinates, as the files'
+    own HDF5 dimension scales do (docs/output.md; a sweep's points become the
+    grid of its variables):
       afm     maps (ny, nx) over ("support_y", "support_x"), the line offset
               across the scan and the support position along it (angstrom),
               coordinates of /afm that /afm/trace and /afm/retrace inherit;
@@ -113,6 +122,8 @@ def load(path, scene=None):
               Poincare points over "strobe_t" and "section_t"; the Lyapunov
               curves over "benettin_time", "rosenstein_time" and
               "exponents_time"
+      machine the run over "t"; the events over "event" with their times t;
+              the spectrum over "frequency"; the Lyapunov curve over "time"
       sweep   per point over the swept variable ("brake.v_dr_prime"), or over
               both variables (a grid, the second varying fastest); the brake's
               maxima over "maximum", with the swept values of their point as
@@ -128,7 +139,7 @@ def load(path, scene=None):
     if isinstance(path, xr.DataTree):
         return path
     path = _check_path(path)
-    raw, group_attrs, scales = {}, {"": {}}, {}
+    raw, group_attrs = {}, {"": {}}
     try:
         with h5py.File(path, "r") as f:
             group_attrs[""] = _attrs(f.attrs)
@@ -136,10 +147,6 @@ def load(path, scene=None):
             def visit(name, item):
                 if isinstance(item, h5py.Dataset):
                     raw[name] = (_read_values(item), _attrs(item.attrs))
-                    axes = [item.dims[k][0].name.strip("/") if len(item.dims[k]) else None
-                            for k in range(item.ndim)]
-                    if axes and all(axes):
-                        scales[name] = axes
                 else:
                     group_attrs[name] = _attrs(item.attrs)
             f.visititems(visit)
@@ -150,12 +157,10 @@ def load(path, scene=None):
         # (RuntimeError, KeyError, ValueError) said nothing of the file.
         raise FileError(f"the HDF5 file is damaged ({type(err).__name__}: {err})") from None
     labels = _label(raw, group_attrs[""], group_attrs)
-    labels.update(_scales(raw, scales))
     nodes = {name: {"data": {}, "coords": {}} for name in group_attrs}
     for name, (values, attrs) in raw.items():
         group, _, short = name.rpartition("/")
         nodes.setdefault(group, {"data": {}, "coords": {}})
-        attrs = {k: v for k, v in attrs.items() if k not in SCALE_ATTRIBUTES}
         dims, role = labels.get(name, (tuple(f"{name}_dim_{k}" for k in range(values.ndim)), "data"))
         reshaped = values.reshape([n for n in labels.get(name + "#shape", values.shape)])
         nodes[group][role][short] = xr.Variable(dims, reshaped, attrs)
@@ -168,29 +173,6 @@ def load(path, scene=None):
         return xr.DataTree.from_dict(datasets)
     except ValueError as err:
         raise FileError(f"unexpected data in the file ({err})") from None
-
-
-#: HDF5's bookkeeping of dimension scales: the dimensions and coordinates say it.
-SCALE_ATTRIBUTES = {"CLASS", "NAME", "DIMENSION_LIST", "REFERENCE_LIST", "coordinates"}
-
-
-def _scales(raw, scales):
-    """The dimensions and coordinates the file states itself: a dataset whose
-    every axis has an HDF5 dimension scale runs along the scales' names, a
-    scale is the coordinate of its dimension, and the datasets a `coordinates`
-    attribute names (in the same group) are coordinates too."""
-    labels = {name: (tuple(axis.rsplit("/", 1)[-1] for axis in axes), "data") for name, axes in scales.items()}
-    for name in scales:
-        group = name.rpartition("/")[0]
-        for word in str(raw[name][1].get("coordinates", "")).split():
-            other = f"{group}/{word}"
-            if other in raw:
-                labels[other] = (labels.get(other, labels[name])[0], "coords")
-    for axes in scales.values():
-        for axis in axes:
-            if axis in raw:
-                labels[axis] = ((axis.rsplit("/", 1)[-1],), "coords")
-    return labels
 
 
 def _label(raw, root, group_attrs):
@@ -207,6 +189,8 @@ def _label(raw, root, group_attrs):
             _sweep_layout(raw, root, group_attrs, labels)
         if "surface/atoms" in raw:
             _surface_layout(raw, labels)
+        if "machine/t" in raw:
+            _machine_layout(raw, labels)
     return labels
 
 
@@ -259,12 +243,22 @@ def _brake_layout(raw, labels):
     for curve in ("benettin", "rosenstein"):
         _along(raw, labels, "brake/lyapunov/", f"brake/lyapunov/{curve}_time", f"{curve}_time",
                lambda rest, curve=curve: rest.startswith(f"{curve}_"))
+    _along(raw, labels, "brake/orbit/branch/", "brake/orbit/branch/parameter", "parameter", lambda rest: True)
+    _along(raw, labels, "brake/orbit/branch/", "brake/orbit/branch/section_parameter", "section_parameter",
+           lambda rest: rest.startswith("section_"))
     history = "brake/lyapunov/exponents_history"
     if "brake/lyapunov/exponents_time" in raw and history in raw:
         n = raw["brake/lyapunov/exponents_time"][0].size
         if raw[history][0].ndim == 2 and raw[history][0].shape[0] == n:
             labels["brake/lyapunov/exponents_time"] = (("exponents_time",), "coords")
             labels[history] = (("exponents_time", "exponent"), "data")
+
+
+def _machine_layout(raw, labels):
+    _along(raw, labels, "machine/", "machine/t", "t", lambda rest: True)
+    _along(raw, labels, "machine/events/", "machine/events/t", "event", lambda rest: True)
+    _along(raw, labels, "machine/spectrum/", "machine/spectrum/frequency", "frequency", lambda rest: True)
+    _along(raw, labels, "machine/lyapunov/", "machine/lyapunov/time", "time", lambda rest: True)
 
 
 def _sweep_layout(raw, root, group_attrs, labels):

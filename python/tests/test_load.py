@@ -154,11 +154,12 @@ def test_a_tree_is_loaded_once(naf_map):
     assert friction.load(data) is data
 
 
-def test_xarray_opens_the_files_themselves(naf_map, brake_run):
+def test_xarray_opens_the_files_themselves(naf_map, brake_run, brake_sweep, afm_sweep):
     """The files carry their coordinates as HDF5 dimension scales, so xarray
     opens them without this package (engine h5netcdf): a map's axes, the
     trajectory's time, the spectrum's frequencies, the events' numbers and
-    times, with the values h5py reads."""
+    times, a sweep's points with their swept values (a grid by xarray's
+    unstack), with the values h5py reads."""
     import h5netcdf  # noqa: F401  (xarray's engine; scripts/install-deps installs it)
     tree = xr.open_datatree(naf_map, engine="h5netcdf", phony_dims="sort")
     fx = tree["afm/trace/fx"]
@@ -179,3 +180,15 @@ def test_xarray_opens_the_files_themselves(naf_map, brake_run):
     assert kind.dims == ("event",) and np.array_equal(kind["t"].values, et)
     assert np.array_equal(kind["event"].values, np.arange(1, et.size + 1))
     assert brake["brake/poincare/strobe_x"].dims == ("strobe_t",)
+    # a sweep: every per-point column over the points' numbers, the swept values as coordinates
+    sweep = xr.open_datatree(brake_sweep, engine="h5netcdf", phony_dims="sort")
+    values, _ = raw(brake_sweep, "sweep/values")
+    lyapunov = sweep["sweep/lyapunov"]
+    assert lyapunov.dims == ("point",) and np.array_equal(lyapunov["values"].values, values)
+    assert np.array_equal(lyapunov["point"].values, np.arange(1, values.size + 1))
+    grid = xr.open_datatree(afm_sweep, engine="h5netcdf", phony_dims="sort")["sweep"].to_dataset()
+    v0, _ = raw(afm_sweep, "sweep/values")
+    velocity, _ = raw(afm_sweep, "sweep/values2")
+    friction_values, _ = raw(afm_sweep, "sweep/mean_friction")
+    unstacked = grid.set_index(point=["values", "values2"]).unstack("point")["mean_friction"]
+    assert unstacked.sel(values=v0[3], values2=velocity[3]).item() == friction_values[3]

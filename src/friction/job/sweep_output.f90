@@ -178,6 +178,7 @@ contains
       call out%set_text('sweep/reason', 'meaning', 'a failed point''s error message (empty otherwise)')
       call out%add_column('sweep/compute_time', 'r', int(n, i8), 's')
       call out%add_column('sweep/computed_by_this_run', 'i', int(n, i8), '')
+      call describe_axes(out)
       allocate (character(len=longest) :: texts(copy_points))
 
       ! Second pass: every column, a piece at a time, in point order.
@@ -258,6 +259,7 @@ contains
             call out%put('sweep/compute_time', at, cost(1:c))
             whole(1:c) = merge(1, 0, run(1:c) == ckpt%run .and. status(1:c) /= status_pending)
             call out%put('sweep/computed_by_this_run', at, whole(1:c))
+            call out%put('sweep/point', at, [(first + k - 1, k = 1, c)])
             self%counts(1) = self%counts(1) + count(status(1:c) == status_done)
             self%counts(2) = self%counts(2) + count(status(1:c) == status_failed)
             self%counts(3) = self%counts(3) + sum(whole(1:c))
@@ -273,6 +275,32 @@ contains
          end if
       end if
       call out%close(error)
+
+   contains
+
+      !> The points' own axis for netCDF readers: /sweep/point (1 to n) as
+      !> the dimension scale of every per-point column, the swept values as
+      !> their CF coordinates (a grid's two are not an axis each: the points
+      !> are stored flat, the second variable fastest).
+      subroutine describe_axes(out)
+         type(h5_table), intent(inout) :: out
+         character(len=:), allocatable :: along(:), coordinates
+         integer :: i
+
+         call out%add_column('sweep/point', 'i', int(n, i8), '1')
+         call out%set_text('sweep/point', 'meaning', 'the point''s number, 1 to n, in the order of the points')
+         coordinates = merge('values values2', 'values        ', self%sweep%n_variables == 2)
+         along = [character(len=64) :: 'values', 'values2', (self%names(i)%name, i = 1, size(self%names)), &
+            & 'status', 'reason', 'compute_time', 'computed_by_this_run']
+         if (len(self%series_name) > 0) along = [character(len=64) :: along, self%series_name//'_offset', &
+            & self%series_name//'_count']
+         do i = 1, size(along)
+            if (trim(along(i)) == 'values2' .and. self%sweep%n_variables < 2) cycle
+            call out%attach_scales('sweep/'//trim(along(i)), ['sweep/point'])
+            if (trim(along(i)) /= 'values' .and. trim(along(i)) /= 'values2') &
+               & call out%set_text('sweep/'//trim(along(i)), 'coordinates', trim(coordinates))
+         end do
+      end subroutine describe_axes
    end subroutine writer_write
 
 end module friction_job_sweep_output

@@ -58,7 +58,8 @@ module friction_output_h5
       end function h5ds_attach_scale
    end interface
 
-   public :: h5_file, h5_status, error_printing, room_to_close, new_text_attribute, new_scalar_attribute, open_hdf5
+   public :: h5_file, h5_status, error_printing, room_to_close, new_text_attribute, new_scalar_attribute, open_hdf5, &
+      & attach_dimension_scales
 
    !> H5E_DEFAULT of the C API: the default error stack (hid_t is int64_t
    !> since HDF5 1.10).
@@ -349,30 +350,40 @@ contains
    subroutine attach_scales(self, name, scales)
       class(h5_file), intent(inout) :: self
       character(len=*), intent(in) :: name, scales(:)
-      integer(hid_t) :: dset, scale
-      integer :: stat, k
-      character(len=:), allocatable :: path
       type(error_printing) :: printing
 
       if (self%status /= 0) return
       call printing%silence()
-      call h5dopen_f(self%id, name, dset, stat)
-      call self%check(stat, 'opening dataset '//name//' for its coordinates')
+      call attach_dimension_scales(self, self%id, name, scales)
+      call printing%restore()
+   end subroutine attach_scales
+
+   !> attach_scales on the file `file` (an hid_t), the failure kept in status.
+   subroutine attach_dimension_scales(status, file, name, scales)
+      class(h5_status), intent(inout) :: status
+      integer(hid_t), intent(in) :: file
+      character(len=*), intent(in) :: name, scales(:)
+      integer(hid_t) :: dset, scale
+      integer :: stat, k
+      character(len=:), allocatable :: path
+
+      call h5dopen_f(file, name, dset, stat)
+      call status%check(stat, 'opening dataset '//name//' for its coordinates')
+      if (stat /= 0) return
       do k = 1, size(scales)
          path = trim(scales(k))
-         if (self%status /= 0 .or. len(path) == 0) cycle
-         call h5dopen_f(self%id, path, scale, stat)
-         call self%check(stat, 'opening coordinate '//path)
+         if (status%status /= 0 .or. len(path) == 0) cycle
+         call h5dopen_f(file, path, scale, stat)
+         call status%check(stat, 'opening coordinate '//path)
          if (stat /= 0) cycle
-         if (h5ds_is_scale(scale) <= 0) call self%check(int(h5ds_set_scale(scale, &
+         if (h5ds_is_scale(scale) <= 0) call status%check(int(h5ds_set_scale(scale, &
             & path(index(path, '/', back=.true.) + 1:)//c_null_char)), 'making '//path//' a dimension scale')
-         call self%check(int(h5ds_attach_scale(dset, scale, int(k - 1, c_int))), &
+         call status%check(int(h5ds_attach_scale(dset, scale, int(k - 1, c_int))), &
             & 'attaching coordinate '//path//' to '//name)
          call h5dclose_f(scale, stat)
       end do
-      if (self%status == 0) call h5dclose_f(dset, stat)
-      call printing%restore()
-   end subroutine attach_scales
+      call h5dclose_f(dset, stat)
+   end subroutine attach_dimension_scales
 
    !> A 1-D integer dataset that every rank holds whole; rank 0 writes it
    !> (flags, codes).  Collective like the others.

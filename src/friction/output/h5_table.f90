@@ -26,7 +26,7 @@ module friction_output_h5_table
    use friction_files, only: truncate_file, free_bytes, min_free_bytes, full_text
    use friction_strings, only: bytes_text
    use friction_output_h5, only: h5_status, error_printing, room_to_close, new_text_attribute, new_scalar_attribute, &
-      & open_hdf5
+      & open_hdf5, attach_dimension_scales
    implicit none
    private
 
@@ -54,6 +54,7 @@ module friction_output_h5_table
       generic :: put => put_real, put_int, put_long, put_bytes, put_text
       procedure, private :: get_real, get_int, get_long, get_bytes
       generic :: get => get_real, get_int, get_long, get_bytes
+      procedure :: attach_scales => table_attach_scales
       procedure :: set_text => set_text_attribute
       procedure :: text => text_attribute
       procedure :: set_integer => set_integer_attribute
@@ -461,6 +462,18 @@ contains
    end subroutine get_bytes
 
    !> A text attribute of the object at path object ('/' for the root).
+   !> The coordinates of a column's axis (h5_file's attach_scales).
+   subroutine table_attach_scales(self, name, scales)
+      class(h5_table), intent(inout) :: self
+      character(len=*), intent(in) :: name, scales(:)
+      type(error_printing) :: printing
+
+      if (self%status /= 0) return
+      call printing%silence()
+      call attach_dimension_scales(self, self%id, name, scales)
+      call printing%restore()
+   end subroutine table_attach_scales
+
    subroutine set_text_attribute(self, object, name, text)
       class(h5_table), intent(inout) :: self
       character(len=*), intent(in) :: object, name, text
