@@ -4,11 +4,12 @@
 !> extend it; only brake_run's factory (simulate.f90) names them.
 module friction_brake_integrator
    use friction_kinds, only: wp
-   use friction_error, only: error_type
+   use friction_error, only: error_type, fatal_error, error_numerical
+   use friction_strings, only: rtoa
    use friction_ode_solver, only: integrator_statistics
-   use friction_ode_events, only: event_locator
+   use friction_ode_events, only: event_locator, event_falling, event_rising
    use friction_brake_config, only: brake_config
-   use friction_brake_record, only: brake_event_table
+   use friction_brake_record, only: brake_event_table, event_stick_to_slip, event_slip_to_stick
    use friction_analysis_lyapunov_spectrum, only: pack_tangent, unpack_tangent
    implicit none
    private
@@ -37,6 +38,7 @@ module friction_brake_integrator
       procedure :: start_tangent
       procedure :: locator_advance
       procedure :: locator_restart
+      procedure :: record_band_hits
    end type brake_integrator
 
    abstract interface
@@ -124,5 +126,33 @@ contains
       ! stick harmless: a slip restarts it anyway), at the step it had reached.
       call self%locator_restart(0.0_wp)
    end subroutine reset_tangent
+
+   !> The hits of the last locator advance of a model whose stick is the
+   !> creep band |v_rel| < v_s (events N' = 0, v_rel - v_s, v_rel + v_s):
+   !> a lift-off is an error (`model` prefixes it), a band crossing an event.
+   subroutine record_band_hits(self, events, model, error)
+      class(brake_integrator), intent(in) :: self
+      type(brake_event_table), intent(inout) :: events
+      character(len=*), intent(in) :: model
+      type(error_type), allocatable, intent(out) :: error
+      integer :: i
+
+      do i = 1, self%locator%n_hits
+         associate (hit => self%locator%hits(i))
+            select case (hit%which)
+            case (1)
+               call fatal_error(error, model//"N' reached 0 at τ = "//rtoa(hit%t) &
+                  & //': the pad lifts off the belt, outside Eq. 10', error_numerical)
+               return
+            case (2)   ! v_rel - v_s: falling enters the band from above
+               call events%add(hit%t, merge(event_slip_to_stick, event_stick_to_slip, &
+                  & hit%direction == event_falling), hit%y(1:4))
+            case default   ! v_rel + v_s: rising enters the band from below
+               call events%add(hit%t, merge(event_slip_to_stick, event_stick_to_slip, &
+                  & hit%direction == event_rising), hit%y(1:4))
+            end select
+         end associate
+      end do
+   end subroutine record_band_hits
 
 end module friction_brake_integrator

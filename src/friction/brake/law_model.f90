@@ -24,7 +24,7 @@ module friction_brake_law_model
    use friction_kinds, only: wp
    use friction_error, only: error_type, fatal_error, error_numerical
    use friction_strings, only: rtoa
-   use friction_ode_events, only: event_system, event_falling, event_either, event_rising
+   use friction_ode_events, only: event_system, event_falling, event_either
    use friction_law, only: sliding_law, max_law_states
    use friction_law_factory, only: make_law
    use friction_output_law_files, only: law_with_files
@@ -408,7 +408,7 @@ contains
       type(brake_event_table), intent(inout) :: events
       type(error_type), allocatable, intent(out) :: error
       real(wp) :: s(4 + max_law_states)
-      integer :: i, ns
+      integer :: ns
 
       ns = self%flow%n_states
       s(1:4) = self%y
@@ -418,22 +418,8 @@ contains
          self%y = s(1:4)
          self%z(1:ns) = s(5:4 + ns) * self%flow%scale(1:ns)
          if (allocated(error)) return
-         do i = 1, self%locator%n_hits
-            associate (hit => self%locator%hits(i))
-               select case (hit%which)
-               case (1)
-                  call fatal_error(error, "N' reached 0 at τ = "//rtoa(hit%t) &
-                     & //': the pad lifts off the belt, outside Eq. 10', error_numerical)
-                  return
-               case (2)   ! v_rel - v_s: falling enters the band from above
-                  call events%add(hit%t, merge(event_slip_to_stick, event_stick_to_slip, &
-                     & hit%direction == event_falling), hit%y(1:4))
-               case default   ! v_rel + v_s: rising enters the band from below
-                  call events%add(hit%t, merge(event_slip_to_stick, event_stick_to_slip, &
-                     & hit%direction == event_rising), hit%y(1:4))
-               end select
-            end associate
-         end do
+         call self%record_band_hits(events, '', error)
+         if (allocated(error)) return
       end do
    end subroutine advance_flow
 

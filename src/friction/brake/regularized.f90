@@ -14,16 +14,14 @@
 !> the creep band the output counts as stick.
 module friction_brake_regularized
    use friction_kinds, only: wp
-   use friction_error, only: error_type, fatal_error, error_numerical
-   use friction_strings, only: rtoa
+   use friction_error, only: error_type
    use friction_ode_solver, only: solver_settings, is_implicit_step_type
-   use friction_ode_events, only: event_system, event_falling, event_either, &
-      & event_rising
+   use friction_ode_events, only: event_system, event_falling, event_either
    use friction_law_arctan, only: arctan_force, arctan_slope
    use friction_brake_params, only: brake_parameters
    use friction_brake_config, only: brake_config
    use friction_brake_integrator, only: brake_integrator
-   use friction_brake_record, only: brake_event_table, event_stick_to_slip, event_slip_to_stick
+   use friction_brake_record, only: brake_event_table
    use friction_analysis_lyapunov_spectrum, only: tangent_system
    implicit none
    private
@@ -203,7 +201,6 @@ contains
       real(wp), intent(in) :: t_target
       type(brake_event_table), intent(inout) :: events
       type(error_type), allocatable, intent(out) :: error
-      integer :: i
 
       do while (self%t < t_target)
          call self%locator_advance(t_target, error)
@@ -216,22 +213,8 @@ contains
             error%message = error%message//')'
             return
          end if
-         do i = 1, self%locator%n_hits
-            associate (hit => self%locator%hits(i))
-               select case (hit%which)
-               case (1)
-                  call fatal_error(error, "regularized model: N' reached 0 at τ = "//rtoa(hit%t) &
-                     & //': the pad lifts off the belt, outside Eq. 10', error_numerical)
-                  return
-               case (2)   ! v_rel - v_s: falling enters the band from above
-                  call events%add(hit%t, merge(event_slip_to_stick, event_stick_to_slip, &
-                     & hit%direction == event_falling), hit%y(1:4))
-               case default   ! v_rel + v_s: rising enters the band from below
-                  call events%add(hit%t, merge(event_slip_to_stick, event_stick_to_slip, &
-                     & hit%direction == event_rising), hit%y(1:4))
-               end select
-            end associate
-         end do
+         call self%record_band_hits(events, 'regularized model: ', error)
+         if (allocated(error)) return
       end do
    end subroutine integrator_advance_to
 

@@ -461,7 +461,6 @@ contains
       end do
    end subroutine get_bytes
 
-   !> A text attribute of the object at path object ('/' for the root).
    !> The coordinates of a column's axis (h5_file's attach_scales).
    subroutine table_attach_scales(self, name, scales)
       class(h5_table), intent(inout) :: self
@@ -474,6 +473,7 @@ contains
       call printing%restore()
    end subroutine table_attach_scales
 
+   !> A text attribute of the object at path object ('/' for the root).
    subroutine set_text_attribute(self, object, name, text)
       class(h5_table), intent(inout) :: self
       character(len=*), intent(in) :: object, name, text
