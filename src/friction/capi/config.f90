@@ -90,6 +90,43 @@ contains
          & //trim(config%job%scene_name)//"' (friction_config_new chooses the scene)", error_input)
    end subroutine check_scene_kept
 
+   !> The start of every call on one variable: the live configuration of
+   !> cfg, a copy of its job (work: a value refused changes nothing) and the
+   !> variable name_c names in the copy.  False when the handle, a pointer
+   !> (value_c too, when given) or the name is wrong, its error reported
+   !> through handle into status.
+   logical function variable_of(cfg, name_c, handle, config, work, full, group, name, first, info, status, &
+      & value_c) result(ok)
+      type(c_ptr), intent(in) :: cfg, name_c, handle
+      type(capi_config), pointer, intent(out) :: config
+      type(job_config), intent(out) :: work
+      character(len=:), allocatable, intent(out) :: full, group, name
+      integer, intent(out) :: first
+      type(parameter_info), intent(out) :: info
+      integer(c_int), intent(out) :: status
+      type(c_ptr), intent(in), optional :: value_c
+      type(error_type), allocatable :: error
+
+      ok = .false.
+      status = 0
+      if (.not. config_of(cfg, config, error)) then
+         status = report(handle, error)
+      else if (present(value_c) .and. (.not. c_associated(name_c) .or. .not. c_associated(value_c))) then
+         status = refuse(handle, 'name and value must not be null pointers')
+      else if (.not. c_associated(name_c)) then
+         status = refuse(handle, 'name must not be a null pointer')
+      else
+         full = c_string(name_c)
+         work = config%job
+         call resolve_name(work, full, group, name, first, info, error)
+         if (allocated(error)) then
+            status = report(handle, error)
+         else
+            ok = .true.
+         end if
+      end if
+   end function variable_of
+
    !> int friction_config_set(friction_config *cfg, const char *name, const char *value,
    !>                         friction_error *err)
    integer(c_int) function friction_config_set(cfg, name_c, value_c, handle) bind(c, name='friction_config_set_body') &
@@ -102,20 +139,10 @@ contains
       character(len=:), allocatable :: full, value, group, name
       integer :: first
 
-      if (.not. config_of(cfg, config, error)) then
-         status = report(handle, error)
-         return
-      end if
-      if (.not. c_associated(name_c) .or. .not. c_associated(value_c)) then
-         status = refuse(handle, 'name and value must not be null pointers')
-         return
-      end if
-      full = c_string(name_c)
+      if (.not. variable_of(cfg, name_c, handle, config, work, full, group, name, first, info, status, value_c)) &
+         & return
       value = c_string(value_c)
-      ! On a copy: a value refused changes nothing.
-      work = config%job
-      call resolve_name(work, full, group, name, first, info, error)
-      if (.not. allocated(error)) call set_checked_text(work, group, name, first, info, value, error)
+      call set_checked_text(work, group, name, first, info, value, error)
       if (allocated(error)) then
          status = report(handle, error)
          return
@@ -175,21 +202,7 @@ contains
       character(len=:), allocatable :: full, group, name
       integer :: first
 
-      if (.not. config_of(cfg, config, error)) then
-         status = report(handle, error)
-         return
-      end if
-      if (.not. c_associated(name_c)) then
-         status = refuse(handle, 'name must not be a null pointer')
-         return
-      end if
-      full = c_string(name_c)
-      work = config%job
-      call resolve_name(work, full, group, name, first, info, error)
-      if (allocated(error)) then
-         status = report(handle, error)
-         return
-      end if
+      if (.not. variable_of(cfg, name_c, handle, config, work, full, group, name, first, info, status)) return
       call set_checked_number(work, group, name, first, real(x, wp), error)
       if (.not. allocated(error)) then
          config%job = work
@@ -211,21 +224,8 @@ contains
       character(len=:), allocatable :: full, group, name, text, problem
       integer :: first
 
-      if (.not. config_of(cfg, config, error)) then
-         status = report(handle, error)
-         return
-      end if
-      if (.not. c_associated(name_c)) then
-         status = refuse(handle, 'name must not be a null pointer')
-         return
-      end if
-      full = c_string(name_c)
-      work = config%job   ! (visiting writes each value back: a copy leaves the handle untouched)
-      call resolve_name(work, full, group, name, first, info, error)
-      if (allocated(error)) then
-         status = report(handle, error)
-         return
-      end if
+      ! (work: visiting writes each value back, and a copy leaves the handle untouched)
+      if (.not. variable_of(cfg, name_c, handle, config, work, full, group, name, first, info, status)) return
       call get_parameter(work, group, name, first, text, problem)
       if (len_text(problem) > 0) then
          call fatal_error(error, "name '"//full//"': "//problem, error_input)
