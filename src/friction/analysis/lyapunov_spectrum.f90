@@ -23,7 +23,7 @@ module friction_analysis_lyapunov_spectrum
    private
 
    public :: tangent_system, tangent_settings, spectrum_accumulator, tangent_spectrum, kaplan_yorke
-   public :: orthonormalise, pack_tangent, unpack_tangent, generic_frame
+   public :: orthonormalise, pack_tangent, unpack_tangent, generic_frame, max_base
 
    !> Largest base system: n + n² must fit the GSL bridge's 20 (ode/solver.f90).
    integer, parameter :: max_base = 4

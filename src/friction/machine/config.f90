@@ -12,7 +12,7 @@
 !> at load_velocity.
 module friction_machine_config
    use friction_kinds, only: wp, i8
-   use friction_strings, only: rtoa
+   use friction_strings, only: rtoa, itoa
    use friction_parameters, only: configurable, parameter_visitor
    use friction_checks, only: config_checker
    use friction_ode_solver, only: solver_settings
@@ -22,6 +22,7 @@ module friction_machine_config
    use friction_output_law_files, only: law_with_files
    use friction_law, only: sliding_law
    use friction_analysis_settings, only: analysis_settings
+   use friction_analysis_lyapunov_spectrum, only: max_tangent_base => max_base
    implicit none
    private
 
@@ -59,8 +60,8 @@ module friction_machine_config
       procedure :: grid_time
    end type machine_config
 
-   character(len=*), parameter :: not_yet = "not computed for scene 'machine' (its &analysis has spectrum " &
-      & //'and lyapunov); the brake has it'
+   character(len=*), parameter :: not_yet = "not computed for scene 'machine' (its &analysis has spectrum, " &
+      & //'lyapunov, poincare and lyapunov_spectrum); the brake has it'
 
 contains
 
@@ -129,8 +130,6 @@ contains
       ! The machine's diagnostics so far: the spectrum, and Benettin's exponent for the laws that
       ! are one ODE; the others are refused by name rather than ignored.
       associate (a => self%analysis)
-         if (a%poincare) call c%reject('analysis', 'poincare', '.true.', not_yet)
-         if (a%lyapunov_spectrum) call c%reject('analysis', 'lyapunov_spectrum', '.true.', not_yet)
          if (a%orbit) call c%reject('analysis', 'orbit', '.true.', not_yet)
          if (a%rosenstein) call c%reject('analysis', 'rosenstein', '.true.', not_yet)
          if (a%lyapunov) then
@@ -142,8 +141,31 @@ contains
                   & //"' switches between stick and slip (a smooth law: lugre, elastoplastic, dahl, rate_state, arctan, karnopp)")
             end block
          end if
+         if (a%poincare .or. a%lyapunov_spectrum) call check_sections_and_tangent(self, c)
       end associate
    end subroutine validate
+
+   !> What the machine's Poincaré maps and Lyapunov spectrum need of the law:
+   !> the located slip onsets exist for a set-valued law only, and the
+   !> tangent equations hold n + n² values with n = 2 + the law's states.
+   subroutine check_sections_and_tangent(self, c)
+      class(machine_config), intent(in) :: self
+      type(config_checker), intent(inout) :: c
+      class(sliding_law), allocatable :: law
+
+      call new_law(self%law, law)
+      associate (a => self%analysis)
+         if (a%poincare .and. trim(a%section) == 'stick_to_slip' .and. .not. law%set_valued()) &
+            & call c%reject('analysis', 'section', "'stick_to_slip'", "the located slip onsets are the events of " &
+            & //"exact stick; &law model = '"//trim(self%law%model)//"' has none: use section = 'w_zero_up' " &
+            & //"(the sliding velocity crossing 0 upwards) or 'none'")
+         ! The orbit, Φ and ∫ tr J in the stepper's 20 values: n + n² + 1 <= 20 with n = 2 + states.
+         if (a%lyapunov_spectrum .and. 2 + law%state_count() > max_tangent_base - 1) &
+            & call c%reject('analysis', 'lyapunov_spectrum', '.true.', "&law model = '"//trim(self%law%model) &
+            & //"' has "//itoa(law%state_count())//' internal states: the tangent equations take at most ' &
+            & //itoa(max_tangent_base - 3)//' besides x and v')
+      end associate
+   end subroutine check_sections_and_tangent
 
    pure integer function grid_size(self)
       class(machine_config), intent(in) :: self

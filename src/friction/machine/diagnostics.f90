@@ -1,19 +1,22 @@
 !> The machine's chaos diagnostics (&analysis): the amplitude spectrum of x
-!> or v over the analysis window, and the largest Lyapunov exponent from the
-!> equations (Benettin) for a law that is one ODE, through the library's
-!> scene-independent tools (analysis/).
+!> or v over the analysis window, the largest Lyapunov exponent from the
+!> equations (Benettin) for a law that is one ODE, the Poincaré maps
+!> (section.f90) and the whole Lyapunov spectrum (lyapunov.f90), through the
+!> library's scene-independent tools (analysis/).
 module friction_machine_diagnostics
    use friction_kinds, only: wp
    use friction_error, only: error_type
    use friction_ode_watch, only: step_watch
    use friction_analysis_spectrum, only: spectrum_settings, spectrum_result, amplitude_spectrum
    use friction_analysis_lyapunov_flow, only: benettin_settings, benettin_accumulator, benettin_exponent
-   use friction_law, only: sliding_law, max_law_states
+   use friction_law, only: sliding_law
    use friction_law_factory, only: make_law
    use friction_output_law_files, only: law_with_files
    use friction_machine_config, only: machine_config
    use friction_machine_model, only: machine_smooth
    use friction_machine_run, only: machine_run, machine_watch
+   use friction_machine_section, only: machine_poincare, machine_sections
+   use friction_machine_lyapunov, only: machine_spectrum, machine_lyapunov_spectrum, smooth_start
    implicit none
    private
 
@@ -23,6 +26,9 @@ module friction_machine_diagnostics
       logical :: spectrum = .false., lyapunov = .false.
       type(spectrum_result) :: peak
       type(benettin_accumulator) :: flow
+      logical :: poincare = .false., lyapunov_spectrum = .false.
+      type(machine_poincare) :: sections
+      type(machine_spectrum) :: qr
    end type machine_diagnostics
 
 contains
@@ -56,6 +62,22 @@ contains
             end block
          end if
          if (a%lyapunov) call lyapunov(error)
+         if (allocated(error)) return
+         d%poincare = a%poincare
+         d%lyapunov_spectrum = a%lyapunov_spectrum
+         if (a%poincare) call machine_sections(c, run, d%sections, error)
+         if (allocated(error)) return
+         if (a%lyapunov_spectrum) then
+            if (present(watch)) then
+               call machine_lyapunov_spectrum(c, d%qr, error, watch)
+            else
+               block
+                  class(step_watch), allocatable :: own
+                  allocate (own, source=machine_watch(c, '&analysis: the Lyapunov spectrum'))
+                  call machine_lyapunov_spectrum(c, d%qr, error, own)
+               end block
+            end if
+         end if
       end associate
 
    contains
@@ -66,32 +88,23 @@ contains
          type(machine_smooth), target :: system
          class(sliding_law), allocatable :: law
          type(benettin_settings) :: b
-         real(wp) :: y(2 + max_law_states), z(max_law_states)
-         integer :: ns
+         real(wp), allocatable :: y(:)
 
          call make_law(law_with_files(c%law), law, error)
          if (allocated(error)) return
-         ns = law%state_count()
-         call system%m%from_config(c)
-         allocate (system%law, source=law)
-         system%n_states = ns
-         if (ns > 0) call law%state_scale(system%scale(1:ns))
-         z = 0.0_wp
-         if (ns > 0 .and. c%steady_start) call law%steady_state(c%v0 - c%belt_velocity, c%normal, z(1:ns))
-         y(1:2) = [c%x0, c%v0]
-         y(3:2 + ns) = z(1:ns) / system%scale(1:ns)
+         call smooth_start(c, law, system, y)
          b%transient = c%analysis%lyapunov_transient
          b%duration = c%analysis%lyapunov_duration
          if (b%duration == 0.0_wp) b%duration = c%t_end - c%t_start - b%transient
          b%renormalise = c%analysis%lyapunov_renormalise
          b%d0 = c%analysis%lyapunov_d0
          if (present(watch)) then
-            call benettin_exponent(system, c%solver, y(1:2 + ns), c%t_start, b, d%flow, error, watch)
+            call benettin_exponent(system, c%solver, y, c%t_start, b, d%flow, error, watch)
          else
             block
                class(step_watch), allocatable :: own
                allocate (own, source=machine_watch(c, "&analysis: the Lyapunov exponent (Benettin)"))
-               call benettin_exponent(system, c%solver, y(1:2 + ns), c%t_start, b, d%flow, error, own)
+               call benettin_exponent(system, c%solver, y, c%t_start, b, d%flow, error, own)
             end block
          end if
       end subroutine lyapunov

@@ -12,6 +12,8 @@ module friction_machine_output
    use friction_machine_config, only: machine_config
    use friction_machine_run, only: machine_run, event_kind_names
    use friction_machine_diagnostics, only: machine_diagnostics
+   use friction_machine_section, only: write_machine_poincare
+   use friction_machine_lyapunov, only: write_machine_spectrum
    implicit none
    private
 
@@ -106,6 +108,11 @@ contains
             call file%attach_scales('/machine/lyapunov/estimate', ['/machine/lyapunov/time'])
          end associate
       end if
+      if (diagnostics%lyapunov_spectrum) then
+         if (.not. diagnostics%lyapunov) call file%create_group('/machine/lyapunov')
+         call write_machine_spectrum(file, '/machine/lyapunov', diagnostics%qr)
+      end if
+      if (diagnostics%poincare) call write_machine_poincare(file, config, run, diagnostics%sections)
       call file%close(error)
    end subroutine write_machine_file
 

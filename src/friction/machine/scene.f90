@@ -97,7 +97,8 @@ contains
       self%record%compute_time = wall_seconds() - start
       if (.not. allocated(error)) then
          deallocate (watch)
-         allocate (watch, source=machine_watch(self%config, '&analysis: the Lyapunov exponent (Benettin)', &
+         allocate (watch, source=machine_watch(self%config, '&analysis: the Lyapunov '//trim(merge('exponent (Benettin)', &
+            & 'spectrum           ', self%config%analysis%lyapunov .or. .not. self%config%analysis%lyapunov_spectrum)), &
             & reporter))
          call diagnose_machine(self%config, self%result, self%diagnostics, error, watch)
       end if
@@ -173,7 +174,14 @@ contains
       results(2) = real(count(run%stick(half:) == 1), wp) / real(run%n - half + 1, wp)
       results(3) = maxval(run%v(half:)) - minval(run%v(half:))
       results(4) = sum(run%force(half:)) / real(run%n - half + 1, wp)
-      call diagnose_machine(self%config, run, d, error)
+      ! A point's results need neither the Poincaré maps nor the whole spectrum: not computed there.
+      block
+         type(machine_config) :: point
+         point = self%config
+         point%analysis%poincare = .false.
+         point%analysis%lyapunov_spectrum = .false.
+         call diagnose_machine(point, run, d, error)
+      end block
       if (allocated(error)) return
       if (d%spectrum) results(5) = d%peak%peak_frequency
       if (d%lyapunov) results(6) = d%flow%current()

@@ -1,0 +1,411 @@
+!> The machine's whole Lyapunov spectrum (&analysis lyapunov_spectrum;
+!> docs/chaos.md, "The machine").  The orbit and its tangent matrix Φ are
+!> integrated side by side and Φ is factored Φ = Q R every renormalisation
+!> interval (analysis/lyapunov_spectrum.f90).
+!>
+!> - A law that is one ODE (arctan, Karnopp, Dahl, LuGre, elasto-plastic,
+!>   rate and state): the variational equations Φ' = J Φ with J from the
+!>   law's analytic partial derivatives (model.f90's Jacobian).
+!> - A set-valued law (Coulomb, Stribeck, the table) with exact stick: the
+!>   slip's variational equations, the saltation matrix at every switch, and
+!>   in stick the velocity pinned to the belt, which forgets δv: one direction
+!>   is lost (its exponent -inf) once the run has stuck.
+module friction_machine_lyapunov
+   use friction_kinds, only: wp, i8
+   use friction_error, only: error_type, fatal_error, error_input
+   use friction_ode_solver, only: ode_solver
+   use friction_ode_watch, only: step_watch
+   use friction_ode_events, only: event_locator, event_falling
+   use friction_output_h5, only: h5_file
+   use friction_analysis_lyapunov_spectrum, only: tangent_system, tangent_settings, spectrum_accumulator, &
+      & kaplan_yorke, generic_frame, pack_tangent, unpack_tangent, max_base
+   use friction_law, only: sliding_law, max_law_states
+   use friction_law_factory, only: make_law
+   use friction_output_law_files, only: law_with_files
+   use friction_machine_config, only: machine_config
+   use friction_machine_model, only: mechanics, machine_smooth, machine_slip, machine_stick
+   implicit none
+   private
+
+   public :: machine_spectrum, machine_lyapunov_spectrum, smooth_start, write_machine_spectrum
+
+   !> The spectrum and what it was computed over.
+   type :: machine_spectrum
+      type(tangent_settings) :: settings
+      type(spectrum_accumulator) :: qr
+      real(wp), allocatable :: exponents(:)   !! largest first; -inf for the direction stick forgets
+      real(wp) :: kaplan_yorke = 0.0_wp
+      logical :: has_divergence = .false.     !! a law that is one ODE
+      real(wp) :: divergence = 0.0_wp         !! 1/s: the time average of tr J over the same span
+   end type machine_spectrum
+
+   !> The orbit and its tangent (analysis' tangent_system) and one value
+   !> more, D' = tr J(y): for the exact flow ∫ tr J dt = ln det Φ, which the
+   !> exponents sum to (Liouville).  The steps are the orbit's (the tangent
+   !> does not vote), so the sum falls short of D where they do not resolve a
+   !> fast direction: the check the file carries (docs/chaos.md).
+   type, extends(tangent_system) :: divergence_tangent
+   contains
+      procedure :: dimension => divergence_dimension
+      procedure :: rhs => divergence_rhs
+      procedure :: jacobian => divergence_jacobian
+   end type divergence_tangent
+
+contains
+
+   pure function divergence_dimension(self) result(n)
+      class(divergence_tangent), intent(in) :: self
+      integer :: n
+
+      n = self%tangent_system%dimension() + 1
+   end function divergence_dimension
+
+   pure subroutine divergence_rhs(self, t, y, dydt)
+      class(divergence_tangent), intent(in) :: self
+      real(wp), intent(in) :: t
+      real(wp), intent(in), contiguous :: y(:)
+      real(wp), intent(out), contiguous :: dydt(:)
+      real(wp) :: jac(max_base, max_base), d0(max_base)
+      integer :: n, m, i
+
+      n = self%base%dimension()
+      m = n + n * n
+      call self%tangent_system%rhs(t, y(1:m), dydt(1:m))
+      call self%base%jacobian(t, y(1:n), jac(1:n, 1:n), d0(1:n))
+      dydt(m + 1) = 0.0_wp
+      do i = 1, n
+         dydt(m + 1) = dydt(m + 1) + jac(i, i)
+      end do
+   end subroutine divergence_rhs
+
+   !> The tangent system's, and nothing for D (a quadrature: nothing depends on it).
+   pure subroutine divergence_jacobian(self, t, y, dfdy, dfdt)
+      class(divergence_tangent), intent(in) :: self
+      real(wp), intent(in) :: t
+      real(wp), intent(in) :: y(:)
+      real(wp), intent(out) :: dfdy(:, :)
+      real(wp), intent(out) :: dfdt(:)
+      integer :: m
+
+      m = self%tangent_system%dimension()
+      dfdy = 0.0_wp
+      dfdt = 0.0_wp
+      call self%tangent_system%jacobian(t, y(1:m), dfdy(1:m, 1:m), dfdt(1:m))
+   end subroutine divergence_jacobian
+
+   !> The ODE of a law that is one ODE, and its initial state (x0, v0, the
+   !> states in steady sliding at v0 - belt_velocity or 0, over their scales).
+   subroutine smooth_start(c, law, system, y0)
+      type(machine_config), intent(in) :: c
+      class(sliding_law), intent(in) :: law
+      type(machine_smooth), intent(out) :: system
+      real(wp), allocatable, intent(out) :: y0(:)
+      real(wp) :: z(max_law_states)
+      integer :: ns
+
+      ns = law%state_count()
+      call system%m%from_config(c)
+      allocate (system%law, source=law)
+      system%n_states = ns
+      if (ns > 0) call law%state_scale(system%scale(1:ns))
+      z = 0.0_wp
+      if (ns > 0 .and. c%steady_start) call law%steady_state(c%v0 - c%belt_velocity, c%normal, z(1:ns))
+      allocate (y0(2 + ns))
+      y0(1:2) = [c%x0, c%v0]
+      y0(3:2 + ns) = z(1:ns) / system%scale(1:ns)
+   end subroutine smooth_start
+
+   !> The spectrum of checked settings c from the start of the run: the
+   !> transient, then a QR step every renormalisation interval.  `watch` is
+   !> asked inside the integrations and after every interval.
+   subroutine machine_lyapunov_spectrum(c, result, error, watch)
+      type(machine_config), intent(in) :: c
+      type(machine_spectrum), intent(out) :: result
+      type(error_type), allocatable, intent(out) :: error
+      class(step_watch), intent(inout) :: watch
+      class(sliding_law), allocatable :: law
+
+      associate (a => c%analysis, s => result%settings)
+         s%transient = a%lyapunov_spectrum_transient
+         s%duration = a%lyapunov_spectrum_duration
+         if (s%duration == 0.0_wp) s%duration = c%t_end - c%t_start - s%transient
+         s%renormalise = a%lyapunov_spectrum_renormalise
+         if (.not. (s%renormalise > 0.0_wp .and. s%duration >= s%renormalise .and. s%transient >= 0.0_wp)) then
+            call fatal_error(error, '&analysis: the Lyapunov spectrum needs lyapunov_spectrum_renormalise > 0, ' &
+               & //'a duration of at least one interval after lyapunov_spectrum_transient', error_input)
+            return
+         end if
+      end associate
+      call make_law(law_with_files(c%law), law, error)
+      if (allocated(error)) return
+      if (law%set_valued()) then
+         call switched_spectrum(c, law, result%settings, result%qr, error, watch)
+      else
+         result%has_divergence = .true.
+         call smooth_spectrum(c, law, result%settings, result%qr, result%divergence, error, watch)
+      end if
+      if (allocated(error)) return
+      result%exponents = result%qr%exponents()
+      result%kaplan_yorke = kaplan_yorke(result%exponents)
+   end subroutine machine_lyapunov_spectrum
+
+   !> A law that is one ODE: the orbit alone over the transient, then the
+   !> orbit with Φ from the generic frame.
+   subroutine smooth_spectrum(c, law, s, qr, divergence, error, watch)
+      type(machine_config), intent(in) :: c
+      class(sliding_law), intent(in) :: law
+      type(tangent_settings), intent(in) :: s
+      type(spectrum_accumulator), intent(out) :: qr
+      real(wp), intent(out) :: divergence
+      type(error_type), allocatable, intent(out) :: error
+      class(step_watch), intent(inout) :: watch
+      type(machine_smooth) :: system
+      type(divergence_tangent), target :: extended
+      type(ode_solver) :: orbit, tangent
+      real(wp), allocatable :: y(:), phi(:, :), z(:)
+      real(wp) :: t, h, t0, trace_integral
+      integer :: n, k, intervals
+
+      divergence = 0.0_wp
+      call smooth_start(c, law, system, y)
+      n = size(y)
+      allocate (extended%base, source=system)
+      h = c%solver%h_start
+      if (.not. (h > 0.0_wp)) h = 1.0e-6_wp * c%dt_out
+      t = c%t_start
+      t0 = c%t_start + s%transient
+      if (s%transient > 0.0_wp) then
+         call orbit%init(extended%base, c%solver, h, error)
+         if (allocated(error)) return
+         call orbit%advance(t, t0, y, error, watch)
+         call orbit%destroy()
+         if (allocated(error)) return
+      end if
+      phi = generic_frame(n)
+      call tangent%init(extended, c%solver, h, error)
+      if (allocated(error)) return
+      intervals = int(s%duration / s%renormalise + 1.0e-9_wp)
+      call qr%start(n, intervals)
+      trace_integral = 0.0_wp
+      allocate (z(n + n * n + 1))
+      do k = 1, intervals
+         z(1:n + n * n) = pack_tangent(y, phi)
+         z(n + n * n + 1) = 0.0_wp
+         call tangent%advance(t, t0 + k * s%renormalise, z, error, watch)
+         if (allocated(error)) exit
+         call unpack_tangent(z(1:n + n * n), y, phi)
+         trace_integral = trace_integral + z(n + n * n + 1)
+         call qr%renormalise(phi, s%renormalise, 0)
+         ! Φ changed under the stepper: restart it at the step it had reached.
+         call tangent%restart(tangent%step_size())
+         call watch%check(t, error)
+         if (allocated(error)) exit
+      end do
+      call tangent%destroy()
+      if (qr%elapsed > 0.0_wp) divergence = trace_integral / qr%elapsed
+   end subroutine smooth_spectrum
+
+   !> A set-valued law: run.f90's stick/slip logic with Φ beside the state.
+   !> In slip Φ follows the slip's variational equations; in stick v is the
+   !> belt's, so δv is set to 0 (the direction lost) and δx is carried
+   !> unchanged (x' = belt_velocity does not depend on the state).  At each
+   !> switch through the surface h(t, y) = 0 from the field f⁻ into f⁺,
+   !> Φ ← (I + (f⁺ - f⁻) ∇hᵀ / (∇h·f⁻ + ∂h/∂t)) Φ (docs/chaos.md).
+   subroutine switched_spectrum(c, law, s, qr, error, watch)
+      type(machine_config), intent(in) :: c
+      class(sliding_law), intent(in) :: law
+      type(tangent_settings), intent(in) :: s
+      type(spectrum_accumulator), intent(out) :: qr
+      type(error_type), allocatable, intent(out) :: error
+      class(step_watch), intent(inout) :: watch
+      type(mechanics) :: m
+      type(machine_slip) :: slip
+      type(tangent_system), target :: slipping_system
+      type(machine_stick), target :: stick
+      type(event_locator) :: slipping, sticking
+      real(wp) :: t, y(2), phi(2, 2), limit, h, a, t0, direction
+      logical :: in_stick
+      integer :: k, intervals, lost
+
+      call m%from_config(c)
+      limit = law%static_force(m%normal)
+      slip%m = m
+      allocate (slip%law, source=law)
+      allocate (slipping_system%base, source=slip)
+      stick%m = m
+      stick%limit = limit
+      h = c%solver%h_start
+      if (.not. (h > 0.0_wp)) h = 1.0e-6_wp * c%dt_out
+      call slipping%init(slipping_system, c%solver, [event_falling], [.true.], c%event_tolerance, h, error, 't', ' s')
+      if (allocated(error)) return
+      call sticking%init(stick, c%solver, [event_falling, event_falling], [.true., .true.], c%event_tolerance, h, &
+         & error, 't', ' s')
+      if (allocated(error)) return
+      t = c%t_start
+      y = [c%x0, c%v0]
+      phi = generic_frame(2)
+      lost = 0
+      a = m%applied(t, y(1), y(2))
+      in_stick = y(2) == m%belt .and. abs(a) <= limit
+      if (in_stick) then
+         call sticking%restart(t, y, h)
+      else if (y(2) /= m%belt) then
+         call start_slip(sign(1.0_wp, y(2) - m%belt))
+      else
+         call start_slip(sign(1.0_wp, a))
+      end if
+      t0 = c%t_start + s%transient
+      ! The transient in renormalisation intervals too, so that Φ stays bounded.
+      do while (t < t0)
+         call advance(min(t + s%renormalise, t0))
+         if (allocated(error)) return
+         call reset(generic_frame(2))
+         call watch%check(t, error)
+         if (allocated(error)) return
+      end do
+      intervals = int(s%duration / s%renormalise + 1.0e-9_wp)
+      call qr%start(2, intervals)
+      do k = 1, intervals
+         call advance(t0 + k * s%renormalise)
+         if (allocated(error)) return
+         call qr%renormalise(phi, s%renormalise, lost)
+         call reset(phi)
+         call watch%check(t, error)
+         if (allocated(error)) return
+      end do
+
+   contains
+
+      !> Through any number of stick and slip phases to t_target.
+      subroutine advance(t_target)
+         real(wp), intent(in) :: t_target
+         real(wp) :: zz(6), sigma, f_minus(2)
+         integer :: which
+
+         do while (t < t_target)
+            if (in_stick) then
+               call pin()
+               call sticking%advance(t, t_target, y, error, watch)
+               if (allocated(error)) return
+               y(2) = m%belt   ! exact in stick
+               if (sticking%n_hits == 0) cycle
+               which = sticking%hits(sticking%n_hits)%which
+               ! The applied force reached σ limit: h = limit - σ A(t, x, belt), slip that way.
+               sigma = merge(1.0_wp, -1.0_wp, which == 1)
+               in_stick = .false.
+               call set_direction(sigma)
+               call saltation([m%belt, 0.0_wp], slip_field(), [sigma * m%stiffness, 0.0_wp], &
+                  & -sigma * m%applied_rate(t))
+               call restart_slip()
+            else
+               zz = pack_tangent(y, phi)
+               call slipping%advance(t, t_target, zz, error, watch)
+               if (allocated(error)) return
+               call unpack_tangent(zz, y, phi)
+               if (slipping%n_hits == 0) cycle
+               ! h = s (v - belt): the slip in direction s ends.
+               f_minus = slip_field()
+               sigma = direction
+               a = m%applied(t, y(1), m%belt)
+               if (abs(a) <= limit) then
+                  in_stick = .true.
+                  call saltation(f_minus, [m%belt, 0.0_wp], [0.0_wp, sigma], 0.0_wp)
+                  y(2) = m%belt   ! exact: the event left w within the tolerance of 0
+                  call sticking%restart(t, y, h)
+               else
+                  call set_direction(sign(1.0_wp, a))
+                  call saltation(f_minus, slip_field(), [0.0_wp, sigma], 0.0_wp)
+                  call restart_slip()
+               end if
+            end if
+         end do
+      end subroutine advance
+
+      !> In stick: δv is forgotten.
+      subroutine pin()
+         if (any(phi(2, :) /= 0.0_wp)) then
+            phi(2, :) = 0.0_wp
+            lost = 1
+         end if
+      end subroutine pin
+
+      !> Slip in direction sigma from here.
+      subroutine start_slip(sigma)
+         real(wp), intent(in) :: sigma
+
+         call set_direction(sigma)
+         call restart_slip()
+      end subroutine start_slip
+
+      subroutine set_direction(sigma)
+         real(wp), intent(in) :: sigma
+
+         direction = sigma
+         select type (b => slipping_system%base)
+         type is (machine_slip)
+            b%direction = sigma
+         end select
+      end subroutine set_direction
+
+      subroutine restart_slip()
+         call slipping%restart(t, pack_tangent(y, phi), h)
+      end subroutine restart_slip
+
+      !> The slip's field at (t, y) in the current direction.
+      function slip_field() result(f)
+         real(wp) :: f(2)
+
+         select type (b => slipping_system%base)
+         type is (machine_slip)
+            call b%rhs(t, y, f)
+         end select
+      end function slip_field
+
+      !> Φ across h = 0 (gradient `normal`, time derivative `rate_t`) from f⁻ into f⁺.
+      !> A grazing crossing (∇h·f⁻ + ∂h/∂t = 0, measure zero) leaves Φ as it is.
+      subroutine saltation(f_minus, f_plus, normal, rate_t)
+         real(wp), intent(in) :: f_minus(2), f_plus(2), normal(2), rate_t
+         real(wp) :: rate, row(2)
+         integer :: i
+
+         rate = dot_product(normal, f_minus) + rate_t
+         if (rate == 0.0_wp) return
+         row = matmul(normal, phi) / rate
+         do i = 1, 2
+            phi(i, :) = phi(i, :) + (f_plus(i) - f_minus(i)) * row
+         end do
+      end subroutine saltation
+
+      !> Φ replaced (a QR step): the steppers' copies are stale.
+      subroutine reset(q)
+         real(wp), intent(in) :: q(2, 2)
+
+         phi = q
+         lost = 0
+         if (in_stick) then
+            call sticking%restart(t, y, 0.0_wp)
+         else
+            call slipping%restart(t, pack_tangent(y, phi), 0.0_wp)
+         end if
+      end subroutine reset
+
+   end subroutine switched_spectrum
+
+   !> /machine/lyapunov's spectrum (docs/output.md); the group exists.
+   subroutine write_machine_spectrum(file, group, d)
+      type(h5_file), intent(inout) :: file
+      character(len=*), intent(in) :: group
+      type(machine_spectrum), intent(in) :: d
+
+      call file%write_vector(group//'/exponents', d%exponents, '1/s')
+      call file%write_vector(group//'/exponents_time', d%qr%time(1:d%qr%count), 's')
+      call file%write_matrix(group//'/exponents_history', d%qr%history(:, 1:d%qr%count), '1/s')
+      call file%write_attribute_real(group, 'kaplan_yorke_dimension', d%kaplan_yorke, '1')
+      call file%write_attribute_integer(group, 'spectrum_lost_directions', int(d%qr%lost, i8))
+      call file%write_attribute_real(group, 'spectrum_transient', d%settings%transient, 's')
+      call file%write_attribute_real(group, 'spectrum_duration', d%settings%duration, 's')
+      call file%write_attribute_real(group, 'spectrum_renormalise', d%settings%renormalise, 's')
+      if (d%has_divergence) call file%write_attribute_real(group, 'spectrum_divergence', d%divergence, '1/s')
+   end subroutine write_machine_spectrum
+
+end module friction_machine_lyapunov
