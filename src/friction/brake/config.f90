@@ -304,13 +304,17 @@ contains
       if (c%failed()) return
       why = "is not computed for &brake model = 'law' (the state has the law's own variables and no tangent " &
          & //'equations here): use the switched or the regularized model'
+      call new_law(self%law, law)
       associate (a => self%analysis)
-         if (a%lyapunov) call c%reject('analysis', 'lyapunov', '.true.', why)
+         ! Benettin's runs restart from the brake's four variables: the whole state of a law without states.
+         if (a%lyapunov .and. law%state_count() > 0) call c%reject('analysis', 'lyapunov', '.true.', &
+            & "is not computed for &brake model = 'law' with &law model = '"//trim(self%law%model) &
+            & //"' (Benettin's restarts would not carry its internal states): use a law without states " &
+            & //'(coulomb, stribeck, table, arctan, karnopp), or the switched or the regularized model')
          if (a%lyapunov_spectrum) call c%reject('analysis', 'lyapunov_spectrum', '.true.', why)
          if (a%orbit) call c%reject('analysis', 'orbit', '.true.', why)
       end associate
       if (c%failed()) return
-      call new_law(self%law, law)
       ! Exact stick holds the closed-form stick phase, whose end needs a static limit affine in N'.
       if (law%set_valued()) then
          block
