@@ -246,11 +246,16 @@ def _brake_layout(raw, labels):
     _along(raw, labels, "brake/orbit/branch/", "brake/orbit/branch/parameter", "parameter", lambda rest: True)
     _along(raw, labels, "brake/orbit/branch/", "brake/orbit/branch/section_parameter", "section_parameter",
            lambda rest: rest.startswith("section_"))
-    history = "brake/lyapunov/exponents_history"
-    if "brake/lyapunov/exponents_time" in raw and history in raw:
-        n = raw["brake/lyapunov/exponents_time"][0].size
+    _exponents_history(raw, labels, "brake/lyapunov/")
+
+
+def _exponents_history(raw, labels, prefix):
+    """The QR spectrum's running estimates along their times (exponents_time, exponent)."""
+    history = prefix + "exponents_history"
+    if prefix + "exponents_time" in raw and history in raw:
+        n = raw[prefix + "exponents_time"][0].size
         if raw[history][0].ndim == 2 and raw[history][0].shape[0] == n:
-            labels["brake/lyapunov/exponents_time"] = (("exponents_time",), "coords")
+            labels[prefix + "exponents_time"] = (("exponents_time",), "coords")
             labels[history] = (("exponents_time", "exponent"), "data")
 
 
@@ -258,7 +263,12 @@ def _machine_layout(raw, labels):
     _along(raw, labels, "machine/", "machine/t", "t", lambda rest: True)
     _along(raw, labels, "machine/events/", "machine/events/t", "event", lambda rest: True)
     _along(raw, labels, "machine/spectrum/", "machine/spectrum/frequency", "frequency", lambda rest: True)
-    _along(raw, labels, "machine/lyapunov/", "machine/lyapunov/time", "time", lambda rest: True)
+    _along(raw, labels, "machine/lyapunov/", "machine/lyapunov/time", "time", lambda rest: rest == "estimate")
+    _along(raw, labels, "machine/poincare/", "machine/poincare/strobe_t", "strobe_t",
+           lambda rest: rest.startswith("strobe_"))
+    _along(raw, labels, "machine/poincare/", "machine/poincare/section_t", "section_t",
+           lambda rest: rest.startswith("section_"))
+    _exponents_history(raw, labels, "machine/lyapunov/")
 
 
 def _sweep_layout(raw, root, group_attrs, labels):

@@ -68,6 +68,25 @@ def test_a_brake_run(brake_run):
     assert data["brake/spectrum"].attrs["peak_frequency_units"] == "1/tau"
 
 
+def test_a_machine_run_with_its_maps_and_spectrum(program, tmp_path):
+    """The machine's Poincaré maps along their times and its QR spectrum's history."""
+    import subprocess
+    path = tmp_path / "machine.h5"
+    subprocess.run([str(program), "--quiet", "-o", str(path), str(ROOT / "inputs" / "machine_coulomb.nml"),
+                    "--set", "analysis.poincare=.true.", "--set", "analysis.strobe_period=1.0",
+                    "--set", "analysis.lyapunov=.false.", "--set", "analysis.lyapunov_spectrum=.true.",
+                    "--set", "analysis.lyapunov_spectrum_transient=10"], check=True)
+    data = friction.load(path, scene="machine")
+    st, _ = raw(path, "machine/poincare/strobe_t")
+    strobe = data["machine/poincare/strobe_x"]
+    assert strobe.dims == ("strobe_t",) and np.array_equal(strobe["strobe_t"].values, st)
+    assert data["machine/poincare/section_v"].dims == ("section_t",)
+    history = data["machine/lyapunov/exponents_history"]
+    et, _ = raw(path, "machine/lyapunov/exponents_time")
+    assert history.dims == ("exponents_time", "exponent") and np.array_equal(history["exponents_time"].values, et)
+    assert history.attrs["units"] == "1/s" and data["machine/lyapunov/exponents"].size == 2
+
+
 def test_a_brake_sweep(brake_sweep):
     data = friction.load(brake_sweep, scene="sweep")
     values, vattrs = raw(brake_sweep, "sweep/values")
