@@ -302,8 +302,8 @@ contains
       end if
       call check_law(law_with_files(self%law), c)
       if (c%failed()) return
-      why = "is not computed for &brake model = 'law' (the state has the law's own variables and no tangent " &
-         & //'equations here): use the switched or the regularized model'
+      why = "is not computed for &brake model = 'law' (the periodic orbit is found on the switched model's " &
+         & //"located slip onsets): use model = 'switched'"
       call new_law(self%law, law)
       associate (a => self%analysis)
          ! Benettin's runs restart from the brake's four variables: the whole state of a law without states.
@@ -311,7 +311,11 @@ contains
             & "is not computed for &brake model = 'law' with &law model = '"//trim(self%law%model) &
             & //"' (Benettin's restarts would not carry its internal states): use a law without states " &
             & //'(coulomb, stribeck, table, arctan, karnopp), or the switched or the regularized model')
-         if (a%lyapunov_spectrum) call c%reject('analysis', 'lyapunov_spectrum', '.true.', why)
+         if (a%lyapunov_spectrum .and. law%state_count() > 0) call c%reject('analysis', 'lyapunov_spectrum', &
+            & '.true.', "is not computed for &brake model = 'law' with &law model = '"//trim(self%law%model) &
+            & //"' (the tangent equations take the brake's four variables; its states would make them " &
+            & //'too many): use a law without states (coulomb, stribeck, table, arctan, karnopp), or the ' &
+            & //'switched or the regularized model')
          if (a%orbit) call c%reject('analysis', 'orbit', '.true.', why)
       end associate
       if (c%failed()) return

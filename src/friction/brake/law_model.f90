@@ -31,7 +31,9 @@ module friction_brake_law_model
    use friction_brake_params, only: brake_parameters
    use friction_brake_config, only: brake_config
    use friction_brake_integrator, only: brake_integrator
-   use friction_brake_stick, only: stick_motion, stick_end_lift_off
+   use friction_brake_stick, only: stick_motion, stick_end_lift_off, stick_end_force_positive, stick_tangent
+   use friction_brake_switched, only: saltation
+   use friction_analysis_lyapunov_spectrum, only: tangent_system
    use friction_brake_record, only: brake_event_table, event_stick_to_slip, event_slip_to_stick, &
       & event_slip_reversal
    implicit none
@@ -83,6 +85,7 @@ module friction_brake_law_model
       logical :: switching = .false.               !! a set-valued law: exact stick
       type(brake_law_flow), allocatable :: flow
       type(brake_law_slip), allocatable :: slip
+      type(tangent_system), allocatable :: extended   !! the flow or the slip with its tangent (when tangent)
       type(stick_motion) :: stick
       logical :: sticking = .false.
       real(wp) :: z(max_law_states) = 0.0_wp       !! the law's states now, in its units
@@ -321,8 +324,17 @@ contains
          self%slip%units = self%units
          self%h_start = config%solver%h_start
          if (.not. (self%h_start > 0.0_wp)) self%h_start = 1.0e-3_wp
-         call self%locator%init(self%slip, config%solver, [event_falling, event_falling], [.true., .true.], &
-            & config%event_tolerance, self%h_start, error, time_name='τ', time_unit='')
+         if (self%tangent) then
+            if (allocated(self%extended)) deallocate (self%extended)
+            allocate (self%extended)
+            allocate (self%extended%base, source=self%slip)
+            call self%locator%init(self%extended, config%solver, [event_falling, event_falling], [.true., .true.], &
+               & config%event_tolerance, self%h_start, error, time_name='τ', time_unit='')
+            call self%start_tangent()
+         else
+            call self%locator%init(self%slip, config%solver, [event_falling, event_falling], [.true., .true.], &
+               & config%event_tolerance, self%h_start, error, time_name='τ', time_unit='')
+         end if
          if (allocated(error)) return
          if (y0(2) == self%p%v_dr .and. abs(self%p%elastic_force(y0(1), y0(3))) <= self%limit(y0(3))) then
             self%sticking = .true.
@@ -357,6 +369,18 @@ contains
       if (ns > 0) fastest = max(fastest, maxval(abs(dgdz(1:ns, 1:ns))) * self%units%time)
       self%h_start = config%solver%h_start
       if (.not. (self%h_start > 0.0_wp)) self%h_start = min(1.0e-3_wp, 0.1_wp / fastest)
+      if (self%tangent) then
+         ! A law without states (checked on input): the tangent of (x, v, y, w) is the whole tangent.
+         if (allocated(self%extended)) deallocate (self%extended)
+         allocate (self%extended)
+         allocate (self%extended%base, source=self%flow)
+         call self%locator%init(self%extended, config%solver, [event_falling, event_either, event_either], &
+            & [.true., .false., .false.], config%event_tolerance, self%h_start, error, time_name='τ', time_unit='')
+         if (allocated(error)) return
+         call self%start_tangent()
+         call self%locator_restart(self%h_start)
+         return
+      end if
       call self%locator%init(self%flow, config%solver, [event_falling, event_either, event_either], &
          & [.true., .false., .false.], config%event_tolerance, self%h_start, error, time_name='τ', time_unit='')
       if (allocated(error)) return
@@ -411,6 +435,15 @@ contains
       integer :: ns
 
       ns = self%flow%n_states
+      if (self%tangent) then
+         do while (self%t < t_target)
+            call self%locator_advance(t_target, error)
+            if (allocated(error)) return
+            call self%record_band_hits(events, '', error)
+            if (allocated(error)) return
+         end do
+         return
+      end if
       s(1:4) = self%y
       s(5:4 + ns) = self%z(1:ns) / self%flow%scale(1:ns)
       do while (self%t < t_target)
@@ -438,6 +471,10 @@ contains
             call self%stick%find_end(self%t, t_target, found, t_end, which)
             if (.not. found) t_end = t_target
             self%stick_time = self%stick_time + (t_end - self%t)
+            if (self%tangent) then
+               self%phi = matmul(stick_tangent(self%p, t_end - self%t), self%phi)
+               self%lost = 1
+            end if
             self%y = self%stick%state_at(t_end)
             self%t = t_end
             if (.not. found) cycle
@@ -447,20 +484,28 @@ contains
                return
             end if
             self%sticking = .false.
+            if (self%tangent) call stick_exit_saltation(self, which)
             call slip_by_force(self, -1.0_wp)
             call events%add(self%t, event_stick_to_slip, self%y)
          else
-            call self%locator%advance(self%t, t_target, self%y, error)
+            call self%locator_advance(t_target, error)
             if (allocated(error)) return
             if (self%locator%n_hits == 0) cycle
             select case (self%locator%hits(self%locator%n_hits)%which)
             case (1)
                if (abs(self%p%elastic_force(self%y(1), self%y(3))) <= self%limit(self%y(3))) then
                   self%sticking = .true.
+                  if (self%tangent) then
+                     call saltation(self%phi, slip_field(self, self%slip%direction), stick_field(self), &
+                        & [0.0_wp, self%slip%direction, 0.0_wp, 0.0_wp])
+                     self%lost = 1
+                  end if
                   self%y(2) = self%p%v_dr   ! exact: the event left v_rel within the tolerance of 0
                   call self%stick%start(self%p, self%t, self%y, self%slope, self%level)
                   call events%add(self%t, event_slip_to_stick, self%y)
                else
+                  if (self%tangent) call saltation(self%phi, slip_field(self, self%slip%direction), &
+                     & slip_field(self, -self%slip%direction), [0.0_wp, self%slip%direction, 0.0_wp, 0.0_wp])
                   call slip_by_force(self, -1.0_wp)
                   call events%add(self%t, event_slip_reversal, self%y)
                end if
@@ -492,7 +537,48 @@ contains
 
       self%sticking = .false.
       self%slip%direction = s
-      call self%locator%restart(self%t, self%y, h_start)
+      if (self%tangent) then
+         select type (b => self%extended%base)
+         type is (brake_law_slip)
+            b%direction = s
+         end select
+      end if
+      call self%locator_restart(h_start)
    end subroutine slip_in
+
+   !> The right-hand side of slip in direction s at the current state.
+   function slip_field(self, s) result(f)
+      type(law_integrator), intent(in) :: self
+      real(wp), intent(in) :: s
+      real(wp) :: f(4)
+      type(brake_law_slip) :: slip
+
+      slip%params = self%p
+      allocate (slip%law, source=self%law)
+      slip%units = self%units
+      slip%direction = s
+      call slip%rhs(self%t, self%y, f)
+   end function slip_field
+
+   !> The right-hand side of stick (the block's velocity pinned to the belt).
+   pure function stick_field(self) result(f)
+      type(law_integrator), intent(in) :: self
+      real(wp) :: f(4)
+
+      f = [self%p%v_dr, 0.0_wp, self%y(4), (self%y(1) - self%p%kappa * self%y(3)) / self%p%xi]
+   end function stick_field
+
+   !> Leaving stick where the limit `which` was reached: h = slope N' + level ∓ (2x - y)
+   !> with normal ∇h, into slip in the direction the springs' pull drives (the
+   !> switched model's, with the law's static limit).
+   subroutine stick_exit_saltation(self, which)
+      type(law_integrator), intent(inout) :: self
+      integer, intent(in) :: which
+      real(wp) :: sigma, normal(4)
+
+      sigma = merge(1.0_wp, -1.0_wp, which == stick_end_force_positive)
+      normal = [-2.0_wp * sigma, 0.0_wp, self%slope * (1.0_wp - self%p%kappa) + sigma, 0.0_wp]
+      call saltation(self%phi, stick_field(self), slip_field(self, -sigma), normal)
+   end subroutine stick_exit_saltation
 
 end module friction_brake_law_model

@@ -32,7 +32,7 @@ module friction_brake_switched
    implicit none
    private
 
-   public :: brake_slip, switched_integrator, kinetic_friction
+   public :: brake_slip, switched_integrator, kinetic_friction, saltation
 
    !> Eq. 10 during one slip, with s the sign of v_rel.
    type, extends(event_system) :: brake_slip
