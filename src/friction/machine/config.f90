@@ -127,20 +127,11 @@ contains
       if (c%failed()) return
       call self%analysis%validate(c, self%t_start, self%t_end, ['x', 'v'])
       if (c%failed()) return
-      ! The machine's diagnostics so far: the spectrum, and Benettin's exponent for the laws that
-      ! are one ODE; the others are refused by name rather than ignored.
+      ! The machine's diagnostics so far: the spectrum, Benettin's exponent, the Poincaré maps and
+      ! the Lyapunov spectrum; the others are refused by name rather than ignored.
       associate (a => self%analysis)
          if (a%orbit) call c%reject('analysis', 'orbit', '.true.', not_yet)
          if (a%rosenstein) call c%reject('analysis', 'rosenstein', '.true.', not_yet)
-         if (a%lyapunov) then
-            block
-               class(sliding_law), allocatable :: law
-               call new_law(self%law, law)
-               if (law%set_valued()) call c%reject('analysis', 'lyapunov', '.true.', "the machine's exponent " &
-                  & //"is computed for the laws that are one ODE; &law model = '"//trim(self%law%model) &
-                  & //"' switches between stick and slip (a smooth law: lugre, elastoplastic, dahl, rate_state, arctan, karnopp)")
-            end block
-         end if
          if (a%poincare .or. a%lyapunov_spectrum) call check_sections_and_tangent(self, c)
       end associate
    end subroutine validate

@@ -1,6 +1,6 @@
 !> The machine's chaos diagnostics (&analysis): the amplitude spectrum of x
 !> or v over the analysis window, the largest Lyapunov exponent from the
-!> equations (Benettin) for a law that is one ODE, the Poincaré maps
+!> equations (Benettin; through exact stick for a set-valued law), the Poincaré maps
 !> (section.f90) and the whole Lyapunov spectrum (lyapunov.f90), through the
 !> library's scene-independent tools (analysis/).
 module friction_machine_diagnostics
@@ -16,7 +16,7 @@ module friction_machine_diagnostics
    use friction_machine_model, only: machine_smooth
    use friction_machine_run, only: machine_run, machine_watch
    use friction_machine_section, only: machine_poincare, machine_sections
-   use friction_machine_lyapunov, only: machine_spectrum, machine_lyapunov_spectrum, smooth_start
+   use friction_machine_lyapunov, only: machine_spectrum, machine_lyapunov_spectrum, smooth_start, switched_benettin
    implicit none
    private
 
@@ -92,12 +92,25 @@ contains
 
          call make_law(law_with_files(c%law), law, error)
          if (allocated(error)) return
-         call smooth_start(c, law, system, y)
          b%transient = c%analysis%lyapunov_transient
          b%duration = c%analysis%lyapunov_duration
          if (b%duration == 0.0_wp) b%duration = c%t_end - c%t_start - b%transient
          b%renormalise = c%analysis%lyapunov_renormalise
          b%d0 = c%analysis%lyapunov_d0
+         if (law%set_valued()) then
+            ! Two runs through exact stick and slip (lyapunov.f90).
+            if (present(watch)) then
+               call switched_benettin(c, law, b, d%flow, error, watch)
+            else
+               block
+                  class(step_watch), allocatable :: own
+                  allocate (own, source=machine_watch(c, "&analysis: the Lyapunov exponent (Benettin)"))
+                  call switched_benettin(c, law, b, d%flow, error, own)
+               end block
+            end if
+            return
+         end if
+         call smooth_start(c, law, system, y)
          if (present(watch)) then
             call benettin_exponent(system, c%solver, y, c%t_start, b, d%flow, error, watch)
          else
