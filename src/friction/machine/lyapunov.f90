@@ -1,7 +1,9 @@
 !> The machine's whole Lyapunov spectrum (&analysis lyapunov_spectrum;
 !> docs/chaos.md, "The machine").  The orbit and its tangent matrix Φ are
 !> integrated side by side and Φ is factored Φ = Q R every renormalisation
-!> interval (analysis/lyapunov_spectrum.f90).
+!> interval (analysis/lyapunov_spectrum.f90).  Also Benettin's exponent of a
+!> set-valued law, two switching runs without Φ (the smooth laws' is the
+!> analysis layer's, diagnostics.f90).
 !>
 !> - A law that is one ODE (arctan, Karnopp, Dahl, LuGre, elasto-plastic,
 !>   rate and state): the variational equations Φ' = J Φ with J from the
