@@ -70,7 +70,7 @@ def run(args, workdir, ranks, files, name):
     subprocess.run(cmd, check=True, cwd=workdir)
     with h5py.File(out, "r") as f:
         return (f["sweep/values"].size, float(f.attrs["wall_time"]),
-                f["sweep/peak_memory_per_rank"][()], f["sweep/compute_time"][()])
+                f["sweep/peak_memory_per_rank"][()] / 1024.0, f["sweep/compute_time"][()])   # bytes -> KiB
 
 
 # The cheap grid of --scale: mu (valid, below mu_s = 0.59) by xi, tau = 60.

@@ -1241,6 +1241,7 @@ def brake_file(args, name):
         data["root"] = dict(f.attrs)
         data["verify"] = dict(f["brake/verify"].attrs) if "brake/verify" in f else None
         data["units"] = {key: f["brake"][key].attrs["units"] for key in ("t", "x", "v", "y", "w", "stick")}
+        data["units_tau"] = {key: f["brake"][key].attrs.get("units_tau") for key in ("t", "x", "v", "y", "w")}
     return data
 
 
@@ -1262,9 +1263,10 @@ def case_brake_run(args):
     t = d["t"]
     if t.shape != (1001,) or abs(t[0]) > 0 or abs(t[-1] - 100.0) > 1e-9:
         fail(f"grid: {t.shape}, {t[0]} .. {t[-1]}")
-    for key, unit in [("x", b"m"), ("t", b"tau")]:
-        if d["units"][key] != unit:
-            fail(f"/brake/{key} units {d['units'][key]}")
+    # UDUNITS strings, τ as a pure number; the unit in τ beside it (docs/output.md#units-udunits-strings).
+    for key, unit, tau in [("x", b"m", None), ("t", b"1", b"tau"), ("v", b"m", b"m/tau")]:
+        if d["units"][key] != unit or d["units_tau"][key] != tau:
+            fail(f"/brake/{key} units {d['units'][key]}, in tau {d['units_tau'][key]}")
     a = d["attrs"]
     expected = {"xi": 0.412, "kappa": 1.5, "g_prime": 0.01778, "mu": 0.59, "mu_s": 0.59,
                 "v_dr_prime": -0.002788, "epsilon_prime": 3.5121e7, "delta_prime": 3.5121}
@@ -1350,7 +1352,7 @@ def case_brake_orbit(args):
                 fail(f"{key} differs between 1 and {n} ranks")
     with h5py.File(os.path.join(args.workdir, "o1.h5"), "r") as f:
         o = f["brake/orbit"]
-        if o.attrs["found"] != 1 or o.attrs["period_units"] != b"tau" or "reason" in o.attrs:
+        if o.attrs["found"] != 1 or o.attrs["period_units_tau"] != b"tau" or "reason" in o.attrs:
             fail(f"orbit attributes {dict(o.attrs)}")
         mu = o["floquet_multipliers"][()]
         lam = o["floquet_exponents"][()]
@@ -1403,7 +1405,8 @@ def case_brake_analysis(args):
     a = files[1]
     if abs(a["brake/spectrum@resolution"] - 1 / (3501 * 0.1)) > 1e-12:
         fail(f"resolution {a['brake/spectrum@resolution']}, expected 1/(3501 * 0.1)")
-    if a["brake/spectrum/frequency@units"] != b"cycles per unit tau" or a["brake/spectrum/amplitude@units"] != b"m":
+    if a["brake/spectrum/frequency@units"] != b"1" or a["brake/spectrum/frequency@units_tau"] != b"1/tau" \
+            or a["brake/spectrum/amplitude@units"] != b"m":
         fail("spectrum units")
     if not 0.1 < a["brake/spectrum@peak_frequency"] < 0.2:
         fail(f"peak frequency {a['brake/spectrum@peak_frequency']} outside the stick-slip band")
@@ -1434,10 +1437,10 @@ def case_brake_analysis(args):
             fail(f"exponents_history shape {history.shape}")
         if sorted(history[-1]) != sorted(exponents):
             fail("the last running estimate is not the spectrum")
-        if lyap["spectrum_renormalise"] != 1.0 or lyap["spectrum_transient_units"] != b"tau" \
+        if lyap["spectrum_renormalise"] != 1.0 or lyap["spectrum_transient_units_tau"] != b"tau" \
                 or lyap["spectrum_lost_directions"] != 1 or "kaplan_yorke_dimension" not in lyap:
             fail("spectrum settings not recorded")
-        if f["brake/lyapunov/exponents"].attrs["units"] != b"1/tau":
+        if f["brake/lyapunov/exponents"].attrs["units_tau"] != b"1/tau":
             fail("exponents units")
     # With the spectrum off the file is the same apart from the spectrum's
     # objects and the echo of the input.
@@ -1769,7 +1772,7 @@ def case_sweep_ranks(args):
                 fail(f"/sweep/{key} differs between 1 rank and {label}: {reference[key]} vs {runs[label][0][key]}")
     with h5py.File(os.path.join(args.workdir, "s1.h5"), "r") as handle:
         for key, unit in (("maxima", "m"), ("peak_frequency", "1/tau"), ("lyapunov", "1/tau")):
-            if handle["sweep"][key].attrs["units"].decode() != unit:
+            if handle["sweep"][key].attrs.get("units_tau", handle["sweep"][key].attrs["units"]).decode() != unit:
                 fail(f"/sweep/{key} units {handle['sweep'][key].attrs['units']!r}, expected {unit}")
         for name in ("program", "version", "input", "nranks", "wall_time"):
             if name not in handle.attrs:

@@ -53,3 +53,10 @@ add_test(NAME python-law
           --basetemp "${_fp_work}/pytest-law"
   WORKING_DIRECTORY "${_fp_work}")
 set_tests_properties(python-law PROPERTIES LABELS "python;capi" TIMEOUT 120 ENVIRONMENT "${_fp_env}")
+
+# Every unit the program's files state parses with UDUNITS-2 and pint (docs/output.md#units-udunits-strings).
+add_test(NAME python-units
+  COMMAND ${Python3_EXECUTABLE} -m pytest "${PROJECT_SOURCE_DIR}/python/tests/test_units.py" -q -p no:cacheprovider
+          --basetemp "${_fp_work}/pytest-units"
+  WORKING_DIRECTORY "${_fp_work}")
+set_tests_properties(python-units PROPERTIES LABELS "python;output" TIMEOUT 120 ENVIRONMENT "${_fp_env}")

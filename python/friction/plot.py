@@ -510,7 +510,7 @@ def _diagnostics(data):
             s = present["brake/spectrum"]
             d["spectrum"] = {"frequency": data["brake/spectrum/frequency"].values,
                              "amplitude": data["brake/spectrum/amplitude"].values,
-                             "amplitude_units": data["brake/spectrum/amplitude"].attrs.get("units"),
+                             "amplitude_units": _unit_of(data["brake/spectrum/amplitude"].attrs),
                              "series": str(s["series"]), "window": str(s["window"]),
                              **{k: float(s[k]) for k in ("peak_frequency", "resolution", "window_start",
                                                          "window_end")}}
@@ -743,15 +743,21 @@ def _sweep(data):
             s["variable2"] = str(data.attrs["sweep_variable2"])
             s["values2"] = np.ravel(data["sweep/values2"].values)
         # Axis labels with the swept variables' units, which /sweep/values and values2 carry.
-        s["label"] = _with_unit(s["variable"], data["sweep/values"].attrs.get("units"))
+        s["label"] = _with_unit(s["variable"], _unit_of(data["sweep/values"].attrs))
         if "variable2" in s:
-            s["label2"] = _with_unit(s["variable2"], data["sweep/values2"].attrs.get("units"))
+            s["label2"] = _with_unit(s["variable2"], _unit_of(data["sweep/values2"].attrs))
     n = s["values"].size
     if any(s[key].size != n for key in keys if key != "maxima"):
         raise FileError("per-point datasets of different lengths")
     if s["scene"] == "brake" and s["maxima_count"].sum() != s["maxima"].size:
         raise FileError("maxima_count does not add up to the maxima")
     return s
+
+
+def _unit_of(attrs):
+    """A dataset's unit for a label: in the brake's time τ where it has one
+    (`units_tau`, 'm/tau'), else its UDUNITS `units` ('m', 'eV')."""
+    return attrs.get("units_tau", attrs.get("units"))
 
 
 def _with_unit(name, unit):

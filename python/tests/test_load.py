@@ -49,14 +49,15 @@ def test_a_brake_run(brake_run):
     t, _ = raw(brake_run, "brake/t")
     x = data["brake/x"]
     assert x.dims == ("t",) and np.array_equal(x["t"].values, t) and x.attrs["units"] == "m"
-    assert data["brake/v"].attrs["units"] == "m per unit tau" and data["brake/stick"].dims == ("t",)
+    v = data["brake/v"].attrs    # UDUNITS at τ = 1, and in τ (docs/output.md#units-udunits-strings)
+    assert v["units"] == "m" and v["units_tau"] == "m/tau" and data["brake/stick"].dims == ("t",)
     events = data["brake/events/kind"]
     et, _ = raw(brake_run, "brake/events/t")
     assert events.dims == ("event",) and np.array_equal(events["t"].values, et)
     spectrum = data["brake/spectrum/amplitude"]
     f, _ = raw(brake_run, "brake/spectrum/frequency")
     assert spectrum.dims == ("frequency",) and np.array_equal(spectrum["frequency"].values, f)
-    assert spectrum["frequency"].attrs["units"] == "cycles per unit tau"
+    assert spectrum["frequency"].attrs["units"] == "1" and spectrum["frequency"].attrs["units_tau"] == "1/tau"
     assert data["brake/poincare/strobe_x"].dims == ("strobe_t",)
     st, _ = raw(brake_run, "brake/poincare/strobe_t")
     assert np.array_equal(data["brake/poincare/strobe_x"]["strobe_t"].values, st)
@@ -64,8 +65,9 @@ def test_a_brake_run(brake_run):
     assert data["brake/lyapunov/benettin_estimate"].dims == ("benettin_time",)
     assert data["brake/lyapunov/rosenstein_divergence"].dims == ("rosenstein_time",)
     brake = data["brake"].attrs
-    assert brake["v_dr_prime"] == -0.002788 and brake["v_dr_prime_units"] == "m/tau"
-    assert data["brake/spectrum"].attrs["peak_frequency_units"] == "1/tau"
+    assert brake["v_dr_prime"] == -0.002788 and brake["v_dr_prime_units"] == "m"
+    assert brake["v_dr_prime_units_tau"] == "m/tau"
+    assert data["brake/spectrum"].attrs["peak_frequency_units_tau"] == "1/tau"
 
 
 def test_a_machine_run_with_its_maps_and_spectrum(program, tmp_path):
@@ -91,9 +93,9 @@ def test_a_brake_sweep(brake_sweep):
     data = friction.load(brake_sweep, scene="sweep")
     values, vattrs = raw(brake_sweep, "sweep/values")
     lyap = data["sweep/lyapunov"]
-    assert lyap.dims == ("brake.v_dr_prime",) and lyap.attrs["units"] == "1/tau"
+    assert lyap.dims == ("brake.v_dr_prime",) and lyap.attrs["units_tau"] == "1/tau"
     assert np.array_equal(lyap["brake.v_dr_prime"].values, values)
-    assert lyap["brake.v_dr_prime"].attrs["units"] == vattrs["units"].decode() == "m/tau"
+    assert lyap["brake.v_dr_prime"].attrs["units_tau"] == vattrs["units_tau"].decode() == "m/tau"
     maxima = data["sweep/maxima"]
     counts, _ = raw(brake_sweep, "sweep/maxima_count")
     assert maxima.dims == ("maximum",) and maxima.size == counts.sum()

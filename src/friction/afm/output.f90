@@ -194,7 +194,7 @@ contains
          call file%write_attribute_real('/surface', 'table_tolerance', how%tolerance, 'nN')
          call file%write_attribute_real('/surface', 'table_error', how%error, 'nN')
          call file%write_attribute_integer('/surface', 'table_points', int(how%points, i8))
-         call file%write_attribute_integer('/surface', 'table_bytes', int(how%bytes, i8), 'B')
+         call file%write_attribute_integer('/surface', 'table_bytes', int(how%bytes, i8), 'byte')
          call file%write_attribute_integer('/surface', 'table_nodes', int(how%nodes(1), i8) * how%nodes(2) &
             & * how%nodes(3))
          call file%write_attribute_integer('/surface', 'table_layers', int(how%nodes(3), i8))

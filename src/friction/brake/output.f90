@@ -21,6 +21,9 @@ module friction_brake_output
 
    public :: brake_run_summary, brake_check_summary, write_brake_file
 
+   !> The units of the state's columns (x, x', y, y') in τ: their `units` is 'm' at τ = 1.
+   character(len=*), parameter :: state_units_tau = 'm, m/tau, m, m/tau'
+
    !> What the file records about the run besides the trajectory.
    type, extends(run_summary) :: brake_run_summary
       real(wp) :: compute_time = 0.0_wp    !! s, integration of the main run alone
@@ -37,6 +40,30 @@ module friction_brake_output
    end type brake_check_summary
 
 contains
+
+   !> A &law unit (SI) as the nondimensional brake's law reads its value
+   !> (docs/laws.md, "The brake with any law"): a force over k1 in m, a time in τ.
+   pure function brake_unit(unit) result(mapped)
+      character(len=*), intent(in) :: unit
+      character(len=:), allocatable :: mapped
+
+      select case (unit)
+      case ('N')
+         mapped = 'm'
+      case ('s')
+         mapped = 'tau'
+      case ('m/s')
+         mapped = 'm/tau'
+      case ('s/m')
+         mapped = 'tau/m'
+      case ('N/m')
+         mapped = '1'
+      case ('N s/m')
+         mapped = 'tau'
+      case default   ! '1', 'm'
+         mapped = unit
+      end select
+   end function brake_unit
 
    subroutine write_brake_file(path, comm, config, trajectory, events, summary, check, error, diagnostics)
       character(len=*), intent(in) :: path
@@ -103,15 +130,24 @@ contains
          ! The law's parameters in its own group (names such as mu and delta are &brake's too).
          call file%create_group('/brake/law')
          call file%write_attribute_text('/brake/law', 'model', trim(config%law%model))
-         call write_parameter_attributes(file, '/brake/law', copy, [character(len=17) :: 'law'])
+         if (trim(config%units) == 'dimensional') then
+            call write_parameter_attributes(file, '/brake/law', copy, [character(len=17) :: 'law'])
+         else
+            call write_parameter_attributes(file, '/brake/law', copy, [character(len=17) :: 'law'], brake_unit)
+         end if
       end if
 
       call file%write_vector('/brake/t', trajectory%t, 'tau')
       call file%write_vector('/brake/x', trajectory%x, 'm')
-      call file%write_vector('/brake/v', trajectory%v, 'm per unit tau')
+      call file%write_vector('/brake/v', trajectory%v, 'm/tau')
       call file%write_vector('/brake/y', trajectory%y, 'm')
-      call file%write_vector('/brake/w', trajectory%w, 'm per unit tau')
+      call file%write_vector('/brake/w', trajectory%w, 'm/tau')
       call file%write_vector_integer('/brake/stick', trajectory%stick, '1')
+      call file%write_attribute_text('/brake/t', 'long_name', 'dimensionless time tau')
+      call file%write_attribute_text('/brake/x', 'long_name', 'block displacement x')
+      call file%write_attribute_text('/brake/v', 'long_name', "block velocity x' = dx/dtau")
+      call file%write_attribute_text('/brake/y', 'long_name', 'crank-tip displacement y')
+      call file%write_attribute_text('/brake/w', 'long_name', "crank-tip velocity y' = dy/dtau")
       do k = 1, 5
          call file%attach_scales('/brake/'//trim(along_t(k)), ['/brake/t'])
       end do
@@ -123,12 +159,12 @@ contains
       end do
       n = events%n
       call file%write_attribute_text('/brake/events', 'kind_names', join(codes))
-      call file%write_vector('/brake/events/t', event_column(0), '1')
+      call file%write_vector('/brake/events/t', event_column(0), 'tau')
       call file%write_vector_integer('/brake/events/kind', event_kinds(), '1')
       call file%write_vector('/brake/events/x', event_column(1), 'm')
-      call file%write_vector('/brake/events/v', event_column(2), 'm per unit tau')
+      call file%write_vector('/brake/events/v', event_column(2), 'm/tau')
       call file%write_vector('/brake/events/y', event_column(3), 'm')
-      call file%write_vector('/brake/events/w', event_column(4), 'm per unit tau')
+      call file%write_vector('/brake/events/w', event_column(4), 'm/tau')
       ! The events' own axis: their number, the coordinate every /brake/events dataset runs along
       ! (their time t cannot be: a child's dimension named t would clash with the trajectory's).
       call file%write_vector_integer('/brake/events/event', [(k, k = 1, n)], '1')
@@ -190,10 +226,10 @@ contains
    subroutine write_diagnostics(file, d)
       type(h5_file), intent(inout) :: file
       type(brake_diagnostics), intent(in) :: d
-      character(len=*), parameter :: frequency_unit = 'cycles per unit tau'
+      character(len=*), parameter :: frequency_unit = '1/tau'   !! cycles per unit τ
       integer :: k
       character(len=*), parameter :: names(4) = ['x', 'v', 'y', 'w']
-      character(len=*), parameter :: units(4) = [character(len=14) :: 'm', 'm per unit tau', 'm', 'm per unit tau']
+      character(len=*), parameter :: units(4) = [character(len=5) :: 'm', 'm/tau', 'm', 'm/tau']
 
       associate (a => d%settings)
          if (a%spectrum) then
@@ -209,6 +245,7 @@ contains
             call file%write_attribute_real('/brake/spectrum', 'peak_amplitude', d%spectrum%peak_amplitude)
             call file%write_attribute_real('/brake/spectrum', 'resolution', d%spectrum%resolution, '1/tau')
             call file%write_vector('/brake/spectrum/frequency', d%spectrum%frequency, frequency_unit)
+            call file%write_attribute_text('/brake/spectrum/frequency', 'long_name', 'frequency in cycles per unit tau')
             k = findloc(names, trim(a%series), 1)
             call file%write_vector('/brake/spectrum/amplitude', d%spectrum%amplitude, trim(units(max(k, 1))))
             call file%attach_scales('/brake/spectrum/amplitude', ['/brake/spectrum/frequency'])
@@ -267,7 +304,9 @@ contains
                & int(a%rosenstein_fit_start, i8))
             call file%write_attribute_integer('/brake/lyapunov', 'rosenstein_fit_end', int(a%rosenstein_fit_end, i8))
             call file%write_vector('/brake/lyapunov/rosenstein_time', d%series%time, '1')
-            call file%write_vector('/brake/lyapunov/rosenstein_divergence', d%series%divergence, 'ln of the series unit')
+            call file%write_vector('/brake/lyapunov/rosenstein_divergence', d%series%divergence, '1')
+            call file%write_attribute_text('/brake/lyapunov/rosenstein_divergence', 'long_name', &
+               & 'mean natural log of the distance between neighbours, the distance in the unit of the series')
             call file%attach_scales('/brake/lyapunov/rosenstein_divergence', ['/brake/lyapunov/rosenstein_time'])
          end if
       end associate
@@ -293,8 +332,9 @@ contains
          call file%write_attribute_integer(group, 'iterations', int(o%orbit%iterations, i8))
          call file%write_attribute_real(group, 'residual', o%orbit%residual, 'm')
          ! The fixed point, or Newton's last iterate when none was found.
-         call file%write_vector(group//'/point', o%state, 'm, m per unit tau, m, m per unit tau')
+         call file%write_vector(group//'/point', o%state, 'm')
          call file%write_attribute_text(group//'/point', 'names', 'x, v, y, w')
+         call file%write_attribute_text(group//'/point', 'column_units_tau', state_units_tau)
          if (len_trim(a%continuation) > 0) call write_branch(file, d%branch)
          if (.not. o%orbit%found) return
          call file%write_attribute_real(group, 'period', o%orbit%period, 'tau')
@@ -328,7 +368,8 @@ contains
       call file%write_vector_integer(group//'/source', b%source, '1')
       call file%write_attribute_text(group//'/source', 'names', '1 = continued, 2 = from the attractor')
       call file%write_vector(group//'/period', b%period, 'tau')
-      call file%write_matrix(group//'/point', b%state, 'm, m per unit tau, m, m per unit tau')
+      call file%write_matrix(group//'/point', b%state, 'm')
+      call file%write_attribute_text(group//'/point', 'column_units_tau', state_units_tau)
       call file%write_matrix(group//'/floquet_multipliers_real', real(b%multipliers), '1')
       call file%write_matrix(group//'/floquet_multipliers_imag', aimag(b%multipliers), '1')
       call file%write_vector(group//'/max_modulus', b%max_modulus, '1')

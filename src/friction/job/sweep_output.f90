@@ -98,7 +98,7 @@ contains
       character(len=:), allocatable :: stepper(:)   !! as wide as the column (the memory type is the file's)
       integer, allocatable :: status(:), run(:), series_count(:), reason_length(:), whole(:)
       integer(i8), allocatable :: series_offset(:), reason_offset(:), out_offset(:)
-      real(wp), allocatable :: cost(:), values(:), results(:), series(:)
+      real(wp), allocatable :: cost(:), values(:), results(:), series(:), bytes(:)
       integer(i8) :: total, written
       integer :: n, k, j, first, piece, longest, a, b
       logical :: have
@@ -119,8 +119,11 @@ contains
       call file%create_group('/sweep')
       call file%write_attribute_integer('/sweep', 'shape', int(self%sweep%shape(1), i8))
       call file%write_attribute_integer('/sweep', 'shape2', int(self%sweep%shape(2), i8))
-      call file%write_integer_vector('/sweep/peak_memory_per_rank', self%memory)
-      call file%write_attribute_text('/sweep/peak_memory_per_rank', 'units', 'kB (VmHWM; 0: unknown)')
+      ! In bytes: UDUNITS knows no kibibyte (VmHWM's kB are 1024 bytes).
+      bytes = 1024.0_wp * real(self%memory, wp)
+      call file%write_vector('/sweep/peak_memory_per_rank', bytes, 'byte')
+      call file%write_attribute_text('/sweep/peak_memory_per_rank', 'long_name', &
+         & 'peak resident memory (VmHWM) of each rank; 0: unknown')
       call file%close(error)
       if (allocated(error)) return
 

@@ -2,7 +2,8 @@
 !> close), opened with the MPI-IO driver so every rank writes its own block
 !> of scan lines collectively.  Every call is collective: all ranks call it
 !> with the same names and the same small data.  A `units` attribute goes on
-!> every dataset.
+!> every dataset, a UDUNITS string (output/units.f90: a unit in τ as its
+!> value at τ = 1, and as given in `units_tau`).
 !>
 !> HDF5's automatic error printing is the program's: every operation saves
 !> the setting of the default error stack, switches printing off for its
@@ -21,6 +22,7 @@ module friction_output_h5
    use friction_error, only: error_type, fatal_error, error_io
    use friction_files, only: truncate_file, free_bytes, min_free_bytes, full_text, size_limit_room
    use friction_strings, only: bytes_text
+   use friction_output_units, only: plain_unit, mentions_tau
    implicit none
    private
 
@@ -124,6 +126,7 @@ module friction_output_h5
       procedure :: write_attribute_text
       procedure :: write_attribute_real
       procedure :: write_attribute_integer
+      procedure :: write_attribute_units
       procedure :: attach_scales
       procedure :: has_attribute
       procedure :: close
@@ -316,7 +319,7 @@ contains
       call h5screate_simple_f(rank, dims(1:rank), filespace, stat)
       if (.not. self%create_dataset(name, type, filespace, dset)) return
       if (n_total == 0) then   ! an empty dataset: nothing to write (and no buffer to point at)
-         if (len_trim(units) > 0) call attribute_text(self, dset, 'units', units)
+         if (len_trim(units) > 0) call dataset_units(self, dset, units)
          call h5dclose_f(dset, stat)
          call h5sclose_f(filespace, stat)
          return
@@ -339,7 +342,7 @@ contains
       call h5pclose_f(xfer, stat)
       call h5sclose_f(memspace, stat)
       call h5sclose_f(filespace, stat)
-      if (len_trim(units) > 0) call attribute_text(self, dset, 'units', units)
+      if (len_trim(units) > 0) call dataset_units(self, dset, units)
       call h5dclose_f(dset, stat)
    end subroutine write_block_silently
 
@@ -411,7 +414,7 @@ contains
       call h5screate_simple_f(1, dims, filespace, stat)
       if (.not. self%create_dataset(name, H5T_NATIVE_INTEGER, filespace, dset)) return
       if (size(values) == 0) then   ! an empty dataset: nothing to write
-         call attribute_text(self, dset, 'units', units)
+         call dataset_units(self, dset, units)
          call h5dclose_f(dset, stat)
          call h5sclose_f(filespace, stat)
          return
@@ -430,7 +433,7 @@ contains
       call h5pclose_f(xfer, stat)
       call h5sclose_f(memspace, stat)
       call h5sclose_f(filespace, stat)
-      call attribute_text(self, dset, 'units', units)
+      call dataset_units(self, dset, units)
       call h5dclose_f(dset, stat)
    end subroutine write_vector_integer_silently
 
@@ -494,6 +497,17 @@ contains
       end if
       call printing%restore()
    end subroutine write_attribute_text
+
+   !> A dataset's `units`, a UDUNITS string; a unit in τ also as given, in
+   !> `units_tau`.
+   subroutine dataset_units(self, dset, units)
+      class(h5_file), intent(inout) :: self
+      integer(hid_t), intent(in) :: dset
+      character(len=*), intent(in) :: units
+
+      call attribute_text(self, dset, 'units', plain_unit(units))
+      if (mentions_tau(units)) call attribute_text(self, dset, 'units_tau', trim(units))
+   end subroutine dataset_units
 
    subroutine attribute_text(self, obj, name, text)
       class(h5_file), intent(inout) :: self
@@ -568,7 +582,7 @@ contains
       character(len=*), intent(in), optional :: units
 
       call scalar_attribute(self, object, name, H5T_NATIVE_DOUBLE, c_loc(value))
-      if (present(units)) call self%write_attribute_text(object, name//'_units', units)
+      if (present(units)) call self%write_attribute_units(object, name, units)
    end subroutine write_attribute_real
 
    subroutine write_attribute_integer(self, object, name, value, units)
@@ -578,8 +592,18 @@ contains
       character(len=*), intent(in), optional :: units
 
       call scalar_attribute(self, object, name, h5kind_to_type(int64, H5_INTEGER_KIND), c_loc(value))
-      if (present(units)) call self%write_attribute_text(object, name//'_units', units)
+      if (present(units)) call self%write_attribute_units(object, name, units)
    end subroutine write_attribute_integer
+
+   !> The unit of attribute name as the text attribute NAME_units, a UDUNITS
+   !> string; a unit in τ also as given, in NAME_units_tau.
+   subroutine write_attribute_units(self, object, name, units)
+      class(h5_file), intent(inout) :: self
+      character(len=*), intent(in) :: object, name, units
+
+      call self%write_attribute_text(object, name//'_units', plain_unit(units))
+      if (mentions_tau(units)) call self%write_attribute_text(object, name//'_units_tau', trim(units))
+   end subroutine write_attribute_units
 
    !> Whether the object at path object has an attribute of that name.
    logical function has_attribute(self, object, name)

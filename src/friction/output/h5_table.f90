@@ -27,6 +27,7 @@ module friction_output_h5_table
    use friction_strings, only: bytes_text
    use friction_output_h5, only: h5_status, error_printing, room_to_close, new_text_attribute, new_scalar_attribute, &
       & open_hdf5, attach_dimension_scales
+   use friction_output_units, only: plain_unit, mentions_tau
    implicit none
    private
 
@@ -203,7 +204,7 @@ contains
    end function kind_type
 
    !> A chunked column of n zeros (n < 0: extendible, of none yet), with a
-   !> units attribute unless units is blank.
+   !> units attribute unless units is blank (a UDUNITS string, as h5_file writes it).
    subroutine add_column(self, name, kind, n, units)
       class(h5_table), intent(inout) :: self
       character(len=*), intent(in) :: name, units
@@ -234,9 +235,10 @@ contains
       character(len=*), intent(in) :: name, units
       integer(hid_t), intent(in) :: type
       integer(i8), intent(in) :: n
-      integer(hid_t) :: space, plist, dset, attr_space, attr_type, attr
+      integer(hid_t) :: space, plist, dset
       integer(hsize_t) :: dims(1), maxdims(1), chunk(1)
       integer :: stat
+      character(len=:), allocatable :: what
       type(error_printing) :: printing
 
       if (self%status /= 0) return
@@ -255,18 +257,12 @@ contains
       call self%check(stat, 'creating dataset '//name)
       if (stat == 0) then
          if (len_trim(units) > 0) then
-            call h5screate_f(H5S_SCALAR_F, attr_space, stat)
-            call h5tcopy_f(H5T_FORTRAN_S1, attr_type, stat)
-            call h5tset_size_f(attr_type, int(len(units), size_t), stat)
-            call h5tset_cset_f(attr_type, H5T_CSET_UTF8_F, stat)
-            call h5acreate_f(dset, 'units', attr_type, attr_space, attr, stat)
-            call self%check(stat, 'creating the units of '//name)
-            if (stat == 0) then
-               call h5awrite_f(attr, attr_type, units, [1_hsize_t], stat)
-               call h5aclose_f(attr, stat)
+            call new_text_attribute(dset, 'units', plain_unit(units), stat, what)
+            call self%check(stat, what)
+            if (mentions_tau(units)) then
+               call new_text_attribute(dset, 'units_tau', trim(units), stat, what)
+               call self%check(stat, what)
             end if
-            call h5tclose_f(attr_type, stat)
-            call h5sclose_f(attr_space, stat)
          end if
          call h5dclose_f(dset, stat)
       end if

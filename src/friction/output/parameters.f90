@@ -10,17 +10,27 @@ module friction_output_parameters
    implicit none
    private
 
-   public :: write_parameter_attributes
+   public :: write_parameter_attributes, unit_map
+
+   abstract interface
+      !> A declared unit in the units the object's values are in, when a
+      !> scene computes in other units than its input declares.
+      pure function unit_map(unit) result(mapped)
+         character(len=*), intent(in) :: unit
+         character(len=:), allocatable :: mapped
+      end function unit_map
+   end interface
 
 contains
 
-   subroutine write_parameter_attributes(file, object, config, groups)
+   subroutine write_parameter_attributes(file, object, config, groups, unit_of)
       type(h5_file), intent(inout) :: file
       character(len=*), intent(in) :: object
       class(configurable), intent(inout) :: config
       character(len=*), intent(in) :: groups(:)
+      procedure(unit_map), optional :: unit_of   !! the declared units' counterparts (default: as declared)
       type(parameter_info), allocatable :: list(:)
-      character(len=:), allocatable :: text, problem
+      character(len=:), allocatable :: text, problem, unit
       real(wp) :: value
       integer :: k, stat
 
@@ -28,15 +38,17 @@ contains
       do k = 1, size(list)
          associate (p => list(k))
             if (.not. any(groups == p%group) .or. p%kind /= 'r' .or. p%size /= 1 .or. len_trim(p%unit) == 0) cycle
+            unit = trim(p%unit)
+            if (present(unit_of)) unit = unit_of(unit)
             if (file%has_attribute(object, trim(p%name))) then
                if (.not. file%has_attribute(object, trim(p%name)//'_units')) &
-                  & call file%write_attribute_text(object, trim(p%name)//'_units', trim(p%unit))
+                  & call file%write_attribute_units(object, trim(p%name), unit)
                cycle
             end if
             call get_parameter(config, trim(p%group), trim(p%name), 0, text, problem)
             if (len(problem) > 0) cycle
             read (text, *, iostat=stat) value
-            if (stat == 0) call file%write_attribute_real(object, trim(p%name), value, trim(p%unit))
+            if (stat == 0) call file%write_attribute_real(object, trim(p%name), value, unit)
          end associate
       end do
    end subroutine write_parameter_attributes
