@@ -60,3 +60,10 @@ add_test(NAME python-units
           --basetemp "${_fp_work}/pytest-units"
   WORKING_DIRECTORY "${_fp_work}")
 set_tests_properties(python-units PROPERTIES LABELS "python;output" TIMEOUT 120 ENVIRONMENT "${_fp_env}")
+
+# The public Python API has type hints and numpydoc docstrings (numpydoc's own validation).
+add_test(NAME python-api-docs
+  COMMAND ${Python3_EXECUTABLE} -m pytest "${PROJECT_SOURCE_DIR}/python/tests/test_api_docs.py" -q -p no:cacheprovider
+          --basetemp "${_fp_work}/pytest-api-docs"
+  WORKING_DIRECTORY "${_fp_work}")
+set_tests_properties(python-api-docs PROPERTIES LABELS python TIMEOUT 120 ENVIRONMENT "${_fp_env}")

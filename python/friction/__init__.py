@@ -35,9 +35,15 @@ __all__ = ["__version__", "library_version", "api_version", "library_path", "Fri
            "plot", "fit", "law", "thermal"]
 
 
-def library_version():
+def library_version() -> str:
     """The version of the loaded library (friction_version() of the C API);
-    __version__ is the package's, and the two agree for a matched install."""
+    __version__ is the package's, and the two agree for a matched install.
+
+    Returns
+    -------
+    str
+        The library's version ("0.1.0").
+    """
     return _capi.version()
 
 

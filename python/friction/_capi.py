@@ -42,6 +42,8 @@ from the first of (find_library):
   5. the system's loader (LD_LIBRARY_PATH, ldconfig's cache): libfriction.so.0.
 A library of another C API version is refused.
 """
+from __future__ import annotations
+
 import ctypes
 import ctypes.util
 import numbers
@@ -50,6 +52,7 @@ import os
 import signal
 import threading
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -69,11 +72,19 @@ OK, ERROR_INPUT, ERROR_NUMERICAL, ERROR_IO, ERROR_INTERNAL, INTERRUPTED = 0, 1, 
 
 
 class FrictionError(RuntimeError):
-    """A call the library refused or could not finish; .status is its code
-    (1 input, 2 numerical, 3 I/O, 4 internal, 5 stopped on request),
-    .message the library's message."""
+    """A call the library refused or could not finish.
 
-    def __init__(self, status, message):
+    Parameters
+    ----------
+    status : int
+        Its code: 1 input, 2 numerical, 3 I/O, 4 internal, 5 stopped on request.
+    message : str
+        The library's message.
+    """
+
+    def __init__(self, status: int, message: str) -> None:
+        """The status and the message, as the library gave them.
+        """
         super().__init__(f"{message} (status {status})")
         self.status = status
         self.message = message
@@ -231,8 +242,19 @@ def library():
     return _loaded
 
 
-def library_path():
-    """The file the library was loaded from (loading it if need be)."""
+def library_path() -> str:
+    """The file the library was loaded from (loading it if need be).
+
+    Returns
+    -------
+    str
+        Its real path.
+
+    Raises
+    ------
+    LibraryNotFoundError
+        No library could be loaded.
+    """
     library()
     if os.path.sep in _loaded_path:
         return os.path.realpath(_loaded_path)
@@ -257,8 +279,19 @@ def version():
     return buf.value.decode()
 
 
-def api_version():
-    """The library's C API version (FRICTION_API_VERSION)."""
+def api_version() -> int:
+    """The library's C API version (FRICTION_API_VERSION).
+
+    Returns
+    -------
+    int
+        The version.
+
+    Raises
+    ------
+    LibraryNotFoundError
+        No library could be loaded.
+    """
     return library().friction_api_version()
 
 
@@ -462,8 +495,11 @@ class Config:
             self.set(name, value)
 
     # ---- lifetime ----
-    def close(self):
-        """Free the configuration (also at the end of a `with` block, or when collected)."""
+    def close(self) -> None:
+        """Free the configuration (also at the end of a `with` block, or when collected).
+
+        Closing twice is harmless.
+        """
         if self._handle:
             self._lib.friction_config_free(self._handle)
             self._handle = None
@@ -479,20 +515,68 @@ class Config:
             self.close()
 
     @property
-    def handle(self):
+    def handle(self) -> int:
+        """The C API's handle of the configuration.
+
+        Returns
+        -------
+        int
+            The handle.
+
+        Raises
+        ------
+        ValueError
+            A closed configuration.
+        """
         if not self._handle:
             raise ValueError("the configuration is closed")
         return self._handle
 
     # ---- values ----
-    def read(self, path):
-        """Apply a namelist file over the current values (all or nothing)."""
+    def read(self, path: str | os.PathLike[str]) -> Config:
+        """Apply a namelist file over the current values (all or nothing).
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            A namelist file.
+
+        Returns
+        -------
+        Config
+            This configuration, for chaining.
+
+        Raises
+        ------
+        FrictionError
+            The library's refusal: the program's message (file, line, group, variable) and status.
+        """
         _call(self._lib.friction_config_read, self.handle, _c_path(path))
         return self
 
-    def set(self, name, value):
+    def set(self, name: str, value: Any) -> Config:
         """Set "group.variable" (or "group.variable(k)"): a number, True/False, a
-        text (quoted for you), or a list of them."""
+        text (quoted for you), or a list of them.
+
+        Parameters
+        ----------
+        name : str
+            "group.variable", or "group.variable(k)" from element k on.
+        value : float or int or bool or str or sequence
+            The value; a list sets elements one after another.
+
+        Returns
+        -------
+        Config
+            This configuration, for chaining.
+
+        Raises
+        ------
+        FrictionError
+            The library's refusal: the program's message (file, line, group, variable) and status.
+        ValueError
+            A name or value with a NUL character.
+        """
         if isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_)):
             _call(self._lib.friction_config_set_real, self.handle, _c_text(name, "name"), float(value))
         elif isinstance(value, (list, tuple, np.ndarray)):
@@ -501,13 +585,49 @@ class Config:
             self.set_text(name, _item(value))
         return self
 
-    def set_text(self, name, text):
-        """Set a variable from namelist value text ("5.0", "'hopg'", ".true.", "3*0.0")."""
+    def set_text(self, name: str, text: str) -> Config:
+        """Set a variable from namelist value text ("5.0", "'hopg'", ".true.", "3*0.0").
+
+        Parameters
+        ----------
+        name : str
+            "group.variable", or "group.variable(k)" from element k on.
+        text : str
+            Namelist value text.
+
+        Returns
+        -------
+        Config
+            This configuration, for chaining.
+
+        Raises
+        ------
+        FrictionError
+            The library's refusal: the program's message (file, line, group, variable) and status.
+        ValueError
+            A NUL character.
+        """
         _call(self._lib.friction_config_set, self.handle, _c_text(name, "name"), _c_text(text, "value"))
         return self
 
-    def get(self, name):
-        """A variable's value as namelist text ("10.0", "'naf'", ".true.", "2*0.0")."""
+    def get(self, name: str) -> str:
+        """A variable's value as namelist text ("10.0", "'naf'", ".true.", "2*0.0").
+
+        Parameters
+        ----------
+        name : str
+            "group.variable", or "group.variable(k)" from element k on.
+
+        Returns
+        -------
+        str
+            The value as namelist text.
+
+        Raises
+        ------
+        FrictionError
+            The library's refusal: the program's message (file, line, group, variable) and status.
+        """
         buf = ctypes.create_string_buffer(1 << 16)
         _call(self._lib.friction_config_get, self.handle, _c_text(name, "name"), buf, len(buf))
         return buf.value.decode()
@@ -521,21 +641,44 @@ class Config:
             raise FrictionError(ERROR_INPUT, f"{function.__name__}: the text did not fit")
         return buf.value.decode()
 
-    def text(self):
-        """The whole configuration as namelist text (read() reads it back)."""
+    def text(self) -> str:
+        """The whole configuration as namelist text (read() reads it back).
+
+        Returns
+        -------
+        str
+            Namelist groups, every variable of the scene.
+        """
         return self._text(self._lib.friction_config_text)
 
-    def names(self):
+    def names(self) -> list[tuple[str, str, int, str]]:
         """Every variable: a list of (name, kind, elements, unit), kind "real",
-        "integer", "logical" or "text"."""
+        "integer", "logical" or "text".
+
+        Returns
+        -------
+        list of tuple
+            (name, kind, elements, unit) per variable.
+        """
         rows = []
         for line in self._text(self._lib.friction_config_names).splitlines():
             name, kind, size, unit = line.split("\t")
             rows.append((name, kind, int(size), unit))
         return rows
 
-    def check(self):
-        """The scene's checks; FrictionError with the first value refused."""
+    def check(self) -> Config:
+        """The scene's checks; FrictionError with the first value refused.
+
+        Returns
+        -------
+        Config
+            This configuration, for chaining.
+
+        Raises
+        ------
+        FrictionError
+            The library's refusal: the program's message (file, line, group, variable) and status.
+        """
         _call(self._lib.friction_config_check, self.handle)
         return self
 

@@ -12,8 +12,12 @@ The files' layouts (which dataset runs along which other) are the program's
 own, so load() names the dimensions and coordinates that the files do not
 yet mark themselves; xarray does the rest.
 """
+from __future__ import annotations
+
 import contextlib
+import os
 from pathlib import Path
+from typing import Any, Iterator
 
 import h5py
 import numpy as np
@@ -28,8 +32,19 @@ class FileError(ValueError):
     message says which (the scripts print it after the file's name)."""
 
 
-def text(value):
-    """HDF5 string attributes come back as (arrays of) bytes; give str."""
+def text(value: Any) -> str:
+    """HDF5 string attributes come back as (arrays of) bytes; give str.
+
+    Parameters
+    ----------
+    value : bytes or str or numpy.ndarray
+        An attribute's value.
+
+    Returns
+    -------
+    str
+        The text.
+    """
     if isinstance(value, np.ndarray) and value.shape == ():
         value = value[()]
     return value.decode() if isinstance(value, bytes) else str(value)
@@ -69,9 +84,20 @@ def _attrs(raw):
     return {name: _python(raw[name]) for name in raw.keys() if name not in SCALE_ATTRIBUTES}
 
 
-def paths(tree):
+def paths(tree: xr.DataTree) -> list[str]:
     """The path of every array in a loaded file ("afm/trace/fx", "brake/t"),
-    coordinates included, in the file's order of groups."""
+    coordinates included, in the file's order of groups.
+
+    Parameters
+    ----------
+    tree : xarray.DataTree
+        A loaded file (friction.load).
+
+    Returns
+    -------
+    list of str
+        The paths.
+    """
     out = []
     for node in tree.subtree:
         prefix = node.path.strip("/")
@@ -80,9 +106,20 @@ def paths(tree):
     return out
 
 
-def groups(tree):
+def groups(tree: xr.DataTree) -> dict[str, Any]:
     """{group path: its attributes} of every group of a loaded file ("afm",
-    "brake/spectrum"); the root's are tree.attrs."""
+    "brake/spectrum"); the root's are tree.attrs.
+
+    Parameters
+    ----------
+    tree : xarray.DataTree
+        A loaded file (friction.load).
+
+    Returns
+    -------
+    dict
+        {group path: attributes}.
+    """
     return {node.path.strip("/"): node.attrs for node in tree.subtree if node.path != "/"}
 
 
@@ -104,7 +141,7 @@ def _read_values(dataset):
     return np.asarray(values)
 
 
-def load(path, scene=None):
+def load(path: str | os.PathLike[str] | xr.DataTree, scene: str | None = None) -> xr.DataTree:
     """Read a friction output file (any HDF5 file) into an xarray.DataTree:
     a node per group, a variable per dataset (named by the dataset), the
     root's and each group's attributes as the node's attrs.
@@ -133,7 +170,31 @@ def load(path, scene=None):
 
     scene: 'afm', 'brake' or 'sweep' to require a file the program wrote for
     that scene.  Raises FileError for a missing file, one that is not HDF5,
-    or not of the scene asked for."""
+    or not of the scene asked for.
+
+    Parameters
+    ----------
+    path : str or os.PathLike or xarray.DataTree
+        The file (a tree is returned as it is).
+    scene : str, optional
+        'afm', 'brake' or 'sweep': require a file of that scene.
+
+    Returns
+    -------
+    xarray.DataTree
+        The file, read whole (the file is closed).
+
+    Raises
+    ------
+    FileError
+        A missing file, one that is not HDF5, or not of the scene asked for.
+
+    Examples
+    --------
+    >>> data = friction.load("naf.h5")  # doctest: +SKIP
+    >>> data["afm/trace/fx"].attrs["units"]  # doctest: +SKIP
+    'nN'
+    """
     if scene is not None:
         return require(path, scene)
     if isinstance(path, xr.DataTree):
@@ -308,13 +369,32 @@ def _sweep_layout(raw, root, group_attrs, labels):
 
 
 @contextlib.contextmanager
-def open_output(path, scene, what):
+def open_output(path: str | os.PathLike[str], scene: str, what: str) -> Iterator[h5py.File]:
     """Open a friction output file of the given scene with h5py, for reading.
 
     path: a file name; scene: 'afm', 'brake' or 'sweep', also the group that
     must exist; what: how to call the file in messages ('force-map', 'brake').
     Missing datasets (KeyError), unreadable files (OSError) and unexpected
     data (TypeError, ValueError) inside the block become FileError.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file.
+    scene : str
+        'afm', 'brake' or 'sweep', also the group that must exist.
+    what : str
+        How to call the file in messages.
+
+    Yields
+    ------
+    h5py.File
+        The open file.
+
+    Raises
+    ------
+    FileError
+        A file that is not of the scene, or fails inside the block.
     """
     path = _check_path(path)
     try:

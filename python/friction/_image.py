@@ -15,13 +15,21 @@ plain text (.txt, .csv, .dat) always.  The readers of the three
 instrument formats are optional dependencies, imported on first use.
 Lengths are given in angstrom (the model's unit), angles in degrees.
 """
+from __future__ import annotations
+
 import math
 import os
 import re
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import TYPE_CHECKING, Any, Mapping
 
 import numpy as np
+
+if TYPE_CHECKING:
+    import os
+
+    from numpy.typing import ArrayLike
 
 __all__ = ["MeasuredImage", "ImageError", "read_image", "image_from_arrays"]
 
@@ -41,18 +49,35 @@ class ImageError(ValueError):
 class MeasuredImage:
     """A lateral-force image: trace (and retrace) of one channel.
 
-    trace, retrace  (ny, nx) arrays, row j the j-th line in the order the
-                    file stores it, column i the i-th sample along the line;
-                    retrace stored by position, like trace (None if absent)
-    unit            of the values ("V" raw, "nN" once calibrated)
-    size            (along the lines, across them), angstrom
-    pixels          (nx, ny)
-    direction       the frame's direction ("down", "up" or "")
-    angle           the scan angle, degrees (0 when the file has none)
-    channel, path, format   where the data came from
-    mask            (ny, nx) bool, True where the pixel is valid (finite in
-                    trace and retrace); masked is the number of invalid ones
-    metadata        what else the reader found (a Bruker setpoint, ...)"""
+    Parameters
+    ----------
+    trace : numpy.ndarray
+        (ny, nx): row j the j-th line in the order the file stores it,
+        column i the i-th sample along the line.
+    retrace : numpy.ndarray, optional
+        (ny, nx), stored by position like trace (None if absent).
+    unit : str
+        Of the values ("V" raw, "nN" once calibrated).
+    size : tuple of float
+        (along the lines, across them), angstrom.
+    direction : str
+        The frame's direction ("down", "up" or "").
+    angle : float
+        The scan angle, degrees (0 when the file has none).
+    channel : str
+        The channel's name.
+    path : str
+        The file it came from.
+    format : str
+        The format read.
+    metadata : dict
+        What else the reader found (a Bruker setpoint, ...).
+
+    Raises
+    ------
+    ImageError
+        Arrays that are not 2-D or differ in shape.
+    """
 
     trace: np.ndarray
     retrace: np.ndarray = None
@@ -79,51 +104,158 @@ class MeasuredImage:
         return self.path or "the image"
 
     @property
-    def pixels(self):
+    def pixels(self) -> tuple[int, int]:
+        """The image's size in pixels, (nx, ny).
+
+        Returns
+        -------
+        tuple of int
+            (nx, ny).
+        """
         return (self.trace.shape[1], self.trace.shape[0])
 
     @property
-    def mask(self):
+    def mask(self) -> np.ndarray:
+        """Where the pixels are valid (finite in trace and retrace).
+
+        Returns
+        -------
+        numpy.ndarray
+            (ny, nx) bool.
+        """
         valid = np.isfinite(self.trace)
         if self.retrace is not None:
             valid &= np.isfinite(self.retrace)
         return valid
 
     @property
-    def masked(self):
+    def masked(self) -> int:
+        """The number of invalid pixels.
+
+        Returns
+        -------
+        int
+            The count.
+        """
         return int(self.mask.size - np.count_nonzero(self.mask))
 
     def _needs_retrace(self, what):
         if self.retrace is None:
             raise ImageError(f"{self._where()}: channel {self.channel!r} has no retrace: {what} needs both passes")
 
-    def friction(self):
-        """(trace - retrace) / 2 per pixel: half the friction loop's width, NaN where masked."""
+    def friction(self) -> np.ndarray:
+        """(trace - retrace) / 2 per pixel: half the friction loop's width, NaN where masked.
+
+        Returns
+        -------
+        numpy.ndarray
+            (ny, nx).
+
+        Raises
+        ------
+        ImageError
+            An image without retrace.
+        """
         self._needs_retrace("the friction")
         return np.where(self.mask, (self.trace - self.retrace) / 2.0, np.nan)
 
-    def offset(self):
-        """(trace + retrace) / 2 per pixel: the loop's centre (the signal's offset, topography's cross-talk)."""
+    def offset(self) -> np.ndarray:
+        """(trace + retrace) / 2 per pixel: the loop's centre (the signal's offset, topography's cross-talk).
+
+        Returns
+        -------
+        numpy.ndarray
+            (ny, nx).
+
+        Raises
+        ------
+        ImageError
+            An image without retrace.
+        """
         self._needs_retrace("the offset")
         return np.where(self.mask, (self.trace + self.retrace) / 2.0, np.nan)
 
-    def line_friction(self):
-        """The friction of each line: the mean of (trace - retrace)/2 over its valid pixels, (ny,)."""
+    def line_friction(self) -> np.ndarray:
+        """The friction of each line: the mean of (trace - retrace)/2 over its valid pixels, (ny,).
+
+        Returns
+        -------
+        numpy.ndarray
+            (ny,).
+
+        Raises
+        ------
+        ImageError
+            An image without retrace.
+        """
         return _row_means(self.friction())
 
-    def line_offset(self):
+    def line_offset(self) -> np.ndarray:
+        """The offset of each line: the mean of (trace + retrace)/2 over its valid pixels.
+
+        Returns
+        -------
+        numpy.ndarray
+            (ny,).
+
+        Raises
+        ------
+        ImageError
+            An image without retrace.
+        """
         return _row_means(self.offset())
 
-    def mean_friction(self):
-        """The image's friction: the mean of (trace - retrace)/2 over its valid pixels."""
+    def mean_friction(self) -> float:
+        """The image's friction: the mean of (trace - retrace)/2 over its valid pixels.
+
+        Returns
+        -------
+        float
+            In the image's unit.
+
+        Raises
+        ------
+        ImageError
+            An image without retrace.
+        """
         return float(np.nanmean(self.friction()))
 
-    def mean_offset(self):
+    def mean_offset(self) -> float:
+        """The image's offset: the mean of (trace + retrace)/2 over its valid pixels.
+
+        Returns
+        -------
+        float
+            In the image's unit.
+
+        Raises
+        ------
+        ImageError
+            An image without retrace.
+        """
         return float(np.nanmean(self.offset()))
 
-    def calibrated(self, factor, unit="nN"):
+    def calibrated(self, factor: float, unit: str = "nN") -> MeasuredImage:
         """The image in force units: every value times `factor` (nN per V, the
-        lateral sensitivity the user calibrated)."""
+        lateral sensitivity the user calibrated).
+
+        Parameters
+        ----------
+        factor : float
+            Units of the result per unit of the image (nN per V).
+        unit : str
+            The result's unit.
+
+        Returns
+        -------
+        MeasuredImage
+            A new image; this one is unchanged.
+
+        Raises
+        ------
+        ImageError
+            A factor that is 0 or not finite.
+        """
         factor = float(factor)
         if not math.isfinite(factor) or factor == 0.0:
             raise ImageError(f"{self._where()}: the calibration factor must be finite and nonzero, not {factor}")
@@ -144,9 +276,44 @@ def _row_means(values):
     return np.where(counts > 0, sums / np.maximum(counts, 1), np.nan)
 
 
-def image_from_arrays(trace, retrace=None, size=None, unit="", angle=0.0, direction="", channel="",
-                      path="", format="arrays", metadata=None):
-    """A MeasuredImage from numpy arrays (size in angstrom along and across the lines)."""
+def image_from_arrays(trace: ArrayLike, retrace: ArrayLike | None = None, size: tuple[float, float] | None = None,
+                      unit: str = "", angle: float = 0.0, direction: str = "", channel: str = "", path: str = "",
+                      format: str = "arrays", metadata: Mapping[str, Any] | None = None) -> MeasuredImage:
+    """A MeasuredImage from numpy arrays (size in angstrom along and across the lines).
+
+    Parameters
+    ----------
+    trace : array_like
+        (ny, nx).
+    retrace : array_like, optional
+        (ny, nx), stored by position.
+    size : tuple of float, optional
+        (along, across) in angstrom.
+    unit : str
+        Of the values.
+    angle : float
+        The scan angle, degrees.
+    direction : str
+        "down", "up" or "".
+    channel : str
+        The channel's name.
+    path : str
+        Where it came from.
+    format : str
+        The format read.
+    metadata : dict, optional
+        What else is known.
+
+    Returns
+    -------
+    MeasuredImage
+        The image.
+
+    Raises
+    ------
+    ImageError
+        Arrays not 2-D or of different shapes.
+    """
     trace = np.asarray(trace, dtype=float)
     if size is None:
         size = (float("nan"), float("nan"))
@@ -333,24 +500,40 @@ def _read_text(path, channel, retrace):
     return image_from_arrays(trace, back, None, "", 0.0, "", channel or "", str(path), "text")
 
 
-def read_image(path, channel=None, retrace=None, calibration=None, size=None):
-    """A lateral-force image from a microscope's file: a MeasuredImage.
+def read_image(path: str | os.PathLike[str], channel: str | None = None, retrace: str | os.PathLike[str] | None = None, calibration: float | None = None, size: tuple[float, float] | None = None) -> MeasuredImage:
+    """A lateral-force image from a microscope's file.
 
-    path         .spm or .000-.999 (Bruker Nanoscope, pySPM), .sxm (Nanonis,
-                 pySPM), .gwy (Gwyddion, gwyfile), .npy ((ny, nx) or
-                 (2, ny, nx): trace and retrace), .npz (arrays "trace",
-                 "retrace", optional "size", "angle", "unit"; with channel
-                 "fy": "fy/trace", "fy/retrace"), or text (.txt, .dat, .asc
-                 whitespace, .csv commas: one (ny, nx) table, the trace)
-    channel      the channel's name ("Friction"); None: the first lateral
-                 one (a name with friction, lateral, LFM)
-    retrace      for a text file, the file of the retrace
-    calibration  nN per unit of the file's values (V): the image returned
-                 in nN (MeasuredImage.calibrated)
-    size         (along, across) in angstrom, for files that carry none
-    Raises ImageError naming the file: a missing file or channel, a format
-    not among these, a file whose content is not its format's, a reader
-    package that is not installed."""
+    Parameters
+    ----------
+    path : str or os.PathLike
+        .spm or .000-.999 (Bruker Nanoscope, pySPM), .sxm (Nanonis, pySPM),
+        .gwy (Gwyddion, gwyfile), .npy ((ny, nx) or (2, ny, nx): trace and
+        retrace), .npz (arrays "trace", "retrace", optional "size", "angle",
+        "unit"; with channel "fy": "fy/trace", "fy/retrace"), or text (.txt,
+        .dat, .asc whitespace, .csv commas: one (ny, nx) table, the trace).
+    channel : str, optional
+        The channel's name ("Friction"); None: the first lateral one (a name
+        with friction, lateral, LFM).
+    retrace : str or os.PathLike, optional
+        For a text file, the file of the retrace.
+    calibration : float, optional
+        nN per unit of the file's values (V): the image returned in nN
+        (MeasuredImage.calibrated).
+    size : tuple of float, optional
+        (along, across) in angstrom, for files that carry none.
+
+    Returns
+    -------
+    MeasuredImage
+        Trace and retrace of the channel.
+
+    Raises
+    ------
+    ImageError
+        Naming the file: a missing file or channel, a format not among these,
+        a file whose content is not its format's, a reader package that is
+        not installed.
+    """
     path = Path(os.fspath(path))
     if not path.is_file():
         raise ImageError(f"{path}: no such file")

@@ -16,7 +16,23 @@ def input_file(name: str) -> Path:
     """The path of the project's input file `name` ("hopg.nml"), for
     friction.run or Config(files=...) from any folder.
 
-    Raises FileNotFoundError naming the folders looked in."""
+    Raises FileNotFoundError naming the folders looked in.
+
+    Parameters
+    ----------
+    name : str
+        The file's name ("hopg.nml").
+
+    Returns
+    -------
+    pathlib.Path
+        Its path.
+
+    Raises
+    ------
+    FileNotFoundError
+        No such input file; the message names the folders looked in.
+    """
     for folder in _FOLDERS:
         if (folder / name).is_file():
             return folder / name

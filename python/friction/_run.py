@@ -4,12 +4,15 @@ The library's job runs the program's whole computation (every group: &analysis,
 &verify, &sweep) on this process and writes the program's HDF5 file; the
 computations return numpy arrays without a file.
 """
+from __future__ import annotations
+
 import os
 import re
 import sys
 import time
 from collections import namedtuple
 from pathlib import Path
+from typing import Any, Callable, Mapping, Sequence, Union
 
 import numpy as np
 
@@ -17,9 +20,23 @@ from . import _capi
 
 __all__ = ["Config", "run", "afm_line", "brake", "compute", "Line"]
 
+#: A file's name or path.
+PathLike = Union[str, "os.PathLike[str]"]
+#: What `progress` takes: True (a bar), False (nothing) or a callable (message, fraction).
+Progress = Union[bool, Callable[[str, float], Any]]
+
 Line = namedtuple("Line", "x fx fy")
-Line.__doc__ = """One scan line: support positions x along the scan (angstrom) and the
-lateral force fx, fy along the lattice axes (nN) there."""
+Line.__doc__ = """One scan line.
+
+Parameters
+----------
+x : numpy.ndarray
+    Support positions along the scan (angstrom).
+fx : numpy.ndarray
+    Lateral force along the lattice's x axis there (nN).
+fy : numpy.ndarray
+    Lateral force along the lattice's y axis there (nN).
+"""
 
 
 class _TextProgress:
@@ -94,32 +111,58 @@ def _files(files):
     return [Path(f) for f in files]
 
 
-def run(files, output=None, force=False, resume=False, progress=True):
-    """Run a job as the program does: read the namelist files in order (a
-    later file overrides earlier values variable by variable), compute the
-    scene or sweep they describe on this process, write the HDF5 file.
+def run(files: PathLike | Sequence[PathLike], output: PathLike | None = None, force: bool = False, resume: bool = False, progress: Progress = True) -> Path:
+    """Run a job as the program does, to its HDF5 file.
 
-    files     a namelist file or a list of them
-    output    the HDF5 file (default: the first file's name with .h5, in the
-              current directory, as the program's)
-    force     overwrite an existing output (otherwise FrictionError)
-    resume    a sweep reuses the checkpoints of an interrupted run
-    progress  True: a tqdm bar where tqdm is installed, else a line on
-              stderr every 2 s; False: nothing; a callable: called with
-              (message, fraction), fraction in [0, 1] for progress ("12 of 64
-              lines") and -1 for notes (a verify result)
-    Returns the output's Path.  Raises FrictionError for bad input (the
-    program's message, with file and line), a failed integration or an
-    unwritable file (nothing is written then).  Ctrl-C stops the job at its
-    next scan line or sweep point and raises KeyboardInterrupt, its context
-    a FrictionError with status 5: a sweep's file holds the points done, a
-    map keeps the lines done beside the output; resume=True computes only
-    the rest.
+    Read the namelist files in order (a later file overrides earlier values
+    variable by variable), compute the scene or sweep they describe on this
+    process, write the HDF5 file (under a temporary name, renamed when
+    complete).  Ctrl-C stops the job at its next scan line or sweep point and
+    raises KeyboardInterrupt, its context a FrictionError with status 5: a
+    sweep's file holds the points done, a map keeps the lines done beside the
+    output; resume=True computes only the rest.
 
     MPI: in a process without MPI the job runs serially on this process,
     without starting MPI (the same file as `mpirun -n 1`); under
     `mpirun -n N python ...` with mpi4py initialising MPI first, the job is
-    collective over every rank, as the program's."""
+    collective over every rank, as the program's.
+
+    Parameters
+    ----------
+    files : str or os.PathLike or sequence of them
+        A namelist file or a list of them.
+    output : str or os.PathLike, optional
+        The HDF5 file (default: the first file's name with .h5, in the
+        current directory, as the program's).
+    force : bool
+        Overwrite an existing output.
+    resume : bool
+        A sweep or map reuses the checkpoints of an interrupted run.
+    progress : bool or callable
+        True: a tqdm bar where tqdm is installed, else a line on stderr every
+        2 s; False: nothing; a callable: called with (message, fraction),
+        fraction in [0, 1] for progress ("12 of 64 lines") and -1 for notes.
+
+    Returns
+    -------
+    pathlib.Path
+        The output file.
+
+    Raises
+    ------
+    FrictionError
+        Bad input (the program's message, with file and line), a failed
+        integration or an unwritable file, or an existing output without force:
+        nothing is written then.
+    ValueError
+        No file.
+    KeyboardInterrupt
+        Ctrl-C, after the job stopped.
+
+    Examples
+    --------
+    >>> path = friction.run(friction.input_file("naf.nml"), "naf.h5", force=True)  # doctest: +SKIP
+    """
     paths = _files(files)
     if not paths:
         raise ValueError("run() needs at least one namelist file")
@@ -185,20 +228,57 @@ class Config(_capi.Config):
         maps = cfg.compute()                 # {"trace/fx": (ny, nx) array, ..., "support_x": ...}
         cfg.run("naf.h5", force=True)        # the job with every group, to a file
 
-    scene: "afm" (a friction-force map) or "brake" (the Girling brake);
-    files: namelist files read in order; values: {"group.variable": value}
-    set after them.  Units are those of the namelist input."""
+    Units are those of the namelist input.
 
-    def __init__(self, scene="afm", files=(), values=None):
+    Parameters
+    ----------
+    scene : str
+        "afm" (a friction-force map) or "brake" (the Girling brake).
+    files : str or os.PathLike or sequence of them
+        Namelist files read in order over the defaults.
+    values : dict, optional
+        {"group.variable": value} set after them.
+
+    Raises
+    ------
+    FrictionError
+        An unknown scene, a file or value the program refuses.
+    """
+
+    def __init__(self, scene: str = "afm", files: PathLike | Sequence[PathLike] = (), values: Mapping[str, Any] | None = None) -> None:
+        """Read the files over the scene's defaults, then set the values.
+        """
         super().__init__(scene, files, values)
 
-    def kinds(self):
-        """{name: (kind, elements, unit)} of every variable."""
+    def kinds(self) -> dict[str, tuple[str, int, str]]:
+        """{name: (kind, elements, unit)} of every variable.
+
+        Returns
+        -------
+        dict
+            {name: (kind, elements, unit)}.
+        """
         return {name: (kind, size, unit) for name, kind, size, unit in self.names()}
 
-    def value(self, name):
+    def value(self, name: str) -> Any:
         """A variable's value as Python: float, int, bool, str, or a list of
-        them for an array variable ("surface.sigma")."""
+        them for an array variable ("surface.sigma").
+
+        Parameters
+        ----------
+        name : str
+            "group.variable" or "group.variable(k)".
+
+        Returns
+        -------
+        float or int or bool or str or list
+            The value; one element for name(k).
+
+        Raises
+        ------
+        FrictionError
+            An unknown name.
+        """
         base = re.sub(r"\(\d+\)$", "", name)
         kinds = self.kinds()
         if base not in kinds:
@@ -209,8 +289,24 @@ class Config(_capi.Config):
             return items[0] if items else None
         return items
 
-    def unit(self, name):
-        """The unit of "group.variable" ('N/m', 'angstrom', '' for none)."""
+    def unit(self, name: str) -> str:
+        """The unit of "group.variable" ('N/m', 'angstrom', '' for none).
+
+        Parameters
+        ----------
+        name : str
+            "group.variable".
+
+        Returns
+        -------
+        str
+            The unit.
+
+        Raises
+        ------
+        KeyError
+            An unknown name.
+        """
         return self.kinds()[re.sub(r"\(\d+\)$", "", name)][2]
 
     def __getitem__(self, name):
@@ -219,27 +315,81 @@ class Config(_capi.Config):
     def __setitem__(self, name, value):
         self.set(name, value)
 
-    def support_x(self):
-        """The support positions along a scan line (angstrom), as /afm/support_x."""
+    def support_x(self) -> np.ndarray:
+        """The support positions along a scan line (angstrom), as /afm/support_x.
+
+        Returns
+        -------
+        numpy.ndarray
+            scan.nx positions (angstrom).
+        """
         nx, length = int(self.value("scan.nx")), float(self.value("scan.length"))
         return length * np.arange(nx, dtype=float) / float(nx - 1)
 
-    def afm_line(self, line=0, forward=True):
+    def afm_line(self, line: int = 0, forward: bool = True) -> Line:
         """Line `line` (0-based) of the map, trace (forward) or retrace: a Line
-        (x, fx, fy), exactly the file's line of /afm/trace (/afm/retrace)."""
+        (x, fx, fy), exactly the file's line of /afm/trace (/afm/retrace).
+
+        Parameters
+        ----------
+        line : int
+            The line, 0-based.
+        forward : bool
+            Trace (True) or retrace.
+
+        Returns
+        -------
+        Line
+            (x, fx, fy): angstrom, nN, nN.
+
+        Raises
+        ------
+        FrictionError
+            The library's refusal: the program's message (file, line, group, variable) and status.
+        ValueError
+            A line beyond C's int.
+
+        Examples
+        --------
+        >>> x, fx, fy = friction.Config("afm", files=["inputs/naf.nml"]).afm_line(0)  # doctest: +SKIP
+        """
         fx, fy = super().afm_line(line, forward)
         return Line(self.support_x(), fx, fy)
 
-    def run(self, output, force=False, resume=False, progress=True):
+    def run(self, output: PathLike, force: bool = False, resume: bool = False, progress: Progress = True) -> Path:
         """The configuration's job (every group: &analysis, &verify, &sweep) to
         the HDF5 file `output`, whose `input` attribute is text(); arguments
-        and MPI as friction.run().  Returns the output's Path."""
+        and MPI as friction.run().  Returns the output's Path.
+
+        Parameters
+        ----------
+        output : str or os.PathLike
+            The HDF5 file.
+        force : bool
+            Overwrite an existing output.
+        resume : bool
+            Reuse an interrupted run's checkpoints.
+        progress : bool or callable
+            As friction.run().
+
+        Returns
+        -------
+        pathlib.Path
+            The output file.
+
+        Raises
+        ------
+        FrictionError
+            The library's refusal: the program's message (file, line, group, variable) and status.
+        KeyboardInterrupt
+            Ctrl-C, after the job stopped.
+        """
         output = Path(output)
         _job(lambda report: _capi.Config.run(self, output, force=force, resume=resume, report=report),
              progress, output.name)
         return output
 
-    def compute(self, progress=False):
+    def compute(self, progress: Progress = False) -> dict[str, np.ndarray]:
         """The whole scene on this process, without a file: a dict of numpy
         arrays named as in the program's file (compute()).  progress: False
         (the default: a fit calls this often), True (a tqdm bar or a line on
@@ -247,7 +397,25 @@ class Config(_capi.Config):
         each scan line of a map ("12 of 48 lines") and 200 times along a
         brake trajectory.  Ctrl-C stops the computation at its next report
         and raises KeyboardInterrupt, its context a FrictionError with
-        status 5; the Config stays as it was, ready for the next call."""
+        status 5; the Config stays as it was, ready for the next call.
+
+        Parameters
+        ----------
+        progress : bool or callable
+            False (the default), True, or a callable (message, fraction).
+
+        Returns
+        -------
+        dict of str to numpy.ndarray
+            The arrays.
+
+        Raises
+        ------
+        FrictionError
+            The library's refusal: the program's message (file, line, group, variable) and status.
+        KeyboardInterrupt
+            Ctrl-C, after the computation stopped.
+        """
         return _job(lambda report: _capi.Config.compute(self, report=report), progress, self.scene)
 
     def __repr__(self):
@@ -255,30 +423,94 @@ class Config(_capi.Config):
         return f"<friction.Config {self.scene}: {state}>"
 
 
-def compute(scene, files=(), values=None, progress=False):
+def compute(scene: str, files: PathLike | Sequence[PathLike] = (), values: Mapping[str, Any] | None = None, progress: Progress = False) -> dict[str, np.ndarray]:
     """The scene's computation on this process, without a file: a dict of
     numpy arrays named as in the program's file ("trace/fx" (ny, nx), ...,
     "support_x"; "t", "x", ..., "events/t").  &analysis, &verify and &sweep
     are for jobs (run()): a &sweep or &verify check = .true. is refused.
-    progress and Ctrl-C as Config.compute()."""
+    progress and Ctrl-C as Config.compute().
+
+    Parameters
+    ----------
+    scene : str
+        "afm" or "brake".
+    files : str or os.PathLike or sequence of them
+        Namelist files, read in order.
+    values : dict, optional
+        {"group.variable": value} set after them.
+    progress : bool or callable
+        As Config.compute().
+
+    Returns
+    -------
+    dict of str to numpy.ndarray
+        The arrays.
+
+    Raises
+    ------
+    FrictionError
+        The library's refusal: the program's message (file, line, group, variable) and status.
+    """
     with Config(scene, files, values) as cfg:
         return cfg.compute(progress)
 
 
-def afm_line(files=(), values=None, line=0, forward=True):
+def afm_line(files: PathLike | Sequence[PathLike] = (), values: Mapping[str, Any] | None = None, line: int = 0, forward: bool = True) -> Line:
     """One line of a friction-force map: Line(x, fx, fy), numpy arrays.
 
-        x, fx, fy = friction.afm_line("inputs/naf.nml", {"scan.nx": 64})"""
+        x, fx, fy = friction.afm_line("inputs/naf.nml", {"scan.nx": 64})
+
+    Parameters
+    ----------
+    files : str or os.PathLike or sequence of them
+        Namelist files, read in order.
+    values : dict, optional
+        {"group.variable": value} set after them.
+    line : int
+        The line, 0-based.
+    forward : bool
+        Trace (True) or retrace.
+
+    Returns
+    -------
+    Line
+        (x, fx, fy): angstrom, nN, nN.
+
+    Raises
+    ------
+    FrictionError
+        The library's refusal: the program's message (file, line, group, variable) and status.
+    """
     with Config("afm", files, values) as cfg:
         return cfg.afm_line(line, forward)
 
 
-def brake(files=(), values=None, progress=False):
+def brake(files: PathLike | Sequence[PathLike] = (), values: Mapping[str, Any] | None = None, progress: Progress = False) -> dict[str, np.ndarray]:
     """A Girling brake run: a dict of numpy arrays, the trajectory "t", "x",
     "v", "y", "w", "stick" on the output grid and the events "events/t",
     "events/kind", "events/x", ... (as /brake of the program's file).
 
         run = friction.brake(values={"brake.t_end": 300.0})
 
-    progress and Ctrl-C as Config.compute()."""
+    progress and Ctrl-C as Config.compute().
+
+    Parameters
+    ----------
+    files : str or os.PathLike or sequence of them
+        Namelist files, read in order.
+    values : dict, optional
+        {"group.variable": value} set after them.
+    progress : bool or callable
+        As Config.compute().
+
+    Returns
+    -------
+    dict of str to numpy.ndarray
+        The trajectory and events.
+
+    Raises
+    ------
+    FrictionError
+        The library's refusal: the program's message (file, line, group, variable) and status.
+    """
     return compute("brake", files, values, progress)

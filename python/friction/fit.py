@@ -22,6 +22,8 @@ by a pool of processes, each with its own copy of the configuration; the
 Jacobian's finite differences are computed together, one image per free
 parameter, and its columns for the offset and calibration are exact.
 """
+from __future__ import annotations
+
 import concurrent.futures
 import concurrent.futures.process
 import math
@@ -32,11 +34,17 @@ import tempfile
 import threading
 import warnings
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any, Mapping, Sequence
 
 import numpy as np
 
 from . import _capi
 from ._run import Config
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
+
+    from ._image import MeasuredImage
 
 __all__ = ["image", "identifiability", "compare", "fit_line", "FitResult", "ImageFit", "Identifiability",
            "example", "NAF_LINE", "NUISANCES"]
@@ -485,23 +493,54 @@ def _value_errors(problem, x, cov):
 
 @dataclass
 class ImageFit:
-    """The fit of an image (friction.fit.image).
+    """The fit of an image (friction.fit.image makes it).
 
-    names         the fitted parameters in order: the free ones (ties
-                  joined with "=": "tip.kx=tip.ky") then the nuisances
-    values, errors  {name: estimate}, {name: standard error} (from the
-                  Jacobian at the minimum, scaled by the noise level)
-    correlation   (p, p) correlation matrix over names (of the fitted
-                  coordinates: logarithms for positive parameters)
-    noise         the noise level: the residuals' rms, sqrt(SSR / (N - p))
-    converged, reason, status   scipy's success flag, message and status
-    evaluations   model images computed (each one line per fitted line and
-                  pass; those of the coarse first fit included)
-    lines_computed  scan lines computed
-    fitted, residuals  {channel: (lines, nx)} model and measured - model (NaN where masked)
-    masked        pixels masked (NaN in the measurement) and not fitted
-    degenerate    pairs (a, b, correlation) with |correlation| > 0.9
-    singular      whether J^T J was singular (errors from its pseudo-inverse)"""
+    Parameters
+    ----------
+    names : list of str
+        The fitted parameters in order: the free ones (ties joined with
+        "=": "tip.kx=tip.ky") then the nuisances.
+    values : dict of str to float
+        {name: estimate}.
+    errors : dict of str to float
+        {name: standard error} (from the Jacobian at the minimum, scaled by
+        the noise level).
+    correlation : numpy.ndarray
+        (p, p) over names (of the fitted coordinates: logarithms for
+        positive parameters).
+    covariance : numpy.ndarray
+        (p, p) of the fitted coordinates.
+    noise : float
+        The noise level: the residuals' rms, sqrt(SSR / (N - p)).
+    converged : bool
+        scipy's success flag.
+    reason : str
+        scipy's message.
+    status : int
+        scipy's status.
+    evaluations : int
+        Model images computed (those of the coarse first fit included).
+    lines_computed : int
+        Scan lines computed.
+    cost : float
+        Half the sum of squared residuals at the minimum.
+    fitted : dict of str to numpy.ndarray
+        {channel: (lines, nx)} the model (NaN where masked).
+    residuals : dict of str to numpy.ndarray
+        {channel: (lines, nx)} measured - model (NaN where masked).
+    masked : int
+        Pixels masked (NaN in the measurement) and not fitted.
+    degenerate : list of tuple
+        Pairs (a, b, correlation) with |correlation| > 0.9.
+    singular : bool
+        Whether J^T J was singular (errors from its pseudo-inverse).
+    x : numpy.ndarray
+        The minimum in the fitted coordinates.
+    jacobian : numpy.ndarray
+        The Jacobian there.
+    _problem : object
+        The fit's problem, for profile() and sample().
+    """
 
     names: list
     values: dict
@@ -524,8 +563,14 @@ class ImageFit:
     jacobian: np.ndarray = field(default=None, repr=False)
     _problem: object = field(default=None, repr=False)
 
-    def summary(self):
-        """The estimates as a table of text."""
+    def summary(self) -> str:
+        """The estimates as a table of text.
+
+        Returns
+        -------
+        str
+            One row per parameter (estimate, standard error), then the noise and convergence.
+        """
         rows = [f"{'parameter':<22} {'estimate':>13} {'std. error':>12}"]
         for name in self.names:
             rows.append(f"{name:<22} {self.values[name]:>13.6g} {self.errors[name]:>12.3g}")
@@ -535,11 +580,30 @@ class ImageFit:
             rows.append("degenerate: " + ", ".join(f"{a} ~ {b} ({c:+.3f})" for a, b, c in self.degenerate))
         return "\n".join(rows)
 
-    def profile(self, name, points=9, span=3.0, workers=None):
+    def profile(self, name: str, points: int = 9, span: float = 3.0, workers: int | None = None) -> tuple[np.ndarray, np.ndarray]:
         """The profile likelihood of one parameter: at `points` values across
         estimate +- span standard errors (in the fitted coordinate), the
         others refitted.  Returns (values, delta_chi2), delta_chi2 =
-        (SSR - SSR_min) / noise^2: the 68 % interval is where it is below 1."""
+        (SSR - SSR_min) / noise^2: the 68 % interval is where it is below 1.
+
+        Parameters
+        ----------
+        name : str
+            One of names.
+        points : int
+            Values of the parameter.
+        span : float
+            Standard errors on each side of the estimate.
+        workers : int, optional
+            Processes computing lines (default: as the fit).
+
+        Returns
+        -------
+        values : numpy.ndarray
+            The parameter's values.
+        delta_chi2 : numpy.ndarray
+            (SSR - SSR_min) / noise^2 at each.
+        """
         problem = self._problem
         i = self.names.index(name)
         if workers is not None:
@@ -571,11 +635,33 @@ class ImageFit:
         values = [math.exp(g) if problem.parameters[i].log else g for g in grid]
         return np.array(values), (np.array(out) - 2.0 * self.cost) / self.noise ** 2
 
-    def sample(self, steps=200, walkers=None, seed=0, burn=None):
+    def sample(self, steps: int = 200, walkers: int | None = None, seed: int = 0, burn: int | None = None) -> np.ndarray:
         """An MCMC sample of the posterior (emcee's affine-invariant ensemble;
         flat priors within the bounds in the fitted coordinates, Gaussian
         noise of the fitted level).  Returns (steps - burn) * walkers rows of
-        the values, columns in the order of names."""
+        the values, columns in the order of names.
+
+        Parameters
+        ----------
+        steps : int
+            Steps of every walker.
+        walkers : int, optional
+            Walkers (default 2 p + 2).
+        seed : int
+            Seed of numpy's default_rng (the sample is reproducible).
+        burn : int, optional
+            Steps discarded (default steps // 4).
+
+        Returns
+        -------
+        numpy.ndarray
+            (steps - burn) * walkers rows of the values, columns in the order of names.
+
+        Raises
+        ------
+        ImportError
+            Without the emcee package.
+        """
         try:
             import emcee
         except ImportError:
@@ -612,42 +698,80 @@ class ImageFit:
         return np.where(logs, np.exp(chain), chain)
 
 
-def image(measured, config, free, lines=None, nuisances=("offset", "calibration", "drift_x", "drift_y"),
-          bounds=None, workers=None, step=1e-6, max_evaluations=None, tolerance=1e-6, coarse=8):
+def image(measured: MeasuredImage | Mapping[str, np.ndarray] | np.ndarray, config: Config,
+          free: Mapping[str | tuple[str, ...], float | None] | Sequence[str | tuple[str, ...]],
+          lines: Sequence[int] | None = None,
+          nuisances: Sequence[str] | Mapping[str, float] = ("offset", "calibration", "drift_x", "drift_y"),
+          bounds: Mapping[str, tuple[float, float]] | None = None, workers: int | None = None, step: float = 1e-6,
+          max_evaluations: int | None = None, tolerance: float = 1e-6, coarse: int = 8) -> ImageFit:
     """Fit the configuration's parameters to a measured image by least squares.
 
-    measured    a MeasuredImage (trace and retrace compared with the model's
-                force along the scan, "trace/along", "retrace/along"), a dict
-                {"trace/fx": (ny, nx), "retrace/fy": ..., "trace/along": ...}
-                of any of trace|retrace and fx|fy|along|across, or one
-                (ny, nx) array ("trace/fx"); NaN pixels are masked (warned,
-                counted in .masked)
-    config      a friction.Config of scene "afm" whose scan (scan.nx,
-                scan.ny) the image's shape must match; not changed
-    free        {parameter: start} or a list of parameters (started at the
-                configuration's values); a parameter is "group.variable" or
-                tied variables sharing one value, "tip.kx=tip.ky" or
-                ("tip.kx", "tip.ky"); fitted through their logarithm unless
-                the variable may be signed (scan.angle, scan.origin_*)
-    lines       the lines fitted (default all); measured may hold all the
-                scan's lines or just these
-    nuisances   of NUISANCES, a list (started at 0 offset, calibration 1, no
-                drift) or {name: start}: measured = calibration * model +
-                offset, the support drifting drift_x, drift_y angstrom per
-                line along the lattice's axes; the noise level is always
-                estimated (the residuals' rms)
-    bounds      {parameter: (low, high)} in the parameter's units; positive
-                parameters default to start/1000 .. start*1000
-    workers     processes computing lines (default: the processors this
-                process may use); 1: on this process
-                (spawned processes: a script must guard its top level with
-                `if __name__ == "__main__":`, as multiprocessing asks)
-    step        the finite differences' step (in log for positive parameters;
-                1e-6 wants the integrator's rtol at 1e-4 or below)
-    coarse      when more than twice this many lines are fitted, a first fit
-                on this many evenly spaced lines, from which the fit of all
-                starts (most iterations then cost a few lines); 0: none
-    Returns an ImageFit."""
+    scipy's least_squares (trust-region reflective, with bounds), positive
+    parameters through their logarithms, the Jacobian by finite differences
+    computed together over a pool of processes.
+
+    Parameters
+    ----------
+    measured : MeasuredImage or dict of str to numpy.ndarray or numpy.ndarray
+        A MeasuredImage (trace and retrace compared with the model's force
+        along the scan, "trace/along", "retrace/along"), a dict
+        {"trace/fx": (ny, nx), "retrace/fy": ..., "trace/along": ...} of any of
+        trace|retrace and fx|fy|along|across, or one (ny, nx) array
+        ("trace/fx"); NaN pixels are masked (warned, counted in .masked).
+    config : friction.Config
+        Of scene "afm", whose scan (scan.nx, scan.ny) the image's shape must
+        match; not changed.
+    free : dict or sequence
+        {parameter: start} or a list of parameters (started at the
+        configuration's values); a parameter is "group.variable" or tied
+        variables sharing one value, "tip.kx=tip.ky" or ("tip.kx", "tip.ky");
+        fitted through their logarithm unless the variable may be signed
+        (scan.angle, scan.origin_*).
+    lines : sequence of int, optional
+        The lines fitted (default all); measured may hold all the scan's lines
+        or just these.
+    nuisances : sequence of str or dict of str to float
+        Of NUISANCES, a list (started at 0 offset, calibration 1, no drift) or
+        {name: start}: measured = calibration * model + offset, the support
+        drifting drift_x, drift_y angstrom per line along the lattice's axes;
+        the noise level is always estimated (the residuals' rms).
+    bounds : dict of str to (float, float), optional
+        {parameter: (low, high)} in the parameter's units; positive parameters
+        default to start/1000 .. start*1000.
+    workers : int, optional
+        Processes computing lines (default: the processors this process may
+        use); 1: on this process (spawned processes: a script must guard its top
+        level with `if __name__ == "__main__":`, as multiprocessing asks).
+    step : float
+        The finite differences' step (in log for positive parameters; 1e-6
+        wants the integrator's rtol at 1e-4 or below).
+    max_evaluations : int, optional
+        scipy's max_nfev.
+    tolerance : float
+        scipy's ftol, xtol and gtol.
+    coarse : int
+        When more than twice this many lines are fitted, a first fit on this
+        many evenly spaced lines, from which the fit of all starts (most
+        iterations then cost a few lines); 0: none.
+
+    Returns
+    -------
+    ImageFit
+        The estimates, their standard errors and correlations, the fitted maps.
+
+    Raises
+    ------
+    ValueError
+        A measured image whose shape or channels do not fit the configuration,
+        or an unknown parameter or nuisance.
+    friction.FrictionError
+        A configuration the program refuses, or a failed line.
+
+    Examples
+    --------
+    >>> fit = friction.fit.image(measured, cfg, free={"surface.v0": 0.5})  # doctest: +SKIP
+    >>> fit.values["surface.v0"], fit.errors["surface.v0"]  # doctest: +SKIP
+    """
     from scipy.optimize import least_squares
     data, where = _channels_of(measured)
     _check_size(measured, config, where)
@@ -696,14 +820,30 @@ def image(measured, config, free, lines=None, nuisances=("offset", "calibration"
 
 @dataclass
 class Identifiability:
-    """What a planned scan would determine (friction.fit.identifiability).
+    """What a planned scan would determine (friction.fit.identifiability makes it).
 
-    names, values   the parameters and their planned (true) values
-    errors          {name: standard error} from the Fisher information
-                    J^T J / noise^2 at the planned values
-    relative        {name: error / |value|}
-    correlation     (p, p) over names; degenerate: pairs with |corr| > 0.9
-    pixels          the samples the plan measures"""
+    Parameters
+    ----------
+    names : list of str
+        The parameters.
+    values : dict of str to float
+        Their planned (true) values.
+    errors : dict of str to float
+        {name: standard error} from the Fisher information J^T J / noise^2
+        at the planned values.
+    relative : dict of str to float
+        {name: error / |value|}.
+    correlation : numpy.ndarray
+        (p, p) over names.
+    degenerate : list of tuple
+        Pairs (a, b, correlation) with |correlation| above the threshold.
+    pixels : int
+        The samples the plan measures.
+    singular : bool
+        Whether the Fisher information was singular.
+    jacobian : numpy.ndarray
+        The Jacobian at the planned values.
+    """
 
     names: list
     values: dict
@@ -716,14 +856,48 @@ class Identifiability:
     jacobian: np.ndarray = field(default=None, repr=False)
 
 
-def identifiability(config, free, noise, channels=("trace/fx",), lines=None, nuisances=(), workers=None,
-                    step=1e-6, threshold=0.9):
+def identifiability(config: Config, free: Mapping[str, float | None] | Sequence[str] | str, noise: float,
+                    channels: Sequence[str] = ("trace/fx",), lines: Sequence[int] | None = None,
+                    nuisances: Sequence[str] | Mapping[str, float] = (), workers: int | None = None,
+                    step: float = 1e-6, threshold: float = 0.9) -> Identifiability:
     """The Fisher-information standard errors of the free parameters for a
     planned scan: the configuration (its values are the truth), the
     channels measured (of trace|retrace / fx|fy|along|across), the noise
     level (the measured force's standard deviation, nN) and the nuisances
     fitted alongside (default none).  free and lines as for image().
-    Returns an Identifiability."""
+    Returns an Identifiability.
+
+    Parameters
+    ----------
+    config : friction.Config
+        Of scene "afm": its values are the truth.
+    free : dict or sequence of str or str
+        The free parameters, as for image().
+    noise : float
+        The measured force's standard deviation (nN).
+    channels : sequence of str
+        The channels measured, of trace|retrace / fx|fy|along|across.
+    lines : sequence of int, optional
+        The lines measured (default all).
+    nuisances : sequence of str or dict of str to float
+        Fitted alongside, as for image() (default none).
+    workers : int, optional
+        Processes computing lines.
+    step : float
+        The finite differences' step.
+    threshold : float
+        |correlation| above which a pair is degenerate.
+
+    Returns
+    -------
+    Identifiability
+        The standard errors, relative errors and correlations.
+
+    Raises
+    ------
+    ValueError
+        An unknown parameter or channel.
+    """
     nx, ny = int(config.value("scan.nx")), int(config.value("scan.ny"))
     rows = ny if lines is None else len(list(lines))
     data = {c: np.zeros((rows, nx)) for c in channels}
@@ -744,10 +918,35 @@ def identifiability(config, free, noise, channels=("trace/fx",), lines=None, nui
                            problem.count, singular, jac)
 
 
-def compare(config, scans, free, noise, channels=("trace/fx",), nuisances=(), workers=None):
+def compare(config: Config, scans: Mapping[str, Mapping[str, Any]], free: Mapping[str, float | None] | Sequence[str],
+            noise: float, channels: Sequence[str] = ("trace/fx",), nuisances: Sequence[str] | Mapping[str, float] = (),
+            workers: int | None = None) -> dict[str, Identifiability]:
     """Identifiability of several scan choices: scans = {label: {"scan.angle":
     45.0, ...}} (values set over a copy of config; a "channels" entry
-    replaces the channels measured).  Returns {label: Identifiability}."""
+    replaces the channels measured).  Returns {label: Identifiability}.
+
+    Parameters
+    ----------
+    config : friction.Config
+        Of scene "afm": its values are the truth.
+    scans : dict of str to dict
+        {label: {"scan.angle": 45.0, ..., "channels": [...]}}.
+    free : dict or sequence of str
+        The free parameters, as for image().
+    noise : float
+        The measured force's standard deviation (nN).
+    channels : sequence of str
+        The channels measured where a scan names none.
+    nuisances : sequence of str or dict of str to float
+        Fitted alongside.
+    workers : int, optional
+        Processes computing lines.
+
+    Returns
+    -------
+    dict of str to Identifiability
+        One per scan.
+    """
     out = {}
     for label, values in scans.items():
         values = dict(values)
@@ -774,10 +973,27 @@ def _copy(config):
 
 @dataclass
 class FitResult:
-    """values: the fitted parameters, keyed as `start` was; residual: the sum
-    of squared differences (nN^2); rms: its root mean square per sample (nN);
-    evaluations: lines computed; line: the fitted model's line; errors:
-    standard errors; converged, reason: scipy's flag and message."""
+    """The fit of one line (friction.fit.fit_line makes it).
+
+    Parameters
+    ----------
+    values : dict
+        The fitted parameters, keyed as `start` was.
+    residual : float
+        The sum of squared differences (nN^2).
+    rms : float
+        Its root mean square per sample (nN).
+    evaluations : int
+        Lines computed.
+    line : numpy.ndarray
+        The fitted model's line (nN).
+    errors : dict
+        Standard errors, keyed as values.
+    converged : bool
+        scipy's flag.
+    reason : str
+        scipy's message.
+    """
 
     values: dict
     residual: float
@@ -789,20 +1005,47 @@ class FitResult:
     reason: str = ""
 
 
-def fit_line(measured, config, start, component="fx", line=0, forward=True, step=1e-6, tolerance=1e-10,
-             max_evaluations=400):
-    """Fit parameters of `config` (a friction.Config of scene "afm") so that
-    its scan line matches `measured` (nN at the scan.nx support positions):
-    image() for one line and no nuisances, on this process.
+def fit_line(measured: ArrayLike, config: Config, start: Mapping[str | tuple[str, ...], float], component: str = "fx",
+             line: int = 0, forward: bool = True, step: float = 1e-6, tolerance: float = 1e-10,
+             max_evaluations: int = 400) -> FitResult:
+    """Fit parameters of a configuration so that one scan line matches a measurement.
 
-    start      {parameter: starting value}; a parameter is "group.variable"
-               or a tuple of them that share one value (("tip.kx", "tip.ky"));
-               values must be positive (they are fitted through their logarithms)
-    component  "fx" or "fy": the force compared
-    line, forward  the line of the map and its direction
-    step, tolerance, max_evaluations  of the finite differences and of
-               scipy's least_squares
-    The configuration is left at the fitted values.  Returns a FitResult."""
+    image() for one line and no nuisances, on this process.  The configuration
+    is left at the fitted values.
+
+    Parameters
+    ----------
+    measured : array_like
+        nN at the scan.nx support positions.
+    config : friction.Config
+        Of scene "afm".
+    start : dict
+        {parameter: starting value}; a parameter is "group.variable" or a tuple
+        of them that share one value (("tip.kx", "tip.ky")); values must be
+        positive (they are fitted through their logarithms).
+    component : str
+        "fx" or "fy": the force compared.
+    line : int
+        The line of the map.
+    forward : bool
+        Trace (True) or retrace.
+    step : float
+        The finite differences' step.
+    tolerance : float
+        scipy least_squares' tolerances.
+    max_evaluations : int
+        scipy least_squares' max_nfev.
+
+    Returns
+    -------
+    FitResult
+        The fitted values, their errors and the fit's quality.
+
+    Raises
+    ------
+    ValueError
+        An unknown component, no parameter, or a starting value <= 0.
+    """
     if component not in ("fx", "fy"):
         raise ValueError(f"component must be 'fx' or 'fy', not {component!r}")
     if not start:
@@ -824,11 +1067,30 @@ def fit_line(measured, config, start, component="fx", line=0, forward=True, step
                      result.converged, result.reason)
 
 
-def example(true=(0.8, 6.0), start=(0.5, 12.0), noise=0.05, seed=8):
+def example(true: tuple[float, float] = (0.8, 6.0), start: tuple[float, float] = (0.5, 12.0), noise: float = 0.05, seed: int = 8) -> tuple[FitResult, np.ndarray]:
     """The fit of scripts/fit_example.py: a NaF line (NAF_LINE) computed for
     V0 = true[0] eV and k = kx = ky = true[1] N/m, plus Gaussian noise of
     `noise` nN (numpy's default_rng(seed)), fitted from V0 = start[0],
-    k = start[1].  Returns (FitResult, measured line)."""
+    k = start[1].  Returns (FitResult, measured line).
+
+    Parameters
+    ----------
+    true : tuple of float
+        V0 (eV) and k (N/m) the line is computed for.
+    start : tuple of float
+        V0 and k the fit starts from.
+    noise : float
+        Standard deviation of the Gaussian noise added (nN).
+    seed : int
+        Seed of numpy's default_rng.
+
+    Returns
+    -------
+    result : FitResult
+        The fit.
+    measured : numpy.ndarray
+        The noisy line fitted (nN).
+    """
     with Config("afm", values=NAF_LINE) as cfg:
         cfg.set("surface.v0", true[0]).set("tip.kx", true[1]).set("tip.ky", true[1])
         measured = cfg.afm_line(0).fx

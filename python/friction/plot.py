@@ -22,9 +22,13 @@ shown or kept open behind the caller's back, and no display is needed.  In a
 notebook a figure shows as a cell's value.  A file that is not what a
 function draws raises friction.FileError, as the scripts report it.
 """
+from __future__ import annotations
+
 import io
 import math
+import os
 import warnings
+from typing import TYPE_CHECKING, Any, Mapping, Sequence, Union
 
 import numpy as np
 from matplotlib import colormaps
@@ -35,6 +39,16 @@ from matplotlib.figure import Figure as _Figure
 from matplotlib.patches import Polygon, Rectangle
 
 from ._data import FileError, groups, load, paths, reading, require
+
+if TYPE_CHECKING:
+    import xarray as xr
+    from numpy.typing import ArrayLike
+
+    from ._image import MeasuredImage
+    from .fit import ImageFit
+
+#: What the plots take: a loaded file (friction.load) or a file's path.
+DataLike = Union["xr.DataTree", str, "os.PathLike[str]"]
 
 __all__ = ["afm_maps", "friction_loop", "graphite_net", "stacked_lines", "brake_phase", "brake_x",
            "brake_spectrum", "poincare", "lyapunov", "floquet", "orbit_branch", "sweep", "bifurcation",
@@ -97,10 +111,36 @@ def _pixel_extent(x, y):
     return [x[0] - dx / 2, x[-1] + dx / 2, y[0] - dy / 2, y[-1] + dy / 2]
 
 
-def afm_maps(data, trip="trace", cmap="RdBu_r"):
+def afm_maps(data: DataLike, trip: str = "trace", cmap: str = "RdBu_r") -> Figure:
     """Fx and Fy maps side by side over the scanned area (the paper's Fig. 7b/8b):
     the support position along the scan against the line offset across it
-    (Å); colour scale symmetric about 0 nN.  trip: 'trace' or 'retrace'."""
+    (Å); colour scale symmetric about 0 nN.  trip: 'trace' or 'retrace'.
+
+    Parameters
+    ----------
+    data : xarray.DataTree or str or os.PathLike
+        The file's data (friction.load) or its path.
+    trip : str
+        'trace' or 'retrace'.
+    cmap : str
+        A matplotlib colour map.
+
+    Returns
+    -------
+    Figure
+        The figure (matplotlib, outside pyplot).
+
+    Raises
+    ------
+    friction.FileError
+        A file that is not of the kind drawn, or lacks what the picture needs.
+    ValueError
+        An unknown trip.
+
+    Examples
+    --------
+    >>> fig = friction.plot.afm_maps(friction.load("naf.h5"))  # doctest: +SKIP
+    """
     scan = _scan(data)
     if trip not in scan:
         raise FileError(f"no /afm/{trip}: the run had retrace off")
@@ -121,10 +161,30 @@ def afm_maps(data, trip="trace", cmap="RdBu_r"):
     return fig
 
 
-def friction_loop(data, line=None):
+def friction_loop(data: DataLike, line: int | None = None) -> Figure:
     """Trace and retrace f_along of one line against the support position:
     the friction loop, with the line's friction (/afm/friction) in the title.
-    line: 0 .. ny-1 (default: the middle line, ny // 2)."""
+    line: 0 .. ny-1 (default: the middle line, ny // 2).
+
+    Parameters
+    ----------
+    data : xarray.DataTree or str or os.PathLike
+        The file's data (friction.load) or its path.
+    line : int, optional
+        The line, 0 .. ny - 1; default the middle line, ny // 2.
+
+    Returns
+    -------
+    Figure
+        The figure (matplotlib, outside pyplot).
+
+    Raises
+    ------
+    friction.FileError
+        A file that is not of the kind drawn, or lacks what the picture needs.
+    ValueError
+        A line out of range.
+    """
     scan = _scan(data)
     if "retrace" not in scan or scan["friction"] is None:
         raise FileError("no /afm/retrace: the run had retrace off (no friction loop)")
@@ -268,11 +328,33 @@ def bonds(xyz, cutoff):
     return pairs[np.lexsort((pairs[:, 1], pairs[:, 0]))]
 
 
-def graphite_net(data, margin=5.0, whole=False, tip_line=0):
+def graphite_net(data: DataLike, margin: float = 5.0, whole: bool = False, tip_line: int | None = 0) -> Figure:
     """The crystal net of a lattice-sum map (the paper's Fig. 9a): atoms by
     species, bonds (pairs closer than 1.2 x the nearest-neighbour distance),
     the scan region and the tip's path on trace line `tip_line` (None: no
-    path); zoomed to the scan region plus `margin` Å, or the whole net."""
+    path); zoomed to the scan region plus `margin` Å, or the whole net.
+
+    Parameters
+    ----------
+    data : xarray.DataTree or str or os.PathLike
+        The file's data (friction.load) or its path.
+    margin : float
+        Angstrom around the scan region shown.
+    whole : bool
+        Show the whole net instead.
+    tip_line : int or None
+        The trace line whose tip path is drawn; None for none.
+
+    Returns
+    -------
+    Figure
+        The figure (matplotlib, outside pyplot).
+
+    Raises
+    ------
+    friction.FileError
+        A file that is not of the kind drawn, or lacks what the picture needs.
+    """
     lattice = _lattice(data)
     xyz = lattice["atoms"]
     species = lattice["species"]
@@ -352,12 +434,36 @@ def graphite_net(data, margin=5.0, whole=False, tip_line=0):
     return fig
 
 
-def stacked_lines(data, trip="trace", component="fx", offset=None):
+def stacked_lines(data: DataLike, trip: str = "trace", component: str = "fx", offset: float | None = None) -> Figure:
     """The scan lines stacked as in the paper's Fig. 9b: one force component
     against the support position, line j shifted up by j x offset nN
     (default: 1.2 x the largest peak-to-peak of the lines), labelled with its
     offset across the scan.  The offset used is the figure's attribute
-    `line_offset`."""
+    `line_offset`.
+
+    Parameters
+    ----------
+    data : xarray.DataTree or str or os.PathLike
+        The file's data (friction.load) or its path.
+    trip : str
+        'trace' or 'retrace'.
+    component : str
+        The force dataset drawn: 'fx', 'fy', 'fz', 'f_along' or 'f_across'.
+    offset : float, optional
+        nN between lines; default 1.2 times the largest peak-to-peak.
+
+    Returns
+    -------
+    Figure
+        The figure (matplotlib, outside pyplot).
+
+    Raises
+    ------
+    friction.FileError
+        A file that is not of the kind drawn, or lacks what the picture needs.
+    ValueError
+        An unknown trip or component.
+    """
     lattice = _lattice(data)
     if trip not in lattice["trips"]:
         raise FileError(f"no /afm/{trip}: the run had retrace off")
@@ -447,11 +553,31 @@ def _window(run, window):
     return t0, t1
 
 
-def brake_phase(data, window=None):
+def brake_phase(data: DataLike, window: tuple[float, float] | None = None) -> Figure:
     """The phase plane (x, x') over the time window (default: the run's second
     half, after the transient; the paper's Fig. 12 is tau in [100, 1000],
     inside the transient); stick points in their own colour, the belt
-    velocity dashed."""
+    velocity dashed.
+
+    Parameters
+    ----------
+    data : xarray.DataTree or str or os.PathLike
+        The file's data (friction.load) or its path.
+    window : tuple of float, optional
+        The time window (tau_start, tau_end); default the run's second half.
+
+    Returns
+    -------
+    Figure
+        The figure (matplotlib, outside pyplot).
+
+    Raises
+    ------
+    friction.FileError
+        A file that is not of the kind drawn, or lacks what the picture needs.
+    ValueError
+        A window outside the run.
+    """
     run = _brake_run(data)
     t0, t1 = _window(run, window)
     inside = (run["t"] >= t0) & (run["t"] <= t1)
@@ -472,9 +598,29 @@ def brake_phase(data, window=None):
     return fig
 
 
-def brake_x(data, window=None):
+def brake_x(data: DataLike, window: tuple[float, float] | None = None) -> Figure:
     """x(tau): the whole run above, the last 30 tau of the window below, where
-    stick shows as straight stretches of slope v'_dr."""
+    stick shows as straight stretches of slope v'_dr.
+
+    Parameters
+    ----------
+    data : xarray.DataTree or str or os.PathLike
+        The file's data (friction.load) or its path.
+    window : tuple of float, optional
+        The time window (tau_start, tau_end); default the run's second half.
+
+    Returns
+    -------
+    Figure
+        The figure (matplotlib, outside pyplot).
+
+    Raises
+    ------
+    friction.FileError
+        A file that is not of the kind drawn, or lacks what the picture needs.
+    ValueError
+        A window outside the run.
+    """
     run = _brake_run(data)
     window = _window(run, window)
     t, x, stick = run["t"], run["x"], run["stick"] == 1
@@ -535,9 +681,25 @@ def _need(d, part):
     return d[part]
 
 
-def brake_spectrum(data):
+def brake_spectrum(data: DataLike) -> Figure:
     """The amplitude spectrum of the analysed variable over its window (the
-    paper's Fig. 13), with the peak frequency and the bin width."""
+    paper's Fig. 13), with the peak frequency and the bin width.
+
+    Parameters
+    ----------
+    data : xarray.DataTree or str or os.PathLike
+        The file's data (friction.load) or its path.
+
+    Returns
+    -------
+    Figure
+        The figure (matplotlib, outside pyplot).
+
+    Raises
+    ------
+    friction.FileError
+        A file that is not of the kind drawn, or lacks what the picture needs.
+    """
     d = _diagnostics(data)
     s = _need(d, "spectrum")
     fig = _figure(figsize=(8, 5), layout="constrained")
@@ -555,9 +717,25 @@ def brake_spectrum(data):
     return fig
 
 
-def poincare(data):
+def poincare(data: DataLike) -> Figure:
     """The stroboscopic map (x, x') at the strobe period (the paper's Fig. 14),
-    beside the true section (x, y)."""
+    beside the true section (x, y).
+
+    Parameters
+    ----------
+    data : xarray.DataTree or str or os.PathLike
+        The file's data (friction.load) or its path.
+
+    Returns
+    -------
+    Figure
+        The figure (matplotlib, outside pyplot).
+
+    Raises
+    ------
+    friction.FileError
+        A file that is not of the kind drawn, or lacks what the picture needs.
+    """
     d = _diagnostics(data)
     p = _need(d, "poincare")
     fig = _figure(figsize=(12, 5), layout="constrained")
@@ -578,9 +756,25 @@ def poincare(data):
     return fig
 
 
-def lyapunov(data):
+def lyapunov(data: DataLike) -> Figure:
     """The running Benettin estimate (from the equations) and the Rosenstein
-    divergence curve with its fit range and slope (from the series)."""
+    divergence curve with its fit range and slope (from the series).
+
+    Parameters
+    ----------
+    data : xarray.DataTree or str or os.PathLike
+        The file's data (friction.load) or its path.
+
+    Returns
+    -------
+    Figure
+        The figure (matplotlib, outside pyplot).
+
+    Raises
+    ------
+    friction.FileError
+        A file that is not of the kind drawn, or lacks what the picture needs.
+    """
     d = _diagnostics(data)
     g = _need(d, "lyapunov")
     a = g["attrs"]
@@ -638,9 +832,25 @@ def _orbit(data):
     return o
 
 
-def floquet(data):
+def floquet(data: DataLike) -> Figure:
     """The periodic orbit's Floquet multipliers in the complex plane with the
-    unit circle (the stick's exact 0 and the trivial 1 included)."""
+    unit circle (the stick's exact 0 and the trivial 1 included).
+
+    Parameters
+    ----------
+    data : xarray.DataTree or str or os.PathLike
+        The file's data (friction.load) or its path.
+
+    Returns
+    -------
+    Figure
+        The figure (matplotlib, outside pyplot).
+
+    Raises
+    ------
+    friction.FileError
+        A file that is not of the kind drawn, or lacks what the picture needs.
+    """
     o = _orbit(data)
     a = o["attrs"]
     fig = _figure(figsize=(5.5, 5.5), layout="constrained")
@@ -666,11 +876,27 @@ def floquet(data):
     return fig
 
 
-def orbit_branch(data):
+def orbit_branch(data: DataLike) -> Figure:
     """The bifurcation diagram along a continuation line: the attractor's x at
     its slip onsets (dots), the followed orbit's slip onset x (solid where
     stable, dashed where unstable), the detected bifurcations; below, the
-    largest |μ| of the section map against 1."""
+    largest |μ| of the section map against 1.
+
+    Parameters
+    ----------
+    data : xarray.DataTree or str or os.PathLike
+        The file's data (friction.load) or its path.
+
+    Returns
+    -------
+    Figure
+        The figure (matplotlib, outside pyplot).
+
+    Raises
+    ------
+    friction.FileError
+        A file that is not of the kind drawn, or lacks what the picture needs.
+    """
     o = _orbit(data)
     if "branch/parameter" not in o:
         raise FileError("no /brake/orbit/branch in the file (run friction with &analysis continuation)")
@@ -792,9 +1018,25 @@ def _brake_sweep(data):
     return s
 
 
-def bifurcation(data):
+def bifurcation(data: DataLike) -> Figure:
     """A brake sweep's bifurcation diagram: the local maxima of x after the
-    transient against the swept parameter; failed points as red lines."""
+    transient against the swept parameter; failed points as red lines.
+
+    Parameters
+    ----------
+    data : xarray.DataTree or str or os.PathLike
+        The file's data (friction.load) or its path.
+
+    Returns
+    -------
+    Figure
+        The figure (matplotlib, outside pyplot).
+
+    Raises
+    ------
+    friction.FileError
+        A file that is not of the kind drawn, or lacks what the picture needs.
+    """
     s = _brake_sweep(data)
     fig = _figure(figsize=(7, 4.5))
     ax = fig.subplots()
@@ -815,8 +1057,24 @@ def bifurcation(data):
     return fig
 
 
-def sweep_lyapunov(data):
-    """A brake sweep's Benettin exponent and stick fraction against the parameter."""
+def sweep_lyapunov(data: DataLike) -> Figure:
+    """A brake sweep's Benettin exponent and stick fraction against the parameter.
+
+    Parameters
+    ----------
+    data : xarray.DataTree or str or os.PathLike
+        The file's data (friction.load) or its path.
+
+    Returns
+    -------
+    Figure
+        The figure (matplotlib, outside pyplot).
+
+    Raises
+    ------
+    friction.FileError
+        A file that is not of the kind drawn, or lacks what the picture needs.
+    """
     s = _brake_sweep(data)
     done = s["status"] == 1
     fig = _figure(figsize=(7, 6))
@@ -861,10 +1119,26 @@ def _edges(centres, log):
     return np.exp(e) if log else e
 
 
-def atlas(data):
+def atlas(data: DataLike) -> Figure:
     """A two-variable brake sweep as maps: the Benettin exponent (chaos where
     it is positive) and the stick fraction over the grid; failed or pending
-    points are grey."""
+    points are grey.
+
+    Parameters
+    ----------
+    data : xarray.DataTree or str or os.PathLike
+        The file's data (friction.load) or its path.
+
+    Returns
+    -------
+    Figure
+        The figure (matplotlib, outside pyplot).
+
+    Raises
+    ------
+    friction.FileError
+        A file that is not of the kind drawn, or lacks what the picture needs.
+    """
     s = _brake_sweep(data)
     if "values2" not in s:
         raise FileError("an atlas needs a sweep over two variables (sweep_variable2)")
@@ -904,9 +1178,25 @@ def atlas(data):
     return fig
 
 
-def sweep_friction(data):
+def sweep_friction(data: DataLike) -> Figure:
     """An AFM sweep's mean friction and maximum lateral force against the
-    parameter, a line per value of a second variable."""
+    parameter, a line per value of a second variable.
+
+    Parameters
+    ----------
+    data : xarray.DataTree or str or os.PathLike
+        The file's data (friction.load) or its path.
+
+    Returns
+    -------
+    Figure
+        The figure (matplotlib, outside pyplot).
+
+    Raises
+    ------
+    friction.FileError
+        A file that is not of the kind drawn, or lacks what the picture needs.
+    """
     s = _sweep(data)
     if s["scene"] != "afm":
         raise FileError("not an AFM sweep (sweep_scene = 'brake': use bifurcation, sweep_lyapunov)")
@@ -933,11 +1223,27 @@ def sweep_friction(data):
     return fig
 
 
-def sweep(data):
+def sweep(data: DataLike) -> dict[str, Figure]:
     """Every chart of a sweep file: {"bifurcation": Figure, "lyapunov": Figure}
     for a brake sweep, and "atlas" (maps) when it has a second variable (only
     the maps when that has more than 8 values: a line each would not read);
-    {"friction": Figure} for an AFM sweep."""
+    {"friction": Figure} for an AFM sweep.
+
+    Parameters
+    ----------
+    data : xarray.DataTree or str or os.PathLike
+        The file's data (friction.load) or its path.
+
+    Returns
+    -------
+    dict of str to Figure
+        The charts by name.
+
+    Raises
+    ------
+    friction.FileError
+        A file that is not of the kind drawn, or lacks what the picture needs.
+    """
     data = require(data, "sweep", "sweep")
     s = _sweep(data)
     if s["scene"] == "brake":
@@ -961,10 +1267,28 @@ STYLE = {"rk2": ("tab:gray", "o"), "rk4": ("tab:brown", "s"), "rkf45": ("tab:blu
          "rodas4": ("darkgreen", "X"), "switched": ("k", "x")}
 
 
-def work_precision(data, scene):
+def work_precision(data: DataLike, scene: str) -> Figure:
     """The work-precision chart of one scene of a work_precision.h5: error
     against CPU time, log-log, a line per method (its 'ok' points), the
-    series measured elsewhere dashed, the reference's own check dotted."""
+    series measured elsewhere dashed, the reference's own check dotted.
+
+    Parameters
+    ----------
+    data : xarray.DataTree or str or os.PathLike
+        The file's data (friction.load) or its path.
+    scene : str
+        The scene's group in the file ('naf', 'brake_switched', ...).
+
+    Returns
+    -------
+    Figure
+        The figure (matplotlib, outside pyplot).
+
+    Raises
+    ------
+    friction.FileError
+        A file that is not of the kind drawn, or lacks what the picture needs.
+    """
     data = load(data)
     if scene not in groups(data):
         known = sorted(g for g in groups(data) if "/" not in g)
@@ -1006,10 +1330,26 @@ FAILURE_COLOURS = ["#dddddd", "#4daf4a", "#ffd92f", "#e41a1c", "#984ea3"]  # non
 PARAMETER_LABELS = {"epsilon_prime": lambda v: f"ε' = {v:.0e}", "damping_ratio": lambda v: f"ζ = {v:g}"}
 
 
-def failure_map(data):
+def failure_map(data: DataLike) -> Figure:
     """The failure maps of a failure_map.h5: every method against each
     setting of a parameter, ok, slow, failed or silently wrong, with the CPU
-    time in ms."""
+    time in ms.
+
+    Parameters
+    ----------
+    data : xarray.DataTree or str or os.PathLike
+        The file's data (friction.load) or its path.
+
+    Returns
+    -------
+    Figure
+        The figure (matplotlib, outside pyplot).
+
+    Raises
+    ------
+    friction.FileError
+        A file that is not of the kind drawn, or lacks what the picture needs.
+    """
     data = load(data)
     maps = [g for g in groups(data) if "/" not in g]
     if not maps:
@@ -1047,24 +1387,52 @@ def failure_map(data):
     return fig
 
 
-def sang_fit(velocity, friction, sem, temperature=300.0):
+def sang_fit(velocity: ArrayLike, friction: ArrayLike, sem: ArrayLike, temperature: float = 300.0) -> tuple[float, float, float]:
     """Sang, Dube and Grant's law F = F_c - B [ln(v_c/v)]^(2/3) (PRL 87,
     174301, 2001) through the points, weighted by their standard errors
     (friction.thermal.fit_sang at one temperature, where only
     B = (beta k_B T)^(2/3) is determined).  Returns (F_c, B, v_c), v_c in
-    the units of velocity."""
+    the units of velocity.
+
+    Parameters
+    ----------
+    velocity : array_like
+        Support velocities (angstrom/s).
+    friction : array_like
+        Mean friction at each (nN).
+    sem : array_like
+        Its standard errors (nN).
+    temperature : float
+        K.
+
+    Returns
+    -------
+    tuple of float
+        (F_c, B, v_c): nN, nN, angstrom/s.
+    """
     from . import thermal
     fit = thermal.fit_sang(velocity, friction, temperature, sem)
     b = (fit.values["beta"] * thermal.K_B * temperature) ** (2.0 / 3.0)
     return fit.values["F_c"], float(b), fit.values["v_c"]
 
 
-def friction_velocity(rows):
+def friction_velocity(rows: Sequence[Mapping[str, Any]]) -> Figure:
     """The mean friction against the support velocity with error bars (one
     standard error), a series per model ('kramers', 'langevin'), and
     Sang et al.'s law fitted through the reduced model's points below
     3 Å/s (where its jumps are thermal).  rows: dicts with model, velocity
-    (Å/s), friction and sem (nN), as scripts/thermal_velocity.py gives."""
+    (Å/s), friction and sem (nN), as scripts/thermal_velocity.py gives.
+
+    Parameters
+    ----------
+    rows : sequence of dict
+        Points with model, velocity (angstrom/s), friction and sem (nN).
+
+    Returns
+    -------
+    Figure
+        The figure (matplotlib, outside pyplot).
+    """
     fig = _figure(figsize=(6.4, 4.4))
     ax = fig.add_subplot()
     styles = {"kramers": ("o", "tab:blue", "reduced model (Kramers KMC)"),
@@ -1095,7 +1463,7 @@ def friction_velocity(rows):
     return fig
 
 
-def temperature_fit(rows, below=300.0):
+def temperature_fit(rows: Sequence[Mapping[str, Any]], below: float = 300.0) -> tuple[float, float, float, float]:
     """The law of thermally activated slips at a fixed velocity, F = F_c -
     C T^(2/3) (Sang et al.'s F_c - [beta k_B T ln(v_c/v)]^(2/3) with the
     logarithm's slow change with T left out), fitted by weighted least
@@ -1105,7 +1473,20 @@ def temperature_fit(rows, below=300.0):
     realizations all agree (standard error below 1e-9 nN: at low T the jumps scatter
     less than the sample spacing, so no sample tells them apart) gets the
     smallest standard error of the others.  Returns (F_c in nN, C in
-    nN/K^(2/3), alpha, its standard error)."""
+    nN/K^(2/3), alpha, its standard error).
+
+    Parameters
+    ----------
+    rows : sequence of dict
+        Points with temperature (K), friction and sem (nN).
+    below : float
+        Only points with 0 < T < below (K) are fitted.
+
+    Returns
+    -------
+    tuple of float
+        (F_c in nN, C in nN/K^(2/3), the free exponent alpha, its standard error).
+    """
     pts = [(r["temperature"], r["friction"], r["sem"]) for r in rows if 0.0 < r["temperature"] < below]
     t, f, e = (np.array(x, float) for x in zip(*pts))
     e = np.where(e > 1e-9, e, e[e > 1e-9].min())
@@ -1123,11 +1504,22 @@ def temperature_fit(rows, below=300.0):
     return float(fc), float(c), float(alpha), float(math.sqrt(cov[2, 2]))
 
 
-def friction_temperature(rows):
+def friction_temperature(rows: Sequence[Mapping[str, Any]]) -> Figure:
     """The mean friction against the temperature with error bars (one
     standard error) and the law F_c - C T^(2/3) fitted below 300 K
     (temperature_fit).  rows: dicts with temperature (K), friction and sem
-    (nN), as scripts/thermal_temperature.py gives."""
+    (nN), as scripts/thermal_temperature.py gives.
+
+    Parameters
+    ----------
+    rows : sequence of dict
+        Points with temperature (K), friction and sem (nN).
+
+    Returns
+    -------
+    Figure
+        The figure (matplotlib, outside pyplot).
+    """
     fig = _figure(figsize=(6.4, 4.4))
     ax = fig.add_subplot()
     pts = sorted((r["temperature"], r["friction"], r["sem"]) for r in rows)
@@ -1156,10 +1548,23 @@ def friction_temperature(rows):
 # --------------------------------------------------------------------------
 # fits of measured images (friction.fit)
 
-def fit_maps(fit, channel=None):
+def fit_maps(fit: ImageFit, channel: str | None = None) -> Figure:
     """A fit's measured, fitted and residual maps side by side (one channel of
     a friction.fit.ImageFit: the first, or `channel`), the residuals on their
-    own colour scale."""
+    own colour scale.
+
+    Parameters
+    ----------
+    fit : friction.fit.ImageFit
+        A fit of friction.fit.image.
+    channel : str, optional
+        The channel drawn; default the first.
+
+    Returns
+    -------
+    Figure
+        The figure (matplotlib, outside pyplot).
+    """
     channel = channel or sorted(fit.fitted)[0]
     if channel not in fit.fitted:
         raise ValueError(f"the fit has no channel {channel!r}: it has {sorted(fit.fitted)}")
@@ -1182,10 +1587,30 @@ def fit_maps(fit, channel=None):
     return fig
 
 
-def fit_corner(sample, names, truths=None):
+def fit_corner(sample: np.ndarray, names: Sequence[str], truths: Sequence[float] | None = None) -> Figure:
     """The corner plot of an MCMC sample (ImageFit.sample(): rows of values in
     the order of `names`), with the truth marked when known (corner's
-    corner.corner on a Figure of this module)."""
+    corner.corner on a Figure of this module).
+
+    Parameters
+    ----------
+    sample : numpy.ndarray
+        Rows of values (ImageFit.sample()).
+    names : sequence of str
+        The parameters' names, in the columns' order.
+    truths : sequence of float, optional
+        The true values, marked.
+
+    Returns
+    -------
+    Figure
+        The figure (matplotlib, outside pyplot).
+
+    Raises
+    ------
+    ImportError
+        Without the corner package.
+    """
     try:
         import corner
     except ImportError:
@@ -1198,11 +1623,29 @@ def fit_corner(sample, names, truths=None):
     return fig
 
 
-def friction_load(images, labels=None):
+def friction_load(images: Sequence[MeasuredImage], labels: Sequence[str] | None = None) -> Figure:
     """Friction against load from measured images (friction.read_image): each
     image's mean (trace - retrace)/2 with the standard error of its lines'
     means, against its setpoint (metadata["setpoint"]), and the line fitted
-    through them (numpy's polyfit)."""
+    through them (numpy's polyfit).
+
+    Parameters
+    ----------
+    images : sequence of MeasuredImage
+        Measured images with metadata["setpoint"] (friction.read_image).
+    labels : sequence of str, optional
+        A label per image.
+
+    Returns
+    -------
+    Figure
+        The figure (matplotlib, outside pyplot).
+
+    Raises
+    ------
+    ValueError
+        An image without a setpoint.
+    """
     points = []
     for image in images:
         if "setpoint" not in image.metadata:

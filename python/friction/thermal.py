@@ -25,11 +25,19 @@ curve_fit does without absolute_sigma).  Units: friction in the data's
 unit (nN for the program's), velocity in the data's unit (v_c comes out in
 it), temperature in K; beta is in friction^(3/2) per eV.
 """
+from __future__ import annotations
+
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+if TYPE_CHECKING:
+    import os
+
+    from numpy.typing import ArrayLike
 
 __all__ = ["K_B", "LawFit", "sang", "log_law", "fit_sang", "fit_log", "compare", "read_table", "TableError"]
 
@@ -41,30 +49,81 @@ class TableError(ValueError):
     """A table of measurements that cannot be fitted: the message names the file and what is wrong."""
 
 
-def sang(velocity, temperature, f_c, beta, v_c):
-    """Sang et al.'s law F = F_c - (beta k_B T ln(v_c/v))^(2/3) (v < v_c)."""
+def sang(velocity: ArrayLike, temperature: ArrayLike, f_c: float, beta: float, v_c: float) -> np.ndarray:
+    """Sang et al.'s law F = F_c - (beta k_B T ln(v_c/v))^(2/3) (v < v_c).
+
+    Parameters
+    ----------
+    velocity : array_like
+        Support velocities (any unit; v_c comes out in it).
+    temperature : array_like
+        K.
+    f_c : float
+        F_c, in the friction's unit.
+    beta : float
+        1/eV.
+    v_c : float
+        In the velocity's unit.
+
+    Returns
+    -------
+    numpy.ndarray
+        F at each velocity.
+    """
     v = np.asarray(velocity, float)
     return f_c - (beta * K_B * np.asarray(temperature, float) * np.log(v_c / v)) ** (2.0 / 3.0)
 
 
-def log_law(velocity, f_0, f_1):
-    """The logarithmic law F = F_0 + F_1 ln v (v in the data's unit)."""
+def log_law(velocity: ArrayLike, f_0: float, f_1: float) -> np.ndarray:
+    """The logarithmic law F = F_0 + F_1 ln v (v in the data's unit).
+
+    Parameters
+    ----------
+    velocity : array_like
+        Support velocities (any unit; v_c comes out in it).
+    f_0 : float
+        F_0.
+    f_1 : float
+        F_1.
+
+    Returns
+    -------
+    numpy.ndarray
+        F at each velocity.
+    """
     return f_0 + f_1 * np.log(np.asarray(velocity, float))
 
 
 @dataclass
 class LawFit:
-    """A law fitted to points.
+    """A law fitted to points (fit_sang, fit_log make it).
 
-    law         'sang' or 'log'
-    values      {parameter: estimate}; errors {parameter: standard error}
-    covariance  of the parameters in the order of `values`
-    chi2, dof   the sum of squared weighted residuals and the degrees of freedom
-    aic         Akaike's criterion chi2 + 2 k (k parameters): the smaller, the
-                better the law describes the same points (with the points' own
-                standard errors; without them, n ln(chi2/n) + 2 k)
-    residuals   (friction - law) of each point, in the data's unit
-    converged, message   scipy's verdict
+    Parameters
+    ----------
+    law : str
+        'sang' or 'log'.
+    values : dict of str to float
+        {parameter: estimate}.
+    errors : dict of str to float
+        {parameter: standard error}.
+    covariance : numpy.ndarray
+        Of the parameters in the order of values.
+    chi2 : float
+        The sum of squared weighted residuals.
+    dof : int
+        The degrees of freedom.
+    aic : float
+        Akaike's criterion chi2 + 2 k (k parameters): the smaller, the better
+        the law describes the same points (with the points' own standard
+        errors; without them, n ln(chi2/n) + 2 k).
+    residuals : numpy.ndarray
+        (friction - law) of each point, in the data's unit.
+    converged : bool
+        scipy's verdict.
+    message : str
+        scipy's message.
+    temperatures : numpy.ndarray
+        The temperatures of the logarithmic law's parameters (K).
     """
     law: str
     values: dict
@@ -78,8 +137,26 @@ class LawFit:
     message: str
     temperatures: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
-    def predict(self, velocity, temperature=None):
-        """The fitted law at the given velocities (and temperature, K)."""
+    def predict(self, velocity: ArrayLike, temperature: float | None = None) -> np.ndarray:
+        """The fitted law at the given velocities (and temperature, K).
+
+        Parameters
+        ----------
+        velocity : array_like
+            Support velocities (any unit; v_c comes out in it).
+        temperature : float, optional
+            K; needed for Sang et al.'s law, and for the logarithmic law fitted at several temperatures.
+
+        Returns
+        -------
+        numpy.ndarray
+            The law's friction.
+
+        Raises
+        ------
+        ValueError
+            A temperature missing or not fitted.
+        """
         if self.law == "sang":
             if temperature is None:
                 raise ValueError("Sang et al.'s law needs the temperature")
@@ -91,8 +168,14 @@ class LawFit:
         k = _temperature_index(self.temperatures, temperature)
         return log_law(velocity, self.values[f"F_0[{k}]"], self.values[f"F_1[{k}]"])
 
-    def summary(self):
-        """The estimates with their standard errors, one per line, and the fit's quality."""
+    def summary(self) -> str:
+        """The estimates with their standard errors, one per line, and the fit's quality.
+
+        Returns
+        -------
+        str
+            The table, one line per parameter.
+        """
         lines = [f"{'Sang et al.' if self.law == 'sang' else 'logarithmic'} law: chi2 = {self.chi2:.4g} "
                  f"for {self.dof} degrees of freedom, AIC = {self.aic:.4g}"
                  + ("" if self.converged else f" (NOT CONVERGED: {self.message})")]
@@ -154,7 +237,7 @@ def _fit(law, residuals, p0, transform, names, f, s, absolute, temperatures=np.z
                   float(aic), fitted_residuals, bool(result.success), str(result.message), temperatures)
 
 
-def fit_sang(velocity, friction, temperature=None, sem=None):
+def fit_sang(velocity: ArrayLike, friction: ArrayLike, temperature: ArrayLike | None = None, sem: ArrayLike | None = None) -> LawFit:
     """Sang et al.'s law through the points: F_c, beta, v_c with standard errors.
 
     velocity, friction: arrays (any velocity unit; v_c comes out in it);
@@ -163,7 +246,29 @@ def fit_sang(velocity, friction, temperature=None, sem=None):
     that temperature); sem: the points' standard errors (absolute), or None.
     Internally v_c = v_max exp(e^u) keeps v_c above the fastest point and
     beta = e^b positive; the start is the best of a scan of u, where F_c and
-    beta^(2/3) are linear."""
+    beta^(2/3) are linear.
+
+    Parameters
+    ----------
+    velocity : array_like
+        Support velocities (any unit; v_c comes out in it).
+    friction : array_like
+        The mean friction at each.
+    temperature : array_like, optional
+        K, a number or one per point (300 K when not given).
+    sem : array_like, optional
+        The points' standard errors (absolute).
+
+    Returns
+    -------
+    LawFit
+        F_c, beta, v_c with standard errors, chi2 and AIC.
+
+    Raises
+    ------
+    ValueError
+        Fewer than 4 points, or a point that is not finite or not positive.
+    """
     v, f, t, s, absolute = _points(velocity, friction, temperature, sem)
     if v.size < 4:
         raise ValueError("Sang et al.'s law has 3 parameters: give at least 4 points")
@@ -194,10 +299,32 @@ def fit_sang(velocity, friction, temperature=None, sem=None):
     return _fit("sang", residuals, p0, transform, ("F_c", "beta", "v_c"), f, s, absolute)
 
 
-def fit_log(velocity, friction, temperature=None, sem=None):
+def fit_log(velocity: ArrayLike, friction: ArrayLike, temperature: ArrayLike | None = None, sem: ArrayLike | None = None) -> LawFit:
     """The logarithmic law F = F_0 + F_1 ln v at each temperature of the
     points: parameters F_0[k], F_1[k] for the k-th temperature (sorted),
-    with standard errors; `temperatures` of the result lists them."""
+    with standard errors; `temperatures` of the result lists them.
+
+    Parameters
+    ----------
+    velocity : array_like
+        Support velocities (any unit; v_c comes out in it).
+    friction : array_like
+        The mean friction at each.
+    temperature : array_like, optional
+        K, a number or one per point.
+    sem : array_like, optional
+        The points' standard errors (absolute).
+
+    Returns
+    -------
+    LawFit
+        F_0[k], F_1[k] per temperature with standard errors.
+
+    Raises
+    ------
+    ValueError
+        Fewer than 3 points at a temperature, or a bad point.
+    """
     v, f, t, s, absolute = _points(velocity, friction, temperature, sem)
     temperatures = np.unique(t)
     which = np.searchsorted(temperatures, t)
@@ -223,9 +350,31 @@ def fit_log(velocity, friction, temperature=None, sem=None):
     return _fit("log", residuals, p0, transform, names, f, s, absolute, temperatures)
 
 
-def compare(velocity, friction, temperature=None, sem=None):
+def compare(velocity: ArrayLike, friction: ArrayLike, temperature: ArrayLike | None = None, sem: ArrayLike | None = None) -> dict[str, Any]:
     """Both laws on the same points: {"sang": LawFit, "log": LawFit,
-    "preferred": the law of the smaller AIC}."""
+    "preferred": the law of the smaller AIC}.
+
+    Parameters
+    ----------
+    velocity : array_like
+        Support velocities (any unit; v_c comes out in it).
+    friction : array_like
+        The mean friction at each.
+    temperature : array_like, optional
+        K.
+    sem : array_like, optional
+        Standard errors.
+
+    Returns
+    -------
+    dict
+        {"sang": LawFit, "log": LawFit, "preferred": name}.
+
+    Raises
+    ------
+    ValueError
+        Points either fit refuses.
+    """
     fits = {"sang": fit_sang(velocity, friction, temperature, sem),
             "log": fit_log(velocity, friction, temperature, sem)}
     fits["preferred"] = min(("sang", "log"), key=lambda name: fits[name].aic)
@@ -237,13 +386,29 @@ COLUMNS = {"velocity": ("velocity", "v"), "temperature": ("temperature", "t"), "
            "sem": ("sem", "error", "standard_error")}
 
 
-def read_table(path):
+def read_table(path: str | os.PathLike[str]) -> dict[str, np.ndarray | None]:
     """A table of measured (or computed) friction: text with a header line
     naming the columns velocity, temperature, friction and optionally sem
     (any order; commas or blanks between values; lines starting with # are
     comments).  Returns {"velocity", "temperature", "friction", "sem"} as
     numpy arrays (sem None when absent), ready for fit_sang(**table).
-    TableError names the file and line of what is wrong."""
+    TableError names the file and line of what is wrong.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The table's file.
+
+    Returns
+    -------
+    dict
+        Arrays "velocity", "temperature", "friction", "sem" (None when absent).
+
+    Raises
+    ------
+    TableError
+        The file and line of what is wrong.
+    """
     path = Path(path)
     try:
         text = path.read_text()
