@@ -165,6 +165,22 @@ int friction_config_names(const friction_config *cfg, char *buf, size_t len, siz
  * (preceded by "file:line: " when the value was read from a file). */
 int friction_config_check(const friction_config *cfg, friction_error *err);
 
+/* The warnings the program's input would give for the configuration's
+ * values, one a line in the program's words, "" for none (the library
+ * prints nothing: show them as you show its messages):
+ *   - a value set (friction_config_set, _set_real, friction_config_read)
+ *     that looks like a number in another unit than its variable's:
+ *     "&scan: angle = 0.122: below 2 pi and not a whole or half degree: it
+ *     looks like radians, and the unit is degrees (...)";
+ *   - the scene's own ("&tip: kx = 10000.0: far outside the springs of AFM tips ...");
+ *   - a sweep's values that look like another unit, once per swept variable:
+ *     "&sweep: sweep_variable = 'scan.angle': 5 of its 5 values, from 0.1 to
+ *     0.5, look like another unit than degree; the first: ...";
+ * each preceded by "file:line: " when the value was read from a file.  The
+ * checks run first: a configuration they refuse has no warnings
+ * (friction_config_check gives its error).  Buffer as friction_config_text. */
+int friction_config_warnings(const friction_config *cfg, char *buf, size_t len, size_t *needed);
+
 /* ---- computations on the calling process (no MPI) ---- */
 
 /* Line `line` (0-based, < scan.ny) of the map of an "afm" configuration:

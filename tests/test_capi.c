@@ -612,6 +612,56 @@ static void check_jobs(friction_error *err) {
   friction_config_free(cfg);
 }
 
+/* friction_config_warnings: the warnings the program's input would give for the values
+ * (docs/input.md, Units), returned, never printed. */
+static void check_warnings(friction_error *err) {
+  char buf[4096];
+  size_t needed = 0;
+  friction_config *cfg = friction_config_new("afm", err);
+  expect_ok(friction_config_warnings(cfg, buf, sizeof buf, &needed), err, "warnings of the defaults");
+  CHECK(strcmp(buf, "") == 0 && needed == 1, "the defaults warn: '%s' (%zu bytes)", buf, needed);
+  /* an angle in radians, an energy in joules: the program's words, one a line */
+  expect_ok(friction_config_set_real(cfg, "scan.angle", 0.122, err), err, "angle");
+  expect_ok(friction_config_set(cfg, "surface.v0", "1.6e-19", err), err, "v0");
+  expect_ok(friction_config_warnings(cfg, NULL, 0, &needed), err, "size query");
+  CHECK(needed > 1 && needed <= sizeof buf, "size query: %zu bytes", needed);
+  expect_ok(friction_config_warnings(cfg, buf, sizeof buf, NULL), err, "warnings");
+  /* (in the order of the groups, as the program's) */
+  CHECK(strstr(buf, "&surface: v0 = 1.6e-19: below 1e-10 eV: it looks like joules, and the unit is eV") == buf,
+        "v0 warning: '%s'", buf);
+  CHECK(strstr(buf, "\n&scan: angle = 0.122: below 2 pi and not a whole or half degree: it looks like radians, and "
+                    "the unit is degrees (0.122") != NULL,
+        "angle warning: '%s'", buf);
+  CHECK(buf[strlen(buf) - 1] == '\n' && strchr(strchr(buf, '\n') + 1, '\n') == buf + strlen(buf) - 1,
+        "two lines: '%s'", buf);
+  CHECK(friction_config_warnings(cfg, buf, 10, &needed) == FRICTION_ERROR_INPUT, "a short buffer is refused");
+  /* the scene's own warning (a spring in another unit), and none once the values are plausible */
+  expect_ok(friction_config_set_real(cfg, "scan.angle", 7.0, err), err, "angle 7");
+  expect_ok(friction_config_set_real(cfg, "surface.v0", 1.0, err), err, "v0 1");
+  expect_ok(friction_config_set_real(cfg, "tip.kx", 10000.0, err), err, "kx");
+  expect_ok(friction_config_warnings(cfg, buf, sizeof buf, NULL), err, "kx warnings");
+  CHECK(strncmp(buf, "&tip: kx = 10000", 16) == 0 && strstr(buf, "far outside the springs of AFM tips") != NULL,
+        "kx warning: '%s'", buf);
+  expect_ok(friction_config_set_real(cfg, "tip.kx", 5.0, err), err, "kx 5");
+  expect_ok(friction_config_warnings(cfg, buf, sizeof buf, NULL), err, "plausible");
+  CHECK(strcmp(buf, "") == 0, "plausible values warn: '%s'", buf);
+  /* a sweep's values: once for the variable, with their range */
+  expect_ok(friction_config_set(cfg, "sweep.sweep_variable", "'scan.angle'", err), err, "sweep variable");
+  expect_ok(friction_config_set(cfg, "sweep.sweep_values", "0.1, 0.3, 45.0, 0.5", err), err, "sweep values");
+  expect_ok(friction_config_warnings(cfg, buf, sizeof buf, NULL), err, "sweep warnings");
+  /* (0.5 is a half degree, 45 a whole one: the rule's two exceptions) */
+  CHECK(strcmp(buf, "&sweep: sweep_variable = 'scan.angle': 2 of its 4 values, from 0.100000 to 0.300000, look like "
+                    "another unit than degree; the first: below 2 pi and not a whole or half degree: it looks like "
+                    "radians, and the unit is degrees (0.100000 rad = 5.72958 degrees)\n") == 0,
+        "sweep warning: '%s'", buf);
+  /* a configuration the checks refuse has no warnings: its error is friction_config_check's */
+  expect_ok(friction_config_set_real(cfg, "tip.mass", -1.0, err), err, "mass");
+  expect_ok(friction_config_warnings(cfg, buf, sizeof buf, NULL), err, "refused");
+  CHECK(strcmp(buf, "") == 0, "a refused configuration warns: '%s'", buf);
+  CHECK(friction_config_warnings(NULL, buf, sizeof buf, NULL) == FRICTION_ERROR_INPUT, "a NULL configuration");
+  friction_config_free(cfg);
+}
+
 static int checks(void) {
   friction_error *err = friction_error_new();
   check_versions();
@@ -620,6 +670,7 @@ static int checks(void) {
   check_freed_handles(err);
   check_set_get(err);
   check_checks(err);
+  check_warnings(err);
   check_files(err);
   check_results(err);
   check_progress(err);

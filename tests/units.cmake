@@ -10,6 +10,9 @@
 #   units-velocity           scan.velocity = 4e-8 (400 angstrom/s in m/s): a line of 5e8 s
 #   units-plausible          2.5 degrees and 0.05 N/m: no warning
 #   units-print-input        --print-input gives each variable's unit
+#   units-sweep-radians      a sweep of scan.angle from 0.122 to 0.488 (radians): one warning naming
+#                            the file and line of sweep_variable, &sweep, the variable, the count and range
+#   units-sweep-plausible    a sweep of whole and half degrees: no warning
 #   units-paper-<input>      the shipped inputs give no such warning
 
 set(_un_data "${CMAKE_CURRENT_SOURCE_DIR}/data/units")
@@ -36,6 +39,12 @@ friction_units_case(velocity ARGS "${_un_inputs}/naf.nml" "${_un_data}/velocity_
   EXPECT "warning: [^\n]*velocity_metres\\.nml:2: &scan: velocity = 4[^\n]*: a line of 20[^\n]* takes 5[^\n]* s of scan time at this velocity, more than a day: the unit is angstrom/s \\([^\n]* m/s = 400")
 friction_units_case(print-input ARGS "${_un_inputs}/naf.nml"
   EXPECT "  v0 = 1\\.0 +! eV\n.*  kx = 10\\.0 +! N/m\n.*  velocity = 400\\.0 +! angstrom/s\n.*  rtol = 0\\.001\n")
+
+friction_units_case(sweep-radians ARGS "${_un_inputs}/naf.nml" "${_un_data}/sweep_angle_radians.nml"
+  EXPECT "warning: [^\n]*sweep_angle_radians\\.nml:2: &sweep: sweep_variable = 'scan\\.angle': 4 of its 4 values, from 0\\.122[0-9]* to 0\\.488[0-9]*, look like another unit than degree; the first: [^\n]*looks like radians")
+add_test(NAME units-sweep-plausible COMMAND $<TARGET_FILE:friction_app> --print-input "${_un_inputs}/naf.nml"
+  "${_un_data}/sweep_plausible.nml")
+set_tests_properties(units-sweep-plausible PROPERTIES LABELS cli FAIL_REGULAR_EXPRESSION "warning:")
 
 # The plausible values: no warning, and exit 0.
 add_test(NAME units-plausible COMMAND $<TARGET_FILE:friction_app> --print-input "${_un_inputs}/naf.nml" "${_un_data}/plausible.nml")

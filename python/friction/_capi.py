@@ -182,6 +182,7 @@ def _signatures(lib):
         "friction_config_text": (c_int, [c_void_p, c_char_p, c_size_t, size_p]),
         "friction_config_names": (c_int, [c_void_p, c_char_p, c_size_t, size_p]),
         "friction_config_check": (c_int, [c_void_p, c_void_p]),
+        "friction_config_warnings": (c_int, [c_void_p, c_char_p, c_size_t, size_p]),
         "friction_afm_line": (c_int, [c_void_p, c_int, c_int, c_void_p, c_void_p, c_size_t, c_void_p]),
         "friction_compute": (c_void_p, [c_void_p, c_void_p]),
         "friction_compute_progress": (c_void_p, [c_void_p, _PROGRESS, c_void_p, c_void_p]),
@@ -650,6 +651,25 @@ class Config:
             Namelist groups, every variable of the scene.
         """
         return self._text(self._lib.friction_config_text)
+
+    def warnings(self) -> list[str]:
+        """The warnings the program's input would give for these values
+        (friction.h: friction_config_warnings): a value that looks like a
+        number in another unit than its variable's, the scene's own, and a
+        sweep's values that do; none when the checks refuse the
+        configuration (check() says why).
+
+        Returns
+        -------
+        list of str
+            One per warning, in the program's words ("&scan: angle = 0.122:
+            ... it looks like radians, and the unit is degrees (...)").
+
+        Examples
+        --------
+        >>> friction.Config("afm", values={"scan.angle": 0.122}).warnings()  # doctest: +SKIP
+        """
+        return self._text(self._lib.friction_config_warnings).splitlines()
 
     def names(self) -> list[tuple[str, str, int, str]]:
         """Every variable: a list of (name, kind, elements, unit), kind "real",

@@ -234,3 +234,22 @@ def test_threads_read_files_at_once(friction):
     for thread in threads:
         thread.join()
     assert not failures, failures[:3]
+
+
+def test_warnings_are_the_programs(friction, program, tmp_path):
+    """Config.warnings(): the words the program's input gives on stderr for the
+    same values (a file's origin included), returned and never printed."""
+    (tmp_path / "slips.nml").write_text("&scan angle = 0.122 /\n&sweep sweep_variable = 'surface.v0', "
+                                        "sweep_values = 1.0, 1.6e-19, 3.2e-19 /\n")
+    with friction.Config("afm", files=[friction.input_file("naf.nml"), tmp_path / "slips.nml"]) as cfg:
+        warnings = cfg.warnings()
+        cfg.set("scan.angle", 7.0)
+        assert cfg.warnings() == warnings[1:]
+        cfg.set("sweep.sweep_variable", "")
+        assert cfg.warnings() == []
+    done = helpers.run([program, "--print-input", friction.input_file("naf.nml"), tmp_path / "slips.nml"],
+                       cwd=tmp_path)
+    said = [line.split("friction: warning: ", 1)[1] for line in done.stderr.splitlines() if "warning: " in line]
+    assert warnings == said and len(said) == 2
+    assert "slips.nml:1: &scan: angle = 0.122" in said[0] and "looks like radians" in said[0]
+    assert "slips.nml:2: &sweep: sweep_variable = 'surface.v0': 2 of its 3 values, from 1.6" in said[1]

@@ -28,7 +28,8 @@ module friction_capi
    use friction_capi_handles, only: capi_result, friction_error_new, friction_error_free, friction_error_status, &
       & friction_error_message, friction_config_new, friction_config_free, friction_result_free
    use friction_capi_config, only: friction_config_read, friction_config_set, friction_config_set_real, &
-      & friction_config_get, friction_config_text, friction_config_names, friction_config_check
+      & friction_config_get, friction_config_text, friction_config_names, friction_config_check, &
+      & friction_config_warnings
    use friction_capi_compute, only: friction_afm_line, friction_compute, friction_compute_progress, &
       & friction_result_get, friction_result_shape, friction_result_names
    use friction_capi_jobs, only: friction_run_job, friction_run_config
@@ -41,7 +42,7 @@ module friction_capi
       & friction_error_status, friction_error_message
    public :: friction_config_new, friction_config_free, friction_config_read, friction_config_set, &
       & friction_config_set_real, friction_config_get, friction_config_text, friction_config_names, &
-      & friction_config_check
+      & friction_config_check, friction_config_warnings
    public :: friction_afm_line, friction_compute, friction_compute_progress, friction_result_get, &
       & friction_result_shape, friction_result_names, friction_result_free
    public :: friction_run_job, friction_run_config

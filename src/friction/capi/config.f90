@@ -12,14 +12,15 @@ module friction_capi_config
       & set_parameter_number, get_parameter, kind_text, value_has_kind, unit_hint
    use friction_checks, only: config_checker
    use friction_input_reader, only: namelist_source, scan_files, apply_files, parse_variable_name
-   use friction_job_config, only: job_config, check_job, job_text, all_parameters, parameter_groups, not_in_scene
+   use friction_job_config, only: job_config, check_job, job_text, all_parameters, parameter_groups, not_in_scene, &
+      & warn_units
    use friction_capi_text, only: c_string, copy_text, len_text, text_status, element_name
    use friction_capi_handles, only: capi_config, kind_config, friction_handle_live, report, refuse, config_of
    implicit none
    private
 
    public :: friction_config_set, friction_config_set_real, friction_config_get, friction_config_text, &
-      & friction_config_names, friction_config_read, friction_config_check
+      & friction_config_names, friction_config_read, friction_config_check, friction_config_warnings
    !> For the C API's other files: the checks, the setting of a checked
    !> value (the laws' too), and the message of a forked process.
    public :: check_config, set_checked_text, set_checked_number, forked_message
@@ -395,5 +396,43 @@ contains
       if (config_of(cfg, config, error)) call check_config(config, work, error)
       status = report(handle, error)
    end function friction_config_check
+
+   !> int friction_config_warnings(const friction_config *cfg, char *buf, size_t len, size_t *needed):
+   !> the warnings the program's input would give for these values, one a
+   !> line (the library prints nothing: the host shows them).  None when the
+   !> checks refuse the configuration (friction_config_check says why).
+   integer(c_int) function friction_config_warnings(cfg, buf, len, needed) &
+      & bind(c, name='friction_config_warnings_body') result(status)
+      type(c_ptr), value :: cfg, buf, needed
+      integer(c_size_t), value :: len
+      type(capi_config), pointer :: config
+      type(job_config) :: work
+      type(config_checker) :: checker
+      character(len=:), allocatable :: text
+      integer :: k
+      integer(c_int) :: taken
+
+      status = error_input
+      if (.not. c_associated(cfg)) return
+      if (friction_handle_live(cfg, kind_config) == 0) return
+      call c_f_pointer(cfg, config)
+      work = config%job
+      checker = config%origins
+      ! (The numbers are formatted by internal writes: under the read lock, as friction_config_text.)
+      taken = friction_read_begin()
+      if (taken < 0) return   ! (a process forked mid-job: job_lock.c)
+      call check_job(work, checker)
+      text = ''
+      if (.not. checker%failed()) then
+         call warn_units(work, checker)
+         if (allocated(checker%warnings)) then
+            do k = 1, size(checker%warnings)
+               text = text//trim(checker%warnings(k))//new_line('a')
+            end do
+         end if
+      end if
+      if (taken /= 0) call friction_read_end()
+      status = text_status(text, buf, len, needed)
+   end function friction_config_warnings
 
 end module friction_capi_config

@@ -56,6 +56,9 @@ FP_GUARDED(int, friction_config_text, (const friction_config *cfg, char *buf, si
 
 FP_GUARDED(int, friction_config_check, (const friction_config *cfg, friction_error *err), (cfg, err))
 
+FP_GUARDED(int, friction_config_warnings, (const friction_config *cfg, char *buf, size_t len, size_t *needed),
+           (cfg, buf, len, needed))
+
 FP_GUARDED(int, friction_afm_line,
            (friction_config *cfg, int line, int forward, double *fx, double *fy, size_t n,
             friction_error *err),

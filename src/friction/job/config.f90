@@ -8,6 +8,7 @@ module friction_job_config
    use friction_parameters, only: configurable, parameter_visitor, parameter_info, list_parameters, &
       & parameters_text, split_name, parameter_finding, implausible_values
    use friction_checks, only: config_checker
+   use friction_plausibility, only: unit_plausibility
    use friction_input_reader, only: namelist_source, scan_files, apply_files, override_source, source_place, last_text
    use friction_scene, only: scene
    use friction_job_factory, only: scene_names, new_scene
@@ -15,7 +16,7 @@ module friction_job_config
    private
 
    public :: job_config, sweep_settings, read_input, check_job, all_parameters, job_text, &
-      & parameter_groups, not_in_scene
+      & parameter_groups, not_in_scene, warn_units
 
    !> &sweep: one or two numeric variables of the scene ('group.name'), each
    !> over a list, a linspace or a logspace; the points are the grid of the
@@ -232,7 +233,7 @@ contains
          call move_alloc(checker%error, error)
          return
       end if
-      call warn_implausible(config, checker)
+      call warn_units(config, checker)
       if (present(notes) .and. allocated(checker%warnings)) then
          do k = 1, size(checker%warnings)
             notes = [character(len=1024) :: notes, 'warning: '//trim(checker%warnings(k))]
@@ -240,6 +241,17 @@ contains
       end if
       input_text = job_text(config, units)
    end subroutine read_input
+
+   !> The warnings of a checked configuration's values that look like numbers
+   !> in another unit than their variable's: those the input set
+   !> (warn_implausible) and those a sweep sets (warn_implausible_sweep).
+   subroutine warn_units(config, checker)
+      type(job_config), intent(inout) :: config
+      type(config_checker), intent(inout) :: checker
+
+      call warn_implausible(config, checker)
+      call warn_implausible_sweep(config, checker)
+   end subroutine warn_units
 
    !> Warnings for the values the input gives that look like numbers in
    !> another unit than their variable's (friction_plausibility), each naming
@@ -262,6 +274,50 @@ contains
          end associate
       end do
    end subroutine warn_implausible
+
+   !> Warnings for the values a sweep sets that look like numbers in another
+   !> unit than the swept variable's (friction_plausibility): one per swept
+   !> variable, where its sweep_variable was set, with how many of its values
+   !> do, their range and the first one's reason.
+   subroutine warn_implausible_sweep(config, checker)
+      type(job_config), intent(in) :: config
+      type(config_checker), intent(inout) :: checker
+      type(parameter_info), allocatable :: list(:)
+      class(scene), allocatable :: copy
+      character(len=:), allocatable :: group, name, unit, reason, first, suffix
+      real(wp) :: x, low, high
+      integer :: a, k, m, flagged
+
+      if (.not. config%sweep%enabled()) return
+      allocate (copy, source=config%scene)
+      list = list_parameters(copy)
+      do a = 1, config%sweep%n_variables
+         call split_name(config%sweep%variables(a), group, name)
+         unit = ''
+         do m = 1, size(list)
+            if (list(m)%group == group .and. list(m)%name == name .and. list(m)%kind == 'r') unit = trim(list(m)%unit)
+         end do
+         if (len(unit) == 0) cycle
+         flagged = 0
+         first = ''
+         low = huge(1.0_wp)
+         high = -huge(1.0_wp)
+         do k = 1, config%sweep%shape(a)
+            x = config%sweep%value(a, k)
+            reason = unit_plausibility(unit, x)
+            if (len(reason) == 0) cycle
+            flagged = flagged + 1
+            if (flagged == 1) first = reason
+            low = min(low, x)
+            high = max(high, x)
+         end do
+         if (flagged == 0) cycle
+         suffix = merge('  ', '2 ', a == 1)
+         call checker%warn('sweep', 'sweep_variable'//trim(suffix), "'"//trim(config%sweep%variables(a))//"'", &
+            & itoa(flagged)//' of its '//itoa(config%sweep%shape(a))//' values, from '//rtoa(low)//' to ' &
+            & //rtoa(high)//', look like another unit than '//unit//'; the first: '//first)
+      end do
+   end subroutine warn_implausible_sweep
 
    !> Groups of the sources that are not part of the job's scene: in an
    !> override (--set), an error with the C API's message; in a file, a
