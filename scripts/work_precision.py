@@ -453,6 +453,21 @@ def auto_evidence(res) -> list:
     return out
 
 
+def with_units(dataset, units: str, long_name: str = "") -> None:
+    """A dataset's unit as a UDUNITS string that pint also reads (docs/output.md#units-udunits-strings),
+    and its description in long_name."""
+    dataset.attrs["units"] = units
+    if long_name:
+        dataset.attrs["long_name"] = long_name
+
+
+def write_extra(e, ex, unit: str) -> None:
+    """One series measured elsewhere as the group extra/<label>."""
+    s = e.create_group(ex["label"])
+    with_units(s.create_dataset("error", data=np.asarray(ex["error"], dtype=float)), unit)
+    with_units(s.create_dataset("cpu_time", data=np.asarray(ex["cpu_time"], dtype=float)), "s")
+
+
 def write_scene(f: h5py.File, res, extras) -> None:
     scene = res["scene"]
     g = f.create_group(scene.name)
@@ -470,24 +485,25 @@ def write_scene(f: h5py.File, res, extras) -> None:
     a["reference_check_rtol"] = scene.ref_tol * 10
     a["reference_check"] = res["check"]
     for method, pts in res["rows"].items():
-        write_method(g, method, pts)
+        write_method(g, method, pts, scene.unit)
     if extras:
         e = g.create_group("extra")
         for ex in extras:
-            s = e.create_group(ex["label"])
-            s.create_dataset("error", data=np.asarray(ex["error"], dtype=float))
-            s.create_dataset("cpu_time", data=np.asarray(ex["cpu_time"], dtype=float))
+            write_extra(e, ex, scene.unit)
     write_derived(g, res)
 
 
-def write_method(g, method: str, pts) -> None:
-    """One method's ladder as the group /<scene>/<method>."""
+def write_method(g, method: str, pts, unit: str) -> None:
+    """One method's ladder as the group /<scene>/<method>; unit: the error's."""
     m = g.create_group(method)
-    m.create_dataset("tolerance", data=np.array([p.rtol for p in pts]))
-    m.create_dataset("atol", data=np.array([p.atol for p in pts]))
-    m.create_dataset("error", data=np.array([p.error for p in pts]))
-    m.create_dataset("cpu_time", data=np.array([p.time for p in pts]))
-    m.create_dataset("rhs_evaluations", data=np.array([p.rhs for p in pts], dtype=np.int64))
+    with_units(m.create_dataset("tolerance", data=np.array([p.rtol for p in pts])), "1", "rtol")
+    # (atol is in the units of each integrated state: a mix, so no one unit)
+    m.create_dataset("atol", data=np.array([p.atol for p in pts])).attrs["long_name"] = \
+        "atol, in the units of each integrated state"
+    with_units(m.create_dataset("error", data=np.array([p.error for p in pts])), unit,
+               "max |q - q_ref| over the samples")
+    with_units(m.create_dataset("cpu_time", data=np.array([p.time for p in pts])), "s")
+    with_units(m.create_dataset("rhs_evaluations", data=np.array([p.rhs for p in pts], dtype=np.int64)), "1")
     m.create_dataset("status", data=[p.status for p in pts], dtype=h5py.string_dtype())
     m.create_dataset("message", data=[p.message for p in pts], dtype=h5py.string_dtype())
 
@@ -624,17 +640,16 @@ def write_failure_maps(path: Path, maps, methods, meta) -> None:
             g.attrs["unit"] = mp["unit"]
             g.create_dataset(mp["parameter"], data=np.array(mp["values"], dtype=float))
             if "c" in mp:
-                g.create_dataset("c", data=np.array(mp["c"]))
-                g["c"].attrs["unit"] = "N s/m (cx; cy likewise from ky)"
-            write_map_points(g, mp["parameter"], methods, mp["columns"])
+                with_units(g.create_dataset("c", data=np.array(mp["c"])), "N s/m", "cx; cy likewise from ky")
+            write_map_points(g, mp["parameter"], methods, mp["columns"], mp["unit"])
 
 
 MAP_POINT_DATA = ("methods", "category", "error", "cpu_time", "asked_tolerance", "status", "message",
                   "reference_check")
 
 
-def write_map_points(g, parameter: str, methods, cols) -> None:
-    """A failure map's points (methods x settings) and categories."""
+def write_map_points(g, parameter: str, methods, cols, unit: str) -> None:
+    """A failure map's points (methods x settings) and categories; unit: the error's."""
     for d in MAP_POINT_DATA:
         if d in g:
             del g[d]
@@ -648,6 +663,8 @@ def write_map_points(g, parameter: str, methods, cols) -> None:
     g.create_dataset("message", data=np.array([[p.message for p in c["points"]] for c in cols],
                                                dtype=object).T, dtype=h5py.string_dtype())
     g.create_dataset("reference_check", data=np.array([c["ref_check"] for c in cols]))
+    for d, units in (("error", unit), ("cpu_time", "s"), ("asked_tolerance", "1"), ("reference_check", unit)):
+        with_units(g[d], units)
     for d in ("category", "error", "cpu_time", "status"):
         g[d].attrs["axes"] = f"methods x {parameter}"
 
@@ -708,9 +725,7 @@ def replot(path: Path, out: Path, extras: dict) -> int:
                 e = g.require_group("extra")
                 if ex["label"] in e:
                     del e[ex["label"]]
-                s = e.create_group(ex["label"])
-                s.create_dataset("error", data=np.asarray(ex["error"], dtype=float))
-                s.create_dataset("cpu_time", data=np.asarray(ex["cpu_time"], dtype=float))
+                write_extra(e, ex, scenes[name].unit)
             replotted.append((name, len(g.get("extra", {}))))
     data = friction.load(path)
     for name, count in replotted:
@@ -744,7 +759,7 @@ def add_to(directory: Path, results, maps, methods, meta) -> tuple[list, list, l
             for method, pts in res["rows"].items():
                 if method in g:
                     del g[method]
-                write_method(g, method, pts)
+                write_method(g, method, pts, res["scene"].unit)
                 g[method].attrs["added"] = stamp
             rows = {m: read_method(g[m], m) for m in all_methods if m in g}
             merged = dict(res, rows=rows)
@@ -765,7 +780,7 @@ def add_to(directory: Path, results, maps, methods, meta) -> tuple[list, list, l
                 for old, new in zip(old_cols, mp["columns"]):
                     pts = [p for p in old["points"] if p.method not in methods] + new["points"]
                     cols.append(dict(new, points=pts, codes=category_codes(pts)))
-                write_map_points(g, mp["parameter"], map_methods, cols)
+                write_map_points(g, mp["parameter"], map_methods, cols, mp["unit"])
                 merged_maps.append(dict(mp, columns=cols, methods=map_methods))
             f.attrs["added"] = f"{','.join(methods)}: {stamp}"
     return merged_results, merged_maps, all_methods

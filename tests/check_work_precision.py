@@ -17,6 +17,9 @@ rhs_evaluations and status for the quick ladder.  The oracles:
   hundredfold step gives room: the measured factors are 10 to 600.
 * The --extra series of tests/data/extra_series.json is stored under
   /naf/extra with its values.
+* Every dataset's `units` in both files parses with UDUNITS-2 (cf-units)
+  and pint (docs/output.md#units-udunits-strings), and the errors and CPU
+  times have theirs (the scene's unit, s).
 * failure_map.h5 holds both maps with a category for every method and
   setting, each a known code; every 'ok' point's error is within 100x of
   the asked tolerance (that is what 'ok' means); at NaF damping ratio 1
@@ -99,6 +102,29 @@ def main():
         # ok or slow (timing depends on the machine's load): neither failed nor wrong
         need(g["category"][methods.index("rk8pd"), j] in (0, 1),
              "naf_damping: rk8pd at damping ratio 1 failed or wrong")
+
+    import cf_units
+    import pint
+    registry = pint.UnitRegistry()
+    for name in ("work_precision.h5", "failure_map.h5"):
+        with h5py.File(out / name, "r") as f:
+            stated = []
+            f.visititems(lambda path, obj: stated.append((path, obj.attrs["units"]))
+                         if isinstance(obj, h5py.Dataset) and "units" in obj.attrs else None)
+            for path, unit in stated:
+                unit = unit.decode() if isinstance(unit, bytes) else str(unit)
+                try:
+                    cf_units.Unit(unit)
+                    registry.parse_units(unit)
+                except Exception as err:   # either library's refusal, whatever its type
+                    need(False, f"{name}: /{path} units {unit!r}: {err}")
+            units = dict((path, u.decode() if isinstance(u, bytes) else str(u)) for path, u in stated)
+            for path in ("naf/rkf45/error", "naf/rkf45/cpu_time", "naf_damping/c", "naf_damping/error"):
+                if name == "work_precision.h5" and path.startswith("naf/") \
+                        or name == "failure_map.h5" and path.startswith("naf_damping/"):
+                    need(path in units, f"{name}: /{path} has no units")
+            need(units.get("naf/rkf45/error", "nN") == "nN" and units.get("naf_damping/c", "N s/m") == "N s/m",
+                 f"{name}: units {units}")
 
     for p in problems:
         print(f"check_work_precision: {p}", file=sys.stderr)
