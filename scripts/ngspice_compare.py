@@ -308,7 +308,12 @@ def write_json(path: Path, record: dict) -> None:
 
 
 def write_hdf5(path: Path, record: dict) -> None:
-    """Scalars as root attributes, the curves as datasets, the ladder as a table."""
+    """Scalars as root attributes, the curves as datasets, the ladder as a table;
+    each dataset's unit as the program's files state theirs (docs/output.md#units-udunits-strings):
+    the brake's time tau as a pure number, 'tau' beside it in units_tau."""
+    unit, time_unit = record.get("unit", ""), record.get("time_unit", "s")
+    units = {"t": time_unit, "kernel": unit, "ngspice": unit, "ladder/reltol": "1", "ladder/error": unit,
+             "ladder/t_error": time_unit, "ladder/cpu_time": "s", "ladder/wall_time": "s", "ladder/points": "1"}
     with h5py.File(path, "w") as f:
         for key, value in record.items():
             if isinstance(value, np.ndarray):
@@ -318,6 +323,11 @@ def write_hdf5(path: Path, record: dict) -> None:
                     f[f"ladder/{column}"] = np.array([row[column] for row in value])
             elif value is not None and not isinstance(value, (dict, list)):
                 f.attrs[key] = str(value) if isinstance(value, Path) else value
+        for name, stated in units.items():
+            if name in f and stated:
+                f[name].attrs["units"] = "1" if stated == "tau" else stated
+                if stated == "tau":
+                    f[name].attrs["units_tau"] = "tau"
 
 
 # ------------------------------------------------------------------ main
