@@ -500,7 +500,9 @@ def _read_text(path, channel, retrace):
     return image_from_arrays(trace, back, None, "", 0.0, "", channel or "", str(path), "text")
 
 
-def read_image(path: str | os.PathLike[str], channel: str | None = None, retrace: str | os.PathLike[str] | None = None, calibration: float | None = None, size: tuple[float, float] | None = None) -> MeasuredImage:
+def read_image(path: str | os.PathLike[str], channel: str | None = None,
+               retrace: str | os.PathLike[str] | None = None, calibration: float | None = None,
+               size: tuple[float, float] | None = None) -> MeasuredImage:
     """A lateral-force image from a microscope's file.
 
     Parameters

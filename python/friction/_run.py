@@ -111,7 +111,8 @@ def _files(files):
     return [Path(f) for f in files]
 
 
-def run(files: PathLike | Sequence[PathLike], output: PathLike | None = None, force: bool = False, resume: bool = False, progress: Progress = True) -> Path:
+def run(files: PathLike | Sequence[PathLike], output: PathLike | None = None, force: bool = False,
+        resume: bool = False, progress: Progress = True) -> Path:
     """Run a job as the program does, to its HDF5 file.
 
     Read the namelist files in order (a later file overrides earlier values
@@ -245,7 +246,8 @@ class Config(_capi.Config):
         An unknown scene, a file or value the program refuses.
     """
 
-    def __init__(self, scene: str = "afm", files: PathLike | Sequence[PathLike] = (), values: Mapping[str, Any] | None = None) -> None:
+    def __init__(self, scene: str = "afm", files: PathLike | Sequence[PathLike] = (),
+                 values: Mapping[str, Any] | None = None) -> None:
         """Read the files over the scene's defaults, then set the values.
         """
         super().__init__(scene, files, values)
@@ -423,7 +425,8 @@ class Config(_capi.Config):
         return f"<friction.Config {self.scene}: {state}>"
 
 
-def compute(scene: str, files: PathLike | Sequence[PathLike] = (), values: Mapping[str, Any] | None = None, progress: Progress = False) -> dict[str, np.ndarray]:
+def compute(scene: str, files: PathLike | Sequence[PathLike] = (), values: Mapping[str, Any] | None = None,
+            progress: Progress = False) -> dict[str, np.ndarray]:
     """The scene's computation on this process, without a file: a dict of
     numpy arrays named as in the program's file ("trace/fx" (ny, nx), ...,
     "support_x"; "t", "x", ..., "events/t").  &analysis, &verify and &sweep
@@ -455,7 +458,8 @@ def compute(scene: str, files: PathLike | Sequence[PathLike] = (), values: Mappi
         return cfg.compute(progress)
 
 
-def afm_line(files: PathLike | Sequence[PathLike] = (), values: Mapping[str, Any] | None = None, line: int = 0, forward: bool = True) -> Line:
+def afm_line(files: PathLike | Sequence[PathLike] = (), values: Mapping[str, Any] | None = None, line: int = 0,
+             forward: bool = True) -> Line:
     """One line of a friction-force map: Line(x, fx, fy), numpy arrays.
 
         x, fx, fy = friction.afm_line("inputs/naf.nml", {"scan.nx": 64})
@@ -485,7 +489,8 @@ def afm_line(files: PathLike | Sequence[PathLike] = (), values: Mapping[str, Any
         return cfg.afm_line(line, forward)
 
 
-def brake(files: PathLike | Sequence[PathLike] = (), values: Mapping[str, Any] | None = None, progress: Progress = False) -> dict[str, np.ndarray]:
+def brake(files: PathLike | Sequence[PathLike] = (), values: Mapping[str, Any] | None = None,
+          progress: Progress = False) -> dict[str, np.ndarray]:
     """A Girling brake run: a dict of numpy arrays, the trajectory "t", "x",
     "v", "y", "w", "stick" on the output grid and the events "events/t",
     "events/kind", "events/x", ... (as /brake of the program's file).

@@ -580,7 +580,8 @@ class ImageFit:
             rows.append("degenerate: " + ", ".join(f"{a} ~ {b} ({c:+.3f})" for a, b, c in self.degenerate))
         return "\n".join(rows)
 
-    def profile(self, name: str, points: int = 9, span: float = 3.0, workers: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+    def profile(self, name: str, points: int = 9, span: float = 3.0,
+                workers: int | None = None) -> tuple[np.ndarray, np.ndarray]:
         """The profile likelihood of one parameter: at `points` values across
         estimate +- span standard errors (in the fitted coordinate), the
         others refitted.  Returns (values, delta_chi2), delta_chi2 =
@@ -635,7 +636,8 @@ class ImageFit:
         values = [math.exp(g) if problem.parameters[i].log else g for g in grid]
         return np.array(values), (np.array(out) - 2.0 * self.cost) / self.noise ** 2
 
-    def sample(self, steps: int = 200, walkers: int | None = None, seed: int = 0, burn: int | None = None) -> np.ndarray:
+    def sample(self, steps: int = 200, walkers: int | None = None, seed: int = 0,
+               burn: int | None = None) -> np.ndarray:
         """An MCMC sample of the posterior (emcee's affine-invariant ensemble;
         flat priors within the bounds in the fitted coordinates, Gaussian
         noise of the fitted level).  Returns (steps - burn) * walkers rows of
@@ -1067,7 +1069,8 @@ def fit_line(measured: ArrayLike, config: Config, start: Mapping[str | tuple[str
                      result.converged, result.reason)
 
 
-def example(true: tuple[float, float] = (0.8, 6.0), start: tuple[float, float] = (0.5, 12.0), noise: float = 0.05, seed: int = 8) -> tuple[FitResult, np.ndarray]:
+def example(true: tuple[float, float] = (0.8, 6.0), start: tuple[float, float] = (0.5, 12.0), noise: float = 0.05,
+            seed: int = 8) -> tuple[FitResult, np.ndarray]:
     """The fit of scripts/fit_example.py: a NaF line (NAF_LINE) computed for
     V0 = true[0] eV and k = kx = ky = true[1] N/m, plus Gaussian noise of
     `noise` nN (numpy's default_rng(seed)), fitted from V0 = start[0],

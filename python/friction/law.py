@@ -178,7 +178,8 @@ class Law:
                 err.check(err.status())
         return count
 
-    def history(self, t: ArrayLike, u: ArrayLike, normal: float = 1.0, displacement: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    def history(self, t: ArrayLike, u: ArrayLike, normal: float = 1.0,
+                displacement: bool = False) -> tuple[np.ndarray, np.ndarray]:
         """The force (N) at the times t (s) along the velocities u (m/s) or,
         with displacement=True, the displacements u (m); and the states,
         shape (n, state_count).

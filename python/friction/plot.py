@@ -1387,7 +1387,8 @@ def failure_map(data: DataLike) -> Figure:
     return fig
 
 
-def sang_fit(velocity: ArrayLike, friction: ArrayLike, sem: ArrayLike, temperature: float = 300.0) -> tuple[float, float, float]:
+def sang_fit(velocity: ArrayLike, friction: ArrayLike, sem: ArrayLike,
+             temperature: float = 300.0) -> tuple[float, float, float]:
     """Sang, Dube and Grant's law F = F_c - B [ln(v_c/v)]^(2/3) (PRL 87,
     174301, 2001) through the points, weighted by their standard errors
     (friction.thermal.fit_sang at one temperature, where only

@@ -237,7 +237,8 @@ def _fit(law, residuals, p0, transform, names, f, s, absolute, temperatures=np.z
                   float(aic), fitted_residuals, bool(result.success), str(result.message), temperatures)
 
 
-def fit_sang(velocity: ArrayLike, friction: ArrayLike, temperature: ArrayLike | None = None, sem: ArrayLike | None = None) -> LawFit:
+def fit_sang(velocity: ArrayLike, friction: ArrayLike, temperature: ArrayLike | None = None,
+             sem: ArrayLike | None = None) -> LawFit:
     """Sang et al.'s law through the points: F_c, beta, v_c with standard errors.
 
     velocity, friction: arrays (any velocity unit; v_c comes out in it);
@@ -299,7 +300,8 @@ def fit_sang(velocity: ArrayLike, friction: ArrayLike, temperature: ArrayLike | 
     return _fit("sang", residuals, p0, transform, ("F_c", "beta", "v_c"), f, s, absolute)
 
 
-def fit_log(velocity: ArrayLike, friction: ArrayLike, temperature: ArrayLike | None = None, sem: ArrayLike | None = None) -> LawFit:
+def fit_log(velocity: ArrayLike, friction: ArrayLike, temperature: ArrayLike | None = None,
+            sem: ArrayLike | None = None) -> LawFit:
     """The logarithmic law F = F_0 + F_1 ln v at each temperature of the
     points: parameters F_0[k], F_1[k] for the k-th temperature (sorted),
     with standard errors; `temperatures` of the result lists them.
@@ -350,7 +352,8 @@ def fit_log(velocity: ArrayLike, friction: ArrayLike, temperature: ArrayLike | N
     return _fit("log", residuals, p0, transform, names, f, s, absolute, temperatures)
 
 
-def compare(velocity: ArrayLike, friction: ArrayLike, temperature: ArrayLike | None = None, sem: ArrayLike | None = None) -> dict[str, Any]:
+def compare(velocity: ArrayLike, friction: ArrayLike, temperature: ArrayLike | None = None,
+            sem: ArrayLike | None = None) -> dict[str, Any]:
     """Both laws on the same points: {"sang": LawFit, "log": LawFit,
     "preferred": the law of the smaller AIC}.
 
