@@ -10,6 +10,7 @@ module friction_afm_config
    use friction_surface_naf, only: new_naf_potential
    use friction_surface_hopg, only: new_hopg_potential
    use friction_surface_row, only: new_row_potential
+   use friction_surface_fourier, only: new_fourier_potential, max_harmonics
    use friction_surface_net, only: crystal_net, graphite_net, square_net, read_xyz, max_local_density, sort_order, &
       & net_lattice, graphite_lattice, square_lattice, detect_lattice
    use friction_surface_lennard_jones, only: lj_potential, new_lj_potential, cutoff_for_tolerance, table_settings
@@ -30,14 +31,16 @@ module friction_afm_config
    public :: afm_config, potential_names, net_names, tip_model_names, new_potential, new_tip, new_tip_owning, &
       & net_sites, max_species, max_defects, species_count, surface_curvature, thermal_step_limit, tip_stiffness, &
       & evaluation_names, surface_evaluation, table_energy_window, table_reach, scan_region, auto_method
-   public :: surface_naf, surface_hopg, surface_lattice_sum, surface_row
+   public :: surface_naf, surface_hopg, surface_lattice_sum, surface_row, surface_fourier, fourier_harmonics
 
    !> &surface potential as a kind (afm_config's surface_kind): the analytic
    !> NaF (Eq. 1) and HOPG (Eq. 2) surfaces, the Lennard-Jones lattice sum (Eq. 3),
-   !> a one-dimensional row -V0 cos(2πx/ax) (friction_surface_row).
-   integer, parameter :: surface_naf = 1, surface_hopg = 2, surface_lattice_sum = 3, surface_row = 4
+   !> a one-dimensional row -V0 cos(2πx/ax) (friction_surface_row), a
+   !> one-dimensional Fourier series along x (friction_surface_fourier).
+   integer, parameter :: surface_naf = 1, surface_hopg = 2, surface_lattice_sum = 3, surface_row = 4, &
+      & surface_fourier = 5
 
-   character(len=*), parameter :: potential_names(4) = [character(len=4) :: 'naf', 'hopg', 'lj', 'row']
+   character(len=*), parameter :: potential_names(5) = [character(len=7) :: 'naf', 'hopg', 'lj', 'row', 'fourier']
    character(len=*), parameter :: net_names(3) = [character(len=8) :: 'graphite', 'square', 'file']
    !> &surface evaluation of a lattice sum: interpolated from a table of the
    !> perfect lattice (where it meets table_tolerance), or the direct sum.
@@ -81,6 +84,9 @@ module friction_afm_config
       real(wp) :: cutoff_tolerance = 1.0e-4_wp   !! largest force of the atoms beyond the cutoff, nN
       character(len=16) :: evaluation = 'table'   !! 'table' or 'direct'
       real(wp) :: table_tolerance = 0.0_wp       !! largest force error of the table, nN; 0: cutoff_tolerance
+      ! &fourier: V = -Σ_n [cosine(n) cos(2πnx/ax) + sine(n) sin(2πnx/ax)] for potential = 'fourier'
+      real(wp) :: cosine(max_harmonics) = 0.0_wp   !! eV
+      real(wp) :: sine(max_harmonics) = 0.0_wp     !! eV
       ! &tip
       character(len=16) :: model = 'inertial'   !! 'inertial', 'overdamped' or 'quasistatic'
       real(wp) :: mass = 1.0e-8_wp     !! kg
@@ -180,6 +186,12 @@ contains
       call v%item('evaluation', self%evaluation, fold=.true.)
       call v%item('table_tolerance', self%table_tolerance, 'nN')
       call v%end_group()
+      ! (A group of its own, echoed only for potential = 'fourier' (afm_groups),
+      ! so the other surfaces' echoed input is what it was.)
+      call v%begin_group('fourier')
+      call v%item('cosine', self%cosine, 'eV')
+      call v%item('sine', self%sine, 'eV')
+      call v%end_group()
       call v%begin_group('tip')
       call v%item('model', self%model, fold=.true.)
       given = v%found
@@ -236,6 +248,16 @@ contains
       end do
       species_count = max_species
    end function species_count
+
+   !> The harmonics of &fourier in use: up to the last nonzero coefficient (at least 1).
+   pure integer function fourier_harmonics(config) result(n)
+      type(afm_config), intent(in) :: config
+
+      do n = max_harmonics, 2, -1
+         if (config%cosine(n) /= 0.0_wp .or. config%sine(n) /= 0.0_wp) return
+      end do
+      n = 1
+   end function fourier_harmonics
 
    !> Number of sites of the net the settings describe (before vacancies),
    !> without building it; -1 if an XYZ file cannot tell.
@@ -359,6 +381,9 @@ contains
          allocate (potential, source=new_hopg_potential(config%v0, config%a))
       case ('row')
          allocate (potential, source=new_row_potential(config%v0, config%ax))
+      case ('fourier')
+         ns = fourier_harmonics(config)
+         allocate (potential, source=new_fourier_potential(config%cosine(1:ns), config%sine(1:ns), config%ax))
       case ('lj')
          call new_net(config, atoms, error)
          if (allocated(error)) return
@@ -465,6 +490,10 @@ contains
          curvature = largest_curvature(potential, [0.0_wp, 0.0_wp], [config%a, sqrt(3.0_wp) * config%a], 32)
       case ('row')
          curvature = largest_curvature(potential, [0.0_wp, 0.0_wp], [config%ax, config%ax], 32)
+      case ('fourier')
+         ! (32 points per period of the highest harmonic; one harmonic samples as the row does.)
+         curvature = largest_curvature(potential, [0.0_wp, 0.0_wp], [config%ax, config%ax], &
+            & 32 * fourier_harmonics(config))
       case ('lj')
          curvature = 0.0_wp
          origin = [config%origin_x, config%origin_y, 0.0_wp]
@@ -601,6 +630,8 @@ contains
          kind = surface_lattice_sum
       case ('row')
          kind = surface_row
+      case ('fourier')
+         kind = surface_fourier
       case default
          kind = surface_naf
       end select

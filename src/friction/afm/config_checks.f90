@@ -39,6 +39,7 @@ contains
          if (self%potential == 'lj') call require_damped('cz', self%cz)
       end if
       if (self%potential == 'lj') call check_net()
+      call check_fourier()
       call c%positive('scan', 'velocity', self%velocity, 'Å/s; the direction is set by angle')
       call c%positive('scan', 'length', self%length, 'angstrom')
       call c%nonnegative('scan', 'width', self%width, 'angstrom')
@@ -183,6 +184,31 @@ contains
             & //"the scan: escape is then limited by energy diffusion, where Kramers' rate does not hold); " &
             & //"use model = 'langevin'")
       end subroutine check_kramers
+
+      !> &fourier: finite coefficients, not all zero, and only for potential = 'fourier'.
+      subroutine check_fourier()
+         integer :: n
+
+         do n = 1, max_harmonics
+            if (.not. (abs(self%cosine(n)) <= huge(1.0_wp))) call c%reject('fourier', 'cosine', &
+               & rtoa(self%cosine(n)), 'must be a finite number (eV)', n)
+            if (.not. (abs(self%sine(n)) <= huge(1.0_wp))) call c%reject('fourier', 'sine', &
+               & rtoa(self%sine(n)), 'must be a finite number (eV)', n)
+         end do
+         if (c%failed()) return
+         n = fourier_harmonics(self)
+         if (self%potential == 'fourier') then
+            if (all(self%cosine == 0.0_wp) .and. all(self%sine == 0.0_wp)) call c%reject('fourier', 'cosine', &
+               & '0.0', "every coefficient of &fourier is 0 (a flat surface): give at least cosine(1), the " &
+               & //"amplitude V0 of -V0 cos(2 pi x/ax)")
+         else if (self%cosine(n) /= 0.0_wp) then
+            call c%reject('fourier', 'cosine', rtoa(self%cosine(n)), "is used only with &surface potential = " &
+               & //"'fourier' (here '"//trim(self%potential)//"')", n)
+         else if (self%sine(n) /= 0.0_wp) then
+            call c%reject('fourier', 'sine', rtoa(self%sine(n)), "is used only with &surface potential = " &
+               & //"'fourier' (here '"//trim(self%potential)//"')", n)
+         end if
+      end subroutine check_fourier
 
       !> The overdamped model divides by the damping of every moving direction.
       subroutine require_damped(name, value)

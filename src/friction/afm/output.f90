@@ -5,7 +5,8 @@ module friction_afm_output
    use friction_kinds, only: wp, i8
    use friction_error, only: error_type
    use friction_ode_solver, only: integrator_statistics
-   use friction_afm_config, only: afm_config, surface_evaluation
+   use friction_afm_config, only: afm_config, surface_evaluation, surface_fourier
+   use friction_afm_shape, only: write_shape
    use friction_afm_trip, only: quantity_names, quantity_units, quantity_count, q_f_along, q_jumps, &
       & support_along, support_across
    use friction_output_h5, only: h5_file
@@ -132,6 +133,8 @@ contains
          call file%write_attribute_real('/surface', 'cutoff', surface%cutoff, 'angstrom')
          call write_evaluation(surface%evaluation)
       end if
+      ! A Fourier landscape: its coefficients and its barrier's shape.
+      if (config%surface_kind() == surface_fourier) call write_shape(file, config)
       if (present(thermal)) then
          call file%write_attribute_real('/afm', 'temperature', config%thermal%temperature, 'K')
          call file%write_attribute_integer('/afm', 'seed', config%thermal%seed)

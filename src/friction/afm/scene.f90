@@ -18,7 +18,7 @@ module friction_afm_scene
    use friction_scene_context, only: job_context, agree_on_error, ranks_text, share_of, job_wall_time, &
       & job_sharing, mpi_sharing
    use friction_afm_tip, only: model_overdamped, model_quasistatic
-   use friction_afm_config, only: afm_config, auto_method, new_potential, species_count, scan_region
+   use friction_afm_config, only: afm_config, auto_method, new_potential, species_count, scan_region, surface_fourier
    use friction_afm_scan, only: afm_scanner
    use friction_afm_trip, only: line_record, trip_record, q_fx, q_fy, q_f_along, q_jumps, quantity_names, &
       & quantity_count, support_along, support_across
@@ -29,6 +29,7 @@ module friction_afm_scene
    use friction_afm_line_checkpoint, only: line_checkpoint_name
    use friction_afm_map_share, only: map_share
    use friction_afm_map_verify, only: verify_map
+   use friction_afm_shape, only: shape_summary
    implicit none
    private
 
@@ -82,6 +83,8 @@ contains
       character(len=32), allocatable, intent(out) :: names(:)
 
       names = [character(len=32) :: 'surface', 'tip', 'scan', 'integrator']
+      ! &fourier only for its surface: the others' echo stays as it was.
+      if (self%config%surface_kind() == surface_fourier) names = [character(len=32) :: names, 'fourier']
       ! &thermal only at a temperature: at T = 0 its other variables do
       ! nothing, and the echo is the deterministic program's.
       if (self%config%thermal%enabled()) names = [character(len=32) :: names, 'thermal']
@@ -352,6 +355,7 @@ contains
                & //trim(adjustl(seconds))//' s'
          end if
       end if
+      if (self%ran%surface_kind() == surface_fourier) text = text//'; '//shape_summary(self%ran)
    end function afm_summary
 
    function afm_point_results(self) result(results)
@@ -602,7 +606,7 @@ contains
 
       copy = c
       write (rectangle, '(4(1x, z16.16))') transfer(scan_region(c, 0.0_wp), [0_i8])
-      key = parameters_text(copy, [character(len=7) :: 'surface'])//' scan rectangle'//rectangle
+      key = parameters_text(copy, [character(len=7) :: 'surface', 'fourier'])//' scan rectangle'//rectangle
    end function surface_key
 
 end module friction_afm_scene

@@ -4,7 +4,7 @@
 module friction_afm_validity
    use friction_kinds, only: wp, i8, ev_per_angstrom_to_nn, deg_to_rad
    use friction_error, only: error_type
-   use friction_afm_config, only: afm_config, new_tip, tip_stiffness, surface_hopg, surface_row
+   use friction_afm_config, only: afm_config, new_tip, tip_stiffness, surface_hopg, surface_row, surface_fourier
    use friction_ode_auto, only: stiff_threshold
    use friction_afm_tip, only: afm_tip, model_inertial, model_overdamped, model_quasistatic, find_height
    use friction_afm_scan, only: afm_scanner
@@ -168,7 +168,7 @@ contains
          theta = config%angle * deg_to_rad
          if (config%surface_kind() == surface_hopg) then
             period = sqrt(3.0_wp) * config%a
-         else if (config%surface_kind() == surface_row) then
+         else if (config%surface_kind() == surface_row .or. config%surface_kind() == surface_fourier) then
             period = config%ax / max(abs(cos(theta)), 1.0e-12_wp)
          else
             period = min(config%ax / max(abs(cos(theta)), 1.0e-12_wp), config%ay / max(abs(sin(theta)), 1.0e-12_wp))
