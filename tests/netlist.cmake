@@ -2,6 +2,7 @@
 # scripts/ngspice_compare.py (label "netlist"):
 #   netlist-brake, netlist-naf   the netlist in ngspice agrees with the kernel
 #   netlist-hopg, netlist-row    the same for the other potentials' SPICE forms
+#   netlist-fourier              (and the Fourier series')
 #   netlist-switched             a switched brake is written as the arctan law
 #   netlist-compare              scripts/ngspice_compare.py end to end
 #   netlist-bad-*                bad input: clear message, exit code, no file
@@ -10,7 +11,7 @@
 # comparison could hide a broken network model.
 # (FRICTION_NGSPICE_EXECUTABLE: found, or configuration stopped, by cmake/FrictionTestTools.cmake.)
 
-foreach(case brake naf hopg row switched bad-graphite bad-no-name bad-switched-mu bad-exists compare bad-compare)
+foreach(case brake naf hopg row fourier switched bad-graphite bad-no-name bad-switched-mu bad-exists compare bad-compare)
   add_test(NAME netlist-${case}
     COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_SOURCE_DIR}/netlist_test.py
       --binary $<TARGET_FILE:friction_app> --inputs ${PROJECT_SOURCE_DIR}/inputs

@@ -107,6 +107,15 @@ def case_row(args, work):
     agreement(args, work, [Path(args.inputs) / "naf.nml"], "&surface potential = 'row' /\n", 1.0e-4, "nN")
 
 
+def case_fourier(args, work):
+    # NaF's line 0 over a three-term Fourier landscape with a sine (fourier.f90's
+    # spice: the series' gradient term by term, no force across).  Bound: as for
+    # the row, the kernel's own default accuracy, 1e-4 nN.
+    agreement(args, work, [Path(args.inputs) / "naf.nml"],
+              "&surface potential = 'fourier' /\n&fourier cosine = 1.0, -0.2, 0.05, sine = 0.0, 0.1 /\n",
+              1.0e-4, "nN")
+
+
 def case_switched(args, work):
     result = run([args.binary, "--netlist", "switched.cir", Path(args.inputs) / "brake.nml"], work)
     text = (work / "switched.cir").read_text()
@@ -174,7 +183,7 @@ def case_bad_compare(args, work):
             "friction's reason, no traceback")
 
 
-CASES = {"brake": case_brake, "naf": case_naf, "hopg": case_hopg, "row": case_row, "switched": case_switched,
+CASES = {"brake": case_brake, "naf": case_naf, "hopg": case_hopg, "row": case_row, "fourier": case_fourier, "switched": case_switched,
          "bad-graphite": case_bad_graphite, "bad-no-name": case_bad_no_name, "bad-switched-mu": case_bad_switched_mu,
          "bad-exists": case_bad_exists, "compare": case_compare, "bad-compare": case_bad_compare}
 

@@ -148,8 +148,8 @@ contains
       character(len=:), allocatable :: terms, n
       integer :: k
 
-      form%comment = [character(len=100) :: 'Surface: a one-dimensional Fourier series, ' &
-         & //'V = -sum_n [cn cos(n qx x) + sn sin(n qx x)], qx = 2 pi/ax.']
+      form%comment = [character(len=100) :: 'Surface: a one-dimensional Fourier series along x, flat across,', &
+         & 'V = -sum_n [cn cos(n qx x) + sn sin(n qx x)], qx = 2 pi/ax.']
       form%names = [character(len=8) :: 'qx']
       form%values = [self%q]
       terms = ''
@@ -160,7 +160,8 @@ contains
          if (k > 1) terms = terms//'+'
          terms = terms//'c'//n//'*'//n//'*qx*sin('//n//'*qx*V(xt))-s'//n//'*'//n//'*qx*cos('//n//'*qx*V(xt))'
       end do
-      form%gradient_x = terms
+      ! (In parentheses: the netlist subtracts it from the spring's force.)
+      form%gradient_x = '('//terms//')'
       form%gradient_y = '0'
       form%why = ''
    end subroutine spice
