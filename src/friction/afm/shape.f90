@@ -7,7 +7,7 @@
 module friction_afm_shape
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
    use friction_kinds, only: wp, ev_per_angstrom_to_nn, n_per_m_to_internal, deg_to_rad
-   use friction_strings, only: rtoa
+   use friction_value_text, only: shortest
    use friction_surface_fourier, only: fourier_potential, new_fourier_potential, fold_shape, barrier_shape
    use friction_output_h5, only: h5_file
    use friction_afm_config, only: afm_config, fourier_harmonics
@@ -122,8 +122,8 @@ contains
       if (len(shape%why) > 0) then
          text = 'barrier shape: none ('//shape%why//')'
       else
-         text = 'barrier shape: Delta E = mu (F_c - F)^1.5, beta = 1/mu = '//rtoa(round(shape%line_beta)) &
-            & //' nN^1.5/eV, F_c = '//rtoa(round(shape%line_friction))//' nN'
+         text = 'barrier shape: Delta E = mu (F_c - F)^1.5, beta = 1/mu = '//trim(shortest(round(shape%line_beta))) &
+            & //' nN^1.5/eV, F_c = '//trim(shortest(round(shape%line_friction)))//' nN'
       end if
    end function shape_summary
 
