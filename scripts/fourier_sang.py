@@ -4,7 +4,7 @@ shape parameter the program reports for the landscape (docs/physics.md, Barrier 
 sinusoid).
 
     fourier_sang.py --binary build/friction [--input inputs/row_fourier_thermal.nml]
-                    [--velocities 0.01,0.03,0.1,0.3,1,3,10,30] [--jobs 2] [-o DIR]
+                    [--velocities 0.01,0.03,0.1,0.3,1,3,10,30] [--temperature K] [--jobs 2] [-o DIR]
 
 Runs the input (a one-dimensional Fourier landscape with &thermal model = 'kramers') at each velocity,
 fits F = F_c - (beta k_B T ln(v_c/v))^(2/3) through the mean friction and its standard error with
@@ -28,10 +28,12 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "python"))
 from friction import thermal  # noqa: E402
 
 
-def point(binary, source, velocity, directory):
+def point(binary, source, velocity, seed, temperature, directory):
     out = Path(directory) / f"v{velocity:g}.h5"
-    subprocess.run([binary, "--quiet", "-o", str(out), source, "--set", f"scan.velocity={velocity!r}"],
-                   check=True, capture_output=True, text=True)
+    extra = ["--set", f"thermal.temperature={temperature!r}"] if temperature else []
+    # (A seed per point: with one seed the points' noise is shared and the fit's chi2 means little.)
+    subprocess.run([binary, "--quiet", "-f", "-o", str(out), source, "--set", f"scan.velocity={velocity!r}",
+                    "--set", f"thermal.seed={seed}", *extra], check=True, capture_output=True, text=True)
     with h5py.File(out, "r") as f:
         friction, sem = f["afm/friction"][()], f["afm/friction_sem"][()]
         temperature = float(f["afm"].attrs["temperature"])
@@ -46,6 +48,7 @@ def main():
     parser.add_argument("--input", default=str(Path(__file__).resolve().parent.parent / "inputs"
                                                 / "row_fourier_thermal.nml"))
     parser.add_argument("--velocities", default="0.01,0.03,0.1,0.3,1,3,10,30", help="angstrom/s, comma-separated")
+    parser.add_argument("--temperature", type=float, help="K, instead of the input's")
     parser.add_argument("--jobs", type=int, default=1, help="runs at once")
     parser.add_argument("-o", "--output", help="directory for the runs' files (default: a temporary one)")
     args = parser.parse_args()
@@ -54,7 +57,8 @@ def main():
         directory = args.output or scratch
         os.makedirs(directory, exist_ok=True)
         with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
-            results = list(pool.map(lambda v: point(args.binary, args.input, v, directory), velocities))
+            results = list(pool.map(lambda k: point(args.binary, args.input, velocities[k], k + 1, args.temperature,
+                                                    directory), range(len(velocities))))
     friction = np.array([r[0] for r in results])
     sem = np.array([r[1] for r in results])
     temperature, beta, critical = results[0][2], results[0][3], results[0][4]
