@@ -8,6 +8,8 @@ history) and, for the mechanisms, from the program's files:
   laws_presliding.png     LuGre and the elasto-plastic law under a small
                           oscillating displacement (pre-sliding)
   laws_rate_state.png     rate and state after a tenfold velocity step
+  laws_gms_memory.png     the Generalized Maxwell-Slip law's pre-sliding
+                          loops with nonlocal memory
   machine_stick_slip.png  the belt oscillator's phase plane with four laws
 
     scripts/plot_laws.py [--out DIR] [--binary build/friction]
@@ -120,6 +122,26 @@ def stick_slip(out, binary):
     fig.savefig(out / "machine_stick_slip.png", dpi=110)
 
 
+def gms_memory(out):
+    # Slowly (1e-5 m/s, far below v_s): reversals at 40, -40, 15, -5, 15 and 40 µm.
+    turns = 1e-6 * np.array([0.0, 40.0, -40.0, 15.0, -5.0, 15.0, 40.0])
+    path = np.concatenate([[0.0]] + [np.linspace(a, b, 400)[1:] for a, b in zip(turns[:-1], turns[1:])])
+    # A rest sample first (the states start in steady sliding at the first velocity: at rest, relaxed).
+    x = np.concatenate([[0.0], path])
+    t = np.concatenate([[-1.0], np.cumsum(np.r_[0.0, np.abs(np.diff(path))]) / 1e-5])
+    with Law("gms") as law:
+        force, _ = law.history(t, x, displacement=True)
+    fig, ax = plt.subplots(figsize=(5, 4))
+    ax.plot(1e6 * x, force, lw=1.0, color="C0")
+    ax.plot(1e6 * x[:400], force[:400], lw=2.0, color="C1", label="virgin curve")
+    ax.set_xlabel("displacement x (µm)")
+    ax.set_ylabel("friction F (N)")
+    ax.set_title("GMS: Masing loops with nonlocal memory")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(out / "laws_gms_memory.png", dpi=110)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--out", default=".")
@@ -131,6 +153,7 @@ def main():
     dahl_loop(out)
     presliding(out)
     rate_state(out)
+    gms_memory(out)
     stick_slip(out, args.binary)
     return 0
 

@@ -336,6 +336,9 @@ def _item(value):
         return str(int(value))
     if isinstance(value, numbers.Real):
         return repr(float(value))
+    if isinstance(value, (list, tuple, np.ndarray)):
+        # A whole array (&law element_stiffness): its items, comma-separated.
+        return ", ".join(_item(item) for item in value)
     return _quote(value)
 
 

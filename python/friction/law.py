@@ -35,7 +35,7 @@ from . import _capi
 
 __all__ = ["Law", "fit", "FitResult", "LAWS"]
 
-LAWS = ("coulomb", "arctan", "stribeck", "karnopp", "dahl", "lugre", "elastoplastic", "rate_state", "table")
+LAWS = ("coulomb", "arctan", "stribeck", "karnopp", "dahl", "lugre", "elastoplastic", "rate_state", "table", "gms")
 
 
 def _full(name):

@@ -15,14 +15,15 @@ module friction_law_factory
    use friction_law_elastoplastic, only: elastoplastic_law
    use friction_law_rate_state, only: rate_state_law
    use friction_law_table, only: table_law
+   use friction_law_gms, only: gms_law
    implicit none
    private
 
    public :: law_names, new_law, check_law, make_law
 
    !> &law model = '...' (the first is the default).
-   character(len=*), parameter :: law_names(9) = [character(len=13) :: 'coulomb', 'arctan', 'stribeck', &
-      & 'karnopp', 'dahl', 'lugre', 'elastoplastic', 'rate_state', 'table']
+   character(len=*), parameter :: law_names(10) = [character(len=13) :: 'coulomb', 'arctan', 'stribeck', &
+      & 'karnopp', 'dahl', 'lugre', 'elastoplastic', 'rate_state', 'table', 'gms']
 
 contains
 
@@ -50,6 +51,8 @@ contains
          allocate (rate_state_law :: law)
       case ('table')
          allocate (table_law :: law)
+      case ('gms')
+         allocate (gms_law :: law)
       case default
          return
       end select

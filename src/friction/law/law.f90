@@ -11,14 +11,15 @@ module friction_law
    use friction_kinds, only: wp
    use friction_error, only: error_type
    use friction_checks, only: config_checker
-   use friction_law_settings, only: law_settings
+   use friction_law_settings, only: law_settings, max_gms_elements
    implicit none
    private
 
    public :: sliding_law, max_law_states, difference_partials, exact_stick_force
 
-   !> The most internal states a law has (the ODE bridge's room).
-   integer, parameter :: max_law_states = 4
+   !> The most internal states a law has (the ODE bridge's room): the
+   !> Generalized Maxwell-Slip law's elements.
+   integer, parameter :: max_law_states = max_gms_elements
 
    type, abstract :: sliding_law
       type(law_settings) :: p   !! the &law parameters the law was made from

@@ -11,11 +11,13 @@ module friction_law_settings
    implicit none
    private
 
-   public :: law_settings, law_group, law_path_length
+   public :: law_settings, law_group, law_path_length, max_gms_elements
 
    !> The namelist group the parameters are read from.
    character(len=*), parameter :: law_group = 'law'
    integer, parameter :: law_path_length = 4096
+   !> The most elements of the Generalized Maxwell-Slip law (each one state).
+   integer, parameter :: max_gms_elements = 8
 
    type :: law_settings
       character(len=16) :: model = 'coulomb'   !! the law's name (friction_law_factory's law_names)
@@ -43,6 +45,15 @@ module friction_law_settings
       real(wp) :: dc = 1.0e-5_wp        !! characteristic slip distance D_c, m
       real(wp) :: v0 = 1.0e-6_wp        !! reference velocity, m/s
       character(len=8) :: evolution = 'aging'   !! 'aging' or 'slip'
+      ! Generalized Maxwell-Slip: elements in parallel, each a spring that
+      ! saturates at its share of the Stribeck curve.  The defaults' stiffnesses
+      ! add up to Table I's sigma0.
+      integer :: elements = 4           !! number of elements N (1 to max_gms_elements)
+      real(wp) :: element_stiffness(max_gms_elements) = [4.0e4_wp, 3.0e4_wp, 2.0e4_wp, 1.0e4_wp, &
+         & 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp]   !! k_i, N/m
+      real(wp) :: element_weight(max_gms_elements) = [0.1_wp, 0.2_wp, 0.3_wp, 0.4_wp, &
+         & 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp]   !! w_i, the share of the Stribeck curve (they add up to 1)
+      real(wp) :: attraction = 20.0_wp  !! C, N/s: how fast a slipping element's force approaches its limit
       ! Tabulated F(v)
       character(len=law_path_length) :: table_file = ''   !! two columns: v (m/s), F (N)
       real(wp) :: scale = 1.0_wp        !! the table's force times this (number of contacts)
@@ -85,6 +96,10 @@ contains
       call v%item('dc', self%dc, 'm')
       call v%item('v0', self%v0, 'm/s')
       call v%item('evolution', self%evolution, fold=.true.)
+      call v%item('elements', self%elements)
+      call v%item('element_stiffness', self%element_stiffness, 'N/m', fill=0.0_wp)
+      call v%item('element_weight', self%element_weight, '1', fill=0.0_wp)
+      call v%item('attraction', self%attraction, 'N/s')
       call v%item('table_file', self%table_file, path=.true.)
       call v%item('scale', self%scale, '1')
       call v%item('extrapolation', self%extrapolation, fold=.true.)
