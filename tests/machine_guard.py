@@ -14,6 +14,10 @@ file written (an existing one is left as it was).
   benettin-wall-time  a cheap arctan-law run whose Benettin exponent
                     renormalises 1e6 times, max_wall_time = 1 s: the run
                     ends in a fraction of the limit, Benettin at the limit
+  sweep-signal      a sweep whose one point is that stalled slider, SIGTERM
+                    inside the point: exit 6 within the margin, the file
+                    written whole over the one it replaces with the point
+                    pending (status 0: a resume computes it)
 
     machine_guard.py --binary build/friction --inputs inputs --workdir DIR CASE
 """
@@ -116,13 +120,39 @@ def benettin_wall_time(args):
     assert not out.exists(), "a file was written"
 
 
+def sweep_signal(args):
+    import h5py
+
+    out = Path(args.workdir) / "sweep.h5"
+    out.write_bytes(b"an earlier output the interrupted sweep replaces only with a whole file\n")
+    sweep = Path(args.workdir) / "one_point.nml"
+    sweep.write_text("&sweep sweep_variable = 'machine.stiffness', sweep_values = 600.0 /\n")
+    process = subprocess.Popen(command(args, out, [str(sweep), "--force"]), stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 60
+    while not catches_sigterm(process.pid) and process.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.02)
+    time.sleep(0.5)
+    assert process.poll() is None, "the stalled point ended by itself"
+    sent = time.monotonic()
+    process.send_signal(signal.SIGTERM)
+    stderr = finished(process, MARGIN)
+    took = time.monotonic() - sent
+    print(f"sweep-signal: exit {process.returncode} {took:.2f} s after SIGTERM: {stderr.strip()}")
+    assert process.returncode == 6, process.returncode
+    assert "sweep interrupted" in stderr, stderr
+    with h5py.File(out, "r") as handle:
+        status = handle["sweep/status"][()]
+    assert list(status) == [0], f"the point inside which the stop came is not pending: {status}"
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--binary", required=True)
     parser.add_argument("--inputs", required=True)
     parser.add_argument("--workdir", required=True)
     cases = {"stall-wall-time": stall_wall_time, "stall-signal": stall_signal,
-             "benettin-wall-time": benettin_wall_time}
+             "benettin-wall-time": benettin_wall_time, "sweep-signal": sweep_signal}
     parser.add_argument("case", choices=sorted(cases))
     args = parser.parse_args()
     Path(args.workdir).mkdir(parents=True, exist_ok=True)

@@ -373,11 +373,12 @@ contains
       unit = ''
    end subroutine afm_point_series
 
-   subroutine afm_run_point(self, sink, memory, error)
+   subroutine afm_run_point(self, sink, memory, error, reporter)
       class(afm_scene), intent(inout) :: self
       class(result_sink), intent(inout) :: sink
       type(point_memory), intent(inout) :: memory
       type(error_type), allocatable, intent(out) :: error
+      class(job_reporter), intent(inout), optional :: reporter
       real(wp) :: results(2)
 
       results = 0.0_wp

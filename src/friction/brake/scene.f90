@@ -247,11 +247,12 @@ contains
    !> period, the largest |μ| and the critical μ; 0 when none or off) and the
    !> local maxima of x after the transient (the bifurcation diagram).  (A
    !> brake point keeps nothing in `memory`: its set-up costs nothing.)
-   subroutine brake_run_point(self, sink, memory, error)
+   subroutine brake_run_point(self, sink, memory, error, reporter)
       class(brake_scene), intent(inout) :: self
       class(result_sink), intent(inout) :: sink
       type(point_memory), intent(inout) :: memory
       type(error_type), allocatable, intent(out) :: error
+      class(job_reporter), intent(inout), optional :: reporter
       real(wp) :: results(9)
       type(brake_config) :: point
       type(brake_run), target :: run

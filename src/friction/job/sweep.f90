@@ -58,7 +58,7 @@ contains
       integer :: n, n_work, i, flag, last_taken, counts(3)
       real(wp) :: wall
       character(len=12) :: seconds
-      logical :: interrupted, all_failed, use_todo, arrived
+      logical :: interrupted, all_failed, use_todo, arrived, stopped_inside
 
       names = point_names(config)
       n = config%sweep%points()
@@ -112,7 +112,12 @@ contains
                exit
             end if
          end if
-         call compute_point(config, i, size(names), kept, mine, warning)
+         call compute_point(config, i, size(names), kept, mine, warning, reporter, stopped_inside)
+         ! A stop request inside the point: it stays pending (a resume computes it).
+         if (stopped_inside) then
+            interrupted = .true.
+            exit
+         end if
          if (len(warning) > 0) then
             warned = warned + 1
             first_warned = min(first_warned, i)

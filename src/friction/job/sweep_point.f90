@@ -7,12 +7,13 @@
 module friction_job_sweep_point
    use friction_kinds, only: wp
    use friction_clock, only: wall_seconds
-   use friction_error, only: error_type, fatal_error, error_input
+   use friction_error, only: error_type, fatal_error, error_input, error_interrupted
    use friction_strings, only: itoa, one_line
    use friction_ode_solver, only: step_type_index
    use friction_parameters, only: set_parameter_number, split_name
    use friction_checks, only: config_checker
    use friction_scene, only: scene, point_result, point_memory, result_sink
+   use friction_scene_report, only: job_reporter
    use friction_job_config, only: job_config
    implicit none
    private
@@ -63,20 +64,28 @@ contains
    !> Compute point i with what this rank's earlier points left in `kept`
    !> (point_memory): `point` is done or failed (with its reason), its cost
    !> the wall time it took.  `warning`: the scene's settings_warning for the
-   !> point ('' for none, or when its check failed).
-   subroutine compute_point(config, i, n_results, kept, point, warning)
+   !> point ('' for none, or when its check failed).  The scene may ask
+   !> `reporter` for a stop request inside the point: `interrupted` then says
+   !> the point was left unfinished (neither done nor failed: pending).
+   subroutine compute_point(config, i, n_results, kept, point, warning, reporter, interrupted)
       type(job_config), intent(in) :: config
       integer, intent(in) :: i, n_results
       type(point_memory), intent(inout) :: kept
       type(finished_point), intent(out) :: point
       character(len=:), allocatable, intent(out) :: warning
+      class(job_reporter), intent(inout), optional :: reporter
+      logical, intent(out), optional :: interrupted
       type(error_type), allocatable :: error
       real(wp), allocatable :: results(:), series(:)
       real(wp) :: t0, cost
 
       allocate (results(n_results))
       t0 = wall_seconds()
-      call run_point(config, i, results, series, kept, warning, error)
+      call run_point(config, i, results, series, kept, warning, error, reporter)
+      if (present(interrupted)) then
+         interrupted = .false.
+         if (allocated(error)) interrupted = error%stat == error_interrupted
+      end if
       if (.not. allocated(series)) allocate (series(0))
       cost = wall_seconds() - t0
       point%header = [i, status_done, n_results, size(series), 0]
@@ -95,7 +104,7 @@ contains
 
    !> Point i's scene run on this process: `results` holds the scene's point
    !> results, then the index of the stepper it ran (method_result).
-   subroutine run_point(config, i, results, series, kept, warning, error)
+   subroutine run_point(config, i, results, series, kept, warning, error, reporter)
       type(job_config), intent(in) :: config
       integer, intent(in) :: i
       real(wp), intent(out) :: results(:)
@@ -103,6 +112,7 @@ contains
       type(point_memory), intent(inout) :: kept
       character(len=:), allocatable, intent(out) :: warning
       type(error_type), allocatable, intent(out) :: error
+      class(job_reporter), intent(inout), optional :: reporter
       class(scene), allocatable :: point
       type(point_sink) :: sink
       character(len=:), allocatable :: unit
@@ -118,7 +128,7 @@ contains
       call point%point_series(sink%series_name, unit)
       allocate (sink%results(size(sink%names)), source=0.0_wp)
       allocate (sink%series(0))
-      call point%run_point(sink, kept, error)
+      call point%run_point(sink, kept, error, reporter)
       results(:size(results) - 1) = sink%results
       call move_alloc(sink%series, series)
    end subroutine run_point

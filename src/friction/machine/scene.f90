@@ -154,20 +154,25 @@ contains
    !> A sweep point: the run's events, the fraction of the output grid in
    !> stick, the range of the velocity and the mean friction force over the
    !> second half of the run (after a transient), and the local maxima of x
-   !> there (the bifurcation diagram).
-   subroutine machine_run_point(self, sink, memory, error)
+   !> there (the bifurcation diagram).  The run and Benettin's exponent ask
+   !> one watch, from the point's start: max_wall_time, and the stop
+   !> requests of `reporter` if given (a point that crawls ends inside).
+   subroutine machine_run_point(self, sink, memory, error, reporter)
       class(machine_scene), intent(inout) :: self
       class(result_sink), intent(inout) :: sink
       type(point_memory), intent(inout) :: memory
       type(error_type), allocatable, intent(out) :: error
+      class(job_reporter), intent(inout), optional :: reporter
       real(wp) :: results(6)
       type(machine_run) :: run
       type(machine_diagnostics) :: d
+      class(step_watch), allocatable :: watch
       logical, allocatable :: peak(:)
       integer :: j, half
 
       results = 0.0_wp
-      call run_machine(self%config, run, error)
+      allocate (watch, source=machine_watch(self%config, 'the sweep point', reporter))
+      call run_machine(self%config, run, error, watch)
       if (allocated(error)) return
       half = run%n / 2 + 1
       results(1) = run%n_events
@@ -180,7 +185,7 @@ contains
          point = self%config
          point%analysis%poincare = .false.
          point%analysis%lyapunov_spectrum = .false.
-         call diagnose_machine(point, run, d, error)
+         call diagnose_machine(point, run, d, error, watch)
       end block
       if (allocated(error)) return
       if (d%spectrum) results(5) = d%peak%peak_frequency

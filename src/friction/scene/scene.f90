@@ -61,7 +61,9 @@ module friction_scene
       !> One sweep point on this process alone, into `sink` as compute's
       !> arrays go: each of point_results as a 1 x 1 array, and the series
       !> (point_series) as one column; nothing on an error.  `memory` is what
-      !> the process kept from its earlier points (point_memory).
+      !> the process kept from its earlier points (point_memory); a scene may
+      !> ask `reporter` (the job's, if given) for stop requests inside the
+      !> point, ending it with an error of stat error_interrupted.
       procedure(point_interface), deferred :: run_point
       !> Give `sink` a point's results, in the order of point_results, and
       !> its series: what run_point does once the point is computed.
@@ -142,12 +144,13 @@ module friction_scene
          character(len=:), allocatable, intent(out) :: name, unit
       end subroutine series_interface
 
-      subroutine point_interface(self, sink, memory, error)
-         import :: scene, result_sink, error_type, point_memory
+      subroutine point_interface(self, sink, memory, error, reporter)
+         import :: scene, result_sink, error_type, point_memory, job_reporter
          class(scene), intent(inout) :: self
          class(result_sink), intent(inout) :: sink
          type(point_memory), intent(inout) :: memory
          type(error_type), allocatable, intent(out) :: error
+         class(job_reporter), intent(inout), optional :: reporter
       end subroutine point_interface
 
       subroutine compute_interface(self, sink, memory, reporter, error)
