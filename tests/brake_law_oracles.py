@@ -228,7 +228,9 @@ def refusals(args):
     result = subprocess.run([args.binary, "--netlist", str(netlist), str(Path(args.inputs) / "brake_lugre.nml")],
                             capture_output=True, text=True)
     print(f"refusals: --netlist: exit {result.returncode}: {result.stderr.strip()}")
-    assert result.returncode == 3 and "&brake model = 'law'" in result.stderr and "no netlist" in result.stderr
+    # Named as an input error is: the file and line of &brake model = 'law', the group, the variable.
+    assert result.returncode == 3 and "brake_lugre.nml:11: &brake: model = 'law': --netlist: no netlist with " \
+        "&law model = 'lugre'" in result.stderr, result.stderr
     assert not netlist.exists()
 
 

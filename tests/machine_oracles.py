@@ -8,8 +8,9 @@ oracles computed here:
   rate-state-critical  a sweep of the spring-slider's stiffness finds the onset
                        of instability at k_c = N (b - a)/D_c (1 + m V^2/(N a D_c)),
                        without and with the inertial correction
-  bad-input            every refused law or machine value: exit code 3, the file,
-                       line, group and variable in the message, no file written
+  bad-input            every refused law or machine value, and --netlist: exit
+                       code 3, the file, line, group and variable in the
+                       message, no file written
   table-onset          a tabulated velocity-weakening law on the belt: a sweep of
                        the damping finds the onset of growth where c = -dF/dv,
                        the slope of the table's interpolant (SciPy's PCHIP)
@@ -163,6 +164,10 @@ def bad_input(args):
          str(work / "other.h5") + ": a sweep of 'surface.v0'; the table needs one of scan.velocity"),
         ("&machine\n  stiffness = -2.0\n/\n", 6, "&machine: stiffness = ", "must be >= 0"),
         ("&law\n  model = 'bristles'\n/\n", 6, "&law: model = ", "unknown friction law"),
+        ("&law\n  model = 'gms'\n  element_stiffness(3) = -2.0e4\n/\n", 7, "&law: element_stiffness(3) = ",
+         "must be a finite number > 0"),
+        ("&law\n  model = 'gms'\n  element_weight = 0.5, 0.2, 0.2, 0.2\n/\n", 7, "&law: element_weight = ",
+         "add up to 1.1"),
     ]
     for i, (group, line, names, why) in enumerate(cases):
         path = work / f"bad{i}.nml"
@@ -173,6 +178,14 @@ def bad_input(args):
         assert result.returncode == 3, result
         assert f"{path}:{line}: {names}" in result.stderr and why in result.stderr, result.stderr
         assert not out.exists()
+    # --netlist: the machine has no circuit form, refused naming where &job scene = 'machine' was set.
+    netlist = work / "machine.cir"
+    result = subprocess.run([args.binary, "--netlist", str(netlist), str(work / "bad0.nml"), "--set",
+                             "law.sigma0=1.0e5"], capture_output=True, text=True)
+    print(f"bad-input: --netlist: exit {result.returncode}: {result.stderr.strip()}")
+    assert result.returncode == 3, result
+    assert f"{work / 'bad0.nml'}:3: &job: scene = 'machine': --netlist: no netlist" in result.stderr, result.stderr
+    assert not netlist.exists()
 
 
 def main():

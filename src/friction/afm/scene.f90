@@ -513,11 +513,12 @@ contains
       call sink%add('fy', c%nx, 1, trip%values(:, q_fy))
    end subroutine afm_compute_line
 
-   subroutine afm_netlist_text(self, data_file, version, text, note, error)
+   subroutine afm_netlist_text(self, data_file, version, text, note, error, origins)
       class(afm_scene), intent(in) :: self
       character(len=*), intent(in) :: data_file, version
       character(len=:), allocatable, intent(out) :: text, note
       type(error_type), allocatable, intent(out) :: error
+      type(config_checker), intent(in), optional :: origins
 
       note = ''
       if (self%config%thermal%enabled()) note = 'the netlist is the deterministic tip: &thermal ' &

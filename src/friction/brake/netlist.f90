@@ -6,6 +6,7 @@ module friction_brake_netlist
    use friction_kinds, only: wp, pi
    use friction_error, only: error_type, fatal_error, error_input
    use friction_strings, only: rtoa
+   use friction_checks, only: config_checker
    use friction_netlist_spice, only: nl, tolerances, control_end, num
    use friction_brake_config, only: brake_config
    implicit none
@@ -16,19 +17,26 @@ module friction_brake_netlist
 contains
 
    !> Eq. 10 with the arctan law; states x, v = x', y, w = y' in m and m/τ.
-   subroutine brake_netlist(c, data_file, version, text, note, error)
+   !> A brake with a law is refused naming where &brake model was set
+   !> (`origins`: the input's).
+   subroutine brake_netlist(c, data_file, version, text, note, error, origins)
       type(brake_config), intent(in) :: c
       character(len=*), intent(in) :: data_file, version
       character(len=:), allocatable, intent(out) :: text, note
       type(error_type), allocatable, intent(out) :: error
+      type(config_checker), intent(in), optional :: origins
+      type(config_checker) :: refusal
       character(len=:), allocatable :: law
 
       note = ''   ! (a note only for the switched model; the caller reads it always)
       if (c%uses_law()) then
          ! The network is Eq. 10's; a law's states and exact stick have no element in it.
-         call fatal_error(error, "--netlist: &brake model = 'law' (&law model = '"//trim(c%law%model) &
-            & //"'): no netlist: the network is written for the arctan law of Eq. 10 only; use &brake " &
-            & //"model = 'regularized' (its mu, epsilon_prime and delta_prime) for one", error_input)
+         if (present(origins)) refusal = origins
+         if (allocated(refusal%error)) deallocate (refusal%error)
+         call refusal%reject('brake', 'model', "'law'", "--netlist: no netlist with &law model = '" &
+            & //trim(c%law%model)//"': the network is written for the arctan law of Eq. 10 only; use &brake " &
+            & //"model = 'regularized' (its mu, epsilon_prime and delta_prime) for one")
+         call move_alloc(refusal%error, error)
          return
       end if
       associate (p => c%params)

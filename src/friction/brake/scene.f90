@@ -359,13 +359,14 @@ contains
       end do
    end subroutine brake_compute
 
-   subroutine brake_netlist_text(self, data_file, version, text, note, error)
+   subroutine brake_netlist_text(self, data_file, version, text, note, error, origins)
       class(brake_scene), intent(in) :: self
       character(len=*), intent(in) :: data_file, version
       character(len=:), allocatable, intent(out) :: text, note
       type(error_type), allocatable, intent(out) :: error
+      type(config_checker), intent(in), optional :: origins
 
-      call brake_netlist(self%resolved(), data_file, version, text, note, error)
+      call brake_netlist(self%resolved(), data_file, version, text, note, error, origins)
    end subroutine brake_netlist_text
 
    !> One brake run, in pieces so that long runs can report progress in τ,

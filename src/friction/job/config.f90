@@ -186,7 +186,7 @@ contains
    !> an error if the scene is the default one: the input then most likely
    !> forgot its &job (docs/cli.md, Groups of another scene).  With `units`,
    !> input_text has each variable's unit as a comment (--print-input).
-   subroutine read_input(paths, config, input_text, error, overrides, notes, units)
+   subroutine read_input(paths, config, input_text, error, overrides, notes, units, origins)
       character(len=*), intent(in) :: paths(:)
       type(job_config), intent(out) :: config
       character(len=:), allocatable, intent(out) :: input_text
@@ -194,6 +194,7 @@ contains
       character(len=*), intent(in), optional :: overrides(:)
       character(len=1024), allocatable, intent(out), optional :: notes(:)
       logical, intent(in), optional :: units
+      type(config_checker), intent(out), optional :: origins
       type(namelist_source), allocatable :: sources(:), files(:)
       type(parameter_info), allocatable :: universe(:)
       type(config_checker) :: checker
@@ -240,6 +241,7 @@ contains
          end do
       end if
       input_text = job_text(config, units)
+      if (present(origins)) origins = checker
    end subroutine read_input
 
    !> The warnings of a checked configuration's values that look like numbers

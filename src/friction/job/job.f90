@@ -130,7 +130,7 @@ contains
    !> Read the input into `config` and `job%input_text` on every rank, the
    !> ranks agreeing on an error; rank 0 passes the reader's warnings on.
    !> With `units`, the text has each variable's unit as a comment.
-   subroutine read_job_input(job, files, overrides, reporter, config, error, units)
+   subroutine read_job_input(job, files, overrides, reporter, config, error, units, origins)
       type(job_context), intent(inout) :: job
       character(len=*), intent(in) :: files(:)
       character(len=*), intent(in), optional :: overrides(:)
@@ -138,10 +138,11 @@ contains
       type(job_config), intent(out) :: config
       type(error_type), allocatable, intent(out) :: error
       logical, intent(in), optional :: units
+      type(config_checker), intent(out), optional :: origins
       character(len=1024), allocatable :: notes(:)
       integer :: k
 
-      call read_input(files, config, job%input_text, error, overrides, notes, units)
+      call read_input(files, config, job%input_text, error, overrides, notes, units, origins)
       call name_unread_pipe(job, files, error)
       call agree_on_error(job, error)
       if (allocated(error)) return
@@ -326,11 +327,12 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(job_context) :: job
       type(job_config) :: config
+      type(config_checker) :: origins
       character(len=:), allocatable :: text, note, data_file, problem
       integer :: dot, k
 
       call set_comm(comm, job)
-      call read_job_input(job, files, overrides, reporter, config, error)
+      call read_job_input(job, files, overrides, reporter, config, error, origins=origins)
       if (allocated(error)) return
       dot = index(path, '.', back=.true.)
       if (dot > index(path, '/', back=.true.) + 1) then
@@ -343,7 +345,7 @@ contains
             & '(write one point with an override file instead)', error_input)
          return
       end if
-      call config%scene%netlist(data_file, version_string, text, note, error)
+      call config%scene%netlist(data_file, version_string, text, note, error, origins)
       if (allocated(error)) return
       if (file_exists(path) .and. .not. force) then
          call fatal_error(error, path//': the netlist file exists; use --force to overwrite it', error_input)

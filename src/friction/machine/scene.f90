@@ -230,16 +230,23 @@ contains
 
    !> No circuit form: the laws with states and the exact stick have no
    !> SPICE element here.
-   subroutine machine_netlist(self, data_file, version, text, note, error)
+   subroutine machine_netlist(self, data_file, version, text, note, error, origins)
       class(machine_scene), intent(in) :: self
       character(len=*), intent(in) :: data_file, version
       character(len=:), allocatable, intent(out) :: text, note
       type(error_type), allocatable, intent(out) :: error
+      type(config_checker), intent(in), optional :: origins
+
+      type(config_checker) :: refusal
 
       text = ''
       note = ''
-      call fatal_error(error, "scene 'machine': no netlist: the friction laws at the machine scale have no " &
-         & //"circuit form in this program (the brake's has one: &job scene = 'brake')", error_input)
+      ! Named where &job scene was set, as an input error is.
+      if (present(origins)) refusal = origins
+      if (allocated(refusal%error)) deallocate (refusal%error)
+      call refusal%reject('job', 'scene', "'machine'", "--netlist: no netlist: the friction laws at the machine " &
+         & //"scale have no circuit form in this program (the brake's has one: &job scene = 'brake')")
+      call move_alloc(refusal%error, error)
    end subroutine machine_netlist
 
 end module friction_machine_scene

@@ -78,7 +78,8 @@ module friction_scene
       !> values (a line longer than that is an input error, found before any
       !> computation).  By default an error: the scene has no lines.
       procedure :: compute_line
-      !> The scene as a SPICE netlist for ngspice.
+      !> The scene as a SPICE netlist for ngspice; a refusal names where the
+      !> variable that rules it out was set (`origins`, the input's, if given).
       procedure(netlist_interface), deferred :: netlist
       !> '' or a warning that the settings, though valid, make a result
       !> unreliable; cheap, from the settings alone.  The job says it before
@@ -162,12 +163,13 @@ module friction_scene
          type(error_type), allocatable, intent(out) :: error
       end subroutine compute_interface
 
-      subroutine netlist_interface(self, data_file, version, text, note, error)
-         import :: scene, error_type
+      subroutine netlist_interface(self, data_file, version, text, note, error, origins)
+         import :: scene, error_type, config_checker
          class(scene), intent(in) :: self
          character(len=*), intent(in) :: data_file, version
          character(len=:), allocatable, intent(out) :: text, note
          type(error_type), allocatable, intent(out) :: error
+         type(config_checker), intent(in), optional :: origins
       end subroutine netlist_interface
    end interface
 
