@@ -8,6 +8,10 @@ oracles computed here:
   rate-state-critical  a sweep of the spring-slider's stiffness finds the onset
                        of instability at k_c = N (b - a)/D_c (1 + m V^2/(N a D_c)),
                        without and with the inertial correction
+  gms-saturated        the Generalized Maxwell-Slip law on a damped belt
+                       oscillator far from the belt's speed, every element at
+                       its limit: the linear motion in closed form, and all
+                       four elements' deflections in the file
   bad-input            every refused law or machine value, and --netlist: exit
                        code 3, the file, line, group and variable in the
                        message, no file written
@@ -34,7 +38,7 @@ def run(args, name, files, sets):
         command += ["--set", f"{key}={value}"]
     subprocess.run(command, check=True)
     with h5py.File(out) as f:
-        return {key: f["machine"][key][:] for key in ("t", "x", "v", "force")}
+        return {key: f["machine"][key][:] for key in f["machine"] if key != "events"}
 
 
 def lugre_radau(args):
@@ -188,16 +192,40 @@ def bad_input(args):
     assert not netlist.exists()
 
 
+def gms_saturated(args):
+    # The GMS law (inputs/machine_gms.nml) on a damped belt oscillator (c = 5 N s/m) released from
+    # x0 = 0.3 m at rest in steady sliding: the block never comes within 0.025 m/s of the belt, where
+    # the Stribeck curve is F_c to e^-625, so every element stays at its limit and the friction is
+    # -F_c + sigma2 w: m x'' = -k x - c x' + F_c - sigma2 (x' - v_b), linear, in closed form.  Each
+    # element's deflection stays -w_i F_c/k_i, and the file holds all four (/machine/z1 ... z4).
+    got = run(args, "gms", ["machine_gms.nml"], {"machine.damping": 5.0, "machine.x0": 0.3, "machine.t_end": 20.0})
+    m, k, c, vb, fc, sigma2 = 1.0, 2.0, 5.0, 0.1, 1.0, 0.4
+    # x'' + 5.4 x' + 2 x = 1.04: roots -0.4 and -5, x(0) = 0.3, x'(0) = 0.
+    eq = (fc + sigma2 * vb) / k
+    roots = np.roots([m, c + sigma2, k])
+    amplitudes = np.linalg.solve([[1.0, 1.0], roots], [0.3 - eq, 0.0])
+    t = got["t"]
+    exact = eq + sum(a * np.exp(r * t) for a, r in zip(amplitudes, roots))
+    error = np.max(np.abs(got["x"] - exact))
+    print(f"gms-saturated: max |x - closed form| = {error:.2e} m over {t[-1]:g} s")
+    assert np.max(got["v"]) < vb - 0.025, "the block came near the belt's speed: the premise fails"
+    # rodas4 at rtol 1e-9 (the input's): some 1e-9 of the 0.22 m travelled.
+    assert error < 1e-8, error
+    for i, (ki, wi) in enumerate(zip([4e4, 3e4, 2e4, 1e4], [0.1, 0.2, 0.3, 0.4]), start=1):
+        np.testing.assert_allclose(got[f"z{i}"], -wi * fc / ki, rtol=1e-9)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--binary", required=True)
     parser.add_argument("--inputs", required=True)
     parser.add_argument("--workdir", required=True)
-    parser.add_argument("case", choices=["lugre-radau", "rate-state-critical", "table-onset", "bad-input"])
+    parser.add_argument("case", choices=["lugre-radau", "rate-state-critical", "table-onset", "bad-input",
+                                         "gms-saturated"])
     args = parser.parse_args()
     Path(args.workdir).mkdir(parents=True, exist_ok=True)
     {"lugre-radau": lugre_radau, "rate-state-critical": rate_state_critical,
-     "table-onset": table_onset, "bad-input": bad_input}[args.case](args)
+     "table-onset": table_onset, "bad-input": bad_input, "gms-saturated": gms_saturated}[args.case](args)
     return 0
 
 

@@ -61,11 +61,15 @@ contains
       call file%write_vector('/machine/v', run%v, 'm/s')
       call file%write_vector('/machine/force', run%force, 'N')
       call file%write_vector_integer('/machine/stick', run%stick, '1')
-      if (run%n_states > 0) call file%write_vector('/machine/'//run%state_name, run%states(1, :), run%state_unit)
+      do k = 1, run%n_states
+         call file%write_vector('/machine/'//trim(run%state_names(k)), run%states(k, :), trim(run%state_units(k)))
+      end do
       do k = 1, size(along_t)
          call file%attach_scales('/machine/'//trim(along_t(k)), ['/machine/t'])
       end do
-      if (run%n_states > 0) call file%attach_scales('/machine/'//run%state_name, ['/machine/t'])
+      do k = 1, run%n_states
+         call file%attach_scales('/machine/'//trim(run%state_names(k)), ['/machine/t'])
+      end do
       call file%create_group('/machine/events')
       do k = 1, size(event_kind_names)
          write (codes(k), '(i0, a)') k, ' = '//trim(event_kind_names(k))

@@ -31,7 +31,8 @@ module friction_machine_run
       real(wp), allocatable :: t(:), x(:), v(:), force(:), states(:, :)
       integer, allocatable :: stick(:)
       integer :: n_states = 0
-      character(len=:), allocatable :: state_name, state_unit
+      !> the law's states' names and units (z; theta; z1 ... zN of the GMS law's elements)
+      character(len=16), allocatable :: state_names(:), state_units(:)
       integer :: n_events = 0
       real(wp), allocatable :: event_t(:), event_x(:), event_v(:)
       integer, allocatable :: event_kind(:)
@@ -95,7 +96,7 @@ contains
       class(sliding_law), allocatable :: law
       class(step_watch), allocatable :: own
       type(mechanics) :: m
-      integer :: n
+      integer :: n, k
 
       call make_law(law_with_files(c%law), law, error)
       if (allocated(error)) return
@@ -107,12 +108,11 @@ contains
       allocate (run%event_t(16), run%event_x(16), run%event_v(16), run%event_kind(16))
       run%states = 0.0_wp
       run%stick = 0
-      run%state_name = ''
-      run%state_unit = ''
-      if (run%n_states > 0) then
-         run%state_name = law%state_name(1)
-         run%state_unit = law%state_unit(1)
-      end if
+      allocate (run%state_names(run%n_states), run%state_units(run%n_states))
+      do k = 1, run%n_states
+         run%state_names(k) = law%state_name(k)
+         run%state_units(k) = law%state_unit(k)
+      end do
       if (present(watch)) then
          call integrate(watch)
       else

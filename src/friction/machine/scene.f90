@@ -198,8 +198,8 @@ contains
    end subroutine machine_run_point
 
    !> The run on this process into named arrays, as /machine holds them:
-   !> "t", "x", "v", "force", "stick", the law's state ("z", "theta") if it
-   !> has one, and "events/t", "events/kind", "events/x", "events/v".
+   !> "t", "x", "v", "force", "stick", the law's states ("z", "theta", "z1"
+   !> ... "zN") if it has any, and "events/t", "events/kind", "events/x", "events/v".
    subroutine machine_compute(self, sink, memory, reporter, error)
       class(machine_scene), intent(inout) :: self
       class(result_sink), intent(inout) :: sink
@@ -208,7 +208,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(machine_run) :: run
       class(step_watch), allocatable :: watch
-      integer :: n
+      integer :: n, k
 
       allocate (watch, source=machine_watch(self%config, 'the run', reporter))
       call run_machine(self%config, run, error, watch)
@@ -220,7 +220,9 @@ contains
       call sink%add('v', run%n, 1, run%v)
       call sink%add('force', run%n, 1, run%force)
       call sink%add('stick', run%n, 1, real(run%stick, wp))
-      if (run%n_states > 0) call sink%add(run%state_name, run%n, 1, run%states(1, :))
+      do k = 1, run%n_states
+         call sink%add(trim(run%state_names(k)), run%n, 1, run%states(k, :))
+      end do
       n = run%n_events
       call sink%add('events/t', n, 1, run%event_t(1:n))
       call sink%add('events/kind', n, 1, real(run%event_kind(1:n), wp))

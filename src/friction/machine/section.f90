@@ -130,8 +130,8 @@ contains
       names = [character(len=16) :: 'x', 'v', '']
       units = [character(len=16) :: 'm', 'm/s', '']
       if (run%n_states > 0) then
-         names(3) = run%state_name
-         units(3) = run%state_unit
+         names(3) = run%state_names(1)
+         units(3) = run%state_units(1)
       end if
       call file%create_group(group)
       call file%write_attribute_real(group, 'strobe_period', p%strobe_period, 's')
