@@ -183,7 +183,9 @@ def test_gms_hysteresis_loop_against_radau():
     # oracle: the same equations written here, each interval (constant velocity) integrated by
     # SciPy's Radau at rtol 1e-11, an element's switch from stick to slip located as a terminal
     # event (the right-hand side is smooth between switches).  The library integrates at rtol 1e-9
-    # of each element's break-away deflection: 1e-8 N is some ten times its error on forces of 1.5 N.
+    # of each element's break-away deflection, a bound of 1.5e-9 N on each element's force; measured
+    # 1.2e-11 N, and 1e-8 N leaves room for the entry band (1e-5 of a limit over 1e-5 of its
+    # deflection, gone within a sample) without letting a wrong branch (0.1 N) pass.
     k = np.array([4e4, 3e4, 2e4, 1e4])
     w = np.array([0.1, 0.2, 0.3, 0.4])
     c, sigma2 = 20.0, 0.4
