@@ -31,6 +31,7 @@ module friction_afm_config
    public :: afm_config, potential_names, net_names, tip_model_names, new_potential, new_tip, new_tip_owning, &
       & net_sites, max_species, max_defects, species_count, surface_curvature, thermal_step_limit, tip_stiffness, &
       & evaluation_names, surface_evaluation, table_energy_window, table_reach, scan_region, auto_method
+   public :: attempt_damping, with_attempt_damping
    public :: surface_naf, surface_hopg, surface_lattice_sum, surface_row, surface_fourier, fourier_harmonics
 
    !> &surface potential as a kind (afm_config's surface_kind): the analytic
@@ -94,6 +95,8 @@ module friction_afm_config
       !> overdamped model has no mass, and its check of the damping ratio
       !> uses only a mass given for the tip, never the default
       logical :: mass_given = .false.
+      !> whether cx or cy was set: &thermal attempt_frequency stands for them
+      logical :: damping_given = .false.
       real(wp) :: kx = 10.0_wp         !! N/m
       real(wp) :: ky = 10.0_wp         !! N/m
       real(wp) :: cx = 1.0e-3_wp       !! N s/m
@@ -200,8 +203,10 @@ contains
       call v%item('kx', self%kx, 'N/m')
       call v%item('ky', self%ky, 'N/m')
       call v%item('kz', self%kz, 'N/m')
+      given = v%found
       call v%item('cx', self%cx, 'N s/m')
       call v%item('cy', self%cy, 'N s/m')
+      if (v%setting() .and. v%found .and. .not. given) self%damping_given = .true.
       call v%item('cz', self%cz, 'N s/m')
       call v%item('support_z', self%support_z, 'angstrom')
       call v%end_group()
@@ -659,6 +664,85 @@ contains
 
       moves_in_3d = self%surface_kind() == surface_lattice_sum
    end function moves_in_3d
+
+   !> The damping c (N s/m, on x and y alike) for which the Kramers rate of
+   !> the tip model has the prefactor f0 = &thermal attempt_frequency
+   !> (docs/physics.md, The attempt frequency): for the tip at rest in a
+   !> well of the surface's cut along the scan, with K the surface's
+   !> curvature along the scan at its minimum at the origin and k the spring
+   !> along the scan, the well's curvature is K + k and the barrier top's
+   !> k - K.  Overdamped (Smoluchowski): f0 = sqrt(K**2 - k**2)/(2 pi c);
+   !> inertial (Kramers, moderate to strong friction): f0 = (omega_w/(2 pi
+   !> omega_b)) lambda, lambda = sqrt(gamma**2/4 + omega_b**2) - gamma/2,
+   !> gamma = c/m, solved for gamma.  `why` is empty, or says why no
+   !> damping gives f0 (then damping is 0).
+   subroutine attempt_damping(config, damping, why)
+      type(afm_config), intent(in) :: config
+      real(wp), intent(out) :: damping
+      character(len=:), allocatable, intent(out) :: why
+      class(surface_potential), allocatable :: potential
+      type(error_type), allocatable :: error
+      real(wp) :: h(3, 3), d(3), curvature, spring, f0, omega_w, omega_b, lambda
+      character(len=16) :: text
+
+      damping = 0.0_wp
+      why = ''
+      f0 = config%thermal%attempt_frequency
+      if (config%moves_in_3d()) then
+         why = "stands for the damping of a tip in the well of a two-dimensional surface: not for potential = 'lj' " &
+            & //'(give cx, cy and cz)'
+         return
+      end if
+      call new_potential(config, potential, error)
+      if (allocated(error)) then
+         why = 'cannot be turned into a damping: '//error%message
+         return
+      end if
+      call potential%hessian([0.0_wp, 0.0_wp, 0.0_wp], h)
+      d = config%scan_direction()
+      ! (N/m: the internal spring unit's factor is the damping's.)
+      curvature = dot_product(d(1:2), matmul(h(1:2, 1:2), d(1:2))) / n_per_m_to_internal
+      spring = config%kx * d(1)**2 + config%ky * d(2)**2
+      if (.not. (curvature > spring)) then
+         write (text, '(es12.5)') curvature
+         why = 'has no barrier to stand for: the surface''s curvature along the scan at its minimum, K = ' &
+            & //trim(adjustl(text))//' N/m, is not above the spring along the scan ('
+         write (text, '(es12.5)') spring
+         why = why//trim(adjustl(text))//' N/m), so the tip at rest does not sit in a well with a barrier'
+         return
+      end if
+      if (config%tip_model() == model_inertial) then
+         omega_w = sqrt((curvature + spring) / config%mass)
+         omega_b = sqrt((curvature - spring) / config%mass)
+         lambda = 2.0_wp * pi * f0 * omega_b / omega_w
+         if (.not. (lambda < omega_b)) then
+            write (text, '(es12.5)') omega_w / (2.0_wp * pi)
+            why = 'is at or above the inertial tip''s highest prefactor, its frequency in the well ' &
+               & //'sqrt((K + k)/m)/(2 pi) = '//trim(adjustl(text))//' Hz (no damping)'
+            return
+         end if
+         damping = config%mass * (omega_b**2 - lambda**2) / lambda
+      else
+         damping = sqrt((curvature - spring) * (curvature + spring)) / (2.0_wp * pi * f0)
+      end if
+   end subroutine attempt_damping
+
+   !> The settings with cx = cy the damping &thermal attempt_frequency stands
+   !> for, at a temperature when it is given (unchanged otherwise, or when
+   !> it stands for none: the checks say why).
+   function with_attempt_damping(config) result(c)
+      type(afm_config), intent(in) :: config
+      type(afm_config) :: c
+      character(len=:), allocatable :: why
+      real(wp) :: damping
+
+      c = config
+      if (.not. (config%thermal%enabled() .and. config%thermal%attempt_frequency > 0.0_wp)) return
+      call attempt_damping(config, damping, why)
+      if (len(why) > 0) return
+      c%cx = damping
+      c%cy = damping
+   end function with_attempt_damping
 
    !> The tip's model and constants around its potential (new_tip).
    subroutine set_up_tip(config, tip)

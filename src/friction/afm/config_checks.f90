@@ -15,6 +15,9 @@ submodule (friction_afm_config) friction_afm_config_checks
 contains
 
    module procedure validate
+      !> at a temperature, the settings with the damping &thermal
+      !> attempt_frequency stands for (check_thermal)
+      type(afm_config) :: eff
 
       if (.not. any(potential_names == self%potential)) call c%reject('surface', 'potential', &
          & "'"//trim(self%potential)//"'", 'unknown potential (known: '//quoted(potential_names)//')')
@@ -133,6 +136,11 @@ contains
                & //"lattice-sum surface, a tip moving in 3D): use model = 'langevin'")
             return
          end if
+         if (self%thermal%attempt_frequency > 0.0_wp) then
+            call check_attempt_frequency()
+            if (c%failed()) return
+         end if
+         eff = with_attempt_damping(self)
          ! Fluctuation-dissipation: the bath that heats an axis is its damper.
          if (.not. (self%cx > 0.0_wp)) call c%reject('tip', 'cx', rtoa(self%cx), 'must be > 0 (N s/m)'//at// &
             & ': the heat bath acts through the damper (fluctuation-dissipation), an undamped axis has none')
@@ -151,11 +159,27 @@ contains
                & //'to choose one')
             if (c%failed()) return
          end if
-         limit = thermal_step_limit(self)
+         limit = thermal_step_limit(eff)
          if (limit > 0.0_wp .and. self%thermal%time_step >= limit) call c%reject('thermal', 'time_step', &
             & rtoa(self%thermal%time_step), 'is at or above the stability limit '//rtoa(limit)//' s of the ' &
             & //'Langevin integrator (2/omega_max inertial, 2 c/k_max overdamped; 0 chooses a step)')
       end subroutine check_thermal
+
+      !> &thermal attempt_frequency stands for the damping: not with cx or cy
+      !> given too, and only where some damping gives it (attempt_damping).
+      subroutine check_attempt_frequency()
+         character(len=:), allocatable :: why
+         real(wp) :: damping
+
+         if (self%damping_given) then
+            call c%reject('thermal', 'attempt_frequency', rtoa(self%thermal%attempt_frequency), 'is given with ' &
+               & //'&tip cx or cy (cx = '//rtoa(self%cx)//', cy = '//rtoa(self%cy)//' N s/m): the attempt ' &
+               & //'frequency sets the damping cx = cy (docs/physics.md, The attempt frequency); give one of them')
+            return
+         end if
+         call attempt_damping(self, damping, why)
+         if (len(why) > 0) call c%reject('thermal', 'attempt_frequency', rtoa(self%thermal%attempt_frequency), why)
+      end subroutine check_attempt_frequency
 
       !> model = 'kramers' with the inertial tip: Kramers' rate in the
       !> spatial-diffusion regime needs the damping not weak.  Below
@@ -175,6 +199,14 @@ contains
          omega = sqrt((self%kx * cos(theta)**2 + self%ky * sin(theta)**2) / self%mass)
          least = omega / kmc_barrier_floor
          why = "a damping for &thermal model = 'kramers' (c/m = "
+         if (self%thermal%attempt_frequency > 0.0_wp) then
+            ! (The damping is the attempt frequency's: the message names it.)
+            if (eff%cx / self%mass < least) call c%reject('thermal', 'attempt_frequency', &
+               & rtoa(self%thermal%attempt_frequency), 'stands for a damping too weak '//why//rtoa(eff%cx / self%mass) &
+               & //' /s below omega = '//rtoa(least)//" /s, with the spring along the scan: escape is then limited " &
+               & //"by energy diffusion, where Kramers' rate does not hold); use model = 'langevin'")
+            return
+         end if
          if (self%cx / self%mass < least) call c%reject('tip', 'cx', rtoa(self%cx), 'is too weak '//why &
             & //rtoa(self%cx / self%mass)//' /s below omega = '//rtoa(least)//" /s, with the spring along " &
             & //"the scan: escape is then limited by energy diffusion, where Kramers' rate does not hold); " &

@@ -18,7 +18,8 @@ module friction_afm_scene
    use friction_scene_context, only: job_context, agree_on_error, ranks_text, share_of, job_wall_time, &
       & job_sharing, mpi_sharing
    use friction_afm_tip, only: model_overdamped, model_quasistatic
-   use friction_afm_config, only: afm_config, auto_method, new_potential, species_count, scan_region, surface_fourier
+   use friction_afm_config, only: afm_config, auto_method, new_potential, species_count, scan_region, surface_fourier, &
+      & with_attempt_damping
    use friction_afm_scan, only: afm_scanner
    use friction_afm_trip, only: line_record, trip_record, q_fx, q_fy, q_f_along, q_jumps, quantity_names, &
       & quantity_count, support_along, support_across
@@ -112,14 +113,15 @@ contains
       call self%config%validate(checker)
    end subroutine afm_check
 
-   !> The settings that run: method = 'auto' becomes the stepper the
+   !> The settings that run: &thermal attempt_frequency becomes the damping
+   !> it stands for (with_attempt_damping); method = 'auto' becomes the stepper the
    !> work-precision charts show fastest for the potential at this rtol, or
    !> the implicit one where the tip is stiff (tip_stiffness).
    function resolved(self) result(c)
       class(afm_scene), intent(in) :: self
       type(afm_config) :: c
 
-      c = self%config
+      c = with_attempt_damping(self%config)
       if (c%solver%method == auto_name) c%solver%method = auto_method(c)
    end function resolved
 

@@ -40,6 +40,9 @@ module friction_afm_thermal
       integer :: realizations = 1             !! independent repetitions of every line
       character(len=16) :: model = 'langevin'
       real(wp) :: time_step = 0.0_wp          !! s; 0: from the tip's fastest time scale
+      !> Hz; > 0: the damping cx = cy that gives this Kramers prefactor
+      !> (afm_config's attempt_damping); 0: &tip's cx, cy
+      real(wp) :: attempt_frequency = 0.0_wp
    contains
       procedure :: visit
       procedure :: validate
@@ -59,6 +62,7 @@ contains
       call v%item('realizations', self%realizations)
       call v%item('model', self%model, fold=.true.)
       call v%item('time_step', self%time_step, 's')
+      call v%item('attempt_frequency', self%attempt_frequency, 'Hz')
       call v%end_group()
    end subroutine visit
 
@@ -98,6 +102,8 @@ contains
       end if
       call c%finite('thermal', 'time_step', self%time_step)
       call c%nonnegative('thermal', 'time_step', self%time_step, 's; 0 chooses it')
+      call c%finite('thermal', 'attempt_frequency', self%attempt_frequency)
+      call c%nonnegative('thermal', 'attempt_frequency', self%attempt_frequency, "Hz; 0: &tip's cx, cy")
    end subroutine validate
 
    !> Welford's update of the running mean and sum of squared deviations
