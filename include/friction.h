@@ -204,10 +204,11 @@ int friction_afm_line(friction_config *cfg, int line, int forward, double *fx, d
  *          "trace/fx", "trace/fy", "trace/f_along", "trace/f_across",
  *          "trace/tip_x", "trace/tip_y" as (ny, nx) maps (also "trace/fz",
  *          "trace/tip_z" for a tip moving in z, "trace/jumps" for the
- *          quasistatic model); the same under "retrace/" and "friction"
- *          (ny, nN) when scan.retrace.  At a temperature the means over the
- *          realizations, with their standard errors beside them as in the
- *          file: "trace/fx_sem", ..., "friction_sem".
+ *          quasistatic model); the same under "retrace/" and "friction",
+ *          "mean_abs_force" and "peak_force" (ny, nN) when scan.retrace.
+ *          At a temperature the means over the realizations, with their
+ *          standard errors beside them as in the file: "trace/fx_sem", ...,
+ *          "friction_sem".
  *   brake: as /brake: "t", "x", "v", "y", "w", "stick" (1 stick, 0 slip) on
  *          the output grid; the events "events/t", "events/kind", "events/x",
  *          "events/v", "events/y", "events/w".  (&analysis and &verify are

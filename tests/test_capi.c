@@ -459,7 +459,7 @@ static void check_results(friction_error *err) {
     CHECK(friction_result_names(res, names, sizeof names) == FRICTION_OK, "result names");
     CHECK(strcmp(names, "support_x\nsupport_y\ntrace/fx\ntrace/fy\ntrace/f_along\ntrace/f_across\ntrace/tip_x\n"
                         "trace/tip_y\nretrace/fx\nretrace/fy\nretrace/f_along\nretrace/f_across\nretrace/tip_x\n"
-                        "retrace/tip_y\nfriction") == 0, "names:\n%s", names);
+                        "retrace/tip_y\nfriction\nmean_abs_force\npeak_force") == 0, "names:\n%s", names);
     CHECK(friction_result_names(res, names, 10) == FRICTION_ERROR_INPUT, "names into 10 bytes");
     expect_ok(friction_result_shape(res, "trace/fx", shape, err), err, "shape");
     CHECK(shape[0] == 3 && shape[1] == 16, "trace/fx shape %zu x %zu", shape[0], shape[1]);

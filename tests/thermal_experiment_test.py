@@ -9,6 +9,8 @@ Cases:
                      that damping is the formula's, and the input errors name file and line
   attempt-fit        the attempt frequency a fit of the program's friction against velocity
                      implies matches the one given, within the fit's standard errors
+  loop-forces        each line's mean |F| and mean peak force of the friction loop, and a
+                     sweep's, against the same reduction of the written f_along arrays
 """
 import argparse
 import math
@@ -187,7 +189,92 @@ def case_attempt_fit(args):
         fail(f"implied f0 = {implied:.4g} Hz is {z:+.2f} standard errors from the {f0:g} Hz given")
 
 
-CASES = {"attempt-frequency": case_attempt_frequency, "attempt-fit": case_attempt_fit}
+def loop_oracle(trace, retrace):
+    """Per line, from the force arrays alone: the mean |F| over both trips, and the peaks,
+    the force where a run of falling samples begins that falls by more than a quarter of
+    the trip's range (met in the order of the support's motion, the retrace's force
+    against the motion -F), pooled over both trips; a trip without one gives its
+    largest force against the motion."""
+    mean_abs = 0.5 * (np.mean(np.abs(trace), axis=1) + np.mean(np.abs(retrace), axis=1))
+    peaks = []
+    for j in range(trace.shape[0]):
+        found = []
+        for force in (trace[j], -retrace[j][::-1]):
+            before = len(found)
+            least = 0.25 * (force.max() - force.min())
+            falling = np.diff(force) < 0.0
+            k = 0
+            while k < falling.size:
+                if not falling[k]:
+                    k += 1
+                    continue
+                end = k
+                while end < falling.size and falling[end]:
+                    end += 1
+                if force[k] - force[end] > least:
+                    found.append(force[k])
+                k = end
+            if len(found) == before:
+                found.append(force.max())   # no slip: the trip's top
+        peaks.append(found)
+    return mean_abs, peaks
+
+
+def case_loop_forces(args):
+    """/afm/mean_abs_force and /afm/peak_force against the same reduction of the written
+    f_along arrays, on the paper's NaF map (deterministic), a Langevin map and a sweep."""
+    naf = "&surface potential = 'naf' /\n&scan nx = 128, ny = 3, velocity = 400.0 /\n"
+    write(args, "naf.nml", naf)
+    write(args, "hot.nml", naf + "&tip model = 'overdamped' /\n&thermal temperature = 300.0, realizations = 2 /\n")
+    for name in ("naf", "hot"):
+        run(args, "-o", f"{name}.h5", f"{name}.nml")
+        with h5py.File(os.path.join(args.workdir, f"{name}.h5"), "r") as f:
+            trace, retrace = f["afm/trace/f_along"][()], f["afm/retrace/f_along"][()]
+            mean_abs, peak = f["afm/mean_abs_force"][()], f["afm/peak_force"][()]
+            unit = f["afm/peak_force"].attrs["units"]
+        want_abs, peaks = loop_oracle(trace, retrace)
+        want_peak = np.array([np.mean(p) for p in peaks])
+        # The same sums in another order: a few ulp of forces of order 1 nN.
+        if not np.allclose(mean_abs, want_abs, rtol=1e-12, atol=1e-14):
+            fail(f"{name}: mean_abs_force {mean_abs} against {want_abs} from f_along")
+        if not (np.allclose(peak, want_peak, rtol=1e-12, atol=1e-14) and np.all(np.isfinite(peak))):
+            fail(f"{name}: peak_force {peak} against {want_peak} from f_along")
+        # NaF at 400 A/s sticks and slips at least once per 4.62 A (twice between the
+        # rows of minima): 4 or more slips a trip over 20 A, 8 a line.  (The mean of
+        # two realizations at 300 K may fall in two steps where they slip apart.)
+        counts = [len(p) for p in peaks]
+        if name == "naf" and not all(8 <= c <= 20 for c in counts):
+            fail(f"{name}: {counts} peaks per line over trace and retrace, expected 8 to 20")
+        if unit not in ("nN", b"nN"):
+            fail(f"{name}: peak_force in {unit!r}")
+        # Below the peaks lies the mean |F|; above it the friction.
+        with h5py.File(os.path.join(args.workdir, f"{name}.h5"), "r") as f:
+            friction = f["afm/friction"][()]
+        if not (np.all(friction <= mean_abs) and np.all(mean_abs < peak)):
+            fail(f"{name}: friction {friction}, mean |F| {mean_abs}, peak {peak} out of order")
+        print(f"{name}: mean |F| {np.round(mean_abs, 4)} nN, peak {np.round(peak, 4)} nN "
+              f"({counts} peaks), as from f_along")
+    # A sweep's points: the same reduction over the whole map of each point.
+    write(args, "sweep.nml", naf.replace("ny = 3", "ny = 2")
+          + "&sweep sweep_variable = 'scan.velocity', sweep_values = 100.0, 1000.0 /\n")
+    run(args, "-o", "sweep.h5", "sweep.nml")
+    with h5py.File(os.path.join(args.workdir, "sweep.h5"), "r") as f:
+        swept_abs, swept_peak = f["sweep/mean_abs_force"][()], f["sweep/peak_force"][()]
+    for i, velocity in enumerate((100.0, 1000.0)):
+        run(args, "-o", "point.h5", "naf.nml", "--set", "scan.ny=2", "--set", f"scan.velocity={velocity}")
+        with h5py.File(os.path.join(args.workdir, "point.h5"), "r") as f:
+            trace, retrace = f["afm/trace/f_along"][()], f["afm/retrace/f_along"][()]
+        want_abs, peaks = loop_oracle(trace, retrace)
+        pooled = [p for line in peaks for p in line]
+        if not (math.isclose(swept_abs[i], np.mean(want_abs), rel_tol=1e-12)
+                and math.isclose(swept_peak[i], np.mean(pooled), rel_tol=1e-12)):
+            fail(f"sweep point {i}: mean_abs_force {swept_abs[i]}, peak_force {swept_peak[i]} against "
+                 f"{np.mean(want_abs)}, {np.mean(pooled)} from the map's f_along")
+    print(f"sweep: mean_abs_force {swept_abs}, peak_force {swept_peak} nN, as from each point's map")
+
+
+CASES = {"attempt-frequency": case_attempt_frequency, "attempt-fit": case_attempt_fit,
+         "loop-forces": case_loop_forces}
 
 
 def main():

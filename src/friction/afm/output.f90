@@ -15,6 +15,7 @@ module friction_afm_output
    use friction_surface_net, only: crystal_net
    use friction_afm_tip, only: model_quasistatic
    use friction_strings, only: join
+   use friction_afm_loop, only: loop_forces
    implicit none
    private
 
@@ -80,7 +81,8 @@ contains
    !> /afm/friction_sem, and /afm the attributes temperature, seed,
    !> realizations, time_step (the Langevin step used) and scheme; and the
    !> slips, /afm/slips/line, realization, trip, support, force, jump,
-   !> jump_across.
+   !> jump_across.  With the retrace, each line's mean |F| and mean peak
+   !> force, /afm/mean_abs_force and /afm/peak_force.
    subroutine write_afm_file(path, comm, config, first, stride, trace, retrace, summary, error, surface, thermal, &
       & verify)
       character(len=*), intent(in) :: path
@@ -155,6 +157,7 @@ contains
             & config%ny, first, stride, 'nN')
          call file%attach_scales('/afm/friction', map_axes(1:1))
          if (present(thermal)) call file%attach_scales('/afm/friction_sem', map_axes(1:1))
+         call write_loop_forces()
       end if
       if (present(thermal)) then
          call file%create_group('/afm/slips')
@@ -183,6 +186,18 @@ contains
       call file%close(error)
 
    contains
+
+      !> Each line's mean |F| and mean peak force of its friction loop
+      !> (friction_afm_loop), at a temperature those of the mean loop.
+      subroutine write_loop_forces()
+         real(wp) :: mean_abs(size(trace, 2)), peak(size(trace, 2))
+
+         call loop_forces(trace(:, :, q_f_along), retrace(:, :, q_f_along), mean_abs, peak)
+         call file%write_vector_block('/afm/mean_abs_force', mean_abs, config%ny, first, stride, 'nN')
+         call file%attach_scales('/afm/mean_abs_force', map_axes(1:1))
+         call file%write_vector_block('/afm/peak_force', peak, config%ny, first, stride, 'nN')
+         call file%attach_scales('/afm/peak_force', map_axes(1:1))
+      end subroutine write_loop_forces
 
       !> How the lattice sum was evaluated: /surface evaluation and, for the
       !> table, its size and its force error measured against the direct sum

@@ -31,6 +31,7 @@ module friction_afm_scene
    use friction_afm_map_share, only: map_share
    use friction_afm_map_verify, only: verify_map
    use friction_afm_shape, only: shape_summary
+   use friction_afm_loop, only: loop_abs_sum, loop_peaks, loop_forces
    implicit none
    private
 
@@ -364,7 +365,8 @@ contains
       class(afm_scene), intent(in) :: self
       type(point_result), allocatable :: results(:)
 
-      results = [point_result('mean_friction', 'nN', .false.), point_result('max_force', 'nN', .false.)]
+      results = [point_result('mean_friction', 'nN', .false.), point_result('max_force', 'nN', .false.), &
+         & point_result('mean_abs_force', 'nN', .false.), point_result('peak_force', 'nN', .false.)]
    end function afm_point_results
 
    subroutine afm_point_series(self, name, unit)
@@ -381,10 +383,10 @@ contains
       type(point_memory), intent(inout) :: memory
       type(error_type), allocatable, intent(out) :: error
       class(job_reporter), intent(inout), optional :: reporter
-      real(wp) :: results(2)
+      real(wp) :: results(4)
 
       results = 0.0_wp
-      call afm_friction(self%resolved(), results(1), results(2), error, memory)
+      call afm_friction(self%resolved(), results(1), results(2), error, memory, results(3), results(4))
       if (.not. allocated(error)) call self%put_point(sink, results, [real(wp) ::])
    end subroutine afm_run_point
 
@@ -445,9 +447,19 @@ contains
          if (scanner%thermal) call add_trips('retrace', retrace_sem, '_sem')
          call sink%add('friction', c%ny, 1, line_friction(trace, retrace))
          if (scanner%thermal) call sink%add('friction_sem', c%ny, 1, friction_sem)
+         call add_loop_forces()
       end if
 
    contains
+
+      !> Each line's mean |F| and mean peak force, as /afm holds them.
+      subroutine add_loop_forces()
+         real(wp) :: mean_abs(c%ny), peak(c%ny)
+
+         call loop_forces(trace(:, :, q_f_along), retrace(:, :, q_f_along), mean_abs, peak)
+         call sink%add('mean_abs_force', c%ny, 1, mean_abs)
+         call sink%add('peak_force', c%ny, 1, peak)
+      end subroutine add_loop_forces
 
       subroutine add_trips(trip_name, values, suffix)
          character(len=*), intent(in) :: trip_name, suffix
@@ -538,16 +550,19 @@ contains
    !> same settings (surface_key) and left in it for the next point: a sweep
    !> over the tip, the scan's speed or sampling or the integrator builds a
    !> lattice sum's table once per process, not once per point.
-   subroutine afm_friction(c, mean_friction, max_force, error, memory)
+   subroutine afm_friction(c, mean_friction, max_force, error, memory, mean_abs_force, peak_force)
       type(afm_config), intent(in) :: c
       real(wp), intent(out) :: mean_friction, max_force
       type(error_type), allocatable, intent(out) :: error
       type(point_memory), intent(inout), optional :: memory
+      !> the mean |F| along the scan over every sample of the trips run, and
+      !> the mean of their peaks (friction_afm_loop)
+      real(wp), intent(out), optional :: mean_abs_force, peak_force
       type(afm_scanner), target :: scanner
       class(surface_potential), allocatable :: potential
       type(line_record) :: line
-      real(wp) :: total
-      integer :: j
+      real(wp) :: total, abs_total, peak_total, peaks
+      integer :: j, count
 
       mean_friction = 0.0_wp
       max_force = 0.0_wp
@@ -560,14 +575,21 @@ contains
       call scanner%init_owning(c, potential, error)
       if (allocated(error)) return
       total = 0.0_wp
+      abs_total = 0.0_wp
+      peak_total = 0.0_wp
+      peaks = 0.0_wp
       do j = 0, c%ny - 1
          call scanner%run_line(j, line, error)
          if (allocated(error)) exit
          total = total + sum(line%trace(:, q_f_along))
          max_force = max(max_force, maxval(hypot(line%trace(:, q_fx), line%trace(:, q_fy))))
+         abs_total = abs_total + loop_abs_sum(line%trace(:, q_f_along))
+         call add_peaks(line%trace(:, q_f_along), .true.)
          if (c%retrace) then
             total = total - sum(line%retrace(:, q_f_along))
             max_force = max(max_force, maxval(hypot(line%retrace(:, q_fx), line%retrace(:, q_fy))))
+            abs_total = abs_total + loop_abs_sum(line%retrace(:, q_f_along))
+            call add_peaks(line%retrace(:, q_f_along), .false.)
          end if
       end do
       ! (The surface goes back also after a failed line: it is not what failed.)
@@ -577,6 +599,21 @@ contains
          return
       end if
       mean_friction = total / (real(c%nx, wp) * c%ny * merge(2, 1, c%retrace))
+      if (present(mean_abs_force)) mean_abs_force = abs_total / (real(c%nx, wp) * c%ny * merge(2, 1, c%retrace))
+      if (present(peak_force)) peak_force = peak_total / max(peaks, 1.0_wp)
+
+   contains
+
+      subroutine add_peaks(force, forward)
+         real(wp), intent(in) :: force(:)
+         logical, intent(in) :: forward
+         real(wp) :: part
+
+         call loop_peaks(force, forward, part, count)
+         peak_total = peak_total + part
+         peaks = peaks + count
+      end subroutine add_peaks
+
    end subroutine afm_friction
 
    !> The surface of `c` for a scan: `memory`'s when it was made from the
