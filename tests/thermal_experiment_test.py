@@ -11,6 +11,8 @@ Cases:
                      implies matches the one given, within the fit's standard errors
   loop-forces        each line's mean |F| and mean peak force of the friction loop, and a
                      sweep's, against the same reduction of the written f_along arrays
+  kramers-slips      the reduced model's slips record the barrier and prefactor of the exit
+                     taken, against the one-dimensional landscape at the recorded support
 """
 import argparse
 import math
@@ -273,8 +275,71 @@ def case_loop_forces(args):
     print(f"sweep: mean_abs_force {swept_abs}, peak_force {swept_peak} nN, as from each point's map")
 
 
+def case_kramers_slips(args):
+    """Each slip of the reduced model on a one-dimensional row (flat across, so the tip's
+    minimum and saddles lie on y = 0) records the barrier and the rate prefactor of the
+    exit it took: against the 1-D landscape E(x) = -V0 cos(2 pi x/a) + k (x - X)^2/2 at
+    the recorded support X, with the minimum x_w = X - F/k from the recorded force F and
+    the saddle next to it on the side of the jump, solved here by Newton's method:
+    barrier E(x_s) - E(x_w), prefactor sqrt(E''(x_w) |E''(x_s)|)/(2 pi c) (Smoluchowski;
+    the spring across, the same at both points, cancels)."""
+    v0, a, spring = 0.5, 4.0, 1.0
+    write(args, "slips.nml", ROW.format(model="overdamped", velocity=10.0).replace("length = 8.0", "length = 16.0")
+          + "&thermal temperature = 300.0, model = 'kramers', realizations = 4, attempt_frequency = 1e6 /\n")
+    run(args, "-o", "slips.h5", "slips.nml")
+    with h5py.File(os.path.join(args.workdir, "slips.h5"), "r") as f:
+        slips = {key: f["afm/slips"][key][()] for key in ("trip", "support", "force", "jump", "barrier", "prefactor")}
+        units = (f["afm/slips/barrier"].attrs["units"], f["afm/slips/prefactor"].attrs["units"])
+        damping = float(f["afm"].attrs["cx"]) * N_PER_M     # eV s/A^2
+    k = spring * N_PER_M
+    q = 2.0 * math.pi / a
+
+    def de(x, support):
+        return v0 * q * math.sin(q * x) + k * (x - support)
+
+    def d2e(x):
+        return v0 * q * q * math.cos(q * x) + k
+
+    def energy(x, support):
+        return -v0 * math.cos(q * x) + 0.5 * k * (x - support) ** 2
+
+    def newton(x, support):
+        for _ in range(100):
+            step = de(x, support) / d2e(x)
+            x -= step
+            if abs(step) < 1e-14:
+                break
+        return x
+
+    n = slips["support"].size
+    if n < 16 or tuple(u.decode() if isinstance(u, bytes) else u for u in units) != ("eV", "1/s"):
+        fail(f"{n} slips (expected 4 a trip), units {units}")
+    worst = [0.0, 0.0]
+    for i in range(n):
+        support, force = slips["support"][i], slips["force"][i]
+        well = newton(support - force / (spring * 0.1), support)    # F = k (X - x), k in nN/A
+        motion = 1.0 if slips["trip"][i] == 0 else -1.0
+        ahead = motion * math.copysign(1.0, slips["jump"][i])
+        saddle = newton(well + ahead * 0.4 * a, support)
+        if not (d2e(well) > 0 and d2e(saddle) < 0 and 0 < ahead * (saddle - well) < a):
+            fail(f"slip {i}: no well and saddle found at X = {support} (x_w {well}, x_s {saddle})")
+        barrier = energy(saddle, support) - energy(well, support)
+        prefactor = math.sqrt(d2e(well) * -d2e(saddle)) / (2.0 * math.pi * damping)
+        errors = (abs(slips["barrier"][i] - barrier), abs(slips["prefactor"][i] / prefactor - 1.0))
+        worst = [max(w, e) for w, e in zip(worst, errors)]
+    # The program's points are converged Newton iterates: the barrier is quadratic in
+    # their error, the prefactor linear (the third derivative times it over the second).
+    if not (worst[0] < 1e-9 and worst[1] < 1e-7):
+        fail(f"barrier off by up to {worst[0]:.2e} eV, prefactor by {worst[1]:.2e} (relative)")
+    if not np.all(slips["barrier"] > 0.0):
+        fail("a slip at zero barrier where no minimum vanishes")
+    print(f"{n} slips: barriers {slips['barrier'].min():.4f} to {slips['barrier'].max():.4f} eV, prefactors "
+          f"{slips['prefactor'].min():.4g} to {slips['prefactor'].max():.4g} /s; against the 1-D landscape "
+          f"within {worst[0]:.1e} eV and {worst[1]:.1e}")
+
+
 CASES = {"attempt-frequency": case_attempt_frequency, "attempt-fit": case_attempt_fit,
-         "loop-forces": case_loop_forces}
+         "loop-forces": case_loop_forces, "kramers-slips": case_kramers_slips}
 
 
 def main():

@@ -25,8 +25,8 @@
 !> stationary point) starts a new search there.  A sample records the tip
 !> in its minimum: the force -k u_min is the mean over the well's thermal
 !> spread up to O(k_B T) anharmonic terms.  Slips: every jump, with the
-!> support where it happened, the force before it and the move of the
-!> minimum.
+!> support where it happened, the force before it, the move of the
+!> minimum, and the barrier and rate prefactor of the exit taken.
 module friction_afm_kramers_trip
    use friction_kinds, only: wp, i8, pi
    use friction_error, only: error_type, fatal_error, error_numerical, error_interrupted
@@ -286,17 +286,22 @@ contains
 
          call jump_landing(tip, te, taken%u_min(1:nd), taken%u_saddle(1:nd), u_next(1:nd), error)
          if (allocated(error)) return
-         call add_slip(te, taken%u_min, u_next)
+         ! (The prefactor from ln r = ln prefactor - ΔE/k_B T at the jump.)
+         call add_slip(te, taken%u_min, u_next, taken%barrier, &
+            & exp(taken%log_rate + taken%barrier / (boltzmann * temperature)))
          u_cur = u_next
          t_cur = te
       end subroutine jump
 
-      !> A slip at support time te from the minimum `before` to `after`.
-      subroutine add_slip(te, before, after)
+      !> A slip at support time te from the minimum `before` to `after`, over
+      !> the barrier (eV) with the prefactor (1/s) of the exit taken (none: 0,
+      !> the minimum vanished at a fold).
+      subroutine add_slip(te, before, after, barrier, prefactor)
          real(wp), intent(in) :: te, before(3), after(3)
+         real(wp), intent(in), optional :: barrier, prefactor
 
          if (present(slips)) call slips%add_jump(path, path%position(config, te), path%spring_force(tip, before), &
-            & after - before)
+            & after - before, barrier, prefactor)
       end subroutine add_slip
 
    end subroutine run

@@ -21,7 +21,7 @@ module friction_afm_map_share
    public :: map_share, n_slip_items
 
    !> A slip's items: line, realization, trip, support, force, jump, jump_across.
-   integer, parameter :: n_slip_items = 7
+   integer, parameter :: n_slip_items = 9
 
    type :: map_share
       type(afm_config) :: config               !! the settings that run
@@ -250,7 +250,8 @@ contains
       more(:, 1:n) = self%slips
       do k = 1, slips%n
          more(:, n + k) = [real(global_line, wp), real(slips%realization(k), wp), real(slips%trip(k), wp), &
-            & slips%support(k), slips%force(k), slips%jump(k), slips%jump_across(k)]
+            & slips%support(k), slips%force(k), slips%jump(k), slips%jump_across(k), slips%barrier(k), &
+            & slips%prefactor(k)]
       end do
       call move_alloc(more, self%slips)
    end subroutine keep_slips

@@ -41,7 +41,8 @@ module friction_afm_output
       real(wp) :: time_step = 0.0_wp
       character(len=:), allocatable :: scheme
       !> every rank's slips, the same on every rank: line, realization,
-      !> trip, support (Å), force (nN), jump along and across (Å) for each
+      !> trip, support (Å), force (nN), jump along and across (Å), and the
+      !> reduced model's barrier (eV) and prefactor (1/s) for each
       real(wp), allocatable :: slips(:, :)
    end type afm_thermal_record
 
@@ -81,7 +82,7 @@ contains
    !> /afm/friction_sem, and /afm the attributes temperature, seed,
    !> realizations, time_step (the Langevin step used) and scheme; and the
    !> slips, /afm/slips/line, realization, trip, support, force, jump,
-   !> jump_across.  With the retrace, each line's mean |F| and mean peak
+   !> jump_across (and barrier, prefactor for the thermal reduced model).  With the retrace, each line's mean |F| and mean peak
    !> force, /afm/mean_abs_force and /afm/peak_force.
    subroutine write_afm_file(path, comm, config, first, stride, trace, retrace, summary, error, surface, thermal, &
       & verify)
@@ -168,6 +169,10 @@ contains
          call file%write_vector('/afm/slips/force', thermal%slips(5, :), 'nN')
          call file%write_vector('/afm/slips/jump', thermal%slips(6, :), 'angstrom')
          call file%write_vector('/afm/slips/jump_across', thermal%slips(7, :), 'angstrom')
+         if (config%thermal%reduced()) then
+            call file%write_vector('/afm/slips/barrier', thermal%slips(8, :), 'eV')
+            call file%write_vector('/afm/slips/prefactor', thermal%slips(9, :), '1/s')
+         end if
       end if
       if (present(verify)) then
          if (verify%enabled) then

@@ -80,11 +80,14 @@ module friction_afm_trip
    !> Slips in the order they happened: realization (0-based), trip (0
    !> trace, 1 retrace), support position along the line (Å, as
    !> support_along), force along the scan before the slip (nN), jump of
-   !> the minimum along the support's motion and across the scan (Å).
+   !> the minimum along the support's motion and across the scan (Å); for
+   !> the thermal reduced model the barrier (eV) and the rate's prefactor
+   !> (1/s) of the exit taken (0 for a Langevin slip, and for a jump where
+   !> the minimum vanished at a fold: no saddle, no rate).
    type :: slip_list
       integer :: n = 0
       integer, allocatable :: realization(:), trip(:)
-      real(wp), allocatable :: support(:), force(:), jump(:), jump_across(:)
+      real(wp), allocatable :: support(:), force(:), jump(:), jump_across(:), barrier(:), prefactor(:)
    contains
       procedure :: clear => slips_clear
       procedure :: add => slips_add
@@ -372,24 +375,27 @@ contains
    !> line) and the force along the scan `force` (nN) before it: the
    !> minimum's move `jump` (Å) resolved along the support's motion and
    !> across the scan.
-   subroutine add_jump(self, path, support, force, jump)
+   subroutine add_jump(self, path, support, force, jump, barrier, prefactor)
       class(slip_list), intent(inout) :: self
       type(trip_path), intent(in) :: path
       real(wp), intent(in) :: support, force, jump(3)
+      !> the reduced model's barrier (eV) and prefactor (1/s) of the exit taken
+      real(wp), intent(in), optional :: barrier, prefactor
 
       call self%add(path%realization, path%trip(), support, force, dot_product(jump, path%motion), &
-         & dot_product(jump, path%across))
+         & dot_product(jump, path%across), barrier, prefactor)
    end subroutine add_jump
 
-   subroutine slips_add(self, realization, trip, support, force, jump, jump_across)
+   subroutine slips_add(self, realization, trip, support, force, jump, jump_across, barrier, prefactor)
       class(slip_list), intent(inout) :: self
       integer, intent(in) :: realization, trip
       real(wp), intent(in) :: support, force, jump, jump_across
+      real(wp), intent(in), optional :: barrier, prefactor
       integer :: room
 
       if (.not. allocated(self%realization)) then
          allocate (self%realization(16), self%trip(16), self%support(16), self%force(16), self%jump(16), &
-            & self%jump_across(16))
+            & self%jump_across(16), self%barrier(16), self%prefactor(16))
       end if
       if (self%n == size(self%realization)) then
          ! Twice the room, the entries kept.
@@ -400,6 +406,8 @@ contains
          self%force = [self%force, spread(0.0_wp, 1, room)]
          self%jump = [self%jump, spread(0.0_wp, 1, room)]
          self%jump_across = [self%jump_across, spread(0.0_wp, 1, room)]
+         self%barrier = [self%barrier, spread(0.0_wp, 1, room)]
+         self%prefactor = [self%prefactor, spread(0.0_wp, 1, room)]
       end if
       self%n = self%n + 1
       self%realization(self%n) = realization
@@ -408,6 +416,10 @@ contains
       self%force(self%n) = force
       self%jump(self%n) = jump
       self%jump_across(self%n) = jump_across
+      self%barrier(self%n) = 0.0_wp
+      self%prefactor(self%n) = 0.0_wp
+      if (present(barrier)) self%barrier(self%n) = barrier
+      if (present(prefactor)) self%prefactor(self%n) = prefactor
    end subroutine slips_add
 
 end module friction_afm_trip
