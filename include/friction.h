@@ -218,14 +218,21 @@ int friction_afm_line(friction_config *cfg, int line, int forward, double *fx, d
 friction_result *friction_compute(friction_config *cfg, friction_error *err);
 
 /* Progress of a computation on the calling process: "12 of 48 lines" or
- * "τ = 120.0 of 1000.0", fraction in [0, 1].  A nonzero return asks the
- * computation to stop there. */
+ * "τ = 120.0 of 1000.0", fraction in [0, 1]; fraction -1 is a poll from
+ * inside a map's line (below).  A nonzero return asks the computation to
+ * stop there. */
 typedef int (*friction_progress_fn)(const char *message, double fraction, void *user);
 
 /* friction_compute with progress, and a way to stop it: `progress` (if not
  * NULL) is called on the calling thread after each scan line of a map and
- * 200 times along a brake trajectory, with `user` passed through.  When it
- * returns nonzero before the last report, the computation stops there:
+ * 200 times along a brake trajectory, with `user` passed through; within a
+ * map's line it is also called every 0.1 s of a line at a temperature (and
+ * of a line slower than that at T = 0) with the last message ("started"
+ * before the first) and fraction -1: a poll, not progress, whose nonzero
+ * return stops the line within the trip's next look (a Langevin tip's
+ * 0.05 A of support travel or 1e5 steps, a reduced-model search: measured
+ * within 1 ms of the return).  When it returns nonzero before the last
+ * report, the computation stops there:
  * NULL, status FRICTION_INTERRUPTED ("the map stopped on request after 12
  * of 48 lines: no result"), and the configuration as it was (its kept
  * surface too).  The request is this call's own: computations on other

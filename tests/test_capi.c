@@ -5,6 +5,8 @@
  *                               or variable, wrong kind, too short arrays, bad values)
  *   test_capi threads           two threads on two handles == the same one after the
  *                               other, bitwise
+ *   test_capi thermal-stop      a stop request from the progress function inside a
+ *                               single-line thermal computation (Langevin, Kramers) ends it
  *   test_capi afm FILE...       friction_config_read(FILE...), friction_compute and
  *                               friction_afm_line of every line: prints every array
  *   test_capi brake FILE...     friction_config_read(FILE...), friction_compute: prints
@@ -27,6 +29,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 /* From the MPI library the friction library links (callable before MPI_Init):
  * whether a job initialised MPI. */
@@ -849,15 +852,87 @@ static int run_job(int argc, char **argv, const char *scene, int init_mpi) {
   return failures != 0;
 }
 
+/* ---- a stop request inside a thermal line ---- */
+static double seconds_now(void) {
+  struct timespec t;
+  clock_gettime(CLOCK_MONOTONIC, &t);
+  return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+struct stop_log {
+  double start, asked;   /* when the computation began; when a poll got the request (0: none yet) */
+  int reports, polls;
+};
+
+/* Reports (fraction in [0, 1]) and polls (fraction -1, inside a line): the first poll
+ * 0.5 s after the start gets the request. */
+static int stop_in_line(const char *message, double fraction, void *user) {
+  struct stop_log *log = user;
+  (void)message;
+  if (fraction >= 0.0) {
+    log->reports++;
+    return 0;
+  }
+  log->polls++;
+  if (log->asked == 0.0 && seconds_now() - log->start > 0.5) log->asked = seconds_now();
+  return log->asked != 0.0;
+}
+
+/* A single-line thermal map that takes tens of seconds, stopped by its progress
+ * function from inside the line: no result, FRICTION_INTERRUPTED, within a second of
+ * the request (the trip looks every 0.1 s of wall time; the bound allows a loaded
+ * machine ten times that), and the configuration computes again afterwards. */
+static int thermal_stop(void) {
+  friction_error *err = friction_error_new();
+  /* the Langevin tip at 0.1 A/s over 20 A (some 4e7 steps: half a minute), and the
+   * reduced model in its thermolubric regime (1e-6 A/s: jumps back and forth, 30 s) */
+  const char *cases[2][8] = {
+      {"thermal.model", "'langevin'", "scan.velocity", "0.1", "tip.model", "'inertial'", "thermal.realizations",
+       "1"},
+      {"thermal.model", "'kramers'", "scan.velocity", "1e-6", "tip.model", "'overdamped'", "thermal.realizations",
+       "2"}};
+  for (int c = 0; c < 2; c++) {
+    friction_config *cfg = friction_config_new("afm", err);
+    expect_ok(friction_config_set(cfg, "scan.ny", "1", err), err, "ny");
+    expect_ok(friction_config_set(cfg, "scan.length", "9.24", err), err, "length");
+    expect_ok(friction_config_set(cfg, "thermal.temperature", "300.0", err), err, "temperature");
+    for (int k = 0; k < 8; k += 2) expect_ok(friction_config_set(cfg, cases[c][k], cases[c][k + 1], err), err, cases[c][k]);
+    struct stop_log log = {seconds_now(), 0.0, 0, 0};
+    friction_result *res = friction_compute_progress(cfg, stop_in_line, &log, err);
+    double ended = seconds_now();
+    CHECK(res == NULL, "%s: the stopped line gave a result", cases[c][1]);
+    CHECK(friction_error_status(err) == FRICTION_INTERRUPTED, "%s: status %d", cases[c][1], friction_error_status(err));
+    friction_error_message(err, last_message, sizeof last_message);
+    CHECK(strstr(last_message, "stopped on request") != NULL, "%s: message %s", cases[c][1], last_message);
+    CHECK(log.asked > 0.0 && ended - log.asked < 1.0, "%s: ended %.3f s after the request (%d polls)", cases[c][1],
+          log.asked > 0.0 ? ended - log.asked : -1.0, log.polls);
+    CHECK(log.reports == 0, "%s: %d line reports before the line ended", cases[c][1], log.reports);
+    printf("%s: stopped %.3f s after the request, %.2f s into the line, %d polls: %s\n", cases[c][1],
+           ended - log.asked, ended - log.start, log.polls, last_message);
+    /* the configuration as it was: a short line computes */
+    expect_ok(friction_config_set(cfg, "scan.length", "0.5", err), err, "length");
+    expect_ok(friction_config_set(cfg, "scan.nx", "2", err), err, "nx");
+    expect_ok(friction_config_set(cfg, "scan.velocity", "1e4", err), err, "velocity");
+    res = friction_compute(cfg, err);
+    CHECK(res != NULL, "%s: no result after the stop", cases[c][1]);
+    friction_result_free(res);
+    friction_config_free(cfg);
+  }
+  friction_error_free(err);
+  if (failures == 0) printf("thermal-stop: all passed\n");
+  return failures != 0;
+}
+
 int main(int argc, char **argv) {
   const char *mode = argc > 1 ? argv[1] : "checks";
   if (strcmp(mode, "checks") == 0) return checks();
   if (strcmp(mode, "threads") == 0) return threads();
+  if (strcmp(mode, "thermal-stop") == 0) return thermal_stop();
   if (strcmp(mode, "afm") == 0 || strcmp(mode, "brake") == 0) return print_scene(mode, argc - 2, argv + 2);
   if (strcmp(mode, "job") == 0) return run_job(argc - 2, argv + 2, NULL, 1);
   if (strcmp(mode, "serial-job") == 0) return run_job(argc - 2, argv + 2, NULL, 0);
   if (strcmp(mode, "config-job") == 0 && argc > 2) return run_job(argc - 3, argv + 3, argv[2], 1);
-  fprintf(stderr, "usage: test_capi checks|threads|afm FILE...|brake FILE...|job OUT FILE...|"
+  fprintf(stderr, "usage: test_capi checks|threads|thermal-stop|afm FILE...|brake FILE...|job OUT FILE...|"
                   "serial-job OUT FILE...|config-job SCENE OUT FILE...\n");
   return 2;
 }

@@ -458,7 +458,9 @@ class _JobReport(_Stoppable):
 class _ComputeProgress(_Stoppable):
     """A computation's progress callback (friction_compute_progress): it
     returns 1, stopping the computation at its next report, once Ctrl-C came
-    or the report raised anything."""
+    or the report raised anything.  A call with fraction -1 is a poll from
+    inside a scan line at a temperature (every 0.1 s), not progress: it is
+    not delivered, and so Ctrl-C stops such a line within it."""
 
     def __init__(self, lib, report):
         super().__init__(lib, report)
@@ -466,7 +468,8 @@ class _ComputeProgress(_Stoppable):
         self.function = _PROGRESS(self._called)
 
     def _called(self, message, fraction, user):
-        self._deliver(message, fraction)
+        if fraction >= 0.0:
+            self._deliver(message, fraction)
         return int(self.stop)
 
     def _ask_stop(self):

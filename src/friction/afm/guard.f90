@@ -82,7 +82,7 @@ contains
       end if
       if (.not. allocated(self%stopper) .or. now < self%next_poll) return
       self%next_poll = self%next_look(now)
-      if (self%stopper%stop_requested()) call fatal_error(error, what//': stopped on request at t = '//rtoa(t) &
+      if (self%stopper%poll_stop()) call fatal_error(error, what//': stopped on request at t = '//rtoa(t) &
          & //' s', error_interrupted)
    end subroutine check
 

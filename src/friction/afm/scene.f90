@@ -413,6 +413,10 @@ contains
       if (allocated(error)) return
       call scanner%init_owning(c, potential, error)
       if (allocated(error)) return
+      ! Within a line too (a thermal line can take minutes): the caller's
+      ! stop request, through a copy of the reporter made anew after each report.
+      allocate (scanner%guard%stopper, source=reporter)
+      call poll_later()
       ! (line j's samples are trace(:, j, q): row-major (ny, nx) as it lies)
       allocate (trace(c%nx, c%ny, size(quantity_names)), retrace(c%nx, merge(c%ny, 0, c%retrace), &
          & size(quantity_names)))
@@ -430,6 +434,9 @@ contains
             friction_sem(j) = line%friction_sem
          end if
          call reporter%progress(real(j, wp), real(c%ny, wp), 'lines', j == c%ny)
+         deallocate (scanner%guard%stopper)
+         allocate (scanner%guard%stopper, source=reporter)
+         call poll_later()
          if (j < c%ny .and. reporter%stop_requested()) then
             call fatal_error(error, 'the map stopped on request after '//itoa(j)//' of '//itoa(c%ny) &
                & //' lines: no result', error_interrupted)
@@ -451,6 +458,15 @@ contains
       end if
 
    contains
+
+      !> The first look at the stop request within a line a poll interval
+      !> from now: a line shorter than that asks only its report.
+      subroutine poll_later()
+         integer(i8) :: now
+
+         call system_clock(now)
+         scanner%guard%next_poll = scanner%guard%next_look(now)
+      end subroutine poll_later
 
       !> Each line's mean |F| and mean peak force, as /afm holds them.
       subroutine add_loop_forces()

@@ -22,10 +22,13 @@ module friction_capi_reporter
       procedure(progress_function), pointer, nopass :: ask => null()
       type(c_ptr) :: user = c_null_ptr
       logical :: stop = .false.   !! `ask` returned nonzero
+      !> the last progress message given to `ask`, C string ('started' before any)
+      character(len=:), allocatable :: last_text
    contains
       procedure :: progress => callback_progress
       procedure :: note => callback_note
       procedure :: stop_requested => callback_stop_requested
+      procedure :: poll_stop => callback_poll_stop
    end type callback_reporter
 
    abstract interface
@@ -65,6 +68,7 @@ contains
       fraction = real(max(0.0_wp, min(1.0_wp, done / max(total, tiny(total)))), c_double)
       if (associated(self%call)) call self%call(text, fraction, self%user)
       if (associated(self%ask)) self%stop = self%stop .or. self%ask(text, fraction, self%user) /= 0
+      self%last_text = text
    end subroutine callback_progress
 
    subroutine callback_note(self, text)
@@ -85,5 +89,21 @@ contains
          callback_stop_requested = friction_job_stop_asked() /= 0
       end if
    end function callback_stop_requested
+
+   !> Within a piece of work: a computation's progress function is called
+   !> again with the last message and fraction -1 (a poll, not progress:
+   !> friction.h), and its nonzero return stops the computation there; a
+   !> job's stop request as between pieces.
+   logical function callback_poll_stop(self)
+      class(callback_reporter), intent(inout) :: self
+
+      if (.not. associated(self%ask)) then
+         callback_poll_stop = self%stop_requested()
+         return
+      end if
+      if (.not. allocated(self%last_text)) self%last_text = 'started'//c_null_char
+      if (.not. self%stop) self%stop = self%ask(self%last_text, -1.0_c_double, self%user) /= 0
+      callback_poll_stop = self%stop
+   end function callback_poll_stop
 
 end module friction_capi_reporter

@@ -29,6 +29,10 @@ module friction_scene_report
       !> a stop request would.  By default a stop request alone; a test's
       !> reporter stops after a given piece.
       procedure :: stop_after => stop_after_request
+      !> Asked from within a piece of work, at most every 0.1 s (a thermal
+      !> trip's guard): true stops it.  By default stop_requested; the C
+      !> API's computation asks its caller's progress function again.
+      procedure :: poll_stop => poll_request
    end type job_reporter
 
    !> What a long loop inside a run asks between its pieces (a Lyapunov
@@ -152,6 +156,12 @@ contains
 
       never_stop = .false.
    end function never_stop
+
+   logical function poll_request(self)
+      class(job_reporter), intent(inout) :: self
+
+      poll_request = self%stop_requested()
+   end function poll_request
 
    logical function stop_after_request(self, item)
       class(job_reporter), intent(inout) :: self
