@@ -25,7 +25,8 @@ module friction_afm_scene
       & quantity_count, support_along, support_across
    use friction_afm_output, only: write_afm_file, afm_surface_record, afm_thermal_record, afm_verify_record, &
       & line_friction
-   use friction_afm_validity, only: afm_model_warnings, quasistatic_friction_warning
+   use friction_afm_validity, only: afm_model_warnings, quasistatic_friction_warning, following_bias, &
+      & following_bias_warning
    use friction_afm_netlist, only: afm_netlist
    use friction_afm_line_checkpoint, only: line_checkpoint_name
    use friction_afm_map_share, only: map_share
@@ -238,6 +239,7 @@ contains
                & //'compute only the others', error_interrupted)
             return
          end if
+         if (c%tip_model() == model_overdamped .and. .not. scanner%thermal) call check_following()
          if (c%verify%enabled) then
             ! (The surface the map ran on, handed over: a table is not built again.)
             call scanner%release_potential(potential)
@@ -290,6 +292,18 @@ contains
          so_far = scanner%statistics()
          now = [so_far%steps, so_far%failed_steps, so_far%rhs_evaluations, so_far%jacobian_evaluations]
       end function scanner_counts
+
+      !> The overdamped map at T = 0: a bias of its integration where the tip
+      !> follows its minimum (friction_afm_validity's following_bias).
+      subroutine check_following()
+         real(wp) :: worst
+         character(len=:), allocatable :: warning
+
+         worst = following_bias(self%ran, scanner%tip, self%map%trace, self%map%retrace)
+         if (job%parallel()) call MPI_Allreduce(MPI_IN_PLACE, worst, 1, MPI_DOUBLE_PRECISION, MPI_MAX, job%comm)
+         warning = following_bias_warning(self%ran, worst)
+         if (job%rank == 0 .and. len(warning) > 0) call reporter%note('warning: '//warning)
+      end subroutine check_following
 
       !> The quasistatic map's mean friction against the drag it leaves out.
       subroutine check_friction()

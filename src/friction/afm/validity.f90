@@ -11,10 +11,13 @@ module friction_afm_validity
    use friction_surface_potential, only: surface_potential
    use friction_strings, only: rtoa, itoa, fixed_text
    use friction_scene_report, only: job_reporter
+   use friction_afm_slow_limit, only: in_slow_limit, following_excess, bias_factor
+   use friction_afm_trip, only: q_fx, q_fy, q_tip_x, q_tip_y
    implicit none
    private
 
-   public :: afm_model_warnings, surface_force_scale, quasistatic_friction_warning
+   public :: afm_model_warnings, surface_force_scale, quasistatic_friction_warning, following_bias, &
+      & following_bias_warning
 
    !> quasistatic: largest viscous drag c v, as a share of the surface force
    real(wp), parameter :: drag_share = 0.01_wp
@@ -245,6 +248,91 @@ contains
          & //fixed(friction, 4)//" nN (> "//itoa(nint(100 * drag_share))//" %): the full model's friction is " &
          & //"higher by at least that (use 'inertial' or a lower velocity)"
    end function quasistatic_friction_warning
+
+   !> After an overdamped map at T = 0 in the slow limit (in_slow_limit):
+   !> the largest distance of a sample from where the tip follows its
+   !> minimum, in units of the tolerances' bound (following_excess), over
+   !> the samples of `trace` and `retrace` (values(i, j, q) of this rank's
+   !> lines) whose two intervals before, in the order of the support's
+   !> motion, hold no slip (the tip moved less than 0.5 Å in each; the
+   !> first two samples of a trip have none); 0 where not checked.  The
+   !> slip check (friction_afm_slow_limit) catches wrong slips during the
+   !> trip; this catches a bias that leaves every slip where it belongs.
+   function following_bias(config, tip, trace, retrace) result(worst)
+      type(afm_config), intent(in) :: config
+      type(afm_tip), intent(in) :: tip
+      real(wp), intent(in) :: trace(:, :, :), retrace(:, :, :)
+      real(wp) :: worst
+      type(afm_tip) :: probe
+      real(wp) :: d(3), excess, minimum(2, 3)
+      integer :: j, k, i, trip, n, step, first, last
+      logical :: valid
+
+      worst = 0.0_wp
+      if (config%tip_model() /= model_overdamped .or. config%thermal%enabled() .or. tip%ndim /= 2) return
+      if (.not. in_slow_limit(tip, config%velocity)) return
+      probe = tip
+      d = config%scan_direction()
+      n = size(trace, 1)
+      do trip = 0, merge(1, 0, config%retrace)
+         do j = 1, size(trace, 2)
+            first = merge(1, n, trip == 0)
+            last = merge(n, 1, trip == 0)
+            step = merge(1, -1, trip == 0)
+            probe%support_velocity = merge(1.0_wp, -1.0_wp, trip == 0) * config%velocity * d
+            minimum = huge(1.0_wp)
+            do i = first, last, step
+               if (trip == 0) then
+                  call at_sample(trace(i, j, :))
+               else
+                  call at_sample(retrace(i, j, :))
+               end if
+            end do
+         end do
+      end do
+
+   contains
+
+      !> One sample in the order of the motion: its minimum's absolute
+      !> position kept for the next two (minimum(:, 1) the newest), and its
+      !> excess where the two intervals before hold no slip.
+      subroutine at_sample(values)
+         real(wp), intent(in) :: values(:)
+         real(wp) :: u(2), r(2)
+         logical :: followed
+
+         r = [values(q_tip_x), values(q_tip_y)]
+         ! F = k (r_M - r) = -k u, nN against eV/Å².
+         u = -[values(q_fx), values(q_fy)] / (ev_per_angstrom_to_nn * tip%spring(1:2))
+         probe%support_start(1:2) = r - u
+         probe%support_start(3) = 0.0_wp
+         call following_excess(probe, 0.0_wp, u, [config%solver%rtol, config%solver%atol], excess, valid)
+         ! (The tip's own position stands for its minimum's: a slip moves both a lattice site.)
+         minimum(:, 3) = minimum(:, 2)
+         minimum(:, 2) = minimum(:, 1)
+         minimum(:, 1) = r
+         followed = norm2(minimum(:, 1) - minimum(:, 2)) < 0.5_wp .and. norm2(minimum(:, 2) - minimum(:, 3)) < 0.5_wp
+         if (valid .and. followed) worst = max(worst, excess)
+      end subroutine at_sample
+
+   end function following_bias
+
+   !> '' or the warning when following_bias (over the whole map) is above
+   !> bias_factor: the stepper, its tolerances and the remedy.
+   function following_bias_warning(config, worst) result(text)
+      type(afm_config), intent(in) :: config
+      real(wp), intent(in) :: worst
+      character(len=:), allocatable :: text
+
+      text = ''
+      if (.not. (worst > bias_factor)) return
+      text = 'overdamped tip at T = 0: where it follows its minimum of the total energy, the tip is up to ' &
+         & //fixed(worst, 1)//' times the tolerances'' bound atol + rtol |u| from where it lags behind it ' &
+         & //'(a bias of '//trim(config%solver%method)//' at rtol = '//rtoa(config%solver%rtol)//', atol = ' &
+         & //rtoa(config%solver%atol)//": the tolerances bound each step, not the run; on a stiff 1-D row " &
+         & //"rk4imp's bias moved the friction by 1.1e-3 nN): tighten rtol and atol, or use method = " &
+         & //"'rodas4' or 'auto' (docs/physics.md, reduced tip models)"
+   end function following_bias_warning
 
    !> The slowest decay time of m x'' + c x' + k x = 0, s (SI inputs): the
    !> envelope 2m/c when underdamped, else the slow root's 1/|λ|.
