@@ -330,6 +330,9 @@ def _machine_layout(raw, labels):
     _along(raw, labels, "machine/poincare/", "machine/poincare/section_t", "section_t",
            lambda rest: rest.startswith("section_"))
     _exponents_history(raw, labels, "machine/lyapunov/")
+    _along(raw, labels, "machine/orbit/branch/", "machine/orbit/branch/parameter", "parameter", lambda rest: True)
+    _along(raw, labels, "machine/orbit/branch/", "machine/orbit/branch/section_parameter", "section_parameter",
+           lambda rest: rest.startswith("section_"))
 
 
 def _sweep_layout(raw, root, group_attrs, labels):

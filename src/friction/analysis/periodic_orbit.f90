@@ -23,17 +23,25 @@ module friction_analysis_periodic_orbit
    use friction_error, only: error_type, fatal_error, error_input
    use friction_ode_system, only: ode_system
    use friction_ode_events, only: event_system, event_locator, event_rising
-   use friction_ode_solver, only: solver_settings
+   use friction_ode_solver, only: solver_settings, ode_solver
+   use friction_ode_watch, only: step_watch
    use friction_analysis_lyapunov_spectrum, only: tangent_system, pack_tangent, unpack_tangent
    implicit none
    private
 
    public :: section_map, orbit_settings, periodic_orbit, find_periodic_orbit, section_multipliers
-   public :: floquet_multipliers, floquet_exponents, hyperplane_map
+   public :: floquet_multipliers, floquet_exponents, hyperplane_map, stroboscopic_map, small_eigenvalues
+   public :: bifurcation_period_doubling, bifurcation_fold, bifurcation_neimark_sacker, crossing_kind
 
    !> Largest section dimension whose multipliers are computed (closed form):
-   !> the brake's section is 2-dimensional, a planar flow's 1.
-   integer, parameter :: max_section = 2
+   !> the brake's section is 2-dimensional, a planar flow's 1, a forced
+   !> oscillator with one law state's stroboscopic section 3.
+   integer, parameter :: max_section = 3
+
+   !> Where a multiplier of a section map leaves (or enters) the unit circle.
+   integer, parameter :: bifurcation_period_doubling = 1  !! a real multiplier through -1
+   integer, parameter :: bifurcation_fold = 2             !! a real multiplier through +1
+   integer, parameter :: bifurcation_neimark_sacker = 3   !! a complex pair through |μ| = 1
 
    !> A return map of a section, in section coordinates.
    type, abstract :: section_map
@@ -94,6 +102,21 @@ module friction_analysis_periodic_orbit
 
    !> The return map of y_k = c crossed upwards (y_k' > 0) for a smooth system;
    !> returns later than max_return count as none.
+   !> The period map of a system periodic in time with `period` (a forced
+   !> oscillator), from t0 to t0 + period: P(s) = y(t0 + T), DP = Φ(t0 + T),
+   !> the whole state being the section's coordinates.
+   type, extends(section_map) :: stroboscopic_map
+      type(tangent_system), allocatable :: extended
+      type(solver_settings) :: solver
+      real(wp) :: t0 = 0.0_wp
+      real(wp) :: period = 1.0_wp
+      class(step_watch), pointer :: watch => null()   !! asked between steps when associated
+   contains
+      procedure :: setup => stroboscopic_setup
+      procedure :: dimension => stroboscopic_dimension
+      procedure :: evaluate => stroboscopic_evaluate
+   end type stroboscopic_map
+
    type, extends(section_map) :: hyperplane_map
       type(tangent_system), allocatable :: extended
       type(solver_settings) :: solver
@@ -101,6 +124,7 @@ module friction_analysis_periodic_orbit
       real(wp) :: level = 0.0_wp
       real(wp) :: max_return = 1000.0_wp
       real(wp) :: event_tolerance = 1.0e-12_wp
+      class(step_watch), pointer :: watch => null()   !! asked between steps when associated
    contains
       procedure :: setup => hyperplane_setup
       procedure :: dimension => hyperplane_map_dimension
@@ -125,7 +149,7 @@ contains
 
       n = map%dimension()
       if (size(guess) /= n .or. n < 1 .or. n > max_section) then
-         call fatal_error(error, 'periodic orbit: the section must have 1 to 2 dimensions and the guess as many', &
+         call fatal_error(error, 'periodic orbit: the section must have 1 to 3 dimensions and the guess as many', &
             & error_input)
          return
       end if
@@ -205,14 +229,150 @@ contains
          x(1) = (a(2, 2) * b(1) - a(1, 2) * b(2)) / det
          x(2) = (a(1, 1) * b(2) - a(2, 1) * b(1)) / det
       case default
-         return
+         call eliminate(a, b, x, solved)
+         if (.not. solved) return
       end select
       solved = all(abs(x) < huge(1.0_wp))
    end subroutine solve_shifted
 
-   !> Eigenvalues of a 1 x 1 or 2 x 2 section Jacobian, by decreasing modulus
-   !> (a complex pair: positive imaginary part first).
+   !> a x = b by Gaussian elimination with partial pivoting; solved = .false.
+   !> for an exactly singular a.
+   pure subroutine eliminate(a_in, b_in, x, solved)
+      real(wp), intent(in) :: a_in(:, :), b_in(:)
+      real(wp), intent(out) :: x(:)
+      logical, intent(out) :: solved
+      real(wp) :: a(size(b_in), size(b_in)), b(size(b_in)), row(size(b_in)), swap, factor
+      integer :: n, i, j, p
+
+      a = a_in
+      b = b_in
+      n = size(b)
+      x = 0.0_wp
+      solved = .false.
+      do j = 1, n
+         p = j - 1 + maxloc(abs(a(j:n, j)), 1)
+         if (a(p, j) == 0.0_wp) return
+         if (p /= j) then
+            row = a(j, :)
+            a(j, :) = a(p, :)
+            a(p, :) = row
+            swap = b(j)
+            b(j) = b(p)
+            b(p) = swap
+         end if
+         do i = j + 1, n
+            factor = a(i, j) / a(j, j)
+            a(i, j:n) = a(i, j:n) - factor * a(j, j:n)
+            b(i) = b(i) - factor * b(j)
+         end do
+      end do
+      do i = n, 1, -1
+         x(i) = (b(i) - dot_product(a(i, i + 1:n), x(i + 1:n))) / a(i, i)
+      end do
+      solved = .true.
+   end subroutine eliminate
+
+   !> The kind of bifurcation where `critical`, the multiplier of a section
+   !> map that crosses the unit circle, leaves it: complex, Neimark–Sacker;
+   !> real negative, period doubling; real positive, fold.
+   pure integer function crossing_kind(critical)
+      complex(wp), intent(in) :: critical
+
+      if (aimag(critical) /= 0.0_wp) then
+         crossing_kind = bifurcation_neimark_sacker
+      else if (real(critical) < 0.0_wp) then
+         crossing_kind = bifurcation_period_doubling
+      else
+         crossing_kind = bifurcation_fold
+      end if
+   end function crossing_kind
+
+   !> Eigenvalues of a real n x n matrix, n <= 3, by decreasing modulus (a
+   !> complex pair: positive imaginary part first): section_multipliers for
+   !> n <= 2, and for n = 3 a real root of the characteristic cubic (the
+   !> trigonometric or Cardano form, polished by Newton) and the quadratic
+   !> left, whose product is det/root.
+   pure function small_eigenvalues(a) result(mu)
+      real(wp), intent(in) :: a(:, :)
+      complex(wp), allocatable :: mu(:)
+      real(wp) :: c2, c1, c0, q, r, disc, root, theta, p, dp, sum_rest, product_rest, d
+      real(wp) :: pair(2, 2)
+      complex(wp) :: rest(2), swap
+      integer :: k, i, j
+
+      if (size(a, 1) <= 2) then
+         mu = pair_roots(a)
+         return
+      end if
+      ! λ³ + c2 λ² + c1 λ + c0
+      c2 = -(a(1, 1) + a(2, 2) + a(3, 3))
+      c1 = a(1, 1) * a(2, 2) - a(1, 2) * a(2, 1) + a(1, 1) * a(3, 3) - a(1, 3) * a(3, 1) &
+         & + a(2, 2) * a(3, 3) - a(2, 3) * a(3, 2)
+      c0 = -(a(1, 1) * (a(2, 2) * a(3, 3) - a(2, 3) * a(3, 2)) - a(1, 2) * (a(2, 1) * a(3, 3) - a(2, 3) * a(3, 1)) &
+         & + a(1, 3) * (a(2, 1) * a(3, 2) - a(2, 2) * a(3, 1)))
+      q = (c2**2 - 3.0_wp * c1) / 9.0_wp
+      r = (2.0_wp * c2**3 - 9.0_wp * c2 * c1 + 27.0_wp * c0) / 54.0_wp
+      disc = r**2 - q**3
+      if (disc < 0.0_wp) then
+         ! Three real roots: the one of largest modulus, by the trigonometric form.
+         theta = acos(max(-1.0_wp, min(1.0_wp, r / sqrt(q**3))))
+         root = -2.0_wp * sqrt(q) * cos(theta / 3.0_wp) - c2 / 3.0_wp
+         do k = 1, 2
+            d = -2.0_wp * sqrt(q) * cos((theta + 2.0_wp * k * acos(-1.0_wp)) / 3.0_wp) - c2 / 3.0_wp
+            if (abs(d) > abs(root)) root = d
+         end do
+      else
+         d = -sign(1.0_wp, r) * (abs(r) + sqrt(disc))**(1.0_wp / 3.0_wp)
+         root = d - c2 / 3.0_wp
+         if (d /= 0.0_wp) root = d + q / d - c2 / 3.0_wp
+      end if
+      do k = 1, 3
+         p = ((root + c2) * root + c1) * root + c0
+         dp = (3.0_wp * root + 2.0_wp * c2) * root + c1
+         if (dp == 0.0_wp) exit
+         root = root - p / dp
+      end do
+      sum_rest = -c2 - root
+      if (root /= 0.0_wp) then
+         product_rest = -c0 / root
+      else
+         product_rest = c1
+      end if
+      ! The pair as the 2 x 2 matrix with that trace and determinant.
+      pair = reshape([sum_rest, -product_rest, 1.0_wp, 0.0_wp], [2, 2])
+      rest = pair_roots(pair)
+      if (aimag(rest(1)) /= 0.0_wp) then
+         ! A complex pair stays together, the real root before or after it.
+         if (abs(root) >= abs(rest(1))) then
+            mu = [cmplx(root, 0.0_wp, wp), rest]
+         else
+            mu = [rest, cmplx(root, 0.0_wp, wp)]
+         end if
+      else
+         mu = [cmplx(root, 0.0_wp, wp), rest]
+         do i = 1, 2
+            do j = 1, 3 - i
+               if (abs(mu(j + 1)) > abs(mu(j))) then
+                  swap = mu(j)
+                  mu(j) = mu(j + 1)
+                  mu(j + 1) = swap
+               end if
+            end do
+         end do
+      end if
+   end function small_eigenvalues
+
+   !> Eigenvalues of a section Jacobian (1 x 1 to 3 x 3), by decreasing
+   !> modulus (a complex pair: positive imaginary part first).
    pure function section_multipliers(jac) result(mu)
+      real(wp), intent(in) :: jac(:, :)
+      complex(wp), allocatable :: mu(:)
+
+      mu = small_eigenvalues(jac)
+   end function section_multipliers
+
+   !> The closed form for n = 1, 2.
+   pure function pair_roots(jac) result(mu)
       real(wp), intent(in) :: jac(:, :)
       complex(wp), allocatable :: mu(:)
       real(wp) :: half_trace, det, disc, root
@@ -242,7 +402,7 @@ contains
             mu(2) = conjg(mu(1))
          end if
       end select
-   end function section_multipliers
+   end function pair_roots
 
    !> All Floquet multipliers of an orbit: the trivial 1 (along the flow),
    !> those of the section map, and `lost` zeros for directions the flow
@@ -356,6 +516,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(event_locator) :: locator
       real(wp) :: y(size(s) + 1), phi(size(s) + 1, size(s) + 1), f(size(s) + 1), z((size(s) + 1) * (size(s) + 2))
+      real(wp) :: row(size(s) + 1)
       real(wp) :: t, h
       integer :: n, i, k
       integer, allocatable :: others(:)
@@ -382,7 +543,11 @@ contains
       z = pack_tangent(y, phi)
       call locator%restart(t, z, h)
       do while (t < self%max_return)
-         call locator%advance(t, self%max_return, z, error)
+         if (associated(self%watch)) then
+            call locator%advance(t, self%max_return, z, error, self%watch)
+         else
+            call locator%advance(t, self%max_return, z, error)
+         end if
          if (allocated(error)) return
          if (locator%n_hits > 0) then
             if (locator%hits(locator%n_hits)%terminal) then
@@ -400,13 +565,74 @@ contains
       end if
       call unpack_tangent(z, y, phi)
       call self%extended%base%rhs(t, y, f)
+      ! Row k as it was before the loop zeroes it: the rows after k need it too.
+      row = phi(k, :)
       do i = 1, n
-         phi(i, :) = phi(i, :) - f(i) * phi(k, :) / f(k)
+         phi(i, :) = phi(i, :) - f(i) * row / f(k)
       end do
       image = y(others)
       jacobian = phi(others, others)
       period = t
       returned = .true.
    end subroutine hyperplane_evaluate
+
+   !> The period map of `system` from t0 over `period`.
+   subroutine stroboscopic_setup(self, system, solver, t0, period)
+      class(stroboscopic_map), intent(inout) :: self
+      class(ode_system), intent(in) :: system
+      type(solver_settings), intent(in) :: solver
+      real(wp), intent(in) :: t0, period
+
+      if (allocated(self%extended)) deallocate (self%extended)
+      allocate (self%extended)
+      allocate (self%extended%base, source=system)
+      self%solver = solver
+      self%t0 = t0
+      self%period = period
+   end subroutine stroboscopic_setup
+
+   pure integer function stroboscopic_dimension(self)
+      class(stroboscopic_map), intent(in) :: self
+
+      stroboscopic_dimension = self%extended%base%dimension()
+   end function stroboscopic_dimension
+
+   subroutine stroboscopic_evaluate(self, s, image, jacobian, period, returned, reason, error)
+      class(stroboscopic_map), intent(inout) :: self
+      real(wp), intent(in) :: s(:)
+      real(wp), intent(out) :: image(:), jacobian(:, :), period
+      logical, intent(out) :: returned
+      character(len=:), allocatable, intent(out) :: reason
+      type(error_type), allocatable, intent(out) :: error
+      type(ode_solver) :: solver
+      real(wp) :: phi(size(s), size(s)), z(size(s) * (size(s) + 1)), t, h, y(size(s))
+      integer :: i
+
+      image = s
+      jacobian = 0.0_wp
+      period = self%period
+      returned = .false.
+      reason = ''
+      phi = 0.0_wp
+      do i = 1, size(s)
+         phi(i, i) = 1.0_wp
+      end do
+      h = self%solver%h_start
+      if (.not. (h > 0.0_wp)) h = 1.0e-6_wp * self%period
+      call solver%init(self%extended, self%solver, h, error)
+      if (allocated(error)) return
+      t = self%t0
+      z = pack_tangent(s, phi)
+      if (associated(self%watch)) then
+         call solver%advance(t, self%t0 + self%period, z, error, self%watch)
+      else
+         call solver%advance(t, self%t0 + self%period, z, error)
+      end if
+      if (allocated(error)) return
+      call unpack_tangent(z, y, phi)
+      image = y
+      jacobian = phi
+      returned = .true.
+   end subroutine stroboscopic_evaluate
 
 end module friction_analysis_periodic_orbit

@@ -54,7 +54,7 @@ module friction_analysis_settings
       real(wp) :: orbit_tolerance = 1.0e-9_wp      !! max |P(s) - s| accepted, in the section's units
       integer :: orbit_max_iterations = 20         !! Newton steps
       ! ... followed along a line of one variable of the scene (the branch)
-      character(len=16) :: continuation = ''        !! the variable varied; '' for none
+      character(len=24) :: continuation = ''        !! the variable varied; '' for none
       real(wp) :: continuation_end = 0.0_wp         !! its value at the end of the line
       integer :: continuation_points = 11           !! points on the line, both ends included
       ! ... and from the series (Rosenstein); lengths in samples of the strided series

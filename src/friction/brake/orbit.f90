@@ -28,7 +28,8 @@ module friction_brake_orbit
    use friction_brake_switched, only: switched_integrator, brake_slip
    use friction_scene_report, only: job_reporter, loop_guard
    use friction_analysis_periodic_orbit, only: section_map, orbit_settings, periodic_orbit, &
-      & find_periodic_orbit, floquet_multipliers, floquet_exponents
+      & find_periodic_orbit, floquet_multipliers, floquet_exponents, bifurcation_period_doubling, &
+      & bifurcation_fold, bifurcation_neimark_sacker, crossing_kind
    implicit none
    private
 
@@ -36,10 +37,8 @@ module friction_brake_orbit
    public :: orbit_branch, follow_branch, detect_bifurcations, bifurcation_names
    public :: bifurcation_period_doubling, bifurcation_fold, bifurcation_neimark_sacker, bifurcation_discontinuity
 
-   !> Where a multiplier of the section map leaves (or enters) the unit circle.
-   integer, parameter :: bifurcation_period_doubling = 1  !! a real multiplier through -1
-   integer, parameter :: bifurcation_fold = 2             !! a real multiplier through +1
-   integer, parameter :: bifurcation_neimark_sacker = 3   !! a complex pair through |μ| = 1
+   ! Where a multiplier of the section map leaves (or enters) the unit circle: the kinds 1 to 3
+   ! of analysis/periodic_orbit.f90 (period doubling, fold, Neimark–Sacker), shared with the machine.
    !> The orbits at two consecutive points are not on one smooth branch:
    !> their patterns of events differ, or the period jumps by more than half
    !> the crank's period in stick, π/ω with ω = √(κ/ξ) (the stick ends at
@@ -408,13 +407,7 @@ contains
          outer = merge(k, k - 1, m1 > 1.0_wp)
          ! Multipliers 2:3 are the section map's, the larger first.
          critical = branch%multipliers(2, outer)
-         if (aimag(critical) /= 0.0_wp) then
-            kind = bifurcation_neimark_sacker
-         else if (real(critical) < 0.0_wp) then
-            kind = bifurcation_period_doubling
-         else
-            kind = bifurcation_fold
-         end if
+         kind = crossing_kind(critical)
          branch%kind = [branch%kind, kind]
          branch%at = [branch%at, branch%parameter(k - 1) + (1.0_wp - m0) / (m1 - m0) &
             & * (branch%parameter(k) - branch%parameter(k - 1))]

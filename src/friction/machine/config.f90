@@ -12,8 +12,8 @@
 !> at load_velocity.
 module friction_machine_config
    use friction_kinds, only: wp, i8
-   use friction_strings, only: rtoa, itoa
-   use friction_parameters, only: configurable, parameter_visitor
+   use friction_strings, only: rtoa, quoted, itoa
+   use friction_parameters, only: configurable, parameter_visitor, set_parameter_number
    use friction_checks, only: config_checker
    use friction_ode_solver, only: solver_settings
    use friction_ode_settings, only: visit_integrator, check_integrator
@@ -26,7 +26,7 @@ module friction_machine_config
    implicit none
    private
 
-   public :: machine_config, machine_solver_defaults
+   public :: machine_config, machine_solver_defaults, orbit_variables
 
    !> Rodas4 at tight tolerances: the laws with states are stiff (LuGre's
    !> contact period is 20 ms against seconds of stick-slip).
@@ -60,8 +60,12 @@ module friction_machine_config
       procedure :: grid_time
    end type machine_config
 
+   !> The &machine variables a periodic orbit can be continued in (&analysis continuation).
+   character(len=*), parameter :: orbit_variables(8) = [character(len=17) :: 'belt_velocity', 'stiffness', &
+      & 'damping', 'normal', 'mass', 'load_velocity', 'support_amplitude', 'support_frequency']
+
    character(len=*), parameter :: not_yet = "not computed for scene 'machine' (its &analysis has spectrum, " &
-      & //'lyapunov, poincare and lyapunov_spectrum); the brake has it'
+      & //'lyapunov, poincare, lyapunov_spectrum and orbit); the brake has it'
 
 contains
 
@@ -130,7 +134,7 @@ contains
       ! The machine's diagnostics so far: the spectrum, Benettin's exponent, the Poincaré maps and
       ! the Lyapunov spectrum; the others are refused by name rather than ignored.
       associate (a => self%analysis)
-         if (a%orbit) call c%reject('analysis', 'orbit', '.true.', not_yet)
+         if (a%orbit) call check_orbit(self, c)
          if (a%rosenstein) call c%reject('analysis', 'rosenstein', '.true.', not_yet)
          if (a%poincare .or. a%lyapunov_spectrum) call check_sections_and_tangent(self, c)
       end associate
@@ -157,6 +161,60 @@ contains
             & //itoa(max_tangent_base - 3)//' besides x and v')
       end associate
    end subroutine check_sections_and_tangent
+
+   !> &analysis orbit (and continuation): a smooth law with few enough states
+   !> for the section's closed-form multipliers; the line's end a valid machine
+   !> of the same kind (forced or not).
+   subroutine check_orbit(self, c)
+      type(machine_config), intent(in) :: self
+      type(config_checker), intent(inout) :: c
+      class(sliding_law), allocatable :: law
+      logical :: forced
+      integer :: most
+
+      call new_law(self%law, law)
+      if (law%set_valued()) then
+         call c%reject('analysis', 'orbit', '.true.', "the machine's orbits are computed for the laws that are " &
+            & //"one ODE (lugre, elastoplastic, dahl, rate_state, arctan); &law model = '"//trim(self%law%model) &
+            & //"' switches between stick and slip, whose saltation the machine's section map does not carry")
+         return
+      end if
+      forced = self%support_amplitude > 0.0_wp .and. self%support_frequency > 0.0_wp
+      ! The section's multipliers are closed forms up to 3 coordinates: (x, v, states) when forced, (x, states) if not.
+      most = merge(1, 2, forced)
+      if (law%state_count() > most) then
+         call c%reject('analysis', 'orbit', '.true.', "&law model = '"//trim(self%law%model)//"' has " &
+            & //itoa(law%state_count())//' states; the orbit takes at most '//merge('1', '2', forced) &
+            & //trim(merge(' (with a moving support)', ' (without one)          ', forced)))
+         return
+      end if
+      if (len_trim(self%analysis%continuation) == 0) return
+      if (.not. any(orbit_variables == self%analysis%continuation)) then
+         call c%reject('analysis', 'continuation', "'"//trim(self%analysis%continuation)//"'", &
+            & 'not a variable of &machine the orbit can follow (known: '//quoted(orbit_variables)//')')
+         return
+      end if
+      block
+         type(machine_config) :: end_point
+         type(config_checker) :: inner
+         character(len=:), allocatable :: problem
+         end_point = self
+         end_point%analysis%continuation = ''
+         call set_parameter_number(end_point, 'machine', trim(self%analysis%continuation), &
+            & self%analysis%continuation_end, problem)
+         call end_point%validate(inner)
+         if (inner%failed()) then
+            associate (message => inner%error%message, origin => index(inner%error%message, '(default): '))
+               call c%reject('analysis', 'continuation_end', rtoa(self%analysis%continuation_end), &
+                  & 'the end of the line is not a valid machine: '//message(merge(origin + 11, 1, origin == 1):))
+            end associate
+         else if ((end_point%support_amplitude > 0.0_wp .and. end_point%support_frequency > 0.0_wp) .neqv. forced) then
+            call c%reject('analysis', 'continuation_end', rtoa(self%analysis%continuation_end), 'the line must ' &
+               & //'keep the support moving (support_amplitude and support_frequency > 0) or keep it still at ' &
+               & //'both ends: the section changes between them')
+         end if
+      end block
+   end subroutine check_orbit
 
    pure integer function grid_size(self)
       class(machine_config), intent(in) :: self

@@ -17,6 +17,8 @@ module friction_machine_diagnostics
    use friction_machine_run, only: machine_run, machine_watch
    use friction_machine_section, only: machine_poincare, machine_sections
    use friction_machine_lyapunov, only: machine_spectrum, machine_lyapunov_spectrum, smooth_start, switched_benettin
+   use friction_analysis_periodic_orbit, only: orbit_settings
+   use friction_machine_orbit, only: machine_orbit, machine_branch, machine_periodic_orbit, follow_machine_branch
    implicit none
    private
 
@@ -29,6 +31,10 @@ module friction_machine_diagnostics
       logical :: poincare = .false., lyapunov_spectrum = .false.
       type(machine_poincare) :: sections
       type(machine_spectrum) :: qr
+      logical :: orbit = .false.           !! &analysis orbit: the periodic orbit ...
+      type(machine_orbit) :: periodic
+      logical :: continued = .false.       !! ... and its continuation
+      type(machine_branch) :: branch
    end type machine_diagnostics
 
 contains
@@ -78,6 +84,8 @@ contains
                end block
             end if
          end if
+         if (allocated(error)) return
+         if (a%orbit) call periodic_orbit(error)
       end associate
 
    contains
@@ -121,6 +129,21 @@ contains
             end block
          end if
       end subroutine lyapunov
+
+      !> Newton from the run's section point after orbit_transient, and its branch.
+      subroutine periodic_orbit(error)
+         type(error_type), allocatable, intent(out) :: error
+         type(orbit_settings) :: s
+
+         s%tolerance = c%analysis%orbit_tolerance
+         s%max_iterations = c%analysis%orbit_max_iterations
+         d%orbit = .true.
+         call machine_periodic_orbit(c, run, c%analysis%orbit_transient, s, d%periodic, error, watch)
+         if (allocated(error) .or. len_trim(c%analysis%continuation) == 0) return
+         d%continued = .true.
+         call follow_machine_branch(c, d%periodic, c%analysis%continuation_end, c%analysis%continuation_points, &
+            & c%analysis%orbit_transient, s, d%branch, error, watch)
+      end subroutine periodic_orbit
 
    end subroutine diagnose_machine
 

@@ -14,6 +14,7 @@ module friction_machine_output
    use friction_machine_diagnostics, only: machine_diagnostics
    use friction_machine_section, only: write_machine_poincare
    use friction_machine_lyapunov, only: write_machine_spectrum
+   use friction_machine_orbit_output, only: write_machine_orbit
    implicit none
    private
 
@@ -117,6 +118,13 @@ contains
          call write_machine_spectrum(file, '/machine/lyapunov', diagnostics%qr)
       end if
       if (diagnostics%poincare) call write_machine_poincare(file, config, run, diagnostics%sections)
+      if (diagnostics%orbit) then
+         call write_machine_orbit(file, config, diagnostics%periodic, diagnostics%continued, diagnostics%branch, error)
+         if (allocated(error)) then
+            call file%close(close_error)
+            return
+         end if
+      end if
       call file%close(error)
    end subroutine write_machine_file
 

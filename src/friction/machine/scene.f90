@@ -97,9 +97,14 @@ contains
       self%record%compute_time = wall_seconds() - start
       if (.not. allocated(error)) then
          deallocate (watch)
-         allocate (watch, source=machine_watch(self%config, '&analysis: the Lyapunov '//trim(merge('exponent (Benettin)', &
-            & 'spectrum           ', self%config%analysis%lyapunov .or. .not. self%config%analysis%lyapunov_spectrum)), &
-            & reporter))
+         if (self%config%analysis%orbit .and. .not. (self%config%analysis%lyapunov .or. &
+            & self%config%analysis%lyapunov_spectrum)) then
+            allocate (watch, source=machine_watch(self%config, '&analysis: the periodic orbit', reporter))
+         else
+            allocate (watch, source=machine_watch(self%config, '&analysis: the Lyapunov '//trim(merge('exponent (Benettin)', &
+               & 'spectrum           ', self%config%analysis%lyapunov .or. .not. self%config%analysis%lyapunov_spectrum)), &
+               & reporter))
+         end if
          call diagnose_machine(self%config, self%result, self%diagnostics, error, watch)
       end if
       call agree_on_error(job, error)
@@ -179,12 +184,14 @@ contains
       results(2) = real(count(run%stick(half:) == 1), wp) / real(run%n - half + 1, wp)
       results(3) = maxval(run%v(half:)) - minval(run%v(half:))
       results(4) = sum(run%force(half:)) / real(run%n - half + 1, wp)
-      ! A point's results need neither the Poincaré maps nor the whole spectrum: not computed there.
+      ! A point's results need neither the Poincaré maps nor the whole spectrum: not computed there;
+      ! a point is one run: its orbit (if asked) is not followed along a line.
       block
          type(machine_config) :: point
          point = self%config
          point%analysis%poincare = .false.
          point%analysis%lyapunov_spectrum = .false.
+         point%analysis%continuation = ''
          call diagnose_machine(point, run, d, error, watch)
       end block
       if (allocated(error)) return
