@@ -38,11 +38,14 @@ contains
       call file%write_attribute_integer(group, 'iterations', int(o%orbit%iterations, i8))
       call file%write_attribute_real(group, 'residual', o%orbit%residual, '1')
       ! The orbit's section point, or Newton's last iterate (the run's last state when it had none).
-      call file%write_vector(group//'/point', o%state, units)
+      ! Its columns differ in unit: no single `units`, each column's in `column_units` (UDUNITS each).
+      call file%write_vector(group//'/point', o%state, '')
       call file%write_attribute_text(group//'/point', 'names', names)
+      call file%write_attribute_text(group//'/point', 'column_units', units)
       if (o%has_equilibrium) then
-         call file%write_vector(group//'/equilibrium', o%equilibrium, units)
+         call file%write_vector(group//'/equilibrium', o%equilibrium, '')
          call file%write_attribute_text(group//'/equilibrium', 'names', names)
+         call file%write_attribute_text(group//'/equilibrium', 'column_units', units)
          allocate (parts(2, size(o%eigenvalues)))
          parts(1, :) = real(o%eigenvalues)
          parts(2, :) = aimag(o%eigenvalues)
@@ -80,7 +83,8 @@ contains
       call file%write_vector_integer(group//'/source', b%source, '1')
       call file%write_attribute_text(group//'/source', 'names', '1 = continued, 2 = from the attractor')
       call file%write_vector(group//'/period', b%period, 's')
-      call file%write_matrix(group//'/point', b%state, units)
+      call file%write_matrix(group//'/point', b%state, '')
+      call file%write_attribute_text(group//'/point', 'column_units', units)
       call file%write_matrix(group//'/floquet_multipliers_real', real(b%multipliers), '1')
       call file%write_matrix(group//'/floquet_multipliers_imag', aimag(b%multipliers), '1')
       call file%write_vector(group//'/max_modulus', b%max_modulus, '1')
