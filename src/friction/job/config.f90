@@ -288,7 +288,11 @@ contains
       class(scene), allocatable :: copy
       character(len=:), allocatable :: group, name, unit, reason, first, suffix
       real(wp) :: x, low, high
-      integer :: a, k, m, flagged
+      integer :: a, k, m, flagged, n, stride, examined
+      character(len=:), allocatable :: counted
+      ! More values than this are sampled evenly (the ends included): a sweep of
+      ! 2**31 points must reach its room check, not spend minutes here.
+      integer, parameter :: most_examined = 100000
 
       if (.not. config%sweep%enabled()) return
       allocate (copy, source=config%scene)
@@ -304,21 +308,37 @@ contains
          first = ''
          low = huge(1.0_wp)
          high = -huge(1.0_wp)
-         do k = 1, config%sweep%shape(a)
-            x = config%sweep%value(a, k)
-            reason = unit_plausibility(unit, x)
-            if (len(reason) == 0) cycle
-            flagged = flagged + 1
-            if (flagged == 1) first = reason
-            low = min(low, x)
-            high = max(high, x)
+         n = config%sweep%shape(a)
+         stride = max(1, n / most_examined)
+         examined = 0
+         do k = 1, n, stride
+            call examine(k)
          end do
+         if (mod(n - 1, stride) /= 0) call examine(n)
          if (flagged == 0) cycle
+         counted = ' of its '//itoa(n)//' values'
+         if (examined < n) counted = ' of '//itoa(examined)//' of its '//itoa(n)//' values (one in ' &
+            & //itoa(stride)//' and the last)'
          suffix = merge('  ', '2 ', a == 1)
          call checker%warn('sweep', 'sweep_variable'//trim(suffix), "'"//trim(config%sweep%variables(a))//"'", &
-            & itoa(flagged)//' of its '//itoa(config%sweep%shape(a))//' values, from '//rtoa(low)//' to ' &
+            & itoa(flagged)//counted//', from '//rtoa(low)//' to ' &
             & //rtoa(high)//', look like another unit than '//unit//'; the first: '//first)
       end do
+
+   contains
+
+      subroutine examine(k)
+         integer, intent(in) :: k
+
+         examined = examined + 1
+         x = config%sweep%value(a, k)
+         reason = unit_plausibility(unit, x)
+         if (len(reason) == 0) return
+         flagged = flagged + 1
+         if (flagged == 1) first = reason
+         low = min(low, x)
+         high = max(high, x)
+      end subroutine examine
    end subroutine warn_implausible_sweep
 
    !> Groups of the sources that are not part of the job's scene: in an
