@@ -32,6 +32,7 @@ module friction_analysis_periodic_orbit
    public :: section_map, orbit_settings, periodic_orbit, find_periodic_orbit, section_multipliers
    public :: floquet_multipliers, floquet_exponents, hyperplane_map, stroboscopic_map, small_eigenvalues
    public :: bifurcation_period_doubling, bifurcation_fold, bifurcation_neimark_sacker, crossing_kind
+   public :: halving_walk, branch_values, modulus_crossing
 
    !> Largest section dimension whose multipliers are computed (closed form):
    !> the brake's section is 2-dimensional, a planar flow's 1, a forced
@@ -69,6 +70,21 @@ module friction_analysis_periodic_orbit
          type(error_type), allocatable, intent(out) :: error
       end subroutine map_evaluate_interface
    end interface
+
+   !> A walk in a continuation variable from `from` to `to`: the whole step
+   !> first, halved (at most 5 times) while no orbit is found, the rest of
+   !> the way from each value reached; done at the orbit at `to` or the
+   !> sixth failure.  The caller tries `trial` and records whether it found
+   !> an orbit there (a state, not a callback: no closure, no trampoline).
+   type :: halving_walk
+      real(wp) :: trial = 0.0_wp   !! the value to try next
+      logical :: done = .false.
+      real(wp), private :: from = 0.0_wp, to = 0.0_wp, at = 0.0_wp, step = 0.0_wp
+      integer, private :: halvings = 0
+   contains
+      procedure :: start => walk_start
+      procedure :: record => walk_record
+   end type halving_walk
 
    type :: orbit_settings
       real(wp) :: tolerance = 1.0e-9_wp   !! max |P(s) - s| accepted, in the section's units
@@ -286,6 +302,82 @@ contains
          crossing_kind = bifurcation_fold
       end if
    end function crossing_kind
+
+   !> The walk from `from` to `to`, its first trial the whole step.
+   pure subroutine walk_start(self, from, to)
+      class(halving_walk), intent(inout) :: self
+      real(wp), intent(in) :: from, to
+
+      self%done = .false.
+      self%from = from
+      self%to = to
+      self%at = from
+      self%step = to - from
+      self%halvings = 0
+      call next_trial(self)
+   end subroutine walk_start
+
+   !> Whether an orbit was found at the trial: on from it, or a halved step.
+   pure subroutine walk_record(self, found)
+      class(halving_walk), intent(inout) :: self
+      logical, intent(in) :: found
+
+      if (found) then
+         if (self%trial == self%to) then
+            self%done = .true.
+            return
+         end if
+         self%at = self%trial
+         self%step = self%to - self%at
+      else
+         self%halvings = self%halvings + 1
+         if (self%halvings > 5) then
+            self%done = .true.
+            return
+         end if
+         self%step = self%step / 2
+      end if
+      call next_trial(self)
+   end subroutine walk_record
+
+   pure subroutine next_trial(walk)
+      type(halving_walk), intent(inout) :: walk
+
+      walk%trial = walk%at + walk%step
+      if (abs(walk%to - walk%trial) <= 1.0e-12_wp * abs(walk%to - walk%from)) walk%trial = walk%to
+   end subroutine next_trial
+
+   !> n values of a branch's parameter evenly from start to last (exactly).
+   pure function branch_values(start, last, n) result(values)
+      real(wp), intent(in) :: start, last
+      integer, intent(in) :: n
+      real(wp) :: values(n)
+      integer :: k
+
+      do k = 1, n
+         values(k) = start + (last - start) * real(k - 1, wp) / real(n - 1, wp)
+      end do
+      values(n) = last
+   end function branch_values
+
+   !> Whether the largest |μ| of a section map, m0 at the value p0 and m1 at
+   !> p1, crosses 1 between them: the kind from the critical multiplier
+   !> (critical0 at p0, critical1 at p1) on the outer side, the value by
+   !> linear interpolation of |μ| - 1.
+   pure subroutine modulus_crossing(p0, p1, m0, m1, critical0, critical1, crossed, kind, at)
+      real(wp), intent(in) :: p0, p1, m0, m1
+      complex(wp), intent(in) :: critical0, critical1
+      logical, intent(out) :: crossed
+      integer, intent(out) :: kind
+      real(wp), intent(out) :: at
+
+      kind = 0
+      at = 0.0_wp
+      crossed = (m0 - 1.0_wp) * (m1 - 1.0_wp) < 0.0_wp
+      if (.not. crossed) return
+      kind = crossing_kind(merge(critical1, critical0, m1 > 1.0_wp))
+      at = p0 + (1.0_wp - m0) / (m1 - m0) * (p1 - p0)
+   end subroutine modulus_crossing
 
    !> Eigenvalues of a real n x n matrix, n <= 3, by decreasing modulus (a
    !> complex pair: positive imaginary part first): section_multipliers for

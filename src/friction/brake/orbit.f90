@@ -29,7 +29,8 @@ module friction_brake_orbit
    use friction_scene_report, only: job_reporter, loop_guard
    use friction_analysis_periodic_orbit, only: section_map, orbit_settings, periodic_orbit, &
       & find_periodic_orbit, floquet_multipliers, floquet_exponents, bifurcation_period_doubling, &
-      & bifurcation_fold, bifurcation_neimark_sacker, crossing_kind
+      & bifurcation_fold, bifurcation_neimark_sacker, halving_walk, branch_values, &
+      & modulus_crossing
    implicit none
    private
 
@@ -257,10 +258,7 @@ contains
          & branch%multipliers(4, n), branch%max_modulus(n), branch%kind(0), branch%at(0), &
          & branch%pattern(size(event_kind_names), n), &
          & branch%section_parameter(0), branch%section_x(0))
-      do k = 1, n
-         branch%parameter(k) = start + (last - start) * real(k - 1, wp) / real(n - 1, wp)
-      end do
-      branch%parameter(n) = last
+      branch%parameter = branch_values(start, last, n)
       previous = first
       do k = 1, n
          point = continuation_config(config, branch%parameter(k))
@@ -321,30 +319,17 @@ contains
       type(brake_orbit), intent(out) :: result
       type(error_type), allocatable, intent(out) :: error
       type(brake_orbit) :: reached
-      real(wp) :: at, step, trial
-      integer :: halvings
+      type(halving_walk) :: walk
 
       reached = previous
-      at = from
-      step = to - from
-      halvings = 0
-      do
-         trial = at + step
-         if (abs(to - trial) <= 1.0e-12_wp * abs(to - from)) trial = to
+      call walk%start(from, to)
+      do while (.not. walk%done)
          result = brake_orbit()
-         call continue_orbit(continuation_config(config, trial), reached%limit, reached%orbit%point, settings, &
+         call continue_orbit(continuation_config(config, walk%trial), reached%limit, reached%orbit%point, settings, &
             & result, error)
          if (allocated(error)) return
-         if (result%orbit%found) then
-            if (trial == to) return
-            reached = result
-            at = trial
-            step = to - at
-         else
-            halvings = halvings + 1
-            if (halvings > 5) return
-            step = step / 2
-         end if
+         if (result%orbit%found) reached = result
+         call walk%record(result%orbit%found)
       end do
    end subroutine continue_along
 
@@ -385,9 +370,9 @@ contains
    subroutine detect_bifurcations(config, branch)
       type(brake_config), intent(in) :: config
       type(orbit_branch), intent(inout) :: branch
-      integer :: k, outer, kind
-      real(wp) :: m0, m1, half_crank_period
-      complex(wp) :: critical
+      integer :: k, kind
+      real(wp) :: half_crank_period, at
+      logical :: crossed
 
       do k = 2, size(branch%parameter)
          if (.not. (branch%found(k - 1) .and. branch%found(k))) cycle
@@ -401,16 +386,12 @@ contains
             branch%at = [branch%at, (branch%parameter(k - 1) + branch%parameter(k)) / 2]
             cycle
          end if
-         m0 = branch%max_modulus(k - 1)
-         m1 = branch%max_modulus(k)
-         if (.not. ((m0 - 1.0_wp) * (m1 - 1.0_wp) < 0.0_wp)) cycle
-         outer = merge(k, k - 1, m1 > 1.0_wp)
          ! Multipliers 2:3 are the section map's, the larger first.
-         critical = branch%multipliers(2, outer)
-         kind = crossing_kind(critical)
+         call modulus_crossing(branch%parameter(k - 1), branch%parameter(k), branch%max_modulus(k - 1), &
+            & branch%max_modulus(k), branch%multipliers(2, k - 1), branch%multipliers(2, k), crossed, kind, at)
+         if (.not. crossed) cycle
          branch%kind = [branch%kind, kind]
-         branch%at = [branch%at, branch%parameter(k - 1) + (1.0_wp - m0) / (m1 - m0) &
-            & * (branch%parameter(k) - branch%parameter(k - 1))]
+         branch%at = [branch%at, at]
       end do
    end subroutine detect_bifurcations
 

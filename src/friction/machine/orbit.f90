@@ -32,7 +32,8 @@ module friction_machine_orbit
    use friction_law_factory, only: make_law
    use friction_output_law_files, only: law_with_files
    use friction_analysis_periodic_orbit, only: section_map, orbit_settings, periodic_orbit, find_periodic_orbit, &
-      & floquet_multipliers, floquet_exponents, hyperplane_map, stroboscopic_map, small_eigenvalues, crossing_kind
+      & floquet_multipliers, floquet_exponents, hyperplane_map, stroboscopic_map, small_eigenvalues, &
+      & halving_walk, branch_values, modulus_crossing
    use friction_machine_config, only: machine_config
    use friction_machine_model, only: machine_smooth
    use friction_machine_run, only: machine_run, run_machine
@@ -488,10 +489,7 @@ contains
       allocate (branch%parameter(p), branch%found(p), branch%source(p), branch%period(p), branch%state(n, p), &
          & branch%multipliers(m, p), branch%max_modulus(p), branch%growth(p), branch%kind(0), branch%at(0), &
          & branch%section_parameter(0), branch%section_x(0))
-      do k = 1, p
-         branch%parameter(k) = start + (last - start) * real(k - 1, wp) / real(p - 1, wp)
-      end do
-      branch%parameter(p) = last
+      branch%parameter = branch_values(start, last, p)
       previous = first
       do k = 1, p
          point = machine_point_config(c, branch%parameter(k))
@@ -564,30 +562,17 @@ contains
       type(error_type), allocatable, intent(out) :: error
       class(step_watch), intent(inout), optional :: watch
       type(machine_orbit) :: reached
-      real(wp) :: at, step, trial
-      integer :: halvings
+      type(halving_walk) :: walk
 
       reached = previous
-      at = from
-      step = to - from
-      halvings = 0
-      do
-         trial = at + step
-         if (abs(to - trial) <= 1.0e-12_wp * abs(to - from)) trial = to
+      call walk%start(from, to)
+      do while (.not. walk%done)
          result = machine_orbit()
-         call orbit_from(machine_point_config(c, trial), reached%orbit%point, reached%guess_time, settings, result, &
-            & error, watch)
+         call orbit_from(machine_point_config(c, walk%trial), reached%orbit%point, reached%guess_time, settings, &
+            & result, error, watch)
          if (allocated(error)) return
-         if (result%orbit%found) then
-            if (trial == to) return
-            reached = result
-            at = trial
-            step = to - at
-         else
-            halvings = halvings + 1
-            if (halvings > 5) return
-            step = step / 2
-         end if
+         if (result%orbit%found) reached = result
+         call walk%record(result%orbit%found)
       end do
    end subroutine continue_along
 
@@ -631,8 +616,9 @@ contains
       type(machine_config), intent(in) :: c
       type(machine_branch), intent(inout) :: branch
       type(error_type), allocatable, intent(out) :: error
-      integer :: k, outer
-      real(wp) :: m0, m1
+      integer :: k, critical, kind
+      real(wp) :: at
+      logical :: crossed
 
       do k = 2, size(branch%parameter)
          if (branch%found(k - 1) .and. branch%found(k)) then
@@ -640,15 +626,14 @@ contains
                branch%kind = [branch%kind, bifurcation_discontinuity]
                branch%at = [branch%at, (branch%parameter(k - 1) + branch%parameter(k)) / 2]
             else
-               m0 = branch%max_modulus(k - 1)
-               m1 = branch%max_modulus(k)
-               if ((m0 - 1.0_wp) * (m1 - 1.0_wp) < 0.0_wp) then
-                  outer = merge(k, k - 1, m1 > 1.0_wp)
-                  ! The section map's multipliers, the largest first (after the trivial 1 when autonomous).
-                  branch%kind = [branch%kind, crossing_kind(branch%multipliers(merge(1, 2, &
-                     & machine_orbit_forced(c)), outer))]
-                  branch%at = [branch%at, branch%parameter(k - 1) + (1.0_wp - m0) / (m1 - m0) &
-                     & * (branch%parameter(k) - branch%parameter(k - 1))]
+               ! The section map's multipliers, the largest first (after the trivial 1 when autonomous).
+               critical = merge(1, 2, machine_orbit_forced(c))
+               call modulus_crossing(branch%parameter(k - 1), branch%parameter(k), branch%max_modulus(k - 1), &
+                  & branch%max_modulus(k), branch%multipliers(critical, k - 1), branch%multipliers(critical, k), &
+                  & crossed, kind, at)
+               if (crossed) then
+                  branch%kind = [branch%kind, kind]
+                  branch%at = [branch%at, at]
                end if
             end if
          end if
