@@ -14,6 +14,7 @@ module friction_brake_output
    use friction_brake_diagnostics, only: brake_diagnostics
    use friction_brake_orbit, only: orbit_branch, bifurcation_names
    use friction_output_h5, only: h5_file
+   use friction_output_branch, only: write_branch_sections, write_bifurcations
    use friction_output_parameters, only: write_parameter_attributes
    use friction_output_summary, only: run_summary, write_run_attributes
    implicit none
@@ -358,8 +359,6 @@ contains
       !> every axis of a dataset or on none: netCDF's readers refuse a mix)
       character(len=*), parameter :: along_branch(4) = [character(len=11) :: 'found', 'source', 'period', &
          & 'max_modulus']
-      character(len=32) :: codes(size(bifurcation_names))
-      integer :: k
 
       call file%create_group(group)
       call file%write_attribute_text(group, 'variable', trim(b%variable))
@@ -374,19 +373,8 @@ contains
       call file%write_matrix(group//'/floquet_multipliers_imag', aimag(b%multipliers), '1')
       call file%write_vector(group//'/max_modulus', b%max_modulus, '1')
       call file%write_matrix(group//'/events_per_period', real(b%pattern, wp), '1')
-      call file%write_vector(group//'/section_parameter', b%section_parameter, b%unit)
-      call file%write_vector(group//'/section_x', b%section_x, 'm')
-      call file%attach_scales(group//'/section_x', [group//'/section_parameter'])
-      do k = 1, size(along_branch)
-         call file%attach_scales(group//'/'//trim(along_branch(k)), [group//'/parameter'])
-      end do
-      call file%create_group('/brake/orbit/bifurcations')
-      do k = 1, size(bifurcation_names)
-         write (codes(k), '(i0, a)') k, ' = '//trim(bifurcation_names(k))
-      end do
-      call file%write_attribute_text('/brake/orbit/bifurcations', 'kind_names', join(codes))
-      call file%write_vector_integer('/brake/orbit/bifurcations/kind', b%kind, '1')
-      call file%write_vector('/brake/orbit/bifurcations/parameter', b%at, b%unit)
+      call write_branch_sections(file, group, b%section_parameter, b%section_x, b%unit, along_branch)
+      call write_bifurcations(file, '/brake/orbit/bifurcations', bifurcation_names, b%kind, b%at, b%unit)
    end subroutine write_branch
 
 end module friction_brake_output

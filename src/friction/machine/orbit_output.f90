@@ -4,8 +4,8 @@
 module friction_machine_orbit_output
    use friction_kinds, only: wp, i8
    use friction_error, only: error_type
-   use friction_strings, only: join
    use friction_output_h5, only: h5_file
+   use friction_output_branch, only: write_branch_sections, write_bifurcations
    use friction_machine_config, only: machine_config
    use friction_machine_orbit, only: machine_orbit, machine_branch, machine_bifurcation_names, machine_orbit_names
    implicit none
@@ -73,8 +73,6 @@ contains
       !> the branch's series along its points, whose coordinate is the parameter
       character(len=*), parameter :: along_branch(5) = [character(len=11) :: 'found', 'source', 'period', &
          & 'max_modulus', 'growth']
-      character(len=32) :: codes(size(machine_bifurcation_names))
-      integer :: k
 
       call file%create_group(group)
       call file%write_attribute_text(group, 'variable', trim(b%variable))
@@ -89,19 +87,8 @@ contains
       call file%write_matrix(group//'/floquet_multipliers_imag', aimag(b%multipliers), '1')
       call file%write_vector(group//'/max_modulus', b%max_modulus, '1')
       call file%write_vector(group//'/growth', b%growth, '1/s')
-      call file%write_vector(group//'/section_parameter', b%section_parameter, b%unit)
-      call file%write_vector(group//'/section_x', b%section_x, 'm')
-      call file%attach_scales(group//'/section_x', [group//'/section_parameter'])
-      do k = 1, size(along_branch)
-         call file%attach_scales(group//'/'//trim(along_branch(k)), [group//'/parameter'])
-      end do
-      call file%create_group('/machine/orbit/bifurcations')
-      do k = 1, size(machine_bifurcation_names)
-         write (codes(k), '(i0, a)') k, ' = '//trim(machine_bifurcation_names(k))
-      end do
-      call file%write_attribute_text('/machine/orbit/bifurcations', 'kind_names', join(codes))
-      call file%write_vector_integer('/machine/orbit/bifurcations/kind', b%kind, '1')
-      call file%write_vector('/machine/orbit/bifurcations/parameter', b%at, b%unit)
+      call write_branch_sections(file, group, b%section_parameter, b%section_x, b%unit, along_branch)
+      call write_bifurcations(file, '/machine/orbit/bifurcations', machine_bifurcation_names, b%kind, b%at, b%unit)
    end subroutine write_branch
 
 end module friction_machine_orbit_output
