@@ -22,22 +22,16 @@ program and its file, against oracles computed here:
 
     machine_chaos.py --binary build/friction --inputs inputs --workdir DIR CASE
 """
-import argparse
-import subprocess
 import sys
-from pathlib import Path
 
 import h5py
 import numpy as np
 
+from machine_cases import run_program, check_refusals, case_main
+
 
 def run(args, name, files, sets):
-    out = Path(args.workdir) / f"{name}.h5"
-    command = [args.binary, "--quiet", "--force", "-o", str(out)] + [str(Path(args.inputs) / f) for f in files]
-    for key, value in sets.items():
-        command += ["--set", f"{key}={value}"]
-    subprocess.run(command, check=True)
-    return h5py.File(out)
+    return h5py.File(run_program(args, name, files, sets))
 
 
 def linear(args):
@@ -271,33 +265,16 @@ def coulomb_forced(args):
 
 
 def refusals(args):
-    work = Path(args.workdir)
     cases = [  # (the groups' lines, the line named, what the message names, why)
         ("&law\n  model = 'lugre'\n/\n&analysis\n  poincare = .true.\n  section = 'stick_to_slip'\n/\n", 10,
          "&analysis: section = ", "has none: use section = 'w_zero_up'"),
     ]
-    for i, (group, line, names, why) in enumerate(cases):
-        path = work / f"bad{i}.nml"
-        path.write_text("! a refused value\n&job\n  scene = 'machine'\n/\n" + group)
-        out = work / f"bad{i}.h5"
-        result = subprocess.run([args.binary, "-o", str(out), str(path)], capture_output=True, text=True)
-        print(f"refusals: exit {result.returncode}: {result.stderr.strip()}")
-        assert result.returncode == 3, result
-        assert f"{path}:{line}: {names}" in result.stderr and why in result.stderr, result.stderr
-        assert not out.exists()
+    check_refusals(args, cases, "refusals")
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--binary", required=True)
-    parser.add_argument("--inputs", required=True)
-    parser.add_argument("--workdir", required=True)
-    parser.add_argument("case", choices=["linear", "sum-rule", "coulomb-cycle", "coulomb-forced", "refusals"])
-    args = parser.parse_args()
-    Path(args.workdir).mkdir(parents=True, exist_ok=True)
-    {"linear": linear, "sum-rule": sum_rule, "coulomb-cycle": coulomb_cycle, "coulomb-forced": coulomb_forced,
-     "refusals": refusals}[args.case](args)
-    return 0
+    return case_main(__doc__, {"linear": linear, "sum-rule": sum_rule, "coulomb-cycle": coulomb_cycle,
+                               "coulomb-forced": coulomb_forced, "refusals": refusals})
 
 
 if __name__ == "__main__":

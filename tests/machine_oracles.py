@@ -21,7 +21,6 @@ oracles computed here:
 
     machine_oracles.py --binary build/friction --inputs inputs --workdir DIR CASE
 """
-import argparse
 import subprocess
 import sys
 from pathlib import Path
@@ -30,14 +29,11 @@ import h5py
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from machine_cases import run_program, check_refusals, case_main
+
 
 def run(args, name, files, sets):
-    out = Path(args.workdir) / f"{name}.h5"
-    command = [args.binary, "--quiet", "--force", "-o", str(out)] + [str(Path(args.inputs) / f) for f in files]
-    for key, value in sets.items():
-        command += ["--set", f"{key}={value}"]
-    subprocess.run(command, check=True)
-    with h5py.File(out) as f:
+    with h5py.File(run_program(args, name, files, sets)) as f:
         return {key: f["machine"][key][:] for key in f["machine"] if key != "events"}
 
 
@@ -173,15 +169,7 @@ def bad_input(args):
         ("&law\n  model = 'gms'\n  element_weight = 0.5, 0.2, 0.2, 0.2\n/\n", 7, "&law: element_weight = ",
          "add up to 1.1"),
     ]
-    for i, (group, line, names, why) in enumerate(cases):
-        path = work / f"bad{i}.nml"
-        path.write_text("! a refused value\n&job\n  scene = 'machine'\n/\n" + group)
-        out = work / f"bad{i}.h5"
-        result = subprocess.run([args.binary, "-o", str(out), str(path)], capture_output=True, text=True)
-        print(f"bad-input: exit {result.returncode}: {result.stderr.strip()}")
-        assert result.returncode == 3, result
-        assert f"{path}:{line}: {names}" in result.stderr and why in result.stderr, result.stderr
-        assert not out.exists()
+    check_refusals(args, cases, "bad-input")
     # --netlist: the machine has no circuit form, refused naming where &job scene = 'machine' was set.
     netlist = work / "machine.cir"
     result = subprocess.run([args.binary, "--netlist", str(netlist), str(work / "bad0.nml"), "--set",
@@ -216,17 +204,8 @@ def gms_saturated(args):
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--binary", required=True)
-    parser.add_argument("--inputs", required=True)
-    parser.add_argument("--workdir", required=True)
-    parser.add_argument("case", choices=["lugre-radau", "rate-state-critical", "table-onset", "bad-input",
-                                         "gms-saturated"])
-    args = parser.parse_args()
-    Path(args.workdir).mkdir(parents=True, exist_ok=True)
-    {"lugre-radau": lugre_radau, "rate-state-critical": rate_state_critical,
-     "table-onset": table_onset, "bad-input": bad_input, "gms-saturated": gms_saturated}[args.case](args)
-    return 0
+    return case_main(__doc__, {"lugre-radau": lugre_radau, "rate-state-critical": rate_state_critical,
+                               "table-onset": table_onset, "bad-input": bad_input, "gms-saturated": gms_saturated})
 
 
 if __name__ == "__main__":

@@ -17,24 +17,18 @@ the program and its file, against oracles computed here:
 
     machine_orbit_oracles.py --binary build/friction --inputs inputs --workdir DIR CASE
 """
-import argparse
-import subprocess
 import sys
-from pathlib import Path
 
 import h5py
 import numpy as np
 from scipy.integrate import solve_ivp, trapezoid
 from scipy.optimize import brentq
 
+from machine_cases import run_program, check_refusals, case_main
+
 
 def run(args, name, files, sets):
-    out = Path(args.workdir) / f"{name}.h5"
-    command = [args.binary, "--quiet", "--force", "-o", str(out)] + [str(Path(args.inputs) / f) for f in files]
-    for key, value in sets.items():
-        command += ["--set", f"{key}={value}"]
-    subprocess.run(command, check=True)
-    with h5py.File(out) as f:
+    with h5py.File(run_program(args, name, files, sets)) as f:
         g = f["machine/orbit"]
         orbit = {key: g[key][()] for key in g if isinstance(g[key], h5py.Dataset)}
         orbit.update({key: value for key, value in g.attrs.items()})
@@ -229,7 +223,6 @@ def hopf_belt(args):
 
 
 def refusals(args):
-    work = Path(args.workdir)
     cases = [  # (the groups, the line named, what the message names, why)
         ("&law\n  model = 'coulomb'\n/\n&analysis\n  orbit = .true.\n/\n", 9, "&analysis: orbit = ",
          "switches between stick and slip"),
@@ -241,29 +234,12 @@ def refusals(args):
          "&analysis\n  orbit = .true.\n  continuation = 'support_amplitude'\n  continuation_end = 0.0\n/\n", 15,
          "&analysis: continuation_end = ", "keep the support moving"),
     ]
-    for i, (groups, line, names, why) in enumerate(cases):
-        path = work / f"bad{i}.nml"
-        path.write_text("! a refused value\n&job\n  scene = 'machine'\n/\n" + groups)
-        out = work / f"bad{i}.h5"
-        result = subprocess.run([args.binary, "-o", str(out), str(path)], capture_output=True, text=True)
-        print(f"refusals: exit {result.returncode}: {result.stderr.strip()}")
-        assert result.returncode == 3, result
-        assert f"{path}:{line}: {names}" in result.stderr and why in result.stderr, result.stderr
-        assert not out.exists()
+    check_refusals(args, cases, "refusals")
 
 
 def main():
-    cases = {"forced-linear": forced_linear, "forced-lugre": forced_lugre, "arctan-belt": arctan_belt,
-             "hopf-belt": hopf_belt, "refusals": refusals}
-    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--binary", required=True)
-    parser.add_argument("--inputs", required=True)
-    parser.add_argument("--workdir", required=True)
-    parser.add_argument("case", choices=list(cases))
-    args = parser.parse_args()
-    Path(args.workdir).mkdir(parents=True, exist_ok=True)
-    cases[args.case](args)
-    return 0
+    return case_main(__doc__, {"forced-linear": forced_linear, "forced-lugre": forced_lugre,
+                               "arctan-belt": arctan_belt, "hopf-belt": hopf_belt, "refusals": refusals})
 
 
 if __name__ == "__main__":
