@@ -32,7 +32,7 @@ module friction_brake_law_model
    use friction_brake_config, only: brake_config
    use friction_brake_integrator, only: brake_integrator
    use friction_brake_stick, only: stick_motion, stick_end_lift_off, stick_end_force_positive, stick_tangent
-   use friction_brake_switched, only: saltation
+   use friction_brake_switched, only: saltation, stick_field
    use friction_analysis_lyapunov_spectrum, only: tangent_system
    use friction_brake_record, only: brake_event_table, event_stick_to_slip, event_slip_to_stick, &
       & event_slip_reversal
@@ -496,7 +496,7 @@ contains
                if (abs(self%p%elastic_force(self%y(1), self%y(3))) <= self%limit(self%y(3))) then
                   self%sticking = .true.
                   if (self%tangent) then
-                     call saltation(self%phi, slip_field(self, self%slip%direction), stick_field(self), &
+                     call saltation(self%phi, slip_field(self, self%slip%direction), stick_field(self%p, self%y), &
                         & [0.0_wp, self%slip%direction, 0.0_wp, 0.0_wp])
                      self%lost = 1
                   end if
@@ -560,14 +560,6 @@ contains
       call slip%rhs(self%t, self%y, f)
    end function slip_field
 
-   !> The right-hand side of stick (the block's velocity pinned to the belt).
-   pure function stick_field(self) result(f)
-      type(law_integrator), intent(in) :: self
-      real(wp) :: f(4)
-
-      f = [self%p%v_dr, 0.0_wp, self%y(4), (self%y(1) - self%p%kappa * self%y(3)) / self%p%xi]
-   end function stick_field
-
    !> Leaving stick where the limit `which` was reached: h = slope N' + level ∓ (2x - y)
    !> with normal ∇h, into slip in the direction the springs' pull drives (the
    !> switched model's, with the law's static limit).
@@ -578,7 +570,7 @@ contains
 
       sigma = merge(1.0_wp, -1.0_wp, which == stick_end_force_positive)
       normal = [-2.0_wp * sigma, 0.0_wp, self%slope * (1.0_wp - self%p%kappa) + sigma, 0.0_wp]
-      call saltation(self%phi, stick_field(self), slip_field(self, -sigma), normal)
+      call saltation(self%phi, stick_field(self%p, self%y), slip_field(self, -sigma), normal)
    end subroutine stick_exit_saltation
 
 end module friction_brake_law_model

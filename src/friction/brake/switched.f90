@@ -32,7 +32,7 @@ module friction_brake_switched
    implicit none
    private
 
-   public :: brake_slip, switched_integrator, kinetic_friction, saltation
+   public :: brake_slip, switched_integrator, kinetic_friction, saltation, stick_field
 
    !> Eq. 10 during one slip, with s the sign of v_rel.
    type, extends(event_system) :: brake_slip
@@ -291,7 +291,7 @@ contains
                   & self%p%mu_s * self%p%normal_force(self%y(3))) then
                   self%sticking = .true.
                   if (self%tangent) then
-                     call saltation(self%phi, slip_field(self, self%slip%direction), stick_field(self), &
+                     call saltation(self%phi, slip_field(self, self%slip%direction), stick_field(self%p, self%y), &
                         & [0.0_wp, self%slip%direction, 0.0_wp, 0.0_wp])
                      self%lost = 1
                   end if
@@ -351,12 +351,14 @@ contains
       call slip%rhs(self%t, self%y, f)
    end function slip_field
 
-   !> The right-hand side of stick (the block's velocity pinned to the belt).
-   pure function stick_field(self) result(f)
-      class(switched_integrator), intent(in) :: self
+   !> The right-hand side of stick at the state y (the block's velocity
+   !> pinned to the belt), whatever the friction model.
+   pure function stick_field(p, y) result(f)
+      type(brake_parameters), intent(in) :: p
+      real(wp), intent(in) :: y(4)
       real(wp) :: f(4)
 
-      f = [self%p%v_dr, 0.0_wp, self%y(4), (self%y(1) - self%p%kappa * self%y(3)) / self%p%xi]
+      f = [p%v_dr, 0.0_wp, y(4), (y(1) - p%kappa * y(3)) / p%xi]
    end function stick_field
 
    !> Tangent vectors across a switching surface h = 0 with normal n = ∇h,
@@ -388,7 +390,7 @@ contains
       sigma = merge(1.0_wp, -1.0_wp, which == stick_end_force_positive)
       normal = [-2.0_wp * sigma, 0.0_wp, self%p%mu_s * (1.0_wp - self%p%kappa) + sigma, 0.0_wp]
       s = -sigma
-      call saltation(self%phi, stick_field(self), slip_field(self, s), normal)
+      call saltation(self%phi, stick_field(self%p, self%y), slip_field(self, s), normal)
    end subroutine stick_exit_saltation
 
 end module friction_brake_switched
