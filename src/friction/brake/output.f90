@@ -14,7 +14,7 @@ module friction_brake_output
    use friction_brake_diagnostics, only: brake_diagnostics
    use friction_brake_orbit, only: orbit_branch, bifurcation_names
    use friction_output_h5, only: h5_file
-   use friction_output_branch, only: write_branch_sections, write_bifurcations
+   use friction_output_branch, only: write_branch_points, write_branch_sections, write_bifurcations
    use friction_output_parameters, only: write_parameter_attributes
    use friction_output_summary, only: run_summary, write_run_attributes
    implicit none
@@ -360,12 +360,7 @@ contains
       character(len=*), parameter :: along_branch(4) = [character(len=11) :: 'found', 'source', 'period', &
          & 'max_modulus']
 
-      call file%create_group(group)
-      call file%write_attribute_text(group, 'variable', trim(b%variable))
-      call file%write_vector(group//'/parameter', b%parameter, b%unit)
-      call file%write_vector_integer(group//'/found', merge(1, 0, b%found), '1')
-      call file%write_vector_integer(group//'/source', b%source, '1')
-      call file%write_attribute_text(group//'/source', 'names', '1 = continued, 2 = from the attractor')
+      call write_branch_points(file, group, trim(b%variable), b%parameter, b%unit, b%found, b%source)
       call file%write_vector(group//'/period', b%period, 'tau')
       call file%write_matrix(group//'/point', b%state, 'm')
       call file%write_attribute_text(group//'/point', 'column_units_tau', state_units_tau)

@@ -5,7 +5,7 @@ module friction_machine_orbit_output
    use friction_kinds, only: wp, i8
    use friction_error, only: error_type
    use friction_output_h5, only: h5_file
-   use friction_output_branch, only: write_branch_sections, write_bifurcations
+   use friction_output_branch, only: write_branch_points, write_branch_sections, write_bifurcations
    use friction_machine_config, only: machine_config
    use friction_machine_orbit, only: machine_orbit, machine_branch, machine_bifurcation_names, machine_orbit_names
    implicit none
@@ -74,12 +74,7 @@ contains
       character(len=*), parameter :: along_branch(5) = [character(len=11) :: 'found', 'source', 'period', &
          & 'max_modulus', 'growth']
 
-      call file%create_group(group)
-      call file%write_attribute_text(group, 'variable', trim(b%variable))
-      call file%write_vector(group//'/parameter', b%parameter, b%unit)
-      call file%write_vector_integer(group//'/found', merge(1, 0, b%found), '1')
-      call file%write_vector_integer(group//'/source', b%source, '1')
-      call file%write_attribute_text(group//'/source', 'names', '1 = continued, 2 = from the attractor')
+      call write_branch_points(file, group, trim(b%variable), b%parameter, b%unit, b%found, b%source)
       call file%write_vector(group//'/period', b%period, 's')
       call file%write_matrix(group//'/point', b%state, '')
       call file%write_attribute_text(group//'/point', 'column_units', units)

@@ -1,6 +1,6 @@
 !> What the brake's and the machine's continued branches of periodic orbits
-!> write alike: the attractor's section points along the branch and the
-!> bifurcations group (docs/output.md).
+!> write alike: the points and where each orbit came from, the attractor's
+!> section points along the branch and the bifurcations group (docs/output.md).
 module friction_output_branch
    use friction_kinds, only: wp
    use friction_strings, only: join
@@ -8,9 +8,26 @@ module friction_output_branch
    implicit none
    private
 
-   public :: write_branch_sections, write_bifurcations
+   public :: write_branch_points, write_branch_sections, write_bifurcations
 
 contains
+
+   !> The group `group` of a branch in the variable `variable`: its points'
+   !> parameter (in `unit`), whether each has an orbit and where it came from.
+   subroutine write_branch_points(file, group, variable, parameter, unit, found, source)
+      type(h5_file), intent(inout) :: file
+      character(len=*), intent(in) :: group, variable, unit
+      real(wp), intent(in), contiguous :: parameter(:)
+      logical, intent(in) :: found(:)
+      integer, intent(in) :: source(:)
+
+      call file%create_group(group)
+      call file%write_attribute_text(group, 'variable', variable)
+      call file%write_vector(group//'/parameter', parameter, unit)
+      call file%write_vector_integer(group//'/found', merge(1, 0, found), '1')
+      call file%write_vector_integer(group//'/source', source, '1')
+      call file%write_attribute_text(group//'/source', 'names', '1 = continued, 2 = from the attractor')
+   end subroutine write_branch_points
 
    !> group/section_parameter and group/section_x (x in m) with the one as
    !> the other's scale, and group/parameter as the scale of each `along` series.
