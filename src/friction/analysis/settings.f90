@@ -4,6 +4,8 @@
 module friction_analysis_settings
    use friction_kinds, only: wp
    use friction_analysis_spectrum, only: window_hann
+   use friction_error, only: error_type
+   use friction_analysis_lyapunov_series, only: rosenstein_settings, rosenstein_result, rosenstein_exponent
    use friction_strings, only: itoa, rtoa, quoted
    use friction_parameters, only: parameter_visitor
    use friction_checks, only: config_checker
@@ -69,9 +71,29 @@ module friction_analysis_settings
    contains
       procedure :: visit
       procedure :: validate
+      procedure :: rosenstein_of
    end type analysis_settings
 
 contains
+
+   !> Rosenstein's exponent of a scene's window series sampled every `dt`,
+   !> strided by rosenstein_stride (the strided spacing in `spacing`), with
+   !> these settings; an error says which settings the series is too short for.
+   subroutine rosenstein_of(self, window_series, dt, result, spacing, error)
+      class(analysis_settings), intent(in) :: self
+      real(wp), intent(in) :: window_series(:), dt
+      type(rosenstein_result), intent(out) :: result
+      real(wp), intent(out) :: spacing
+      type(error_type), allocatable, intent(out) :: error
+
+      spacing = dt * self%rosenstein_stride
+      call rosenstein_exponent(window_series(1::self%rosenstein_stride), spacing, &
+         & rosenstein_settings(dimension=self%rosenstein_dimension, delay=self%rosenstein_delay, &
+         & theiler=self%rosenstein_theiler, horizon=self%rosenstein_horizon, &
+         & fit_start=self%rosenstein_fit_start, fit_end=self%rosenstein_fit_end), result, error)
+      if (allocated(error)) error%message = '&analysis: '//error%message//' (the window [window_start, ' &
+         & //'window_end] strided by rosenstein_stride against the embedding and rosenstein_horizon)'
+   end subroutine rosenstein_of
 
    !> The group &analysis; `time_unit` is the unit of the scene's time.
    subroutine visit(self, v, time_unit)

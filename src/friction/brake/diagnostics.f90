@@ -16,7 +16,7 @@ module friction_brake_diagnostics
    use friction_analysis_lyapunov_flow, only: benettin_settings, benettin_accumulator
    use friction_analysis_lyapunov_spectrum, only: tangent_settings, spectrum_accumulator, kaplan_yorke, &
       & generic_frame
-   use friction_analysis_lyapunov_series, only: rosenstein_settings, rosenstein_result, rosenstein_exponent
+   use friction_analysis_lyapunov_series, only: rosenstein_result
    use friction_analysis_periodic_orbit, only: orbit_settings
    use friction_brake_orbit, only: brake_orbit, brake_periodic_orbit, orbit_branch, follow_branch
    use friction_scene_report, only: job_reporter, loop_guard
@@ -161,16 +161,8 @@ contains
             end if
          end if
          if (a%rosenstein) then
-            result%series_dt = config%dt_out * a%rosenstein_stride
-            call rosenstein_exponent(window_series(1::a%rosenstein_stride), result%series_dt, &
-               & rosenstein_settings(dimension=a%rosenstein_dimension, delay=a%rosenstein_delay, &
-               & theiler=a%rosenstein_theiler, horizon=a%rosenstein_horizon, &
-               & fit_start=a%rosenstein_fit_start, fit_end=a%rosenstein_fit_end), result%series, error)
-            if (allocated(error)) then
-               error%message = '&analysis: '//error%message//' (the window [window_start, window_end] ' &
-                  & //'strided by rosenstein_stride against the embedding and rosenstein_horizon)'
-               return
-            end if
+            call a%rosenstein_of(window_series, config%dt_out, result%series, result%series_dt, error)
+            if (allocated(error)) return
          end if
       end associate
    end subroutine diagnose_brake

@@ -15,6 +15,7 @@ module friction_brake_output
    use friction_brake_orbit, only: orbit_branch, bifurcation_names
    use friction_output_h5, only: h5_file
    use friction_output_branch, only: write_branch_points, write_branch_sections, write_bifurcations
+   use friction_output_rosenstein, only: write_rosenstein
    use friction_output_parameters, only: write_parameter_attributes
    use friction_output_summary, only: run_summary, write_run_attributes
    implicit none
@@ -288,28 +289,7 @@ contains
             call file%attach_scales('/brake/lyapunov/benettin_estimate', ['/brake/lyapunov/benettin_time'])
          end if
          if (a%orbit) call write_orbit(file, d)
-         if (a%rosenstein) then
-            call file%write_attribute_real('/brake/lyapunov', 'rosenstein_exponent', d%series%exponent, '1/tau')
-            ! OpenTSTool's largelyap unit: log2 per sample of the series.
-            call file%write_attribute_real('/brake/lyapunov', 'rosenstein_log2_per_sample', &
-               & d%series%exponent * d%series_dt / log(2.0_wp))
-            call file%write_attribute_text('/brake/lyapunov', 'rosenstein_series', trim(a%series))
-            call file%write_attribute_real('/brake/lyapunov', 'rosenstein_sample_spacing', d%series_dt)
-            call file%write_attribute_integer('/brake/lyapunov', 'rosenstein_stride', int(a%rosenstein_stride, i8))
-            call file%write_attribute_integer('/brake/lyapunov', 'rosenstein_dimension', &
-               & int(a%rosenstein_dimension, i8))
-            call file%write_attribute_integer('/brake/lyapunov', 'rosenstein_delay', int(a%rosenstein_delay, i8))
-            call file%write_attribute_integer('/brake/lyapunov', 'rosenstein_theiler', int(a%rosenstein_theiler, i8))
-            call file%write_attribute_integer('/brake/lyapunov', 'rosenstein_horizon', int(a%rosenstein_horizon, i8))
-            call file%write_attribute_integer('/brake/lyapunov', 'rosenstein_fit_start', &
-               & int(a%rosenstein_fit_start, i8))
-            call file%write_attribute_integer('/brake/lyapunov', 'rosenstein_fit_end', int(a%rosenstein_fit_end, i8))
-            call file%write_vector('/brake/lyapunov/rosenstein_time', d%series%time, '1')
-            call file%write_vector('/brake/lyapunov/rosenstein_divergence', d%series%divergence, '1')
-            call file%write_attribute_text('/brake/lyapunov/rosenstein_divergence', 'long_name', &
-               & 'mean natural log of the distance between neighbours, the distance in the unit of the series')
-            call file%attach_scales('/brake/lyapunov/rosenstein_divergence', ['/brake/lyapunov/rosenstein_time'])
-         end if
+         if (a%rosenstein) call write_rosenstein(file, '/brake/lyapunov', a, d%series, d%series_dt, '1/tau', '1')
       end associate
    end subroutine write_diagnostics
 

@@ -64,9 +64,6 @@ module friction_machine_config
    character(len=*), parameter :: orbit_variables(8) = [character(len=17) :: 'belt_velocity', 'stiffness', &
       & 'damping', 'normal', 'mass', 'load_velocity', 'support_amplitude', 'support_frequency']
 
-   character(len=*), parameter :: not_yet = "not computed for scene 'machine' (its &analysis has spectrum, " &
-      & //'lyapunov, poincare, lyapunov_spectrum and orbit); the brake has it'
-
 contains
 
    subroutine visit(self, v)
@@ -131,11 +128,9 @@ contains
       if (c%failed()) return
       call self%analysis%validate(c, self%t_start, self%t_end, ['x', 'v'])
       if (c%failed()) return
-      ! The machine's diagnostics so far: the spectrum, Benettin's exponent, the Poincaré maps and
-      ! the Lyapunov spectrum; the others are refused by name rather than ignored.
+      ! Every diagnostic of &analysis runs on the machine; what a law cannot give is refused by name.
       associate (a => self%analysis)
          if (a%orbit) call check_orbit(self, c)
-         if (a%rosenstein) call c%reject('analysis', 'rosenstein', '.true.', not_yet)
          if (a%poincare .or. a%lyapunov_spectrum) call check_sections_and_tangent(self, c)
       end associate
    end subroutine validate

@@ -1,6 +1,7 @@
 !> The machine's chaos diagnostics (&analysis): the amplitude spectrum of x
 !> or v over the analysis window, the largest Lyapunov exponent from the
-!> equations (Benettin; through exact stick for a set-valued law), the Poincaré maps
+!> equations (Benettin; through exact stick for a set-valued law) and from the
+!> series (Rosenstein), the Poincaré maps
 !> (section.f90) and the whole Lyapunov spectrum (lyapunov.f90), through the
 !> library's scene-independent tools (analysis/).
 module friction_machine_diagnostics
@@ -9,6 +10,7 @@ module friction_machine_diagnostics
    use friction_ode_watch, only: step_watch
    use friction_analysis_spectrum, only: spectrum_settings, spectrum_result, amplitude_spectrum
    use friction_analysis_lyapunov_flow, only: benettin_settings, benettin_accumulator, benettin_exponent
+   use friction_analysis_lyapunov_series, only: rosenstein_result
    use friction_law, only: sliding_law
    use friction_law_factory, only: make_law
    use friction_output_law_files, only: law_with_files
@@ -27,6 +29,9 @@ module friction_machine_diagnostics
    type :: machine_diagnostics
       logical :: spectrum = .false., lyapunov = .false.
       type(spectrum_result) :: peak
+      logical :: rosenstein = .false.      !! &analysis rosenstein: the exponent from the series
+      type(rosenstein_result) :: series
+      real(wp) :: series_dt = 0.0_wp      !! the strided series' sample spacing (s)
       type(benettin_accumulator) :: flow
       logical :: poincare = .false., lyapunov_spectrum = .false.
       type(machine_poincare) :: sections
@@ -69,6 +74,22 @@ contains
          end if
          if (a%lyapunov) call lyapunov(error)
          if (allocated(error)) return
+         d%rosenstein = a%rosenstein
+         if (a%rosenstein) then
+            block
+               logical :: inside(run%n)
+               real(wp), allocatable :: window_series(:)
+
+               inside = run%t >= a%window_start .and. run%t <= a%window_end
+               if (a%series == 'v') then
+                  window_series = pack(run%v, inside)
+               else
+                  window_series = pack(run%x, inside)
+               end if
+               call a%rosenstein_of(window_series, c%dt_out, d%series, d%series_dt, error)
+               if (allocated(error)) return
+            end block
+         end if
          d%poincare = a%poincare
          d%lyapunov_spectrum = a%lyapunov_spectrum
          if (a%poincare) call machine_sections(c, run, d%sections, error)

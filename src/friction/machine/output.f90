@@ -14,6 +14,7 @@ module friction_machine_output
    use friction_machine_diagnostics, only: machine_diagnostics
    use friction_machine_section, only: write_machine_poincare
    use friction_machine_lyapunov, only: write_machine_spectrum
+   use friction_output_rosenstein, only: write_rosenstein
    use friction_machine_orbit_output, only: write_machine_orbit
    implicit none
    private
@@ -116,6 +117,11 @@ contains
       if (diagnostics%lyapunov_spectrum) then
          if (.not. diagnostics%lyapunov) call file%create_group('/machine/lyapunov')
          call write_machine_spectrum(file, '/machine/lyapunov', diagnostics%qr)
+      end if
+      if (diagnostics%rosenstein) then
+         if (.not. (diagnostics%lyapunov .or. diagnostics%lyapunov_spectrum)) call file%create_group('/machine/lyapunov')
+         call write_rosenstein(file, '/machine/lyapunov', config%analysis, diagnostics%series, diagnostics%series_dt, &
+            & '1/s', 's', 's')
       end if
       if (diagnostics%poincare) call write_machine_poincare(file, config, run, diagnostics%sections)
       if (diagnostics%orbit) then

@@ -184,13 +184,15 @@ contains
       results(2) = real(count(run%stick(half:) == 1), wp) / real(run%n - half + 1, wp)
       results(3) = maxval(run%v(half:)) - minval(run%v(half:))
       results(4) = sum(run%force(half:)) / real(run%n - half + 1, wp)
-      ! A point's results need neither the Poincaré maps nor the whole spectrum: not computed there;
+      ! A point's results need neither the Poincaré maps, the whole spectrum nor Rosenstein's exponent:
+      ! not computed there;
       ! a point is one run: its orbit (if asked) is not followed along a line.
       block
          type(machine_config) :: point
          point = self%config
          point%analysis%poincare = .false.
          point%analysis%lyapunov_spectrum = .false.
+         point%analysis%rosenstein = .false.
          point%analysis%continuation = ''
          call diagnose_machine(point, run, d, error, watch)
       end block
