@@ -32,7 +32,7 @@ module friction_brake_law_model
    use friction_brake_config, only: brake_config
    use friction_brake_integrator, only: brake_integrator
    use friction_brake_stick, only: stick_motion, stick_end_lift_off, stick_end_force_positive, stick_tangent
-   use friction_brake_switched, only: saltation, stick_field
+   use friction_brake_switched, only: saltation, stick_field, slip_events
    use friction_analysis_lyapunov_spectrum, only: tangent_system
    use friction_brake_record, only: brake_event_table, event_stick_to_slip, event_slip_to_stick, &
       & event_slip_reversal
@@ -277,16 +277,14 @@ contains
       n = 2
    end function slip_event_count
 
-   !> 1: s v_rel, falling through 0 when the block catches up with the belt;
-   !> 2: N', falling through 0 when the pad lifts off.
+   !> The slip's two events (slip_events).
    pure subroutine slip_event_values(self, t, y, g)
       class(brake_law_slip), intent(in) :: self
       real(wp), intent(in) :: t
       real(wp), intent(in) :: y(:)
       real(wp), intent(out) :: g(:)
 
-      g(1) = self%direction * (y(2) - self%params%v_dr)
-      g(2) = (1.0_wp - self%params%kappa) * y(3) + self%params%g_prime
+      call slip_events(self%params, self%direction, y, g)
    end subroutine slip_event_values
 
    ! ---- the integrator ----

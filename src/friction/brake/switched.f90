@@ -32,7 +32,7 @@ module friction_brake_switched
    implicit none
    private
 
-   public :: brake_slip, switched_integrator, kinetic_friction, saltation, stick_field
+   public :: brake_slip, switched_integrator, kinetic_friction, saltation, stick_field, slip_events
 
    !> Eq. 10 during one slip, with s the sign of v_rel.
    type, extends(event_system) :: brake_slip
@@ -128,17 +128,28 @@ contains
       n = 2
    end function event_count
 
-   !> 1: s v_rel, falling through 0 when the block catches up with the belt;
-   !> 2: N', falling through 0 when the pad lifts off.
+   !> The slip's two events (slip_events).
    pure subroutine event_values(self, t, y, g)
       class(brake_slip), intent(in) :: self
       real(wp), intent(in) :: t
       real(wp), intent(in) :: y(:)
       real(wp), intent(out) :: g(:)
 
-      g(1) = self%direction * (y(2) - self%params%v_dr)
-      g(2) = (1.0_wp - self%params%kappa) * y(3) + self%params%g_prime
+      call slip_events(self%params, self%direction, y, g)
    end subroutine event_values
+
+   !> A slip's two events, whatever its law: 1: s v_rel, falling through 0
+   !> when the block catches up with the belt; 2: N', falling through 0 when
+   !> the pad lifts off.
+   pure subroutine slip_events(p, direction, y, g)
+      type(brake_parameters), intent(in) :: p
+      real(wp), intent(in) :: direction
+      real(wp), intent(in) :: y(:)
+      real(wp), intent(out) :: g(:)
+
+      g(1) = direction * (y(2) - p%v_dr)
+      g(2) = (1.0_wp - p%kappa) * y(3) + p%g_prime
+   end subroutine slip_events
 
    subroutine switched_start(self, config, t0, y0, events, error)
       class(switched_integrator), target, intent(inout) :: self
