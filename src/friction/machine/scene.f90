@@ -3,6 +3,7 @@
 !> Every rank integrates the same run (it is deterministic and short), so
 !> the file does not depend on the number of ranks and nothing is broadcast.
 module friction_machine_scene
+   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
    use friction_kinds, only: wp, i8
    use friction_strings, only: fixed_text
    use friction_error, only: error_type, fatal_error, error_input
@@ -145,7 +146,10 @@ contains
 
       results = [point_result('events', '1', .true.), point_result('stick_fraction', '1', .false.), &
          & point_result('velocity_range', 'm/s', .false.), point_result('force_mean', 'N', .false.), &
-         & point_result('peak_frequency', 'Hz', .false.), point_result('lyapunov', '1/s', .false.)]
+         & point_result('peak_frequency', 'Hz', .false.), point_result('lyapunov', '1/s', .false.), &
+         & point_result('orbit_found', '1', .true.), point_result('orbit_period', 's', .false.), &
+         & point_result('orbit_max_multiplier', '1', .false.), point_result('orbit_critical_real', '1', .false.), &
+         & point_result('orbit_critical_imag', '1', .false.)]
    end function machine_point_results
 
    subroutine machine_point_series(self, name, unit)
@@ -158,9 +162,13 @@ contains
 
    !> A sweep point: the run's events, the fraction of the output grid in
    !> stick, the range of the velocity and the mean friction force over the
-   !> second half of the run (after a transient), and the local maxima of x
-   !> there (the bifurcation diagram).  The run and Benettin's exponent ask
-   !> one watch, from the point's start: max_wall_time, and the stop
+   !> second half of the run (after a transient), the spectrum's peak and
+   !> Benettin's exponent when asked, the periodic orbit with &analysis
+   !> orbit (found, period, the section map's largest |mu| and that
+   !> multiplier; NaN where no orbit was found or none was asked, since 0 is
+   !> a multiplier an orbit can have), and the local maxima of x in the
+   !> second half (the bifurcation diagram).  The run and the diagnostics
+   !> ask one watch, from the point's start: max_wall_time, and the stop
    !> requests of `reporter` if given (a point that crawls ends inside).
    subroutine machine_run_point(self, sink, memory, error, reporter)
       class(machine_scene), intent(inout) :: self
@@ -168,7 +176,7 @@ contains
       type(point_memory), intent(inout) :: memory
       type(error_type), allocatable, intent(out) :: error
       class(job_reporter), intent(inout), optional :: reporter
-      real(wp) :: results(6)
+      real(wp) :: results(11)
       type(machine_run) :: run
       type(machine_diagnostics) :: d
       class(step_watch), allocatable :: watch
@@ -176,6 +184,7 @@ contains
       integer :: j, half
 
       results = 0.0_wp
+      results(8:11) = ieee_value(1.0_wp, ieee_quiet_nan)
       allocate (watch, source=machine_watch(self%config, 'the sweep point', reporter))
       call run_machine(self%config, run, error, watch)
       if (allocated(error)) return
@@ -199,6 +208,15 @@ contains
       if (allocated(error)) return
       if (d%spectrum) results(5) = d%peak%peak_frequency
       if (d%lyapunov) results(6) = d%flow%current()
+      if (d%orbit) then
+         associate (o => d%periodic%orbit)
+            if (o%found .and. size(o%multipliers) > 0) then
+               ! The section map's multipliers come by decreasing modulus: the first is the critical one.
+               results(7:11) = [1.0_wp, o%period, abs(o%multipliers(1)), real(o%multipliers(1)), &
+                  & aimag(o%multipliers(1))]
+            end if
+         end associate
+      end if
       allocate (peak(run%n), source=.false.)
       do j = max(2, half), run%n - 1
          peak(j) = run%x(j) > run%x(j - 1) .and. run%x(j) >= run%x(j + 1)
