@@ -5,8 +5,10 @@ unit support reads), and both agree on its size (docs/output.md#units).
 One file of every scene and kind: a map, a lattice-sum map with its table, a
 thermal map, the brake with every diagnostic, the brake in SI units, the
 brake with a law in SI and in its own units, a continuation, the machine
-with its diagnostics, a brake sweep and an AFM sweep.  Checked: every
-dataset's `units` and every attribute `NAME_units`; a unit in the brake's
+with its diagnostics, the machine's periodic orbit and continuation, a
+brake sweep, an AFM sweep and a machine sweep with its orbits.  Checked:
+every dataset's `units`, every attribute `NAME_units` and each column's
+unit in a `column_units`; a unit in the brake's
 time τ (`units_tau`, `NAME_units_tau`, `column_units_tau`) is its `units`
 at τ = 1, and with the SI brake's `time_scale` (τ in s) it converts to SI.
 """
@@ -38,6 +40,11 @@ KINDS = {
     "continuation": ([INPUTS / "brake.nml", INPUTS / "brake_continuation.nml",
                       DATA / "brake_continuation_short.nml"], ""),
     "machine": ([INPUTS / "machine_lugre.nml"], ""),
+    # The orbit's point and equilibrium (column_units), its branch; and a machine sweep with its orbits.
+    "machine_orbit": ([INPUTS / "machine_orbit.nml"], ""),
+    "machine_sweep": ([INPUTS / "machine_orbit.nml"],
+                      "&analysis continuation = '' /\n&sweep sweep_variable = 'machine.belt_velocity', "
+                      "sweep_spacing = 'list', sweep_values = 0.0026, 0.3 /\n"),
     "brake_sweep": ([INPUTS / "brake_sweep.nml", DATA / "sweep_small.nml"], ""),
     "afm_sweep": ([INPUTS / "afm_sweep.nml", DATA / "afm_sweep_small.nml"], ""),
 }
@@ -55,7 +62,10 @@ def stated_units(path):
         for key, value in obj.attrs.items():
             where = f"/{name}@{key}"
             # A group's `units` is not a unit: /brake's is &brake's variable (the parameter set).
-            if key.endswith("_units") or (key == "units" and isinstance(obj, h5py.Dataset)):
+            if key == "column_units":
+                # A dataset whose columns differ in unit (/machine/orbit/point): each column's.
+                units.extend((f"{where}[{i}]", column.strip()) for i, column in enumerate(text(value).split(",")))
+            elif key.endswith("_units") or (key == "units" and isinstance(obj, h5py.Dataset)):
                 units.append((where, text(value)))
                 tau = obj.attrs.get(key + "_tau")
                 columns = obj.attrs.get("column_units_tau") if key == "units" else None
