@@ -13,7 +13,7 @@ module friction_brake_config
    use friction_ode_settings, only: visit_integrator, check_integrator, verify_settings, visit_verify, check_verify, &
       & verify_solver
    use friction_law_settings, only: law_settings, law_group
-   use friction_law_factory, only: check_law, new_law
+   use friction_law_factory, only: check_law, new_law, make_law
    use friction_output_law_files, only: law_with_files
    use friction_law, only: sliding_law
    implicit none
@@ -323,6 +323,13 @@ contains
       if (law%set_valued()) then
          block
             real(wp) :: f0, f1, f2
+            type(error_type), allocatable :: error
+            ! The law ready to compute: a table's static limit is its first row (its file read).
+            call make_law(law_with_files(self%law), law, error)
+            if (allocated(error)) then
+               call c%reject(law_group, 'table_file', "'"//trim(self%law%table_file)//"'", error%message)
+               return
+            end if
             f0 = law%static_force(0.0_wp)
             f1 = law%static_force(1.0_wp)
             f2 = law%static_force(2.0_wp)

@@ -289,7 +289,8 @@ contains
 
    ! ---- the integrator ----
 
-   !> Start at (t0, y0): the law made from &law (its table read), its states
+   !> Start at (t0, y0) of the configuration the integrator was made for: the
+   !> law made from &law at the first start (its table read once), its states
    !> in steady sliding at the initial v_rel; a set-valued law sticks when
    !> v_rel0 = 0 within the static limit, else slips.
    subroutine law_start(self, config, t0, y0, events, error)
@@ -302,9 +303,12 @@ contains
          & dgdz(max_law_states, max_law_states), fastest
       integer :: ns
 
-      if (allocated(self%law)) deallocate (self%law)
-      call make_law(law_with_files(config%law), self%law, error)
-      if (allocated(error)) return
+      ! An integrator runs one configuration (new_brake_integrator's) and Benettin restarts it every
+      ! interval: the law, a table file read, is made at its first start only.
+      if (.not. allocated(self%law)) then
+         call make_law(law_with_files(config%law), self%law, error)
+         if (allocated(error)) return
+      end if
       self%p = config%params
       call config%law_units(self%units%force, self%units%velocity, self%units%time)
       self%switching = self%law%set_valued()
