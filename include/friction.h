@@ -6,8 +6,8 @@
  * (friction_config_read) or by name ("tip.kx", friction_config_set), checked
  * by the scene's own checks, the very code that checks the program's input
  * (friction_config_check; every computation runs it first).  Computations on
- * the calling process (friction_afm_line, friction_compute,
- * friction_compute_progress) need no MPI;
+ * the calling process (friction_afm_line, friction_afm_line_progress,
+ * friction_compute, friction_compute_progress) need no MPI;
  * a friction_result holds a whole computation's arrays.  Jobs
  * (friction_run_job, friction_run_config) run the program's job and write
  * its HDF5 file.
@@ -30,8 +30,8 @@
  * its own handles (configuration, result, error).  A handle must not be used
  * by two threads at once.  Functions that take a `const` handle only read it;
  * two threads may read one configuration at once only through those.  The
- * computing functions (friction_afm_line, friction_compute,
- * friction_compute_progress) take a non-const configuration: they keep the
+ * computing functions (friction_afm_line, friction_afm_line_progress,
+ * friction_compute, friction_compute_progress) take a non-const configuration: they keep the
  * surface they built in it for the next call, so a configuration shared by
  * threads that compute needs the caller's lock, or one copy per thread
  * (friction_config_text and friction_config_read make one).  The state shared between calls is a
@@ -198,6 +198,18 @@ int friction_config_warnings(const friction_config *cfg, char *buf, size_t len, 
 int friction_afm_line(friction_config *cfg, int line, int forward, double *fx, double *fy, size_t n,
                       friction_error *err);
 
+/* friction_afm_line with a progress function (friction_progress_fn, below),
+ * polled as friction_compute_progress polls it within a line: every 0.1 s of
+ * a line that takes longer, with the message "started" and fraction -1,
+ * whose nonzero return stops the line within the trip's next look
+ * (FRICTION_INTERRUPTED, nothing written, the configuration as it was); and
+ * called once when the line is done ("1 of 1 lines", fraction 1; its return
+ * is not a stop: the line is written).  With progress = NULL it is
+ * friction_afm_line. */
+typedef int (*friction_progress_fn)(const char *message, double fraction, void *user);
+int friction_afm_line_progress(friction_config *cfg, int line, int forward, double *fx, double *fy, size_t n,
+                               friction_progress_fn progress, void *user, friction_error *err);
+
 /* The configuration's whole computation on the calling process, checked
  * first; NULL (and a message) on an error.  Free with friction_result_free.
  *   afm:   as /afm of the program's file: "support_x" (nx), "support_y" (ny);
@@ -217,11 +229,11 @@ int friction_afm_line(friction_config *cfg, int line, int forward, double *fx, d
  * The afm surface is kept in the configuration as by friction_afm_line. */
 friction_result *friction_compute(friction_config *cfg, friction_error *err);
 
-/* Progress of a computation on the calling process: "12 of 48 lines" or
+/* friction_progress_fn (declared above friction_afm_line_progress): progress
+ * of a computation on the calling process: "12 of 48 lines" or
  * "τ = 120.0 of 1000.0", fraction in [0, 1]; fraction -1 is a poll from
  * inside a map's line (below).  A nonzero return asks the computation to
  * stop there. */
-typedef int (*friction_progress_fn)(const char *message, double fraction, void *user);
 
 /* friction_compute with progress, and a way to stop it: `progress` (if not
  * NULL) is called on the calling thread after each scan line of a map and

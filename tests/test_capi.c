@@ -6,7 +6,8 @@
  *   test_capi threads           two threads on two handles == the same one after the
  *                               other, bitwise
  *   test_capi thermal-stop      a stop request from the progress function inside a
- *                               single-line thermal computation (Langevin, Kramers) ends it
+ *                               single-line thermal computation (Langevin, Kramers) ends it,
+ *                               through friction_compute_progress and friction_afm_line_progress
  *   test_capi afm FILE...       friction_config_read(FILE...), friction_compute and
  *                               friction_afm_line of every line: prints every array
  *   test_capi brake FILE...     friction_config_read(FILE...), friction_compute: prints
@@ -562,6 +563,20 @@ static void check_progress(friction_error *err) {
   CHECK(log.calls == 1, "the map went on after the stop: %d reports", log.calls);
   /* ... and the configuration computes as before */
   expect_map(friction_compute(cfg, err), plain, "compute after a stop", err);
+  /* a line with progress: the line of friction_afm_line, one report when it is done (a line this
+   * short is never polled), and NULL progress is friction_afm_line */
+  {
+    double fx[16], fy[16], px[16], py[16];
+    expect_ok(friction_afm_line(cfg, 2, 0, fx, fy, 16, err), err, "line without progress");
+    log = (struct progress_log){0, 1, -1.0, ""};
+    expect_ok(friction_afm_line_progress(cfg, 2, 0, px, py, 16, log_progress, &log, err), err, "line with progress");
+    CHECK(memcmp(fx, px, sizeof fx) == 0 && memcmp(fy, py, sizeof fy) == 0, "the line with progress differs");
+    CHECK(log.calls == 1 && log.last == 1.0 && strcmp(log.first, "1 of 1 lines") == 0,
+          "line progress: %d calls, last fraction %g, first '%s'", log.calls, log.last, log.first);
+    memset(px, 0, sizeof px);
+    expect_ok(friction_afm_line_progress(cfg, 2, 0, px, py, 16, NULL, NULL, err), err, "line with NULL progress");
+    CHECK(memcmp(fx, px, sizeof fx) == 0, "the line with NULL progress differs");
+  }
   /* the brake reports along τ and stops at the request */
   log = (struct progress_log){0, 5, -1.0, ""};
   CHECK(friction_compute_progress(brake, log_progress, &log, err) == NULL, "a stopped brake gave a result");
@@ -909,6 +924,21 @@ static int thermal_stop(void) {
     CHECK(log.reports == 0, "%s: %d line reports before the line ended", cases[c][1], log.reports);
     printf("%s: stopped %.3f s after the request, %.2f s into the line, %d polls: %s\n", cases[c][1],
            ended - log.asked, ended - log.start, log.polls, last_message);
+    /* the same line through friction_afm_line_progress: stopped inside, nothing written */
+    {
+      double fx[128], fy[128];
+      fx[0] = 12345.0;
+      struct stop_log line_log = {seconds_now(), 0.0, 0, 0};
+      int status = friction_afm_line_progress(cfg, 0, 1, fx, fy, 128, stop_in_line, &line_log, err);
+      double line_ended = seconds_now();
+      CHECK(status == FRICTION_INTERRUPTED, "%s: afm_line_progress status %d", cases[c][1], status);
+      CHECK(line_log.asked > 0.0 && line_ended - line_log.asked < 1.0 && line_log.reports == 0,
+            "%s: the line ended %.3f s after the request, %d reports", cases[c][1],
+            line_log.asked > 0.0 ? line_ended - line_log.asked : -1.0, line_log.reports);
+      CHECK(fx[0] == 12345.0, "%s: a stopped line wrote", cases[c][1]);
+      printf("%s: friction_afm_line_progress stopped %.3f s after the request, %d polls\n", cases[c][1],
+             line_ended - line_log.asked, line_log.polls);
+    }
     /* the configuration as it was: a short line computes */
     expect_ok(friction_config_set(cfg, "scan.length", "0.5", err), err, "length");
     expect_ok(friction_config_set(cfg, "scan.nx", "2", err), err, "nx");

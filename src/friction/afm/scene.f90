@@ -510,7 +510,7 @@ contains
    !> temperature the means over the realizations of whole lines (a trip's
    !> noise is its own, whatever else is computed).  `capacity` below nx is
    !> an input error.
-   subroutine afm_compute_line(self, line, forward, capacity, sink, memory, error)
+   subroutine afm_compute_line(self, line, forward, capacity, sink, memory, error, reporter)
       class(afm_scene), intent(inout) :: self
       integer, intent(in) :: line
       logical, intent(in) :: forward
@@ -518,6 +518,7 @@ contains
       class(result_sink), intent(inout) :: sink
       type(point_memory), intent(inout) :: memory
       type(error_type), allocatable, intent(out) :: error
+      class(job_reporter), intent(inout), optional :: reporter
       type(afm_config) :: c
       class(surface_potential), allocatable :: potential
       type(afm_scanner), target :: scanner
@@ -537,6 +538,15 @@ contains
       end if
       call take_surface(c, memory, potential, error)
       if (.not. allocated(error)) call scanner%init_owning(c, potential, error)
+      if (.not. allocated(error) .and. present(reporter)) then
+         ! The caller's stop request within the line, as afm_compute asks it.
+         allocate (scanner%guard%stopper, source=reporter)
+         block
+            integer(i8) :: now
+            call system_clock(now)
+            scanner%guard%next_poll = scanner%guard%next_look(now)
+         end block
+      end if
       if (allocated(error)) then
          continue
       else if (scanner%thermal) then
@@ -553,6 +563,7 @@ contains
       end if
       call scanner%release_potential(memory%surface)
       if (allocated(error)) return
+      if (present(reporter)) call reporter%progress(1.0_wp, 1.0_wp, 'lines', .true.)
       call sink%add('fx', c%nx, 1, trip%values(:, q_fx))
       call sink%add('fy', c%nx, 1, trip%values(:, q_fy))
    end subroutine afm_compute_line

@@ -30,8 +30,8 @@ module friction_capi
    use friction_capi_config, only: friction_config_read, friction_config_set, friction_config_set_real, &
       & friction_config_get, friction_config_text, friction_config_names, friction_config_check, &
       & friction_config_warnings
-   use friction_capi_compute, only: friction_afm_line, friction_compute, friction_compute_progress, &
-      & friction_result_get, friction_result_shape, friction_result_names
+   use friction_capi_compute, only: friction_afm_line, friction_afm_line_progress, friction_compute, &
+      & friction_compute_progress, friction_result_get, friction_result_shape, friction_result_names
    use friction_capi_jobs, only: friction_run_job, friction_run_config
    use friction_capi_law, only: friction_law_new, friction_law_free, friction_law_set, friction_law_set_real, &
       & friction_law_get, friction_law_check, friction_law_state_count, friction_law_history
@@ -43,8 +43,8 @@ module friction_capi
    public :: friction_config_new, friction_config_free, friction_config_read, friction_config_set, &
       & friction_config_set_real, friction_config_get, friction_config_text, friction_config_names, &
       & friction_config_check, friction_config_warnings
-   public :: friction_afm_line, friction_compute, friction_compute_progress, friction_result_get, &
-      & friction_result_shape, friction_result_names, friction_result_free
+   public :: friction_afm_line, friction_afm_line_progress, friction_compute, friction_compute_progress, &
+      & friction_result_get, friction_result_shape, friction_result_names, friction_result_free
    public :: friction_run_job, friction_run_config
    public :: friction_law_new, friction_law_free, friction_law_set, friction_law_set_real, friction_law_get, &
       & friction_law_check, friction_law_state_count, friction_law_history

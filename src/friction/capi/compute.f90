@@ -19,8 +19,8 @@ module friction_capi_compute
    implicit none
    private
 
-   public :: friction_afm_line, friction_compute, friction_compute_progress, friction_result_get, &
-      & friction_result_shape, friction_result_names
+   public :: friction_afm_line, friction_afm_line_progress, friction_compute, friction_compute_progress, &
+      & friction_result_get, friction_result_shape, friction_result_names
 
 contains
 
@@ -31,6 +31,19 @@ contains
       type(c_ptr), value :: cfg, fx, fy, handle
       integer(c_int), value :: line, forward
       integer(c_size_t), value :: n
+
+      status = friction_afm_line_progress(cfg, line, forward, fx, fy, n, c_null_funptr, c_null_ptr, handle)
+   end function friction_afm_line
+
+   !> int friction_afm_line_progress(friction_config *cfg, int line, int forward, double *fx,
+   !>     double *fy, size_t n, friction_progress_fn progress, void *user, friction_error *err)
+   integer(c_int) function friction_afm_line_progress(cfg, line, forward, fx, fy, n, progress, user, handle) &
+      & bind(c, name='friction_afm_line_progress_body') result(status)
+      type(c_ptr), value :: cfg, fx, fy, user, handle
+      integer(c_int), value :: line, forward
+      integer(c_size_t), value :: n
+      type(c_funptr), value :: progress
+      type(callback_reporter) :: reporter
       type(capi_config), pointer :: config
       type(error_type), allocatable :: error
       type(job_config) :: work
@@ -47,8 +60,16 @@ contains
          return
       end if
       call check_config(config, work, error)
-      if (.not. allocated(error)) call work%scene%compute_line(int(line), forward /= 0, &
-         & int(n, i8), arrays, config%memory, error)
+      if (.not. allocated(error)) then
+         if (c_associated(progress)) then
+            call c_f_procpointer(progress, reporter%ask)
+            reporter%user = user
+            call work%scene%compute_line(int(line), forward /= 0, int(n, i8), arrays, config%memory, error, &
+               & reporter)
+         else
+            call work%scene%compute_line(int(line), forward /= 0, int(n, i8), arrays, config%memory, error)
+         end if
+      end if
       if (allocated(error)) then
          status = report(handle, error)
          return
@@ -59,7 +80,7 @@ contains
          out = arrays%items(i)%values
       end do
       status = report(handle, error)
-   end function friction_afm_line
+   end function friction_afm_line_progress
 
    !> friction_result *friction_compute(const friction_config *cfg, friction_error *err)
    type(c_ptr) function friction_compute(cfg, handle) bind(c, name='friction_compute_body') result(res)

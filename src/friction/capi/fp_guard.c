@@ -64,6 +64,11 @@ FP_GUARDED(int, friction_afm_line,
             friction_error *err),
            (cfg, line, forward, fx, fy, n, err))
 
+FP_GUARDED(int, friction_afm_line_progress,
+           (friction_config *cfg, int line, int forward, double *fx, double *fy, size_t n,
+            friction_progress_fn progress, void *user, friction_error *err),
+           (cfg, line, forward, fx, fy, n, progress, user, err))
+
 FP_GUARDED(friction_result *, friction_compute, (friction_config *cfg, friction_error *err), (cfg, err))
 
 FP_GUARDED(friction_result *, friction_compute_progress,

@@ -76,7 +76,9 @@ module friction_scene
       !> One line of a scene made of lines, trace (`forward`) or retrace, on
       !> this process: its named arrays in `sink`, each of at most `capacity`
       !> values (a line longer than that is an input error, found before any
-      !> computation).  By default an error: the scene has no lines.
+      !> computation); `reporter`, if given, is polled for a stop request
+      !> within the line and told when it is done.  By default an error: the
+      !> scene has no lines.
       procedure :: compute_line
       !> The scene as a SPICE netlist for ngspice; a refusal names where the
       !> variable that rules it out was set (`origins`, the input's, if given).
@@ -191,7 +193,7 @@ contains
       if (len(series_name) > 0) call sink%add(series_name, size(series), 1, series)
    end subroutine put_point
 
-   subroutine compute_line(self, line, forward, capacity, sink, memory, error)
+   subroutine compute_line(self, line, forward, capacity, sink, memory, error, reporter)
       class(scene), intent(inout) :: self
       integer, intent(in) :: line
       logical, intent(in) :: forward
@@ -199,6 +201,7 @@ contains
       class(result_sink), intent(inout) :: sink
       type(point_memory), intent(inout) :: memory
       type(error_type), allocatable, intent(out) :: error
+      class(job_reporter), intent(inout), optional :: reporter
 
       call fatal_error(error, "scene '"//self%name()//"' is not made of scan lines: compute it whole", error_input)
    end subroutine compute_line
