@@ -12,6 +12,18 @@ the program and its file, against oracles computed here:
                     arctan law (the section v = 0 upwards): the same two checks
   hopf-belt         the LuGre paper's belt oscillator continued in belt_velocity:
                     the Hopf bifurcation of steady sliding where c + dF/dv = 0
+  coulomb-cycle     Coulomb with exact stick (mu_s > mu) on the belt and driven at
+                    the load point: the piecewise-harmonic stick-slip cycle in
+                    closed form (section point, stick time, period), superstable:
+                    its section multiplier exactly 0
+  forced-switching  Stribeck and Coulomb on a harmonically moving support
+                    (stroboscopic section through stick and slip, the strobe in
+                    a slip and in a stick): the orbit and the section map's
+                    Jacobian against central differences of the map integrated
+                    here with SciPy's located events
+  stribeck-hopf     the Stribeck belt oscillator continued in belt_velocity through
+                    the Hopf of steady sliding where c + dF/dv = 0, the law's
+                    slope written here
   refusals          what the orbit cannot do is refused with file, line, group
                     and variable, exit code 3, no file written
 
@@ -222,10 +234,213 @@ def hopf_belt(args):
     assert np.all(got["branch"]["found"] == 1)
 
 
+def coulomb_cycle(args):
+    # Between sticks the block slips with the kinetic force s F_k (s the sign of w = v - belt): in the load
+    # point's frame, e = x - load t, m e'' = -k e - s F_k, harmonic about e_k = -s F_k / k.  The stick
+    # (e' = belt - load) ends where -k e = s F_s, at e_k - s d, d = (F_s - F_k)/k, with e' = b = belt - load:
+    # the slip is an arc of the circle of radius R = sqrt(d² + (b/ω)²) from there to its mirror point e_k + s d
+    # (the angle π + 2 atan(|b|/(ω d))), and the stick carries e back over 2d at |b|.  The section v = load,
+    # e' = 0 with e'' > 0, is the circle's end below e_k: e = e_k - R.
+    m, k, normal, mu, mu_s = 1.0, 2.0, 1.0, 0.5, 1.0
+    for name, belt, load in (("belt", 0.1, 0.0), ("slider", 0.0, 0.1)):
+        got = run(args, f"coulomb_{name}", ["machine_coulomb.nml"], {
+            "law.mu": mu, "law.mu_s": mu_s, "law.sigma2": 0.0, "machine.belt_velocity": belt,
+            "machine.load_velocity": load, "machine.v0": belt, "machine.t_end": 60.0, "analysis.orbit": ".true.",
+            "analysis.orbit_transient": 20.0})
+        omega = np.sqrt(k / m)
+        b = belt - load
+        s = -np.sign(b)   # the slip after a stick: the spring pulls against the stick's motion
+        fk, fs = mu * normal, mu_s * normal
+        d = (fs - fk) / k
+        radius = np.hypot(d, b / omega)
+        section = -s * fk / k - radius
+        stick = 2 * d / abs(b)
+        slip = (np.pi + 2 * np.arctan(abs(b) / (omega * d))) / omega
+        mu_got = got["multipliers"]
+        print(f"coulomb-cycle ({name}): section e = {got['point'][0]:.12f} m against {section:.12f}, stick "
+              f"{got['stick_time']:.12f} s against {stick:.12f}, period {got['period']:.12f} s against "
+              f"{stick + slip:.12f}; multipliers {mu_got}, DP = {got['section_jacobian'].ravel()}, exponents "
+              f"{got['floquet_exponents']}, {got['stick_phases']} stick phase(s), {got['iterations']} Newton steps")
+        # The program locates the switches to event_tolerance 1e-10 s and integrates at rtol 1e-9 (|e| ~ 1):
+        # 1e-8 m and s is a hundred times either.
+        assert abs(got["point"][0] - section) < 1e-8
+        assert abs(got["point"][1] - load) == 0.0
+        assert abs(got["stick_time"] - stick) < 1e-8
+        assert abs(got["period"] - (stick + slip)) < 1e-8
+        assert got["stick_phases"] == 1
+        # Superstable: the stick forgets δv and, the flow being one-dimensional there, the rest is a shift in
+        # time that the section removes: the section multiplier is 0 exactly (round-off would leave ~1e-16;
+        # the variational equations without the projection in stick, rtol |Φ| ~ 1e-9), beside the trivial 1.
+        assert mu_got[0] == 1.0 and abs(mu_got[1]) < 1e-15, mu_got
+        assert got["floquet_exponents"][0] == 0.0 and np.isneginf(got["floquet_exponents"][1])
+        # Newton from the run's point: with DP = 0 one step lands on the fixed point.
+        assert got["iterations"] <= 2
+
+
+def stribeck_slip_force(w, s, fc, fs, vs, exponent, sigma2):
+    """The Stribeck law's slip force in the direction s (docs/laws.md), smooth through w = 0."""
+    return s * (fc + (fs - fc) * np.exp(-np.abs(w / vs) ** exponent)) + sigma2 * w
+
+
+def switching_strobe(p, t0, period, state, rtol=1e-12, atol=1e-14):
+    """The block's state at t0 + period from `state` at t0 with exact stick and slip, written here: slip with
+    the sign s of w = v - belt fixed until s w falls through 0, then stick if |A| <= F_s (v = belt exactly)
+    or a slip the other way; in stick x' = belt until |A| reaches F_s.  SciPy's DOP853 with located events."""
+    om = 2 * np.pi * p["freq"]
+
+    def applied(t, x, v):
+        u = p["load"] * t + p["amp"] * np.sin(om * t)
+        du = p["load"] + p["amp"] * om * np.cos(om * t)
+        return -p["k"] * (x - u) - p["c"] * (v - du)
+
+    def slip_force(w, s):
+        if p["law"] == "coulomb":
+            return s * p["fc"] + p["sigma2"] * w
+        return stribeck_slip_force(w, s, p["fc"], p["fs"], p["vs"], p["exponent"], p["sigma2"])
+
+    t, (x, v) = t0, state
+    belt, limit = p["belt"], p["fs"]
+    stick = v == belt and abs(applied(t, x, v)) <= limit
+    s = np.sign(v - belt) if v != belt else np.sign(applied(t, x, v))
+    end = t0 + period
+    while t < end:
+        if stick:
+            def upper(tt, y):
+                return limit - applied(tt, y[0], belt)
+
+            def lower(tt, y):
+                return limit + applied(tt, y[0], belt)
+            for e in (upper, lower):
+                e.terminal, e.direction = True, -1
+            r = solve_ivp(lambda tt, y: [belt], (t, end), [x], method="DOP853", rtol=rtol, atol=atol,
+                          events=(upper, lower))
+            t, x, v = r.t[-1], r.y[0, -1], belt
+            if r.status == 1:
+                stick = False
+                s = 1.0 if len(r.t_events[0]) else -1.0
+        else:
+            def ends(tt, y, s=s):
+                return s * (y[1] - belt)
+            ends.terminal, ends.direction = True, -1
+            r = solve_ivp(lambda tt, y, s=s: [y[1], (applied(tt, y[0], y[1]) - slip_force(y[1] - belt, s)) / p["m"]],
+                          (t, end), [x, v], method="DOP853", rtol=rtol, atol=atol, events=ends)
+            t, x, v = r.t[-1], r.y[0, -1], r.y[1, -1]
+            if r.status == 1:
+                a = applied(t, x, belt)
+                if abs(a) <= limit:
+                    stick, v = True, belt
+                else:
+                    s = np.sign(a)
+    return np.array([x, v])
+
+
+def forced_switching(args):
+    forced_stribeck(args)
+    forced_coulomb_stuck(args)
+
+
+def forced_coulomb_stuck(args):
+    # Coulomb (F_k = 0.5 N, F_s = 1 N) on the same support: a period-1 orbit whose strobe point sticks.  There
+    # δv is forgotten: DP's second column is 0 and its multipliers are DP[0, 0] and 0; the oracle is the
+    # slope of the strobe map in x from central differences of the map integrated here.
+    p = dict(m=1.0, k=2.0, c=0.0, belt=0.1, load=0.0, fc=0.5, fs=1.0, sigma2=0.4, amp=0.2, freq=0.15,
+             law="coulomb")
+    got = run(args, "forced_coulomb", ["machine_coulomb.nml"], {
+        "law.mu": p["fc"], "law.mu_s": p["fs"], "machine.support_amplitude": p["amp"],
+        "machine.support_frequency": p["freq"], "machine.t_end": 320.0, "analysis.orbit": ".true.",
+        "analysis.orbit_transient": 300.0})
+    t0, period = got["guess_time"], 1 / p["freq"]
+    point = got["point"]
+    assert point[1] == p["belt"], point   # in stick, exactly at the belt's velocity
+    closes = np.max(np.abs(switching_strobe(p, t0, period, point) - point))
+    delta = 1e-6
+    slope = (switching_strobe(p, t0, period, point + [delta, 0])[0]
+             - switching_strobe(p, t0, period, point - [delta, 0])[0]) / (2 * delta)
+    dp, mu_got = got["section_jacobian"], got["multipliers"]
+    print(f"forced-coulomb: strobe point {point} in stick at {t0} s closes under SciPy to {closes:.2e}; DP = "
+          f"{dp.ravel()}; multipliers {mu_got} against the map's slope in x {slope:.10f} "
+          f"(difference {abs(mu_got[0] - slope):.2e}), {got['stick_time']:.9f} s in stick")
+    # As forced-stribeck: the orbit to 1e-8, the slope's differences to ~1e-8, DP at rtol 1e-9 to 1e-6.
+    assert closes < 1e-8, closes
+    assert abs(mu_got[0] - slope) < 1e-6 * abs(slope)
+    assert np.all(dp[:, 1] == 0.0) and dp[1, 0] == 0.0, dp   # stuck at both ends: v's row and column are 0
+    assert mu_got[1] == 0.0 and got["stick_phases"] == 1
+
+
+def forced_stribeck(args):
+    p = dict(m=1.0, k=2.0, c=0.0, belt=0.1, load=0.0, fc=1.0, fs=1.5, vs=0.05, exponent=2.0, sigma2=0.4,
+             amp=0.2, freq=0.15, law="stribeck")
+    got = run(args, "forced_stribeck", ["machine_stribeck.nml"], {
+        "law.vs": p["vs"], "machine.support_amplitude": p["amp"], "machine.support_frequency": p["freq"],
+        "machine.t_end": 200.0, "analysis.orbit": ".true.", "analysis.orbit_transient": 150.0})
+    t0, period = got["guess_time"], 1 / p["freq"]
+    point = got["point"]
+    closes = np.max(np.abs(switching_strobe(p, t0, period, point) - point))
+    # The strobe falls in a slip (v != belt): the map is smooth about it, each switch crossed transversally.
+    assert point[1] != p["belt"]
+    steps = [1e-6, 1e-6]
+    fd = np.zeros((2, 2))
+    for j in range(2):
+        d = np.zeros(2)
+        d[j] = steps[j]
+        fd[:, j] = (switching_strobe(p, t0, period, point + d) - switching_strobe(p, t0, period, point - d)) / (2 * steps[j])
+    dp = got["section_jacobian"]
+    fd_error = np.max(np.abs(dp - fd)) / np.max(np.abs(fd))
+    expected = np.linalg.eigvals(fd)
+    big = expected[np.argmax(np.abs(expected))]
+    mu_got = got["multipliers"]
+    print(f"forced-stribeck: strobe point {point} at {t0} s closes under SciPy to {closes:.2e}; "
+          f"{got['stick_phases']} stick phase(s), {got['stick_time']:.9f} s in stick; DP = {dp.ravel()}, "
+          f"differences {fd.ravel()}, max |DP - DP_fd| / max|DP_fd| = {fd_error:.2e}; multipliers {mu_got} against "
+          f"the differences' eigenvalues {expected}")
+    # The program's orbit at rtol 1e-9 and Newton's 1e-9; SciPy at 1e-12: 1e-8 of the ~0.2 m, 0.1 m/s state.
+    assert closes < 1e-8, closes
+    # Differences of ±1e-6: SciPy's noise 1e-14/1e-6 ~ 1e-8, truncation ~1e-12; the program's variational
+    # equations at rtol 1e-9 through two switches: 1e-6 of the largest entry is a thousand times rtol.
+    assert fd_error < 1e-6, (dp, fd)
+    assert abs(mu_got[0] - big) < 1e-6 * abs(big), (mu_got, expected)
+    # The stick forgets δv: DP = M [r; 0] has rank 1, its second multiplier 0 exactly (the differences'
+    # det to their noise), its exponent -inf.
+    assert got["stick_phases"] == 1 and mu_got[1] == 0.0 and np.isneginf(got["floquet_exponents"][1])
+    assert np.min(np.abs(expected)) < 1e-6
+
+
+def stribeck_hopf(args):
+    fc, fs, vs, exponent, sigma2, m, k, c = 1.0, 1.5, 1e-3, 2.0, 0.4, 1.0, 2.0, 0.0
+    got = run(args, "stribeck_hopf", ["machine_stribeck.nml"], {
+        "machine.belt_velocity": 2.6e-3, "machine.t_end": 600.0, "analysis.orbit": ".true.",
+        "analysis.orbit_transient": 200.0, "analysis.continuation": "'belt_velocity'",
+        "analysis.continuation_end": 3.4e-3, "analysis.continuation_points": 9})
+
+    def slope(vb):
+        # dF/dw of the slip force at w = -vb (s = -1), by differentiating the law's formula by hand.
+        w = -vb
+        r = abs(w) / vs
+        return -(fs - fc) * np.exp(-r**exponent) * exponent * r ** (exponent - 1) / vs + sigma2
+
+    # Steady sliding at w = -v_b: m v' = -k x - F(v - v_b) linearized has the eigenvalues of
+    # [[0, 1], [-k/m, -(c + F')/m]], whose real part -(c + F')/(2m) crosses 0 where c + dF/dv = 0.
+    hopf = brentq(lambda vb: c + slope(vb), 2e-3, 4e-3, xtol=1e-18, rtol=1e-15)
+    kinds, where = got["bifurcations"]["kind"], got["bifurcations"]["parameter"]
+    branch = got["branch"]
+    mu = branch["floquet_multipliers_real"] + 1j * branch["floquet_multipliers_imag"]
+    print(f"stribeck-hopf: Hopf at belt_velocity = {where} m/s (kinds {kinds}); c + dF/dv = 0 at {hopf:.12e} m/s "
+          f"(relative difference {abs(where[0] - hopf) / hopf:.2e}); orbits at {int(np.sum(branch['found']))} of "
+          f"{len(branch['found'])} points, periods {branch['period']} s, multipliers {mu}")
+    assert list(kinds) == [5], kinds
+    # The program bisects the largest real part of its equilibrium's eigenvalues (closed form, the law's
+    # analytic slope) to 1e-12 of the step: 1e-9 relative is far outside that and brentq's 1e-15.
+    assert abs(where[0] - hopf) / hopf < 1e-9
+    # Stick-slip on the whole line (the Hopf is subcritical: the cycle coexists with stable sliding above it),
+    # each orbit superstable: the trivial 1 and 0 exactly.
+    assert np.all(branch["found"] == 1)
+    assert np.all(mu[:, 0] == 1.0) and np.all(np.abs(mu[:, 1]) < 1e-15), mu   # h5py: (points, multipliers)
+
+
 def refusals(args):
     cases = [  # (the groups, the line named, what the message names, why)
-        ("&law\n  model = 'coulomb'\n/\n&analysis\n  orbit = .true.\n/\n", 9, "&analysis: orbit = ",
-         "switches between stick and slip"),
+        ("&law\n  model = 'gms'\n/\n&analysis\n  orbit = .true.\n/\n", 9, "&analysis: orbit = ",
+         "states; the orbit takes at most 2"),
         ("&law\n  model = 'lugre'\n/\n&analysis\n  orbit = .true.\n  continuation = 'gravity'\n/\n", 10,
          "&analysis: continuation = ", "not a variable of &machine the orbit can follow"),
         ("&law\n  model = 'lugre'\n/\n&analysis\n  orbit = .true.\n  continuation = 'stiffness'\n"
@@ -239,7 +454,9 @@ def refusals(args):
 
 def main():
     return case_main(__doc__, {"forced-linear": forced_linear, "forced-lugre": forced_lugre,
-                               "arctan-belt": arctan_belt, "hopf-belt": hopf_belt, "refusals": refusals})
+                               "arctan-belt": arctan_belt, "hopf-belt": hopf_belt, "coulomb-cycle": coulomb_cycle,
+                               "forced-switching": forced_switching, "stribeck-hopf": stribeck_hopf,
+                               "refusals": refusals})
 
 
 if __name__ == "__main__":

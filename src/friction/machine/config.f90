@@ -157,9 +157,10 @@ contains
       end associate
    end subroutine check_sections_and_tangent
 
-   !> &analysis orbit (and continuation): a smooth law with few enough states
-   !> for the section's closed-form multipliers; the line's end a valid machine
-   !> of the same kind (forced or not).
+   !> &analysis orbit (and continuation): a law with few enough states for the
+   !> section's closed-form multipliers (a set-valued law has none: its map
+   !> runs through exact stick and slip); the line's end a valid machine of
+   !> the same kind (forced or not).
    subroutine check_orbit(self, c)
       type(machine_config), intent(in) :: self
       type(config_checker), intent(inout) :: c
@@ -168,12 +169,6 @@ contains
       integer :: most
 
       call new_law(self%law, law)
-      if (law%set_valued()) then
-         call c%reject('analysis', 'orbit', '.true.', "the machine's orbits are computed for the laws that are " &
-            & //"one ODE (lugre, elastoplastic, dahl, rate_state, arctan); &law model = '"//trim(self%law%model) &
-            & //"' switches between stick and slip, whose saltation the machine's section map does not carry")
-         return
-      end if
       forced = self%support_amplitude > 0.0_wp .and. self%support_frequency > 0.0_wp
       ! The section's multipliers are closed forms up to 3 coordinates: (x, v, states) when forced, (x, states) if not.
       most = merge(1, 2, forced)

@@ -8,7 +8,8 @@
 !> - machine_slip, machine_stick: a set-valued law (Coulomb, Stribeck, the
 !>   table) with exact stick.  In slip the law's slip force with the sign s
 !>   of the sliding velocity w = v - belt_velocity held fixed; the slip ends
-!>   when s w falls through 0 (event 1).  In stick v = belt_velocity exactly,
+!>   when s w falls through 0 (event 1); a periodic orbit's section, v
+!>   rising through a level, is event 2 when asked.  In stick v = belt_velocity exactly,
 !>   and the stick ends when the applied force A reaches the static limit,
 !>   F_s - A (event 1) or F_s + A (event 2) falling through 0.
 module friction_machine_model
@@ -51,6 +52,8 @@ module friction_machine_model
       type(mechanics) :: m
       class(sliding_law), allocatable :: law
       real(wp) :: direction = 1.0_wp
+      logical :: sectioned = .false.        !! event 2: v - section_level rising (a periodic orbit's section)
+      real(wp) :: section_level = 0.0_wp    !! m/s
    contains
       procedure :: dimension => two
       procedure :: rhs => slip_rhs
@@ -246,7 +249,7 @@ contains
       class(machine_slip), intent(in) :: self
       integer :: n
 
-      n = 1
+      n = merge(2, 1, self%sectioned)
    end function slip_event_count
 
    pure subroutine slip_event_values(self, t, y, g)
@@ -256,6 +259,7 @@ contains
       real(wp), intent(out) :: g(:)
 
       g(1) = self%direction * (y(2) - self%m%belt)
+      if (self%sectioned) g(2) = y(2) - self%section_level
    end subroutine slip_event_values
 
    ! ---- set-valued laws: stick ----

@@ -1,9 +1,12 @@
-!> Periodic orbits of the machine with a smooth law, their Floquet
-!> multipliers, and their continuation in one &machine variable (docs/chaos.md,
-!> "Orbits and continuation of the machine"): Newton shooting on a section
+!> Periodic orbits of the machine, their Floquet multipliers, and their
+!> continuation in one &machine variable (docs/chaos.md, "Orbits and
+!> continuation of the machine"): Newton shooting on a section
 !> (analysis/periodic_orbit.f90), the section map's Jacobian from the
 !> variational equations Φ' = J Φ with the law's partial derivatives (the
-!> analysis layer's tangent system), not from differences.
+!> analysis layer's tangent system), not from differences.  A set-valued law
+!> (exact stick and slip) takes the same sections through the switching run
+!> of switching.f90, with a saltation matrix at every switch; an orbit
+!> through stick is superstable, its section multipliers 0 exactly.
 !>
 !> Coordinates.  The frame moves with the load point: e = x - load_velocity t
 !> (e = x on the belt), so that the spring-slider driven at a constant
@@ -37,6 +40,7 @@ module friction_machine_orbit
    use friction_machine_config, only: machine_config
    use friction_machine_model, only: machine_smooth
    use friction_machine_run, only: machine_run, run_machine
+   use friction_machine_switching, only: switching_section
    implicit none
    private
 
@@ -80,6 +84,8 @@ module friction_machine_orbit
       real(wp), allocatable :: jacobian(:, :)   !! DP in SI section coordinates
       complex(wp), allocatable :: multipliers(:)  !! autonomous: 1 and the section map's; forced: the map's
       real(wp), allocatable :: exponents(:)     !! ln|μ|/T, 1/s
+      integer :: sticks = -1                    !! stick phases over the period (a set-valued law's orbit; -1 none)
+      real(wp) :: stick_time = 0.0_wp           !! s in stick over the period (the same)
       logical :: has_equilibrium = .false.
       real(wp), allocatable :: equilibrium(:)   !! (2 + states) SI
       complex(wp), allocatable :: eigenvalues(:)  !! of the equilibrium's Jacobian, 1/s, by decreasing real part
@@ -275,6 +281,8 @@ contains
       ns = n - 2
       if (machine_orbit_forced(c) .or. .not. (c%stiffness > 0.0_wp) .or. n > 3) return
       w = c%load_velocity - c%belt_velocity
+      ! A set-valued law at w = 0 holds the block in stick: no sliding state, no eigenvalues.
+      if (frame%base%law%set_valued() .and. w == 0.0_wp) return
       z = 0.0_wp
       if (ns > 0) call frame%base%law%steady_state(w, c%normal, z(1:ns))
       force = frame%base%law%force(w, z(1:ns), c%normal, 0.0_wp)
@@ -303,7 +311,18 @@ contains
       type(machine_section), intent(out) :: map
       class(step_watch), intent(inout), optional, target :: watch
 
-      if (machine_orbit_forced(c)) then
+      if (frame%base%law%set_valued()) then
+         block
+            ! Exact stick and slip: the switching run's map, saltations included (switching.f90).
+            type(switching_section) :: jumps
+            real(wp) :: period
+            period = 0.0_wp
+            if (machine_orbit_forced(c)) period = 1.0_wp / c%support_frequency
+            call jumps%setup(c, frame%base%law, machine_orbit_forced(c), t0, period, c%t_end - c%t_start)
+            if (present(watch)) jumps%watch => watch
+            allocate (map%inner, source=jumps)
+         end block
+      else if (machine_orbit_forced(c)) then
          block
             type(stroboscopic_map) :: strobe
             call strobe%setup(frame, c%solver, t0, 1.0_wp / c%support_frequency)
@@ -424,6 +443,16 @@ contains
       call section_of(c, frame, t_guess, map, watch)
       call find_periodic_orbit(map, guess, settings, result%orbit, error)
       if (allocated(error)) return
+      select type (inner => map%inner)
+      type is (switching_section)
+         ! The last evaluation was Newton's last iterate's; a strobe point in stick is one stick phase.
+         result%sticks = max(inner%sticks, merge(1, 0, inner%stuck))
+         result%stick_time = inner%stick_time
+         ! Through a stick the stroboscopic DP = M [r; 0] (δv forgotten, M the rest of the period) has rank 1:
+         ! its multipliers are trace DP and 0 exactly, not 0 plus the round-off of the closed form's det.
+         if (result%orbit%found .and. result%forced .and. inner%stuck) result%orbit%multipliers = &
+            & [cmplx(result%orbit%jacobian(1, 1) + result%orbit%jacobian(2, 2), 0.0_wp, wp), (0.0_wp, 0.0_wp)]
+      end select
       call equilibrium_of(c, result, error)
       if (allocated(error)) return
       if (result%forced) then

@@ -56,6 +56,11 @@ contains
       if (continued) call write_branch(file, branch, units)
       if (.not. o%orbit%found) return
       call file%write_attribute_real(group, 'period', o%orbit%period, 's')
+      ! A set-valued law's orbit: its stick phases and time in stick per period (a stick makes it superstable).
+      if (o%sticks >= 0) then
+         call file%write_attribute_integer(group, 'stick_phases', int(o%sticks, i8))
+         call file%write_attribute_real(group, 'stick_time', o%stick_time, 's')
+      end if
       call file%write_matrix(group//'/section_jacobian', o%jacobian, '1')
       allocate (parts(2, size(o%multipliers)))
       parts(1, :) = real(o%multipliers)
