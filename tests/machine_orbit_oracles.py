@@ -18,7 +18,8 @@ the program and its file, against oracles computed here:
                     its section multiplier exactly 0
   forced-switching  Stribeck and Coulomb on a harmonically moving support
                     (stroboscopic section through stick and slip, the strobe in
-                    a slip and in a stick): the orbit and the section map's
+                    a slip and in a stick; an orbit of slip reversals without
+                    stick): the orbit and the section map's
                     Jacobian against central differences of the map integrated
                     here with SciPy's located events
   stribeck-hopf     the Stribeck belt oscillator continued in belt_velocity through
@@ -337,6 +338,37 @@ def switching_strobe(p, t0, period, state, rtol=1e-12, atol=1e-14):
 def forced_switching(args):
     forced_stribeck(args)
     forced_coulomb_stuck(args)
+    forced_coulomb_reversals(args)
+
+
+def forced_coulomb_reversals(args):
+    # Coulomb on a still surface (belt 0) driven hard (0.5 m at 0.3 Hz): the block never sticks, it reverses
+    # twice a period with |A| above the static limit, so its orbit is all slip and its DP (no zero
+    # multiplier) carries the reversals' saltations, which change the slip force's sign.
+    p = dict(m=1.0, k=2.0, c=0.0, belt=0.0, load=0.0, fc=0.3, fs=0.4, sigma2=0.1, amp=0.5, freq=0.3,
+             law="coulomb")
+    got = run(args, "forced_reversals", ["machine_coulomb.nml"], {
+        "law.mu": p["fc"], "law.mu_s": p["fs"], "law.sigma2": p["sigma2"], "machine.belt_velocity": p["belt"],
+        "machine.support_amplitude": p["amp"], "machine.support_frequency": p["freq"], "machine.t_end": 120.0,
+        "analysis.orbit": ".true.", "analysis.orbit_transient": 100.0})
+    t0, period = got["guess_time"], 1 / p["freq"]
+    point = got["point"]
+    closes = np.max(np.abs(switching_strobe(p, t0, period, point) - point))
+    fd = np.zeros((2, 2))
+    for j in range(2):
+        d = np.zeros(2)
+        d[j] = 1e-6
+        fd[:, j] = (switching_strobe(p, t0, period, point + d) - switching_strobe(p, t0, period, point - d)) / 2e-6
+    dp, mu_got = got["section_jacobian"], got["multipliers"]
+    fd_error = np.max(np.abs(dp - fd)) / np.max(np.abs(fd))
+    expected = np.linalg.eigvals(fd)
+    mu_error = max(np.min(np.abs(expected - mu)) for mu in mu_got) / np.max(np.abs(expected))
+    print(f"forced-reversals: strobe point {point} closes under SciPy to {closes:.2e}; {got['stick_phases']} stick "
+          f"phases; max |DP - DP_fd| / max|DP_fd| = {fd_error:.2e}; multipliers {mu_got} against {expected} "
+          f"({mu_error:.2e})")
+    # As forced-stribeck: the orbit to 1e-8, DP and the multipliers to 1e-6 of the largest.
+    assert got["stick_phases"] == 0 and closes < 1e-8, closes
+    assert fd_error < 1e-6 and mu_error < 1e-6, (dp, fd)
 
 
 def forced_coulomb_stuck(args):
