@@ -22,6 +22,12 @@ the program and its file, against oracles computed here:
                     stick): the orbit and the section map's
                     Jacobian against central differences of the map integrated
                     here with SciPy's located events
+  karnopp-band      Karnopp's law (a band |w| < dv that holds up to F_s, the
+                    Stribeck curve outside): on the belt the orbit through a hold
+                    closes under the band's flow integrated here and is
+                    superstable; on a moving support DP against central
+                    differences of the strobe map integrated here with SciPy's
+                    located events at the band's edges
   stribeck-hopf     the Stribeck belt oscillator continued in belt_velocity through
                     the Hopf of steady sliding where c + dF/dv = 0, the law's
                     slope written here
@@ -437,6 +443,106 @@ def forced_stribeck(args):
     assert np.min(np.abs(expected)) < 1e-6
 
 
+def karnopp_flow(p, t0, duration, state, rtol=1e-12, atol=1e-14):
+    """Karnopp's block from `state` at t0 for `duration`, written here in the band's limit of no depth:
+    outside the band (|w| >= dv) the Stribeck curve; entering it at an edge e with |A| <= F_s, a hold at
+    v = belt + e until |A| reaches F_s (then out at once if A pushes outwards, else through the band);
+    inside otherwise v' = (A - clip(A, ±F_s))/m until an edge is crossed outwards.  SciPy's DOP853 with
+    located events."""
+    om = 2 * np.pi * p["freq"]
+    belt, dv, fs, m = p["belt"], p["dv"], p["fs"], p["m"]
+
+    def applied(t, x, v):
+        u = p["load"] * t + p["amp"] * np.sin(om * t)
+        du = p["load"] + p["amp"] * om * np.cos(om * t)
+        return -p["k"] * (x - u) - p["c"] * (v - du)
+
+    def outside(w):
+        return np.sign(w) * (p["fc"] + (fs - p["fc"]) * np.exp(-np.abs(w / p["vs"]) ** p["exponent"])) + p["sigma2"] * w
+
+    def event(f, direction):
+        f.terminal, f.direction = True, direction
+        return f
+
+    t, (x, v) = t0, state
+    mode, edge = ("out" if abs(v - belt) >= dv else "in"), 0.0
+    end = t0 + duration
+    while t < end:
+        if mode == "out":
+            events = (event(lambda tt, y: y[1] - belt - dv, -1), event(lambda tt, y: y[1] - belt + dv, 1))
+            r = solve_ivp(lambda tt, y: [y[1], (applied(tt, y[0], y[1]) - outside(y[1] - belt)) / m], (t, end),
+                          [x, v], method="DOP853", rtol=rtol, atol=atol, events=events)
+            t, x, v = r.t[-1], r.y[0, -1], r.y[1, -1]
+            if r.status == 1:
+                edge = dv if len(r.t_events[0]) else -dv
+                v = belt + edge
+                mode = "hold" if abs(applied(t, x, v)) <= fs else "in"
+        elif mode == "hold":
+            events = (event(lambda tt, y: fs - applied(tt, y[0], v), -1), event(lambda tt, y: fs + applied(tt, y[0], v), -1))
+            r = solve_ivp(lambda tt, y: [v], (t, end), [x], method="DOP853", rtol=rtol, atol=atol, events=events)
+            t, x = r.t[-1], r.y[0, -1]
+            if r.status == 1:
+                sigma = 1.0 if len(r.t_events[0]) else -1.0
+                mode = "out" if sigma * edge > 0 else "in"
+        else:
+            def inside(tt, y):
+                a = applied(tt, y[0], y[1])
+                return [y[1], (a - np.clip(a, -fs, fs)) / m]
+            events = (event(lambda tt, y: y[1] - belt - dv, 1), event(lambda tt, y: y[1] - belt + dv, -1))
+            r = solve_ivp(inside, (t, end), [x, v], method="DOP853", rtol=rtol, atol=atol, events=events)
+            t, x, v = r.t[-1], r.y[0, -1], r.y[1, -1]
+            if r.status == 1:
+                mode = "out"
+    return np.array([x, v])
+
+
+def karnopp_band(args):
+    # On the belt (inputs/machine_karnopp.nml): the orbit's section point (e, 0) comes back to itself after
+    # the period under the flow integrated here, and its hold makes it superstable.
+    p = dict(m=1.0, k=2.0, c=0.0, belt=0.1, load=0.0, fc=1.0, fs=1.5, vs=1e-3, exponent=2.0, sigma2=0.4,
+             dv=1e-4, amp=0.0, freq=0.0)
+    got = run(args, "karnopp_belt", ["machine_karnopp.nml"], {
+        "machine.t_end": 100.0, "analysis.orbit": ".true.", "analysis.orbit_transient": 30.0})
+    point = got["point"]
+    closes = np.max(np.abs(karnopp_flow(p, 0.0, got["period"], point) - point))
+    print(f"karnopp-band (belt): section point {point}, period {got['period']:.10f} s, closes under the flow here to "
+          f"{closes:.2e}; multipliers {got['multipliers']}, {got['iterations']} Newton steps")
+    # The period's error moves the end along the flow at |v'| ~ 1 m/s²: 1e-8 bounds the program's event
+    # tolerance (1e-10 s) and rtol 1e-9.
+    assert closes < 1e-8, closes
+    assert got["multipliers"][0] == 1.0 and got["multipliers"][1] == 0.0
+    # On a moving support, no edge that attracts from both sides (the force just outside, g(dv) + σ2 dv =
+    # 1.4999 N, stays under F_s): DP against central differences of the strobe map integrated here.
+    p.update(vs=0.05, dv=1e-3, sigma2=0.1, amp=0.2, freq=0.15)
+    got = run(args, "karnopp_forced", ["machine_karnopp.nml"], {
+        "law.vs": p["vs"], "law.dv": p["dv"], "law.sigma2": p["sigma2"], "machine.support_amplitude": p["amp"],
+        "machine.support_frequency": p["freq"], "machine.t_end": 200.0, "analysis.orbit": ".true.",
+        "analysis.orbit_transient": 150.0, "integrator.rtol": 1e-11, "integrator.atol": 1e-14,
+        "machine.event_tolerance": 1e-12})
+    t0, period = got["guess_time"], 1 / p["freq"]
+    point = got["point"]
+    closes = np.max(np.abs(karnopp_flow(p, t0, period, point) - point))
+    fd = np.zeros((2, 2))
+    for j in range(2):
+        d = np.zeros(2)
+        d[j] = 1e-6
+        fd[:, j] = (karnopp_flow(p, t0, period, point + d) - karnopp_flow(p, t0, period, point - d)) / 2e-6
+    dp, mu_got = got["section_jacobian"], got["multipliers"]
+    fd_error = np.max(np.abs(dp - fd)) / np.max(np.abs(fd))
+    expected = np.linalg.eigvals(fd)
+    big = expected[np.argmax(np.abs(expected))]
+    print(f"karnopp-band (forced): strobe point {point} closes to {closes:.2e}; DP {dp.ravel()}, differences "
+          f"{fd.ravel()}, max |DP - DP_fd| / max|DP_fd| = {fd_error:.2e}; multipliers {mu_got} against {expected}")
+    # The orbit to 1e-8; DP to 1e-6 of its largest entry: the program at rtol 1e-11 here leaves 2.8e-7 (at its
+    # default 1e-9 the band's switches leave 5.3e-7; the differences' own error is ~1e-7 of the map's curvature
+    # at the hold's exit).
+    assert closes < 1e-8, closes
+    assert fd_error < 1e-6, (dp, fd)
+    assert abs(mu_got[0] - big) < 1e-6 * abs(big)
+    # The hold forgets δv: the second multiplier is 0 to the round-off of the closed form's determinant.
+    assert abs(mu_got[1]) < 1e-12 * abs(mu_got[0])
+
+
 def stribeck_hopf(args):
     fc, fs, vs, exponent, sigma2, m, k, c = 1.0, 1.5, 1e-3, 2.0, 0.4, 1.0, 2.0, 0.0
     got = run(args, "stribeck_hopf", ["machine_stribeck.nml"], {
@@ -473,6 +579,8 @@ def refusals(args):
     cases = [  # (the groups, the line named, what the message names, why)
         ("&law\n  model = 'gms'\n/\n&analysis\n  orbit = .true.\n/\n", 9, "&analysis: orbit = ",
          "states; the orbit takes at most 2"),
+        ("&law\n  model = 'karnopp'\n  vs = 0.05\n  dv = 1e-3\n  sigma2 = 0.4\n/\n&analysis\n  orbit = .true.\n/\n", 12,
+         "&analysis: orbit = ", "slide along the band's edge"),
         ("&law\n  model = 'lugre'\n/\n&analysis\n  orbit = .true.\n  continuation = 'gravity'\n/\n", 10,
          "&analysis: continuation = ", "not a variable of &machine the orbit can follow"),
         ("&law\n  model = 'lugre'\n/\n&analysis\n  orbit = .true.\n  continuation = 'stiffness'\n"
@@ -487,7 +595,8 @@ def refusals(args):
 def main():
     return case_main(__doc__, {"forced-linear": forced_linear, "forced-lugre": forced_lugre,
                                "arctan-belt": arctan_belt, "hopf-belt": hopf_belt, "coulomb-cycle": coulomb_cycle,
-                               "forced-switching": forced_switching, "stribeck-hopf": stribeck_hopf,
+                               "forced-switching": forced_switching,
+                               "karnopp-band": karnopp_band, "stribeck-hopf": stribeck_hopf,
                                "refusals": refusals})
 
 

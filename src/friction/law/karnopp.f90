@@ -24,6 +24,7 @@ module friction_law_karnopp
       procedure :: check
       procedure :: force
       procedure :: partials
+      procedure :: band
    end type karnopp_law
 
 contains
@@ -63,5 +64,13 @@ contains
          dfdv = stribeck_slope(self%p, v) * sign(1.0_wp, v) + self%p%sigma2
       end if
    end subroutine partials
+
+   pure subroutine band(self, half_width, limit)
+      class(karnopp_law), intent(in) :: self
+      real(wp), intent(out) :: half_width, limit
+
+      half_width = self%p%dv
+      limit = self%p%fs
+   end subroutine band
 
 end module friction_law_karnopp

@@ -48,6 +48,10 @@ module friction_law
       procedure :: set_valued
       procedure :: static_force
       procedure :: slip_force
+      !> A band |v| < half_width where the contact holds the applied force up
+      !> to `limit` and at whose edges the force jumps (Karnopp's); half_width
+      !> 0 for a law without one.
+      procedure :: band
       !> What the law needs before it computes (a table read from its file).
       procedure :: prepare
    end type sliding_law
@@ -177,6 +181,14 @@ contains
 
       static_force = huge(1.0_wp)
    end function static_force
+
+   pure subroutine band(self, half_width, limit)
+      class(sliding_law), intent(in) :: self
+      real(wp), intent(out) :: half_width, limit
+
+      half_width = 0.0_wp
+      limit = 0.0_wp
+   end subroutine band
 
    pure real(wp) function slip_force(self, v, z, normal, s)
       class(sliding_law), intent(in) :: self

@@ -169,6 +169,20 @@ contains
       integer :: most
 
       call new_law(self%law, law)
+      block
+         real(wp) :: width, limit, none(0)
+         call law%band(width, limit)
+         ! Outside an edge the force may exceed the band's hold: the edge then attracts from both sides.
+         if (width > 0.0_wp) then
+            if (law%force(width, none, self%normal, 0.0_wp) > limit) then
+               call c%reject('analysis', 'orbit', '.true.', "&law model = '"//trim(self%law%model)//"': the " &
+                  & //'force just outside the band, '//rtoa(law%force(width, none, self%normal, 0.0_wp)) &
+                  & //' N at dv, exceeds the band''s hold fs = '//rtoa(limit)//' N, so the block would slide ' &
+                  & //'along the band''s edge, which the orbit''s map does not follow: a smaller sigma2 or dv')
+               return
+            end if
+         end if
+      end block
       forced = self%support_amplitude > 0.0_wp .and. self%support_frequency > 0.0_wp
       ! The section's multipliers are closed forms up to 3 coordinates: (x, v, states) when forced, (x, states) if not.
       most = merge(1, 2, forced)
