@@ -27,7 +27,7 @@
 module friction_machine_orbit
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
    use friction_kinds, only: wp
-   use friction_error, only: error_type
+   use friction_error, only: error_type, error_interrupted
    use friction_parameters, only: configurable, set_parameter_number, get_parameter, list_parameters, parameter_info
    use friction_ode_system, only: ode_system
    use friction_ode_solver, only: solver_settings
@@ -424,8 +424,13 @@ contains
       type(error_type), allocatable :: stop
 
       call self%inner%evaluate(s, image, jacobian, period, returned, reason, error)
+      ! A stop request ends the search: the watch polls the reporter at intervals, so asking it again
+      ! here would not say so and the request would pass for a trial's failure.
+      if (allocated(error)) then
+         if (error%stat == error_interrupted) return
+      end if
       if (allocated(error) .and. associated(self%watch)) then
-         ! A stop request or max_wall_time ends the search (the watch still says so), with its own message.
+         ! max_wall_time ends the search (the watch still says so), with its own message.
          call self%watch%check(0.0_wp, stop)
          if (allocated(stop)) return
       end if
