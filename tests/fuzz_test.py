@@ -174,7 +174,7 @@ def stated_nonfinite(handle, name, data):
     leaf = name.split("/")[-1]
     if leaf.endswith("_sem") and "afm" in handle and int(handle["afm"].attrs.get("realizations", 2)) == 1:
         return np.isnan(data)
-    if name.startswith("brake/") and ("exponents" in leaf):
+    if name.startswith(("brake/", "machine/")) and ("exponents" in leaf):
         return np.isneginf(data)
     if name.startswith("brake/orbit/branch/") and leaf in ("period", "max_modulus"):
         found = handle["brake/orbit/branch/found"][()].astype(bool)
