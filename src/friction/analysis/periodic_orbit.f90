@@ -22,7 +22,7 @@ module friction_analysis_periodic_orbit
    use friction_kinds, only: wp
    use friction_error, only: error_type, fatal_error, error_input
    use friction_ode_system, only: ode_system
-   use friction_ode_events, only: event_system, event_locator, event_rising
+   use friction_ode_events, only: event_system, event_locator, event_rising, event_falling
    use friction_ode_solver, only: solver_settings, ode_solver
    use friction_ode_watch, only: step_watch
    use friction_analysis_lyapunov_spectrum, only: tangent_system, pack_tangent, unpack_tangent
@@ -140,6 +140,7 @@ module friction_analysis_periodic_orbit
       real(wp) :: level = 0.0_wp
       real(wp) :: max_return = 1000.0_wp
       real(wp) :: event_tolerance = 1.0e-12_wp
+      logical :: falling = .false.   !! the section crossed downwards (y_k' < 0) instead
       class(step_watch), pointer :: watch => null()   !! asked between steps when associated
    contains
       procedure :: setup => hyperplane_setup
@@ -568,13 +569,15 @@ contains
       g(1) = y(self%coordinate) - self%level
    end subroutine hyperplane_event_values
 
-   !> The section y_k = c of an autonomous system.
-   subroutine hyperplane_setup(self, system, solver, coordinate, level, max_return, event_tolerance)
+   !> The section y_k = c of an autonomous system, crossed upwards (or, with
+   !> falling = .true., downwards).
+   subroutine hyperplane_setup(self, system, solver, coordinate, level, max_return, event_tolerance, falling)
       class(hyperplane_map), intent(inout) :: self
       class(ode_system), intent(in) :: system
       type(solver_settings), intent(in) :: solver
       integer, intent(in) :: coordinate
       real(wp), intent(in) :: level, max_return, event_tolerance
+      logical, intent(in), optional :: falling
       type(hyperplane_system) :: plane
 
       allocate (plane%base, source=system)
@@ -588,6 +591,8 @@ contains
       self%level = level
       self%max_return = max_return
       self%event_tolerance = event_tolerance
+      self%falling = .false.
+      if (present(falling)) self%falling = falling
    end subroutine hyperplane_setup
 
    pure integer function hyperplane_map_dimension(self)
@@ -629,7 +634,8 @@ contains
       reason = ''
       h = self%solver%h_start
       if (.not. (h > 0.0_wp)) h = 1.0e-3_wp
-      call locator%init(self%extended, self%solver, [event_rising], [.true.], self%event_tolerance, h, error)
+      call locator%init(self%extended, self%solver, [merge(event_falling, event_rising, self%falling)], [.true.], &
+         & self%event_tolerance, h, error)
       if (allocated(error)) return
       t = 0.0_wp
       z = pack_tangent(y, phi)

@@ -21,7 +21,8 @@ module friction_brake_config
 
    public :: brake_config, model_names, units_names, brake_solver_defaults
    public :: model_regularized, model_switched, model_law, series_names, continuation_names, continuation_config, &
-      & continuation_variable, rodas4_transition_bound, transition_bound
+      & continuation_variable, rodas4_transition_bound, transition_bound, law_continuation_names, &
+      & brake_law_continuation_names
 
    character(len=*), parameter :: model_names(3) = [character(len=11) :: 'switched', 'regularized', 'law']
    character(len=*), parameter :: units_names(2) = [character(len=14) :: 'nondimensional', 'dimensional']
@@ -36,6 +37,13 @@ module friction_brake_config
    !> The &brake variables a periodic orbit can be continued in (&analysis continuation).
    character(len=*), parameter :: continuation_names(7) = [character(len=11) :: 'mu', 'mu_s', 'xi', 'kappa', &
       & 'g_prime', 'delta_prime', 'v_dr_prime']
+   !> With model = 'law' the friction is &law's: the orbit follows the &brake
+   !> variables of the mechanism, or a parameter of &law's laws without
+   !> internal states (a name both groups have, mu or mu_s, is &law's: &brake's is unused then).
+   character(len=*), parameter :: brake_law_continuation_names(4) = [character(len=10) :: 'xi', 'kappa', &
+      & 'g_prime', 'v_dr_prime']
+   character(len=*), parameter :: law_continuation_names(10) = [character(len=8) :: 'mu', 'mu_s', 'epsilon', &
+      & 'delta', 'fc', 'fs', 'vs', 'exponent', 'sigma2', 'scale']
 
    !> &integrator defaults for the brake when no file sets them: rk8pd, tight
    !> (the benchmark: the switched model reaches 1e-8 on x this way); times in τ.
@@ -241,17 +249,21 @@ contains
       if (c%failed()) return
       call check_law_choice(self, c)
       if (c%failed() .or. len_trim(self%analysis%continuation) == 0) return
-      if (self%model /= model_switched) then
+      if (self%model == model_regularized) then
          call c%reject('analysis', 'continuation', "'"//trim(self%analysis%continuation)//"'", &
-            & "follows the orbit on the located stick-to-slip section: needs model = 'switched'")
+            & "follows the periodic orbit, which the regularized model does not compute: needs model = " &
+            & //"'switched' or 'law'")
          return
       end if
-      if (.not. any(continuation_names == self%analysis%continuation)) then
+      if (self%uses_law()) then
+         call check_law_continuation(self, c)
+      else if (.not. any(continuation_names == self%analysis%continuation)) then
          call c%reject('analysis', 'continuation', "'"//trim(self%analysis%continuation)//"'", &
             & 'not a variable of &brake the orbit can follow (known: '//quoted(continuation_names)//')')
          return
       end if
-      if (self%units == 'dimensional' .and. self%analysis%continuation /= 'mu' .and. &
+      if (c%failed()) return
+      if (self%units == 'dimensional' .and. .not. self%uses_law() .and. self%analysis%continuation /= 'mu' .and. &
          & self%analysis%continuation /= 'mu_s') then
          call c%reject('analysis', 'continuation', "'"//trim(self%analysis%continuation)//"'", &
             & "with units = 'dimensional' only 'mu' and 'mu_s' (the others are derived from &brake_dimensional)")
@@ -302,8 +314,9 @@ contains
       end if
       call check_law(law_with_files(self%law), c)
       if (c%failed()) return
-      why = "is not computed for &brake model = 'law' (the periodic orbit is found on the switched model's " &
-         & //"located slip onsets): use model = 'switched'"
+      why = "is not computed for &brake model = 'law' with &law model = '"//trim(self%law%model)//"' (its " &
+         & //"internal states would make the section more than 3-dimensional): use a law without states " &
+         & //'(coulomb, stribeck, table, arctan), or the switched model'
       call new_law(self%law, law)
       associate (a => self%analysis)
          ! Benettin's runs restart from the brake's four variables: the whole state of a law without states.
@@ -316,7 +329,11 @@ contains
             & //"' (the tangent equations take the brake's four variables; its states would make them " &
             & //'too many): use a law without states (coulomb, stribeck, table, arctan, karnopp), or the ' &
             & //'switched or the regularized model')
-         if (a%orbit) call c%reject('analysis', 'orbit', '.true.', why)
+         if (a%orbit .and. law%state_count() > 0) call c%reject('analysis', 'orbit', '.true.', why)
+         if (a%orbit .and. holds_applied(law)) call c%reject('analysis', 'orbit', '.true.', &
+            & "is not computed for &brake model = 'law' with &law model = '"//trim(self%law%model)//"' (its " &
+            & //'force jumps at the edges of its zero-velocity band, which the variational equations of the ' &
+            & //'section map do not cross): use coulomb, stribeck, table or arctan')
       end associate
       if (c%failed()) return
       ! Exact stick holds the closed-form stick phase, whose end needs a static limit affine in N'.
@@ -340,6 +357,17 @@ contains
       end if
    end subroutine check_law_choice
 
+   !> Whether a single-valued law without states holds the applied force at
+   !> rest (Karnopp's band): its force jumps where the band ends.
+   logical function holds_applied(law)
+      class(sliding_law), intent(in) :: law
+      real(wp) :: none(0)
+
+      holds_applied = .false.
+      if (law%set_valued() .or. law%state_count() > 0) return
+      holds_applied = law%force(0.0_wp, none, 1.0_wp, 0.5_wp) /= law%force(0.0_wp, none, 1.0_wp, 0.0_wp)
+   end function holds_applied
+
    !> The configuration with the continuation variable set to `value` (and no
    !> continuation of its own).
    function continuation_config(self, value) result(point)
@@ -350,8 +378,38 @@ contains
 
       point = self
       point%analysis%continuation = ''
-      call set_parameter_number(point, 'brake', trim(self%analysis%continuation), value, problem)
+      call set_parameter_number(point, continuation_group(self), trim(self%analysis%continuation), value, problem)
    end function continuation_config
+
+   !> The group of the continuation variable: &law's for a law parameter
+   !> with model = 'law', else &brake.
+   pure function continuation_group(self) result(group)
+      type(brake_config), intent(in) :: self
+      character(len=:), allocatable :: group
+
+      group = 'brake'
+      if (self%uses_law() .and. any(law_continuation_names == self%analysis%continuation)) group = law_group
+   end function continuation_group
+
+   !> The continuation variable of the brake with a law: a &brake variable of
+   !> the mechanism (not with units = 'dimensional', which derives them) or
+   !> a parameter of &law.
+   subroutine check_law_continuation(self, c)
+      type(brake_config), intent(in) :: self
+      type(config_checker), intent(inout) :: c
+
+      associate (name => self%analysis%continuation)
+         if (any(law_continuation_names == name)) return
+         if (.not. any(brake_law_continuation_names == name)) then
+            call c%reject('analysis', 'continuation', "'"//trim(name)//"'", "not a variable the orbit of " &
+               & //"&brake model = 'law' can follow (known: &brake's "//quoted(brake_law_continuation_names) &
+               & //" and &law's "//quoted(law_continuation_names)//')')
+         else if (self%units == 'dimensional') then
+            call c%reject('analysis', 'continuation', "'"//trim(name)//"'", "with units = 'dimensional' only " &
+               & //"&law's parameters (the &brake variables are derived from &brake_dimensional)")
+         end if
+      end associate
+   end subroutine check_law_continuation
 
    !> The continuation variable's value in self and its unit, through the
    !> same description of the variables that continuation_config sets by.
@@ -365,12 +423,13 @@ contains
       integer :: k, stat
 
       copy = self   ! (the visitor takes its object inout)
-      call get_parameter(copy, 'brake', trim(self%analysis%continuation), 0, text, problem)
+      call get_parameter(copy, continuation_group(self), trim(self%analysis%continuation), 0, text, problem)
       read (text, *, iostat=stat) value   ! (round-trip text of a checked variable: it reads)
       list = list_parameters(copy)
       unit = ''
       do k = 1, size(list)
-         if (list(k)%group == 'brake' .and. list(k)%name == self%analysis%continuation) unit = trim(list(k)%unit)
+         if (list(k)%group == continuation_group(self) .and. list(k)%name == self%analysis%continuation) &
+            & unit = trim(list(k)%unit)
       end do
    end subroutine continuation_variable
 

@@ -145,7 +145,7 @@ contains
             result%exponents = result%qr%exponents()
             result%kaplan_yorke = kaplan_yorke(result%exponents)
          end if
-         if (a%orbit .and. .not. config%switched()) then
+         if (a%orbit .and. .not. (config%switched() .or. config%uses_law())) then
             result%orbit%orbit%reason = "the section is the switched model's located slip onsets: model = 'switched'"
          else if (a%orbit) then
             ! Not finding one is a result (orbit%found), not an error.

@@ -39,7 +39,7 @@ module friction_brake_law_model
    implicit none
    private
 
-   public :: law_integrator, brake_law_flow, brake_law_slip, law_units
+   public :: law_integrator, brake_law_flow, brake_law_slip, law_units, law_static_line
 
    !> The brake's units in the law's: one brake force is `force` N, one
    !> brake velocity `velocity` m/s, one unit τ `time` s.
@@ -96,6 +96,8 @@ module friction_brake_law_model
       procedure :: advance_to => law_advance_to
       procedure :: is_sticking => law_sticking
       procedure :: limit
+      procedure :: start_slipping => law_start_slipping
+      procedure :: advance_to_slip_onset => law_advance_to_slip_onset
    end type law_integrator
 
 contains
@@ -317,8 +319,7 @@ contains
       call events%clear()
       if (self%switching) then
          self%stick_time = 0.0_wp
-         self%level = self%law%static_force(0.0_wp) / self%units%force
-         self%slope = self%law%static_force(self%units%force) / self%units%force - self%level
+         call law_static_line(self%law, self%units, self%slope, self%level)
          if (allocated(self%slip)) deallocate (self%slip)
          allocate (self%slip)
          self%slip%params = self%p
@@ -458,16 +459,20 @@ contains
       end do
    end subroutine advance_flow
 
-   !> As the switched model: stick in closed form, slips located.
-   subroutine advance_switching(self, t_target, events, error)
+   !> As the switched model: stick in closed form, slips located; with
+   !> slip_onset present, up to the first stick-to-slip event (slip_onset =
+   !> .true.) if it comes before t_target.
+   subroutine advance_switching(self, t_target, events, error, slip_onset)
       type(law_integrator), intent(inout) :: self
       real(wp), intent(in) :: t_target
       type(brake_event_table), intent(inout) :: events
       type(error_type), allocatable, intent(out) :: error
+      logical, intent(out), optional :: slip_onset
       logical :: found
       real(wp) :: t_end
       integer :: which
 
+      if (present(slip_onset)) slip_onset = .false.
       do while (self%t < t_target)
          if (self%sticking) then
             call self%stick%find_end(self%t, t_target, found, t_end, which)
@@ -489,6 +494,10 @@ contains
             if (self%tangent) call stick_exit_saltation(self, which)
             call slip_by_force(self, -1.0_wp)
             call events%add(self%t, event_stick_to_slip, self%y)
+            if (present(slip_onset)) then
+               slip_onset = .true.
+               return
+            end if
          else
             call self%locator_advance(t_target, error)
             if (allocated(error)) return
@@ -574,5 +583,47 @@ contains
       normal = [-2.0_wp * sigma, 0.0_wp, self%slope * (1.0_wp - self%p%kappa) + sigma, 0.0_wp]
       call saltation(self%phi, stick_field(self%p, self%y), slip_field(self, -sigma), normal)
    end subroutine stick_exit_saltation
+
+   !> The static limit of a set-valued law in the brake's units, slope N' +
+   !> level (affine in N': checked on input).
+   pure subroutine law_static_line(law, units, slope, level)
+      class(sliding_law), intent(in) :: law
+      type(law_units), intent(in) :: units
+      real(wp), intent(out) :: slope, level
+
+      level = law%static_force(0.0_wp) / units%force
+      slope = law%static_force(units%force) / units%force - level
+   end subroutine law_static_line
+
+   !> Start at (t0, y0) slipping in direction s = ±1 whatever the state: a
+   !> point of the stick-to-slip section at the instant the slip begins (the
+   !> periodic orbits of a set-valued law, brake/orbit.f90), as the switched
+   !> model's start_slipping.
+   subroutine law_start_slipping(self, config, t0, y0, s, events, error)
+      class(law_integrator), target, intent(inout) :: self
+      type(brake_config), intent(in) :: config
+      real(wp), intent(in) :: t0, y0(4), s
+      type(brake_event_table), intent(inout) :: events
+      type(error_type), allocatable, intent(out) :: error
+
+      call self%start(config, t0, y0, events, error)
+      if (allocated(error)) return
+      call slip_in(self, s, self%h_start)
+   end subroutine law_start_slipping
+
+   !> Advance to the next stick-to-slip event (found) and stop just after it
+   !> (in slip, Φ through the saltation), or to t_limit (not found).  A
+   !> set-valued law's run (started by start_slipping).
+   subroutine law_advance_to_slip_onset(self, t_limit, events, found, error)
+      class(law_integrator), intent(inout) :: self
+      real(wp), intent(in) :: t_limit
+      type(brake_event_table), intent(inout) :: events
+      logical, intent(out) :: found
+      type(error_type), allocatable, intent(out) :: error
+
+      call advance_switching(self, t_limit, events, error, found)
+      if (allocated(error)) error%message = error%message//" (&brake model = 'law', &law model = '" &
+         & //trim(self%law%p%model)//"')"
+   end subroutine law_advance_to_slip_onset
 
 end module friction_brake_law_model

@@ -26,15 +26,21 @@ module friction_brake_orbit
    use friction_brake_params, only: brake_parameters
    use friction_brake_record, only: brake_event_table, event_stick_to_slip, event_kind_names
    use friction_brake_switched, only: switched_integrator, brake_slip
+   use friction_brake_law_model, only: law_integrator, brake_law_slip, brake_law_flow, law_units, law_static_line
+   use friction_brake_integrator, only: brake_integrator
+   use friction_law, only: sliding_law
+   use friction_law_factory, only: make_law, new_law
+   use friction_output_law_files, only: law_with_files
    use friction_scene_report, only: job_reporter, loop_guard
    use friction_analysis_periodic_orbit, only: section_map, orbit_settings, periodic_orbit, &
       & find_periodic_orbit, floquet_multipliers, floquet_exponents, bifurcation_period_doubling, &
       & bifurcation_fold, bifurcation_neimark_sacker, halving_walk, branch_values, &
-      & modulus_crossing
+      & modulus_crossing, hyperplane_map
    implicit none
    private
 
    public :: brake_section_map, brake_orbit, brake_periodic_orbit, section_state, section_limit
+   public :: brake_band_map, exact_stick
    public :: orbit_branch, follow_branch, detect_bifurcations, bifurcation_names
    public :: bifurcation_period_doubling, bifurcation_fold, bifurcation_neimark_sacker, bifurcation_discontinuity
 
@@ -70,17 +76,34 @@ module friction_brake_orbit
       real(wp), allocatable :: section_x(:)          !! ... and x there (the bifurcation diagram)
    end type orbit_branch
 
-   !> The return map of the stick-to-slip section at the limit σ.
+   !> The return map of the stick-to-slip section at the limit σ: the
+   !> switched model's, or a set-valued law's (&brake model = 'law'), whose
+   !> static limit is slope N' + level.
    type, extends(section_map) :: brake_section_map
       type(brake_config) :: config
       real(wp) :: limit = 1.0_wp          !! σ
       real(wp) :: max_return = 1.0e4_wp   !! τ; no slip onset by then: no return
       logical :: tangent = .true.         !! .false.: P alone (jacobian = 0)
       integer :: counts(size(event_kind_names)) = 0   !! events by kind over the last return
+      logical, private :: prepared = .false.          !! slope and level known (model = 'law')
+      real(wp), private :: slope = 0.0_wp, level = 0.0_wp
    contains
       procedure :: dimension => brake_map_dimension
       procedure :: evaluate => brake_map_evaluate
    end type brake_section_map
+
+   !> The return map of a single-valued law without states (&brake model =
+   !> 'law'): the exit from the creep band v_rel = s v_s (s = -σ, v_s the
+   !> brake's stick_velocity) crossed away from 0, the flow's own slip onset;
+   !> coordinates (x, y, w), the Jacobian from the variational equations
+   !> (analysis/periodic_orbit.f90's hyperplane map).  A trial point whose
+   !> integration fails returns nowhere.
+   type, extends(section_map) :: brake_band_map
+      type(hyperplane_map) :: plane
+   contains
+      procedure :: dimension => band_map_dimension
+      procedure :: evaluate => band_map_evaluate
+   end type brake_band_map
 
    !> A brake run's periodic orbit (/brake/orbit, docs/output.md).
    type :: brake_orbit
@@ -93,6 +116,9 @@ module friction_brake_orbit
       !> Events of each kind over one period (stick-to-slip, slip-to-stick,
       !> slip reversal): the orbit's pattern, which a continuous branch keeps.
       integer :: pattern(size(event_kind_names)) = 0
+      !> The section: 'stick_to_slip' (exact stick), or 'creep_band_exit'
+      !> (a single-valued law: |v_rel| leaving stick_velocity).
+      character(len=16) :: section = 'stick_to_slip'
    end type brake_orbit
 
 contains
@@ -105,6 +131,32 @@ contains
 
       z = [(s(1) + limit * p%mu_s * p%normal_force(s(1))) / 2, p%v_dr, s(1), s(2)]
    end function section_state
+
+   !> The section's state at (y, w) = s for the limit σ of a static limit
+   !> slope N' + level.
+   pure function limit_state(p, slope, level, limit, s) result(z)
+      type(brake_parameters), intent(in) :: p
+      real(wp), intent(in) :: slope, level, limit, s(2)
+      real(wp) :: z(4)
+
+      if (level == 0.0_wp) then
+         z = [(s(1) + limit * slope * p%normal_force(s(1))) / 2, p%v_dr, s(1), s(2)]
+      else
+         z = [(s(1) + limit * (slope * p%normal_force(s(1)) + level)) / 2, p%v_dr, s(1), s(2)]
+      end if
+   end function limit_state
+
+   !> Whether the brake's friction sticks exactly (the switched model, or a
+   !> set-valued law of &law): the stick-to-slip section; else the creep band's exit.
+   logical function exact_stick(config)
+      type(brake_config), intent(in) :: config
+      class(sliding_law), allocatable :: law
+
+      exact_stick = .not. config%uses_law()
+      if (exact_stick) return
+      call new_law(config%law, law)
+      exact_stick = law%set_valued()
+   end function exact_stick
 
    !> σ of a slip onset: the sign of the elastic force 2x - y there.
    pure real(wp) function section_limit(p, z)
@@ -127,10 +179,13 @@ contains
       logical, intent(out) :: returned
       character(len=:), allocatable, intent(out) :: reason
       type(error_type), allocatable, intent(out) :: error
-      type(switched_integrator), target :: run
+      type(switched_integrator), target :: switched
+      type(law_integrator), target :: with_law
+      class(brake_integrator), pointer :: run
       type(brake_event_table) :: events
       type(brake_slip) :: slip
-      real(wp) :: normal(4), f(4), b(4, 2), projected(4, 2)
+      type(brake_law_slip) :: law_slip
+      real(wp) :: normal(4), f(4), b(4, 2), projected(4, 2), slope
       integer :: i
 
       image = s
@@ -139,10 +194,26 @@ contains
       returned = .false.
       reason = ''
       associate (p => self%config%params, sigma => self%limit)
-         run%tangent = self%tangent
-         call run%start_slipping(self%config, 0.0_wp, section_state(p, sigma, s), -sigma, events, error)
-         if (allocated(error)) return
-         call run%advance_to_slip_onset(self%max_return, events, returned, error)
+         if (self%config%uses_law()) then
+            if (.not. self%prepared) then
+               call prepare_limit(self, error)
+               if (allocated(error)) return
+            end if
+            slope = self%slope
+            with_law%tangent = self%tangent
+            call with_law%start_slipping(self%config, 0.0_wp, limit_state(p, slope, self%level, sigma, s(1:2)), &
+               & -sigma, events, error)
+            if (allocated(error)) return
+            call with_law%advance_to_slip_onset(self%max_return, events, returned, error)
+            run => with_law
+         else
+            slope = p%mu_s
+            switched%tangent = self%tangent
+            call switched%start_slipping(self%config, 0.0_wp, section_state(p, sigma, s(1:2)), -sigma, events, error)
+            if (allocated(error)) return
+            call switched%advance_to_slip_onset(self%max_return, events, returned, error)
+            run => switched
+         end if
          if (allocated(error)) then
             ! A trial point of Newton's whose orbit leaves Eq. 10 (the pad lifts
             ! off) or defeats the stepper returns nowhere: a result of the search.
@@ -166,13 +237,21 @@ contains
          period = run%t
          image = run%y(3:4)
          if (.not. self%tangent) return
-         ! h = μs N' - σ (2x - y) (switched.f90, stick_exit_saltation).
-         normal = [-2.0_wp * sigma, 0.0_wp, p%mu_s * (1.0_wp - p%kappa) + sigma, 0.0_wp]
-         slip%params = p
-         slip%direction = -sigma
-         call slip%rhs(run%t, run%y, f)
+         ! h = slope N' + level - σ (2x - y) (switched.f90, stick_exit_saltation).
+         normal = [-2.0_wp * sigma, 0.0_wp, slope * (1.0_wp - p%kappa) + sigma, 0.0_wp]
+         if (self%config%uses_law()) then
+            law_slip%params = p
+            allocate (law_slip%law, source=with_law%law)
+            law_slip%units = with_law%units
+            law_slip%direction = -sigma
+            call law_slip%rhs(run%t, run%y, f)
+         else
+            slip%params = p
+            slip%direction = -sigma
+            call slip%rhs(run%t, run%y, f)
+         end if
          b = 0.0_wp
-         b(:, 1) = [(1.0_wp + sigma * p%mu_s * (1.0_wp - p%kappa)) / 2, 0.0_wp, 1.0_wp, 0.0_wp]
+         b(:, 1) = [(1.0_wp + sigma * slope * (1.0_wp - p%kappa)) / 2, 0.0_wp, 1.0_wp, 0.0_wp]
          b(4, 2) = 1.0_wp
          projected = matmul(run%phi, b)
          do i = 1, 2
@@ -182,9 +261,47 @@ contains
       end associate
    end subroutine brake_map_evaluate
 
+   !> The static limit's slope and level of the map's set-valued law.
+   subroutine prepare_limit(map, error)
+      type(brake_section_map), intent(inout) :: map
+      type(error_type), allocatable, intent(out) :: error
+      class(sliding_law), allocatable :: law
+      type(law_units) :: units
+
+      call make_law(law_with_files(map%config%law), law, error)
+      if (allocated(error)) return
+      call map%config%law_units(units%force, units%velocity, units%time)
+      call law_static_line(law, units, map%slope, map%level)
+      map%prepared = .true.
+   end subroutine prepare_limit
+
+   pure integer function band_map_dimension(self)
+      class(brake_band_map), intent(in) :: self
+
+      band_map_dimension = 3
+   end function band_map_dimension
+
+   subroutine band_map_evaluate(self, s, image, jacobian, period, returned, reason, error)
+      class(brake_band_map), intent(inout) :: self
+      real(wp), intent(in) :: s(:)
+      real(wp), intent(out) :: image(:), jacobian(:, :), period
+      logical, intent(out) :: returned
+      character(len=:), allocatable, intent(out) :: reason
+      type(error_type), allocatable, intent(out) :: error
+
+      call self%plane%evaluate(s, image, jacobian, period, returned, reason, error)
+      if (allocated(error)) then
+         ! A trial point whose integration fails (the stepper gives up) returns nowhere.
+         returned = .false.
+         reason = error%message
+         deallocate (error)
+      end if
+   end subroutine band_map_evaluate
+
    !> The periodic orbit through the run's first slip onset at or after
    !> t_start + transient (the guess), Newton on its section.  No slip onset
-   !> there, or no convergence: found = .false. with the reason.
+   !> there, or no convergence: found = .false. with the reason.  A
+   !> single-valued law's slip onsets are the exits from the creep band.
    subroutine brake_periodic_orbit(config, events, transient, settings, result, error)
       type(brake_config), intent(in) :: config
       type(brake_event_table), intent(in) :: events
@@ -194,6 +311,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       integer :: j
 
+      if (.not. exact_stick(config)) result%section = 'creep_band_exit'
       do j = 1, events%n
          if (events%kind(j) == event_stick_to_slip .and. events%t(j) >= config%t_start + transient) exit
       end do
@@ -202,32 +320,96 @@ contains
          return
       end if
       result%guess_time = events%t(j)
-      result%limit = section_limit(config%params, events%state(:, j))
-      call continue_orbit(config, result%limit, events%state(3:4, j), settings, result, error)
+      if (exact_stick(config)) then
+         result%limit = section_limit(config%params, events%state(:, j))
+         call continue_orbit(config, result%limit, events%state(3:4, j), settings, result, error)
+      else
+         ! The slip leaves the band in the direction s = -σ.
+         result%limit = -sign(1.0_wp, events%state(2, j) - config%params%v_dr)
+         call continue_orbit(config, result%limit, events%state([1, 3, 4], j), settings, result, error)
+      end if
    end subroutine brake_periodic_orbit
 
-   !> Newton from the section point (y, w) = guess at the limit σ.
+   !> Newton from the section point guess at the limit σ: (y, w) on the
+   !> stick-to-slip section, (x, y, w) on the creep band's exit.
    subroutine continue_orbit(config, limit, guess, settings, result, error)
       type(brake_config), intent(in) :: config
-      real(wp), intent(in) :: limit, guess(2)
+      real(wp), intent(in) :: limit, guess(:)
       type(orbit_settings), intent(in) :: settings
       type(brake_orbit), intent(inout) :: result
       type(error_type), allocatable, intent(out) :: error
       type(brake_section_map) :: map
 
+      if (.not. exact_stick(config)) then
+         call band_orbit(config, limit, guess, settings, result, error)
+         return
+      end if
       map%config = config
       map%limit = limit
       map%max_return = config%t_end - config%t_start
       result%limit = limit
       call find_periodic_orbit(map, guess, settings, result%orbit, error)
       if (allocated(error)) return
-      result%state = section_state(config%params, limit, result%orbit%point)
+      if (config%uses_law()) then
+         result%state = limit_state(config%params, map%slope, map%level, limit, result%orbit%point)
+      else
+         result%state = section_state(config%params, limit, result%orbit%point)
+      end if
       if (.not. result%orbit%found) return
       ! Newton's last evaluation was at the fixed point.
       result%pattern = map%counts
       result%multipliers = floquet_multipliers(result%orbit, 1)
       result%exponents = floquet_exponents(result%multipliers, result%orbit%period)
    end subroutine continue_orbit
+
+   !> Newton on the creep band's exit of a single-valued law without states;
+   !> the multipliers the trivial 1 and the three of the section map (no
+   !> direction is forgotten: the creep only contracts).  The events of one
+   !> period from a run of the orbit, over [T/2, 3T/2) (away from the
+   !> section's own crossing at 0 and T).
+   subroutine band_orbit(config, limit, guess, settings, result, error)
+      type(brake_config), intent(in) :: config
+      real(wp), intent(in) :: limit, guess(:)
+      type(orbit_settings), intent(in) :: settings
+      type(brake_orbit), intent(inout) :: result
+      type(error_type), allocatable, intent(out) :: error
+      type(brake_law_flow) :: flow
+      type(brake_band_map) :: map
+      type(law_integrator), target :: run
+      type(brake_event_table) :: events
+      type(error_type), allocatable :: run_error
+      real(wp) :: level, period
+      integer :: i
+
+      result%section = 'creep_band_exit'
+      result%limit = limit
+      flow%params = config%params
+      call make_law(law_with_files(config%law), flow%law, error)
+      if (allocated(error)) return
+      if (flow%law%state_count() > 0) then
+         result%orbit%reason = "the law's internal states make the section more than 3-dimensional"
+         return
+      end if
+      call config%law_units(flow%units%force, flow%units%velocity, flow%units%time)
+      flow%stick_velocity = config%stick_velocity
+      level = config%params%v_dr - limit * config%stick_velocity
+      call map%plane%setup(flow, config%solver, 2, level, config%t_end - config%t_start, config%event_tolerance, &
+         & falling=limit > 0.0_wp)
+      call find_periodic_orbit(map, guess, settings, result%orbit, error)
+      if (allocated(error)) return
+      result%state = [result%orbit%point(1), level, result%orbit%point(2), result%orbit%point(3)]
+      if (.not. result%orbit%found) return
+      result%multipliers = floquet_multipliers(result%orbit, 0)
+      result%exponents = floquet_exponents(result%multipliers, result%orbit%period)
+      period = result%orbit%period
+      call run%start(config, 0.0_wp, result%state, events, run_error)
+      if (.not. allocated(run_error)) call run%advance_to(1.5_wp * period, events, run_error)
+      if (allocated(run_error)) return   ! (the orbit closed; its pattern stays unknown, 0)
+      do i = 1, size(result%pattern)
+         result%pattern(i) = count(events%kind(1:events%n) == i .and. events%t(1:events%n) >= period / 2 &
+            & .and. events%t(1:events%n) < 1.5_wp * period)
+      end do
+   end subroutine band_orbit
 
    !> The orbit `first` of the run (config) followed along the line from the
    !> continuation variable's value in config to `last` in n points: at each

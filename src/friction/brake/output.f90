@@ -305,7 +305,7 @@ contains
          call file%create_group(group)
          call file%write_attribute_integer(group, 'found', merge(1_i8, 0_i8, o%orbit%found))
          if (.not. o%orbit%found) call file%write_attribute_text(group, 'reason', o%orbit%reason)
-         call file%write_attribute_text(group, 'section', 'stick_to_slip')
+         call file%write_attribute_text(group, 'section', trim(o%section))
          call file%write_attribute_integer(group, 'static_limit', int(nint(o%limit), i8))
          call file%write_attribute_real(group, 'guess_time', o%guess_time, 'tau')
          call file%write_attribute_real(group, 'transient', a%orbit_transient, 'tau')

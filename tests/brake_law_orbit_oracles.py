@@ -1,0 +1,314 @@
+#!/usr/bin/env python3
+"""The periodic orbits, Floquet multipliers and continuation of the brake with
+a law of &law (&brake model = 'law'), through the program and its file,
+against oracles that are not that model's output:
+
+  coulomb-switched   &law coulomb (δ' = 0, μ and μs the switched model's) on
+                     the paper's brake and brake_continuation.nml's slow belt:
+                     the orbit, its multipliers and the branch followed in &law
+                     mu against the switched model's own, followed in &brake mu
+  stribeck-scipy     a Stribeck law with exact stick: the stick-to-slip section
+                     map's Jacobian against central differences of the map
+                     integrated here (SciPy's DOP853 through the stick/slip
+                     switching, written out below), the fixed point and the
+                     period against that map
+  arctan-scipy       the arctan law (no exact stick; the section is the exit
+                     from the creep band): the same checks against SciPy's
+                     Radau on Eq. 10 with the arctan force
+  refusals           what the orbit of this model does not do is refused with
+                     file, line, group and variable, exit code 3, no file
+
+    brake_law_orbit_oracles.py --binary build/friction --inputs inputs --workdir DIR CASE
+"""
+import subprocess
+import sys
+from pathlib import Path
+
+import h5py
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from machine_cases import run_program, case_main
+
+QUIET = {"analysis.spectrum": ".false.", "analysis.poincare": ".false.", "analysis.lyapunov": ".false.",
+         "analysis.lyapunov_spectrum": ".false.", "analysis.rosenstein": ".false.", "analysis.orbit": ".true."}
+# brake.nml's mechanism (ξ, κ, g') and brake_continuation.nml's slow belt.
+XI, KAPPA, G_PRIME, V_DR = 0.412, 1.5, 0.01778, -2.0e-4
+
+
+def orbit_of(args, name, files, sets):
+    with h5py.File(run_program(args, name, files, {**QUIET, **sets})) as f:
+        g = f["brake/orbit"]
+        orbit = {key: g[key][()] for key in g if isinstance(g[key], h5py.Dataset)}
+        orbit.update({key: value.decode() if isinstance(value, bytes) else value for key, value in g.attrs.items()})
+        if "branch" in g:
+            orbit["branch"] = {key: g["branch"][key][()] for key in g["branch"]
+                               if isinstance(g["branch"][key], h5py.Dataset)}
+            orbit["bifurcations"] = {key: g["bifurcations"][key][()] for key in g["bifurcations"]}
+    assert orbit["found"] == 1, orbit.get("reason")
+    # h5py reads a Fortran (i, j) matrix as [j, i]: the Jacobian back to ∂P_i/∂s_j.
+    orbit["section_jacobian"] = orbit["section_jacobian"].T
+    orbit["multipliers"] = orbit["floquet_multipliers"][:, 0] + 1j * orbit["floquet_multipliers"][:, 1]
+    return orbit
+
+
+def coulomb_switched(args):
+    # Coulomb's law with μ, μs and no viscous term is the switched model's kinetic law when δ' = 0, and its
+    # static limit the same μs N': the same equations through another code path (law_model.f90's slip and
+    # its stick-exit saltation, the law's static line on the section).  The law's slip Jacobian takes
+    # ∂F/∂N' by a central difference where the switched model's is analytic: exact for an affine force up to
+    # rounding, eps μN'/(1e-6 N') ~ 2e-10 relative in one entry of the variational equations; the bound
+    # 1e-8 on the multipliers and the Jacobian is 50 times that.  The states and periods agree to the
+    # integration's rounding (rk8pd at rtol 1e-10 on the same steps): 1e-12.
+    # Two lines: from a stable orbit through a period doubling (μs = 0.59), and of unstable orbits (μs = 0.55).
+    law = {"brake.model": "'law'", "law.model": "'coulomb'", "law.sigma2": 0.0}
+    for mu, mu_s, end, points in ((0.57, 0.59, 0.45, 13), (0.45, 0.55, 0.35, 11)):
+        sets = {"brake.delta_prime": 0.0, "brake.mu": mu, "brake.mu_s": mu_s, "analysis.continuation_end": end,
+                "analysis.continuation_points": points}
+        own = orbit_of(args, f"switched_{mu}", ["brake.nml", "brake_continuation.nml"], sets)
+        got = orbit_of(args, f"law_{mu}", ["brake.nml", "brake_continuation.nml"],
+                       {**sets, **law, "law.mu": mu, "law.mu_s": mu_s})
+        state = np.max(np.abs(got["point"] - own["point"]))
+        period = abs(got["period"] - own["period"])
+        multipliers = np.max(np.abs(got["multipliers"] - own["multipliers"]))
+        jacobian = np.max(np.abs(got["section_jacobian"] - own["section_jacobian"]))
+        print(f"coulomb-switched (mu {mu}, mu_s {mu_s}): period {own['period']:.10f} tau, multipliers "
+              f"{np.round(own['multipliers'], 6)}; differences: state {state:.1e} m, period {period:.1e} tau, "
+              f"multipliers {multipliers:.1e}, section Jacobian {jacobian:.1e}")
+        assert got["section"] == own["section"] == "stick_to_slip"
+        assert np.array_equal(got["events_per_period"], own["events_per_period"])
+        assert state <= 1e-12 and period <= 1e-10, (state, period)
+        assert multipliers <= 1e-8 and jacobian <= 1e-8 * np.max(np.abs(own["section_jacobian"])), \
+            (multipliers, jacobian)
+        a, b = own["branch"], got["branch"]
+        assert np.array_equal(a["parameter"], b["parameter"]) and np.array_equal(a["found"], b["found"]), (a["found"], b["found"])
+        assert a["found"].sum() >= 6, a["found"]
+        found = a["found"] == 1
+        branch_state = np.max(np.abs(a["point"][found] - b["point"][found]))
+        branch_mu = np.max(np.abs((a["floquet_multipliers_real"] + 1j * a["floquet_multipliers_imag"])[found]
+                                  - (b["floquet_multipliers_real"] + 1j * b["floquet_multipliers_imag"])[found]))
+        print(f"  branch in mu to {end}: {int(found.sum())} of {found.size} points with an orbit; differences "
+              f"state {branch_state:.1e} m, multipliers {branch_mu:.1e}; bifurcations "
+              f"{list(own['bifurcations']['kind'])} at {np.round(own['bifurcations']['parameter'], 6)}")
+        assert branch_state <= 1e-10 and branch_mu <= 1e-8, (branch_state, branch_mu)
+        assert np.array_equal(own["bifurcations"]["kind"], got["bifurcations"]["kind"])
+        assert np.allclose(own["bifurcations"]["parameter"], got["bifurcations"]["parameter"], rtol=0, atol=1e-8)
+
+
+class SwitchedBrake:
+    """Eq. 10 with exact stick and a set-valued law: in stick x' = v_dr and the
+    crank moves on; a slip in direction s under slip_force(v_rel, s, N') ends
+    where s v_rel falls through 0 (stick if |2x - y| is within the static
+    limit slope N' + level, else a slip the other way); a stick ends where
+    |2x - y| reaches the limit.  SciPy's DOP853 and its event location."""
+
+    def __init__(self, slope, level, slip_force):
+        self.slope, self.level, self.slip_force = slope, level, slip_force
+        self.tol = dict(rtol=1e-12, atol=1e-15)
+
+    def limit(self, y):
+        return self.slope * ((1 - KAPPA) * y + G_PRIME) + self.level
+
+    def slip_rhs(self, s):
+        def rhs(t, z):
+            x, v, y, w = z
+            return [v, -(2 * x - y) - self.slip_force(v - V_DR, s, (1 - KAPPA) * y + G_PRIME), w,
+                    (x - KAPPA * y) / XI]
+        return rhs
+
+    @staticmethod
+    def stick_rhs(t, z):
+        x, v, y, w = z
+        return [V_DR, 0.0, w, (x - KAPPA * y) / XI]
+
+    def section_map(self, sigma, point, t_max=400.0):
+        """(y, w) on the limit σ to the next slip onset at the same limit; the image and the return time."""
+        y, w = point
+        z = np.array([(y + sigma * self.limit(y)) / 2, V_DR, y, w])
+        t, s = 0.0, -sigma
+        while t < t_max:
+            # Slip: s v_rel grows from 0 (from second order when the slip force at 0 is the static limit):
+            # a short step before the end is looked for.
+            rhs = self.slip_rhs(s)
+            start = solve_ivp(rhs, (t, t + 1e-4), z, method="DOP853", **self.tol)
+            t, z = start.t[-1], start.y[:, -1]
+
+            def end(t, z, s=s):
+                return s * (z[1] - V_DR)
+            end.terminal, end.direction = True, -1
+            sol = solve_ivp(rhs, (t, t_max), z, method="DOP853", events=end, **self.tol)
+            t, z = sol.t_events[0][0], sol.y_events[0][0].copy()
+            if abs(2 * z[0] - z[2]) <= self.limit(z[2]):
+                z[1] = V_DR
+
+                def upper(t, z):
+                    return 2 * z[0] - z[2] - self.limit(z[2])
+
+                def lower(t, z):
+                    return 2 * z[0] - z[2] + self.limit(z[2])
+                upper.terminal, upper.direction = True, 1
+                lower.terminal, lower.direction = True, -1
+                sol = solve_ivp(self.stick_rhs, (t, t_max), z, method="DOP853", events=[upper, lower], **self.tol)
+                which = 0 if sol.t_events[0].size else 1
+                t, z = sol.t_events[which][0], sol.y_events[which][0].copy()
+                exit_limit = 1.0 if which == 0 else -1.0
+                if exit_limit == sigma:
+                    return np.array([z[2], z[3]]), t
+                s = -exit_limit
+            else:
+                s = -s
+        raise RuntimeError("no return")
+
+
+def central_differences(section_map, point, steps):
+    """∂P/∂s by central differences with the given steps."""
+    jac = np.zeros((len(point), len(point)))
+    for j, h in enumerate(steps):
+        d = np.zeros(len(point))
+        d[j] = h
+        jac[:, j] = (section_map(point + d)[0] - section_map(point - d)[0]) / (2 * h)
+    return jac
+
+
+def check_map(label, orbit, section_map, point, step, ratio, period_bound, point_bound, noise):
+    """The program's fixed point, period and section Jacobian against the map integrated here: central
+    differences with steps `step` and step/ratio, extrapolated (Richardson, the h² error removed)."""
+    image, period = section_map(point)
+    closure = np.max(np.abs(image - point))
+    coarse = central_differences(section_map, point, step * np.ones(len(point)))
+    fine = central_differences(section_map, point, step / ratio * np.ones(len(point)))
+    # The spread of the two measures their truncation error: (1 - 1/ratio²) of the coarse one's.
+    spread = np.max(np.abs(coarse - fine))
+    extrapolated = fine + (fine - coarse) / (ratio ** 2 - 1)
+    difference = np.max(np.abs(orbit["section_jacobian"] - extrapolated))
+    size = np.max(np.abs(extrapolated))
+    mu = np.sort_complex(np.linalg.eigvals(extrapolated))[::-1]
+    print(f"{label}: period {orbit['period']:.10f} tau (SciPy's map {period:.10f}), |P(s) - s| by SciPy "
+          f"{closure:.1e}; section Jacobian {difference:.1e} from SciPy's extrapolated differences (largest entry "
+          f"{size:.3g}, the two steps' spread {spread:.1e}); multipliers {np.round(orbit['multipliers'], 7)}, "
+          f"of the differences {np.round(mu, 7)}")
+    assert closure <= point_bound, closure
+    assert abs(period - orbit["period"]) <= period_bound, (period, orbit["period"])
+    # What the extrapolation leaves is the h⁴ term, far below the spread, and the map's noise over the fine
+    # step (`noise` of the entries, from the integration's tolerance).
+    assert difference <= max(spread / ratio ** 2, noise * size), (difference, spread)
+    return extrapolated
+
+
+def stribeck_scipy(args):
+    # The Stribeck law in the brake's units (units = 'nondimensional': forces in m, velocities in m/τ):
+    # F_c = 0.0085, F_s = 0.0105 (about μ N' of the paper's brake), v_s = 2e-4 m/τ, δ = 2, σ2 = 0.
+    fc, fs, vs = 0.0085, 0.0105, 2e-4
+    sets = {"brake.model": "'law'", "law.model": "'stribeck'", "law.fc": fc, "law.fs": fs, "law.vs": vs,
+            "law.exponent": 2.0, "law.sigma2": 0.0, "brake.event_tolerance": 1e-12,
+            "integrator.rtol": 1e-12, "integrator.atol": 1e-15, "analysis.orbit_tolerance": 1e-11}
+    orbit = orbit_of(args, "stribeck", ["brake.nml", "brake_continuation.nml"], sets)
+    assert orbit["section"] == "stick_to_slip"
+    sigma = float(orbit["static_limit"])
+    brake = SwitchedBrake(0.0, fs, lambda v, s, n: s * (fc + (fs - fc) * np.exp(-(v / vs) ** 2)))
+    point = orbit["point"][[2, 3]]
+    # SciPy at rtol 1e-12: the map to ~1e-13 m; Newton stopped at 1e-11 m (the closure bound 1e-9 and the
+    # period's 1e-8 τ leave room for the event times, located to 1e-12 τ, over a dozen events).  Differences
+    # with steps of 1e-6 m and 2e-7 m, extrapolated: measured 8.7e-11 from the program's Jacobian (without
+    # Richardson 1.1e-8, the h² error); the bound 1e-7 of the largest entry is a thousand times that.
+    fine = check_map("stribeck-scipy", orbit, lambda p: brake.section_map(sigma, p), point, 1e-6, 5.0, 1e-8, 1e-9,
+                     1e-7)
+    # The orbit's multipliers: 1, the section map's two, 0 (the stick forgets the velocity).
+    assert orbit["multipliers"][0] == 1 and orbit["multipliers"][3] == 0
+    mu = np.linalg.eigvals(fine)
+    assert np.max(np.abs(np.sort(np.abs(mu)) - np.sort(np.abs(orbit["multipliers"][1:3])))) <= 1e-5
+
+
+def arctan_map(mu, eps, delta, stick_velocity, sigma):
+    """The creep band's exit v_rel = s v_s (s = -σ) crossed away from 0, Eq. 10 with the arctan law, SciPy's
+    Radau with the exact Jacobian; coordinates (x, y, w)."""
+    s = -sigma
+    level = V_DR + s * stick_velocity
+
+    def force(v, n):
+        return mu * n * (2 / np.pi) * np.arctan(eps * v) / (1 + delta * abs(v))
+
+    def rhs(t, z):
+        x, v, y, w = z
+        return [v, -(2 * x - y) - force(v - V_DR, (1 - KAPPA) * y + G_PRIME), w, (x - KAPPA * y) / XI]
+
+    def jac(t, z):
+        x, v, y, w = z
+        u, n = v - V_DR, (1 - KAPPA) * y + G_PRIME
+        d = 1 + delta * abs(u)
+        dfdv = mu * n * (2 / np.pi) * (eps / (1 + (eps * u) ** 2) / d - np.arctan(eps * u) * delta * np.sign(u) / d ** 2)
+        dfdn = force(u, 1.0)
+        return [[0, 1, 0, 0], [-2, -dfdv, 1 - dfdn * (1 - KAPPA), 0], [0, 0, 0, 1], [1 / XI, 0, -KAPPA / XI, 0]]
+
+    def crossing(t, z):
+        return z[1] - level
+    crossing.terminal, crossing.direction = True, s
+
+    def section_map(point):
+        x, y, w = point
+        z = np.array([x, level, y, w])
+        # Leave the start on the section before the crossing is looked for.
+        start = solve_ivp(rhs, (0, 1e-3), z, method="Radau", jac=jac, rtol=1e-12, atol=1e-15)
+        sol = solve_ivp(rhs, (start.t[-1], 400.0), start.y[:, -1], method="Radau", jac=jac, rtol=1e-12,
+                        atol=1e-15, events=crossing)
+        z = sol.y_events[0][0]
+        return np.array([z[0], z[2], z[3]]), sol.t_events[0][0]
+    return section_map
+
+
+def arctan_scipy(args):
+    # The paper's arctan law (μ = 0.59, ε' = 3.5121e7, δ' = 3.5121) on brake_continuation.nml's slow belt, with
+    # a creep band of 1e-5 m/τ: the block creeps down to |v_rel| ~ 3e-6 m/τ, inside the band (the default
+    # 1e-6 it never enters), and leaves it at the smooth flow's slip onset.
+    mu, eps, delta, band = 0.59, 3.5121e7, 3.5121, 1e-5
+    sets = {"brake.model": "'law'", "law.model": "'arctan'", "law.mu": mu, "law.epsilon": eps, "law.delta": delta,
+            "brake.stick_velocity": band, "integrator.method": "'rk4imp'", "integrator.rtol": 1e-12,
+            "integrator.atol": 1e-15, "brake.event_tolerance": 1e-12, "analysis.orbit_tolerance": 1e-10}
+    orbit = orbit_of(args, "arctan", ["brake.nml", "brake_continuation.nml"], sets)
+    assert orbit["section"] == "creep_band_exit"
+    sigma = float(orbit["static_limit"])
+    point = orbit["point"][[0, 2, 3]]
+    # The program on rk4imp at rtol 1e-12 (rodas4, which 'auto' takes, integrates the tangent with the
+    # extended system's approximate Jacobian and loses order there: at rtol 1e-11 its section Jacobian is
+    # 2e-5 off, at 1e-13 7e-6; rk4imp at 1e-12 and rk8pd at 1e-13 agree to 1e-8, measured).  SciPy's Radau
+    # at rtol 1e-12 on the stiff creep (dF/dv ~ 2e5 per τ): the map closes to 1e-13 m.  Differences with steps
+    # 2e-7 m and 1e-7 m (the creep makes the map curve on the scale of 1e-5 m: their spread 3e-5),
+    # extrapolated; the map's noise over 1e-7 m and the h⁴ term that remains: 2e-6 of the largest entry.
+    fine = check_map("arctan-scipy", orbit, arctan_map(mu, eps, delta, band, sigma), point, 2e-7, 2.0, 1e-8, 1e-9,
+                     2e-6)
+    assert orbit["multipliers"][0] == 1
+    mu_fd = np.linalg.eigvals(fine)
+    assert np.max(np.abs(np.sort(np.abs(mu_fd)) - np.sort(np.abs(orbit["multipliers"][1:])))) <= 1e-5
+
+
+def refusals(args):
+    work = Path(args.workdir)
+    cases = [  # (groups, line, names, why)
+        ("&brake\n  model = 'law'\n/\n&law\n  model = 'lugre'\n/\n&analysis\n  orbit = .true.\n/\n", 12,
+         "&analysis: orbit", "internal states"),
+        ("&brake\n  model = 'law'\n/\n&law\n  model = 'karnopp'\n/\n&analysis\n  orbit = .true.\n/\n", 12,
+         "&analysis: orbit", "zero-velocity band"),
+        ("&brake\n  model = 'law'\n/\n&law\n  model = 'coulomb'\n/\n&analysis\n  orbit = .true.\n"
+         "  continuation = 'delta_prime'\n  continuation_end = 1.0\n/\n", 13, "&analysis: continuation",
+         "not a variable"),
+        ("&brake\n  model = 'law'\n  units = 'dimensional'\n/\n&law\n  model = 'coulomb'\n/\n&analysis\n"
+         "  orbit = .true.\n  continuation = 'xi'\n  continuation_end = 0.5\n/\n", 14, "&analysis: continuation",
+         "&brake_dimensional"),
+        ("&brake\n  model = 'law'\n/\n&law\n  model = 'coulomb'\n  mu = 0.3\n  mu_s = 0.4\n/\n&analysis\n"
+         "  orbit = .true.\n  continuation = 'mu'\n  continuation_end = 0.5\n/\n", 16,
+         "&analysis: continuation_end", "mu_s"),
+    ]
+    for i, (groups, line, names, why) in enumerate(cases):
+        path = work / f"bad{i}.nml"
+        path.write_text("! a refused value\n&job\n  scene = 'brake'\n/\n" + groups)
+        out = work / f"bad{i}.h5"
+        result = subprocess.run([args.binary, "-o", str(out), str(path)], capture_output=True, text=True)
+        print(f"refusals: exit {result.returncode}: {result.stderr.strip()}")
+        assert result.returncode == 3, result
+        assert f"{path}:{line}: {names}" in result.stderr and why in result.stderr, result.stderr
+        assert not out.exists()
+
+
+if __name__ == "__main__":
+    sys.exit(case_main(__doc__, {"coulomb-switched": coulomb_switched, "stribeck-scipy": stribeck_scipy,
+                                 "arctan-scipy": arctan_scipy, "refusals": refusals}))
