@@ -939,7 +939,9 @@ def orbit_branch(data: DataLike) -> Figure:
         top.plot(missing, np.full(missing.size, np.nanmin(o["branch/section_x"]) if o["branch/section_x"].size
                                   else 0.0), "x", color="tab:red", label="no orbit found")
     top.set_ylabel("x at slip onset (m)")
-    top.set_title(f"Periodic orbit followed in {o['variable']} (stick-to-slip section)", fontsize="medium")
+    # The section the orbit was found on: stick_to_slip, or creep_band_exit for a law without exact stick.
+    section = str(o["attrs"].get("section", "stick_to_slip")).replace("_", "-")
+    top.set_title(f"Periodic orbit followed in {o['variable']} ({section} section)", fontsize="medium")
     top.legend(fontsize="x-small", loc="lower left")
     bottom.set_xlabel(o["variable"])
     bottom.set_ylabel("largest |μ| of the section map")
