@@ -268,9 +268,9 @@ def arctan_scipy(args):
     assert orbit["section"] == "creep_band_exit"
     sigma = float(orbit["static_limit"])
     point = orbit["point"][[0, 2, 3]]
-    # The program on rk4imp at rtol 1e-12 (rodas4, which 'auto' takes, integrates the tangent with the
-    # extended system's approximate Jacobian and loses order there: at rtol 1e-11 its section Jacobian is
-    # 2e-5 off, at 1e-13 7e-6; rk4imp at 1e-12 and rk8pd at 1e-13 agree to 1e-8, measured).  SciPy's Radau
+    # The program on rk4imp at rtol 1e-12 (rodas4, which 'auto' takes, steps through the creep by the state's
+    # error alone and its uncontrolled tangent lags: at rtol 1e-11 its section Jacobian is 2e-5 off, at 1e-13
+    # 7e-6; rk4imp at 1e-12 and rk8pd at 1e-13 agree to 1e-8, measured).  SciPy's Radau
     # at rtol 1e-12 on the stiff creep (dF/dv ~ 2e5 per τ): the map closes to 1e-13 m.  Differences with steps
     # 2e-7 m and 1e-7 m (the creep makes the map curve on the scale of 1e-5 m: their spread 3e-5),
     # extrapolated; the map's noise over 1e-7 m and the h⁴ term that remains: 2e-6 of the largest entry.
