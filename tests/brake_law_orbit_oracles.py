@@ -287,7 +287,7 @@ def refusals(args):
         ("&brake\n  model = 'law'\n/\n&law\n  model = 'lugre'\n/\n&analysis\n  orbit = .true.\n/\n", 12,
          "&analysis: orbit", "internal states"),
         ("&brake\n  model = 'law'\n/\n&law\n  model = 'karnopp'\n/\n&analysis\n  orbit = .true.\n/\n", 12,
-         "&analysis: orbit", "zero-velocity band"),
+         "&analysis: orbit", "zero-velocity band tangentially"),
         ("&brake\n  model = 'law'\n/\n&law\n  model = 'coulomb'\n/\n&analysis\n  orbit = .true.\n"
          "  continuation = 'delta_prime'\n  continuation_end = 1.0\n/\n", 13, "&analysis: continuation",
          "not a variable"),

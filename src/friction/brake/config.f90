@@ -332,8 +332,9 @@ contains
          if (a%orbit .and. law%state_count() > 0) call c%reject('analysis', 'orbit', '.true.', why)
          if (a%orbit .and. holds_applied(law)) call c%reject('analysis', 'orbit', '.true.', &
             & "is not computed for &brake model = 'law' with &law model = '"//trim(self%law%model)//"' (its " &
-            & //'force jumps at the edges of its zero-velocity band, which the variational equations of the ' &
-            & //'section map do not cross): use coulomb, stribeck, table or arctan')
+            & //'block leaves its zero-velocity band tangentially, as the pull passes F_s, and its force jumps ' &
+            & //'at the band''s edges: no section of the flow is crossed transversally there): use coulomb, ' &
+            & //'stribeck, table or arctan')
       end associate
       if (c%failed()) return
       ! Exact stick holds the closed-form stick phase, whose end needs a static limit affine in N'.
