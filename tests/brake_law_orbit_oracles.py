@@ -12,6 +12,9 @@ against oracles that are not that model's output:
                      integrated here (SciPy's DOP853 through the stick/slip
                      switching, written out below), the fixed point and the
                      period against that map
+  table-stribeck     &law table sampled from that Stribeck curve: the orbit
+                     converges to the Stribeck law's as the rows densify,
+                     within the interpolant's error (SciPy's PCHIP in ln v)
   arctan-scipy       the arctan law (no exact stick; the section is the exit
                      from the creep band): the same checks against SciPy's
                      Radau on Eq. 10 with the arctan force
@@ -27,11 +30,13 @@ from pathlib import Path
 import h5py
 import numpy as np
 from scipy.integrate import solve_ivp
+from scipy.interpolate import PchipInterpolator
 
 from machine_cases import run_program, case_main
 
 QUIET = {"analysis.spectrum": ".false.", "analysis.poincare": ".false.", "analysis.lyapunov": ".false.",
-         "analysis.lyapunov_spectrum": ".false.", "analysis.rosenstein": ".false.", "analysis.orbit": ".true."}
+         "analysis.lyapunov_spectrum": ".false.", "analysis.rosenstein": ".false.", "analysis.orbit": ".true.",
+         "analysis.continuation": "''"}
 # brake.nml's mechanism (ξ, κ, g') and brake_continuation.nml's slow belt.
 XI, KAPPA, G_PRIME, V_DR = 0.412, 1.5, 0.01778, -2.0e-4
 
@@ -63,8 +68,8 @@ def coulomb_switched(args):
     # Two lines: from a stable orbit through a period doubling (μs = 0.59), and of unstable orbits (μs = 0.55).
     law = {"brake.model": "'law'", "law.model": "'coulomb'", "law.sigma2": 0.0}
     for mu, mu_s, end, points in ((0.57, 0.59, 0.45, 13), (0.45, 0.55, 0.35, 11)):
-        sets = {"brake.delta_prime": 0.0, "brake.mu": mu, "brake.mu_s": mu_s, "analysis.continuation_end": end,
-                "analysis.continuation_points": points}
+        sets = {"brake.delta_prime": 0.0, "brake.mu": mu, "brake.mu_s": mu_s, "analysis.continuation": "'mu'",
+                "analysis.continuation_end": end, "analysis.continuation_points": points}
         own = orbit_of(args, f"switched_{mu}", ["brake.nml", "brake_continuation.nml"], sets)
         got = orbit_of(args, f"law_{mu}", ["brake.nml", "brake_continuation.nml"],
                        {**sets, **law, "law.mu": mu, "law.mu_s": mu_s})
@@ -219,6 +224,39 @@ def stribeck_scipy(args):
     assert np.max(np.abs(np.sort(np.abs(mu)) - np.sort(np.abs(orbit["multipliers"][1:3])))) <= 1e-5
 
 
+def table_stribeck(args):
+    # The table law's own code (a monotone cubic in ln v, its first row the static limit) against the
+    # Stribeck law it samples, rows from 1e-7 m/τ (below, the table holds the first row's force where the
+    # curve falls by (F_s - F_c)(v/v_s)² <= 2.5e-10 m) to 1 m/τ.  A force wrong by δF everywhere moves the
+    # orbit by about δF (the brake's forces are lengths; measured: 5.7e-10 m at 40 rows a decade, where
+    # the interpolant is 3.7e-8 m off at most): the state within the interpolant's largest error, and the
+    # period converging faster than h² (PCHIP's h³; measured 3.0e-7 τ then 2.1e-8 τ).
+    fc, fs, vs = 0.0085, 0.0105, 2e-4
+    common = {"brake.model": "'law'", "brake.event_tolerance": 1e-12, "integrator.rtol": 1e-12,
+              "integrator.atol": 1e-15, "analysis.orbit_tolerance": 1e-11}
+    own = orbit_of(args, "stribeck", ["brake.nml", "brake_continuation.nml"],
+                   {**common, "law.model": "'stribeck'", "law.fc": fc, "law.fs": fs, "law.vs": vs,
+                    "law.exponent": 2.0, "law.sigma2": 0.0})
+    periods = []
+    for per_decade in (20, 40):
+        v = np.logspace(-7, 0, 7 * per_decade + 1)
+        force = fc + (fs - fc) * np.exp(-(v / vs) ** 2)
+        table = Path(args.workdir) / f"stribeck_{per_decade}.txt"
+        np.savetxt(table, np.column_stack([v, force]), fmt="%.17e", header="v (m per unit tau), F (m)")
+        fine = np.logspace(-7, -1, 200001)
+        error = np.max(np.abs(PchipInterpolator(np.log(v), force)(np.log(fine))
+                              - (fc + (fs - fc) * np.exp(-(fine / vs) ** 2))))
+        got = orbit_of(args, f"table_{per_decade}", ["brake.nml", "brake_continuation.nml"],
+                       {**common, "law.model": "'table'", "law.table_file": f"'{table}'"})
+        state = np.max(np.abs(got["point"] - own["point"]))
+        periods.append(abs(got["period"] - own["period"]))
+        multipliers = np.max(np.abs(got["multipliers"] - own["multipliers"]))
+        print(f"table-stribeck ({per_decade} rows a decade): state {state:.1e} m, period {periods[-1]:.1e} tau, "
+              f"multipliers {multipliers:.1e} from the Stribeck law's; the interpolant's largest error {error:.1e} m")
+        assert state <= error, (state, error)
+    assert periods[1] <= periods[0] / 4, periods
+
+
 def arctan_map(mu, eps, delta, stick_velocity, sigma):
     """The creep band's exit v_rel = s v_s (s = -σ) crossed away from 0, Eq. 10 with the arctan law, SciPy's
     Radau with the exact Jacobian; coordinates (x, y, w)."""
@@ -311,4 +349,4 @@ def refusals(args):
 
 if __name__ == "__main__":
     sys.exit(case_main(__doc__, {"coulomb-switched": coulomb_switched, "stribeck-scipy": stribeck_scipy,
-                                 "arctan-scipy": arctan_scipy, "refusals": refusals}))
+                                 "table-stribeck": table_stribeck, "arctan-scipy": arctan_scipy, "refusals": refusals}))
