@@ -58,6 +58,7 @@ module friction_analysis_lyapunov_spectrum
    contains
       procedure :: start => accumulator_start
       procedure :: renormalise => accumulator_renormalise
+      procedure :: add_logs => accumulator_add_logs
       procedure :: exponents => accumulator_exponents
    end type spectrum_accumulator
 
@@ -274,18 +275,30 @@ contains
       real(wp) :: r(self%n)
       integer :: i
 
-      self%lost = max(self%lost, lost)
       call orthonormalise(phi, r, lost)
       do i = 1, self%n - lost
-         self%log_sum(i) = self%log_sum(i) + log(r(i))
+         r(i) = log(r(i))
       end do
+      call self%add_logs(r, interval, lost)
+   end subroutine accumulator_renormalise
+
+   !> An interval's sums of log |R_ii| by a caller that factored Φ itself
+   !> (more than once in the interval: machine/lyapunov.f90's stiff tangent).
+   subroutine accumulator_add_logs(self, logs, interval, lost)
+      class(spectrum_accumulator), intent(inout) :: self
+      real(wp), intent(in) :: logs(:)
+      real(wp), intent(in) :: interval
+      integer, intent(in) :: lost
+
+      self%lost = max(self%lost, lost)
+      self%log_sum(1:self%n - lost) = self%log_sum(1:self%n - lost) + logs(1:self%n - lost)
       self%elapsed = self%elapsed + interval
       if (self%count < size(self%time)) then
          self%count = self%count + 1
          self%time(self%count) = self%elapsed
          self%history(:, self%count) = running(self)
       end if
-   end subroutine accumulator_renormalise
+   end subroutine accumulator_add_logs
 
    !> The running estimates in QR column order, -inf for lost directions.
    function running(self) result(lambda)

@@ -1,25 +1,30 @@
 !> The machine's whole Lyapunov spectrum (&analysis lyapunov_spectrum;
-!> docs/chaos.md, "The machine").  The orbit and its tangent matrix Φ are
-!> integrated side by side and Φ is factored Φ = Q R every renormalisation
-!> interval (analysis/lyapunov_spectrum.f90).  Also Benettin's exponent of a
+!> docs/chaos.md, "The machine").  The orbit and its tangent matrix Φ go
+!> side by side and the logs of Φ's QR factors are summed every
+!> renormalisation interval (analysis/lyapunov_spectrum.f90).  Also Benettin's exponent of a
 !> set-valued law, two switching runs without Φ (the smooth laws' is the
 !> analysis layer's, diagnostics.f90).
 !>
 !> - A law that is one ODE (arctan, Karnopp, Dahl, LuGre, elasto-plastic,
 !>   rate and state): the variational equations Φ' = J Φ with J from the
-!>   law's analytic partial derivatives (model.f90's Jacobian).
+!>   law's analytic partial derivatives (model.f90's Jacobian), solved over
+!>   each of the orbit's steps by exponentials and factored within the step
+!>   (analysis/tangent_magnus.f90): a stiff law's fast directions keep their
+!>   exact rates however long the steps.
 !> - A set-valued law (Coulomb, Stribeck, the table) with exact stick: the
 !>   slip's variational equations, the saltation matrix at every switch, and
 !>   in stick the velocity pinned to the belt, which forgets δv: one direction
 !>   is lost (its exponent -inf) once the run has stuck.
 module friction_machine_lyapunov
    use friction_kinds, only: wp, i8
-   use friction_error, only: error_type, fatal_error, error_input
+   use friction_error, only: error_type, fatal_error, error_input, error_numerical
+   use friction_ode_system, only: ode_system
    use friction_ode_solver, only: ode_solver
    use friction_ode_watch, only: step_watch
    use friction_output_h5, only: h5_file
    use friction_analysis_lyapunov_spectrum, only: tangent_system, tangent_settings, spectrum_accumulator, &
-      & kaplan_yorke, generic_frame, pack_tangent, unpack_tangent, max_base
+      & kaplan_yorke, generic_frame, pack_tangent, unpack_tangent
+   use friction_analysis_tangent_magnus, only: magnus_tangent_step
    use friction_analysis_lyapunov_flow, only: benettin_settings, benettin_accumulator
    use friction_law, only: sliding_law, max_law_states
    use friction_law_factory, only: make_law
@@ -42,58 +47,80 @@ module friction_machine_lyapunov
       real(wp) :: divergence = 0.0_wp         !! 1/s: the time average of tr J over the same span
    end type machine_spectrum
 
-   !> The orbit and its tangent (analysis' tangent_system) and one value
-   !> more, D' = tr J(y): for the exact flow ∫ tr J dt = ln det Φ, which the
-   !> exponents sum to (Liouville).  The steps are the orbit's (the tangent
-   !> does not vote), so the sum falls short of D where they do not resolve a
-   !> fast direction: the check the file carries (docs/chaos.md).
-   type, extends(tangent_system) :: divergence_tangent
+   !> The orbit and one value more, D' = tr J(y): for the exact flow
+   !> ∫ tr J dt = ln det Φ, which the exponents sum to (Liouville).  D is
+   !> integrated by the stepper, beside the orbit but not measured by its
+   !> error control, a quadrature independent of how Φ is carried: the
+   !> check the file carries (docs/chaos.md).
+   type, extends(ode_system) :: divergence_system
+      class(ode_system), allocatable :: base
    contains
       procedure :: dimension => divergence_dimension
+      procedure :: controlled_dimension => divergence_controlled_dimension
       procedure :: rhs => divergence_rhs
       procedure :: jacobian => divergence_jacobian
-   end type divergence_tangent
+   end type divergence_system
 
 contains
 
    pure function divergence_dimension(self) result(n)
-      class(divergence_tangent), intent(in) :: self
+      class(divergence_system), intent(in) :: self
       integer :: n
 
-      n = self%tangent_system%dimension() + 1
+      n = self%base%dimension() + 1
    end function divergence_dimension
 
+   pure function divergence_controlled_dimension(self) result(n)
+      class(divergence_system), intent(in) :: self
+      integer :: n
+
+      n = self%base%dimension()
+   end function divergence_controlled_dimension
+
    pure subroutine divergence_rhs(self, t, y, dydt)
-      class(divergence_tangent), intent(in) :: self
+      class(divergence_system), intent(in) :: self
       real(wp), intent(in) :: t
       real(wp), intent(in), contiguous :: y(:)
       real(wp), intent(out), contiguous :: dydt(:)
-      real(wp) :: jac(max_base, max_base), d0(max_base)
-      integer :: n, m, i
+      real(wp) :: jac(size(y) - 1, size(y) - 1), d0(size(y) - 1)
+      integer :: n, i
 
-      n = self%base%dimension()
-      m = n + n * n
-      call self%tangent_system%rhs(t, y(1:m), dydt(1:m))
-      call self%base%jacobian(t, y(1:n), jac(1:n, 1:n), d0(1:n))
-      dydt(m + 1) = 0.0_wp
+      n = size(y) - 1
+      call self%base%rhs(t, y(1:n), dydt(1:n))
+      call self%base%jacobian(t, y(1:n), jac, d0)
+      dydt(n + 1) = 0.0_wp
       do i = 1, n
-         dydt(m + 1) = dydt(m + 1) + jac(i, i)
+         dydt(n + 1) = dydt(n + 1) + jac(i, i)
       end do
    end subroutine divergence_rhs
 
-   !> The tangent system's, and nothing for D (a quadrature: nothing depends on it).
+   !> The orbit's, and nothing for D (a quadrature: nothing depends on it).
    pure subroutine divergence_jacobian(self, t, y, dfdy, dfdt)
-      class(divergence_tangent), intent(in) :: self
+      class(divergence_system), intent(in) :: self
       real(wp), intent(in) :: t
       real(wp), intent(in) :: y(:)
       real(wp), intent(out) :: dfdy(:, :)
       real(wp), intent(out) :: dfdt(:)
-      integer :: m
+      integer :: n
 
-      m = self%tangent_system%dimension()
+      real(wp) :: jp(size(y) - 1, size(y) - 1), jm(size(y) - 1, size(y) - 1), d0(size(y) - 1), yp(size(y) - 1), dy
+      integer :: k, i
+
+      n = size(y) - 1
       dfdy = 0.0_wp
       dfdt = 0.0_wp
-      call self%tangent_system%jacobian(t, y(1:m), dfdy(1:m, 1:m), dfdt(1:m))
+      call self%base%jacobian(t, y(1:n), dfdy(1:n, 1:n), dfdt(1:n))
+      do k = 1, n
+         dy = 1.0e-6_wp * max(1.0_wp, abs(y(k)))
+         yp = y(1:n)
+         yp(k) = y(k) + dy
+         call self%base%jacobian(t, yp, jp, d0)
+         yp(k) = y(k) - dy
+         call self%base%jacobian(t, yp, jm, d0)
+         do i = 1, n
+            dfdy(n + 1, k) = dfdy(n + 1, k) + (jp(i, i) - jm(i, i)) / (2.0_wp * dy)
+         end do
+      end do
    end subroutine divergence_jacobian
 
    !> The ODE of a law that is one ODE, and its initial state (x0, v0, the
@@ -153,7 +180,10 @@ contains
    end subroutine machine_lyapunov_spectrum
 
    !> A law that is one ODE: the orbit alone over the transient, then the
-   !> orbit with Φ from the generic frame.
+   !> orbit with D stepped one accepted step at a time, and Φ from the generic
+   !> frame carried over each step by exponentials (analysis/tangent_magnus.f90),
+   !> factored after every part of a step: the logs are summed over each
+   !> renormalisation interval.
    subroutine smooth_spectrum(c, law, s, qr, divergence, error, watch)
       type(machine_config), intent(in) :: c
       class(sliding_law), intent(in) :: law
@@ -163,11 +193,13 @@ contains
       type(error_type), allocatable, intent(out) :: error
       class(step_watch), intent(inout) :: watch
       type(machine_smooth) :: system
-      type(divergence_tangent), target :: extended
-      type(ode_solver) :: orbit, tangent
-      real(wp), allocatable :: y(:), phi(:, :), z(:)
-      real(wp) :: t, h, t0, trace_integral
+      type(divergence_system), target :: extended
+      type(ode_solver) :: orbit
+      real(wp), allocatable :: y(:), phi(:, :), z(:), y_a(:), f_a(:), f_b(:), logs(:)
+      real(wp) :: t, h, t0, t_a, t_target
+      integer(i8) :: steps
       integer :: n, k, intervals
+      logical :: ok
 
       divergence = 0.0_wp
       call smooth_start(c, law, system, y)
@@ -185,27 +217,55 @@ contains
          if (allocated(error)) return
       end if
       phi = generic_frame(n)
-      call tangent%init(extended, c%solver, h, error)
+      call orbit%init(extended, c%solver, h, error)
       if (allocated(error)) return
       intervals = int(s%duration / s%renormalise + 1.0e-9_wp)
       call qr%start(n, intervals)
-      trace_integral = 0.0_wp
-      allocate (z(n + n * n + 1))
+      allocate (z(n + 1), y_a(n), f_a(n), f_b(n), logs(n))
+      z(1:n) = y
+      z(n + 1) = 0.0_wp
+      call system%rhs(t, y, f_a)
       do k = 1, intervals
-         z(1:n + n * n) = pack_tangent(y, phi)
-         z(n + n * n + 1) = 0.0_wp
-         call tangent%advance(t, t0 + k * s%renormalise, z, error, watch)
+         t_target = t0 + k * s%renormalise
+         logs = 0.0_wp
+         steps = 0
+         do while (t < t_target)
+            t_a = t
+            y_a = z(1:n)
+            call orbit%step(t, t_target, z, error)
+            if (allocated(error)) exit
+            steps = steps + 1
+            if (.not. (t > t_a)) then
+               call fatal_error(error, trim(c%solver%method)//': no progress at '//orbit%time_at(t) &
+                  & //' (the step size fell below the resolution of the time)', error_numerical)
+               exit
+            end if
+            if (steps > c%solver%max_steps) then
+               call fatal_error(error, trim(c%solver%method)//': more than max_steps steps in one ' &
+                  & //'renormalisation interval at '//orbit%time_at(t), error_numerical)
+               exit
+            end if
+            call system%rhs(t, z(1:n), f_b)
+            call magnus_tangent_step(system, t_a, y_a, f_a, t, z(1:n), f_b, phi, logs, ok)
+            if (.not. ok) then
+               call fatal_error(error, 'Lyapunov spectrum: the Jacobian is NaN, Inf or too large to ' &
+                  & //'carry the tangent over the step ending at '//orbit%time_at(t), error_numerical)
+               exit
+            end if
+            f_a = f_b
+            ! (The watch every 16 steps, as the solver's own trips ask it.)
+            if (mod(steps, 16_i8) == 0) then
+               call watch%check(t, error)
+               if (allocated(error)) exit
+            end if
+         end do
          if (allocated(error)) exit
-         call unpack_tangent(z(1:n + n * n), y, phi)
-         trace_integral = trace_integral + z(n + n * n + 1)
-         call qr%renormalise(phi, s%renormalise, 0)
-         ! Φ changed under the stepper: restart it at the step it had reached.
-         call tangent%restart(tangent%step_size())
+         call qr%add_logs(logs, s%renormalise, 0)
          call watch%check(t, error)
          if (allocated(error)) exit
       end do
-      call tangent%destroy()
-      if (qr%elapsed > 0.0_wp) divergence = trace_integral / qr%elapsed
+      call orbit%destroy()
+      if (qr%elapsed > 0.0_wp) divergence = z(n + 1) / qr%elapsed
    end subroutine smooth_spectrum
 
    !> A set-valued law's spectrum: the switching run with Φ; the transient in
