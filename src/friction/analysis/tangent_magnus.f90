@@ -45,12 +45,15 @@ contains
    !> f_a there, to (t_b, y_b) with f_b: Φ orthonormal again, the logs of the
    !> step's R factors added to logs(:).  `ok` false (Φ and logs undefined):
    !> the Jacobian was NaN or Inf, or h J beyond 2^max_parts in norm.
-   pure subroutine magnus_tangent_step(system, t_a, y_a, f_a, t_b, y_b, f_b, phi, logs, ok)
+   !> `depth`: the parts' level j reached by the last step (0 at the start),
+   !> this step's first guess less one: the stiffness met changes slowly.
+   pure subroutine magnus_tangent_step(system, t_a, y_a, f_a, t_b, y_b, f_b, phi, logs, depth, ok)
       class(ode_system), intent(in) :: system
       real(wp), intent(in) :: t_a, t_b
       real(wp), intent(in) :: y_a(:), f_a(:), y_b(:), f_b(:)
       real(wp), intent(inout) :: phi(:, :)
       real(wp), intent(inout) :: logs(:)
+      integer, intent(inout) :: depth
       logical, intent(out) :: ok
       real(wp), parameter :: offset = sqrt(3.0_wp) / 6.0_wp
       real(wp), parameter :: alpha = 0.25_wp + offset, beta = 0.25_wp - offset
@@ -61,22 +64,24 @@ contains
       call system%jacobian(t_a + (0.5_wp - offset) * h, y, a1, dfdt)
       call hermite(0.5_wp + offset, h, y_a, f_a, y_b, f_b, y)
       call system%jacobian(t_a + (0.5_wp + offset) * h, y, a2, dfdt)
-      call apply_exponential(h * (alpha * a1 + beta * a2), phi, logs, ok)
+      call apply_exponential(h * (alpha * a1 + beta * a2), phi, logs, depth, ok)
       if (.not. ok) return
-      call apply_exponential(h * (beta * a1 + alpha * a2), phi, logs, ok)
+      call apply_exponential(h * (beta * a1 + alpha * a2), phi, logs, depth, ok)
    end subroutine magnus_tangent_step
 
    !> Φ ← exp(X) Φ in parts exp(X / 2^j), Φ = Q R after each (Φ ← Q, logs +=
    !> log R_ii).  A part is taken whole when R's diagonal spans at most
    !> e^part_spread, else as two parts of half the size (at ||X / 2^j||_1 <= 1/2
-   !> it spans at most e).
-   pure subroutine apply_exponential(x, phi, logs, ok)
+   !> it spans at most e).  The first parts are tried at level depth - 1;
+   !> depth becomes the finest level taken.
+   pure subroutine apply_exponential(x, phi, logs, depth, ok)
       real(wp), intent(in) :: x(:, :)
       real(wp), intent(inout) :: phi(:, :)
       real(wp), intent(inout) :: logs(:)
+      integer, intent(inout) :: depth
       logical, intent(out) :: ok
       real(wp) :: levels(size(x, 1), size(x, 1), 0:max_parts), norm
-      integer :: scaling, j
+      integer :: scaling, j, first, k
 
       norm = maxval(sum(abs(x), dim=1))
       ok = all(abs(x) <= huge(x)) .and. norm <= pade_norm * 2.0_wp**max_parts
@@ -88,12 +93,17 @@ contains
       do j = scaling - 1, 0, -1
          levels(:, :, j) = matmul(levels(:, :, j + 1), levels(:, :, j + 1))
       end do
-      call apply_part(levels(:, :, 0:scaling), 0, scaling, phi, logs)
+      first = min(max(depth - 1, 0), scaling)
+      depth = first
+      do k = 1, 2**first
+         call apply_part(levels(:, :, 0:scaling), first, scaling, phi, logs, depth)
+      end do
    end subroutine apply_exponential
 
    !> exp(X / 2^level) applied to Φ, whole or as two halves (recursively).
-   pure recursive subroutine apply_part(levels, level, finest, phi, logs)
+   pure recursive subroutine apply_part(levels, level, finest, phi, logs, depth)
       integer, intent(in) :: level, finest
+      integer, intent(inout) :: depth
       real(wp), intent(in) :: levels(:, :, 0:)
       real(wp), intent(inout) :: phi(:, :)
       real(wp), intent(inout) :: logs(:)
@@ -106,9 +116,10 @@ contains
          & .and. minval(r) >= exp(-part_spread) * maxval(r))) then
          phi = trial
          logs = logs + log(r)
+         depth = max(depth, level)
       else
-         call apply_part(levels, level + 1, finest, phi, logs)
-         call apply_part(levels, level + 1, finest, phi, logs)
+         call apply_part(levels, level + 1, finest, phi, logs, depth)
+         call apply_part(levels, level + 1, finest, phi, logs, depth)
       end if
    end subroutine apply_part
 

@@ -198,7 +198,7 @@ contains
       real(wp), allocatable :: y(:), phi(:, :), z(:), y_a(:), f_a(:), f_b(:), logs(:)
       real(wp) :: t, h, t0, t_a, t_target
       integer(i8) :: steps
-      integer :: n, k, intervals
+      integer :: n, k, intervals, depth
       logical :: ok
 
       divergence = 0.0_wp
@@ -225,6 +225,7 @@ contains
       z(1:n) = y
       z(n + 1) = 0.0_wp
       call system%rhs(t, y, f_a)
+      depth = 0
       do k = 1, intervals
          t_target = t0 + k * s%renormalise
          logs = 0.0_wp
@@ -246,7 +247,7 @@ contains
                exit
             end if
             call system%rhs(t, z(1:n), f_b)
-            call magnus_tangent_step(system, t_a, y_a, f_a, t, z(1:n), f_b, phi, logs, ok)
+            call magnus_tangent_step(system, t_a, y_a, f_a, t, z(1:n), f_b, phi, logs, depth, ok)
             if (.not. ok) then
                call fatal_error(error, 'Lyapunov spectrum: the Jacobian is NaN, Inf or too large to ' &
                   & //'carry the tangent over the step ending at '//orbit%time_at(t), error_numerical)
