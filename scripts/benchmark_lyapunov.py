@@ -19,7 +19,7 @@ With --machine, the machine scene instead: each smooth law's input
 (inputs/machine_*.nml, the spectrum after a transient of 10 s, 100 s for
 rate and state) as whole processes, wall clock, plain and with the
 spectrum, the median over --repeats; with --reference PATH, another build
-timed in the same session, runs interleaved (old against new).  Printed
+timed in the same run, the two interleaved (old against new).  Printed
 with the exponents, their sum and spectrum_divergence.
 
 Usage (normally through scripts/benchmark_lyapunov, which builds first):
