@@ -94,17 +94,16 @@ contains
       end do
    end subroutine divergence_rhs
 
-   !> The orbit's, and nothing for D (a quadrature: nothing depends on it).
+   !> The orbit's, and D's row ∂ tr J/∂y from central differences of the
+   !> analytic J: a Rosenbrock stepper's D is of low order without it (docs/chaos.md).
    pure subroutine divergence_jacobian(self, t, y, dfdy, dfdt)
       class(divergence_system), intent(in) :: self
       real(wp), intent(in) :: t
       real(wp), intent(in) :: y(:)
       real(wp), intent(out) :: dfdy(:, :)
       real(wp), intent(out) :: dfdt(:)
-      integer :: n
-
       real(wp) :: jp(size(y) - 1, size(y) - 1), jm(size(y) - 1, size(y) - 1), d0(size(y) - 1), yp(size(y) - 1), dy
-      integer :: k, i
+      integer :: n, k, i
 
       n = size(y) - 1
       dfdy = 0.0_wp
