@@ -20,7 +20,6 @@
 module friction_analysis_tangent_magnus
    use friction_kinds, only: wp
    use friction_ode_system, only: ode_system
-   use friction_analysis_lyapunov_spectrum, only: orthonormalise
    implicit none
    private
 
@@ -45,8 +44,8 @@ contains
    !> f_a there, to (t_b, y_b) with f_b: Φ orthonormal again, the logs of the
    !> step's R factors added to logs(:).  `ok` false (Φ and logs undefined):
    !> the Jacobian was NaN or Inf, or h J beyond 2^max_parts in norm.
-   !> `depth`: the parts' level j reached by the last step (0 at the start),
-   !> this step's first guess less one: the stiffness met changes slowly.
+   !> `depth`: the parts' level j to try first (0 at the start), kept from
+   !> step to step: the stiffness met changes slowly.
    pure subroutine magnus_tangent_step(system, t_a, y_a, f_a, t_b, y_b, f_b, phi, logs, depth, ok)
       class(ode_system), intent(in) :: system
       real(wp), intent(in) :: t_a, t_b
@@ -72,16 +71,17 @@ contains
    !> Φ ← exp(X) Φ in parts exp(X / 2^j), Φ = Q R after each (Φ ← Q, logs +=
    !> log R_ii).  A part is taken whole when R's diagonal spans at most
    !> e^part_spread, else as two parts of half the size (at ||X / 2^j||_1 <= 1/2
-   !> it spans at most e).  The first parts are tried at level depth - 1;
-   !> depth becomes the finest level taken.
+   !> it spans at most e).  The first parts are tried at level `depth`, which
+   !> becomes the finest level taken, or one coarser when every part spanned
+   !> less than e^(part_spread / 2).
    pure subroutine apply_exponential(x, phi, logs, depth, ok)
       real(wp), intent(in) :: x(:, :)
       real(wp), intent(inout) :: phi(:, :)
       real(wp), intent(inout) :: logs(:)
       integer, intent(inout) :: depth
       logical, intent(out) :: ok
-      real(wp) :: levels(size(x, 1), size(x, 1), 0:max_parts), norm
-      integer :: scaling, j, first, k
+      real(wp) :: levels(size(x, 1), size(x, 1), 0:max_parts), norm, product(size(logs)), widest
+      integer :: scaling, j, first, k, finest
 
       norm = maxval(sum(abs(x), dim=1))
       ok = all(abs(x) <= huge(x)) .and. norm <= pade_norm * 2.0_wp**max_parts
@@ -93,35 +93,92 @@ contains
       do j = scaling - 1, 0, -1
          levels(:, :, j) = matmul(levels(:, :, j + 1), levels(:, :, j + 1))
       end do
-      first = min(max(depth - 1, 0), scaling)
-      depth = first
+      first = min(max(depth, 0), scaling)
+      finest = first
+      widest = 1.0_wp
+      product = 1.0_wp
       do k = 1, 2**first
-         call apply_part(levels(:, :, 0:scaling), first, scaling, phi, logs, depth)
+         call apply_part(levels(:, :, 0:scaling), first, scaling, phi, logs, product, finest, widest)
       end do
+      logs = logs + log(product)
+      depth = finest
+      if (finest == first .and. widest <= exp(0.5_wp * part_spread)) depth = max(first - 1, 0)
    end subroutine apply_exponential
 
    !> exp(X / 2^level) applied to Φ, whole or as two halves (recursively).
-   pure recursive subroutine apply_part(levels, level, finest, phi, logs, depth)
-      integer, intent(in) :: level, finest
-      integer, intent(inout) :: depth
+   !> R's diagonals are multiplied into `product` (logs are dear: one a part
+   !> would be a third of the part's cost), which goes into logs before it
+   !> leaves [1e-100, 1e100]; `finest` and `widest` record the finest level
+   !> taken and the largest span of R's diagonal.
+   pure recursive subroutine apply_part(levels, level, last, phi, logs, product, finest, widest)
       real(wp), intent(in) :: levels(:, :, 0:)
+      integer, intent(in) :: level, last
       real(wp), intent(inout) :: phi(:, :)
-      real(wp), intent(inout) :: logs(:)
+      real(wp), intent(inout) :: logs(:), product(:), widest
+      integer, intent(inout) :: finest
       real(wp) :: trial(size(phi, 1), size(phi, 2)), r(size(phi, 2))
+      integer :: n, i, j, k
 
-      trial = matmul(levels(:, :, level), phi)
-      call orthonormalise(trial, r, 0)
+      n = size(phi, 1)
+      do j = 1, n
+         do i = 1, n
+            trial(i, j) = 0.0_wp
+         end do
+         do k = 1, n
+            do i = 1, n
+               trial(i, j) = trial(i, j) + levels(i, k, level) * phi(k, j)
+            end do
+         end do
+      end do
+      call factor(trial, r)
       ! (A part that underflowed or overflowed a column is never taken whole.)
-      if (level == finest .or. (all(r > 0.0_wp .and. r <= huge(r)) &
+      if (level == last .or. (all(r > 0.0_wp .and. r <= huge(r)) &
          & .and. minval(r) >= exp(-part_spread) * maxval(r))) then
          phi = trial
-         logs = logs + log(r)
-         depth = max(depth, level)
+         finest = max(finest, level)
+         widest = max(widest, maxval(r) / minval(r))
+         if (any(product < 1.0e-100_wp .or. product > 1.0e100_wp .or. r < 1.0e-100_wp .or. r > 1.0e100_wp)) then
+            logs = logs + log(product) + log(r)
+            product = 1.0_wp
+         else
+            product = product * r
+         end if
       else
-         call apply_part(levels, level + 1, finest, phi, logs, depth)
-         call apply_part(levels, level + 1, finest, phi, logs, depth)
+         call apply_part(levels, level + 1, last, phi, logs, product, finest, widest)
+         call apply_part(levels, level + 1, last, phi, logs, product, finest, widest)
       end if
    end subroutine apply_part
+
+   !> Φ = Q R by modified Gram–Schmidt with one reorthogonalisation, as
+   !> analysis/lyapunov_spectrum.f90's orthonormalise without its lost
+   !> directions (Φ is regular here), in loops: it is the parts' inner loop.
+   pure subroutine factor(phi, r)
+      real(wp), intent(inout) :: phi(:, :)
+      real(wp), intent(out) :: r(:)
+      real(wp) :: d
+      integer :: n, i, k, pass, l
+
+      n = size(phi, 1)
+      do k = 1, n
+         do pass = 1, 2
+            do i = 1, k - 1
+               d = 0.0_wp
+               do l = 1, n
+                  d = d + phi(l, i) * phi(l, k)
+               end do
+               do l = 1, n
+                  phi(l, k) = phi(l, k) - d * phi(l, i)
+               end do
+            end do
+         end do
+         d = 0.0_wp
+         do l = 1, n
+            d = d + phi(l, k)**2
+         end do
+         r(k) = sqrt(d)
+         if (r(k) > 0.0_wp) phi(:, k) = phi(:, k) / r(k)
+      end do
+   end subroutine factor
 
    !> D(X)^-1 N(X), N and D the Padé (6, 6) polynomials of exp (||X||_1 <= 1/2:
    !> D is then within 0.3 of I and needs no pivoting to speak of).
