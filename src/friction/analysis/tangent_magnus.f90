@@ -31,6 +31,9 @@ module friction_analysis_tangent_magnus
    real(wp), parameter :: part_spread = 18.0_wp
    !> ||X||_1 at most 2^max_parts / 2 (beyond, J is not a number worth trusting).
    integer, parameter :: max_parts = 60
+   !> At most 2^max_level parts to an exponential (seconds of work): a step
+   !> that needs more ends the spectrum with an error instead of stalling.
+   integer, parameter :: max_level = 24
 
    !> Padé (6, 6) of exp(X) is exact to 2e-17 for ||X||_1 <= 1/2 (the
    !> remainder (6!)² / (12! 13!) ||X||^13); larger X is scaled into it.
@@ -43,7 +46,8 @@ contains
    !> Φ (orthonormal) over the accepted step from (t_a, y_a), with the field
    !> f_a there, to (t_b, y_b) with f_b: Φ orthonormal again, the logs of the
    !> step's R factors added to logs(:).  `ok` false (Φ and logs undefined):
-   !> the Jacobian was NaN or Inf, or h J beyond 2^max_parts in norm.
+   !> the Jacobian was NaN or Inf, h J beyond 2^max_parts in norm, or an
+   !> exponential needing more than 2^max_level parts.
    !> `depth`: the parts' level j to try first (0 at the start), kept from
    !> step to step: the stiffness met changes slowly.
    pure subroutine magnus_tangent_step(system, t_a, y_a, f_a, t_b, y_b, f_b, phi, logs, depth, ok)
@@ -99,6 +103,8 @@ contains
       product = 1.0_wp
       do k = 1, 2**first
          call apply_part(levels(:, :, 0:scaling), first, scaling, phi, logs, product, finest, widest)
+         ok = finest <= max_level
+         if (.not. ok) return
       end do
       logs = logs + log(product)
       depth = finest
@@ -109,7 +115,8 @@ contains
    !> R's diagonals are multiplied into `product` (logs are dear: one a part
    !> would be a third of the part's cost), which goes into logs before it
    !> leaves [1e-100, 1e100]; `finest` and `widest` record the finest level
-   !> taken and the largest span of R's diagonal.
+   !> taken and the largest span of R's diagonal (finest > max_level: a part
+   !> beyond max_level was needed, and nothing more is done).
    pure recursive subroutine apply_part(levels, level, last, phi, logs, product, finest, widest)
       real(wp), intent(in) :: levels(:, :, 0:)
       integer, intent(in) :: level, last
@@ -119,6 +126,7 @@ contains
       real(wp) :: trial(size(phi, 1), size(phi, 2)), r(size(phi, 2))
       integer :: n, i, j, k
 
+      if (finest > max_level) return
       n = size(phi, 1)
       do j = 1, n
          do i = 1, n
@@ -143,6 +151,8 @@ contains
          else
             product = product * r
          end if
+      else if (level == max_level) then
+         finest = max_level + 1
       else
          call apply_part(levels, level + 1, last, phi, logs, product, finest, widest)
          call apply_part(levels, level + 1, last, phi, logs, product, finest, widest)

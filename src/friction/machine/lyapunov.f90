@@ -248,8 +248,9 @@ contains
             call system%rhs(t, z(1:n), f_b)
             call magnus_tangent_step(system, t_a, y_a, f_a, t, z(1:n), f_b, phi, logs, depth, ok)
             if (.not. ok) then
-               call fatal_error(error, 'Lyapunov spectrum: the Jacobian is NaN, Inf or too large to ' &
-                  & //'carry the tangent over the step ending at '//orbit%time_at(t), error_numerical)
+               call fatal_error(error, 'Lyapunov spectrum: the Jacobian is NaN or Inf, or too stiff for ' &
+                  & //'the step ending at '//orbit%time_at(t)//' (an exponential of the tangent in more ' &
+                  & //'than 2^24 parts)', error_numerical)
                exit
             end if
             f_a = f_b
