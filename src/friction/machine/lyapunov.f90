@@ -254,8 +254,9 @@ contains
                exit
             end if
             f_a = f_b
-            ! (The watch every 16 steps, as the solver's own trips ask it.)
-            if (mod(steps, 16_i8) == 0) then
+            ! (The watch every 16 steps, as the solver's own trips ask it, and
+            ! after every step whose exponentials took thousands of parts.)
+            if (mod(steps, 16_i8) == 0 .or. depth >= 12) then
                call watch%check(t, error)
                if (allocated(error)) exit
             end if
