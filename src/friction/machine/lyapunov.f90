@@ -22,8 +22,8 @@ module friction_machine_lyapunov
    use friction_ode_solver, only: ode_solver
    use friction_ode_watch, only: step_watch
    use friction_output_h5, only: h5_file
-   use friction_analysis_lyapunov_spectrum, only: tangent_system, tangent_settings, spectrum_accumulator, &
-      & kaplan_yorke, generic_frame, pack_tangent, unpack_tangent
+   use friction_analysis_lyapunov_spectrum, only: tangent_settings, spectrum_accumulator, kaplan_yorke, &
+      & generic_frame
    use friction_analysis_tangent_magnus, only: magnus_tangent_step
    use friction_analysis_lyapunov_flow, only: benettin_settings, benettin_accumulator
    use friction_law, only: sliding_law, max_law_states
