@@ -11,12 +11,19 @@ Not a test: the machine is shared and noisy, so each time is the median of
               1e-6 m/s), 3000 s: the slip rate spans ten decades
 
 Accuracy: the largest difference in x on the output grid from a reference,
-the program at rtol 1e-12, relative to the range of x.  The program's time
-is its whole process (start, input, integration, HDF5 file); SciPy's is
+the program at rtol 1e-12 stepping onto every output time, relative to the
+range of x.  The program's time is its whole process (start, input,
+integration, HDF5 file): "friction" as it runs by default (free steps, the
+grid from rodas4's continuous extension), "stepped" with &machine
+dense_output = .false. (a step ends at every output time).  SciPy's is
 solve_ivp alone (the interpreter already running), with the Jacobian
 estimated by differences (its default).  CVODE's is its whole process too
 (scripts/cvode_laws.c, compiled here: BDF, dense solver, the analytic
 Jacobian; Debian: libsundials-dev, without which its rows are skipped).
+The program's and CVODE's processes run interleaved (friction, stepped,
+CVODE, friction, ...), so that a change of the machine's load falls on all
+three alike; the ratio column is CVODE's median over the program's at the
+same rtol.
 
     scripts/benchmark_laws [--repeats N] [--quick] [--limit S] [--chart FILE.png]
 
@@ -43,6 +50,7 @@ ROOT = Path(__file__).resolve().parent.parent
 
 
 def program_run(binary, work, name, rtol, sets):
+    """(seconds of the whole process, t, x, steps, Jacobians)."""
     out = work / f"{name}.h5"
     command = [str(binary), "--quiet", "--force", "-o", str(out), str(ROOT / "inputs" / f"machine_{name}.nml"),
                "--set", f"integrator.rtol={rtol}", "--set", f"integrator.atol={rtol * 1e-3}"]
@@ -52,7 +60,8 @@ def program_run(binary, work, name, rtol, sets):
     subprocess.run(command, check=True)
     elapsed = time.perf_counter() - start
     with h5py.File(out) as f:
-        return elapsed, f["machine/t"][:], f["machine/x"][:]
+        return (elapsed, f["machine/t"][:], f["machine/x"][:], int(f.attrs["integrator_steps"]),
+                int(f.attrs["jacobian_evaluations"]))
 
 
 def lugre_field():
@@ -128,21 +137,21 @@ def build_cvode(work):
 
 
 def cvode_run(exe, work, name, rtol, dt_out):
-    """(seconds of the whole process, x on the grid) or (seconds, why it failed)."""
+    """(seconds of the whole process, x on the grid, counts) or (seconds, why it failed, None)."""
     out = work / f"cvode_{name}.bin"
     start = time.perf_counter()
     result = subprocess.run([str(exe), name, f"{rtol:.17g}", f"{rtol * 1e-3:.17g}", f"{dt_out:.17g}", str(out)],
                             capture_output=True, text=True)
     elapsed = time.perf_counter() - start
     if result.returncode != 0:
-        return elapsed, result.stderr.strip().splitlines()[-1]
-    json.loads(result.stdout)
-    return elapsed, np.fromfile(out)
+        return elapsed, result.stderr.strip().splitlines()[-1], None
+    return elapsed, np.fromfile(out), json.loads(result.stdout)
 
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--repeats", type=int, default=3, help="runs of the program and CVODE per point")
+    parser.add_argument("--scipy-repeats", type=int, default=3, help="runs of SciPy per point")
     parser.add_argument("--quick", action="store_true", help="fewer tolerances")
     parser.add_argument("--binary", default=str(ROOT / "build" / "friction"))
     parser.add_argument("--limit", type=float, default=60.0, help="seconds before a SciPy run is given up")
@@ -157,21 +166,50 @@ def main():
             print(f"CVODE rows skipped: {why_not}")
         for name, make in (("lugre", lugre_field), ("rate_state", rate_state_field)):
             _, _, t_end, sets = make()
-            _, t, reference = program_run(args.binary, work, name, 1e-12, sets)
+            stepped = dict(sets, **{"machine.dense_output": ".false."})
+            _, t, reference, _, _ = program_run(args.binary, work, name, 1e-12, stepped)
             scale = np.ptp(reference)
             print(f"\n{name}: {t.size} grid points to t = {t_end:g} s; error = max |x - x_ref| / range of x")
-            print(f"{'method':10s} {'rtol':>8s} {'error':>10s} {'time (s)':>10s}")
+            print(f"{'method':10s} {'rtol':>8s} {'error':>10s} {'time (s)':>10s} {'steps':>8s} {'Jacobians':>9s}"
+                  f" {'CVODE/this':>10s}")
+            rows = []
             for rtol in tolerances:
-                elapsed = []
+                times = {"friction": [], "stepped": [], "CVODE": []}
+                last = {}
                 for _ in range(args.repeats):
-                    seconds, _, x = program_run(args.binary, work, name, rtol, sets)
-                    elapsed.append(seconds)
-                error = np.max(np.abs(x - reference)) / scale
-                points.setdefault((name, "friction"), []).append((error, statistics.median(elapsed)))
-                print(f"{'friction':10s} {rtol:8.0e} {error:10.2e} {statistics.median(elapsed):10.4f}")
+                    for method, settings in (("friction", sets), ("stepped", stepped)):
+                        seconds, _, x, steps, jacobians = program_run(args.binary, work, name, rtol, settings)
+                        times[method].append(seconds)
+                        last[method] = (x, steps, jacobians)
+                    if cvode:
+                        seconds, x, counts = cvode_run(cvode, work, name, rtol, float(t[1] - t[0]))
+                        times["CVODE"].append(seconds)
+                        last["CVODE"] = (x, counts)
+                median = {method: statistics.median(v) for method, v in times.items() if v}
+                for method in ("friction", "stepped"):
+                    x, steps, jacobians = last[method]
+                    error = np.max(np.abs(x - reference)) / scale
+                    points.setdefault((name, method), []).append((error, median[method]))
+                    ratio = f"{median['CVODE'] / median[method]:10.2f}" if "CVODE" in median else ""
+                    rows.append(f"{method:10s} {rtol:8.0e} {error:10.2e} {median[method]:10.4f} {steps:8d}"
+                                f" {jacobians:9d} {ratio}")
+                if cvode:
+                    x, counts = last["CVODE"]
+                    if isinstance(x, str) or x.size != t.size:
+                        rows.append(f"{'CVODE':10s} {rtol:8.0e} {'failed':>10s} {median['CVODE']:10.4f}  "
+                                    f"{x if isinstance(x, str) else ''}")
+                    else:
+                        error = np.max(np.abs(x - reference)) / scale
+                        points.setdefault((name, "CVODE"), []).append((error, median["CVODE"]))
+                        rows.append(f"{'CVODE':10s} {rtol:8.0e} {error:10.2e} {median['CVODE']:10.4f}"
+                                    f" {counts['steps']:8d} {counts['jacobian_evaluations']:9d}")
+            for key in ("friction", "stepped", "CVODE"):
+                for row in rows:
+                    if row.startswith(key):
+                        print(row)
             for method in ("Radau", "LSODA"):
                 for rtol in tolerances:
-                    runs = [scipy_run(name, method, t, rtol, args.limit) for _ in range(args.repeats)]
+                    runs = [scipy_run(name, method, t, rtol, args.limit) for _ in range(args.scipy_repeats)]
                     seconds = statistics.median(run[0] for run in runs)
                     _, status, message, x = runs[-1]
                     if status != 0 or x is None or x.size != t.size:
@@ -180,16 +218,6 @@ def main():
                     error = np.max(np.abs(x - reference)) / scale
                     points.setdefault((name, method), []).append((error, seconds))
                     print(f"{method:10s} {rtol:8.0e} {error:10.2e} {seconds:10.4f}")
-            for rtol in tolerances if cvode else []:
-                runs = [cvode_run(cvode, work, name, rtol, float(t[1] - t[0])) for _ in range(args.repeats)]
-                seconds = statistics.median(run[0] for run in runs)
-                x = runs[-1][1]
-                if isinstance(x, str) or x.size != t.size:
-                    print(f"{'CVODE':10s} {rtol:8.0e} {'failed':>10s} {seconds:10.4f}  {x if isinstance(x, str) else ''}")
-                    continue
-                error = np.max(np.abs(x - reference)) / scale
-                points.setdefault((name, "CVODE"), []).append((error, seconds))
-                print(f"{'CVODE':10s} {rtol:8.0e} {error:10.2e} {seconds:10.4f}")
             sys.stdout.flush()
     if args.chart:
         chart(points, args.chart)
@@ -204,7 +232,8 @@ def chart(points, path):
     fig, axes = plt.subplots(1, 2, figsize=(10, 4))
     for ax, (name, title) in zip(axes, (("lugre", "LuGre stick-slip, 30 s"),
                                         ("rate_state", "rate and state spring-slider, 3000 s"))):
-        for method, style in (("friction", "o-"), ("Radau", "s--"), ("LSODA", "^:"), ("CVODE", "D-.")):
+        for method, style in (("friction", "o-"), ("stepped", "o:"), ("Radau", "s--"), ("LSODA", "^:"),
+                              ("CVODE", "D-.")):
             data = sorted(points.get((name, method), []))
             if data:
                 ax.loglog([e for e, _ in data], [s for _, s in data], style, label=method)

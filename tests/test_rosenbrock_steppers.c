@@ -16,6 +16,15 @@
  *   df/dt        y' = -lambda (y - sin t) + cos t, lambda = 1e4, y = sin t:
  *                the error through GSL's evolve at rtol 1e-8; with df/dt
  *                withheld (set to 0) the same fixed steps are far worse.
+ *   dense        rodas4's continuous extension: it meets both ends of the
+ *                step bit for bit; one step from the exact solution, its
+ *                error inside the step falls as h^4 (the local error of a
+ *                cubic of order 3) on Prothero-Robinson with lambda = -1
+ *                and the damped rotations, and as h^3 at least with
+ *                lambda = -1e6 (the stiff limit, where y is the algebraic
+ *                g(t)); through GSL's evolve at rtol 1e-8 the values inside
+ *                the steps are as close to the closed form as the steps'
+ *                ends.  rodas3 has none: asking is GSL_EINVAL.
  *   bad paths    a singular matrix I/(h gamma) - J fails the step with
  *                GSL_ESING and y unchanged, and evolve recovers by halving
  *                the step; a Jacobian of NaN fails every step and evolve
@@ -33,6 +42,8 @@
 
 extern const gsl_odeiv2_step_type *friction_step_rodas3;
 extern const gsl_odeiv2_step_type *friction_step_rodas4;
+int friction_rosenbrock_has_dense(const gsl_odeiv2_step_type *type);
+int friction_rosenbrock_dense(void *state, const gsl_odeiv2_step_type *type, double t, double y[]);
 
 static int failures = 0;
 
@@ -193,6 +204,124 @@ static void check_order(const char *name, const gsl_odeiv2_step_type *type, doub
     }
 }
 
+/* ---- dense output ---- */
+
+static const double dense_thetas[] = {0.2, 0.5, 0.8};
+
+/* Largest error of the continuous extension at dense_thetas within one step
+ * of size h from the exact y(t0); *ends_exact is cleared unless theta = 0
+ * and 1 give y0 and the step's y bit for bit. */
+static double dense_step_error(gsl_odeiv2_system *sys, double t0, double h, void (*exact)(double, double[]),
+                               int *ends_exact)
+{
+    const gsl_odeiv2_step_type *type = friction_step_rodas4;
+    size_t dim = sys->dimension, i, k;
+    gsl_odeiv2_step *s = gsl_odeiv2_step_alloc(type, dim);
+    double y[2 * max_blocks], y0[2 * max_blocks], yerr[2 * max_blocks], out[2 * max_blocks];
+    double value[2 * max_blocks], want[2 * max_blocks], error = 0.0;
+    int status;
+
+    exact(t0, y);
+    memcpy(y0, y, dim * sizeof *y);
+    status = gsl_odeiv2_step_apply(s, t0, h, y, yerr, NULL, out, sys);
+    if (status == GSL_SUCCESS) status = friction_rosenbrock_dense(s->state, type, t0, value);
+    if (status == GSL_SUCCESS && memcmp(value, y0, dim * sizeof *y) != 0) *ends_exact = 0;
+    if (status == GSL_SUCCESS) status = friction_rosenbrock_dense(s->state, type, t0 + h, value);
+    if (status == GSL_SUCCESS && memcmp(value, y, dim * sizeof *y) != 0) *ends_exact = 0;
+    for (k = 0; k < sizeof dense_thetas / sizeof dense_thetas[0] && status == GSL_SUCCESS; k++) {
+        status = friction_rosenbrock_dense(s->state, type, t0 + dense_thetas[k] * h, value);
+        exact(t0 + dense_thetas[k] * h, want);
+        for (i = 0; i < dim; i++) error = fmax(error, fabs(value[i] - want[i]));
+    }
+    gsl_odeiv2_step_free(s);
+    return status == GSL_SUCCESS ? error : NAN;
+}
+
+static void check_dense(void)
+{
+    struct pr mild = {-1.0, 1}, stiff = {-1.0e6, 1};
+    gsl_odeiv2_system pr_sys = {pr_f, pr_jac, 1, &mild};
+    gsl_odeiv2_system lin_sys = {lin_f, lin_jac, 2, NULL};
+    int ends_exact = 1, n;
+
+    CHECK(friction_rosenbrock_has_dense(friction_step_rodas4) && !friction_rosenbrock_has_dense(friction_step_rodas3),
+          "rodas4 has dense output, rodas3 not");
+    /* Local error C h^4 of the extension (its own, not a step's h^5):
+     * log2 of the ratio from h to h/2 is 4; a weight that breaks one of
+     * the order-3 conditions leaves h^3 (3), one of order 2 h^2. */
+    for (n = 0; n < 3; n++) {
+        double h = 0.05 / (1 << n), e1, e2, observed;
+        e1 = dense_step_error(&pr_sys, 0.3, h, pr_exact, &ends_exact);
+        e2 = dense_step_error(&pr_sys, 0.3, h / 2, pr_exact, &ends_exact);
+        observed = log2(e1 / e2);
+        CHECK(fabs(observed - 4.0) <= 0.3, "rodas4 dense output, Prothero-Robinson: order %.3f (h = %g: %.3e, %.3e)",
+              observed, h, e1, e2);
+        for (lin_blocks = 1; lin_blocks <= max_blocks; lin_blocks++) {
+            lin_sys.dimension = (size_t)(2 * lin_blocks);
+            e1 = dense_step_error(&lin_sys, 0.3, h, lin_exact, &ends_exact);
+            e2 = dense_step_error(&lin_sys, 0.3, h / 2, lin_exact, &ends_exact);
+            observed = log2(e1 / e2);
+            CHECK(fabs(observed - 4.0) <= 0.3,
+                  "rodas4 dense output, linear system of dimension %d: order %.3f (h = %g: %.3e, %.3e)",
+                  2 * lin_blocks, observed, h, e1, e2);
+        }
+    }
+    CHECK(ends_exact, "rodas4 dense output: theta = 0 and 1 give the step's ends bit for bit");
+    /* The stiff limit: h |lambda| = 1e5 ... 2.5e4, y = g(t) algebraic. */
+    pr_sys.params = &stiff;
+    for (n = 0; n < 2; n++) {
+        double h = 0.1 / (1 << n), e1, e2, observed;
+        e1 = dense_step_error(&pr_sys, 0.3, h, pr_exact, &ends_exact);
+        e2 = dense_step_error(&pr_sys, 0.3, h / 2, pr_exact, &ends_exact);
+        observed = log2(e1 / e2);
+        CHECK(observed >= 2.8, "rodas4 dense output, Prothero-Robinson lambda = -1e6: order %.3f (h = %g: %.3e, %.3e)",
+              observed, h, e1, e2);
+    }
+    /* Controlled steps: the extension adds an error of the order of the
+     * one the control bounds (the embedded estimate's, O(h^4) too), so its
+     * values between the ends stay within a few times the ends' error. */
+    {
+        gsl_odeiv2_evolve *e;
+        gsl_odeiv2_control *c;
+        gsl_odeiv2_step *s;
+        double y[6] = {1.0, 0.0, 1.0, 0.0, 1.0, 0.0}, want[6], value[6], t = 0.0, h = 1e-3;
+        double at_ends = 0.0, inside = 0.0;
+        int status = GSL_SUCCESS, steps = 0, k;
+        size_t i;
+
+        lin_blocks = 3;
+        lin_sys.dimension = 6;
+        s = gsl_odeiv2_step_alloc(friction_step_rodas4, 6);
+        c = gsl_odeiv2_control_y_new(1e-10, 1e-8);
+        e = gsl_odeiv2_evolve_alloc(6);
+        while (t < 5.0 && status == GSL_SUCCESS) {
+            double t0 = t;
+            status = gsl_odeiv2_evolve_apply(e, c, s, &lin_sys, &t, 5.0, &h, y);
+            steps++;
+            lin_exact(t, want);
+            for (i = 0; i < 6; i++) at_ends = fmax(at_ends, fabs(y[i] - want[i]));
+            for (k = 0; k < 3 && status == GSL_SUCCESS; k++) {
+                double tk = t0 + dense_thetas[k] * (t - t0);
+                status = friction_rosenbrock_dense(s->state, friction_step_rodas4, tk, value);
+                lin_exact(tk, want);
+                for (i = 0; i < 6; i++) inside = fmax(inside, fabs(value[i] - want[i]));
+            }
+        }
+        CHECK(status == GSL_SUCCESS && inside <= 3.0 * at_ends,
+              "rodas4 dense output under evolve: status %d, %d steps, error %.3e inside the steps, %.3e at their ends",
+              status, steps, inside, at_ends);
+        /* Outside the last step, and after a reset: no value. */
+        CHECK(friction_rosenbrock_dense(s->state, friction_step_rodas4, t + 1.0, value) == GSL_EINVAL,
+              "rodas4 dense output beyond the step");
+        gsl_odeiv2_step_reset(s);
+        CHECK(friction_rosenbrock_dense(s->state, friction_step_rodas4, t, value) == GSL_EINVAL,
+              "rodas4 dense output after a reset");
+        gsl_odeiv2_evolve_free(e);
+        gsl_odeiv2_control_free(c);
+        gsl_odeiv2_step_free(s);
+    }
+}
+
 /* ---- stiff decay ---- */
 
 static int decay_f(double t, const double y[], double f[], void *params)
@@ -343,6 +472,7 @@ int main(void)
         check_dfdt(methods[m].name, type);
         check_bad_paths(methods[m].name, type, methods[m].gamma);
     }
+    check_dense();
     if (failures == 0) printf("test_rosenbrock_steppers: all checks passed\n");
     return failures == 0 ? 0 : 1;
 }

@@ -50,6 +50,8 @@ module friction_machine_config
       real(wp) :: dt_out = 0.01_wp           !! s
       real(wp) :: event_tolerance = 1.0e-10_wp   !! s: the stick/slip events' times
       real(wp) :: stick_velocity = 1.0e-6_wp !! m/s: |v - belt_velocity| below this counts as stick (smooth laws)
+      !> smooth laws: free steps and the output grid from the stepper's continuous extension (rodas4)
+      logical :: dense_output = .true.
       type(law_settings) :: law
       type(solver_settings) :: solver = machine_solver_defaults
       type(analysis_settings) :: analysis   !! &analysis: the spectrum and the Lyapunov exponent
@@ -88,6 +90,7 @@ contains
       call v%item('dt_out', self%dt_out, 's')
       call v%item('event_tolerance', self%event_tolerance, 's')
       call v%item('stick_velocity', self%stick_velocity, 'm/s')
+      call v%item('dense_output', self%dense_output)
       call v%end_group()
       call self%law%visit(v)
       call self%analysis%visit(v, 's')

@@ -5,8 +5,8 @@
 !> beyond the static limit reverses); the other laws are one ODE with the
 !> law's states, and the output counts |w| <= stick_velocity as stick.
 module friction_machine_run
-   use friction_kinds, only: wp
-   use friction_error, only: error_type
+   use friction_kinds, only: wp, i8
+   use friction_error, only: error_type, fatal_error, error_numerical
    use friction_ode_solver, only: ode_solver, integrator_statistics
    use friction_ode_watch, only: step_watch
    use friction_scene_report, only: job_reporter, new_job_watch
@@ -161,28 +161,88 @@ contains
       y(2) = c%v0
       y(3:2 + ns) = z(1:ns) / system%scale(1:ns)
       t = c%t_start
-      do i = 1, run%n
-         if (i > 1) then
-            call solver%advance(t, c%grid_time(i), y(1:2 + ns), error, watch)
+      if (c%dense_output .and. solver%has_dense_output()) then
+         call free_steps()
+         if (allocated(error)) return
+      else
+         do i = 1, run%n
+            if (i > 1) then
+               call solver%advance(t, c%grid_time(i), y(1:2 + ns), error, watch)
+               if (allocated(error)) then
+                  call label(c, error)
+                  return
+               end if
+               ! (Also here: a trip of a few steps never reaches the solver's look.)
+               call watch%check(t, error)
+               if (allocated(error)) return
+            end if
+            call record(i, y)
+         end do
+      end if
+      run%stats = solver%statistics()
+
+   contains
+
+      !> Steps of the error control's own size to the last output time, the
+      !> output points within each step from its continuous extension: the
+      !> grid no longer pins the steps (one Jacobian per output point).
+      subroutine free_steps()
+         real(wp) :: t_last, t_grid, yi(2 + max_law_states)
+         integer(i8) :: steps
+         !> Steps between two looks of the watch (as the solver's advance).
+         integer, parameter :: watch_steps = 16
+
+         t_last = c%grid_time(run%n)
+         call record(1, y)
+         i = 2
+         steps = 0
+         do while (i <= run%n)
+            call solver%step(t, t_last, y(1:2 + ns), error)
             if (allocated(error)) then
                call label(c, error)
                return
             end if
-            ! (Also here: a trip of a few steps never reaches the solver's look.)
-            call watch%check(t, error)
-            if (allocated(error)) return
-         end if
-         z(1:ns) = y(3:2 + ns) * system%scale(1:ns)
+            steps = steps + 1
+            if (steps > c%solver%max_steps) then
+               call fatal_error(error, trim(c%solver%method)//': more than max_steps steps at ' &
+                  & //solver%time_at(t), error_numerical)
+               call label(c, error)
+               return
+            end if
+            do while (i <= run%n)
+               t_grid = c%grid_time(i)
+               if (t_grid > t) exit
+               if (t_grid == t) then
+                  call record(i, y)
+               else
+                  call solver%dense_output(t_grid, yi(1:2 + ns), error)
+                  if (allocated(error)) return
+                  call record(i, yi)
+               end if
+               i = i + 1
+            end do
+            if (mod(steps, int(watch_steps, i8)) == 0 .or. i > run%n) then
+               call watch%check(t, error)
+               if (allocated(error)) return
+            end if
+         end do
+      end subroutine free_steps
+
+      !> Output point i from the state yy at the grid time.
+      subroutine record(i, yy)
+         integer, intent(in) :: i
+         real(wp), intent(in) :: yy(:)
+
+         z(1:ns) = yy(3:2 + ns) * system%scale(1:ns)
          run%t(i) = c%grid_time(i)
-         run%x(i) = y(1)
-         run%v(i) = y(2)
-         run%force(i) = law%force(y(2) - m%belt, z(1:ns), m%normal, m%applied(run%t(i), y(1), y(2)))
+         run%x(i) = yy(1)
+         run%v(i) = yy(2)
+         run%force(i) = law%force(yy(2) - m%belt, z(1:ns), m%normal, m%applied(run%t(i), yy(1), yy(2)))
          do k = 1, ns
             run%states(k, i) = z(k)
          end do
-         if (abs(y(2) - m%belt) <= c%stick_velocity) run%stick(i) = 1
-      end do
-      run%stats = solver%statistics()
+         if (abs(yy(2) - m%belt) <= c%stick_velocity) run%stick(i) = 1
+      end subroutine record
    end subroutine run_smooth
 
    !> Exact stick and slip for a set-valued law.

@@ -340,6 +340,19 @@ void friction_gsl_driver_counts(const gsl_odeiv2_driver *d, long *steps, long *f
     *failed = (long)d->e->failed_steps;
 }
 
+/* 1 if the driver's stepper has a continuous extension (dense output). */
+int friction_gsl_driver_has_dense(const gsl_odeiv2_driver *d)
+{
+    return friction_rosenbrock_has_dense(d->s->type);
+}
+
+/* y at time t within the step the driver took last, from the stepper's
+ * continuous extension; GSL_EINVAL without one or outside that step. */
+int friction_gsl_driver_dense(const gsl_odeiv2_driver *d, double t, double y[])
+{
+    return friction_rosenbrock_dense(d->s->state, d->s->type, t, y);
+}
+
 /* The current step size the driver will try next. */
 double friction_gsl_driver_step(const gsl_odeiv2_driver *d)
 {

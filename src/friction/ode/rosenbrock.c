@@ -43,6 +43,7 @@
  * and y bit for bit): evolve does not pass it (can_use_dydt_in = 0), and
  * a rejected step restarts from the same point, so both ends are kept.
  * reset forgets them. */
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -64,6 +65,8 @@ struct rosenbrock_method {
     double gamma_sum[max_stages];    /* gamma_i = sum_j gamma_ij, the df/dt weights */
     double m[max_stages];            /* solution weights */
     double e[max_stages];            /* error weights */
+    int dense;                       /* has the continuous extension below */
+    double d2[max_stages], d3[max_stages];  /* its weights (see friction_rosenbrock_dense) */
 };
 
 /* RODAS3 (Sandu et al. 1997). Stage 2 has the same
@@ -76,6 +79,7 @@ static const struct rosenbrock_method rodas3 = {
     {0.5, 1.5, 0.0, 0.0},
     {2.0, 0.0, 1.0, 1.0},
     {0.0, 0.0, 0.0, 1.0},
+    0, {0}, {0},
 };
 
 /* RODAS (Hairer and Wanner 1996, Sect. IV.7). */
@@ -98,6 +102,12 @@ static const struct rosenbrock_method rodas4 = {
     {0.25, -0.1043, 0.1035, -0.0362, 0.0, 0.0},
     {1.221224509226641, 6.019134481288629, 12.53708332932087, -0.6878860361058950, 1.0, 1.0},
     {0.0, 0.0, 0.0, 0.0, 0.0, 1.0},
+    /* The continuous extension of order 3 (docs/speed.md, "Dense output"):
+     * the order conditions to order 3 for every theta and the index-1
+     * condition of the algebraic components, solved with d_6 = 0. */
+    1,
+    {10.126235083445865, -7.487995877610194, -34.80091861555751, -7.992771707568842, 1.0251377232956649, 0.0},
+    {-0.6762803392800684, 6.087714651680054, 16.430843208924582, 24.767225114183717, -6.594389125716781, 0.0},
 };
 
 /* A right-hand side value kept for reuse: f(t, y) of system sys. */
@@ -117,6 +127,10 @@ struct rosenbrock_state {
     size_t *pivot;
     struct kept_rhs start, end;
     int jacobian_at_start;           /* jac and dfdt are those at `start` (a retried step reuses them) */
+    /* The last accepted step, for its continuous extension: from (dense_t, y0)
+     * to y1 over dense_h with the stages in k; dense_valid until the next try. */
+    int dense_valid;
+    double dense_t, dense_h, *y1;
 };
 
 static void kept_clear(struct kept_rhs *kept)
@@ -151,8 +165,8 @@ static void *alloc_with(const struct rosenbrock_method *method, size_t dim)
         GSL_ERROR_NULL("dimension of the system must be positive", GSL_EINVAL);
     }
     s = calloc(1, sizeof *s);
-    /* y0, ytmp, f, dfdt, 4 kept vectors, inverse_pivot: 9 n; jac, lu: 2 n^2; k: stages n */
-    doubles = 9 * dim + 2 * dim * dim + (size_t)method->stages * dim;
+    /* y0, y1, ytmp, f, dfdt, 4 kept vectors, inverse_pivot: 10 n; jac, lu: 2 n^2; k: stages n */
+    doubles = 10 * dim + 2 * dim * dim + (size_t)method->stages * dim;
     block = s != NULL ? malloc(doubles * sizeof *block) : NULL;
     if (block != NULL) s->pivot = malloc(dim * sizeof *s->pivot);
     if (s == NULL || block == NULL || s->pivot == NULL) {
@@ -181,6 +195,8 @@ static void *alloc_with(const struct rosenbrock_method *method, size_t dim)
     s->lu = s->jac + dim * dim;
     s->k = s->lu + dim * dim;
     s->inverse_pivot = s->k + (size_t)method->stages * dim;
+    s->y1 = s->inverse_pivot + dim;
+    s->dense_valid = 0;
     kept_clear(&s->start);
     kept_clear(&s->end);
     s->jacobian_at_start = 0;
@@ -274,6 +290,7 @@ static inline __attribute__((always_inline)) int step_sized(struct rosenbrock_st
     /* A retry from the same point (a rejected step) keeps f and the Jacobian. */
     const int retry = kept_matches(&s->start, sys, t, y, n);
 
+    s->dense_valid = 0;
     if (!retry) s->jacobian_at_start = 0;
     /* f(t, y): given, kept from this point's previous try or from the last
      * step's end, or evaluated. */
@@ -339,6 +356,13 @@ static inline __attribute__((always_inline)) int step_sized(struct rosenbrock_st
         if (status != GSL_SUCCESS) return status;
         kept_set(&s->end, sys, t + h, s->ytmp, dydt_out, n);
     }
+    if (m->dense) {
+        memcpy(s->y0, y, n * sizeof *y);
+        memcpy(s->y1, s->ytmp, n * sizeof *y);
+        s->dense_t = t;
+        s->dense_h = h;
+        s->dense_valid = 1;
+    }
     for (j = 0; j < n; j++) y[j] = s->ytmp[j];
     return GSL_SUCCESS;
 }
@@ -394,6 +418,7 @@ static int rosenbrock_reset(void *vstate, size_t dim)
     kept_clear(&s->start);
     kept_clear(&s->end);
     s->jacobian_at_start = 0;
+    s->dense_valid = 0;
     return GSL_SUCCESS;
 }
 
@@ -412,6 +437,47 @@ static void rosenbrock_free(void *vstate)
     free(s->y0);
     free(s->pivot);
     free(s);
+}
+
+int friction_rosenbrock_has_dense(const gsl_odeiv2_step_type *type)
+{
+    return type != NULL && type->alloc == rodas4_alloc;
+}
+
+/* The continuous extension of the last accepted step at t in [t0, t0 + h]:
+ *
+ *   y(t0 + theta h) = (1 - theta) y0 + theta y1
+ *                     + theta (1 - theta) sum_i (d2_i + theta d3_i) k_i,
+ *
+ * a cubic in theta that meets both ends of the step exactly.  GSL_EINVAL
+ * when there is no such step (none accepted since the last reset, a try
+ * since, a method without the extension) or t is outside it. */
+int friction_rosenbrock_dense(void *vstate, const gsl_odeiv2_step_type *type, double t, double y[])
+{
+    struct rosenbrock_state *s = vstate;
+    const struct rosenbrock_method *m;
+    double theta;
+    size_t i, n;
+    int stage;
+
+    if (!friction_rosenbrock_has_dense(type) || s == NULL || !s->dense_valid) return GSL_EINVAL;
+    m = s->method;
+    n = s->dim;
+    /* The step's end as evolve computes it is theta = 1 exactly: (t0 + h) - t0
+     * rounded need not be h.  (Rounding may also put a time just before the
+     * end a few ulps past 1.) */
+    theta = t == s->dense_t + s->dense_h ? 1.0 : (t - s->dense_t) / s->dense_h;
+    if (theta > 1.0 && theta <= 1.0 + 64.0 * DBL_EPSILON) theta = 1.0;
+    if (!(theta >= 0.0 && theta <= 1.0)) return GSL_EINVAL;
+    for (i = 0; i < n; i++) {
+        double d2 = 0.0, d3 = 0.0;
+        for (stage = 0; stage < m->stages; stage++) {
+            d2 += m->d2[stage] * s->k[(size_t)stage * n + i];
+            d3 += m->d3[stage] * s->k[(size_t)stage * n + i];
+        }
+        y[i] = (1.0 - theta) * s->y0[i] + theta * (s->y1[i] + (1.0 - theta) * (d2 + theta * d3));
+    }
+    return GSL_SUCCESS;
 }
 
 static const gsl_odeiv2_step_type rodas3_type = {

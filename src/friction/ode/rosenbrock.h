@@ -9,4 +9,9 @@
 extern const gsl_odeiv2_step_type *friction_step_rodas3;
 extern const gsl_odeiv2_step_type *friction_step_rodas4;
 
+/* Whether a step type has a continuous extension, and its value at t within
+ * the last accepted step of the stepper state `state` of that type. */
+int friction_rosenbrock_has_dense(const gsl_odeiv2_step_type *type);
+int friction_rosenbrock_dense(void *state, const gsl_odeiv2_step_type *type, double t, double y[]);
+
 #endif

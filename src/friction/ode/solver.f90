@@ -93,6 +93,8 @@ module friction_ode_solver
       procedure :: advance
       procedure :: step
       procedure :: step_size
+      procedure :: has_dense_output
+      procedure :: dense_output
       procedure :: set_time_label
       procedure :: time_at
       procedure :: statistics
@@ -196,6 +198,20 @@ module friction_ode_solver
          type(c_ptr), value :: driver
          integer(c_long), intent(out) :: steps, failed
       end subroutine friction_gsl_driver_counts
+
+      function friction_gsl_driver_has_dense(driver) result(has) bind(c, name='friction_gsl_driver_has_dense')
+         import :: c_ptr, c_int
+         type(c_ptr), value :: driver
+         integer(c_int) :: has
+      end function friction_gsl_driver_has_dense
+
+      function friction_gsl_driver_dense(driver, t, y) result(status) bind(c, name='friction_gsl_driver_dense')
+         import :: c_ptr, c_double, c_int
+         type(c_ptr), value :: driver
+         real(c_double), value :: t
+         real(c_double), intent(out) :: y(*)
+         integer(c_int) :: status
+      end function friction_gsl_driver_dense
 
       function friction_gsl_driver_step(driver) result(h) bind(c, name='friction_gsl_driver_step')
          import :: c_ptr, c_double
@@ -460,6 +476,33 @@ contains
       h = 0.0_wp
       if (c_associated(self%driver)) h = friction_gsl_driver_step(self%driver)
    end function step_size
+
+   !> Whether the stepper has a continuous extension (rodas4): then a caller
+   !> may take free steps and ask dense_output for the state in between.
+   logical function has_dense_output(self)
+      class(ode_solver), intent(in) :: self
+
+      has_dense_output = .false.
+      if (c_associated(self%driver)) has_dense_output = friction_gsl_driver_has_dense(self%driver) /= 0
+   end function has_dense_output
+
+   !> The state at t within the last step taken by `step`, from the
+   !> stepper's continuous extension (of order 3 for rodas4): an error when
+   !> the stepper has none or t is outside that step.
+   subroutine dense_output(self, t, y, error)
+      class(ode_solver), intent(in) :: self
+      real(wp), intent(in) :: t
+      real(wp), intent(out) :: y(:)
+      type(error_type), allocatable, intent(out) :: error
+
+      y = 0.0_wp
+      if (.not. c_associated(self%driver)) then
+         call fatal_error(error, 'dense output asked of a solver without a driver', error_internal)
+      else if (friction_gsl_driver_dense(self%driver, real(t, c_double), y) /= gsl_success) then
+         call fatal_error(error, trim(self%method)//': no dense output at '//self%time_at(t) &
+            & //' (not within the last step)', error_internal)
+      end if
+   end subroutine dense_output
 
    !> How messages name the time: 't', ' s' by default; a nondimensional
    !> scene passes its own symbol and an empty unit.
