@@ -47,18 +47,26 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 ROOT = Path(__file__).resolve().parent.parent
+# s of integration before a run of the program is given up (its slowest
+# successful run here takes 0.2 s; the free steps crawl on rate and state at
+# rtol 1e-5 with atol 1e-8, above the creeping slip rate: docs/speed.md).
+PROGRAM_LIMIT = 10.0
 
 
-def program_run(binary, work, name, rtol, sets):
-    """(seconds of the whole process, t, x, steps, Jacobians)."""
+def program_run(binary, work, name, rtol, sets, limit=0.0):
+    """(seconds of the whole process, t, x, steps, Jacobians); x is the
+    program's message if it failed (or gave up after `limit` s)."""
     out = work / f"{name}.h5"
     command = [str(binary), "--quiet", "--force", "-o", str(out), str(ROOT / "inputs" / f"machine_{name}.nml"),
-               "--set", f"integrator.rtol={rtol}", "--set", f"integrator.atol={rtol * 1e-3}"]
+               "--set", f"integrator.rtol={rtol}", "--set", f"integrator.atol={rtol * 1e-3}",
+               "--set", f"integrator.max_wall_time={limit}"]
     for key, value in sets.items():
         command += ["--set", f"{key}={value}"]
     start = time.perf_counter()
-    subprocess.run(command, check=True)
+    result = subprocess.run(command, capture_output=True, text=True)
     elapsed = time.perf_counter() - start
+    if result.returncode != 0:
+        return elapsed, None, result.stderr.strip().splitlines()[-1], -1, -1
     with h5py.File(out) as f:
         return (elapsed, f["machine/t"][:], f["machine/x"][:], int(f.attrs["integrator_steps"]),
                 int(f.attrs["jacobian_evaluations"]))
@@ -154,7 +162,8 @@ def main():
     parser.add_argument("--scipy-repeats", type=int, default=3, help="runs of SciPy per point")
     parser.add_argument("--quick", action="store_true", help="fewer tolerances")
     parser.add_argument("--binary", default=str(ROOT / "build" / "friction"))
-    parser.add_argument("--limit", type=float, default=60.0, help="seconds before a SciPy run is given up")
+    parser.add_argument("--limit", type=float, default=60.0,
+                        help="seconds before a SciPy run or the program's integration is given up")
     parser.add_argument("--chart", help="draw the work-precision charts into this PNG")
     args = parser.parse_args()
     tolerances = [1e-5, 1e-7] if args.quick else [1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9]
@@ -178,7 +187,8 @@ def main():
                 last = {}
                 for _ in range(args.repeats):
                     for method, settings in (("friction", sets), ("stepped", stepped)):
-                        seconds, _, x, steps, jacobians = program_run(args.binary, work, name, rtol, settings)
+                        seconds, _, x, steps, jacobians = program_run(args.binary, work, name, rtol, settings,
+                                                                      min(args.limit, PROGRAM_LIMIT))
                         times[method].append(seconds)
                         last[method] = (x, steps, jacobians)
                     if cvode:
@@ -188,6 +198,9 @@ def main():
                 median = {method: statistics.median(v) for method, v in times.items() if v}
                 for method in ("friction", "stepped"):
                     x, steps, jacobians = last[method]
+                    if isinstance(x, str):
+                        rows.append(f"{method:10s} {rtol:8.0e} {'failed':>10s} {median[method]:10.4f}  {x}")
+                        continue
                     error = np.max(np.abs(x - reference)) / scale
                     points.setdefault((name, method), []).append((error, median[method]))
                     ratio = f"{median['CVODE'] / median[method]:10.2f}" if "CVODE" in median else ""

@@ -372,12 +372,14 @@ static inline __attribute__((always_inline)) int step_sized(struct rosenbrock_st
  * the stages' short loops, whose trip counts (1, 2, 3 ...) otherwise change
  * from loop to loop and cost a mispredicted branch each (the step's own
  * work was 210 ns, more than its right-hand sides, on the regularized
- * brake).  Any other size takes the general loops. */
+ * brake; size 3 is the machine with a law of one state).  Any other size
+ * takes the general loops. */
 static int step(struct rosenbrock_state *s, double t, double h, double y[], double yerr[],
                 const double dydt_in[], double dydt_out[], const gsl_odeiv2_system *sys)
 {
     const int stages = s->method->stages;
 
+    if (s->dim == 3 && stages == 6) return step_sized(s, t, h, y, yerr, dydt_in, dydt_out, sys, 3, 6);
     if (s->dim == 4 && stages == 4) return step_sized(s, t, h, y, yerr, dydt_in, dydt_out, sys, 4, 4);
     if (s->dim == 4 && stages == 6) return step_sized(s, t, h, y, yerr, dydt_in, dydt_out, sys, 4, 6);
     if (s->dim == 6 && stages == 4) return step_sized(s, t, h, y, yerr, dydt_in, dydt_out, sys, 6, 4);
