@@ -131,6 +131,9 @@ struct rosenbrock_state {
      * to y1 over dense_h with the stages in k; dense_valid until the next try. */
     int dense_valid;
     double dense_t, dense_h, *y1;
+    /* sum_i d2_i k_i and sum_i d3_i k_i of that step, once it is asked for a value */
+    int dense_sums;
+    double *d2k, *d3k;
 };
 
 static void kept_clear(struct kept_rhs *kept)
@@ -165,8 +168,8 @@ static void *alloc_with(const struct rosenbrock_method *method, size_t dim)
         GSL_ERROR_NULL("dimension of the system must be positive", GSL_EINVAL);
     }
     s = calloc(1, sizeof *s);
-    /* y0, y1, ytmp, f, dfdt, 4 kept vectors, inverse_pivot: 10 n; jac, lu: 2 n^2; k: stages n */
-    doubles = 10 * dim + 2 * dim * dim + (size_t)method->stages * dim;
+    /* y0, y1, ytmp, f, dfdt, 4 kept vectors, inverse_pivot, d2k, d3k: 12 n; jac, lu: 2 n^2; k: stages n */
+    doubles = 12 * dim + 2 * dim * dim + (size_t)method->stages * dim;
     block = s != NULL ? malloc(doubles * sizeof *block) : NULL;
     if (block != NULL) s->pivot = malloc(dim * sizeof *s->pivot);
     if (s == NULL || block == NULL || s->pivot == NULL) {
@@ -196,6 +199,8 @@ static void *alloc_with(const struct rosenbrock_method *method, size_t dim)
     s->k = s->lu + dim * dim;
     s->inverse_pivot = s->k + (size_t)method->stages * dim;
     s->y1 = s->inverse_pivot + dim;
+    s->d2k = s->y1 + dim;
+    s->d3k = s->d2k + dim;
     s->dense_valid = 0;
     kept_clear(&s->start);
     kept_clear(&s->end);
@@ -362,6 +367,7 @@ static inline __attribute__((always_inline)) int step_sized(struct rosenbrock_st
         s->dense_t = t;
         s->dense_h = h;
         s->dense_valid = 1;
+        s->dense_sums = 0;
     }
     for (j = 0; j < n; j++) y[j] = s->ytmp[j];
     return GSL_SUCCESS;
@@ -471,14 +477,20 @@ int friction_rosenbrock_dense(void *vstate, const gsl_odeiv2_step_type *type, do
     theta = t == s->dense_t + s->dense_h ? 1.0 : (t - s->dense_t) / s->dense_h;
     if (theta > 1.0 && theta <= 1.0 + 64.0 * DBL_EPSILON) theta = 1.0;
     if (!(theta >= 0.0 && theta <= 1.0)) return GSL_EINVAL;
-    for (i = 0; i < n; i++) {
-        double d2 = 0.0, d3 = 0.0;
-        for (stage = 0; stage < m->stages; stage++) {
-            d2 += m->d2[stage] * s->k[(size_t)stage * n + i];
-            d3 += m->d3[stage] * s->k[(size_t)stage * n + i];
+    if (!s->dense_sums) {
+        for (i = 0; i < n; i++) {
+            double d2 = 0.0, d3 = 0.0;
+            for (stage = 0; stage < m->stages; stage++) {
+                d2 += m->d2[stage] * s->k[(size_t)stage * n + i];
+                d3 += m->d3[stage] * s->k[(size_t)stage * n + i];
+            }
+            s->d2k[i] = d2;
+            s->d3k[i] = d3;
         }
-        y[i] = (1.0 - theta) * s->y0[i] + theta * (s->y1[i] + (1.0 - theta) * (d2 + theta * d3));
+        s->dense_sums = 1;
     }
+    for (i = 0; i < n; i++)
+        y[i] = (1.0 - theta) * s->y0[i] + theta * (s->y1[i] + (1.0 - theta) * (s->d2k[i] + theta * s->d3k[i]));
     return GSL_SUCCESS;
 }
 
