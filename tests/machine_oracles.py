@@ -18,6 +18,11 @@ oracles computed here:
   table-onset          a tabulated velocity-weakening law on the belt: a sweep of
                        the damping finds the onset of growth where c = -dF/dv,
                        the slope of the table's interpolant (SciPy's PCHIP)
+  dense-output         LuGre and rate and state with free steps and the output
+                       read from rodas4's continuous extension (the default)
+                       against the program stepping onto every output time at a
+                       1000 times tighter tolerance; with the same first step, a
+                       grid of half the spacing holds the same values bit for bit
 
     machine_oracles.py --binary build/friction --inputs inputs --workdir DIR CASE
 """
@@ -203,9 +208,35 @@ def gms_saturated(args):
         np.testing.assert_allclose(got[f"z{i}"], -wi * fc / ki, rtol=1e-9)
 
 
+def dense_output(args):
+    # The oracle steps onto each output time (dense_output = .false.) at rtol 1e-12, atol 1e-15:
+    # its own error is some 1e-12 of the range.  The default run (rtol 1e-9, atol 1e-12) was
+    # measured off by 1.5e-10 (LuGre, 10 s) and 3.4e-9 (rate and state, 1500 s) of the range of x,
+    # its steps' own error; the bound 3e-8 leaves a factor of 9 over the larger.  An extension of
+    # order 1 or 2 (a wrong weight, a straight line between the steps' ends) is off by 1e-6 to
+    # 1e-5 of the range at LuGre's steps of some 4 ms.
+    for name, sets in (("lugre", {"machine.t_end": 10.0}), ("rate_state", {})):
+        stepped = dict(sets, **{"machine.dense_output": ".false.", "integrator.rtol": 1e-12,
+                                "integrator.atol": 1e-15})
+        oracle = run(args, name + "_oracle", [f"machine_{name}.nml"], stepped)
+        got = run(args, name, [f"machine_{name}.nml"], sets)
+        assert np.array_equal(got["t"], oracle["t"])
+        error = np.max(np.abs(got["x"] - oracle["x"])) / np.ptp(oracle["x"])
+        print(f"dense-output, {name}: max |x - stepped at 1e-12| = {error:.2e} of the range of x")
+        assert error < 3e-8, error
+        # The steps do not depend on the grid once the first step is fixed (by default it is
+        # 1e-6 dt_out): a point of both grids is read from the same step at the same time.
+        first = dict(sets, **{"integrator.h_start": 1e-7})
+        coarse = run(args, name + "_coarse", [f"machine_{name}.nml"], dict(first, **{"machine.dt_out": 0.1}))
+        fine = run(args, name + "_fine", [f"machine_{name}.nml"], dict(first, **{"machine.dt_out": 0.05}))
+        for key in ("x", "v", "force"):
+            assert np.array_equal(fine[key][::2], coarse[key]), key
+
+
 def main():
     return case_main(__doc__, {"lugre-radau": lugre_radau, "rate-state-critical": rate_state_critical,
-                               "table-onset": table_onset, "bad-input": bad_input, "gms-saturated": gms_saturated})
+                               "table-onset": table_onset, "bad-input": bad_input, "gms-saturated": gms_saturated,
+                               "dense-output": dense_output})
 
 
 if __name__ == "__main__":
