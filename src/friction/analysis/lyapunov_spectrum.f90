@@ -23,10 +23,7 @@ module friction_analysis_lyapunov_spectrum
    private
 
    public :: tangent_system, tangent_settings, spectrum_accumulator, tangent_spectrum, kaplan_yorke
-   public :: orthonormalise, pack_tangent, unpack_tangent, generic_frame, max_base
-
-   !> Largest base system: n + n² must fit the GSL bridge's 20 (ode/solver.f90).
-   integer, parameter :: max_base = 4
+   public :: orthonormalise, pack_tangent, unpack_tangent, generic_frame, tangent_field
 
    !> The orbit and its tangent matrix as one system (events: those of the base).
    type, extends(event_system) :: tangent_system
@@ -84,30 +81,65 @@ contains
       n = self%base%dimension()
    end function tangent_controlled_dimension
 
-   !> (f(y), J(y) Φ), Φ by columns (no temporaries: this is the hot loop).
+   !> (f(y), J(y) Φ), Φ by columns.
    pure subroutine tangent_rhs(self, t, y, dydt)
       class(tangent_system), intent(in) :: self
       real(wp), intent(in) :: t
       real(wp), intent(in), contiguous :: y(:)
       real(wp), intent(out), contiguous :: dydt(:)
-      real(wp) :: dfdy(max_base, max_base), dfdt(max_base)
-      integer :: n, i, j, k, c
+
+      call tangent_field(self, t, y, dydt)
+   end subroutine tangent_rhs
+
+   !> The tangent system's right-hand side (f(y), J(y) Φ) into dydt(1:n + n²),
+   !> and tr J(y) if asked (the flow's divergence), from one Jacobian.  No
+   !> room of its own, whatever n (this is the hot loop, and a pure procedure
+   !> has no workspace to keep): J is written where J Φ goes and replaced by
+   !> it row by row, the row in hand kept where f goes, which comes last.
+   pure subroutine tangent_field(self, t, y, dydt, trace)
+      class(tangent_system), intent(in) :: self
+      real(wp), intent(in) :: t
+      real(wp), intent(in), contiguous :: y(:)
+      real(wp), intent(out), contiguous :: dydt(:)
+      real(wp), intent(out), optional :: trace
+      integer :: n
 
       n = self%base%dimension()
+      call jacobian_times_frame(self%base, t, y, n, dydt(1:n), dydt(n + 1:n + n * n), trace)
       call self%base%rhs(t, y(1:n), dydt(1:n))
-      call self%base%jacobian(t, y(1:n), dfdy(1:n, 1:n), dfdt(1:n))
-      do j = 1, n
-         c = n + (j - 1) * n
+   end subroutine tangent_field
+
+   !> jphi = J(y) Φ (Φ = y(n + 1:) by columns), with `row` as room; tr J if asked.
+   pure subroutine jacobian_times_frame(base, t, y, n, row, jphi, trace)
+      class(ode_system), intent(in) :: base
+      real(wp), intent(in) :: t
+      real(wp), intent(in) :: y(:)
+      integer, intent(in) :: n
+      real(wp), intent(out) :: row(n), jphi(n, n)
+      real(wp), intent(out), optional :: trace
+      real(wp) :: sum
+      integer :: i, j, k, c
+
+      call base%jacobian(t, y(1:n), jphi, row)
+      if (present(trace)) then
+         trace = 0.0_wp
          do i = 1, n
-            dydt(c + i) = 0.0_wp
+            trace = trace + jphi(i, i)
          end do
-         do k = 1, n
-            do i = 1, n
-               dydt(c + i) = dydt(c + i) + dfdy(i, k) * y(c + k)
+      end if
+      ! Row i of J Φ needs row i of J only: keep that row, overwrite it.
+      do i = 1, n
+         row = jphi(i, :)
+         do j = 1, n
+            c = n + (j - 1) * n
+            sum = 0.0_wp
+            do k = 1, n
+               sum = sum + row(k) * y(c + k)
             end do
+            jphi(i, j) = sum
          end do
       end do
-   end subroutine tangent_rhs
+   end subroutine jacobian_times_frame
 
    !> Jacobian of (f, J Φ) for the implicit steppers: J on the diagonal
    !> blocks, and ∂(J Φ)/∂y from central differences of the analytic J

@@ -22,7 +22,6 @@ module friction_machine_config
    use friction_output_law_files, only: law_with_files
    use friction_law, only: sliding_law
    use friction_analysis_settings, only: analysis_settings
-   use friction_analysis_lyapunov_spectrum, only: max_tangent_base => max_base
    implicit none
    private
 
@@ -134,14 +133,14 @@ contains
       ! Every diagnostic of &analysis runs on the machine; what a law cannot give is refused by name.
       associate (a => self%analysis)
          if (a%orbit) call check_orbit(self, c)
-         if (a%poincare .or. a%lyapunov_spectrum) call check_sections_and_tangent(self, c)
+         if (a%poincare) call check_sections(self, c)
       end associate
    end subroutine validate
 
-   !> What the machine's Poincaré maps and Lyapunov spectrum need of the law:
-   !> the located slip onsets exist for a set-valued law only, and the
-   !> tangent equations hold n + n² values with n = 2 + the law's states.
-   subroutine check_sections_and_tangent(self, c)
+   !> What the machine's Poincaré maps need of the law: the located slip
+   !> onsets exist for a set-valued law only.  (The Lyapunov spectrum needs
+   !> nothing: the tangent equations take any number of states.)
+   subroutine check_sections(self, c)
       class(machine_config), intent(in) :: self
       type(config_checker), intent(inout) :: c
       class(sliding_law), allocatable :: law
@@ -152,13 +151,8 @@ contains
             & call c%reject('analysis', 'section', "'stick_to_slip'", "the located slip onsets are the events of " &
             & //"exact stick; &law model = '"//trim(self%law%model)//"' has none: use section = 'w_zero_up' " &
             & //"(the sliding velocity crossing 0 upwards) or 'none'")
-         ! The orbit, Φ and ∫ tr J in the stepper's 20 values: n + n² + 1 <= 20 with n = 2 + states.
-         if (a%lyapunov_spectrum .and. 2 + law%state_count() > max_tangent_base - 1) &
-            & call c%reject('analysis', 'lyapunov_spectrum', '.true.', "&law model = '"//trim(self%law%model) &
-            & //"' has "//itoa(law%state_count())//' internal states: the tangent equations take at most ' &
-            & //itoa(max_tangent_base - 3)//' besides x and v')
       end associate
-   end subroutine check_sections_and_tangent
+   end subroutine check_sections
 
    !> &analysis orbit (and continuation): a law with few enough states for the
    !> section's closed-form multipliers (a set-valued law has none: its map

@@ -56,9 +56,6 @@ module friction_ode_events
    !> Directions of a crossing: g goes from - to + (rising), + to - (falling).
    integer, parameter :: event_rising = 1, event_falling = -1, event_either = 0
 
-   !> Largest state dimension the locator keeps copies of: a state of 4
-   !> with its 4 x 4 tangent matrix (the Lyapunov spectrum of the brake).
-   integer, parameter :: max_state = 20, max_events = 8
 
    !> An ODE system with event functions.
    type, abstract, extends(ode_system) :: event_system
@@ -91,7 +88,7 @@ module friction_ode_events
       integer :: direction = 0      !! event_rising or event_falling
       logical :: terminal = .false. !! the integration stopped here
       real(wp) :: t = 0.0_wp        !! crossing time, far side, within the tolerance
-      real(wp) :: y(max_state) = 0.0_wp  !! the state at t (first dimension() entries)
+      real(wp), allocatable :: y(:) !! the state at t (dimension() entries, allocated by init)
    end type event_hit
 
    !> Step-by-step integration with event location.  The system must
@@ -107,7 +104,11 @@ module friction_ode_events
       logical, allocatable :: terminal(:)
       integer, allocatable :: last_sign(:) !! sign of g_k on the near side; 0 unknown
       real(wp), allocatable :: g(:)        !! g at the current point
-      real(wp) :: f(max_state) = 0.0_wp    !! the right-hand side at the current point
+      real(wp), allocatable :: f(:)        !! the right-hand side at the current point
+      !> advance's room, allocated by init (none at each step): the step's
+      !> start and its field, a trial state; g at the start, at a trial and
+      !> the slopes of g at the step's ends
+      real(wp), allocatable :: y0(:), f0(:), yc(:), g0(:), gc(:), slope0(:), slope1(:)
       logical :: f_valid = .false.         !! f is up to date (not after a restart)
       real(wp) :: tolerance = 1.0e-10_wp   !! absolute, in the system's time
       real(wp) :: h_first = 1.0e-6_wp      !! first step when nothing better is known
@@ -157,12 +158,12 @@ contains
       type(error_type), allocatable, intent(out) :: error
       character(len=*), intent(in), optional :: time_name, time_unit
       type(solver_settings) :: probe_settings
+      integer :: k
 
       self%system => system
       self%n = system%dimension()
       self%m = system%event_count()
-      if (size(direction) /= self%m .or. size(terminal) /= self%m .or. self%n > max_state &
-         & .or. self%m > max_events) then
+      if (size(direction) /= self%m .or. size(terminal) /= self%m) then
          call fatal_error(error, 'event locator: inconsistent event settings', error_internal)
          return
       end if
@@ -199,8 +200,15 @@ contains
       call self%probe%set_time_label(trim(self%time_name), trim(self%time_unit))
       if (allocated(self%hits)) deallocate (self%hits)
       allocate (self%hits(max(1, 2 * self%m)))
-      if (allocated(self%g)) deallocate (self%last_sign, self%g)
-      allocate (self%last_sign(self%m), self%g(self%m))
+      do k = 1, size(self%hits)
+         allocate (self%hits(k)%y(self%n))
+         self%hits(k)%y = 0.0_wp
+      end do
+      if (allocated(self%g)) deallocate (self%last_sign, self%g, self%f, self%y0, self%f0, self%yc, self%g0, &
+         & self%gc, self%slope0, self%slope1)
+      allocate (self%last_sign(self%m), self%g(self%m), self%f(self%n), self%y0(self%n), self%f0(self%n), &
+         & self%yc(self%n), self%g0(self%m), self%gc(self%m), self%slope0(self%m), self%slope1(self%m))
+      self%f = 0.0_wp
       self%steps = 0
       self%located = 0
       self%probes = 0
@@ -249,30 +257,45 @@ contains
       real(wp), intent(inout) :: y(:)
       type(error_type), allocatable, intent(out) :: error
       class(step_watch), intent(inout), optional :: watch
-      ! (Fixed sizes, and the events of a step gathered in hits itself:
-      ! automatic arrays would be allocated on the heap at every call.)
-      real(wp) :: t0, y0(max_state), g0(max_events), f0(max_state)
-      real(wp) :: tc, yc(max_state), gc(max_events), theta, h, slope0(max_events), slope1(max_events)
-      type(event_hit) :: swap
-      integer :: k, nfound, i, j, first_terminal, near, m
-      real(wp), parameter :: nudge = 1.0e-3_wp
 
-      m = self%m
       self%n_hits = 0
       if (.not. self%ready) then
          call fatal_error(error, 'event locator: advance before restart', error_internal)
          return
       end if
+      call advance_steps(self, t, t1, y, error, watch, self%n, self%m, self%y0, self%f0, self%yc, self%f, &
+         & self%g0, self%gc, self%slope0, self%slope1)
+   end subroutine advance
+
+   !> advance's steps, with the locator's room (allocated by init: nothing
+   !> is allocated at a step) as arrays of their own, not touched through
+   !> self here: the step's start y0 and its field f0, a trial state yc, the
+   !> field f at the current point; g at the step's start g0 and at a trial
+   !> gc, and its slopes at the step's ends.  (Explicit shapes: the hot loop
+   !> indexes them without reloading the components' descriptors.)
+   subroutine advance_steps(self, t, t1, y, error, watch, n, m, y0, f0, yc, f, g0, gc, slope0, slope1)
+      class(event_locator), intent(inout) :: self
+      real(wp), intent(inout) :: t
+      real(wp), intent(in) :: t1
+      real(wp), intent(inout) :: y(:)
+      type(error_type), allocatable, intent(out) :: error
+      class(step_watch), intent(inout), optional :: watch
+      integer, intent(in) :: n, m
+      real(wp), intent(inout) :: y0(n), f0(n), yc(n), f(n), g0(m), gc(m), slope0(m), slope1(m)
+      real(wp) :: t0, tc, theta, h
+      integer :: k, nfound, i, j, first_terminal, near
+      real(wp), parameter :: nudge = 1.0e-3_wp
+
       do while (t < t1)
          t0 = t
-         y0(1:self%n) = y(1:self%n)
+         y0(1:n) = y(1:n)
          g0(1:m) = self%g
          if (.not. self%f_valid) then
-            call self%system%rhs(t0, y0(1:self%n), self%f(1:self%n))
+            call self%system%rhs(t0, y0(1:n), f)
             self%extra_rhs = self%extra_rhs + 1
          end if
-         f0(1:self%n) = self%f(1:self%n)
-         call self%main%step(t, t1, y(1:self%n), error)
+         f0(1:n) = f
+         call self%main%step(t, t1, y(1:n), error)
          if (allocated(error)) return
          self%steps = self%steps + 1
          if (.not. (t > t0)) then
@@ -299,30 +322,30 @@ contains
             call watch%check(t, error)
             if (allocated(error)) return
          end if
-         call self%system%rhs(t, y(1:self%n), self%f(1:self%n))
+         call self%system%rhs(t, y(1:n), f)
          self%extra_rhs = self%extra_rhs + 1
          self%f_valid = .true.
-         call self%system%event_values(t, y(1:self%n), self%g)
+         call self%system%event_values(t, y(1:n), self%g)
          nfound = 0
          h = t - t0
          ! Slopes dg/dθ at both ends, by differences along the step's Hermite
          ! interpolant (θ = (t - t0)/h): with g at the ends they define a
          ! cubic in θ for each g_k, exact when g_k is linear in the state.
          if (self%m > 0) then
-            call hermite(nudge, h, y0(1:self%n), f0(1:self%n), y(1:self%n), self%f(1:self%n), yc(1:self%n))
-            call self%system%event_values(t0 + nudge * h, yc(1:self%n), gc(1:m))
+            call hermite(nudge, h, y0(1:n), f0(1:n), y(1:n), f, yc(1:n))
+            call self%system%event_values(t0 + nudge * h, yc(1:n), gc(1:m))
             slope0(1:m) = (gc(1:m) - g0(1:m)) / nudge
-            call hermite(1.0_wp - nudge, h, y0(1:self%n), f0(1:self%n), y(1:self%n), self%f(1:self%n), &
-               & yc(1:self%n))
-            call self%system%event_values(t - nudge * h, yc(1:self%n), gc(1:m))
+            call hermite(1.0_wp - nudge, h, y0(1:n), f0(1:n), y(1:n), f, &
+               & yc(1:n))
+            call self%system%event_values(t - nudge * h, yc(1:n), gc(1:m))
             slope1(1:m) = (self%g - gc(1:m)) / nudge
          end if
          do k = 1, self%m
             near = self%last_sign(k)
             if (crossed(near, self%g(k), self%direction(k))) then
                nfound = nfound + 1
-               call self%locate(k, t0, y0(1:self%n), g0(k), t, y(1:self%n), -near, &
-                  & self%hits(nfound)%t, self%hits(nfound)%y(1:self%n), error)
+               call self%locate(k, t0, y0(1:n), g0(k), t, y(1:n), -near, &
+                  & self%hits(nfound)%t, self%hits(nfound)%y(1:n), error)
                call describe(self%hits(nfound), k, -near)
                if (allocated(error)) return
                cycle
@@ -334,26 +357,26 @@ contains
             theta = dip(g0(k), self%g(k), slope0(k), slope1(k), near)
             if (theta < 0.0_wp) cycle
             tc = t0
-            yc(1:self%n) = y0(1:self%n)
+            yc(1:n) = y0(1:n)
             call self%probe%restart(theta * h)
-            call self%probe%advance(tc, t0 + theta * h, yc(1:self%n), error)
+            call self%probe%advance(tc, t0 + theta * h, yc(1:n), error)
             self%probes = self%probes + 1
             if (allocated(error)) return
-            call self%system%event_values(tc, yc(1:self%n), gc(1:m))
+            call self%system%event_values(tc, yc(1:n), gc(1:m))
             if (gc(k) == 0.0_wp .or. (gc(k) > 0.0_wp .eqv. near > 0)) cycle   ! the interpolant erred
             ! Out across zero ...
             if (crossed(near, gc(k), self%direction(k))) then
                nfound = nfound + 1
-               call self%locate(k, t0, y0(1:self%n), g0(k), tc, yc(1:self%n), -near, &
-                  & self%hits(nfound)%t, self%hits(nfound)%y(1:self%n), error)
+               call self%locate(k, t0, y0(1:n), g0(k), tc, yc(1:n), -near, &
+                  & self%hits(nfound)%t, self%hits(nfound)%y(1:n), error)
                call describe(self%hits(nfound), k, -near)
                if (allocated(error)) return
             end if
             ! ... and back, if that direction counts.
             if (crossed(-near, self%g(k), self%direction(k))) then
                nfound = nfound + 1
-               call self%locate(k, tc, yc(1:self%n), gc(k), t, y(1:self%n), near, &
-                  & self%hits(nfound)%t, self%hits(nfound)%y(1:self%n), error)
+               call self%locate(k, tc, yc(1:n), gc(k), t, y(1:n), near, &
+                  & self%hits(nfound)%t, self%hits(nfound)%y(1:n), error)
                call describe(self%hits(nfound), k, near)
                if (allocated(error)) return
             end if
@@ -365,16 +388,15 @@ contains
          do i = 1, nfound
             self%hits(i)%terminal = self%terminal(self%hits(i)%which)
          end do
-         ! Time order (few events per step: insertion sort).
+         ! Time order (few events per step: insertion sort by exchanges,
+         ! which move the states' arrays instead of copying them).
          do i = 2, nfound
-            swap = self%hits(i)
-            j = i - 1
-            do while (j >= 1)
-               if (self%hits(j)%t <= swap%t) exit
-               self%hits(j + 1) = self%hits(j)
+            j = i
+            do while (j > 1)
+               if (self%hits(j - 1)%t <= self%hits(j)%t) exit
+               call exchange(self%hits(j - 1), self%hits(j))
                j = j - 1
             end do
-            self%hits(j + 1) = swap
          end do
          first_terminal = 0
          do i = 1, nfound
@@ -386,14 +408,39 @@ contains
          if (first_terminal > 0) then
             nfound = first_terminal
             t = self%hits(nfound)%t
-            y(1:self%n) = self%hits(nfound)%y(1:self%n)
+            y(1:n) = self%hits(nfound)%y(1:n)
             self%ready = .false.
          end if
          self%n_hits = nfound
          self%located = self%located + nfound
          return
       end do
-   end subroutine advance
+   end subroutine advance_steps
+
+   !> Swap two hits (their states by moving the allocations).
+   subroutine exchange(a, b)
+      type(event_hit), intent(inout) :: a, b
+      real(wp), allocatable :: y(:)
+      integer :: which, direction
+      logical :: terminal
+      real(wp) :: t
+
+      which = a%which
+      direction = a%direction
+      terminal = a%terminal
+      t = a%t
+      a%which = b%which
+      a%direction = b%direction
+      a%terminal = b%terminal
+      a%t = b%t
+      b%which = which
+      b%direction = direction
+      b%terminal = terminal
+      b%t = t
+      call move_alloc(a%y, y)
+      call move_alloc(b%y, a%y)
+      call move_alloc(y, b%y)
+   end subroutine exchange
 
    !> Record which function crossed and in which direction.
    subroutine describe(hit, k, direction)

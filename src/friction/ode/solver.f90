@@ -25,9 +25,6 @@ module friction_ode_solver
    !> Room for a step type name (as solver_settings%method).
    integer, parameter :: step_type_name_length = 16
 
-   !> Largest system: a state of 4 with its 4 x 4 tangent matrix (the Lyapunov spectrum).
-   integer, parameter :: max_dimension = 20
-
    !> GSL status codes used here (gsl_errno.h).
    integer(c_int), parameter :: gsl_success = 0, gsl_enomem = 8, gsl_ebadfunc = 9
 
@@ -60,12 +57,15 @@ module friction_ode_solver
       type(c_ptr) :: params
    end type gsl_odeiv2_system
 
-   !> What the C callbacks receive as params: the model and the counters.
+   !> What the C callbacks receive as params: the model, the counters and the
+   !> Jacobian's room (allocated with the driver: no system size is too
+   !> large, and the callback allocates nothing).
    type :: system_box
       class(ode_system), pointer :: model => null()
       integer :: n = 0
       integer(i8) :: rhs_evaluations = 0
       integer(i8) :: jacobian_evaluations = 0
+      real(wp), allocatable :: jac(:, :), ft(:)
    end type system_box
 
    !> A GSL driver bound to one system.  The system must outlive the solver.
@@ -290,13 +290,10 @@ contains
          call fatal_error(error, "unknown step type '"//trim(settings%method)//"'", error_input)
          return
       end if
-      if (model%dimension() > max_dimension) then
-         call fatal_error(error, 'ODE system too large for the GSL bridge', error_internal)
-         return
-      end if
       allocate (self%box, self%sys)
       self%box%model => model
       self%box%n = model%dimension()
+      allocate (self%box%jac(self%box%n, self%box%n), self%box%ft(self%box%n))
       self%sys%function = c_funloc(gsl_rhs)
       self%sys%jacobian = c_funloc(gsl_jacobian)
       self%sys%dimension = int(self%box%n, c_size_t)
@@ -646,17 +643,16 @@ contains
       type(c_ptr), value :: params
       integer(c_int) :: status
       type(system_box), pointer :: box
-      real(wp) :: jac(max_dimension, max_dimension), ft(max_dimension)
       integer :: n, i
 
       call c_f_pointer(params, box)
       n = box%n
-      call box%model%jacobian(t, y(1:n), jac(1:n, 1:n), ft(1:n))
+      call box%model%jacobian(t, y(1:n), box%jac, box%ft)
       box%jacobian_evaluations = box%jacobian_evaluations + 1
       do i = 1, n
-         dfdy((i - 1) * n + 1:i * n) = jac(i, 1:n)
+         dfdy((i - 1) * n + 1:i * n) = box%jac(i, 1:n)
       end do
-      dfdt(1:n) = ft(1:n)
+      dfdt(1:n) = box%ft
       status = gsl_success
    end function gsl_jacobian
 
