@@ -319,16 +319,6 @@ contains
          & //'(coulomb, stribeck, table, arctan), or the switched model'
       call new_law(self%law, law)
       associate (a => self%analysis)
-         ! Benettin's runs restart from the brake's four variables: the whole state of a law without states.
-         if (a%lyapunov .and. law%state_count() > 0) call c%reject('analysis', 'lyapunov', '.true.', &
-            & "is not computed for &brake model = 'law' with &law model = '"//trim(self%law%model) &
-            & //"' (Benettin's restarts would not carry its internal states): use a law without states " &
-            & //'(coulomb, stribeck, table, arctan, karnopp), or the switched or the regularized model')
-         if (a%lyapunov_spectrum .and. law%state_count() > 0) call c%reject('analysis', 'lyapunov_spectrum', &
-            & '.true.', "is not computed for &brake model = 'law' with &law model = '"//trim(self%law%model) &
-            & //"' (the tangent equations take the brake's four variables; its states would make them " &
-            & //'too many): use a law without states (coulomb, stribeck, table, arctan, karnopp), or the ' &
-            & //'switched or the regularized model')
          if (a%orbit .and. law%state_count() > 0) call c%reject('analysis', 'orbit', '.true.', why)
          if (a%orbit .and. holds_applied(law)) call c%reject('analysis', 'orbit', '.true.', &
             & "is not computed for &brake model = 'law' with &law model = '"//trim(self%law%model)//"' (its " &

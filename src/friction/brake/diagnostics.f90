@@ -182,8 +182,9 @@ contains
       class(job_reporter), intent(inout), optional :: reporter
       class(brake_integrator), allocatable, target :: reference_run, perturbed_run
       type(brake_event_table) :: reference_events, perturbed_events
-      real(wp) :: t, reference(4), perturbed(4), direction(4)
-      integer :: k, intervals
+      real(wp) :: t
+      real(wp), allocatable :: reference(:), perturbed(:), direction(:)
+      integer :: k, intervals, n
 
       if (.not. (settings%renormalise > 0.0_wp .and. settings%duration >= settings%renormalise &
          & .and. settings%d0 > 0.0_wp .and. settings%transient >= 0.0_wp)) then
@@ -194,19 +195,23 @@ contains
       call new_brake_integrator(config, reference_run)
       call new_brake_integrator(config, perturbed_run)
       t = config%t_start + settings%transient
-      reference = initial_state(config)
-      call reference_run%start(config, config%t_start, reference, reference_events, error)
+      call reference_run%start(config, config%t_start, initial_state(config), reference_events, error)
       if (allocated(error)) return
+      ! The whole state: the four variables and a law's internal states, which
+      ! the perturbed run's restarts carry (a law's states start steady otherwise).
+      n = 4 + reference_run%state_count()
+      allocate (reference(n), perturbed(n), direction(n))
       call advance(reference_run, reference_events, t, reference)
       if (allocated(error)) return
-      direction = [1.0_wp, 1.0_wp, 1.0_wp, 1.0_wp]
-      if (reference_run%is_sticking()) direction = [1.0_wp, 0.0_wp, 1.0_wp, 0.0_wp]
+      direction = 1.0_wp
+      if (reference_run%is_sticking()) direction(2:4:2) = 0.0_wp
       perturbed = reference + settings%d0 * direction / norm2(direction)
       intervals = int(settings%duration / settings%renormalise + 1.0e-9_wp)
       call result%start(settings%d0, intervals)
       do k = 1, intervals
-         call perturbed_run%start(config, t, perturbed, perturbed_events, error)
+         call perturbed_run%start(config, t, perturbed(1:4), perturbed_events, error)
          if (allocated(error)) return
+         if (n > 4) call perturbed_run%set_states(perturbed(5:n))
          t = config%t_start + settings%transient + k * settings%renormalise
          call advance(reference_run, reference_events, t, reference)
          if (allocated(error)) return
@@ -227,10 +232,11 @@ contains
          class(brake_integrator), intent(inout) :: run
          type(brake_event_table), intent(inout) :: events
          real(wp), intent(in) :: t1
-         real(wp), intent(out) :: y(4)
+         real(wp), intent(out) :: y(:)
 
          call run%advance_to(t1, events, error)
-         y = run%y
+         y(1:4) = run%y
+         if (size(y) > 4) call run%get_states(y(5:))
       end subroutine advance
 
    end subroutine brake_benettin
@@ -248,8 +254,9 @@ contains
       class(job_reporter), intent(inout), optional :: reporter
       class(brake_integrator), allocatable, target :: run
       type(brake_event_table) :: events
-      real(wp) :: phi(4, 4), t0
-      integer :: k, intervals
+      real(wp), allocatable :: phi(:, :)
+      real(wp) :: t0
+      integer :: k, intervals, n
 
       if (.not. (settings%renormalise > 0.0_wp .and. settings%duration >= settings%renormalise &
          & .and. settings%transient >= 0.0_wp)) then
@@ -261,7 +268,9 @@ contains
       run%tangent = .true.
       call run%start(config, config%t_start, initial_state(config), events, error)
       if (allocated(error)) return
-      phi = generic_frame(4)
+      ! The tangent's dimension: the four variables and a law's internal states.
+      n = size(run%phi, 1)
+      phi = generic_frame(n)
       t0 = config%t_start + settings%transient
       ! The transient in renormalisation intervals too, so that Φ stays bounded.
       do while (run%t < t0)
@@ -273,7 +282,7 @@ contains
          if (allocated(error)) return
       end do
       intervals = int(settings%duration / settings%renormalise + 1.0e-9_wp)
-      call result%start(4, intervals)
+      call result%start(n, intervals)
       do k = 1, intervals
          call run%advance_to(t0 + k * settings%renormalise, events, error)
          if (allocated(error)) return

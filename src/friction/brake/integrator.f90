@@ -10,7 +10,6 @@ module friction_brake_integrator
    use friction_ode_events, only: event_locator, event_falling, event_rising
    use friction_brake_config, only: brake_config
    use friction_brake_record, only: brake_event_table, event_stick_to_slip, event_slip_to_stick
-   use friction_analysis_lyapunov_spectrum, only: pack_tangent, unpack_tangent
    implicit none
    private
 
@@ -22,9 +21,13 @@ module friction_brake_integrator
       real(wp) :: stick_time = -1.0_wp      !! time spent in stick, when the model tracks it exactly; else < 0
       type(event_locator) :: locator
       !> Set before start: integrate the tangent matrix phi beside the state
-      !> (the Lyapunov spectrum, docs/physics.md); phi = I at the start.
+      !> (the Lyapunov spectrum, docs/physics.md); phi = I at the start, of
+      !> the dimension of the whole state: x, x', y, y' and a friction law's
+      !> internal states (`states`, as the model integrates them).
       logical :: tangent = .false.
-      real(wp) :: phi(4, 4) = 0.0_wp
+      real(wp), allocatable :: phi(:, :)
+      real(wp), allocatable :: states(:)    !! the tangent run's law states (none for the brake's own models)
+      real(wp), allocatable :: packed(:)    !! (y, states, Φ) as the locator steps them (allocated with Φ)
       integer :: lost = 0                   !! directions mapped to 0 (stick) since reset_tangent
    contains
       !> Start at (t0, y0) with the settings of `config`; the event table is cleared.
@@ -34,6 +37,12 @@ module friction_brake_integrator
       !> Whether the block sticks to the belt now.
       procedure(sticking_interface), deferred :: is_sticking
       procedure :: statistics
+      !> A friction law's internal states beyond (x, x', y, y'), as the model
+      !> integrates them: how many, their values now, and setting them (after
+      !> start, in place of the steady ones: Benettin's perturbed run).
+      procedure :: state_count
+      procedure :: get_states
+      procedure :: set_states
       procedure :: reset_tangent
       procedure :: start_tangent
       procedure :: locator_advance
@@ -75,41 +84,85 @@ contains
       stats = self%locator%statistics()
    end function statistics
 
-   !> Φ = I at the start of a run with the tangent.
-   subroutine start_tangent(self)
-      class(brake_integrator), intent(inout) :: self
-      integer :: i
+   !> No states: the brake's own models.
+   pure integer function state_count(self)
+      class(brake_integrator), intent(in) :: self
 
+      state_count = 0
+   end function state_count
+
+   subroutine get_states(self, states)
+      class(brake_integrator), intent(in) :: self
+      real(wp), intent(out) :: states(:)
+   end subroutine get_states
+
+   subroutine set_states(self, states)
+      class(brake_integrator), intent(inout) :: self
+      real(wp), intent(in) :: states(:)
+   end subroutine set_states
+
+   !> Φ = I at the start of a run with the tangent, for the four variables
+   !> and `states` law states (0 if absent; self%states holds their values).
+   subroutine start_tangent(self, states)
+      class(brake_integrator), intent(inout) :: self
+      integer, intent(in), optional :: states
+      integer :: i, n
+
+      n = 4
+      if (present(states)) n = 4 + states
+      if (allocated(self%phi)) deallocate (self%phi)
+      if (allocated(self%packed)) deallocate (self%packed)
+      allocate (self%phi(n, n), self%packed(n + n * n))
+      if (allocated(self%states)) then
+         if (size(self%states) /= n - 4) deallocate (self%states)
+      end if
+      if (.not. allocated(self%states)) allocate (self%states(n - 4), source=0.0_wp)
       self%phi = 0.0_wp
-      do i = 1, 4
+      do i = 1, n
          self%phi(i, i) = 1.0_wp
       end do
       self%lost = 0
    end subroutine start_tangent
 
-   !> The locator's advance of (t, y), with Φ beside y when the tangent is on.
+   !> (y, states, Φ by columns) into self%packed.
+   subroutine pack_state(self)
+      class(brake_integrator), intent(inout) :: self
+      integer :: n
+
+      n = size(self%phi, 1)
+      self%packed(1:4) = self%y
+      self%packed(5:n) = self%states
+      self%packed(n + 1:) = reshape(self%phi, [n * n])
+   end subroutine pack_state
+
+   !> The locator's advance of (t, y), with the law's states and Φ beside y
+   !> when the tangent is on.
    subroutine locator_advance(self, t_target, error)
       class(brake_integrator), intent(inout) :: self
       real(wp), intent(in) :: t_target
       type(error_type), allocatable, intent(out) :: error
-      real(wp) :: z(20)
+      integer :: n
 
       if (self%tangent) then
-         z = pack_tangent(self%y, self%phi)
-         call self%locator%advance(self%t, t_target, z, error)
-         call unpack_tangent(z, self%y, self%phi)
+         n = size(self%phi, 1)
+         call pack_state(self)
+         call self%locator%advance(self%t, t_target, self%packed, error)
+         self%y = self%packed(1:4)
+         self%states = self%packed(5:n)
+         self%phi = reshape(self%packed(n + 1:), [n, n])
       else
          call self%locator%advance(self%t, t_target, self%y, error)
       end if
    end subroutine locator_advance
 
-   !> The locator's restart at (t, y), with Φ when the tangent is on.
+   !> The locator's restart at (t, y), with the law's states and Φ when the tangent is on.
    subroutine locator_restart(self, h_start)
       class(brake_integrator), intent(inout) :: self
       real(wp), intent(in) :: h_start
 
       if (self%tangent) then
-         call self%locator%restart(self%t, pack_tangent(self%y, self%phi), h_start)
+         call pack_state(self)
+         call self%locator%restart(self%t, self%packed, h_start)
       else
          call self%locator%restart(self%t, self%y, h_start)
       end if
@@ -118,7 +171,7 @@ contains
    !> Replace the tangent matrix (after a QR step) and forget lost directions.
    subroutine reset_tangent(self, phi)
       class(brake_integrator), intent(inout) :: self
-      real(wp), intent(in) :: phi(4, 4)
+      real(wp), intent(in) :: phi(:, :)
 
       self%phi = phi
       self%lost = 0

@@ -95,6 +95,9 @@ module friction_brake_law_model
       procedure :: start => law_start
       procedure :: advance_to => law_advance_to
       procedure :: is_sticking => law_sticking
+      procedure :: state_count => law_state_count
+      procedure :: get_states => law_get_states
+      procedure :: set_states => law_set_states
       procedure :: limit
       procedure :: start_slipping => law_start_slipping
       procedure :: advance_to_slip_onset => law_advance_to_slip_onset
@@ -373,14 +376,15 @@ contains
       self%h_start = config%solver%h_start
       if (.not. (self%h_start > 0.0_wp)) self%h_start = min(1.0e-3_wp, 0.1_wp / fastest)
       if (self%tangent) then
-         ! A law without states (checked on input): the tangent of (x, v, y, w) is the whole tangent.
+         ! The tangent of (x, v, y, w, ẑ): the law's states (in units of their scale) are in it.
          if (allocated(self%extended)) deallocate (self%extended)
          allocate (self%extended)
          allocate (self%extended%base, source=self%flow)
          call self%locator%init(self%extended, config%solver, [event_falling, event_either, event_either], &
             & [.true., .false., .false.], config%event_tolerance, self%h_start, error, time_name='τ', time_unit='')
          if (allocated(error)) return
-         call self%start_tangent()
+         call self%start_tangent(ns)
+         self%states = self%z(1:ns) / self%flow%scale(1:ns)
          call self%locator_restart(self%h_start)
          return
       end if
@@ -403,6 +407,49 @@ contains
          limit = self%slope * self%p%normal_force(y) + self%level
       end if
    end function limit
+
+   !> The single-valued law's states (a set-valued law has none here).
+   pure integer function law_state_count(self)
+      class(law_integrator), intent(in) :: self
+
+      law_state_count = 0
+      if (.not. self%switching .and. allocated(self%flow)) law_state_count = self%flow%n_states
+   end function law_state_count
+
+   !> The states as integrated: in units of their scale.
+   subroutine law_get_states(self, states)
+      class(law_integrator), intent(in) :: self
+      real(wp), intent(out) :: states(:)
+      integer :: ns
+
+      ns = self%state_count()
+      if (self%tangent) then
+         states(1:ns) = self%states
+      else
+         states(1:ns) = self%z(1:ns) / self%flow%scale(1:ns)
+      end if
+   end subroutine law_get_states
+
+   !> Start again from the states given (in units of their scale) at the
+   !> current (t, y), with the first step of start.
+   subroutine law_set_states(self, states)
+      class(law_integrator), intent(inout) :: self
+      real(wp), intent(in) :: states(:)
+      real(wp) :: s(4 + max_law_states)
+      integer :: ns
+
+      ns = self%state_count()
+      if (ns == 0) return
+      self%z(1:ns) = states(1:ns) * self%flow%scale(1:ns)
+      if (self%tangent) then
+         self%states = states(1:ns)
+         call self%locator_restart(self%h_start)
+      else
+         s(1:4) = self%y
+         s(5:4 + ns) = states(1:ns)
+         call self%locator%restart(self%t, s(1:4 + ns), self%h_start)
+      end if
+   end subroutine law_set_states
 
    logical function law_sticking(self)
       class(law_integrator), intent(in) :: self
@@ -441,6 +488,7 @@ contains
       if (self%tangent) then
          do while (self%t < t_target)
             call self%locator_advance(t_target, error)
+            self%z(1:ns) = self%states * self%flow%scale(1:ns)
             if (allocated(error)) return
             call self%record_band_hits(events, '', error)
             if (allocated(error)) return
