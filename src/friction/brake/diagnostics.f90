@@ -170,7 +170,9 @@ contains
    !> Benettin for the brake: a reference and a perturbed run advanced in
    !> lockstep through the same stick/slip logic; after each interval the
    !> perturbed run restarts from the reference plus the separation scaled
-   !> back to d0.  In stick the perturbation is put on the positions only so
+   !> back to d0.  The state is (x, x', y, y') and a law's internal states in
+   !> units of their scale, which the perturbed run's restarts carry.  In
+   !> stick the perturbation is put on the positions (and states) only so
    !> that both runs start in the same phase; a separation with a velocity
    !> part restarts the perturbed run in slip, as the logic decides.
    subroutine brake_benettin(config, settings, result, error, guard, reporter)

@@ -11,7 +11,8 @@
 !>
 !> - A single-valued law (arctan, Karnopp, Dahl, LuGre, elasto-plastic,
 !>   rate and state) is one ODE in (x, v, y, w, ẑ), the law's states in
-!>   units of their scale; events as the regularized model's: N' falling
+!>   units of their scale (the tangent's and Benettin's state too: the
+!>   integrator gives and takes them); events as the regularized model's: N' falling
 !>   through 0 (the pad lifts off: an error) and the edges of the creep
 !>   band |v_rel| <= stick_velocity that the output counts as stick.
 !> - A set-valued law (Coulomb, Stribeck, the table) switches exactly as
