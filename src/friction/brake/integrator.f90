@@ -91,11 +91,13 @@ contains
       state_count = 0
    end function state_count
 
+   !> The states now (none here).
    subroutine get_states(self, states)
       class(brake_integrator), intent(in) :: self
       real(wp), intent(out) :: states(:)
    end subroutine get_states
 
+   !> Continue from these states (none here: nothing to do).
    subroutine set_states(self, states)
       class(brake_integrator), intent(inout) :: self
       real(wp), intent(in) :: states(:)
