@@ -38,6 +38,8 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.linalg import expm
 
+from tangent_oracles import finite_time_benettin, finite_time_spectrum, generic_frame
+
 QUIET = {"analysis.spectrum": ".false.", "analysis.poincare": ".false.", "analysis.lyapunov": ".false.",
          "analysis.lyapunov_spectrum": ".false.", "analysis.orbit": ".false.", "analysis.rosenstein": ".false."}
 
@@ -331,35 +333,9 @@ def lugre_steady(args):
     assert abs(exponents.sum() - np.trace(j)) <= 1e-5 * abs(np.trace(j)), (exponents.sum(), np.trace(j))
 
 
-def finite_time_spectrum(step, frame, intervals):
-    """Σ ln |R_ii| of Q R = step Q over `intervals` QR steps from `frame`, largest first."""
-    logs = np.zeros(frame.shape[1])
-    for _ in range(intervals):
-        q, r = np.linalg.qr(step @ frame)
-        frame, logs = q * np.sign(np.diag(r)), logs + np.log(np.abs(np.diag(r)))
-    return np.sort(logs)[::-1]
-
-
-def finite_time_benettin(step, direction, intervals):
-    """Σ ln |δ_k+1|/|δ_k| with δ renormalised to unit length every interval."""
-    delta, total = direction / np.linalg.norm(direction), 0.0
-    for _ in range(intervals):
-        delta = step @ delta
-        total += np.log(np.linalg.norm(delta))
-        delta /= np.linalg.norm(delta)
-    return total
-
-
 def force_state(force, s0, u):
     """The law's steady state over its scale: z = (F - σ2 w)/σ0 with the belt's w > 0."""
     return (force - u["s2"] * (-u["vdr"] / u["T"])) / s0 / u["scale"]
-
-
-def generic_frame(n):
-    """The tangent vectors' starting frame, the QR of I + the n x n Hilbert matrix (documented in
-    analysis/lyapunov_spectrum.f90), with R's diagonal positive."""
-    q, r = np.linalg.qr(np.eye(n) + 1.0 / (np.add.outer(np.arange(n), np.arange(n)) + 1.0))
-    return q * np.sign(np.diag(r))
 
 
 def lugre_spectrum(args):

@@ -44,6 +44,7 @@ import numpy as np
 from scipy.linalg import expm
 
 from machine_cases import run_program, check_refusals, case_main
+from tangent_oracles import finite_time_benettin, finite_time_spectrum, generic_frame
 
 
 def run(args, name, files, sets):
@@ -459,31 +460,6 @@ def inner_differences(field, ratio, state):
             h = -h
         columns.append((-3 * field(0, state) + 4 * field(0, state + h * e) - field(0, state + 2 * h * e)) / (2 * h))
     return np.column_stack(columns)
-
-
-def finite_time_spectrum(step, frame, intervals):
-    """Σ ln |R_ii| of Q R = step Q over `intervals` QR steps from `frame`, largest first."""
-    logs = np.zeros(frame.shape[1])
-    for _ in range(intervals):
-        q, r = np.linalg.qr(step @ frame)
-        frame, logs = q * np.sign(np.diag(r)), logs + np.log(np.abs(np.diag(r)))
-    return np.sort(logs)[::-1]
-
-
-def finite_time_benettin(step, direction, intervals):
-    """Σ ln |δ_k+1|/|δ_k| with δ renormalised to unit length every interval."""
-    delta, total = direction / np.linalg.norm(direction), 0.0
-    for _ in range(intervals):
-        delta = step @ delta
-        total += np.log(np.linalg.norm(delta))
-        delta /= np.linalg.norm(delta)
-    return total
-
-
-def generic_frame(n):
-    """The tangent vectors' starting frame (analysis/lyapunov_spectrum.f90), R's diagonal positive."""
-    q, r = np.linalg.qr(np.eye(n) + 1.0 / (np.add.outer(np.arange(n), np.arange(n)) + 1.0))
-    return q * np.sign(np.diag(r))
 
 
 def gms_steady(args):
