@@ -116,15 +116,21 @@ def lugre_field(m, k, c, vb, fc, fs, vs, s0, s1, s2, amp=0.0, freq=0.0):
     return field
 
 
+def central_differences(section_map, point, steps):
+    """The Jacobian of `section_map` at `point` by central differences with `steps` per coordinate."""
+    fd = np.zeros((len(point), len(point)))
+    for j in range(len(point)):
+        d = np.zeros(len(point))
+        d[j] = steps[j]
+        fd[:, j] = (section_map(point + d) - section_map(point - d)) / (2 * steps[j])
+    return fd
+
+
 def check_fd_liouville(name, got, section_map, field, states_of, period, steps, tol_fd, tol_liouville):
     """DP against central differences of the map; ∏μ against exp(∮ div f dt) along the orbit."""
     s = got["section"]
     dp = got["section_jacobian"]
-    fd = np.zeros_like(dp)
-    for j in range(len(s)):
-        d = np.zeros(len(s))
-        d[j] = steps[j]
-        fd[:, j] = (section_map(s + d) - section_map(s - d)) / (2 * steps[j])
+    fd = central_differences(section_map, s, steps)
     scale = np.max(np.abs(fd))
     fd_error = np.max(np.abs(dp - fd)) / scale
     # The multipliers: the program's closed forms against NumPy's eigenvalues of the differences' DP
@@ -360,11 +366,7 @@ def forced_coulomb_reversals(args):
     t0, period = got["guess_time"], 1 / p["freq"]
     point = got["point"]
     closes = np.max(np.abs(switching_strobe(p, t0, period, point) - point))
-    fd = np.zeros((2, 2))
-    for j in range(2):
-        d = np.zeros(2)
-        d[j] = 1e-6
-        fd[:, j] = (switching_strobe(p, t0, period, point + d) - switching_strobe(p, t0, period, point - d)) / 2e-6
+    fd = central_differences(lambda q: switching_strobe(p, t0, period, q), point, [1e-6, 1e-6])
     dp, mu_got = got["section_jacobian"], got["multipliers"]
     fd_error = np.max(np.abs(dp - fd)) / np.max(np.abs(fd))
     expected = np.linalg.eigvals(fd)
@@ -417,11 +419,7 @@ def forced_stribeck(args):
     # The strobe falls in a slip (v != belt): the map is smooth about it, each switch crossed transversally.
     assert point[1] != p["belt"]
     steps = [1e-6, 1e-6]
-    fd = np.zeros((2, 2))
-    for j in range(2):
-        d = np.zeros(2)
-        d[j] = steps[j]
-        fd[:, j] = (switching_strobe(p, t0, period, point + d) - switching_strobe(p, t0, period, point - d)) / (2 * steps[j])
+    fd = central_differences(lambda q: switching_strobe(p, t0, period, q), point, steps)
     dp = got["section_jacobian"]
     fd_error = np.max(np.abs(dp - fd)) / np.max(np.abs(fd))
     expected = np.linalg.eigvals(fd)
@@ -522,11 +520,7 @@ def karnopp_band(args):
     t0, period = got["guess_time"], 1 / p["freq"]
     point = got["point"]
     closes = np.max(np.abs(karnopp_flow(p, t0, period, point) - point))
-    fd = np.zeros((2, 2))
-    for j in range(2):
-        d = np.zeros(2)
-        d[j] = 1e-6
-        fd[:, j] = (karnopp_flow(p, t0, period, point + d) - karnopp_flow(p, t0, period, point - d)) / 2e-6
+    fd = central_differences(lambda q: karnopp_flow(p, t0, period, q), point, [1e-6, 1e-6])
     dp, mu_got = got["section_jacobian"], got["multipliers"]
     fd_error = np.max(np.abs(dp - fd)) / np.max(np.abs(fd))
     expected = np.linalg.eigvals(fd)
