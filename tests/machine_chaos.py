@@ -124,6 +124,21 @@ def lugre_jacobian_at_rest(m, k, c, vb, fc, fs, vs, s0, s1, s2):
                      [0.0, dzdot_dw, dzdot_dz]])
 
 
+def lugre_sum_rule(args, name, sets, transient, duration, parameters):
+    """A LuGre run of machine_lugre.nml with `sets`: its exponents and spectrum_divergence, and the time
+    average of tr J after the transient along the written trajectory by the trapezoid, with the
+    quadrature's own error from every second sample (trapezoid: 4 times the error of every sample)."""
+    with run(args, name, ["machine_lugre.nml"], sets) as f:
+        t, x, v, z = (f["machine"][key][:] for key in ("t", "x", "v", "z"))
+        exponents = f["machine/lyapunov/exponents"][:]
+        divergence = f["machine/lyapunov"].attrs["spectrum_divergence"]
+    keep = t >= transient - 1e-12
+    trace = lugre_trace(x[keep], v[keep], z[keep], *parameters)
+    average = np.trapezoid(trace, t[keep]) / duration
+    quadrature = abs(np.trapezoid(trace[::2], t[keep][::2]) / duration - average) / 3
+    return exponents, divergence, average, quadrature
+
+
 def sum_rule(args):
     # LuGre with a soft bristle (σ0 = 100 N/m, σ1 = 10 N s/m): its relaxation σ0|w|/g, 10 1/s here, is
     # resolved by the orbit's own steps (the paper's σ0 = 1e5 N/m is stiff-lugre's).
@@ -133,15 +148,8 @@ def sum_rule(args):
     sets = dict(law, **{"machine.t_end": transient + duration, "machine.dt_out": 2e-4,
                         "analysis.lyapunov_spectrum": ".true.", "analysis.lyapunov_spectrum_transient": transient,
                         "analysis.lyapunov_spectrum_renormalise": 0.1})
-    with run(args, "lugre", ["machine_lugre.nml"], sets) as f:
-        t, x, v, z = (f["machine"][key][:] for key in ("t", "x", "v", "z"))
-        exponents = f["machine/lyapunov/exponents"][:]
-        divergence = f["machine/lyapunov"].attrs["spectrum_divergence"]
-    keep = t >= transient - 1e-12
-    trace = lugre_trace(x[keep], v[keep], z[keep], m, k, c, vb, fc, fs, vs, s0, s1, s2)
-    average = np.trapezoid(trace, t[keep]) / duration
-    # The quadrature's own error, from every second sample (trapezoid: 4 times the error of every sample).
-    quadrature = abs(np.trapezoid(trace[::2], t[keep][::2]) / duration - average) / 3
+    exponents, divergence, average, quadrature = lugre_sum_rule(args, "lugre", sets, transient, duration,
+                                                                (m, k, c, vb, fc, fs, vs, s0, s1, s2))
     print(f"sum-rule: exponents {exponents}, sum {exponents.sum():.9f} 1/s; time average of tr J "
           f"{average:.9f} 1/s (quadrature error ~{quadrature:.1e})")
     # Σλ T = ln det Φ(T) = ∫ tr J dt exactly (Liouville), whatever the motion.  What differs: the tangent's
@@ -227,14 +235,8 @@ def stiff_lugre(args):
     transient, duration = 10.0, 10.0
     sets = {"machine.t_end": transient + duration, "machine.dt_out": 5e-5, "analysis.lyapunov_spectrum": ".true.",
             "analysis.lyapunov_spectrum_transient": transient}
-    with run(args, "stiff_stick_slip", ["machine_lugre.nml"], sets) as f:
-        t, x, v, z = (f["machine"][key][:] for key in ("t", "x", "v", "z"))
-        exponents = f["machine/lyapunov/exponents"][:]
-        divergence = f["machine/lyapunov"].attrs["spectrum_divergence"]
-    keep = t >= transient - 1e-12
-    trace = lugre_trace(x[keep], v[keep], z[keep], m, k, c, vb, fc, fs, vs, s0, s1, s2)
-    average = np.trapezoid(trace, t[keep]) / duration
-    quadrature = abs(np.trapezoid(trace[::2], t[keep][::2]) / duration - average) / 3
+    exponents, divergence, average, quadrature = lugre_sum_rule(args, "stiff_stick_slip", sets, transient,
+                                                                duration, (m, k, c, vb, fc, fs, vs, s0, s1, s2))
     print(f"stiff-lugre: stick-slip: exponents {exponents}, sum "
           f"{exponents.sum():.6f} 1/s; time average of tr J {average:.6f} (quadrature error ~{quadrature:.1e}); "
           f"spectrum_divergence {divergence:.6f}")
