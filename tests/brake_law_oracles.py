@@ -28,7 +28,6 @@ program and its file, against oracles that are not that model's output:
 
     brake_law_oracles.py --binary build/friction --inputs inputs --workdir DIR CASE
 """
-import argparse
 import subprocess
 import sys
 from pathlib import Path
@@ -38,6 +37,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.linalg import expm
 
+from machine_cases import case_main
 from tangent_oracles import finite_time_benettin, finite_time_spectrum, generic_frame
 
 QUIET = {"analysis.spectrum": ".false.", "analysis.poincare": ".false.", "analysis.lyapunov": ".false.",
@@ -415,18 +415,9 @@ def refusals(args):
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--binary", required=True)
-    parser.add_argument("--inputs", required=True)
-    parser.add_argument("--workdir", required=True)
-    cases = {"coulomb-switched": coulomb_switched, "arctan-regularized": arctan_regularized,
-             "lugre-radau": lugre_radau, "refusals": refusals, "benettin": benettin, "spectrum": spectrum,
-             "lugre-steady": lugre_steady, "lugre-spectrum": lugre_spectrum}
-    parser.add_argument("case", choices=sorted(cases))
-    args = parser.parse_args()
-    Path(args.workdir).mkdir(parents=True, exist_ok=True)
-    cases[args.case](args)
-    return 0
+    return case_main(__doc__, {"coulomb-switched": coulomb_switched, "arctan-regularized": arctan_regularized,
+                               "lugre-radau": lugre_radau, "refusals": refusals, "benettin": benettin,
+                               "spectrum": spectrum, "lugre-steady": lugre_steady, "lugre-spectrum": lugre_spectrum})
 
 
 if __name__ == "__main__":

@@ -37,11 +37,14 @@ def check_refusals(args, cases, label):
         assert not out.exists()
 
 
-def case_main(doc, cases):
-    """Runs the case named on the command line (--binary, --inputs, --workdir
-    CASE), `cases` mapping names to functions of the arguments."""
+def case_main(doc, cases, extra=()):
+    """Runs the case named on the command line (--binary, --inputs, --workdir,
+    each option of `extra`, CASE), `cases` mapping names to functions of the
+    arguments."""
     parser = argparse.ArgumentParser(description=doc.split("\n")[0])
     parser.add_argument("--binary", required=True)
+    for option in extra:
+        parser.add_argument(option, required=True)
     parser.add_argument("--inputs", required=True)
     parser.add_argument("--workdir", required=True)
     parser.add_argument("case", choices=list(cases))

@@ -15,7 +15,6 @@ against an oracle that is not the sweep's own output:
 
     machine_sweep_orbit.py --binary build/friction --mpiexec mpiexec --inputs inputs --workdir DIR CASE
 """
-import argparse
 import sys
 from pathlib import Path
 
@@ -23,7 +22,7 @@ import h5py
 import numpy as np
 
 from helpers import file_contents, fail, require, run
-from machine_cases import run_program
+from machine_cases import run_program, case_main
 
 ORBIT = ("orbit_found", "orbit_period", "orbit_max_multiplier", "orbit_critical_real", "orbit_critical_imag")
 
@@ -150,17 +149,8 @@ def ranks(args):
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--binary", required=True)
-    parser.add_argument("--mpiexec", required=True)
-    parser.add_argument("--inputs", required=True)
-    parser.add_argument("--workdir", required=True)
-    cases = {"forced-linear": forced_linear, "lugre-points": lugre_points, "ranks": ranks}
-    parser.add_argument("case", choices=list(cases))
-    args = parser.parse_args()
-    Path(args.workdir).mkdir(parents=True, exist_ok=True)
-    cases[args.case](args)
-    return 0
+    return case_main(__doc__, {"forced-linear": forced_linear, "lugre-points": lugre_points, "ranks": ranks},
+                     extra=["--mpiexec"])
 
 
 if __name__ == "__main__":
