@@ -184,6 +184,8 @@ def _signatures(lib):
         "friction_config_check": (c_int, [c_void_p, c_void_p]),
         "friction_config_warnings": (c_int, [c_void_p, c_char_p, c_size_t, size_p]),
         "friction_afm_line": (c_int, [c_void_p, c_int, c_int, c_void_p, c_void_p, c_size_t, c_void_p]),
+        "friction_afm_line_progress": (c_int, [c_void_p, c_int, c_int, c_void_p, c_void_p, c_size_t, _PROGRESS,
+                                               c_void_p, c_void_p]),
         "friction_compute": (c_void_p, [c_void_p, c_void_p]),
         "friction_compute_progress": (c_void_p, [c_void_p, _PROGRESS, c_void_p, c_void_p]),
         "friction_result_get": (c_int, [c_void_p, c_char_p, c_void_p, c_size_t, size_p, c_void_p]),
@@ -462,13 +464,14 @@ class _ComputeProgress(_Stoppable):
     inside a scan line at a temperature (every 0.1 s), not progress: it is
     not delivered, and so Ctrl-C stops such a line within it."""
 
-    def __init__(self, lib, report):
+    def __init__(self, lib, report, polls=False):
         super().__init__(lib, report)
         self.stop = False
+        self.polls = polls   # deliver the polls too (a single line's callback: its only chance to stop it)
         self.function = _PROGRESS(self._called)
 
     def _called(self, message, fraction, user):
-        if fraction >= 0.0:
+        if fraction >= 0.0 or self.polls:
             self._deliver(message, fraction)
         return int(self.stop)
 
@@ -709,12 +712,23 @@ class Config:
         return self
 
     # ---- computations on this process ----
-    def afm_line(self, line=0, forward=True):
-        """Line `line` (0-based) of the map, trace or retrace: fx, fy (nN) at scan.nx points."""
+    def afm_line(self, line=0, forward=True, report=None, polls=False):
+        """Line `line` (0-based) of the map, trace or retrace: fx, fy (nN) at scan.nx points
+        (friction.h: friction_afm_line_progress).  `report(message, fraction)`
+        if given receives the line's end ("1 of 1 lines", 1.0) and, with
+        `polls`, the library's polls from inside a long line ("started", -1.0)
+        every 0.1 s.  Ctrl-C (on the main thread), or anything the report
+        raises at a poll, stops the line within the trip's next look and
+        raises KeyboardInterrupt (the report's exception), its context a
+        FrictionError with status 5; an exception at the end is raised after
+        the line.  Nothing is returned then; the Config stays as it was."""
         nx = int(self.get("scan.nx")) if self.scene == "afm" else 1
         fx, fy = np.zeros(nx), np.zeros(nx)
-        _call(self._lib.friction_afm_line, self.handle, _c_int(line, "line"), int(bool(forward)),
-              fx.ctypes.data_as(ctypes.c_void_p), fy.ctypes.data_as(ctypes.c_void_p), nx)
+        progress = _ComputeProgress(self._lib, report, polls)
+        line, forward = _c_int(line, "line"), int(bool(forward))
+        progress._guarded(lambda: _call(self._lib.friction_afm_line_progress, self.handle, line, forward,
+                                        fx.ctypes.data_as(ctypes.c_void_p), fy.ctypes.data_as(ctypes.c_void_p),
+                                        nx, progress.function, None))
         return fx, fy
 
     def compute(self, report=None):

@@ -328,9 +328,18 @@ class Config(_capi.Config):
         nx, length = int(self.value("scan.nx")), float(self.value("scan.length"))
         return length * np.arange(nx, dtype=float) / float(nx - 1)
 
-    def afm_line(self, line: int = 0, forward: bool = True) -> Line:
+    def afm_line(self, line: int = 0, forward: bool = True, progress: Progress = False) -> Line:
         """Line `line` (0-based) of the map, trace (forward) or retrace: a Line
-        (x, fx, fy), exactly the file's line of /afm/trace (/afm/retrace).
+        (x, fx, fy), exactly the file's line of /afm/trace (/afm/retrace), with
+        or without `progress`.  A callable `progress(message, fraction)` is
+        called from inside a line that takes longer than 0.1 s, every 0.1 s
+        ("started", fraction -1), and once when the line is done ("1 of 1
+        lines", 1.0); an exception it raises inside the line stops the line
+        there (within 1 ms for the Langevin tip and the reduced model) and is
+        raised, its context a FrictionError with status 5. Ctrl-C stops a line
+        the same way, with or without `progress`, and raises
+        KeyboardInterrupt. Nothing is returned then, and the Config stays as
+        it was, its kept surface too.
 
         Parameters
         ----------
@@ -338,6 +347,9 @@ class Config(_capi.Config):
             The line, 0-based.
         forward : bool
             Trace (True) or retrace.
+        progress : bool or callable
+            False (the default), True (a tqdm bar or a line on stderr at the
+            line's end) or a callable (message, fraction), also given the polls.
 
         Returns
         -------
@@ -350,12 +362,19 @@ class Config(_capi.Config):
             The library's refusal: the program's message (file, line, group, variable) and status.
         ValueError
             A line beyond C's int.
+        KeyboardInterrupt
+            Ctrl-C, after the line stopped.
 
         Examples
         --------
         >>> x, fx, fy = friction.Config("afm", files=["inputs/naf.nml"]).afm_line(0)  # doctest: +SKIP
+        >>> line = cfg.afm_line(0, progress=lambda message, fraction: print(message))  # doctest: +SKIP
         """
-        fx, fy = super().afm_line(line, forward)
+        if callable(progress):
+            fx, fy = _capi.Config.afm_line(self, line, forward, report=progress, polls=True)
+        else:
+            fx, fy = _job(lambda report: _capi.Config.afm_line(self, line, forward, report=report), progress,
+                          f"line {line}")
         return Line(self.support_x(), fx, fy)
 
     def run(self, output: PathLike, force: bool = False, resume: bool = False, progress: Progress = True) -> Path:
@@ -459,7 +478,7 @@ def compute(scene: str, files: PathLike | Sequence[PathLike] = (), values: Mappi
 
 
 def afm_line(files: PathLike | Sequence[PathLike] = (), values: Mapping[str, Any] | None = None, line: int = 0,
-             forward: bool = True) -> Line:
+             forward: bool = True, progress: Progress = False) -> Line:
     """One line of a friction-force map: Line(x, fx, fy), numpy arrays.
 
         x, fx, fy = friction.afm_line("inputs/naf.nml", {"scan.nx": 64})
@@ -474,6 +493,9 @@ def afm_line(files: PathLike | Sequence[PathLike] = (), values: Mapping[str, Any
         The line, 0-based.
     forward : bool
         Trace (True) or retrace.
+    progress : bool or callable
+        As Config.afm_line(): a callable is also polled inside a long line,
+        and an exception it raises there stops the line.
 
     Returns
     -------
@@ -484,9 +506,11 @@ def afm_line(files: PathLike | Sequence[PathLike] = (), values: Mapping[str, Any
     ------
     FrictionError
         The library's refusal: the program's message (file, line, group, variable) and status.
+    KeyboardInterrupt
+        Ctrl-C, after the line stopped.
     """
     with Config("afm", files, values) as cfg:
-        return cfg.afm_line(line, forward)
+        return cfg.afm_line(line, forward, progress)
 
 
 def brake(files: PathLike | Sequence[PathLike] = (), values: Mapping[str, Any] | None = None,

@@ -103,6 +103,113 @@ def test_afm_line_is_the_files_line_to_the_last_bit(friction, naf_map):
     assert isinstance(line, friction.Line) and np.array_equal(line.fx, trace[3])
 
 
+def test_afm_line_with_progress_is_the_line_without(friction, naf_map):
+    """afm_line(progress=callable) goes through friction_afm_line_progress:
+    the file's line and the plain friction_afm_line's (called here through
+    ctypes) to the last bit, and the callable gets the line's end last
+    (before it only the library's polls, should the line take 0.1 s)."""
+    import ctypes
+    with h5py.File(naf_map) as f:
+        trace, retrace = f["afm/trace/fx"][()], f["afm/retrace/fy"][()]
+    with friction.Config("afm", files=NAF) as cfg:
+        for j, forward in ((0, True), (3, False), (9, True)):
+            reports = []
+            line = cfg.afm_line(j, forward, progress=lambda message, fraction: reports.append((message, fraction)))
+            quiet = cfg.afm_line(j, forward)
+            plain_x, plain_y = np.zeros(line.fx.size), np.zeros(line.fx.size)
+            assert cfg._lib.friction_afm_line(cfg.handle, j, int(forward), plain_x.ctypes.data_as(ctypes.c_void_p),
+                                              plain_y.ctypes.data_as(ctypes.c_void_p), plain_x.size, None) == 0
+            for got in (line, quiet):
+                assert np.array_equal(got.fx, plain_x) and np.array_equal(got.fy, plain_y), j
+            assert np.array_equal(line.fx if forward else line.fy, trace[j] if forward else retrace[j]), j
+            assert reports[-1] == ("1 of 1 lines", 1.0), reports
+            assert all(report == ("started", -1.0) for report in reports[:-1]), reports
+        assert np.array_equal(friction.afm_line(NAF, line=3, progress=lambda m, f: None).fx, trace[3])
+
+
+def test_a_progress_that_raises_at_the_end_of_a_line_returns_nothing(friction, naf_map):
+    """An exception of the callable at the line's end ("1 of 1 lines"): the
+    line was done, but the call raises it and returns nothing; the Config
+    computes the same line again."""
+    def progress(message, fraction):
+        raise ValueError(f"no thanks: {message}")
+
+    with friction.Config("afm", files=NAF) as cfg:
+        with pytest.raises(ValueError, match="no thanks: 1 of 1 lines"):
+            cfg.afm_line(2, progress=progress)
+        with h5py.File(naf_map) as f:
+            assert np.array_equal(cfg.afm_line(2).fx, f["afm/trace/fx"][2])
+
+
+# A thermal line that takes tens of seconds (the Langevin tip at 0.1 A/s over 9.24 A, some 4e7
+# steps, as the C API's capi-thermal-stop): a stop that did not happen inside it would show.
+LONG_LINE = {"scan.ny": 1, "scan.length": 9.24, "thermal.temperature": 300.0, "thermal.model": "langevin",
+             "scan.velocity": 0.1, "tip.model": "inertial", "thermal.realizations": 1}
+
+
+def _short_line_after(friction, cfg):
+    """The stopped Config computes again: a two-point line, against a fresh Config's."""
+    short = {"scan.length": 0.5, "scan.nx": 2, "scan.velocity": 1.0e4}
+    for name, value in short.items():
+        cfg[name] = value
+    with friction.Config("afm", values={**LONG_LINE, **short}) as fresh:
+        expected = fresh.afm_line(0)
+    got = cfg.afm_line(0)
+    assert got.fx.size == 2 and np.isfinite(got.fx).all()
+    # the same seed and realizations: the same numbers to the last bit
+    assert np.array_equal(got.fx, expected.fx) and np.array_equal(got.fy, expected.fy)
+
+
+def test_a_progress_that_raises_inside_a_line_stops_it(friction):
+    """The callable raising at a poll from inside a long thermal line stops
+    the line there: its exception, after the library's status 5, within a
+    second of the request (the trip looks every 0.1 s of wall time; the bound
+    allows a loaded machine ten times that), no end report, nothing
+    returned; the Config computes on."""
+    import time
+    polls, asked = [], []
+    start = time.monotonic()
+
+    def progress(message, fraction):
+        polls.append((message, fraction))
+        if fraction < 0 and time.monotonic() - start > 0.3:
+            asked.append(time.monotonic())
+            raise RuntimeError("cancelled")
+
+    with friction.Config("afm", values=LONG_LINE) as cfg:
+        with pytest.raises(RuntimeError, match="cancelled") as caught:
+            cfg.afm_line(0, progress=progress)
+        ended = time.monotonic()
+        assert "stopped on request" in interrupted(caught).message
+        assert len(asked) == 1 and ended - asked[0] < 1.0, (ended - asked[0], len(polls))
+        assert all(poll == ("started", -1.0) for poll in polls), polls
+        _short_line_after(friction, cfg)
+
+
+def test_ctrl_c_stops_a_long_line_without_progress(friction):
+    """A real SIGINT while the main thread is inside a long thermal line, no
+    progress asked for: the line polls the callback every 0.1 s, Python's
+    handler runs there, and the line stops (KeyboardInterrupt after status 5)
+    within seconds instead of the tens of seconds of the whole line."""
+    import os
+    import signal
+    import threading
+    import time
+    timer = threading.Timer(0.3, os.kill, (os.getpid(), signal.SIGINT))
+    with friction.Config("afm", values=LONG_LINE) as cfg:
+        start = time.monotonic()
+        timer.start()
+        try:
+            with pytest.raises(KeyboardInterrupt) as caught:
+                cfg.afm_line(0)
+        finally:
+            timer.cancel()
+        assert time.monotonic() - start < 3.0   # 0.3 s, one poll and the trip's next look; loaded-machine margin
+        assert "stopped on request" in interrupted(caught).message
+        assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+        _short_line_after(friction, cfg)
+
+
 GRAPHITE = [INPUTS / "graphite.nml", DATA / "graphite_small.nml"]
 
 
