@@ -1,7 +1,7 @@
 # Tests of scripts/plot_sweep.py (label "scripts"), in the manner of
 # scripts_brake.cmake:
 #   scripts.sweep_run               friction computes a small sweep (fixture)
-#   scripts.plot_sweep.*            bifurcation and exponent PNGs, --help, errors
+#   scripts.plot_sweep.*            bifurcation and exponent PNGs, --help, errors; AFM and machine sweeps
 # Included from tests/CMakeLists.txt after scripts.cmake (helpers, h5py and
 # matplotlib checks).
 
@@ -64,3 +64,23 @@ add_test(NAME scripts.plot_sweep.afm.png
           "${_fw_work}/plots/afm_sweep_small_friction.png")
 set_tests_properties(scripts.plot_sweep.afm.png PROPERTIES
   FIXTURES_REQUIRED "scripts_afm_sweep_run;scripts_plot_afm_sweep" LABELS scripts)
+
+# A machine sweep (inputs/machine_stribeck_orbit.nml over 4 belt velocities): maxima and results PNGs.
+set(_fw_machine "${_fw_work}/machine_sweep_small.h5")
+add_test(NAME scripts.machine_sweep_run
+  COMMAND $<TARGET_FILE:friction_app> --quiet --force -o "${_fw_machine}"
+          "${_fs_inputs}/machine_stribeck_orbit.nml" "${_fs_tests}/data/machine_sweep_small.nml"
+  WORKING_DIRECTORY "${_fw_work}")
+set_tests_properties(scripts.machine_sweep_run PROPERTIES FIXTURES_SETUP scripts_machine_sweep_run LABELS scripts)
+
+add_test(NAME scripts.plot_sweep.machine.run
+  COMMAND ${_fw_plot} "${_fw_machine}" -o "${_fw_work}/plots"
+  WORKING_DIRECTORY "${_fw_work}")
+set_tests_properties(scripts.plot_sweep.machine.run PROPERTIES
+  FIXTURES_REQUIRED scripts_machine_sweep_run FIXTURES_SETUP scripts_plot_machine_sweep LABELS scripts)
+
+add_test(NAME scripts.plot_sweep.machine.png
+  COMMAND ${Python3_EXECUTABLE} "${_fs_tests}/check_png.py" --newer-than "${_fw_machine}"
+          "${_fw_work}/plots/machine_sweep_small_bifurcation.png" "${_fw_work}/plots/machine_sweep_small_machine.png")
+set_tests_properties(scripts.plot_sweep.machine.png PROPERTIES
+  FIXTURES_REQUIRED "scripts_machine_sweep_run;scripts_plot_machine_sweep" LABELS scripts)

@@ -10,7 +10,7 @@ lattice sums: graphite_net (Fig. 9a), stacked_lines (Fig. 9b)
 brake:        brake_phase (Fig. 12), brake_x, brake_spectrum (Fig. 13),
               poincare (Fig. 14), lyapunov, floquet, orbit_branch
 sweeps:       sweep (every chart of a sweep file), bifurcation, sweep_lyapunov,
-              sweep_friction
+              sweep_friction, sweep_machine
 speed:        work_precision, failure_map (files of scripts/work_precision)
 thermal:      friction_velocity (rows of scripts/thermal_velocity.py), sang_fit,
               friction_temperature (rows of scripts/thermal_temperature.py), temperature_fit
@@ -52,7 +52,7 @@ DataLike = Union["xr.DataTree", str, "os.PathLike[str]"]
 
 __all__ = ["afm_maps", "friction_loop", "graphite_net", "stacked_lines", "brake_phase", "brake_x",
            "brake_spectrum", "poincare", "lyapunov", "floquet", "orbit_branch", "sweep", "bifurcation",
-           "sweep_lyapunov", "atlas", "sweep_friction", "work_precision", "failure_map", "friction_velocity",
+           "sweep_lyapunov", "atlas", "sweep_friction", "sweep_machine", "work_precision", "failure_map", "friction_velocity",
            "sang_fit", "friction_temperature", "temperature_fit", "fit_maps", "fit_corner", "friction_load",
            "Figure"]
 
@@ -961,6 +961,9 @@ def _sweep(data):
         keys = ["values", "status"]
         if s["scene"] == "brake":
             keys += ["maxima", "maxima_offset", "maxima_count", "lyapunov", "stick_fraction"]
+        elif s["scene"] == "machine":
+            keys += ["maxima", "maxima_offset", "maxima_count", "force_mean", "stick_fraction", "events",
+                     "lyapunov", "orbit_found", "orbit_period", "orbit_max_multiplier"]
         else:
             keys += ["mean_friction", "max_force"]
         missing = [key for key in keys if f"sweep/{key}" not in paths(data)]
@@ -977,7 +980,7 @@ def _sweep(data):
     n = s["values"].size
     if any(s[key].size != n for key in keys if key != "maxima"):
         raise FileError("per-point datasets of different lengths")
-    if s["scene"] == "brake" and s["maxima_count"].sum() != s["maxima"].size:
+    if s["scene"] in ("brake", "machine") and s["maxima_count"].sum() != s["maxima"].size:
         raise FileError("maxima_count does not add up to the maxima")
     return s
 
@@ -1016,13 +1019,22 @@ def _log_scale(values):
 def _brake_sweep(data):
     s = _sweep(data)
     if s["scene"] != "brake":
-        raise FileError("not a brake sweep (sweep_scene = 'afm': use sweep_friction)")
+        raise FileError(f"not a brake sweep (sweep_scene = '{s['scene']}': use sweep)")
+    return s
+
+
+def _maxima_sweep(data):
+    """A sweep with the local maxima of x per point: the brake's or the machine's."""
+    s = _sweep(data)
+    if s["scene"] not in ("brake", "machine"):
+        raise FileError(f"not a brake or machine sweep (sweep_scene = '{s['scene']}': use sweep_friction)")
     return s
 
 
 def bifurcation(data: DataLike) -> Figure:
-    """A brake sweep's bifurcation diagram: the local maxima of x after the
-    transient against the swept parameter; failed points as red lines.
+    """A brake or machine sweep's bifurcation diagram: the local maxima of x
+    after the transient (the machine's: over the second half of each run)
+    against the swept parameter; failed points as red lines.
 
     Parameters
     ----------
@@ -1039,7 +1051,7 @@ def bifurcation(data: DataLike) -> Figure:
     friction.FileError
         A file that is not of the kind drawn, or lacks what the picture needs.
     """
-    s = _brake_sweep(data)
+    s = _maxima_sweep(data)
     fig = _figure(figsize=(7, 4.5))
     ax = fig.subplots()
     for k, (label, mask) in enumerate(_series(s)):
@@ -1051,7 +1063,8 @@ def bifurcation(data: DataLike) -> Figure:
             ax.plot([], [], "o", color=f"C{k}", label=label)
     _mark_failed(ax, s)
     ax.set_xlabel(s["label"])
-    ax.set_ylabel("local maxima of x after the transient (m)")
+    ax.set_ylabel("local maxima of x after the transient (m)" if s["scene"] == "brake"
+                  else "local maxima of x, second half of the run (m)")
     ax.set_title("bifurcation diagram")
     if ax.get_legend_handles_labels()[0]:
         ax.legend()
@@ -1201,7 +1214,7 @@ def sweep_friction(data: DataLike) -> Figure:
     """
     s = _sweep(data)
     if s["scene"] != "afm":
-        raise FileError("not an AFM sweep (sweep_scene = 'brake': use bifurcation, sweep_lyapunov)")
+        raise FileError(f"not an AFM sweep (sweep_scene = '{s['scene']}': use sweep)")
     done = s["status"] == 1
     fig = _figure(figsize=(7, 6.5))
     top, bottom = fig.subplots(2, 1, sharex=True)
@@ -1225,11 +1238,74 @@ def sweep_friction(data: DataLike) -> Figure:
     return fig
 
 
+def sweep_machine(data: DataLike) -> Figure:
+    """A machine sweep's results against the parameter, a line per value of
+    a second variable: the mean friction force and the stick fraction over
+    the second half of each run; the stick/slip events when any point has
+    some (set-valued laws); Benettin's exponent when `lyapunov` was on (any
+    point nonzero); and with `&analysis orbit`, where any point found its
+    periodic orbit, the orbit's period and the largest multiplier |μ| of its
+    section map (the unit circle dashed: stable below).  Points without an
+    orbit (NaN) are gaps; failed points are red lines.
+
+    Parameters
+    ----------
+    data : xarray.DataTree or str or os.PathLike
+        The file's data (friction.load) or its path.
+
+    Returns
+    -------
+    Figure
+        The figure (matplotlib, outside pyplot).
+
+    Raises
+    ------
+    friction.FileError
+        A file that is not of the kind drawn, or lacks what the picture needs.
+    """
+    s = _sweep(data)
+    if s["scene"] != "machine":
+        raise FileError(f"not a machine sweep (sweep_scene = '{s['scene']}': use sweep)")
+    done = s["status"] == 1
+    found = done & (s["orbit_found"] == 1)
+    panels = [("force_mean", "mean friction force (N)", done), ("stick_fraction", "stick fraction", done)]
+    if np.any(s["events"][done] > 0):
+        panels.append(("events", "stick/slip events", done))
+    if np.any(s["lyapunov"][done] != 0.0):
+        panels.append(("lyapunov", "Benettin exponent (1/s)", done))
+    if np.any(found):
+        panels += [("orbit_period", "orbit period (s)", found), ("orbit_max_multiplier", "largest |μ|", found)]
+    fig = _figure(figsize=(7, 1.9 * len(panels) + 1.0))
+    axes = np.atleast_1d(fig.subplots(len(panels), 1, sharex=True))
+    for ax, (key, ylabel, shown) in zip(axes, panels):
+        for k, (label, mask) in enumerate(_series(s)):
+            # NaN (no orbit at a point) breaks the line instead of joining its neighbours across it
+            y = np.where(shown & mask, s[key].astype(float), np.nan)[mask]
+            ax.plot(s["values"][mask], y, "o-", ms=3, color=f"C{k}", label=label)
+        if key == "lyapunov":
+            ax.axhline(0.0, color="0.6", lw=0.8)
+        if key == "orbit_max_multiplier":
+            ax.axhline(1.0, color="0.4", lw=0.8, ls="--")
+            if _log_scale(np.append(s[key][shown], 1.0)):   # stick-slip orbits' multipliers lie near 0
+                ax.set_yscale("log")
+        ax.set_ylabel(ylabel)
+        _mark_failed(ax, s)
+    if _log_scale(s["values"]):
+        axes[-1].set_xscale("log")
+    axes[0].set_title("machine sweep: the second half of each run")
+    axes[-1].set_xlabel(s["label"])
+    if axes[0].get_legend_handles_labels()[0]:
+        axes[0].legend(fontsize="small")
+    fig.tight_layout()
+    return fig
+
+
 def sweep(data: DataLike) -> dict[str, Figure]:
     """Every chart of a sweep file: {"bifurcation": Figure, "lyapunov": Figure}
     for a brake sweep, and "atlas" (maps) when it has a second variable (only
     the maps when that has more than 8 values: a line each would not read);
-    {"friction": Figure} for an AFM sweep.
+    {"friction": Figure} for an AFM sweep; {"bifurcation": Figure, "machine":
+    Figure} for a machine sweep (sweep_machine).
 
     Parameters
     ----------
@@ -1255,6 +1331,8 @@ def sweep(data: DataLike) -> dict[str, Figure]:
         if np.unique(s["values2"]).size <= 8:
             figures.update({"bifurcation": bifurcation(data), "lyapunov": sweep_lyapunov(data)})
         return figures
+    if s["scene"] == "machine":
+        return {"bifurcation": bifurcation(data), "machine": sweep_machine(data)}
     return {"friction": sweep_friction(data)}
 
 

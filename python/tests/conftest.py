@@ -136,6 +136,12 @@ def afm_sweep(files):
 
 
 @pytest.fixture(scope="session")
+def machine_sweep(files):
+    """A machine sweep of 4 belt velocities, the Stribeck law with orbits (tests/data/machine_sweep_small.nml)."""
+    return files("machine_sweep_small", [INPUTS / "machine_stribeck_orbit.nml", DATA / "machine_sweep_small.nml"])
+
+
+@pytest.fixture(scope="session")
 def graphite_map(files):
     """A tiny graphite map under a Lennard-Jones tip, with its net (tests/data/graphite_small.nml)."""
     return files("graphite_small", [INPUTS / "graphite.nml", DATA / "graphite_small.nml"])

@@ -141,6 +141,31 @@ def test_sweep_pictures(brake_sweep, afm_sweep, tmp_path):
     saved(afm["friction"], tmp_path / "afm_sweep.png")
 
 
+def test_machine_sweep_pictures(machine_sweep, brake_sweep, tmp_path):
+    """A machine sweep: its maxima, and a panel per result it has, each the
+    file's numbers; no orbit (NaN) is a gap, not a point."""
+    figures = friction.plot.sweep(machine_sweep)
+    assert set(figures) == {"bifurcation", "machine"}
+    data = friction.load(machine_sweep)
+    maxima = figures["bifurcation"].axes[0].lines[0].get_ydata()
+    assert np.array_equal(np.sort(maxima), np.sort(data["sweep/maxima"].values))
+    axes = figures["machine"].axes
+    assert [ax.get_ylabel() for ax in axes] == ["mean friction force (N)", "stick fraction", "stick/slip events",
+                                              "Benettin exponent (1/s)", "orbit period (s)", "largest |μ|"]
+    assert axes[-1].get_xlabel() == "machine.belt_velocity (m/s)"
+    for ax, key in zip(axes, ("force_mean", "stick_fraction", "events", "lyapunov", "orbit_period",
+                              "orbit_max_multiplier")):
+        wanted = data[f"sweep/{key}"].values.astype(float)
+        assert np.array_equal(ax.lines[0].get_ydata(), wanted, equal_nan=True), key
+    assert np.isnan(data["sweep/orbit_period"].values[-1])   # steady sliding at 0.3 m/s: no orbit
+    for name, fig in figures.items():
+        saved(fig, tmp_path / f"machine_{name}.png")
+    with pytest.raises(friction.FileError, match="not a machine sweep"):
+        friction.plot.sweep_machine(brake_sweep)
+    with pytest.raises(friction.FileError, match="not a brake sweep"):
+        friction.plot.sweep_lyapunov(machine_sweep)
+
+
 def test_atlas(brake_atlas, brake_sweep, tmp_path):
     figures = friction.plot.sweep(brake_atlas)
     # 4 values of the second variable: the maps and the lines.

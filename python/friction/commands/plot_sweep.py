@@ -11,10 +11,19 @@ brake sweep:
                           the stick fraction over the grid (then only this
                           one when the second variable has more than 8 values)
 
-and for an AFM sweep:
+for an AFM sweep:
 
   <stem>_friction.png     the mean friction and the maximum lateral force
                           against the parameter
+
+and for a machine sweep (&job scene = 'machine'):
+
+  <stem>_bifurcation.png  the local maxima of x over the second half of each
+                          run against the parameter
+  <stem>_machine.png      the mean friction force and the stick fraction;
+                          the stick/slip events, Benettin's exponent and the
+                          periodic orbit's period and largest multiplier |mu|
+                          when the sweep has them
 
 With a second swept variable, each of its values is a line (a colour) of its
 own.  Failed points are marked by red lines; pending points (an interrupted
@@ -24,6 +33,7 @@ Examples:
   plot_sweep.py brake_sweep.h5
   plot_sweep.py brake_sweep.h5 -o plots --dpi 200
   plot_sweep.py afm_sweep.h5
+  plot_sweep.py machine_orbit_sweep.h5
 
 Exit codes: 0 done, 1 a PNG could not be written, 2 bad command line or bad
 input file (missing, not a sweep file).
@@ -47,7 +57,8 @@ PROG = Path(sys.argv[0]).name if sys.argv and sys.argv[0].endswith("friction-plo
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description="Plot a parameter sweep (brake: bifurcation diagram, exponent; "
-                                     "AFM: friction and maximum force).")
+                                     "AFM: friction and maximum force; machine: maxima, friction force, "
+                                     "stick fraction, events, orbit).")
     parser.add_argument("file", type=Path, help="friction sweep output (.h5)")
     parser.add_argument("-o", "--output-dir", type=Path, default=Path("."), help="directory for the PNGs")
     parser.add_argument("--dpi", type=int, default=150)
