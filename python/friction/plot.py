@@ -1062,6 +1062,8 @@ def bifurcation(data: DataLike) -> Figure:
         if label is not None:
             ax.plot([], [], "o", color=f"C{k}", label=label)
     _mark_failed(ax, s)
+    if _log_scale(s["values"]):
+        ax.set_xscale("log")
     ax.set_xlabel(s["label"])
     ax.set_ylabel("local maxima of x after the transient (m)" if s["scene"] == "brake"
                   else "local maxima of x, second half of the run (m)")
