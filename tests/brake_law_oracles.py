@@ -22,6 +22,10 @@ program and its file, against oracles that are not that model's output:
                        eigenvalues of the Jacobian written out below, their
                        sum against its trace, Benettin's exponent (its runs
                        restart with the law's state) against the largest
+  lugre-stiff-steady   the same with the input's stiff bristles (σ0 = 1e5 N/m):
+                       the five exponents, the bristles' -142 per τ among
+                       them, against e^{J t}'s exact finite-time values,
+                       their sum against the trace
   lugre-spectrum       &law lugre with soft bristles through stick and slip:
                        the spectrum against SciPy's Radau on the variational
                        equations written below, with the same QR steps
@@ -168,8 +172,8 @@ def spectrum(args):
     print(f"spectrum: arctan law {law}, regularized model {own}")
     # The three largest follow the orbit, which the two runs share to 1e-11 m (arctan-regularized):
     # measured 1e-13 per tau apart, bound 1e-8.  The fastest (-1.6 per tau, the arctan's steep slope) is
-    # integrated on the orbit's steps, which the law's differenced dF/dN' changes: measured 8.3e-5 per tau
-    # apart; 1e-3 is 12 times that and 6e-4 of it.
+    # carried by exponentials over the law's run's steps and by the stepper on the regularized model's own:
+    # measured 5.4e-5 per tau apart (8.3e-5 with the stepper on both); 1e-3 is 18 times that and 6e-4 of it.
     assert np.all(np.abs(law[:3] - own[:3]) <= 1e-8), (law, own)
     assert abs(law[3] - own[3]) <= 1e-3, (law, own)
 
@@ -321,16 +325,60 @@ def lugre_steady(args):
           f"{benettin_exact:.9f}")
     assert exponents.size == 5, exponents
     assert np.all(np.abs(exponents - expected) <= bound), (exponents, expected, bound)
-    # The tangent on rodas4's steps (at most the QR interval 0.1 τ on the equilibrium, rtol 1e-9, the
-    # tangent without error control of its own): measured 2.5e-6 per τ off the exact e^{J t} values at
-    # most; 1e-5 is four times that and 2e-3 of the gap to the real parts, which a wrong entry of J moves.
+    # The tangent by exponentials over rodas4's steps: on the equilibrium J is constant and they are
+    # e^{hJ} but for rounding, measured 2.7e-14 per τ off the exact e^{J t} values (the stepper's own
+    # tangent was 2.5e-6 off); 1e-5 is 2e-3 of the gap to the real parts, which a wrong entry of J moves.
     assert np.all(np.abs(exponents - qr_exact) <= 1e-5), (exponents - qr_exact)
     # Benettin's separation 1e-8 against the stepper's atol 1e-12: at most 1e-4 of ln growth a
     # renormalisation (1 τ), so 1e-4 per τ even if every error had one sign; measured 1.1e-5.
     assert abs(benettin - benettin_exact) <= 1e-4, (benettin, benettin_exact)
-    # The sum telescopes to ∫ tr J / T, the trace here, but for the tangent's integration on the orbit's
-    # steps: measured 8e-7 of the trace; 1e-5 of it is ten times that.
+    # The sum telescopes to ∫ tr J / T, the trace here (det e^{hJ} = e^{h tr J}): measured 3e-14 of the
+    # trace (the stepper's own tangent: 8e-7); 1e-5 of it bounds a tangent carried any other stable way.
     assert abs(exponents.sum() - np.trace(j)) <= 1e-5 * abs(np.trace(j)), (exponents.sum(), np.trace(j))
+
+
+def lugre_stiff_steady(args):
+    # The input's bristles (σ0 = 1e5 N/m, σ1 = √σ0 N s/m, σ2 = 0.4 N s/m) in steady sliding on a belt at
+    # 0.05 m/s, as lugre-steady: a stable equilibrium whose fastest direction, the bristles' relaxation
+    # σ0 |w| / g(w) = 5000 1/s (-142.4 per τ), is 1e4 times its slowest.  The stepper takes steps of the whole
+    # QR interval 0.1 τ on it (h λ = -14), where the stiff stepper's own tangent damps that direction by its
+    # stability function rather than by e^{hλ}: the exponents against the exact finite-time values of e^{J t}.
+    s0, s1, s2, v_dr = 1e5, np.sqrt(1e5), 0.4, -0.05
+    field, jacobian, u = brake_lugre(s0, s1, v_dr, s2)
+    wr = -v_dr
+    force = LUGRE["fc"] + (LUGRE["fs"] - LUGRE["fc"]) * np.exp(-(wr / LUGRE["vs"]) ** 2) + s2 * wr
+    y0 = -force / BRAKE_SI["k1"] / (2.0 * u["kappa"] - 1.0)
+    x0 = u["kappa"] * y0
+    state = np.array([x0, 0.0, y0, 0.0, force_state(force, s0, u)])
+    residual = np.max(np.abs(field(0.0, state)))
+    transient, duration, every = 20.0, 200.0, 0.1
+    sets = lugre_sets(s0, s1, v_dr, {"brake.x0": x0, "brake.y0": y0, "brake.v_rel0": -u["vdr"], "brake.w0": 0.0,
+                                     "brake.t_end": transient + duration, "analysis.lyapunov_spectrum": ".true.",
+                                     "analysis.lyapunov_spectrum_transient": transient,
+                                     "analysis.lyapunov_spectrum_renormalise": every}, s2)
+    with brake_spectrum_file(args, "lugre_stiff_steady", sets) as f:
+        exponents = f["brake/lyapunov/exponents"][:]
+        drift = max(float(np.ptp(f["brake"][key][:])) for key in ("x", "y"))
+    j = jacobian(state)
+    fd = np.column_stack([(field(0, state + h * e) - field(0, state - h * e)) / (2 * h)
+                          for h, e in ((1e-7 * max(abs(state[i]), 1e-3), np.eye(5)[i]) for i in range(5))])
+    assert np.allclose(fd, j, rtol=1e-5, atol=1e-6), (fd, j)
+    values, vectors = np.linalg.eig(j)
+    expected = np.sort(values.real)[::-1]
+    bound = np.log(np.linalg.cond(vectors)) / duration
+    qr_exact = finite_time_spectrum(expm(j * every), generic_frame(5), int(round(duration / every))) / duration
+    print(f"lugre-stiff-steady: residual of the start {residual:.1e}, drift {drift:.1e} m; exponents {exponents}; "
+          f"J's eigenvalues' real parts {expected} (bound {bound:.2e}); exact finite-time {qr_exact}; off by "
+          f"{exponents - qr_exact}; sum {exponents.sum():.9f}, trace {np.trace(j):.9f}")
+    assert exponents.size == 5, exponents
+    # The fastest: -142.37 per τ against the real part, within ln(cond V)/T = 4.8e-3.
+    assert np.all(np.abs(exponents - expected) <= bound), (exponents, expected, bound)
+    # On the equilibrium J is constant and the tangent's exponentials are e^{hJ} to the Padé's 2e-17: what
+    # remains is the rounding of the products and factorisations, measured 1.3e-11 per τ at most (the
+    # fastest); 1e-8 is 800 times that.  The stepper's own tangent gave -18.55 for -142.37 here.
+    assert np.all(np.abs(exponents - qr_exact) <= 1e-8), (exponents - qr_exact)
+    # det e^{hJ} = e^{h tr J}: the sum is the trace but for rounding, measured 8e-15 of it; 1e-10 of it.
+    assert abs(exponents.sum() - np.trace(j)) <= 1e-10 * abs(np.trace(j)), (exponents.sum(), np.trace(j))
 
 
 def force_state(force, s0, u):
@@ -380,9 +428,10 @@ def lugre_spectrum(args):
     assert 0 < stick.sum() < stick.size, "stick and slip in the span"
     assert history.shape == (int(round(duration / every)), 5), history.shape
     # The same finite-time exponents, but for the integrations: Radau at rtol 1e-11 controls the error of
-    # Φ too; the program steps Φ on the orbit's steps (rtol 1e-10) without control of its own, through the
-    # kinks |w| puts in J at each pass of the creep band.  Measured: the largest to 9e-7 per τ, the others
-    # to 7.7e-5 at most; 5e-4 per τ is six times that, and 4e-3 of the gap between neighbours.
+    # Φ too; the program carries Φ by exponentials over the orbit's steps (rtol 1e-10) without control of
+    # its own, through the kinks |w| puts in J at each pass of the creep band.  Measured: the largest to
+    # 1.5e-6 per τ, the others to 5.7e-5 at most (the stepper's own tangent: 9e-7, 7.7e-5); 5e-4 per τ is
+    # six times that, and 4e-3 of the gap between neighbours.
     assert np.all(np.abs(exponents - radau) <= 5e-4), (exponents, radau)
 
 
@@ -417,7 +466,8 @@ def refusals(args):
 def main():
     return case_main(__doc__, {"coulomb-switched": coulomb_switched, "arctan-regularized": arctan_regularized,
                                "lugre-radau": lugre_radau, "refusals": refusals, "benettin": benettin,
-                               "spectrum": spectrum, "lugre-steady": lugre_steady, "lugre-spectrum": lugre_spectrum})
+                               "spectrum": spectrum, "lugre-steady": lugre_steady, "lugre-spectrum": lugre_spectrum,
+                               "lugre-stiff-steady": lugre_stiff_steady})
 
 
 if __name__ == "__main__":

@@ -4,12 +4,19 @@
 !> through the same stick/slip logic, Benettin) and from the series
 !> (Rosenstein).  Deterministic: every rank computes the same numbers.
 module friction_brake_diagnostics
-   use friction_kinds, only: wp
-   use friction_error, only: error_type, fatal_error, error_input
-   use friction_brake_config, only: brake_config, series_names
+   use friction_kinds, only: wp, i8
+   use friction_error, only: error_type, fatal_error, error_input, error_numerical
+   use friction_strings, only: rtoa
+   use friction_brake_config, only: brake_config, series_names, model_law
    use friction_brake_record, only: brake_trajectory, brake_event_table, event_stick_to_slip
    use friction_brake_simulate, only: initial_state, new_brake_integrator
    use friction_brake_integrator, only: brake_integrator
+   use friction_brake_law_model, only: law_integrator
+   use friction_law, only: sliding_law
+   use friction_law_factory, only: make_law
+   use friction_output_law_files, only: law_with_files
+   use friction_ode_solver, only: ode_solver
+   use friction_analysis_tangent_magnus, only: magnus_tangent_step
    use friction_analysis_settings, only: analysis_settings
    use friction_analysis_spectrum, only: spectrum_settings, spectrum_result, amplitude_spectrum
    use friction_analysis_poincare, only: stroboscopic_map, upward_section
@@ -246,7 +253,8 @@ contains
    !> The whole spectrum of the brake: one run of either model with its
    !> tangent matrix (the switched model applies the saltation matrices at
    !> its events and the stick flow, which forgets the block's velocity);
-   !> after the transient, a QR step every renormalisation interval.
+   !> after the transient, a QR step every renormalisation interval.  A
+   !> law that is one ODE (&brake model = 'law'): law_flow_spectrum.
    subroutine brake_lyapunov_spectrum(config, settings, result, error, guard, reporter)
       type(brake_config), intent(in) :: config
       type(tangent_settings), intent(in) :: settings
@@ -255,6 +263,7 @@ contains
       type(loop_guard), intent(in), optional :: guard   !! a stop request and max_wall_time, checked each interval
       class(job_reporter), intent(inout), optional :: reporter
       class(brake_integrator), allocatable, target :: run
+      class(sliding_law), allocatable :: law
       type(brake_event_table) :: events
       real(wp), allocatable :: phi(:, :)
       real(wp) :: t0
@@ -265,6 +274,14 @@ contains
          call fatal_error(error, '&analysis: the Lyapunov spectrum needs lyapunov_spectrum_renormalise > 0, ' &
             & //'a duration of at least one interval after lyapunov_spectrum_transient', error_input)
          return
+      end if
+      if (config%model == model_law) then
+         call make_law(law_with_files(config%law), law, error)
+         if (allocated(error)) return
+         if (.not. law%set_valued()) then
+            call law_flow_spectrum(config, settings, result, error, guard, reporter)
+            return
+         end if
       end if
       call new_brake_integrator(config, run)
       run%tangent = .true.
@@ -304,5 +321,111 @@ contains
       end subroutine check_guard
 
    end subroutine brake_lyapunov_spectrum
+
+   !> A law that is one ODE (arctan, Karnopp, Dahl, LuGre, elasto-plastic,
+   !> rate and state, GMS): the orbit alone through the transient (the run's
+   !> event locator: a lift-off is an error), then stepped one accepted step
+   !> at a time with Φ carried over each by exponentials and factored within
+   !> the step (analysis/tangent_magnus.f90, as the machine's), the logs
+   !> summed over each renormalisation interval.  The flow's events (the
+   !> creep band's edges) change neither the field nor the state: Φ needs no
+   !> saltation there, and the stepper does not stop at them.
+   subroutine law_flow_spectrum(config, settings, result, error, guard, reporter)
+      type(brake_config), intent(in) :: config
+      type(tangent_settings), intent(in) :: settings
+      type(spectrum_accumulator), intent(out) :: result
+      type(error_type), allocatable, intent(out) :: error
+      type(loop_guard), intent(in), optional :: guard
+      class(job_reporter), intent(inout), optional :: reporter
+      type(law_integrator), target :: run
+      type(brake_event_table) :: events
+      type(ode_solver) :: orbit
+      real(wp), allocatable :: z(:), y_a(:), f_a(:), f_b(:), phi(:, :), logs(:)
+      real(wp) :: t, t0, t_a, t_target
+      integer(i8) :: steps
+      integer :: n, k, intervals, depth
+      logical :: ok
+
+      call run%start(config, config%t_start, initial_state(config), events, error)
+      if (allocated(error)) return
+      t0 = config%t_start + settings%transient
+      t = run%t
+      do while (run%t < t0)
+         call run%advance_to(min(run%t + settings%renormalise, t0), events, error)
+         if (allocated(error)) return
+         call events%clear()
+         t = run%t
+         call check_guard()
+         if (allocated(error)) return
+      end do
+      n = 4 + run%state_count()
+      allocate (z(n), y_a(n), f_a(n), f_b(n), logs(n))
+      z(1:4) = run%y
+      if (n > 4) call run%get_states(z(5:n))
+      t = run%t
+      phi = generic_frame(n)
+      call orbit%init(run%flow, config%solver, run%h_start, error)
+      if (allocated(error)) return
+      intervals = int(settings%duration / settings%renormalise + 1.0e-9_wp)
+      call result%start(n, intervals)
+      call run%flow%rhs(t, z, f_a)
+      depth = 0
+      do k = 1, intervals
+         t_target = t0 + k * settings%renormalise
+         logs = 0.0_wp
+         steps = 0
+         do while (t < t_target)
+            t_a = t
+            y_a = z
+            call orbit%step(t, t_target, z, error)
+            if (allocated(error)) exit
+            steps = steps + 1
+            if (.not. (t > t_a)) then
+               call fatal_error(error, trim(config%solver%method)//': no progress at '//orbit%time_at(t) &
+                  & //' (the step size fell below the resolution of the time)', error_numerical)
+               exit
+            end if
+            if (steps > config%solver%max_steps) then
+               call fatal_error(error, trim(config%solver%method)//': more than max_steps steps in one ' &
+                  & //'renormalisation interval at '//orbit%time_at(t), error_numerical)
+               exit
+            end if
+            ! (At a step's end: a dip of N' below 0 within one step is the stepper's to resolve.)
+            if (.not. (run%p%normal_force(z(3)) > 0.0_wp)) then
+               call fatal_error(error, "N' reached 0 at τ = "//rtoa(t) &
+                  & //': the pad lifts off the belt, outside Eq. 10', error_numerical)
+               exit
+            end if
+            call run%flow%rhs(t, z, f_b)
+            call magnus_tangent_step(run%flow, t_a, y_a, f_a, t, z, f_b, phi, logs, depth, ok)
+            if (.not. ok) then
+               call fatal_error(error, 'Lyapunov spectrum: the Jacobian is NaN or Inf, or too stiff for ' &
+                  & //'the step ending at '//orbit%time_at(t)//' (an exponential of the tangent in more ' &
+                  & //'than 2^24 parts)', error_numerical)
+               exit
+            end if
+            f_a = f_b
+            ! (The guard every 16 steps, and after every step whose exponentials took thousands of parts.)
+            if (mod(steps, 16_i8) == 0 .or. depth >= 12) then
+               call check_guard()
+               if (allocated(error)) exit
+            end if
+         end do
+         if (allocated(error)) exit
+         call result%add_logs(logs, settings%renormalise, 0)
+         call check_guard()
+         if (allocated(error)) exit
+      end do
+      call orbit%destroy()
+      if (allocated(error)) error%message = error%message//" (&brake model = 'law', &law model = '" &
+         & //trim(run%law%p%model)//"')"
+
+   contains
+
+      subroutine check_guard()
+         if (present(guard)) call guard%check(reporter, '&analysis: the Lyapunov spectrum', t, 'τ', error)
+      end subroutine check_guard
+
+   end subroutine law_flow_spectrum
 
 end module friction_brake_diagnostics
