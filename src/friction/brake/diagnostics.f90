@@ -254,7 +254,7 @@ contains
    !> tangent matrix (the switched model applies the saltation matrices at
    !> its events and the stick flow, which forgets the block's velocity);
    !> after the transient, a QR step every renormalisation interval.  A
-   !> law that is one ODE (&brake model = 'law'): law_flow_spectrum.
+   !> law that is one ODE without a band (&brake model = 'law'): law_flow_spectrum.
    subroutine brake_lyapunov_spectrum(config, settings, result, error, guard, reporter)
       type(brake_config), intent(in) :: config
       type(tangent_settings), intent(in) :: settings
@@ -266,7 +266,7 @@ contains
       class(sliding_law), allocatable :: law
       type(brake_event_table) :: events
       real(wp), allocatable :: phi(:, :)
-      real(wp) :: t0
+      real(wp) :: t0, half_width, limit
       integer :: k, intervals, n
 
       if (.not. (settings%renormalise > 0.0_wp .and. settings%duration >= settings%renormalise &
@@ -278,7 +278,10 @@ contains
       if (config%model == model_law) then
          call make_law(law_with_files(config%law), law, error)
          if (allocated(error)) return
-         if (.not. law%set_valued()) then
+         call law%band(half_width, limit)
+         ! (Karnopp's band, whose force jumps at its edges without an event of the flow, would need a
+         ! saltation there with either tangent: it keeps the stepper's, as before.)
+         if (.not. law%set_valued() .and. half_width == 0.0_wp) then
             call law_flow_spectrum(config, settings, result, error, guard, reporter)
             return
          end if
@@ -322,8 +325,8 @@ contains
 
    end subroutine brake_lyapunov_spectrum
 
-   !> A law that is one ODE (arctan, Karnopp, Dahl, LuGre, elasto-plastic,
-   !> rate and state, GMS): the orbit alone through the transient (the run's
+   !> A law that is one ODE without Karnopp's band (arctan, Dahl, LuGre,
+   !> elasto-plastic, rate and state, GMS): the orbit alone through the transient (the run's
    !> event locator: a lift-off is an error), then stepped one accepted step
    !> at a time with Φ carried over each by exponentials and factored within
    !> the step (analysis/tangent_magnus.f90, as the machine's), the logs
