@@ -7,7 +7,7 @@ module friction_brake_diagnostics
    use friction_kinds, only: wp, i8
    use friction_error, only: error_type, fatal_error, error_input, error_numerical
    use friction_strings, only: rtoa
-   use friction_brake_config, only: brake_config, series_names, model_law
+   use friction_brake_config, only: brake_config, series_names
    use friction_brake_record, only: brake_trajectory, brake_event_table, event_stick_to_slip
    use friction_brake_simulate, only: initial_state, new_brake_integrator
    use friction_brake_integrator, only: brake_integrator
@@ -275,7 +275,7 @@ contains
             & //'a duration of at least one interval after lyapunov_spectrum_transient', error_input)
          return
       end if
-      if (config%model == model_law) then
+      if (config%uses_law()) then
          call make_law(law_with_files(config%law), law, error)
          if (allocated(error)) return
          call law%band(half_width, limit)
