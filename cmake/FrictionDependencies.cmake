@@ -1,4 +1,4 @@
-# Finds GSL, FFTW3, parallel HDF5 with Fortran, and MPI with mpi_f08.  A
+# Finds GSL, FFTW3, LAPACK, parallel HDF5 with Fortran, and MPI with mpi_f08.  A
 # missing dependency stops configuration with the Debian package to install
 # (scripts/install-deps installs them all).
 
@@ -25,6 +25,33 @@ find_package(PkgConfig QUIET)
 friction_require(PKG_CONFIG_FOUND "pkg-config" "pkg-config")
 pkg_check_modules(FFTW3 QUIET IMPORTED_TARGET fftw3)
 friction_require(FFTW3_FOUND "FFTW3" "libfftw3-dev")
+
+# LAPACK's dgeev: the multipliers of a periodic orbit whose section has more
+# than 3 coordinates (a law with several internal states).
+find_package(LAPACK QUIET)
+friction_require(LAPACK_FOUND "LAPACK" "liblapack-dev")
+# The program links the reference LAPACK and BLAS's static archives where
+# Debian ships them (liblapack-dev, libblas-dev), as it does HDF5's: the
+# shared liblapack.so may be OpenBLAS behind Debian's alternatives, whose
+# thread pool starts whenever it is loaded and tripled the program's start-up
+# (docs/speed.md) for eigenvalues of a few rows.  Without the archives, or
+# with -DFRICTION_STATIC_LAPACK=OFF, the LAPACK that FindLAPACK found; the
+# shared library always links that one (Debian's libblas.a is not
+# position-independent).
+option(FRICTION_STATIC_LAPACK "Link the program with the reference LAPACK and BLAS's static archives" ON)
+find_library(FRICTION_LAPACK_ARCHIVE NAMES liblapack.a
+  PATHS /usr/lib/${CMAKE_LIBRARY_ARCHITECTURE}/lapack NO_DEFAULT_PATH)
+find_library(FRICTION_BLAS_ARCHIVE NAMES libblas.a
+  PATHS /usr/lib/${CMAKE_LIBRARY_ARCHITECTURE}/blas NO_DEFAULT_PATH)
+add_library(friction::lapack_program INTERFACE IMPORTED)
+if(FRICTION_STATIC_LAPACK AND FRICTION_LAPACK_ARCHIVE AND FRICTION_BLAS_ARCHIVE)
+  target_link_libraries(friction::lapack_program INTERFACE ${FRICTION_LAPACK_ARCHIVE} ${FRICTION_BLAS_ARCHIVE})
+  set(friction_static_lapack ON)
+else()
+  target_link_libraries(friction::lapack_program INTERFACE LAPACK::LAPACK)
+  set(friction_static_lapack OFF)
+endif()
+message(STATUS "friction: the program links the reference LAPACK's static archives: ${friction_static_lapack}")
 
 # Parallel HDF5 with its Fortran interface, and its high-level library (the
 # dimension scales).  FindHDF5 asks the h5pfc wrapper.

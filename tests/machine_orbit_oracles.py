@@ -31,6 +31,14 @@ the program and its file, against oracles computed here:
   stribeck-hopf     the Stribeck belt oscillator continued in belt_velocity through
                     the Hopf of steady sliding where c + dF/dv = 0, the law's
                     slope written here
+  forced-gms        the Generalized Maxwell-Slip law (2 and 3 elements) on the
+                    belt, the support driven, the block always slower than the
+                    belt and past the Stribeck dip: every element at its limit
+                    is an invariant state and the block a driven linear
+                    oscillator, so the orbit is in closed form and the
+                    section's 4 x 4 and 5 x 5 multipliers (LAPACK's) are
+                    exp(λT), λ the linear system's eigenvalues, and ~0 for
+                    the elements' deflections
   refusals          what the orbit cannot do is refused with file, line, group
                     and variable, exit code 3, no file written
 
@@ -569,10 +577,53 @@ def stribeck_hopf(args):
     assert np.all(mu[:, 0] == 1.0) and np.all(np.abs(mu[:, 1]) < 1e-15), mu   # h5py: (points, multipliers)
 
 
+def forced_gms(args):
+    # The law's states z_i relax to their limits s w_i g / k_i at a rate k_i |w| / (w_i g ε) ~ 1e4 /s and, at
+    # the limit, ż_i = 0 whatever v is: with w = v - vb < 0 throughout and |w| >= 0.05 m/s >> vs (g = fc to
+    # the last bit: exp(-2500) underflows) the friction force is -fc + σ2 w exactly, the block a linear
+    # oscillator m x'' + (c + σ2) x' + k x = k u + c u' + fc + σ2 vb, and the monodromy block-triangular:
+    # the oscillator's exp(λ T) and, for the deflections, exp(-∫ k_i |w| / (w_i g ε) dt) = 0 to the last bit.
+    m, k, c, vb, fc, s2, amp, freq = 1.0, 2.0, 0.1, 0.1, 1.0, 0.4, 0.005, 0.3
+    for stiffness, weights in (([20.0, 10.0], [0.5, 0.5]), ([30.0, 20.0, 10.0], [0.2, 0.3, 0.5])):
+        n = len(stiffness)
+        got = run(args, f"gms{n}", ["machine_gms.nml"], {
+            "machine.damping": c, "machine.support_amplitude": amp, "machine.support_frequency": freq,
+            "machine.v0": 0.0, "machine.t_end": 60.0, "law.elements": n,
+            "law.element_stiffness": ", ".join(map(str, stiffness)),
+            "law.element_weight": ", ".join(map(str, weights)), "analysis.orbit": ".true.",
+            "analysis.orbit_transient": 50.0, "analysis.orbit_tolerance": 1e-12})
+        omega = 2 * np.pi * freq
+        t0 = got["guess_time"]
+        # x = x_s + Im(h e^{iωt}), v = Im(iω h e^{iωt}); the z_i at their limits -w_i fc / k_i.
+        h = (k + 1j * c * omega) * amp / (k - m * omega**2 + 1j * (c + s2) * omega)
+        x = (fc + s2 * vb) / k + np.imag(h * np.exp(1j * omega * t0))
+        v = np.imag(1j * omega * h * np.exp(1j * omega * t0))
+        z = -np.array(weights) * fc / np.array(stiffness)
+        assert np.max(np.abs(v - vb)) > 0.05 and omega * abs(h) < 0.05   # |w| >= 0.05 m/s on the whole orbit
+        lam = np.linalg.eigvals(np.array([[0.0, 1.0], [-k / m, -(c + s2) / m]]))
+        expected = np.exp(lam / freq)
+        mu = got["multipliers"]
+        orbit_error = max(abs(got["point"][0] - x) / abs(h), abs(got["point"][1] - v) / (omega * abs(h)))
+        z_error = np.max(np.abs(got["point"][2:] - z) / np.abs(z))
+        mult_error = np.max(np.abs(np.sort_complex(mu[:2]) - np.sort_complex(expected)))
+        print(f"forced-gms ({n} elements, section {len(got['point'])} x {len(got['point'])}): t0 = {t0} s, "
+              f"|point - closed form|/amplitude = {orbit_error:.2e}, z relative error {z_error:.2e}, multipliers "
+              f"{mu}, exp(lambda T) = {expected}, max difference {mult_error:.2e}")
+        assert len(mu) == n + 2
+        # As forced-linear: the integration (rtol 1e-9) and Newton (1e-12) bound the orbit at ~1e-8 of its
+        # amplitude and the multipliers (|mu| = 0.51) at 100 rtol.
+        assert orbit_error < 1e-7, orbit_error
+        assert mult_error < 1e-7, mult_error
+        # The deflections at their limits to the integration's tolerance (the state's scale is the limit).
+        assert z_error < 1e-7, z_error
+        # Their multipliers: exp(-1e4 x 3.3 s) in exact arithmetic; what the variational equations keep of
+        # them is rounding of the Jacobian's entries (~1e-16 of |mu| ~ 0.5).
+        assert np.all(np.abs(mu[2:]) < 1e-9), mu
+        assert abs(got["period"] - 1 / freq) < 1e-12
+
+
 def refusals(args):
     cases = [  # (the groups, the line named, what the message names, why)
-        ("&law\n  model = 'gms'\n/\n&analysis\n  orbit = .true.\n/\n", 9, "&analysis: orbit = ",
-         "states; the orbit takes at most 2"),
         ("&law\n  model = 'karnopp'\n  vs = 0.05\n  dv = 1e-3\n  sigma2 = 0.4\n/\n&analysis\n  orbit = .true.\n/\n", 12,
          "&analysis: orbit = ", "slide along the band's edge"),
         ("&law\n  model = 'lugre'\n/\n&analysis\n  orbit = .true.\n  continuation = 'gravity'\n/\n", 10,
@@ -590,7 +641,7 @@ def main():
     return case_main(__doc__, {"forced-linear": forced_linear, "forced-lugre": forced_lugre,
                                "arctan-belt": arctan_belt, "hopf-belt": hopf_belt, "coulomb-cycle": coulomb_cycle,
                                "forced-switching": forced_switching,
-                               "karnopp-band": karnopp_band, "stribeck-hopf": stribeck_hopf,
+                               "karnopp-band": karnopp_band, "stribeck-hopf": stribeck_hopf, "forced-gms": forced_gms,
                                "refusals": refusals})
 
 

@@ -23,7 +23,7 @@ import sys
 from pathlib import Path
 
 # CMake's name of a dependency -> Spack's package, for the library and program.
-LIBRARY = {"MPI": "mpi", "GSL": "gsl", "PkgConfig": "pkgconfig", "HDF5": "hdf5", "fftw3": "fftw-api"}
+LIBRARY = {"MPI": "mpi", "GSL": "gsl", "PkgConfig": "pkgconfig", "HDF5": "hdf5", "fftw3": "fftw-api", "LAPACK": "lapack"}
 # The tests' tools (find_package / find_program) -> Spack's package.
 TESTS = {"PFUNIT": "pfunit", "Python3": "python", "ngspice": "ngspice", "gnuplot": "gnuplot"}
 # The tests' tools a library dependency provides: h5dump comes with HDF5.

@@ -18,7 +18,7 @@
 !> hyperplane y_k = c crossed upwards, the section coordinates being the
 !> other n - 1 components.
 module friction_analysis_periodic_orbit
-   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_negative_inf
+   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_negative_inf, ieee_quiet_nan, ieee_is_nan
    use friction_kinds, only: wp
    use friction_error, only: error_type, fatal_error, error_input
    use friction_ode_system, only: ode_system
@@ -32,12 +32,24 @@ module friction_analysis_periodic_orbit
    public :: section_map, orbit_settings, periodic_orbit, find_periodic_orbit, section_multipliers
    public :: floquet_multipliers, floquet_exponents, hyperplane_map, stroboscopic_map, small_eigenvalues
    public :: bifurcation_period_doubling, bifurcation_fold, bifurcation_neimark_sacker, crossing_kind
-   public :: halving_walk, branch_values, modulus_crossing
+   public :: halving_walk, branch_values, modulus_crossing, general_eigenvalues
 
-   !> Largest section dimension whose multipliers are computed (closed form):
-   !> the brake's section is 2-dimensional, a planar flow's 1, a forced
-   !> oscillator with one law state's stroboscopic section 3.
-   integer, parameter :: max_section = 3
+   !> Largest section dimension whose multipliers have closed forms (the
+   !> brake's section is 2-dimensional, a forced oscillator with one law
+   !> state's stroboscopic section 3); larger ones go to LAPACK's dgeev.
+   integer, parameter :: max_closed_form = 3
+
+   interface
+      !> LAPACK's eigenvalues (and optionally eigenvectors) of a real general matrix.
+      subroutine dgeev(jobvl, jobvr, n, a, lda, wr, wi, vl, ldvl, vr, ldvr, work, lwork, info)
+         import :: wp
+         character(len=1), intent(in) :: jobvl, jobvr
+         integer, intent(in) :: n, lda, ldvl, ldvr, lwork
+         real(wp), intent(inout) :: a(lda, *)
+         real(wp), intent(out) :: wr(*), wi(*), vl(ldvl, *), vr(ldvr, *), work(*)
+         integer, intent(out) :: info
+      end subroutine dgeev
+   end interface
 
    !> Where a multiplier of a section map leaves (or enters) the unit circle.
    integer, parameter :: bifurcation_period_doubling = 1  !! a real multiplier through -1
@@ -165,8 +177,8 @@ contains
       integer :: n, halving
 
       n = map%dimension()
-      if (size(guess) /= n .or. n < 1 .or. n > max_section) then
-         call fatal_error(error, 'periodic orbit: the section must have 1 to 3 dimensions and the guess as many', &
+      if (size(guess) /= n .or. n < 1) then
+         call fatal_error(error, 'periodic orbit: the section must have a dimension and the guess as many', &
             & error_input)
          return
       end if
@@ -218,11 +230,16 @@ contains
          period = trial_period
          residual = trial_residual
       end do
-      orbit%found = .true.
       orbit%multipliers = section_multipliers(orbit%jacobian)
+      if (n > max_closed_form .and. any(ieee_is_nan(real(orbit%multipliers)))) then
+         orbit%reason = 'the multipliers of the map''s Jacobian could not be computed (LAPACK dgeev failed)'
+         deallocate (orbit%multipliers)
+         return
+      end if
+      orbit%found = .true.
    end subroutine find_periodic_orbit
 
-   !> (J - I) x = b by Gaussian elimination with partial pivoting (n <= 2).
+   !> (J - I) x = b: closed forms for n <= 2, Gaussian elimination with partial pivoting beyond.
    pure subroutine solve_shifted(jac, b, x, solved)
       real(wp), intent(in) :: jac(:, :), b(:)
       real(wp), intent(out) :: x(:)
@@ -455,14 +472,54 @@ contains
       end if
    end function small_eigenvalues
 
-   !> Eigenvalues of a section Jacobian (1 x 1 to 3 x 3), by decreasing
-   !> modulus (a complex pair: positive imaginary part first).
-   pure function section_multipliers(jac) result(mu)
+   !> Eigenvalues of a section Jacobian, by decreasing modulus (a complex
+   !> pair: positive imaginary part first): the closed forms up to 3 x 3
+   !> (the results every earlier file holds, to the last bit), LAPACK's
+   !> dgeev beyond; NaN for all of them when dgeev fails to converge.
+   function section_multipliers(jac) result(mu)
       real(wp), intent(in) :: jac(:, :)
       complex(wp), allocatable :: mu(:)
 
-      mu = small_eigenvalues(jac)
+      if (size(jac, 1) <= max_closed_form) then
+         mu = small_eigenvalues(jac)
+      else
+         mu = general_eigenvalues(jac)
+      end if
    end function section_multipliers
+
+   !> Eigenvalues of a real n x n matrix by LAPACK's dgeev (balancing, then
+   !> the Hessenberg QR algorithm), by decreasing modulus, a complex pair
+   !> with its positive imaginary part first; NaN when QR does not converge.
+   function general_eigenvalues(a) result(mu)
+      real(wp), intent(in) :: a(:, :)
+      complex(wp), allocatable :: mu(:)
+      real(wp) :: work_a(size(a, 1), size(a, 1)), wr(size(a, 1)), wi(size(a, 1)), left(1, 1), right(1, 1)
+      real(wp) :: work(max(1, 4 * size(a, 1)))
+      complex(wp) :: swap
+      integer :: n, info, i, j
+
+      n = size(a, 1)
+      allocate (mu(n))
+      if (n == 0) return
+      work_a = a
+      call dgeev('N', 'N', n, work_a, n, wr, wi, left, 1, right, 1, work, size(work), info)
+      if (info /= 0) then
+         mu = cmplx(ieee_value(1.0_wp, ieee_quiet_nan), ieee_value(1.0_wp, ieee_quiet_nan), wp)
+         return
+      end if
+      mu = cmplx(wr, wi, wp)
+      ! Insertion sort: stable, so dgeev's pairs (positive imaginary part first) stay in order.
+      do i = 2, n
+         swap = mu(i)
+         j = i - 1
+         do while (j >= 1)
+            if (.not. (abs(swap) > abs(mu(j)) .or. (abs(swap) == abs(mu(j)) .and. aimag(swap) > aimag(mu(j))))) exit
+            mu(j + 1) = mu(j)
+            j = j - 1
+         end do
+         mu(j + 1) = swap
+      end do
+   end function general_eigenvalues
 
    !> The closed form for n = 1, 2.
    pure function pair_roots(jac) result(mu)

@@ -315,7 +315,7 @@ contains
       call check_law(law_with_files(self%law), c)
       if (c%failed()) return
       why = "is not computed for &brake model = 'law' with &law model = '"//trim(self%law%model)//"' (its " &
-         & //"internal states would make the section more than 3-dimensional): use a law without states " &
+         & //"internal states are not carried by the brake's section maps): use a law without states " &
          & //'(coulomb, stribeck, table, arctan), or the switched model'
       call new_law(self%law, law)
       associate (a => self%analysis)

@@ -387,7 +387,7 @@ contains
       call make_law(law_with_files(config%law), flow%law, error)
       if (allocated(error)) return
       if (flow%law%state_count() > 0) then
-         result%orbit%reason = "the law's internal states make the section more than 3-dimensional"
+         result%orbit%reason = "the brake's section maps do not carry the law's internal states"
          return
       end if
       call config%law_units(flow%units%force, flow%units%velocity, flow%units%time)

@@ -12,7 +12,7 @@
 !> at load_velocity.
 module friction_machine_config
    use friction_kinds, only: wp, i8
-   use friction_strings, only: rtoa, quoted, itoa
+   use friction_strings, only: rtoa, quoted
    use friction_parameters, only: configurable, parameter_visitor, set_parameter_number
    use friction_checks, only: config_checker
    use friction_ode_solver, only: solver_settings
@@ -154,16 +154,14 @@ contains
       end associate
    end subroutine check_sections
 
-   !> &analysis orbit (and continuation): a law with few enough states for the
-   !> section's closed-form multipliers (a set-valued law has none: its map
-   !> runs through exact stick and slip); the line's end a valid machine of
-   !> the same kind (forced or not).
+   !> &analysis orbit (and continuation): a band law whose edge holds the
+   !> block (any number of states: the section's multipliers beyond 3 x 3 are
+   !> LAPACK's); the line's end a valid machine of the same kind (forced or not).
    subroutine check_orbit(self, c)
       type(machine_config), intent(in) :: self
       type(config_checker), intent(inout) :: c
       class(sliding_law), allocatable :: law
       logical :: forced
-      integer :: most
 
       call new_law(self%law, law)
       block
@@ -181,14 +179,6 @@ contains
          end if
       end block
       forced = self%support_amplitude > 0.0_wp .and. self%support_frequency > 0.0_wp
-      ! The section's multipliers are closed forms up to 3 coordinates: (x, v, states) when forced, (x, states) if not.
-      most = merge(1, 2, forced)
-      if (law%state_count() > most) then
-         call c%reject('analysis', 'orbit', '.true.', "&law model = '"//trim(self%law%model)//"' has " &
-            & //itoa(law%state_count())//' states; the orbit takes at most '//merge('1', '2', forced) &
-            & //trim(merge(' (with a moving support)', ' (without one)          ', forced)))
-         return
-      end if
       if (len_trim(self%analysis%continuation) == 0) return
       if (.not. any(orbit_variables == self%analysis%continuation)) then
          call c%reject('analysis', 'continuation', "'"//trim(self%analysis%continuation)//"'", &

@@ -38,7 +38,7 @@ module friction_machine_orbit
    use friction_law_factory, only: make_law
    use friction_output_law_files, only: law_with_files
    use friction_analysis_periodic_orbit, only: section_map, orbit_settings, periodic_orbit, find_periodic_orbit, &
-      & floquet_multipliers, floquet_exponents, hyperplane_map, stroboscopic_map, small_eigenvalues, &
+      & floquet_multipliers, floquet_exponents, hyperplane_map, stroboscopic_map, section_multipliers, &
       & halving_walk, branch_values, modulus_crossing
    use friction_machine_config, only: machine_config
    use friction_machine_model, only: machine_smooth
@@ -541,7 +541,7 @@ contains
       if (allocated(error)) return
       n = frame%dimension()
       ns = n - 2
-      if (machine_orbit_forced(c) .or. .not. (c%stiffness > 0.0_wp) .or. n > 3) return
+      if (machine_orbit_forced(c) .or. .not. (c%stiffness > 0.0_wp)) return
       w = c%load_velocity - c%belt_velocity
       ! A set-valued law at w = 0 holds the block in stick: no sliding state, no eigenvalues.
       if (frame%base%law%set_valued() .and. w == 0.0_wp) return
@@ -552,7 +552,7 @@ contains
       y = [-force / c%stiffness, c%load_velocity, z(1:ns) / frame%base%scale(1:ns)]
       allocate (jac(n, n), dfdt(n))
       call frame%jacobian(0.0_wp, y, jac, dfdt)
-      mu = small_eigenvalues(jac)
+      mu = section_multipliers(jac)
       ! By decreasing real part (a complex pair: positive imaginary part first).
       do i = 1, n - 1
          do j = 1, n - i

@@ -30,6 +30,7 @@ class Friction(CMakePackage):
     depends_on("hdf5@1.10:+fortran+mpi")
     depends_on("gsl")
     depends_on("fftw-api@3")
+    depends_on("lapack")
 
     with when("+tests"):
         depends_on("pfunit@4.14:+mpi", type="test")
