@@ -38,7 +38,8 @@ the program and its file, against oracles computed here:
                     oscillator, so the orbit is in closed form and the
                     section's 4 x 4 and 5 x 5 multipliers (LAPACK's) are
                     exp(λT), λ the linear system's eigenvalues, and ~0 for
-                    the elements' deflections
+                    the elements' deflections; without the support, steady
+                    sliding's 4 x 4 eigenvalues against their closed forms
   refusals          what the orbit cannot do is refused with file, line, group
                     and variable, exit code 3, no file written
 
@@ -620,6 +621,25 @@ def forced_gms(args):
         # them is rounding of the Jacobian's entries (~1e-16 of |mu| ~ 0.5).
         assert np.all(np.abs(mu[2:]) < 1e-9), mu
         assert abs(got["period"] - 1 / freq) < 1e-12
+    # Without the support, steady sliding's eigenvalues (the 4 x 4 Jacobian's, LAPACK's): the oscillator's
+    # -(c + σ2)/2m ± i sqrt(k/m - ((c + σ2)/2m)²) and each element's -k_i |w| / (w_i g ε), ε = 1e-5 the law's
+    # entry band (laws.md), which the Jacobian's z rows hold alone at the limit (∂ż_i/∂v ∝ 1 - u_i = 0).
+    stiffness, weights = [60000.0, 40000.0], [0.4, 0.6]
+    with h5py.File(run_program(args, "gms_belt", ["machine_gms.nml"], {
+            "machine.damping": c, "machine.t_end": 2.0, "law.elements": 2,
+            "law.element_stiffness": ", ".join(map(str, stiffness)),
+            "law.element_weight": ", ".join(map(str, weights)), "analysis.orbit": ".true.",
+            "analysis.orbit_transient": 1.0})) as f:
+        eig = f["machine/orbit/equilibrium_eigenvalues"][()]
+    eig = eig[:, 0] + 1j * eig[:, 1]
+    d = (c + s2) / (2 * m)
+    expected = np.array([-d + 1j * np.sqrt(k / m - d**2), -d - 1j * np.sqrt(k / m - d**2)]
+                        + [-ki * vb / (wi * fc * 1e-5) for ki, wi in zip(stiffness, weights)])
+    eig, expected = np.sort_complex(eig), np.sort_complex(expected)
+    eig_error = np.max(np.abs(eig - expected) / np.abs(expected))
+    print(f"forced-gms: steady sliding's eigenvalues {eig}, closed forms {expected}, relative error {eig_error:.2e}")
+    # dgeev's backward error is ~1e-16 of the largest entry (1.5e9): ~1e-7 on the oscillator's 1.4; 1e-6 bounds it.
+    assert eig_error < 1e-6, (eig, expected)
 
 
 def refusals(args):
