@@ -18,12 +18,14 @@
 !> steps, and the logs of R's diagonal are summed into the caller's `logs`.
 !> The parts follow the stiffness met: about (λ_max - λ_min) h / 18 of them.
 module friction_analysis_tangent_magnus
-   use friction_kinds, only: wp
+   use friction_kinds, only: wp, i8
+   use friction_error, only: error_type, fatal_error, error_numerical
    use friction_ode_system, only: ode_system
+   use friction_ode_solver, only: ode_solver
    implicit none
    private
 
-   public :: magnus_tangent_step
+   public :: magnus_tangent_step, orbit_step, tangent_over_step
 
    !> A part may shrink a column to e^-part_spread of another: the
    !> factorisation then loses at most e^18 ulp = 1.5e-8 of the small one,
@@ -42,6 +44,64 @@ module friction_analysis_tangent_magnus
       & 1.0_wp / 792.0_wp, 1.0_wp / 15840.0_wp, 1.0_wp / 665280.0_wp]
 
 contains
+
+   !> One accepted step of `orbit` from (t, z) towards t_target, its start
+   !> kept in t_a and y_a (z's first size(y_a) values) and counted in `steps`:
+   !> an error when it made no progress or the interval has taken more than
+   !> max_steps steps (the scene's spectrum loops, machine/lyapunov.f90 and
+   !> brake/diagnostics.f90).
+   subroutine orbit_step(orbit, method, max_steps, t, t_target, z, t_a, y_a, steps, error)
+      type(ode_solver), intent(inout) :: orbit
+      character(len=*), intent(in) :: method
+      integer(i8), intent(in) :: max_steps
+      real(wp), intent(inout) :: t
+      real(wp), intent(in) :: t_target
+      real(wp), intent(inout) :: z(:)
+      real(wp), intent(out) :: t_a
+      real(wp), intent(out) :: y_a(:)
+      integer(i8), intent(inout) :: steps
+      type(error_type), allocatable, intent(out) :: error
+
+      t_a = t
+      y_a = z(1:size(y_a))
+      call orbit%step(t, t_target, z, error)
+      if (allocated(error)) return
+      steps = steps + 1
+      if (.not. (t > t_a)) then
+         call fatal_error(error, trim(method)//': no progress at '//orbit%time_at(t) &
+            & //' (the step size fell below the resolution of the time)', error_numerical)
+      else if (steps > max_steps) then
+         call fatal_error(error, trim(method)//': more than max_steps steps in one ' &
+            & //'renormalisation interval at '//orbit%time_at(t), error_numerical)
+      end if
+   end subroutine orbit_step
+
+   !> Φ over the step orbit_step just took, from (t_a, y_a) with the field
+   !> f_a to (t, y): the field there into f_a for the next step, an error
+   !> naming the step where magnus_tangent_step cannot go on.
+   subroutine tangent_over_step(system, orbit, t_a, y_a, f_a, t, y, phi, logs, depth, error)
+      class(ode_system), intent(in) :: system
+      type(ode_solver), intent(in) :: orbit
+      real(wp), intent(in) :: t_a, t
+      real(wp), intent(in) :: y_a(:), y(:)
+      real(wp), intent(inout) :: f_a(:)
+      real(wp), intent(inout) :: phi(:, :)
+      real(wp), intent(inout) :: logs(:)
+      integer, intent(inout) :: depth
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: f_b(size(y))
+      logical :: ok
+
+      call system%rhs(t, y, f_b)
+      call magnus_tangent_step(system, t_a, y_a, f_a, t, y, f_b, phi, logs, depth, ok)
+      if (.not. ok) then
+         call fatal_error(error, 'Lyapunov spectrum: the Jacobian is NaN or Inf, or too stiff for ' &
+            & //'the step ending at '//orbit%time_at(t)//' (an exponential of the tangent in more ' &
+            & //'than 2^24 parts)', error_numerical)
+         return
+      end if
+      f_a = f_b
+   end subroutine tangent_over_step
 
    !> Φ (orthonormal) over the accepted step from (t_a, y_a), with the field
    !> f_a there, to (t_b, y_b) with f_b: Φ orthonormal again, the logs of the

@@ -16,7 +16,7 @@ module friction_brake_diagnostics
    use friction_law_factory, only: make_law
    use friction_output_law_files, only: law_with_files
    use friction_ode_solver, only: ode_solver
-   use friction_analysis_tangent_magnus, only: magnus_tangent_step
+   use friction_analysis_tangent_magnus, only: orbit_step, tangent_over_step
    use friction_analysis_settings, only: analysis_settings
    use friction_analysis_spectrum, only: spectrum_settings, spectrum_result, amplitude_spectrum
    use friction_analysis_poincare, only: stroboscopic_map, upward_section
@@ -343,11 +343,10 @@ contains
       type(law_integrator), target :: run
       type(brake_event_table) :: events
       type(ode_solver) :: orbit
-      real(wp), allocatable :: z(:), y_a(:), f_a(:), f_b(:), phi(:, :), logs(:)
+      real(wp), allocatable :: z(:), y_a(:), f_a(:), phi(:, :), logs(:)
       real(wp) :: t, t0, t_a, t_target
       integer(i8) :: steps
       integer :: n, k, intervals, depth
-      logical :: ok
 
       call run%start(config, config%t_start, initial_state(config), events, error)
       if (allocated(error)) return
@@ -362,7 +361,7 @@ contains
          if (allocated(error)) return
       end do
       n = 4 + run%state_count()
-      allocate (z(n), y_a(n), f_a(n), f_b(n), logs(n))
+      allocate (z(n), y_a(n), f_a(n), logs(n))
       z(1:4) = run%y
       if (n > 4) call run%get_states(z(5:n))
       t = run%t
@@ -378,36 +377,17 @@ contains
          logs = 0.0_wp
          steps = 0
          do while (t < t_target)
-            t_a = t
-            y_a = z
-            call orbit%step(t, t_target, z, error)
+            call orbit_step(orbit, config%solver%method, config%solver%max_steps, t, t_target, z, t_a, y_a, &
+               & steps, error)
             if (allocated(error)) exit
-            steps = steps + 1
-            if (.not. (t > t_a)) then
-               call fatal_error(error, trim(config%solver%method)//': no progress at '//orbit%time_at(t) &
-                  & //' (the step size fell below the resolution of the time)', error_numerical)
-               exit
-            end if
-            if (steps > config%solver%max_steps) then
-               call fatal_error(error, trim(config%solver%method)//': more than max_steps steps in one ' &
-                  & //'renormalisation interval at '//orbit%time_at(t), error_numerical)
-               exit
-            end if
             ! (At a step's end: a dip of N' below 0 within one step is the stepper's to resolve.)
             if (.not. (run%p%normal_force(z(3)) > 0.0_wp)) then
                call fatal_error(error, "N' reached 0 at τ = "//rtoa(t) &
                   & //': the pad lifts off the belt, outside Eq. 10', error_numerical)
                exit
             end if
-            call run%flow%rhs(t, z, f_b)
-            call magnus_tangent_step(run%flow, t_a, y_a, f_a, t, z, f_b, phi, logs, depth, ok)
-            if (.not. ok) then
-               call fatal_error(error, 'Lyapunov spectrum: the Jacobian is NaN or Inf, or too stiff for ' &
-                  & //'the step ending at '//orbit%time_at(t)//' (an exponential of the tangent in more ' &
-                  & //'than 2^24 parts)', error_numerical)
-               exit
-            end if
-            f_a = f_b
+            call tangent_over_step(run%flow, orbit, t_a, y_a, f_a, t, z, phi, logs, depth, error)
+            if (allocated(error)) exit
             ! (The guard every 16 steps, and after every step whose exponentials took thousands of parts.)
             if (mod(steps, 16_i8) == 0 .or. depth >= 12) then
                call check_guard()

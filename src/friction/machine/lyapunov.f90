@@ -24,7 +24,7 @@ module friction_machine_lyapunov
    use friction_output_h5, only: h5_file
    use friction_analysis_lyapunov_spectrum, only: tangent_settings, spectrum_accumulator, kaplan_yorke, &
       & generic_frame
-   use friction_analysis_tangent_magnus, only: magnus_tangent_step
+   use friction_analysis_tangent_magnus, only: orbit_step, tangent_over_step
    use friction_analysis_lyapunov_flow, only: benettin_settings, benettin_accumulator
    use friction_law, only: sliding_law, max_law_states
    use friction_law_factory, only: make_law
@@ -194,11 +194,10 @@ contains
       type(machine_smooth) :: system
       type(divergence_system), target :: extended
       type(ode_solver) :: orbit
-      real(wp), allocatable :: y(:), phi(:, :), z(:), y_a(:), f_a(:), f_b(:), logs(:)
+      real(wp), allocatable :: y(:), phi(:, :), z(:), y_a(:), f_a(:), logs(:)
       real(wp) :: t, h, t0, t_a, t_target
       integer(i8) :: steps
       integer :: n, k, intervals, depth
-      logical :: ok
 
       divergence = 0.0_wp
       call smooth_start(c, law, system, y)
@@ -220,7 +219,7 @@ contains
       if (allocated(error)) return
       intervals = int(s%duration / s%renormalise + 1.0e-9_wp)
       call qr%start(n, intervals)
-      allocate (z(n + 1), y_a(n), f_a(n), f_b(n), logs(n))
+      allocate (z(n + 1), y_a(n), f_a(n), logs(n))
       z(1:n) = y
       z(n + 1) = 0.0_wp
       call system%rhs(t, y, f_a)
@@ -230,30 +229,10 @@ contains
          logs = 0.0_wp
          steps = 0
          do while (t < t_target)
-            t_a = t
-            y_a = z(1:n)
-            call orbit%step(t, t_target, z, error)
+            call orbit_step(orbit, c%solver%method, c%solver%max_steps, t, t_target, z, t_a, y_a, steps, error)
             if (allocated(error)) exit
-            steps = steps + 1
-            if (.not. (t > t_a)) then
-               call fatal_error(error, trim(c%solver%method)//': no progress at '//orbit%time_at(t) &
-                  & //' (the step size fell below the resolution of the time)', error_numerical)
-               exit
-            end if
-            if (steps > c%solver%max_steps) then
-               call fatal_error(error, trim(c%solver%method)//': more than max_steps steps in one ' &
-                  & //'renormalisation interval at '//orbit%time_at(t), error_numerical)
-               exit
-            end if
-            call system%rhs(t, z(1:n), f_b)
-            call magnus_tangent_step(system, t_a, y_a, f_a, t, z(1:n), f_b, phi, logs, depth, ok)
-            if (.not. ok) then
-               call fatal_error(error, 'Lyapunov spectrum: the Jacobian is NaN or Inf, or too stiff for ' &
-                  & //'the step ending at '//orbit%time_at(t)//' (an exponential of the tangent in more ' &
-                  & //'than 2^24 parts)', error_numerical)
-               exit
-            end if
-            f_a = f_b
+            call tangent_over_step(system, orbit, t_a, y_a, f_a, t, z(1:n), phi, logs, depth, error)
+            if (allocated(error)) exit
             ! (The watch every 16 steps, as the solver's own trips ask it, and
             ! after every step whose exponentials took thousands of parts.)
             if (mod(steps, 16_i8) == 0 .or. depth >= 12) then
