@@ -47,9 +47,9 @@ contains
 
    !> One accepted step of `orbit` from (t, z) towards t_target, its start
    !> kept in t_a and y_a (z's first size(y_a) values) and counted in `steps`:
-   !> an error when it made no progress or the interval has taken more than
-   !> max_steps steps (the scene's spectrum loops, machine/lyapunov.f90 and
-   !> brake/diagnostics.f90).
+   !> an error when the interval has taken more than max_steps steps (a step
+   !> without progress is the solver's).  For the scenes' spectrum loops
+   !> (machine/lyapunov.f90, brake/diagnostics.f90).
    subroutine orbit_step(orbit, method, max_steps, t, t_target, z, t_a, y_a, steps, error)
       type(ode_solver), intent(inout) :: orbit
       character(len=*), intent(in) :: method
@@ -67,10 +67,7 @@ contains
       call orbit%step(t, t_target, z, error)
       if (allocated(error)) return
       steps = steps + 1
-      if (.not. (t > t_a)) then
-         call fatal_error(error, trim(method)//': no progress at '//orbit%time_at(t) &
-            & //' (the step size fell below the resolution of the time)', error_numerical)
-      else if (steps > max_steps) then
+      if (steps > max_steps) then
          call fatal_error(error, trim(method)//': more than max_steps steps in one ' &
             & //'renormalisation interval at '//orbit%time_at(t), error_numerical)
       end if

@@ -298,11 +298,6 @@ contains
          call self%main%step(t, t1, y(1:n), error)
          if (allocated(error)) return
          self%steps = self%steps + 1
-         if (.not. (t > t0)) then
-            call fatal_error(error, trim(self%method)//': no progress at '//self%main%time_at(t) &
-               & //' (the step size fell below the resolution of the time)', error_numerical)
-            return
-         end if
          if (self%max_steps > 0 .and. self%steps > self%max_steps) then
             call fatal_error(error, trim(self%method)//': more than max_steps = '//itoa(self%max_steps) &
                & //' steps at '//self%main%time_at(t)//' (the step budget of the whole run)', &

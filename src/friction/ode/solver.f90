@@ -449,9 +449,11 @@ contains
       real(wp), intent(inout) :: y(:)
       type(error_type), allocatable, intent(out) :: error
       integer(c_int) :: status
+      real(wp) :: t0
 
       call self%report_failed_restart(error)
       if (allocated(error)) return
+      t0 = t
       status = friction_gsl_driver_step_once(self%driver, t, t1, y)
       if (status == gsl_ebadfunc) then
          call fatal_error(error, trim(self%method)//': the right-hand side became NaN or Inf at ' &
@@ -462,6 +464,10 @@ contains
       else if (.not. all(abs(y) <= huge(y))) then
          call fatal_error(error, trim(self%method)//': the state became NaN or Inf at ' &
             & //self%time_at(t), error_numerical)
+      else if (.not. (t > t0)) then
+         ! A caller stepping until t reaches its target would loop for ever.
+         call fatal_error(error, trim(self%method)//': no progress at '//self%time_at(t) &
+            & //' (the step size fell below the resolution of the time)', error_numerical)
       end if
    end subroutine step
 
