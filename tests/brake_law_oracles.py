@@ -280,6 +280,20 @@ def brake_spectrum_file(args, name, sets):
     return h5py.File(out)
 
 
+def steady_jacobian(field, jacobian, state, duration):
+    """J at the steady state, checked against central differences of the field (the algebra of both,
+    written in the test); its eigenvalues' real parts, largest first; and ln(cond V)/T, which bounds how
+    far the QR estimates over T may lie from them (they tend to the real parts like 1/T, from the tangent
+    vectors' angles to the eigenvectors at the start and the end)."""
+    j = jacobian(state)
+    n = len(state)
+    fd = np.column_stack([(field(0, state + h * e) - field(0, state - h * e)) / (2 * h)
+                          for h, e in ((1e-7 * max(abs(state[i]), 1e-3), np.eye(n)[i]) for i in range(n))])
+    assert np.allclose(fd, j, rtol=1e-5, atol=1e-6), (fd, j)
+    values, vectors = np.linalg.eig(j)
+    return j, np.sort(values.real)[::-1], np.log(np.linalg.cond(vectors)) / duration
+
+
 def lugre_steady(args):
     # A belt at 0.05 m/s, 50 Stribeck velocities: g is F_c there and σ2 > 0 makes the friction rise with
     # the speed, so steady sliding (the pad at rest, v_rel = -v_dr) is a stable equilibrium.  Started on
@@ -305,16 +319,7 @@ def lugre_steady(args):
         exponents = f["brake/lyapunov/exponents"][:]
         benettin = float(f["brake/lyapunov"].attrs["benettin_exponent"])
         drift = max(float(np.ptp(f["brake"][key][:])) for key in ("x", "y"))
-    j = jacobian(state)
-    # The Jacobian written above against central differences of the field written above (its algebra).
-    fd = np.column_stack([(field(0, state + h * e) - field(0, state - h * e)) / (2 * h)
-                          for h, e in ((1e-7 * max(abs(state[i]), 1e-3), np.eye(5)[i]) for i in range(5))])
-    assert np.allclose(fd, j, rtol=1e-5, atol=1e-6), (fd, j)
-    values, vectors = np.linalg.eig(j)
-    expected = np.sort(values.real)[::-1]
-    # Over T the QR and Benettin estimates tend to the real parts like 1/T (the tangent vectors' angles
-    # to the eigenvectors at the start and the end): ln(cond V)/T bounds that for the QR's frame.
-    bound = np.log(np.linalg.cond(vectors)) / duration
+    j, expected, bound = steady_jacobian(field, jacobian, state, duration)
     # On the equilibrium the flow of the perturbations is e^{J t} exactly: the same QR steps and Benettin's
     # renormalisations on it, from the same starting vectors (the generic frame; Benettin's (1, ..., 1)/√5,
     # diagnostics.f90), give the finite-time values themselves, which the program's must match to its
@@ -361,13 +366,7 @@ def lugre_stiff_steady(args):
     with brake_spectrum_file(args, "lugre_stiff_steady", sets) as f:
         exponents = f["brake/lyapunov/exponents"][:]
         drift = max(float(np.ptp(f["brake"][key][:])) for key in ("x", "y"))
-    j = jacobian(state)
-    fd = np.column_stack([(field(0, state + h * e) - field(0, state - h * e)) / (2 * h)
-                          for h, e in ((1e-7 * max(abs(state[i]), 1e-3), np.eye(5)[i]) for i in range(5))])
-    assert np.allclose(fd, j, rtol=1e-5, atol=1e-6), (fd, j)
-    values, vectors = np.linalg.eig(j)
-    expected = np.sort(values.real)[::-1]
-    bound = np.log(np.linalg.cond(vectors)) / duration
+    j, expected, bound = steady_jacobian(field, jacobian, state, duration)
     qr_exact = finite_time_spectrum(expm(j * every), generic_frame(5), int(round(duration / every))) / duration
     print(f"lugre-stiff-steady: residual of the start {residual:.1e}, drift {drift:.1e} m; exponents {exponents}; "
           f"J's eigenvalues' real parts {expected} (bound {bound:.2e}); exact finite-time {qr_exact}; off by "
