@@ -324,8 +324,6 @@ def refusals(args):
     cases = [  # (groups, line, names, why)
         ("&brake\n  model = 'law'\n/\n&law\n  model = 'lugre'\n/\n&analysis\n  orbit = .true.\n/\n", 12,
          "&analysis: orbit", "internal states"),
-        ("&brake\n  model = 'law'\n/\n&law\n  model = 'karnopp'\n/\n&analysis\n  orbit = .true.\n/\n", 12,
-         "&analysis: orbit", "zero-velocity band tangentially"),
         ("&brake\n  model = 'law'\n/\n&law\n  model = 'coulomb'\n/\n&analysis\n  orbit = .true.\n"
          "  continuation = 'delta_prime'\n  continuation_end = 1.0\n/\n", 13, "&analysis: continuation",
          "not a variable"),

@@ -42,8 +42,8 @@ module friction_brake_config
    !> internal states (a name both groups have, mu or mu_s, is &law's: &brake's is unused then).
    character(len=*), parameter :: brake_law_continuation_names(4) = [character(len=10) :: 'xi', 'kappa', &
       & 'g_prime', 'v_dr_prime']
-   character(len=*), parameter :: law_continuation_names(10) = [character(len=8) :: 'mu', 'mu_s', 'epsilon', &
-      & 'delta', 'fc', 'fs', 'vs', 'exponent', 'sigma2', 'scale']
+   character(len=*), parameter :: law_continuation_names(11) = [character(len=8) :: 'mu', 'mu_s', 'epsilon', &
+      & 'delta', 'fc', 'fs', 'vs', 'exponent', 'sigma2', 'scale', 'dv']
 
    !> &integrator defaults for the brake when no file sets them: rk8pd, tight
    !> (the benchmark: the switched model reaches 1e-8 on x this way); times in τ.
@@ -320,12 +320,8 @@ contains
       call new_law(self%law, law)
       associate (a => self%analysis)
          if (a%orbit .and. law%state_count() > 0) call c%reject('analysis', 'orbit', '.true.', why)
-         if (a%orbit .and. holds_applied(law)) call c%reject('analysis', 'orbit', '.true.', &
-            & "is not computed for &brake model = 'law' with &law model = '"//trim(self%law%model)//"' (its " &
-            & //'block leaves its zero-velocity band tangentially, as the pull passes F_s, and its force jumps ' &
-            & //'at the band''s edges: no section of the flow is crossed transversally there): use coulomb, ' &
-            & //'stribeck, table or arctan')
       end associate
+      call check_band_edges(self, law, c)
       if (c%failed()) return
       ! Exact stick holds the closed-form stick phase, whose end needs a static limit affine in N'.
       if (law%set_valued()) then
@@ -348,16 +344,28 @@ contains
       end if
    end subroutine check_law_choice
 
-   !> Whether a single-valued law without states holds the applied force at
-   !> rest (Karnopp's band): its force jumps where the band ends.
-   logical function holds_applied(law)
+   !> A band law (Karnopp's) whose force just outside the band exceeds its
+   !> hold: an edge then attracts from both sides and the block would slide
+   !> along it (a Filippov sliding mode), which the band's switches of the
+   !> orbit and the spectrum (band.f90) do not follow: refused by name.
+   subroutine check_band_edges(self, law, c)
+      type(brake_config), intent(in) :: self
       class(sliding_law), intent(in) :: law
-      real(wp) :: none(0)
+      type(config_checker), intent(inout) :: c
+      real(wp) :: width, limit, outside, none(0)
+      character(len=:), allocatable :: why
 
-      holds_applied = .false.
-      if (law%set_valued() .or. law%state_count() > 0) return
-      holds_applied = law%force(0.0_wp, none, 1.0_wp, 0.5_wp) /= law%force(0.0_wp, none, 1.0_wp, 0.0_wp)
-   end function holds_applied
+      call law%band(width, limit)
+      if (.not. (width > 0.0_wp)) return
+      ! (The band's hold and its edge's force do not depend on the load: Karnopp's F_s and g(Δv) + σ2 Δv.)
+      outside = law%force(width, none, 1.0_wp, 0.0_wp)
+      if (.not. (outside > limit)) return
+      why = "&law model = '"//trim(self%law%model)//"': the force just outside the band, "//rtoa(outside) &
+         & //' at dv, exceeds the band''s hold fs = '//rtoa(limit)//', so the block would slide along the ' &
+         & //'band''s edge, which the band''s switches do not follow: a smaller sigma2 or dv'
+      if (self%analysis%orbit) call c%reject('analysis', 'orbit', '.true.', why)
+      if (self%analysis%lyapunov_spectrum) call c%reject('analysis', 'lyapunov_spectrum', '.true.', why)
+   end subroutine check_band_edges
 
    !> The configuration with the continuation variable set to `value` (and no
    !> continuation of its own).

@@ -12,6 +12,7 @@ module friction_brake_diagnostics
    use friction_brake_simulate, only: initial_state, new_brake_integrator
    use friction_brake_integrator, only: brake_integrator
    use friction_brake_law_model, only: law_integrator
+   use friction_brake_band, only: band_integrator
    use friction_law, only: sliding_law
    use friction_law_factory, only: make_law
    use friction_output_law_files, only: law_with_files
@@ -254,7 +255,9 @@ contains
    !> tangent matrix (the switched model applies the saltation matrices at
    !> its events and the stick flow, which forgets the block's velocity);
    !> after the transient, a QR step every renormalisation interval.  A
-   !> law that is one ODE without a band (&brake model = 'law'): law_flow_spectrum.
+   !> law that is one ODE without a band (&brake model = 'law'): law_flow_spectrum;
+   !> with Karnopp's band, the band's run (band.f90): its edges and the ends
+   !> of its hold located, a saltation at each jump, δv forgotten in a hold.
    subroutine brake_lyapunov_spectrum(config, settings, result, error, guard, reporter)
       type(brake_config), intent(in) :: config
       type(tangent_settings), intent(in) :: settings
@@ -275,18 +278,21 @@ contains
             & //'a duration of at least one interval after lyapunov_spectrum_transient', error_input)
          return
       end if
+      half_width = 0.0_wp
       if (config%uses_law()) then
          call make_law(law_with_files(config%law), law, error)
          if (allocated(error)) return
          call law%band(half_width, limit)
-         ! (Karnopp's band, whose force jumps at its edges without an event of the flow, would need a
-         ! saltation there with either tangent: it keeps the stepper's, as before.)
          if (.not. law%set_valued() .and. half_width == 0.0_wp) then
             call law_flow_spectrum(config, settings, result, error, guard, reporter)
             return
          end if
       end if
-      call new_brake_integrator(config, run)
+      if (half_width > 0.0_wp) then
+         allocate (band_integrator :: run)
+      else
+         call new_brake_integrator(config, run)
+      end if
       run%tangent = .true.
       call run%start(config, config%t_start, initial_state(config), events, error)
       if (allocated(error)) return

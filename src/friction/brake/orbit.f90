@@ -22,12 +22,13 @@ module friction_brake_orbit
    use friction_kinds, only: wp, pi
    use friction_error, only: error_type
    use friction_brake_config, only: brake_config, continuation_config, continuation_variable
-   use friction_brake_simulate, only: brake_run, simulate_brake
+   use friction_brake_simulate, only: brake_run, simulate_brake, initial_state
    use friction_brake_params, only: brake_parameters
    use friction_brake_record, only: brake_event_table, event_stick_to_slip, event_kind_names
    use friction_brake_switched, only: switched_integrator, brake_slip
    use friction_brake_law_model, only: law_integrator, brake_law_slip, brake_law_flow, law_units, law_static_line
    use friction_brake_integrator, only: brake_integrator
+   use friction_brake_band, only: band_integrator
    use friction_law, only: sliding_law
    use friction_law_factory, only: make_law, new_law
    use friction_output_law_files, only: law_with_files
@@ -40,7 +41,7 @@ module friction_brake_orbit
    private
 
    public :: brake_section_map, brake_orbit, brake_periodic_orbit, section_state, section_limit
-   public :: brake_band_map, exact_stick
+   public :: brake_band_map, exact_stick, band_law
    public :: orbit_branch, follow_branch, detect_bifurcations, bifurcation_names
    public :: bifurcation_period_doubling, bifurcation_fold, bifurcation_neimark_sacker, bifurcation_discontinuity
 
@@ -86,6 +87,7 @@ module friction_brake_orbit
       logical :: tangent = .true.         !! .false.: P alone (jacobian = 0)
       integer :: counts(size(event_kind_names)) = 0   !! events by kind over the last return
       logical, private :: prepared = .false.          !! slope and level known (model = 'law')
+      logical, private :: band = .false.              !! a band law: the end of a hold at the edge (band.f90)
       real(wp), private :: slope = 0.0_wp, level = 0.0_wp
    contains
       procedure :: dimension => brake_map_dimension
@@ -116,8 +118,9 @@ module friction_brake_orbit
       !> Events of each kind over one period (stick-to-slip, slip-to-stick,
       !> slip reversal): the orbit's pattern, which a continuous branch keeps.
       integer :: pattern(size(event_kind_names)) = 0
-      !> The section: 'stick_to_slip' (exact stick), or 'creep_band_exit'
-      !> (a single-valued law: |v_rel| leaving stick_velocity).
+      !> The section: 'stick_to_slip' (exact stick), 'band_hold_end' (a
+      !> band law: a hold at the band's edge ending as the pull reaches F_s),
+      !> or 'creep_band_exit' (a single-valued law: |v_rel| leaving stick_velocity).
       character(len=16) :: section = 'stick_to_slip'
    end type brake_orbit
 
@@ -145,6 +148,20 @@ contains
          z = [(s(1) + limit * (slope * p%normal_force(s(1)) + level)) / 2, p%v_dr, s(1), s(2)]
       end if
    end function limit_state
+
+   !> Whether the brake's friction is a law of &law with a band whose force
+   !> jumps at its edges (Karnopp's): the section at the end of its hold.
+   logical function band_law(config)
+      type(brake_config), intent(in) :: config
+      class(sliding_law), allocatable :: law
+      real(wp) :: half_width, limit
+
+      band_law = config%uses_law()
+      if (.not. band_law) return
+      call new_law(config%law, law)
+      call law%band(half_width, limit)
+      band_law = half_width > 0.0_wp
+   end function band_law
 
    !> Whether the brake's friction sticks exactly (the switched model, or a
    !> set-valued law of &law): the stick-to-slip section; else the creep band's exit.
@@ -181,6 +198,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(switched_integrator), target :: switched
       type(law_integrator), target :: with_law
+      type(band_integrator), target :: with_band
       class(brake_integrator), pointer :: run
       type(brake_event_table) :: events
       type(brake_slip) :: slip
@@ -200,12 +218,22 @@ contains
                if (allocated(error)) return
             end if
             slope = self%slope
-            with_law%tangent = self%tangent
-            call with_law%start_slipping(self%config, 0.0_wp, limit_state(p, slope, self%level, sigma, s(1:2)), &
-               & -sigma, events, error)
-            if (allocated(error)) return
-            call with_law%advance_to_slip_onset(self%max_return, events, returned, error)
-            run => with_law
+            if (self%band) then
+               ! The hold at the edge -σ ends: the block leaves it at once (band.f90).
+               with_band%tangent = self%tangent
+               call with_band%start_leaving(self%config, 0.0_wp, limit_state(p, slope, self%level, sigma, &
+                  & s(1:2)), -sigma, events, error)
+               if (allocated(error)) return
+               call with_band%advance_to_hold_end(self%max_return, events, returned, error)
+               run => with_band
+            else
+               with_law%tangent = self%tangent
+               call with_law%start_slipping(self%config, 0.0_wp, limit_state(p, slope, self%level, sigma, &
+                  & s(1:2)), -sigma, events, error)
+               if (allocated(error)) return
+               call with_law%advance_to_slip_onset(self%max_return, events, returned, error)
+               run => with_law
+            end if
          else
             slope = p%mu_s
             switched%tangent = self%tangent
@@ -224,6 +252,7 @@ contains
          end if
          if (.not. returned) then
             reason = 'no slip onset within the longest return time'
+            if (self%band) reason = 'no end of a hold at the band''s edge within the longest return time'
             return
          end if
          if (section_limit(p, run%y) /= sigma) then
@@ -239,7 +268,10 @@ contains
          if (.not. self%tangent) return
          ! h = slope N' + level - σ (2x - y) (switched.f90, stick_exit_saltation).
          normal = [-2.0_wp * sigma, 0.0_wp, slope * (1.0_wp - p%kappa) + sigma, 0.0_wp]
-         if (self%config%uses_law()) then
+         if (self%band) then
+            ! The field outside the edge the block has just left by (slope 0: the hold's limit is F_s).
+            f = with_band%field()
+         else if (self%config%uses_law()) then
             law_slip%params = p
             allocate (law_slip%law, source=with_law%law)
             law_slip%units = with_law%units
@@ -261,17 +293,26 @@ contains
       end associate
    end subroutine brake_map_evaluate
 
-   !> The static limit's slope and level of the map's set-valued law.
+   !> The static limit's slope and level of the map's set-valued law; of a
+   !> band law, the hold's limit F_s (slope 0).
    subroutine prepare_limit(map, error)
       type(brake_section_map), intent(inout) :: map
       type(error_type), allocatable, intent(out) :: error
       class(sliding_law), allocatable :: law
       type(law_units) :: units
+      real(wp) :: half_width, limit
 
       call make_law(law_with_files(map%config%law), law, error)
       if (allocated(error)) return
       call map%config%law_units(units%force, units%velocity, units%time)
-      call law_static_line(law, units, map%slope, map%level)
+      call law%band(half_width, limit)
+      map%band = half_width > 0.0_wp
+      if (map%band) then
+         map%slope = 0.0_wp
+         map%level = limit / units%force
+      else
+         call law_static_line(law, units, map%slope, map%level)
+      end if
       map%prepared = .true.
    end subroutine prepare_limit
 
@@ -310,7 +351,26 @@ contains
       type(brake_orbit), intent(out) :: result
       type(error_type), allocatable, intent(out) :: error
       integer :: j
+      real(wp), allocatable :: times(:), states(:, :)
+      type(error_type), allocatable :: run_error
 
+      if (band_law(config)) then
+         ! The run's events are the law's flow's; the band's own run finds the ends of its holds.
+         result%section = 'band_hold_end'
+         call hold_ends(config, config%t_start + transient, 1, times, states, run_error)
+         if (allocated(run_error)) then
+            result%orbit%reason = 'the run to the first end of a hold failed: '//run_error%message
+            return
+         end if
+         if (size(times) == 0) then
+            result%orbit%reason = 'no end of a hold at the band''s edge after orbit_transient'
+            return
+         end if
+         result%guess_time = times(1)
+         result%limit = section_limit(config%params, states(:, 1))
+         call continue_orbit(config, result%limit, states(3:4, 1), settings, result, error)
+         return
+      end if
       if (.not. exact_stick(config)) result%section = 'creep_band_exit'
       do j = 1, events%n
          if (events%kind(j) == event_stick_to_slip .and. events%t(j) >= config%t_start + transient) exit
@@ -339,11 +399,14 @@ contains
       type(brake_orbit), intent(inout) :: result
       type(error_type), allocatable, intent(out) :: error
       type(brake_section_map) :: map
+      logical :: band
 
-      if (.not. exact_stick(config)) then
+      band = band_law(config)
+      if (.not. (exact_stick(config) .or. band)) then
          call band_orbit(config, limit, guess, settings, result, error)
          return
       end if
+      if (band) result%section = 'band_hold_end'
       map%config = config
       map%limit = limit
       map%max_return = config%t_end - config%t_start
@@ -352,6 +415,7 @@ contains
       if (allocated(error)) return
       if (config%uses_law()) then
          result%state = limit_state(config%params, map%slope, map%level, limit, result%orbit%point)
+         if (band) result%state(2) = hold_velocity(config, -limit)
       else
          result%state = section_state(config%params, limit, result%orbit%point)
       end if
@@ -410,6 +474,49 @@ contains
             & .and. events%t(1:events%n) < 1.5_wp * period)
       end do
    end subroutine band_orbit
+
+   !> The block's velocity in a hold at the band's edge of sign s (the
+   !> edge's, in the brake's units).
+   function hold_velocity(config, s) result(v)
+      type(brake_config), intent(in) :: config
+      real(wp), intent(in) :: s
+      real(wp) :: v
+      class(sliding_law), allocatable :: law
+      type(law_units) :: units
+      real(wp) :: half_width, limit
+
+      call new_law(config%law, law)
+      call law%band(half_width, limit)
+      call config%law_units(units%force, units%velocity, units%time)
+      v = config%params%v_dr + s * half_width / units%velocity
+   end function hold_velocity
+
+   !> A band law's run from the configuration's initial state through its
+   !> band's switches (band.f90): the times and states of the ends of holds
+   !> at the band's edge from t_from on, the first `most` of them, to t_end.
+   subroutine hold_ends(config, t_from, most, times, states, error)
+      type(brake_config), intent(in) :: config
+      real(wp), intent(in) :: t_from
+      integer, intent(in) :: most
+      real(wp), allocatable, intent(out) :: times(:), states(:, :)
+      type(error_type), allocatable, intent(out) :: error
+      type(band_integrator), target :: run
+      type(brake_event_table) :: events
+      logical :: found
+
+      allocate (times(0), states(4, 0))
+      call run%start(config, config%t_start, initial_state(config), events, error)
+      if (allocated(error)) return
+      do while (run%t < config%t_end .and. size(times) < most)
+         call run%advance_to_hold_end(config%t_end, events, found, error)
+         if (allocated(error)) return
+         call events%clear()
+         if (found .and. run%t >= t_from) then
+            times = [times, run%t]
+            states = reshape([states, run%y], [4, size(times)])
+         end if
+      end do
+   end subroutine hold_ends
 
    !> The orbit `first` of the run (config) followed along the line from the
    !> continuation variable's value in config to `last` in n points: at each
@@ -529,8 +636,20 @@ contains
       type(brake_run), target :: run
       type(error_type), allocatable :: run_error
       logical, allocatable :: keep(:)
+      real(wp), allocatable :: times(:), states(:, :)
 
       allocate (onsets(0))
+      if (band_law(point)) then
+         ! The slip onsets are the ends of the band's holds, from the band's own run.
+         call hold_ends(point, point%t_start + transient, huge(1), times, states, run_error)
+         if (allocated(run_error)) then
+            if (fresh) orbit%orbit%reason = 'the run at this point failed: '//run_error%message
+            return
+         end if
+         onsets = states(1, max(1, size(times) - max_section_points + 1):)
+         if (fresh) call brake_periodic_orbit(point, run%events, transient, settings, orbit, error)
+         return
+      end if
       call simulate_brake(point, run, run_error)
       if (allocated(run_error)) then
          if (fresh) orbit%orbit%reason = 'the run at this point failed: '//run_error%message

@@ -1,0 +1,253 @@
+#!/usr/bin/env python3
+"""Karnopp's law on the Girling brake (&brake model = 'law', &law model =
+'karnopp'): the periodic orbit on the section where a hold at the band's edge
+ends, and the Lyapunov spectrum through the band's switches, against the
+band's flow written here (SciPy's DOP853, with located events at the band's
+edges |v_rel| = Δv and where the pull A = -(2x - y) reaches ±F_s):
+
+  orbit-scipy   the section map's Jacobian against central differences of the
+                map integrated here (extrapolated), the program's orbit closing
+                in that map, its period and multipliers
+  spectrum      the finite-time exponents over a window against those of the
+                flow map's Jacobian from central differences of SciPy's flow:
+                the QR of Φ G from the same frame G the program starts from
+  refusals      a band whose edges attract from both sides (the force just
+                outside above the hold) is refused for the orbit and the
+                spectrum with file, line, group and variable, exit code 3
+
+    brake_karnopp_oracles.py --binary build/friction --inputs inputs --workdir DIR CASE
+"""
+import subprocess
+from pathlib import Path
+
+import h5py
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from machine_cases import run_program, case_main
+from brake_law_orbit_oracles import QUIET, XI, KAPPA, V_DR, orbit_of, check_map
+
+# The law in the brake's units (units = 'nondimensional': forces over k1 in m, velocities in m per unit τ):
+# inputs/brake_karnopp.nml's, on the slow belt of brake_continuation.nml.
+FC, FS, VS, DELTA, SIGMA2, DV = 0.0085, 0.0105, 2e-4, 2.0, 0.0, 1e-5
+TIGHT = {"brake.event_tolerance": 1e-12, "integrator.rtol": 1e-12, "integrator.atol": 1e-15}
+
+
+class KarnoppBrake:
+    """Eq. 10 with Karnopp's force, its band taken exactly: outside, F = s g(|w|)
+    + σ2 w (w = v - v_dr, s its sign); a block that reaches an edge with |A| <=
+    F_s holds there (v' = 0, v the edge's); a hold ends where A reaches ±F_s,
+    out through that edge when the pull points that way, else the block
+    drifts into the band under v' = A ∓ F_s, which ends at an edge or where
+    |A| falls back to F_s (a hold inside).  Modes: ('out', s), ('hold', e) with
+    e the edge's sign (0 inside), ('drift', σ)."""
+
+    def __init__(self):
+        self.tol = dict(rtol=1e-12, atol=1e-15)
+
+    @staticmethod
+    def pull(z):
+        return -(2 * z[0] - z[2])
+
+    def rhs(self, mode):
+        kind, s = mode
+
+        def f(t, z):
+            x, v, y, w = z
+            if kind == "out":
+                u = v - V_DR
+                force = s * (FC + (FS - FC) * np.exp(-abs(u / VS) ** DELTA)) + SIGMA2 * u
+                dv = self.pull(z) - force
+            elif kind == "hold":
+                dv = 0.0
+            else:
+                dv = self.pull(z) - s * FS
+            return [v, dv, w, (x - KAPPA * y) / XI]
+        return f
+
+    def events(self, mode):
+        kind, s = mode
+        if kind == "out":
+            def enter(t, z):
+                return s * (z[1] - V_DR) - DV
+            enter.terminal, enter.direction = True, -1
+            return [enter]
+        if kind == "hold":
+            def upper(t, z):
+                return self.pull(z) - FS
+            def lower(t, z):
+                return self.pull(z) + FS
+            upper.terminal, upper.direction = True, 1
+            lower.terminal, lower.direction = True, -1
+            return [upper, lower]
+
+        def top(t, z):
+            return z[1] - V_DR - DV
+        def bottom(t, z):
+            return z[1] - V_DR + DV
+        def back(t, z):
+            return s * self.pull(z) - FS
+        top.terminal, top.direction = True, 1
+        bottom.terminal, bottom.direction = True, -1
+        back.terminal, back.direction = True, -1
+        return [top, bottom, back]
+
+    def switch(self, mode, which, z):
+        """The mode after event `which` of `mode` at z (z's velocity set on the edge);
+        and whether that was the end of a hold at an edge (the section)."""
+        kind, s = mode
+        a = self.pull(z)
+        if kind == "out":
+            z[1] = V_DR + s * DV
+            if abs(a) <= FS:
+                return ("hold", s), False
+            assert np.sign(a) == -s, "the edge attracts from both sides"
+            return ("drift", np.sign(a)), False
+        if kind == "hold":
+            sigma = 1.0 if which == 0 else -1.0
+            if s == sigma:
+                return ("out", sigma), True
+            return ("drift", sigma), False
+        if which == 2:
+            return ("hold", 0.0), False
+        edge = 1.0 if which == 0 else -1.0
+        z[1] = V_DR + edge * DV
+        return ("out", edge), False
+
+    def run(self, t, z, mode, t_end, stop_at_section=False):
+        """From (t, z) in `mode` to t_end, or to the first end of a hold at an edge."""
+        z = np.array(z, dtype=float)
+        while t < t_end:
+            sol = solve_ivp(self.rhs(mode), (t, t_end), z, method="DOP853", events=self.events(mode), **self.tol)
+            hits = [k for k, e in enumerate(sol.t_events) if e.size]
+            if not hits:
+                return sol.t[-1], sol.y[:, -1], mode
+            which = min(hits, key=lambda k: sol.t_events[k][0])
+            t, z = sol.t_events[which][0], sol.y_events[which][0].copy()
+            mode, section = self.switch(mode, which, z)
+            if section and stop_at_section:
+                return t, z, mode
+        return t, z, mode
+
+    def section_map(self, sigma, point, t_max=400.0):
+        """(y, w) where the hold at the edge -σ ends with 2x - y = σ F_s, to the next such end."""
+        y, w = point
+        z = np.array([(y + sigma * FS) / 2, V_DR - sigma * DV, y, w])
+        t, z, mode = self.run(0.0, z, ("out", -sigma), t_max, stop_at_section=True)
+        assert t < t_max and np.sign(2 * z[0] - z[2]) == sigma, "no return to the section"
+        return np.array([z[2], z[3]]), t
+
+
+def karnopp_sets():
+    return {"brake.model": "'law'", "law.model": "'karnopp'", "law.fc": FC, "law.fs": FS, "law.vs": VS,
+            "law.exponent": DELTA, "law.sigma2": SIGMA2, "law.dv": DV, **TIGHT}
+
+
+def orbit_scipy(args):
+    orbit = orbit_of(args, "karnopp", ["brake_karnopp.nml"], {**karnopp_sets(), "analysis.orbit_tolerance": 1e-11})
+    assert orbit["section"] == "band_hold_end", orbit["section"]
+    sigma = float(orbit["static_limit"])
+    point = orbit["point"][[2, 3]]
+    # The section point: 2x - y = σ F_s, the block at the edge -σ of the band.
+    assert abs(2 * orbit["point"][0] - orbit["point"][2] - sigma * FS) <= 1e-15
+    assert abs(orbit["point"][1] - (V_DR - sigma * DV)) <= 1e-18
+    brake = KarnoppBrake()
+    # SciPy at rtol 1e-12: the map to ~1e-13 m; Newton stopped at 1e-11 m.  The closure bound 1e-9 m and the
+    # period's 1e-8 τ leave room for the event times (located to 1e-12 τ by both) over the period's events.
+    # Differences with steps 1e-6 m and 2e-7 m, extrapolated (Richardson); what remains is the h⁴ term and
+    # the map's noise over the fine step, rtol |z| / h = 1e-12 * 0.02 / 2e-7 ~ 1e-7 of the entries: the
+    # bound is 1e-6 of the largest entry.
+    fine = check_map("orbit-scipy", orbit, lambda p: brake.section_map(sigma, p), point, 1e-6, 5.0, 1e-8, 1e-9,
+                     1e-6)
+    # The multipliers: 1 along the flow, the section map's two, 0 (the hold forgets the block's velocity).
+    assert orbit["multipliers"][0] == 1 and orbit["multipliers"][3] == 0, orbit["multipliers"]
+    mu = np.sort_complex(np.linalg.eigvals(fine))[::-1]
+    got = orbit["multipliers"][1:3]
+    difference = np.max(np.abs(np.sort(np.abs(mu)) - np.sort(np.abs(got))))
+    print(f"orbit-scipy: multipliers {np.round(got, 8)} against {np.round(mu, 8)} (|μ| {difference:.1e} apart)")
+    assert difference <= 1e-5, difference
+
+
+def flow_jacobian(brake, t0, z0, mode, t1, frame, step):
+    """Φ(t1, t0) G by central differences along the columns of G (the mode at t0 a slip: smooth there)."""
+    columns = []
+    for j in range(frame.shape[1]):
+        plus = brake.run(t0, z0 + step * frame[:, j], mode, t1)[1]
+        minus = brake.run(t0, z0 - step * frame[:, j], mode, t1)[1]
+        columns.append((plus - minus) / (2 * step))
+    return np.column_stack(columns)
+
+
+def generic_frame(n):
+    """The program's starting frame (analysis/lyapunov_spectrum.f90): Hilbert's matrix plus I, orthonormalised."""
+    q = np.array([[1.0 / (i + j + 1) for j in range(n)] for i in range(n)]) + np.eye(n)
+    return np.linalg.qr(q)[0]
+
+
+def spectrum(args):
+    brake = KarnoppBrake()
+    # SciPy's trajectory from the input's start (x = y = 0, the block at the belt's velocity: inside the band)
+    # to find a window that starts in a slip, where the flow map is smooth in every direction (in a hold at
+    # an edge a change of v would leave the band or not).
+    t0_guess = 60.0
+    t, z, mode = brake.run(0.0, np.array([0.0, V_DR, 0.0, 0.0]), ("hold", 0.0), t0_guess)
+    while mode[0] != "out":
+        t, z, mode = brake.run(t, z, mode, t + 0.05)
+    # Half a slip on: away from the window's start's own event.
+    t_slip = t
+    _, z_end, mode_end = brake.run(t, z, mode, t + 1.0)
+    t0 = round(t_slip + 0.02, 2)
+    t0, z0, mode0 = (t0,) + brake.run(0.0, np.array([0.0, V_DR, 0.0, 0.0]), ("hold", 0.0), t0)[1:]
+    assert mode0[0] == "out", mode0
+    duration = 20.0
+    out = run_program(args, "karnopp_spectrum", ["brake_karnopp.nml"],
+                      {**karnopp_sets(), **{k: v for k, v in QUIET.items() if k != "analysis.orbit"},
+                       "analysis.orbit": ".false.", "analysis.lyapunov_spectrum": ".true.",
+                       "analysis.lyapunov_spectrum_transient": t0, "analysis.lyapunov_spectrum_duration": duration,
+                       "analysis.lyapunov_spectrum_renormalise": 1.0, "brake.t_end": t0 + duration + 1.0})
+    with h5py.File(out) as f:
+        exponents = f["brake/lyapunov/exponents"][()]
+        lost = int(f["brake/lyapunov"].attrs["spectrum_lost_directions"])
+    frame = generic_frame(4)
+    estimates = []
+    for step in (1e-6, 2e-7):
+        phi = flow_jacobian(brake, t0, z0, mode0, t0 + duration, frame, step)
+        r = np.linalg.qr(phi[:, :3])[1]
+        estimates.append(np.log(np.abs(np.diag(r))) / duration)
+    coarse, fine = estimates
+    extrapolated = fine + (fine - coarse) / 24.0
+    spread = np.max(np.abs(coarse - fine))
+    difference = np.max(np.abs(exponents[:3] - extrapolated))
+    print(f"spectrum: window [{t0}, {t0 + duration}] tau; the program's exponents {exponents} (lost {lost}); "
+          f"SciPy's flow map, QR of its differences: {extrapolated} ({difference:.1e} apart, the two steps' "
+          f"spread {spread:.1e})")
+    # The window holds holds: δv is forgotten at each, one direction lost, reported as -inf.
+    assert lost == 1 and exponents[3] == -np.inf, (lost, exponents)
+    # The differences' error: the h² term the two steps' spread shows (Richardson removes it) and the
+    # map's noise, rtol |z| / h ~ 1e-7 of an entry of Φ, 5e-9 per τ in a log over 20 τ; the two
+    # trajectories' start states agree to the integrations' 1e-11 m.  The bound: 1e-7 per τ.
+    assert difference <= max(1e-7, spread / 25), (difference, spread)
+
+
+def refusals(args):
+    work = Path(args.workdir)
+    # σ2 = 1000 m/(m per unit τ): the force just outside the band, g(Δv) + σ2 Δv = 0.0105 + 0.01 - ..., is
+    # above F_s = 0.0105.
+    band = "&law\n  model = 'karnopp'\n  fc = 0.0085\n  fs = 0.0105\n  vs = 2e-4\n  sigma2 = 1000.0\n  dv = 1e-5\n/\n"
+    cases = [(f"&brake\n  model = 'law'\n/\n{band}&analysis\n  orbit = .true.\n/\n", 16, "&analysis: orbit"),
+             (f"&brake\n  model = 'law'\n/\n{band}&analysis\n  lyapunov_spectrum = .true.\n/\n", 16,
+              "&analysis: lyapunov_spectrum")]
+    for i, (groups, line, names) in enumerate(cases):
+        path = work / f"bad{i}.nml"
+        path.write_text("! a refused value\n&job\n  scene = 'brake'\n/\n" + groups)
+        out = work / f"bad{i}.h5"
+        result = subprocess.run([args.binary, "-o", str(out), str(path)], capture_output=True, text=True)
+        print(f"refusals: exit {result.returncode}: {result.stderr.strip()}")
+        assert result.returncode == 3, result
+        assert f"{path}:{line}: {names}" in result.stderr and "slide along the band's edge" in result.stderr, \
+            result.stderr
+        assert not out.exists()
+
+
+if __name__ == "__main__":
+    raise SystemExit(case_main(__doc__, {"orbit-scipy": orbit_scipy, "spectrum": spectrum, "refusals": refusals}))
