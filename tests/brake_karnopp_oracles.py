@@ -11,6 +11,11 @@ edges |v_rel| = Δv and where the pull A = -(2x - y) reaches ±F_s):
   spectrum      the finite-time exponents over a window against those of the
                 flow map's Jacobian from central differences of SciPy's flow:
                 the QR of Φ G from the same frame G the program starts from
+  stick-limit   the orbit followed in dv towards 0 against the Stribeck law's
+                through exact stick (another code path, itself checked against
+                SciPy in brake_law_orbit_oracles.py): the band's hold at F_s is
+                exact stick at the static limit F_s as Δv -> 0; the branch's
+                last three points extrapolated to Δv = 0
   refusals      a band whose edges attract from both sides (the force just
                 outside above the hold) is refused for the orbit and the
                 spectrum with file, line, group and variable, exit code 3
@@ -224,6 +229,44 @@ def spectrum(args):
     assert difference <= max(2e-8, spread / 25), (difference, spread)
 
 
+def stick_limit(args):
+    # Newton does not find the orbit from the attractor at small Δv (the hold's end is then a near-grazing
+    # exit, x'' = A - g(Δv) rising from F_s - g(Δv) ~ (F_s - F_c)(Δv/v_s)²): the branch from the input's
+    # Δv = 1e-4 down to 1e-6 in steps of 3e-6, each point from the previous orbit.
+    sets = {**karnopp_sets(), "analysis.orbit_tolerance": 1e-11, "analysis.continuation": "'dv'",
+            "analysis.continuation_end": 1e-6, "analysis.continuation_points": 34}
+    with h5py.File(run_program(args, "karnopp_dv", ["brake_karnopp.nml"], {**QUIET, **sets})) as f:
+        b = f["brake/orbit/branch"]
+        branch = {key: b[key][()] for key in ("parameter", "found", "period", "point", "floquet_multipliers_real",
+                                               "floquet_multipliers_imag")}
+    stick = orbit_of(args, "stribeck", ["brake_karnopp.nml"], {**karnopp_sets(), "law.model": "'stribeck'",
+                                                                 "analysis.orbit_tolerance": 1e-11,
+                                                                 "analysis.orbit_transient": 200.0,
+                                                                 "brake.t_end": 1200.0})
+    assert stick["section"] == "stick_to_slip"
+    last = slice(-3, None)
+    assert branch["found"][last].all() and np.allclose(branch["parameter"][last], [7e-6, 4e-6, 1e-6], atol=1e-12)
+    dv = branch["parameter"][last]
+    assert np.all(branch["floquet_multipliers_imag"][last] == 0)
+    quantities = {"period (tau)": (branch["period"][last], stick["period"], 1e-9),
+                  "y (m)": (branch["point"][last, 2], stick["point"][2], 1e-10),
+                  "w (m/tau)": (branch["point"][last, 3], stick["point"][3], 1e-10),
+                  "mu_1": (branch["floquet_multipliers_real"][last, 1], stick["multipliers"][1].real, 1e-8),
+                  "mu_2": (branch["floquet_multipliers_real"][last, 2], stick["multipliers"][2].real, 1e-8)}
+    for name, (values, exact, noise) in quantities.items():
+        # Linear in Δv to leading order (the hold's velocity, the edge's crossing): the quadratic through the
+        # three points at Δv = 0, its distance from the linear one through the last two the size of the term
+        # it removes (what remains, the cubic, is smaller); `noise` the orbits' own precision (Newton at
+        # 1e-11 m, events at 1e-12 τ; the multipliers' 1e-8 the section Jacobian's, orbit-scipy).
+        quadratic = np.polyval(np.polyfit(dv, values, 2), 0.0)
+        linear = np.polyval(np.polyfit(dv[1:], values[1:], 1), 0.0)
+        difference = abs(quadratic - exact)
+        print(f"stick-limit: {name}: Karnopp at dv = 1e-6 {values[-1]:.10g}, extrapolated to 0 {quadratic:.10g}, "
+              f"the Stribeck law through exact stick {exact:.10g} ({difference:.1e} apart; the quadratic term "
+              f"{abs(quadratic - linear):.1e})")
+        assert difference <= abs(quadratic - linear) + noise, (name, difference)
+
+
 def refusals(args):
     work = Path(args.workdir)
     # σ2 = 1000 (m per m/τ): the force just outside the band, g(Δv) + σ2 Δv = 0.0105 + 0.01 (to 1e-8), is
@@ -245,4 +288,5 @@ def refusals(args):
 
 
 if __name__ == "__main__":
-    raise SystemExit(case_main(__doc__, {"orbit-scipy": orbit_scipy, "spectrum": spectrum, "refusals": refusals}))
+    raise SystemExit(case_main(__doc__, {"orbit-scipy": orbit_scipy, "spectrum": spectrum,
+                                          "stick-limit": stick_limit, "refusals": refusals}))
