@@ -939,7 +939,8 @@ def orbit_branch(data: DataLike) -> Figure:
         top.plot(missing, np.full(missing.size, np.nanmin(o["branch/section_x"]) if o["branch/section_x"].size
                                   else 0.0), "x", color="tab:red", label="no orbit found")
     top.set_ylabel("x at slip onset (m)")
-    # The section the orbit was found on: stick_to_slip, or creep_band_exit for a law without exact stick.
+    # The section the orbit was found on: stick_to_slip, creep_band_exit for a law without exact stick, or
+    # band_hold_end for a law with a band (Karnopp's).
     section = str(o["attrs"].get("section", "stick_to_slip")).replace("_", "-")
     top.set_title(f"Periodic orbit followed in {o['variable']} ({section} section)", fontsize="medium")
     top.legend(fontsize="x-small", loc="lower left")
