@@ -166,8 +166,9 @@ contains
    ! ---- the integrator ----
 
    !> Start at (t0, y0) of the configuration (a band law of &law): the law
-   !> made at the first start, the locator on the band's flow (with Φ = I
-   !> beside it when tangent).
+   !> made at the first start (an integrator runs one configuration, as the
+   !> law model's), the locator on the band's flow (with Φ = I beside it when
+   !> tangent).
    subroutine band_start(self, config, t0, y0, events, error)
       class(band_integrator), target, intent(inout) :: self
       type(brake_config), intent(in) :: config
