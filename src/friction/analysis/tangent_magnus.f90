@@ -36,6 +36,13 @@ module friction_analysis_tangent_magnus
    !> At most 2^max_level parts to an exponential (seconds of work): a step
    !> that needs more ends the spectrum with an error instead of stalling.
    integer, parameter :: max_level = 24
+   !> A monodromy's (`upper`) exponential is cut into at most 2^lost_level
+   !> parts: a direction that still shrinks past e^-part_spread of the largest
+   !> within one of them (faster than e^(-18 · 1024) over one exponential, the
+   !> GMS elements held at their limits) is lost, its multiplier 0 exactly.
+   integer, parameter :: lost_level = 10
+   !> The log of a lost direction's R factor.
+   real(wp), parameter :: lost_log = -huge(1.0_wp)
 
    !> Padé (6, 6) of exp(X) is exact to 2e-17 for ||X||_1 <= 1/2 (the
    !> remainder (6!)² / (12! 13!) ||X||^13); larger X is scaled into it.
@@ -107,7 +114,12 @@ contains
    !> exponential needing more than 2^max_level parts.
    !> `depth`: the parts' level j to try first (0 at the start), kept from
    !> step to step: the stiffness met changes slowly.
-   pure subroutine magnus_tangent_step(system, t_a, y_a, f_a, t_b, y_b, f_b, phi, logs, depth, ok)
+   !> `upper` (a monodromy matrix, not a spectrum): the whole product R of the
+   !> R factors is kept, R = diag(exp(logs)) upper, `upper` unit upper
+   !> triangular (rows scaled by R's diagonal: bounded while the columns keep
+   !> the order of their growth, as they do from a generic frame), so that
+   !> Φ(t) Φ(t_0)⁻¹ = Q R Φ(t_0)ᵀ with its smallest parts resolved.
+   pure subroutine magnus_tangent_step(system, t_a, y_a, f_a, t_b, y_b, f_b, phi, logs, depth, ok, upper)
       class(ode_system), intent(in) :: system
       real(wp), intent(in) :: t_a, t_b
       real(wp), intent(in) :: y_a(:), f_a(:), y_b(:), f_b(:)
@@ -115,6 +127,7 @@ contains
       real(wp), intent(inout) :: logs(:)
       integer, intent(inout) :: depth
       logical, intent(out) :: ok
+      real(wp), intent(inout), optional :: upper(:, :)
       real(wp), parameter :: offset = sqrt(3.0_wp) / 6.0_wp
       real(wp), parameter :: alpha = 0.25_wp + offset, beta = 0.25_wp - offset
       real(wp) :: a1(size(y_a), size(y_a)), a2(size(y_a), size(y_a)), y(size(y_a)), dfdt(size(y_a)), h
@@ -124,9 +137,9 @@ contains
       call system%jacobian(t_a + (0.5_wp - offset) * h, y, a1, dfdt)
       call hermite(0.5_wp + offset, h, y_a, f_a, y_b, f_b, y)
       call system%jacobian(t_a + (0.5_wp + offset) * h, y, a2, dfdt)
-      call apply_exponential(h * (alpha * a1 + beta * a2), phi, logs, depth, ok)
+      call apply_exponential(h * (alpha * a1 + beta * a2), phi, logs, depth, ok, upper)
       if (.not. ok) return
-      call apply_exponential(h * (beta * a1 + alpha * a2), phi, logs, depth, ok)
+      call apply_exponential(h * (beta * a1 + alpha * a2), phi, logs, depth, ok, upper)
    end subroutine magnus_tangent_step
 
    !> Φ ← exp(X) Φ in parts exp(X / 2^j), Φ = Q R after each (Φ ← Q, logs +=
@@ -135,12 +148,13 @@ contains
    !> it spans at most e).  The first parts are tried at level `depth`, which
    !> becomes the finest level taken, or one coarser when every part spanned
    !> less than e^(part_spread / 2).
-   pure subroutine apply_exponential(x, phi, logs, depth, ok)
+   pure subroutine apply_exponential(x, phi, logs, depth, ok, upper)
       real(wp), intent(in) :: x(:, :)
       real(wp), intent(inout) :: phi(:, :)
       real(wp), intent(inout) :: logs(:)
       integer, intent(inout) :: depth
       logical, intent(out) :: ok
+      real(wp), intent(inout), optional :: upper(:, :)
       real(wp) :: levels(size(x, 1), size(x, 1), 0:max_parts), norm, product(size(logs)), widest
       integer :: scaling, j, first, k, finest
 
@@ -159,7 +173,7 @@ contains
       widest = 1.0_wp
       product = 1.0_wp
       do k = 1, 2**first
-         call apply_part(levels(:, :, 0:scaling), first, scaling, phi, logs, product, finest, widest)
+         call apply_part(levels(:, :, 0:scaling), first, scaling, phi, logs, product, finest, widest, upper)
          ok = finest <= max_level
          if (.not. ok) return
       end do
@@ -174,12 +188,13 @@ contains
    !> leaves [1e-100, 1e100]; `finest` and `widest` record the finest level
    !> taken and the largest span of R's diagonal (finest > max_level: a part
    !> beyond max_level was needed, and nothing more is done).
-   pure recursive subroutine apply_part(levels, level, last, phi, logs, product, finest, widest)
+   pure recursive subroutine apply_part(levels, level, last, phi, logs, product, finest, widest, upper)
       real(wp), intent(in) :: levels(:, :, 0:)
       integer, intent(in) :: level, last
       real(wp), intent(inout) :: phi(:, :)
       real(wp), intent(inout) :: logs(:), product(:), widest
       integer, intent(inout) :: finest
+      real(wp), intent(inout), optional :: upper(:, :)
       real(wp) :: trial(size(phi, 1), size(phi, 2)), r(size(phi, 2))
       integer :: n, i, j, k
 
@@ -195,6 +210,10 @@ contains
             end do
          end do
       end do
+      if (present(upper)) then
+         call monodromy_part(levels, level, last, phi, logs, finest, widest, upper, trial)
+         return
+      end if
       call factor(trial, r)
       ! (A part that underflowed or overflowed a column is never taken whole.)
       if (level == last .or. (all(r > 0.0_wp .and. r <= huge(r)) &
@@ -211,21 +230,53 @@ contains
       else if (level == max_level) then
          finest = max_level + 1
       else
-         call apply_part(levels, level + 1, last, phi, logs, product, finest, widest)
-         call apply_part(levels, level + 1, last, phi, logs, product, finest, widest)
+         call apply_part(levels, level + 1, last, phi, logs, product, finest, widest, upper)
+         call apply_part(levels, level + 1, last, phi, logs, product, finest, widest, upper)
       end if
    end subroutine apply_part
+
+   !> apply_part's for a monodromy matrix: `trial` = the part applied to Φ,
+   !> factored with all of R kept in `upper` and `logs`; the lost directions
+   !> (logs at lost_log) left out of the span the part is judged by.
+   pure recursive subroutine monodromy_part(levels, level, last, phi, logs, finest, widest, upper, applied)
+      real(wp), intent(in) :: levels(:, :, 0:), applied(:, :)
+      integer, intent(in) :: level, last
+      real(wp), intent(inout) :: phi(:, :), logs(:), widest, upper(:, :)
+      integer, intent(inout) :: finest
+      real(wp) :: r(size(phi, 2)), whole(size(phi, 2), size(phi, 2)), top, trial(size(phi, 1), size(phi, 2))
+      logical :: kept(size(phi, 2)), fits
+
+      trial = applied
+      call factor(trial, r, whole)
+      kept = logs > lost_log
+      top = maxval(r, mask=kept)
+      fits = all(.not. kept .or. (r > 0.0_wp .and. r <= huge(r))) .and. top <= huge(r)
+      if (fits) fits = minval(r, mask=kept) >= exp(-part_spread) * top
+      if (level == last .or. level >= lost_level .or. fits) then
+         phi = trial
+         finest = max(finest, level)
+         if (fits) widest = max(widest, top / minval(r, mask=kept))
+         call accumulate(whole, r, logs, upper, kept .and. .not. (r >= exp(-part_spread) * top))
+      else
+         call monodromy_part(levels, level + 1, last, phi, logs, finest, widest, upper, &
+            & matmul(levels(:, :, level + 1), phi))
+         call monodromy_part(levels, level + 1, last, phi, logs, finest, widest, upper, &
+            & matmul(levels(:, :, level + 1), phi))
+      end if
+   end subroutine monodromy_part
 
    !> Φ = Q R by modified Gram–Schmidt with one reorthogonalisation, as
    !> analysis/lyapunov_spectrum.f90's orthonormalise without its lost
    !> directions (Φ is regular here), in loops: it is the parts' inner loop.
-   pure subroutine factor(phi, r)
+   pure subroutine factor(phi, r, whole)
       real(wp), intent(inout) :: phi(:, :)
       real(wp), intent(out) :: r(:)
+      real(wp), intent(out), optional :: whole(:, :)   !! all of R (the monodromy's)
       real(wp) :: d
       integer :: n, i, k, pass, l
 
       n = size(phi, 1)
+      if (present(whole)) whole = 0.0_wp
       do k = 1, n
          do pass = 1, 2
             do i = 1, k - 1
@@ -236,6 +287,7 @@ contains
                do l = 1, n
                   phi(l, k) = phi(l, k) - d * phi(l, i)
                end do
+               if (present(whole)) whole(i, k) = whole(i, k) + d
             end do
          end do
          d = 0.0_wp
@@ -244,8 +296,68 @@ contains
          end do
          r(k) = sqrt(d)
          if (r(k) > 0.0_wp) phi(:, k) = phi(:, k) / r(k)
+         if (present(whole)) then
+            whole(k, k) = r(k)
+            ! A column shrunk to nothing (a lost direction): the basis completed by a unit vector instead.
+            if (.not. (r(k) >= tiny(1.0_wp))) call complete(phi, k)
+         end if
       end do
    end subroutine factor
+
+   !> Column k of Φ: the unit vector orthogonal to columns 1 to k - 1 with
+   !> the largest residual among the axes, orthogonalised twice.
+   pure subroutine complete(phi, k)
+      real(wp), intent(inout) :: phi(:, :)
+      integer, intent(in) :: k
+      real(wp) :: v(size(phi, 1)), best(size(phi, 1)), d
+      integer :: axis, i, pass
+
+      best = 0.0_wp
+      do axis = 1, size(phi, 1)
+         v = 0.0_wp
+         v(axis) = 1.0_wp
+         do pass = 1, 2
+            do i = 1, k - 1
+               d = dot_product(phi(:, i), v)
+               v = v - d * phi(:, i)
+            end do
+         end do
+         if (norm2(v) > norm2(best)) best = v
+      end do
+      phi(:, k) = best / norm2(best)
+   end subroutine complete
+
+   !> R ← R_part R with R = diag(exp(logs)) U: U ← (diag(exp(-logs)) V
+   !> diag(exp(logs))) U, V = diag(r)⁻¹ R_part, then logs += log r.  (A column
+   !> growing past an earlier one by e^700 is capped there: U would overflow.)
+   pure subroutine accumulate(whole, r, logs, upper, lost)
+      real(wp), intent(in) :: whole(:, :), r(:)
+      real(wp), intent(inout) :: logs(:), upper(:, :)
+      logical, intent(in) :: lost(:)   !! directions lost in this part
+      real(wp) :: w(size(r), size(r))
+      integer :: n, i, j
+
+      n = size(r)
+      w = 0.0_wp
+      do j = 1, n
+         w(j, j) = 1.0_wp
+         do i = 1, j - 1
+            ! (A lost row's R is rounding: it stays e_i.)
+            if (logs(i) > lost_log .and. .not. lost(i)) &
+               & w(i, j) = whole(i, j) / r(i) * exp(min(logs(j) - logs(i), 700.0_wp))
+         end do
+      end do
+      upper = matmul(w, upper)
+      do i = 1, n
+         if (lost(i)) then
+            logs(i) = lost_log
+            upper(i, :) = 0.0_wp
+            upper(i, i) = 1.0_wp
+         else if (logs(i) > lost_log) then
+            logs(i) = logs(i) + log(r(i))
+         end if
+      end do
+   end subroutine accumulate
 
    !> D(X)^-1 N(X), N and D the Padé (6, 6) polynomials of exp (||X||_1 <= 1/2:
    !> D is then within 0.3 of I and needs no pivoting to speak of).

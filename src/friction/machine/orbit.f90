@@ -44,6 +44,7 @@ module friction_machine_orbit
    use friction_machine_model, only: machine_smooth
    use friction_machine_run, only: machine_run, run_machine
    use friction_machine_switching, only: switching_section
+   use friction_analysis_magnus_section, only: magnus_map
    implicit none
    private
 
@@ -603,6 +604,20 @@ contains
             if (present(watch)) banded%watch => watch
             allocate (map%inner, source=banded)
          end block
+      else if (frame%base%n_states > 0) then
+         block
+            ! A law with states (stiff bristles, GMS elements): the tangent by exponentials over the orbit's steps.
+            type(magnus_map) :: exponential
+            if (machine_orbit_forced(c)) then
+               call exponential%setup(frame, c%solver, .true., t0, 1.0_wp / c%support_frequency, 2, 0.0_wp, &
+                  & 0.0_wp, c%event_tolerance)
+            else
+               call exponential%setup(frame, c%solver, .false., 0.0_wp, 0.0_wp, 2, c%load_velocity, &
+                  & c%t_end - c%t_start, c%event_tolerance)
+            end if
+            if (present(watch)) exponential%watch => watch
+            allocate (map%inner, source=exponential)
+         end block
       else if (machine_orbit_forced(c)) then
          block
             type(stroboscopic_map) :: strobe
@@ -741,6 +756,7 @@ contains
       type(load_frame) :: frame
       type(machine_section) :: map
       real(wp), allocatable :: scale(:), section_scale(:)
+      complex(wp), allocatable :: logs(:)
       integer :: n, i, j
 
       call frame_of(c, frame, scale, error)
@@ -793,6 +809,20 @@ contains
          result%multipliers = floquet_multipliers(result%orbit, 0)
       end if
       result%exponents = floquet_exponents(result%multipliers, result%orbit%period)
+      select type (inner => map%inner)
+      type is (magnus_map)
+         ! The multipliers from the monodromy's factors, resolved however small: exp of their logs (0 where
+         ! that underflows), the exponents ln|μ|/T from the logs themselves (docs/chaos.md).
+         logs = inner%log_multipliers()
+         result%orbit%multipliers = exp(logs)
+         if (result%forced) then
+            result%multipliers = result%orbit%multipliers
+            result%exponents = real(logs) / result%orbit%period
+         else
+            result%multipliers = floquet_multipliers(result%orbit, 0)
+            result%exponents = [0.0_wp, real(logs) / result%orbit%period]
+         end if
+      end select
    end subroutine orbit_from
 
    ! ---- continuation ----

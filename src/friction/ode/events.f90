@@ -249,22 +249,27 @@ contains
    !> its state: call restart before going on.  Otherwise (t, y) is the end
    !> of that step and advance may simply be called again.  A watch, if
    !> given, is asked every 16 steps (with the wall-clock limit): its error
-   !> ends the advance there.
-   subroutine advance(self, t, t1, y, error, watch)
+   !> ends the advance there.  `single`: return after one accepted step even
+   !> without events (a caller that carries something over each step).
+   subroutine advance(self, t, t1, y, error, watch, single)
       class(event_locator), intent(inout) :: self
       real(wp), intent(inout) :: t
       real(wp), intent(in) :: t1
       real(wp), intent(inout) :: y(:)
       type(error_type), allocatable, intent(out) :: error
       class(step_watch), intent(inout), optional :: watch
+      logical, intent(in), optional :: single
+      logical :: one
 
       self%n_hits = 0
       if (.not. self%ready) then
          call fatal_error(error, 'event locator: advance before restart', error_internal)
          return
       end if
+      one = .false.
+      if (present(single)) one = single
       call advance_steps(self, t, t1, y, error, watch, self%n, self%m, self%y0, self%f0, self%yc, self%f, &
-         & self%g0, self%gc, self%slope0, self%slope1)
+         & self%g0, self%gc, self%slope0, self%slope1, one)
    end subroutine advance
 
    !> advance's steps, with the locator's room (allocated by init: nothing
@@ -273,7 +278,7 @@ contains
    !> field f at the current point; g at the step's start g0 and at a trial
    !> gc, and its slopes at the step's ends.  (Explicit shapes: the hot loop
    !> indexes them without reloading the components' descriptors.)
-   subroutine advance_steps(self, t, t1, y, error, watch, n, m, y0, f0, yc, f, g0, gc, slope0, slope1)
+   subroutine advance_steps(self, t, t1, y, error, watch, n, m, y0, f0, yc, f, g0, gc, slope0, slope1, one)
       class(event_locator), intent(inout) :: self
       real(wp), intent(inout) :: t
       real(wp), intent(in) :: t1
@@ -281,6 +286,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       class(step_watch), intent(inout), optional :: watch
       integer, intent(in) :: n, m
+      logical, intent(in) :: one
       real(wp), intent(inout) :: y0(n), f0(n), yc(n), f(n), g0(m), gc(m), slope0(m), slope1(m)
       real(wp) :: t0, tc, theta, h
       integer :: k, nfound, i, j, first_terminal, near
@@ -379,7 +385,10 @@ contains
          do k = 1, self%m
             if (self%g(k) /= 0.0_wp) self%last_sign(k) = int(sign(1.0_wp, self%g(k)))
          end do
-         if (nfound == 0) cycle
+         if (nfound == 0) then
+            if (one) return
+            cycle
+         end if
          do i = 1, nfound
             self%hits(i)%terminal = self%terminal(self%hits(i)%which)
          end do
