@@ -11,11 +11,20 @@ Measures and prints (not a test; nothing fails):
 * inputs/brake_continuation.nml (59 points in mu): the whole run's
   `wall_time` and the time per point of the line.
 
+With --machine instead: the machine's orbits of laws with states, whose
+section map carries its tangent by exponentials (docs/chaos.md):
+inputs/machine_orbit.nml's first point (LuGre at Table I's stiffness) with
+the orbit and without (Newton's cost), the whole continuation, and the GMS
+stick-slip orbit of inputs/machine_gms.nml (stopped after --limit seconds);
+--before PATH runs the same with a second program (an earlier build) in the
+same session, for the ratio.
+
 Medians over --repeats runs of each.
 
 Usage (normally through scripts/benchmark_orbit, which builds first):
 
     python3 scripts/benchmark_orbit.py [--repeats N] [--binary PATH]
+    python3 scripts/benchmark_orbit.py --machine [--before PATH] [--limit S] [--repeats N]
 """
 import argparse
 import statistics
@@ -49,13 +58,72 @@ def run(args, workdir, name, texts):
         return float(f.attrs["wall_time"]), steps
 
 
+def machine_run(binary, workdir, name, sets, limit):
+    """A machine input with --set options: (its wall_time or None when stopped after `limit` s, the orbit's
+    attributes and its exponents)."""
+    out = workdir / f"{name}.h5"
+    command = [binary, "--quiet", "--force", "-o", str(out), str(ROOT / "inputs" / sets[0])]
+    for item in sets[1:]:
+        command += ["--set", item]
+    try:
+        subprocess.run(command, check=True, cwd=workdir, timeout=limit, capture_output=True)
+    except subprocess.TimeoutExpired:
+        return None, {}, []
+    with h5py.File(out, "r") as f:
+        orbit = f.get("machine/orbit")
+        attrs = dict(orbit.attrs) if orbit is not None else {}
+        exponents = orbit["floquet_exponents"][()].tolist() if orbit is not None and "floquet_exponents" in orbit \
+            else []
+        return float(f.attrs["wall_time"]), attrs, exponents
+
+
+def machine(args):
+    programs = {"this build": args.binary}
+    if args.before:
+        programs["before"] = args.before
+    one = ["machine_orbit.nml", "analysis.continuation=''"]
+    cases = [("LuGre Table I, one orbit (run + Newton)", one, args.repeats),
+             ("the same without the orbit (run only)", one + ["analysis.orbit=.false."], args.repeats),
+             ("LuGre Table I, continuation (9 points)", ["machine_orbit.nml"], args.repeats),
+             ("GMS (4 elements, Table I), one orbit", ["machine_gms.nml", "analysis.orbit=.true.",
+                                                      "analysis.orbit_transient=20"], 1)]
+    print(f"machine orbits of laws with states; median wall_time of {args.repeats} (GMS once, stopped after "
+          f"{args.limit:.0f} s)")
+    print("| case | program | wall | Newton steps | period (s) | exponents ln|mu|/T (1/s) |")
+    print("|---|---|---|---|---|---|")
+    with tempfile.TemporaryDirectory() as tmp:
+        workdir = Path(tmp)
+        for label, sets, repeats in cases:
+            for name, binary in programs.items():
+                walls, attrs, exponents = [], {}, []
+                for _ in range(repeats):
+                    wall, attrs, exponents = machine_run(binary, workdir, "m", sets, args.limit)
+                    if wall is None:
+                        walls = None
+                        break
+                    walls.append(wall)
+                if walls is None:
+                    print(f"| {label} | {name} | stopped after {args.limit:.0f} s | | | |")
+                    continue
+                found = attrs.get("found", 0) == 1
+                print(f"| {label} | {name} | {statistics.median(walls):.3f} s | {attrs.get('iterations', '')} | "
+                      f"{attrs['period'] if found else attrs.get('reason', b'').decode()} | "
+                      f"{', '.join(f'{e:.6g}' for e in exponents) if found else ''} |")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--binary", default=str(ROOT / "build" / "friction"))
+    parser.add_argument("--machine", action="store_true", help="the machine's orbits of laws with states")
+    parser.add_argument("--before", help="a second program to time the same machine cases with")
+    parser.add_argument("--limit", type=float, default=120.0, help="seconds after which a machine case stops")
     args = parser.parse_args()
     if args.repeats < 1:
         sys.exit("benchmark_orbit: --repeats >= 1")
+    if args.machine:
+        machine(args)
+        return
     print(f"switched model, rk8pd rtol 1e-10 (inputs/brake.nml), tau in [0, 3200], dt_out = 1; "
           f"median of {args.repeats}")
     print("| case | run: wall | with orbit: wall | Newton's cost | Newton steps |")
