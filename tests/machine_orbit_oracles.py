@@ -38,7 +38,8 @@ the program and its file, against oracles computed here:
                     oscillator, so the orbit is in closed form and the
                     section's 4 x 4 and 5 x 5 multipliers (LAPACK's) are
                     exp(λT), λ the linear system's eigenvalues, and ~0 for
-                    the elements' deflections; without the support, steady
+                    the elements' deflections, their exponents -k_i vb /
+                    (w_i fc eps) exactly (or lost); without the support, steady
                     sliding's 4 x 4 eigenvalues against their closed forms
   table-lugre       the LuGre paper's belt oscillator at Table I's stiffness
                     (sigma0 = 1e5 N/m): the stick-slip orbit closes under SciPy's
@@ -626,6 +627,15 @@ def forced_gms(args):
         # them is rounding of the Jacobian's entries (~1e-16 of |mu| ~ 0.5).
         assert np.all(np.abs(mu[2:]) < 1e-9), mu
         assert abs(got["period"] - 1 / freq) < 1e-12
+        # Their logs: -∫ k_i |w| / (w_i fc ε) dt over the period, |w| averaging vb (v averages 0), so each
+        # exponent is -k_i vb / (w_i fc ε) exactly; one shrunk beyond e^(-18 · 1024) within a step is lost
+        # (-inf). The Magnus steps' quadrature of a rate linear in v on a smooth orbit: 1e-6 relative is ample.
+        rates = sorted((-ki * vb / (wi * fc * 1e-5) for ki, wi in zip(stiffness, weights)), reverse=True)
+        exponents = got["floquet_exponents"][2:]
+        resolved = np.isfinite(exponents)
+        print(f"forced-gms ({n} elements): the elements' exponents {exponents}, -k_i vb/(w_i fc eps) = {rates}")
+        assert np.all(np.isneginf(exponents[~resolved])) and np.count_nonzero(resolved) >= 1, exponents
+        assert np.allclose(exponents[resolved], np.array(rates)[resolved], rtol=1e-6, atol=0), (exponents, rates)
     # Without the support, steady sliding's eigenvalues (the 4 x 4 Jacobian's, LAPACK's): the oscillator's
     # -(c + σ2)/2m ± i sqrt(k/m - ((c + σ2)/2m)²) and each element's -k_i |w| / (w_i g ε), ε = 1e-5 the law's
     # entry band (laws.md), which the Jacobian's z rows hold alone at the limit (∂ż_i/∂v ∝ 1 - u_i = 0).
