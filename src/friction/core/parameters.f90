@@ -30,6 +30,7 @@ module friction_parameters
       character :: kind = 'r'
       integer :: size = 1
       character(len=40) :: unit = ''
+      real(wp) :: value = 0.0_wp    !! a real scalar's value when listed (what get_parameter would read back)
    end type parameter_info
 
    !> A real value that looks like a number in another unit than its
@@ -255,6 +256,7 @@ contains
       select case (self%mode)
       case (mode_list)
          call self%add_info(name, 'r', size(value), unit)
+         if (size(value) == 1) self%list(self%listed)%value = value(1)
       case (mode_inspect)
          if (.not. present(fill)) call self%inspect_reals(name, value, unit)
       case (mode_write)

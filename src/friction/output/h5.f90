@@ -113,6 +113,11 @@ module friction_output_h5
       integer :: rank = 0         !! this process in the communicator
       type(MPI_Comm) :: comm      !! the file's communicator
       logical :: parallel = .true. !! written through MPI-IO (.false.: serial, MPI not started; sec2 driver)
+      !> The object the last attribute went on, kept open for the next: a
+      !> scene writes its attributes object by object, and opening the
+      !> object by its path for each one cost more than the attribute.
+      integer(hid_t) :: object = -1
+      character(len=:), allocatable :: object_path
    contains
       procedure :: create
       procedure :: create_group
@@ -132,6 +137,8 @@ module friction_output_h5
       procedure :: close
       procedure, private :: agree
       procedure, private :: create_dataset
+      procedure, private :: open_object
+      procedure, private :: close_object
    end type h5_file
 
 contains
@@ -489,14 +496,43 @@ contains
 
       if (self%status /= 0) return
       call printing%silence()
-      call h5oopen_f(self%id, object, obj, stat)
-      call self%check(stat, 'opening '//object)
-      if (stat == 0) then
-         call attribute_text(self, obj, name, text)
-         call h5oclose_f(obj, stat)
-      end if
+      call self%open_object(object, obj, stat)
+      if (stat == 0) call attribute_text(self, obj, name, text)
       call printing%restore()
    end subroutine write_attribute_text
+
+   !> The object at path object, opened or the one kept open (stat 0), the
+   !> failure kept in status; it stays open until another object's turn or
+   !> the file's close.  Every rank opens the same objects in the same order.
+   subroutine open_object(self, object, obj, stat)
+      class(h5_file), intent(inout) :: self
+      character(len=*), intent(in) :: object
+      integer(hid_t), intent(out) :: obj
+      integer, intent(out) :: stat
+
+      stat = 0
+      if (self%object >= 0) then
+         if (self%object_path == object) then
+            obj = self%object
+            return
+         end if
+         call self%close_object()
+      end if
+      call h5oopen_f(self%id, object, obj, stat)
+      call self%check(stat, 'opening '//object)
+      if (stat /= 0) return
+      self%object = obj
+      self%object_path = object
+   end subroutine open_object
+
+   subroutine close_object(self)
+      class(h5_file), intent(inout) :: self
+      integer :: stat
+
+      if (self%object < 0) return
+      call h5oclose_f(self%object, stat)
+      self%object = -1
+   end subroutine close_object
 
    !> A dataset's `units`, a UDUNITS string; a unit in τ also as given, in
    !> `units_tau`.
@@ -610,11 +646,18 @@ contains
       class(h5_file), intent(inout) :: self
       character(len=*), intent(in) :: object, name
       integer :: stat
+      integer(hid_t) :: obj
+      type(error_printing) :: printing
 
       has_attribute = .false.
       if (self%status /= 0) return
-      call h5aexists_by_name_f(self%id, object, name, has_attribute, stat)
-      call self%check(stat, 'looking for attribute '//name)
+      call printing%silence()
+      call self%open_object(object, obj, stat)
+      if (stat == 0) then
+         call h5aexists_f(obj, name, has_attribute, stat)
+         call self%check(stat, 'looking for attribute '//name)
+      end if
+      call printing%restore()
    end function has_attribute
 
    !> A scalar numeric attribute of HDF5 type `type` read from `value`.
@@ -630,12 +673,10 @@ contains
 
       if (self%status /= 0) return
       call printing%silence()
-      call h5oopen_f(self%id, object, obj, stat)
-      call self%check(stat, 'opening '//object)
+      call self%open_object(object, obj, stat)
       if (stat == 0) then
          call new_scalar_attribute(obj, name, type, value, stat, what)
          call self%check(stat, what)
-         call h5oclose_f(obj, stat)
       end if
       call printing%restore()
    end subroutine scalar_attribute
@@ -648,6 +689,7 @@ contains
       type(error_printing) :: printing
 
       call printing%silence()
+      call self%close_object()
       if (self%id >= 0) then
          call give_back_space(self)
          call h5fclose_f(self%id, stat)

@@ -4,8 +4,7 @@
 !> declares a unit (core/parameters.f90).  An attribute the scene's writer
 !> already wrote keeps its value and gets its unit beside it.
 module friction_output_parameters
-   use friction_kinds, only: wp
-   use friction_parameters, only: configurable, parameter_info, list_parameters, get_parameter
+   use friction_parameters, only: configurable, parameter_info, list_parameters
    use friction_output_h5, only: h5_file
    implicit none
    private
@@ -30,9 +29,8 @@ contains
       character(len=*), intent(in) :: groups(:)
       procedure(unit_map), optional :: unit_of   !! the declared units' counterparts (default: as declared)
       type(parameter_info), allocatable :: list(:)
-      character(len=:), allocatable :: text, problem, unit
-      real(wp) :: value
-      integer :: k, stat
+      character(len=:), allocatable :: unit
+      integer :: k
 
       list = list_parameters(config)
       do k = 1, size(list)
@@ -45,10 +43,7 @@ contains
                   & call file%write_attribute_units(object, trim(p%name), unit)
                cycle
             end if
-            call get_parameter(config, trim(p%group), trim(p%name), 0, text, problem)
-            if (len(problem) > 0) cycle
-            read (text, *, iostat=stat) value
-            if (stat == 0) call file%write_attribute_real(object, trim(p%name), value, unit)
+            call file%write_attribute_real(object, trim(p%name), p%value, unit)
          end associate
       end do
    end subroutine write_parameter_attributes
