@@ -53,6 +53,41 @@ else()
 endif()
 message(STATUS "friction: the program links the reference LAPACK's static archives: ${friction_static_lapack}")
 
+# The program links GSL's and FFTW's static archives where Debian ships them
+# (libgsl-dev, libfftw3-dev), as it does HDF5's: the shared libfftw3 is
+# bound at load (BIND_NOW) with some 950 symbol lookups for its codelet
+# tables, a quarter of the loader's work at every start (docs/speed.md, The
+# friction laws), for a spectrum most runs never take.  Without the
+# archives, or with -DFRICTION_STATIC_NUMERICS=OFF, the shared libraries;
+# the shared library always links those.
+option(FRICTION_STATIC_NUMERICS "Link the program with GSL's and FFTW's static archives" ON)
+find_library(FRICTION_GSL_ARCHIVE NAMES libgsl.a)
+find_library(FRICTION_GSLCBLAS_ARCHIVE NAMES libgslcblas.a)
+find_library(FRICTION_FFTW_ARCHIVE NAMES libfftw3.a)
+add_library(friction::numerics_program INTERFACE IMPORTED)
+set(FRICTION_PROGRAM_STATIC_NUMERICS OFF)
+if(FRICTION_STATIC_NUMERICS AND FRICTION_GSL_ARCHIVE AND FRICTION_GSLCBLAS_ARCHIVE AND FRICTION_FFTW_ARCHIVE)
+  # Archives without position-independent code cannot go into the program
+  # (position-independent): a small program linked the same way tells.
+  include(CheckCSourceCompiles)
+  set(CMAKE_REQUIRED_LIBRARIES ${FRICTION_GSL_ARCHIVE} ${FRICTION_GSLCBLAS_ARCHIVE} ${FRICTION_FFTW_ARCHIVE} m)
+  set(CMAKE_REQUIRED_QUIET ON)
+  check_c_source_compiles("#include <stddef.h>
+double gsl_sf_bessel_J0(double);
+void *fftw_malloc(size_t);
+void fftw_free(void *);
+int main(void) { void *p = fftw_malloc(8); fftw_free(p); return gsl_sf_bessel_J0(0.0) > 2.0; }"
+    FRICTION_NUMERICS_ARCHIVES_LINK)
+  unset(CMAKE_REQUIRED_LIBRARIES)
+  unset(CMAKE_REQUIRED_QUIET)
+  if(FRICTION_NUMERICS_ARCHIVES_LINK)
+    target_link_libraries(friction::numerics_program INTERFACE
+      ${FRICTION_GSL_ARCHIVE} ${FRICTION_GSLCBLAS_ARCHIVE} ${FRICTION_FFTW_ARCHIVE} m)
+    set(FRICTION_PROGRAM_STATIC_NUMERICS ON)
+  endif()
+endif()
+message(STATUS "friction: the program links GSL's and FFTW's static archives: ${FRICTION_PROGRAM_STATIC_NUMERICS}")
+
 # Parallel HDF5 with its Fortran interface, and its high-level library (the
 # dimension scales).  FindHDF5 asks the h5pfc wrapper.
 set(HDF5_PREFER_PARALLEL TRUE)
