@@ -106,6 +106,15 @@ module friction_output_h5
       procedure :: check
    end type h5_status
 
+   !> How many objects a file keeps open (h5_file%kept).
+   integer, parameter :: kept_objects = 8
+
+   !> An object kept open, by the path it was opened with.
+   type :: kept_object
+      integer(hid_t) :: id = -1
+      character(len=:), allocatable :: path
+   end type kept_object
+
    type, extends(h5_status) :: h5_file
       private
       integer(hid_t) :: id = -1
@@ -113,11 +122,12 @@ module friction_output_h5
       integer :: rank = 0         !! this process in the communicator
       type(MPI_Comm) :: comm      !! the file's communicator
       logical :: parallel = .true. !! written through MPI-IO (.false.: serial, MPI not started; sec2 driver)
-      !> The object the last attribute went on, kept open for the next: a
-      !> scene writes its attributes object by object, and opening the
-      !> object by its path for each one cost more than the attribute.
-      integer(hid_t) :: object = -1
-      character(len=:), allocatable :: object_path
+      !> The objects last written or opened, kept open for what comes next
+      !> (a group's attributes one after another, a dataset's coordinates
+      !> after its values): opening an object by its path cost more than
+      !> writing an attribute on it.  Closed with the file.
+      type(kept_object) :: kept(kept_objects)
+      integer :: next_kept = 1   !! the entry the next object takes
    contains
       procedure :: create
       procedure :: create_group
@@ -138,7 +148,8 @@ module friction_output_h5
       procedure, private :: agree
       procedure, private :: create_dataset
       procedure, private :: open_object
-      procedure, private :: close_object
+      procedure, private :: keep_object
+      procedure, private :: close_objects
    end type h5_file
 
 contains
@@ -350,7 +361,7 @@ contains
       call h5sclose_f(memspace, stat)
       call h5sclose_f(filespace, stat)
       if (len_trim(units) > 0) call dataset_units(self, dset, units)
-      call h5dclose_f(dset, stat)
+      call self%keep_object(name, dset)   ! its coordinates or attributes come next
    end subroutine write_block_silently
 
    !> The coordinates of a dataset's axes: scales(k) (a dataset's path, or
@@ -362,11 +373,36 @@ contains
       character(len=*), intent(in) :: name, scales(:)
       type(error_printing) :: printing
 
+      integer(hid_t) :: dset, scale
+      integer :: stat, k
+      character(len=:), allocatable :: path
+
       if (self%status /= 0) return
       call printing%silence()
-      call attach_dimension_scales(self, self%id, name, scales)
+      call self%open_object(name, dset, stat)
+      do k = 1, size(scales)
+         path = trim(scales(k))
+         if (self%status /= 0 .or. len(path) == 0) cycle
+         call self%open_object(path, scale, stat, spare=dset)
+         if (stat /= 0) cycle
+         call attach_one_scale(self, dset, scale, name, path, k)
+      end do
       call printing%restore()
    end subroutine attach_scales
+
+   !> Make the open dataset scale (at path) a dimension scale, unless it is
+   !> one, and attach it to axis k of the open dataset dset (at name).
+   subroutine attach_one_scale(status, dset, scale, name, path, k)
+      class(h5_status), intent(inout) :: status
+      integer(hid_t), intent(in) :: dset, scale
+      character(len=*), intent(in) :: name, path
+      integer, intent(in) :: k
+
+      if (h5ds_is_scale(scale) <= 0) call status%check(int(h5ds_set_scale(scale, &
+         & path(index(path, '/', back=.true.) + 1:)//c_null_char)), 'making '//path//' a dimension scale')
+      call status%check(int(h5ds_attach_scale(dset, scale, int(k - 1, c_int))), &
+         & 'attaching coordinate '//path//' to '//name)
+   end subroutine attach_one_scale
 
    !> attach_scales on the file `file` (an hid_t), the failure kept in status.
    subroutine attach_dimension_scales(status, file, name, scales)
@@ -386,10 +422,7 @@ contains
          call h5dopen_f(file, path, scale, stat)
          call status%check(stat, 'opening coordinate '//path)
          if (stat /= 0) cycle
-         if (h5ds_is_scale(scale) <= 0) call status%check(int(h5ds_set_scale(scale, &
-            & path(index(path, '/', back=.true.) + 1:)//c_null_char)), 'making '//path//' a dimension scale')
-         call status%check(int(h5ds_attach_scale(dset, scale, int(k - 1, c_int))), &
-            & 'attaching coordinate '//path//' to '//name)
+         call attach_one_scale(status, dset, scale, name, path, k)
          call h5dclose_f(scale, stat)
       end do
       call h5dclose_f(dset, stat)
@@ -441,7 +474,7 @@ contains
       call h5sclose_f(memspace, stat)
       call h5sclose_f(filespace, stat)
       call dataset_units(self, dset, units)
-      call h5dclose_f(dset, stat)
+      call self%keep_object(name, dset)
    end subroutine write_vector_integer_silently
 
    !> A 1-D dataset of fixed-length UTF-8 texts (rank 0's are written; the
@@ -501,38 +534,61 @@ contains
       call printing%restore()
    end subroutine write_attribute_text
 
-   !> The object at path object, opened or the one kept open (stat 0), the
-   !> failure kept in status; it stays open until another object's turn or
-   !> the file's close.  Every rank opens the same objects in the same order.
-   subroutine open_object(self, object, obj, stat)
+   !> The object at path object, kept open or opened and kept (stat 0), the
+   !> failure kept in status; `spare`, an object the caller still holds,
+   !> is not closed to make room.  Every rank opens the same objects in the
+   !> same order, so all keep the same.
+   subroutine open_object(self, object, obj, stat, spare)
       class(h5_file), intent(inout) :: self
       character(len=*), intent(in) :: object
       integer(hid_t), intent(out) :: obj
       integer, intent(out) :: stat
+      integer(hid_t), intent(in), optional :: spare
+      integer :: k
 
       stat = 0
-      if (self%object >= 0) then
-         if (self%object_path == object) then
-            obj = self%object
+      do k = 1, kept_objects
+         if (self%kept(k)%id < 0) cycle
+         if (self%kept(k)%path == object) then
+            obj = self%kept(k)%id
             return
          end if
-         call self%close_object()
-      end if
+      end do
       call h5oopen_f(self%id, object, obj, stat)
       call self%check(stat, 'opening '//object)
-      if (stat /= 0) return
-      self%object = obj
-      self%object_path = object
+      if (stat == 0) call self%keep_object(object, obj, spare)
    end subroutine open_object
 
-   subroutine close_object(self)
+   !> Keep the open object obj (at path object) until the file's close,
+   !> closing the oldest kept one (other than `spare`) when all are taken.
+   subroutine keep_object(self, object, obj, spare)
       class(h5_file), intent(inout) :: self
+      character(len=*), intent(in) :: object
+      integer(hid_t), intent(in) :: obj
+      integer(hid_t), intent(in), optional :: spare
       integer :: stat
 
-      if (self%object < 0) return
-      call h5oclose_f(self%object, stat)
-      self%object = -1
-   end subroutine close_object
+      if (present(spare)) then
+         if (self%kept(self%next_kept)%id == spare) self%next_kept = mod(self%next_kept, kept_objects) + 1
+      end if
+      associate (entry => self%kept(self%next_kept))
+         if (entry%id >= 0) call h5oclose_f(entry%id, stat)
+         entry%id = obj
+         entry%path = object
+      end associate
+      self%next_kept = mod(self%next_kept, kept_objects) + 1
+   end subroutine keep_object
+
+   subroutine close_objects(self)
+      class(h5_file), intent(inout) :: self
+      integer :: k, stat
+
+      do k = 1, kept_objects
+         if (self%kept(k)%id >= 0) call h5oclose_f(self%kept(k)%id, stat)
+         self%kept(k)%id = -1
+      end do
+      self%next_kept = 1
+   end subroutine close_objects
 
    !> A dataset's `units`, a UDUNITS string; a unit in τ also as given, in
    !> `units_tau`.
@@ -689,7 +745,7 @@ contains
       type(error_printing) :: printing
 
       call printing%silence()
-      call self%close_object()
+      call self%close_objects()
       if (self%id >= 0) then
          call give_back_space(self)
          call h5fclose_f(self%id, stat)
