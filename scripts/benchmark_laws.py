@@ -12,18 +12,28 @@ Not a test: the machine is shared and noisy, so each time is the median of
 
 Accuracy: the largest difference in x on the output grid from a reference,
 the program at rtol 1e-12 stepping onto every output time, relative to the
-range of x.  The program's time is its whole process (start, input,
-integration, HDF5 file): "friction" as it runs by default (free steps, the
-grid from rodas4's continuous extension), "stepped" with &machine
-dense_output = .false. (a step ends at every output time).  SciPy's is
-solve_ivp alone (the interpreter already running), with the Jacobian
-estimated by differences (its default).  CVODE's is its whole process too
-(scripts/cvode_laws.c, compiled here: BDF, dense solver, the analytic
-Jacobian; Debian: libsundials-dev, without which its rows are skipped).
+range of x.  Two times for each run:
+  whole    the whole process: for the program its start, input, integration
+           and HDF5 file, "friction" as it runs by default (free steps, the
+           grid from rodas4's continuous extension), "stepped" with &machine
+           dense_output = .false. (a step ends at every output time); for
+           CVODE its process (scripts/cvode_laws.c, compiled here: BDF, dense
+           solver, the analytic Jacobian; Debian: libsundials-dev, without
+           which its rows are skipped); for SciPy a python3 process that
+           imports SciPy, integrates with solve_ivp and writes its result
+           with h5py, as a user's script would (scripts/scipy_laws.py: the
+           Jacobian estimated by differences, its default)
+  compute  the integration alone: the program's compute_time (its file
+           records it: the run's integration and output grid), CVODE's from
+           its state vector's creation to the last output point (its
+           process times it), solve_ivp's call (the interpreter already
+           running)
 The program's and CVODE's processes run interleaved (friction, stepped,
 CVODE, friction, ...), so that a change of the machine's load falls on all
-three alike; the ratio column is CVODE's median over the program's at the
-same rtol.
+three alike; the ratio columns are CVODE's median over the program's at the
+same rtol.  At the end, each peer's every point against the program's
+fastest run (default settings) with an error at most the peer's: the ratio
+of the peer's median to the program's, whole processes and compute alone.
 
     scripts/benchmark_laws [--repeats N] [--quick] [--limit S] [--chart FILE.png]
 
@@ -32,7 +42,6 @@ one line per method) into FILE.png.
 """
 import argparse
 import json
-import multiprocessing
 import os
 import shutil
 import statistics
@@ -44,9 +53,10 @@ from pathlib import Path
 
 import h5py
 import numpy as np
-from scipy.integrate import solve_ivp
 
 ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "scripts"))
+from scipy_laws import RATE_STATE_STIFFNESS, lugre_field as scipy_lugre, rate_state_field as scipy_rate_state  # noqa: E402,E501
 # s of integration before a run of the program is given up (its slowest
 # successful run here takes 0.2 s; the free steps crawl on rate and state at
 # rtol 1e-5 with atol 1e-8, above the creeping slip rate: docs/speed.md).
@@ -54,8 +64,9 @@ PROGRAM_LIMIT = 10.0
 
 
 def program_run(binary, work, name, rtol, sets, limit=0.0):
-    """(seconds of the whole process, t, x, steps, Jacobians); x is the
-    program's message if it failed (or gave up after `limit` s)."""
+    """(seconds of the whole process, t, x, steps, Jacobians, seconds of
+    compute_time); x is the program's message if it failed (or gave up
+    after `limit` s)."""
     out = work / f"{name}.h5"
     command = [str(binary), "--quiet", "--force", "-o", str(out), str(ROOT / "inputs" / f"machine_{name}.nml"),
                "--set", f"integrator.rtol={rtol}", "--set", f"integrator.atol={rtol * 1e-3}",
@@ -66,65 +77,44 @@ def program_run(binary, work, name, rtol, sets, limit=0.0):
     result = subprocess.run(command, capture_output=True, text=True)
     elapsed = time.perf_counter() - start
     if result.returncode != 0:
-        return elapsed, None, result.stderr.strip().splitlines()[-1], -1, -1
+        return elapsed, None, result.stderr.strip().splitlines()[-1], -1, -1, float("nan")
     with h5py.File(out) as f:
         return (elapsed, f["machine/t"][:], f["machine/x"][:], int(f.attrs["integrator_steps"]),
-                int(f.attrs["jacobian_evaluations"]))
+                int(f.attrs["jacobian_evaluations"]), float(f["machine"].attrs["compute_time"]))
 
 
 def lugre_field():
-    m, k, vb, fc, fs, vs, s0, s1, s2 = 1.0, 2.0, 0.1, 1.0, 1.5, 1e-3, 1e5, np.sqrt(1e5), 0.4
-
-    def g(w):
-        return fc + (fs - fc) * np.exp(-(w / vs) ** 2)
-
-    def field(_, y):
-        x, v, z = y
-        w = v - vb
-        zdot = w - s0 * abs(w) * z / g(w)
-        return [v, (-k * x - (s0 * z + s1 * zdot + s2 * w)) / m, zdot]
-
-    return field, [0.0, 0.0, -g(-vb) / s0], 30.0, {}
+    """(t_end, the program's --set settings) of the LuGre case."""
+    return scipy_lugre()[2], {}
 
 
 def rate_state_field():
-    mass, normal, a, b, dc, v0, mu0, velocity = 1.0, 1.0, 0.010, 0.015, 1e-5, 1e-6, 0.6, 1e-6
-    k = 0.2 * normal * (b - a) / dc
-
-    def field(t, y):
-        x, v, theta = y
-        psi = mu0 + b * np.log(v0 * max(theta, 1e-300) / dc)
-        big = np.log(max(abs(v), 1e-300) / (2.0 * v0)) + psi / a
-        mu = np.sign(v) * a * (big + np.log(2.0)) if big > 18.0 else a * np.arcsinh(np.sign(v) * np.exp(big))
-        return [v, (-k * (x - velocity * t) - normal * mu) / mass, 1.0 - abs(v) * theta / dc]
-
-    x0 = -mu0 * normal / k
-    sets = {"machine.stiffness": k, "machine.x0": x0, "machine.t_end": 3000.0, "machine.dt_out": 0.1}
-    return field, [x0, 1.01 * velocity, dc / (1.01 * velocity)], 3000.0, sets
+    """(t_end, the program's --set settings) of the rate-and-state case:
+    the stiffness and start of scripts/scipy_laws.py's."""
+    _, y0, t_end = scipy_rate_state()
+    sets = {"machine.stiffness": RATE_STATE_STIFFNESS, "machine.x0": y0[0], "machine.t_end": t_end,
+            "machine.dt_out": 0.1}
+    return t_end, sets
 
 
-def _solve(queue, name, method, t, rtol):
-    field, y0, t_end, _ = {"lugre": lugre_field, "rate_state": rate_state_field}[name]()
+def scipy_run(work, name, method, rtol, dt_out, limit):
+    """scripts/scipy_laws.py as a whole python3 process, given up after
+    `limit` s (Radau took 310 s to fail on the rate-and-state case at rtol
+    1e-5): (seconds of the process, seconds of solve_ivp alone, x or why it
+    failed)."""
+    out = work / f"scipy_{name}.h5"
+    command = [sys.executable, str(ROOT / "scripts" / "scipy_laws.py"), name, method, f"{rtol:.17g}",
+               f"{dt_out:.17g}", str(out)]
     start = time.perf_counter()
-    solution = solve_ivp(field, (0.0, t_end), y0, method=method, t_eval=t, rtol=rtol, atol=rtol * 1e-3)
-    queue.put((time.perf_counter() - start, solution.status, solution.message, solution.y[0]))
-
-
-def scipy_run(name, method, t, rtol, limit):
-    """solve_ivp in a child process, given up after `limit` s (Radau took
-    310 s to fail on the rate-and-state case at rtol 1e-5)."""
-    queue = multiprocessing.Queue()
-    child = multiprocessing.Process(target=_solve, args=(queue, name, method, t, rtol))
-    child.start()
     try:
-        return queue.get(timeout=limit)
-    except Exception:
-        return limit, -2, f"gave up after {limit:g} s", None
-    finally:
-        child.join(timeout=1)
-        if child.is_alive():
-            child.kill()
-            child.join()
+        result = subprocess.run(command, capture_output=True, text=True, timeout=limit)
+    except subprocess.TimeoutExpired:
+        return limit, limit, f"gave up after {limit:g} s"
+    elapsed = time.perf_counter() - start
+    if result.returncode != 0:
+        return elapsed, float("nan"), (result.stderr.strip().splitlines() or ["failed"])[-1]
+    with h5py.File(out) as f:
+        return elapsed, json.loads(result.stdout)["seconds"], f[f"{name}/x"][:]
 
 
 SUNDIALS_LIBS = ["-lsundials_cvode", "-lsundials_nvecserial", "-lsundials_sunmatrixdense",
@@ -145,7 +135,8 @@ def build_cvode(work):
 
 
 def cvode_run(exe, work, name, rtol, dt_out):
-    """(seconds of the whole process, x on the grid, counts) or (seconds, why it failed, None)."""
+    """(seconds of the whole process, x on the grid, counts with the
+    integration's "seconds") or (seconds, why it failed, None)."""
     out = work / f"cvode_{name}.bin"
     start = time.perf_counter()
     result = subprocess.run([str(exe), name, f"{rtol:.17g}", f"{rtol * 1e-3:.17g}", f"{dt_out:.17g}", str(out)],
@@ -154,6 +145,25 @@ def cvode_run(exe, work, name, rtol, dt_out):
     if result.returncode != 0:
         return elapsed, result.stderr.strip().splitlines()[-1], None
     return elapsed, np.fromfile(out), json.loads(result.stdout)
+
+
+def equal_error(points, name):
+    """Each peer's point against the program's fastest run (default
+    settings) with an error at most the peer's: rows of text."""
+    ours = points.get((name, "friction"), [])
+    rows = []
+    for method in ("CVODE", "LSODA", "Radau"):
+        for error, whole, compute, rtol in sorted(points.get((name, method), []), key=lambda p: p[3]):
+            good = [p for p in ours if p[0] <= error]
+            if not good:
+                rows.append(f"{method:8s} {rtol:8.0e} {error:10.2e}  the program reaches no error this small")
+                continue
+            fast = min(good, key=lambda p: p[1])
+            fast_compute = min(good, key=lambda p: p[2])
+            rows.append(f"{method:8s} {rtol:8.0e} {error:10.2e} {whole:10.4f} {compute:10.4f}   "
+                        f"{fast[3]:8.0e} {fast[0]:10.2e} {fast[1]:10.4f} {whole / fast[1]:8.2f}   "
+                        f"{fast_compute[3]:8.0e} {fast_compute[2]:10.4f} {compute / fast_compute[2]:8.2f}")
+    return rows
 
 
 def main():
@@ -167,45 +177,52 @@ def main():
     parser.add_argument("--chart", help="draw the work-precision charts into this PNG")
     args = parser.parse_args()
     tolerances = [1e-5, 1e-7] if args.quick else [1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9]
-    points = {}   # (case, method) -> [(error, seconds)]
+    points = {}   # (case, method) -> [(error, seconds of the process, seconds computing, rtol)]
     with tempfile.TemporaryDirectory() as scratch:
         work = Path(scratch)
         cvode, why_not = build_cvode(work)
         if why_not:
             print(f"CVODE rows skipped: {why_not}")
         for name, make in (("lugre", lugre_field), ("rate_state", rate_state_field)):
-            _, _, t_end, sets = make()
+            t_end, sets = make()
             stepped = dict(sets, **{"machine.dense_output": ".false."})
-            _, t, reference, _, _ = program_run(args.binary, work, name, 1e-12, stepped)
+            _, t, reference, _, _, _ = program_run(args.binary, work, name, 1e-12, stepped)
             scale = np.ptp(reference)
-            print(f"\n{name}: {t.size} grid points to t = {t_end:g} s; error = max |x - x_ref| / range of x")
-            print(f"{'method':10s} {'rtol':>8s} {'error':>10s} {'time (s)':>10s} {'steps':>8s} {'Jacobians':>9s}"
-                  f" {'CVODE/this':>10s}")
+            dt_out = float(t[1] - t[0])
+            print(f"\n{name}: {t.size} grid points to t = {t_end:g} s; error = max |x - x_ref| / range of x;"
+                  f" times in s, medians (whole: the process; compute: the integration alone)")
+            print(f"{'method':10s} {'rtol':>8s} {'error':>10s} {'whole':>10s} {'compute':>10s} {'steps':>8s}"
+                  f" {'Jacobians':>9s} {'CVODE/this':>10s} {'(compute)':>10s}")
             rows = []
             for rtol in tolerances:
                 times = {"friction": [], "stepped": [], "CVODE": []}
+                computes = {"friction": [], "stepped": [], "CVODE": []}
                 last = {}
                 for _ in range(args.repeats):
                     for method, settings in (("friction", sets), ("stepped", stepped)):
-                        seconds, _, x, steps, jacobians = program_run(args.binary, work, name, rtol, settings,
-                                                                      min(args.limit, PROGRAM_LIMIT))
+                        seconds, _, x, steps, jacobians, compute = program_run(
+                            args.binary, work, name, rtol, settings, min(args.limit, PROGRAM_LIMIT))
                         times[method].append(seconds)
+                        computes[method].append(compute)
                         last[method] = (x, steps, jacobians)
                     if cvode:
-                        seconds, x, counts = cvode_run(cvode, work, name, rtol, float(t[1] - t[0]))
+                        seconds, x, counts = cvode_run(cvode, work, name, rtol, dt_out)
                         times["CVODE"].append(seconds)
+                        computes["CVODE"].append(counts["seconds"] if counts else float("nan"))
                         last["CVODE"] = (x, counts)
                 median = {method: statistics.median(v) for method, v in times.items() if v}
+                busy = {method: statistics.median(v) for method, v in computes.items() if v}
                 for method in ("friction", "stepped"):
                     x, steps, jacobians = last[method]
                     if isinstance(x, str):
                         rows.append(f"{method:10s} {rtol:8.0e} {'failed':>10s} {median[method]:10.4f}  {x}")
                         continue
                     error = np.max(np.abs(x - reference)) / scale
-                    points.setdefault((name, method), []).append((error, median[method]))
-                    ratio = f"{median['CVODE'] / median[method]:10.2f}" if "CVODE" in median else ""
-                    rows.append(f"{method:10s} {rtol:8.0e} {error:10.2e} {median[method]:10.4f} {steps:8d}"
-                                f" {jacobians:9d} {ratio}")
+                    points.setdefault((name, method), []).append((error, median[method], busy[method], rtol))
+                    ratio = (f"{median['CVODE'] / median[method]:10.2f} {busy['CVODE'] / busy[method]:10.2f}"
+                             if "CVODE" in median else "")
+                    rows.append(f"{method:10s} {rtol:8.0e} {error:10.2e} {median[method]:10.4f}"
+                                f" {busy[method]:10.4f} {steps:8d} {jacobians:9d} {ratio}")
                 if cvode:
                     x, counts = last["CVODE"]
                     if isinstance(x, str) or x.size != t.size:
@@ -213,24 +230,32 @@ def main():
                                     f"{x if isinstance(x, str) else ''}")
                     else:
                         error = np.max(np.abs(x - reference)) / scale
-                        points.setdefault((name, "CVODE"), []).append((error, median["CVODE"]))
+                        points.setdefault((name, "CVODE"), []).append((error, median["CVODE"], busy["CVODE"], rtol))
                         rows.append(f"{'CVODE':10s} {rtol:8.0e} {error:10.2e} {median['CVODE']:10.4f}"
-                                    f" {counts['steps']:8d} {counts['jacobian_evaluations']:9d}")
+                                    f" {busy['CVODE']:10.4f} {counts['steps']:8d} {counts['jacobian_evaluations']:9d}")
             for key in ("friction", "stepped", "CVODE"):
                 for row in rows:
                     if row.startswith(key):
                         print(row)
             for method in ("Radau", "LSODA"):
                 for rtol in tolerances:
-                    runs = [scipy_run(name, method, t, rtol, args.limit) for _ in range(args.scipy_repeats)]
+                    runs = [scipy_run(work, name, method, rtol, dt_out, args.limit) for _ in range(args.scipy_repeats)]
                     seconds = statistics.median(run[0] for run in runs)
-                    _, status, message, x = runs[-1]
-                    if status != 0 or x is None or x.size != t.size:
-                        print(f"{method:10s} {rtol:8.0e} {'failed':>10s} {seconds:10.4f}  {message}")
+                    alone = statistics.median(run[1] for run in runs)
+                    x = runs[-1][2]
+                    if isinstance(x, str) or x.size != t.size:
+                        print(f"{method:10s} {rtol:8.0e} {'failed':>10s} {seconds:10.4f} {alone:10.4f}  "
+                              f"{x if isinstance(x, str) else ''}")
                         continue
                     error = np.max(np.abs(x - reference)) / scale
-                    points.setdefault((name, method), []).append((error, seconds))
-                    print(f"{method:10s} {rtol:8.0e} {error:10.2e} {seconds:10.4f}")
+                    points.setdefault((name, method), []).append((error, seconds, alone, rtol))
+                    print(f"{method:10s} {rtol:8.0e} {error:10.2e} {seconds:10.4f} {alone:10.4f}")
+            print(f"\n{name} at equal or smaller error: each peer's point against the program's fastest run"
+                  f" (default settings) with an error at most the peer's; ratio = the peer's time / the program's")
+            print(f"{'peer':8s} {'rtol':>8s} {'error':>10s} {'whole':>10s} {'compute':>10s}   {'rtol':>8s} {'error':>10s}"
+                  f" {'whole':>10s} {'ratio':>8s}   {'rtol':>8s} {'compute':>10s} {'ratio':>8s}")
+            for row in equal_error(points, name):
+                print(row)
             sys.stdout.flush()
     if args.chart:
         chart(points, args.chart)
@@ -249,9 +274,9 @@ def chart(points, path):
                               ("CVODE", "D-.")):
             data = sorted(points.get((name, method), []))
             if data:
-                ax.loglog([e for e, _ in data], [s for _, s in data], style, label=method)
+                ax.loglog([p[0] for p in data], [p[1] for p in data], style, label=method)
         ax.set_xlabel("error in x / range of x")
-        ax.set_ylabel("time (s)")
+        ax.set_ylabel("time of the whole process (s)")
         ax.set_title(title)
         ax.legend(fontsize=8)
     fig.tight_layout()
