@@ -3,6 +3,7 @@
 !> double, and the checks of a value's kind, range and encoding.  The
 !> parameter visitor (parameters.f90) sets and writes variables through it.
 module friction_value_text
+   use, intrinsic :: iso_c_binding, only: c_double, c_char, c_int
    use friction_kinds, only: wp, i8
    use friction_strings, only: lower, itoa
    implicit none
@@ -15,6 +16,16 @@ module friction_value_text
    !> takes, repeat counts included: a bound on the memory a value text can
    !> ask for.
    integer, parameter :: max_list_values = 10000000
+
+   interface
+      !> x's shortest text into text (no NUL), its length into n.
+      pure subroutine c_shortest(x, text, n) bind(c, name='friction_shortest')
+         import :: c_double, c_char, c_int
+         real(c_double), value :: x
+         character(kind=c_char), intent(out) :: text(32)
+         integer(c_int), intent(out) :: n
+      end subroutine c_shortest
+   end interface
 
 contains
 
@@ -42,68 +53,23 @@ contains
       end do
    end function real_words
 
+   !> The fewest significant digits that read back, from the C library's
+   !> correctly rounded printf and strtod (core/shortest.c): the text that
+   !> Fortran's es and f0.d edit descriptors gave, which cost most of a
+   !> short run's echo of its input.  1.5e-3 is written 0.0015; plain
+   !> decimals for decimal exponents -3 to 14, else 1.5e-20.
    pure function shortest(x) result(word)
       real(wp), intent(in) :: x
       character(len=26) :: word
-      character(len=32) :: buffer
-      character(len=16) :: form
-      real(wp) :: back
-      integer :: digits, stat, e, cut
+      character(kind=c_char) :: buffer(32)
+      integer(c_int) :: n
+      integer :: k
 
-      if (x == 0.0_wp) then
-         word = '0.0'
-         if (sign(1.0_wp, x) < 0.0_wp) word = '-0.0'   ! the same bits back
-         return
-      end if
-      if (abs(x) >= 1.0e-3_wp .and. abs(x) < 1.0e15_wp .and. x == anint(x)) then
-         write (word, '(f0.1)') x
-         return
-      end if
-      ! The fewest digits that read back: when 15 do, the 15-digit rounding
-      ! is that shortest decimal padded with zeros (it lies within half an
-      ! ulp of x, closer than any other 15-digit decimal can), so its
-      ! significant digits are counted; else 16 or 17.  (Trying 1, 2, ...
-      ! digits in turn cost two formatted writes and a read each, most of a
-      ! short run's time spent echoing its input.)  A subnormal's ulp is
-      ! wider than that spacing, so its digits are tried from 1.
-      write (buffer, '(es32.14e3)') x
-      read (buffer, *, iostat=stat) back
-      if (stat == 0 .and. back == x .and. abs(x) >= tiny(x)) then
-         buffer = adjustl(buffer)
-         cut = index(buffer, 'E') - 1
-         do while (buffer(cut:cut) == '0')
-            cut = cut - 1
-         end do
-         digits = count([(verify(buffer(e:e), '0123456789') == 0, e = 1, cut)])
-         write (form, '(a, i0, a)') '(es32.', digits - 1, 'e3)'
-         write (buffer, form) x
-      else
-         do digits = merge(16, 1, abs(x) >= tiny(x)), 17
-            write (form, '(a, i0, a)') '(es32.', digits - 1, 'e3)'
-            write (buffer, form) x
-            read (buffer, *, iostat=stat) back
-            if (stat == 0 .and. back == x) exit
-         end do
-      end if
-      buffer = adjustl(buffer)
-      ! 1.50000e-003 -> 1.5e-3; plain decimals for moderate exponents.
-      e = index(buffer, 'E')
-      read (buffer(e + 1:), *) stat
-      if (stat >= -3 .and. stat < 15) then
-         write (form, '(a, i0, a)') '(f0.', max(1, digits - 1 - stat), ')'
-         write (buffer, form) x
-         buffer = adjustl(buffer)
-         if (buffer(1:1) == '.') buffer = '0'//buffer
-         if (buffer(1:2) == '-.') buffer = '-0'//buffer(2:)
-         word = buffer
-         return
-      end if
-      cut = e - 1
-      do while (buffer(cut:cut) == '0')
-         cut = cut - 1
+      call c_shortest(real(x, c_double), buffer, n)
+      word = ''
+      do k = 1, min(n, len(word))
+         word(k:k) = buffer(k)
       end do
-      if (buffer(cut:cut) == '.') cut = cut - 1
-      write (word, '(a, a, i0)') buffer(1:cut), 'e', stat
    end function shortest
 
    !> Values joined by ', ', repeats as n*value (in two passes, the length
