@@ -107,7 +107,7 @@ module friction_output_h5
    end type h5_status
 
    !> How many objects a file keeps open (h5_file%kept).
-   integer, parameter :: kept_objects = 8
+   integer, parameter :: kept_objects = 16
 
    !> An object kept open, by the path it was opened with.
    type :: kept_object
