@@ -338,7 +338,7 @@ contains
       if (.not. self%create_dataset(name, type, filespace, dset)) return
       if (n_total == 0) then   ! an empty dataset: nothing to write (and no buffer to point at)
          if (len_trim(units) > 0) call dataset_units(self, dset, units)
-         call h5dclose_f(dset, stat)
+         call self%keep_object(name, dset)
          call h5sclose_f(filespace, stat)
          return
       end if
@@ -455,7 +455,7 @@ contains
       if (.not. self%create_dataset(name, H5T_NATIVE_INTEGER, filespace, dset)) return
       if (size(values) == 0) then   ! an empty dataset: nothing to write
          call dataset_units(self, dset, units)
-         call h5dclose_f(dset, stat)
+         call self%keep_object(name, dset)
          call h5sclose_f(filespace, stat)
          return
       end if
