@@ -338,7 +338,7 @@ contains
       if (.not. self%create_dataset(name, type, filespace, dset)) return
       if (n_total == 0) then   ! an empty dataset: nothing to write (and no buffer to point at)
          if (len_trim(units) > 0) call dataset_units(self, dset, units)
-         call self%keep_object(name, dset)
+         call keep_or_close(self, name, dset)
          call h5sclose_f(filespace, stat)
          return
       end if
@@ -361,8 +361,25 @@ contains
       call h5sclose_f(memspace, stat)
       call h5sclose_f(filespace, stat)
       if (len_trim(units) > 0) call dataset_units(self, dset, units)
-      call self%keep_object(name, dset)   ! its coordinates or attributes come next
+      call keep_or_close(self, name, dset)
    end subroutine write_block_silently
+
+   !> A dataset just written kept open (its coordinates or attributes come
+   !> next), or closed at once after a failure: an object left open on a
+   !> full disk could not be closed later, and HDF5's clean-up at exit
+   !> would crash on it.
+   subroutine keep_or_close(self, name, dset)
+      class(h5_file), intent(inout) :: self
+      character(len=*), intent(in) :: name
+      integer(hid_t), intent(in) :: dset
+      integer :: stat
+
+      if (self%status == 0) then
+         call self%keep_object(name, dset)
+      else
+         call h5dclose_f(dset, stat)
+      end if
+   end subroutine keep_or_close
 
    !> The coordinates of a dataset's axes: scales(k) (a dataset's path, or
    !> blank for none) becomes a dimension scale named by its last path
@@ -455,7 +472,7 @@ contains
       if (.not. self%create_dataset(name, H5T_NATIVE_INTEGER, filespace, dset)) return
       if (size(values) == 0) then   ! an empty dataset: nothing to write
          call dataset_units(self, dset, units)
-         call self%keep_object(name, dset)
+         call keep_or_close(self, name, dset)
          call h5sclose_f(filespace, stat)
          return
       end if
@@ -474,7 +491,7 @@ contains
       call h5sclose_f(memspace, stat)
       call h5sclose_f(filespace, stat)
       call dataset_units(self, dset, units)
-      call self%keep_object(name, dset)
+      call keep_or_close(self, name, dset)
    end subroutine write_vector_integer_silently
 
    !> A 1-D dataset of fixed-length UTF-8 texts (rank 0's are written; the
@@ -745,9 +762,11 @@ contains
       type(error_printing) :: printing
 
       call printing%silence()
-      call self%close_objects()
       if (self%id >= 0) then
+         ! (The kept objects after the file is cut, if it is: with a failed
+         ! write behind them they could not be flushed to a full disk.)
          call give_back_space(self)
+         call self%close_objects()
          call h5fclose_f(self%id, stat)
          call self%check(stat, 'closing the file')
          self%id = -1
