@@ -12,8 +12,8 @@ Not a test: the machine is shared and noisy, so each time is the median of
 
 Accuracy: the largest difference in x on the output grid from a reference,
 the program at rtol 1e-12 stepping onto every output time, relative to the
-range of x.  Two times for each run:
-  whole    the whole process: for the program its start, input, integration
+range of x.  Three times for each run:
+  wall     the whole process: for the program its start, input, integration
            and HDF5 file, "friction" as it runs by default (free steps, the
            grid from rodas4's continuous extension), "stepped" with &machine
            dense_output = .false. (a step ends at every output time); for
@@ -23,26 +23,29 @@ range of x.  Two times for each run:
            imports SciPy, integrates with solve_ivp and writes its result
            with h5py, as a user's script would (scripts/scipy_laws.py: the
            Jacobian estimated by differences, its default)
-  compute  the integration alone: the program's compute_time (its file
+  cpu      the same process's CPU time (user and system), which the load of
+           a shared machine changes far less than its wall time
+  compute  the integration alone (wall time inside the process): the program's compute_time (its file
            records it: the run's integration and output grid), CVODE's from
            its state vector's creation to the last output point (its
            process times it), solve_ivp's call (the interpreter already
            running)
 The program's and CVODE's processes run interleaved (friction, stepped,
 CVODE, friction, ...), so that a change of the machine's load falls on all
-three alike; the ratio columns are CVODE's median over the program's at the
-same rtol.  At the end, each peer's every point against the program's
+three alike; the ratio columns are CVODE's medians over the program's at
+the same rtol.  At the end, each peer's every point against the program's
 fastest run (default settings) with an error at most the peer's: the ratio
-of the peer's median to the program's, whole processes and compute alone.
+of the peer's median to the program's, by wall, CPU and compute time.
 
     scripts/benchmark_laws [--repeats N] [--quick] [--limit S] [--chart FILE.png]
 
---chart draws the work-precision chart of each case (time against error,
+--chart draws the work-precision chart of each case (CPU time against error,
 one line per method) into FILE.png.
 """
 import argparse
 import json
 import os
+import resource
 import shutil
 import statistics
 import subprocess
@@ -63,19 +66,29 @@ from scipy_laws import RATE_STATE_STIFFNESS, lugre_field as scipy_lugre, rate_st
 PROGRAM_LIMIT = 10.0
 
 
+def timed(command, timeout=None):
+    """subprocess.run(command): (its result, (wall seconds, CPU seconds:
+    user and system of the process)); TimeoutExpired passes through.  The
+    CPU time is what a shared machine's load changes least."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    start = time.perf_counter()
+    result = subprocess.run(command, capture_output=True, text=True, timeout=timeout)
+    wall = time.perf_counter() - start
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return result, (wall, after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime)
+
+
 def program_run(binary, work, name, rtol, sets, limit=0.0):
-    """(seconds of the whole process, t, x, steps, Jacobians, seconds of
-    compute_time); x is the program's message if it failed (or gave up
-    after `limit` s)."""
+    """((wall, CPU) seconds of the whole process, t, x, steps, Jacobians,
+    seconds of compute_time); x is the program's message if it failed (or
+    gave up after `limit` s)."""
     out = work / f"{name}.h5"
     command = [str(binary), "--quiet", "--force", "-o", str(out), str(ROOT / "inputs" / f"machine_{name}.nml"),
                "--set", f"integrator.rtol={rtol}", "--set", f"integrator.atol={rtol * 1e-3}",
                "--set", f"integrator.max_wall_time={limit}"]
     for key, value in sets.items():
         command += ["--set", f"{key}={value}"]
-    start = time.perf_counter()
-    result = subprocess.run(command, capture_output=True, text=True)
-    elapsed = time.perf_counter() - start
+    result, elapsed = timed(command)
     if result.returncode != 0:
         return elapsed, None, result.stderr.strip().splitlines()[-1], -1, -1, float("nan")
     with h5py.File(out) as f:
@@ -100,17 +113,15 @@ def rate_state_field():
 def scipy_run(work, name, method, rtol, dt_out, limit):
     """scripts/scipy_laws.py as a whole python3 process, given up after
     `limit` s (Radau took 310 s to fail on the rate-and-state case at rtol
-    1e-5): (seconds of the process, seconds of solve_ivp alone, x or why it
-    failed)."""
+    1e-5): ((wall, CPU) seconds of the process, seconds of solve_ivp alone,
+    x or why it failed)."""
     out = work / f"scipy_{name}.h5"
     command = [sys.executable, str(ROOT / "scripts" / "scipy_laws.py"), name, method, f"{rtol:.17g}",
                f"{dt_out:.17g}", str(out)]
-    start = time.perf_counter()
     try:
-        result = subprocess.run(command, capture_output=True, text=True, timeout=limit)
+        result, elapsed = timed(command, limit)
     except subprocess.TimeoutExpired:
-        return limit, limit, f"gave up after {limit:g} s"
-    elapsed = time.perf_counter() - start
+        return (limit, limit), limit, f"gave up after {limit:g} s"
     if result.returncode != 0:
         return elapsed, float("nan"), (result.stderr.strip().splitlines() or ["failed"])[-1]
     with h5py.File(out) as f:
@@ -135,13 +146,10 @@ def build_cvode(work):
 
 
 def cvode_run(exe, work, name, rtol, dt_out):
-    """(seconds of the whole process, x on the grid, counts with the
-    integration's "seconds") or (seconds, why it failed, None)."""
+    """((wall, CPU) seconds of the whole process, x on the grid, counts with
+    the integration's "seconds") or (seconds, why it failed, None)."""
     out = work / f"cvode_{name}.bin"
-    start = time.perf_counter()
-    result = subprocess.run([str(exe), name, f"{rtol:.17g}", f"{rtol * 1e-3:.17g}", f"{dt_out:.17g}", str(out)],
-                            capture_output=True, text=True)
-    elapsed = time.perf_counter() - start
+    result, elapsed = timed([str(exe), name, f"{rtol:.17g}", f"{rtol * 1e-3:.17g}", f"{dt_out:.17g}", str(out)])
     if result.returncode != 0:
         return elapsed, result.stderr.strip().splitlines()[-1], None
     return elapsed, np.fromfile(out), json.loads(result.stdout)
@@ -149,20 +157,21 @@ def cvode_run(exe, work, name, rtol, dt_out):
 
 def equal_error(points, name):
     """Each peer's point against the program's fastest run (default
-    settings) with an error at most the peer's: rows of text."""
+    settings) with an error at most the peer's, by wall time, CPU time and
+    compute time each: rows of text."""
     ours = points.get((name, "friction"), [])
     rows = []
     for method in ("CVODE", "LSODA", "Radau"):
-        for error, whole, compute, rtol in sorted(points.get((name, method), []), key=lambda p: p[3]):
+        for error, wall, cpu, compute, rtol in sorted(points.get((name, method), []), key=lambda p: p[4]):
             good = [p for p in ours if p[0] <= error]
             if not good:
                 rows.append(f"{method:8s} {rtol:8.0e} {error:10.2e}  the program reaches no error this small")
                 continue
-            fast = min(good, key=lambda p: p[1])
-            fast_compute = min(good, key=lambda p: p[2])
-            rows.append(f"{method:8s} {rtol:8.0e} {error:10.2e} {whole:10.4f} {compute:10.4f}   "
-                        f"{fast[3]:8.0e} {fast[0]:10.2e} {fast[1]:10.4f} {whole / fast[1]:8.2f}   "
-                        f"{fast_compute[3]:8.0e} {fast_compute[2]:10.4f} {compute / fast_compute[2]:8.2f}")
+            text = f"{method:8s} {rtol:8.0e} {error:10.2e}"
+            for k, value in ((1, wall), (2, cpu), (3, compute)):
+                fast = min(good, key=lambda p: p[k])
+                text += f"   {value:8.4f} {fast[k]:8.4f} ({fast[4]:5.0e}) {value / fast[k]:7.2f}"
+            rows.append(text)
     return rows
 
 
@@ -177,7 +186,7 @@ def main():
     parser.add_argument("--chart", help="draw the work-precision charts into this PNG")
     args = parser.parse_args()
     tolerances = [1e-5, 1e-7] if args.quick else [1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9]
-    points = {}   # (case, method) -> [(error, seconds of the process, seconds computing, rtol)]
+    points = {}   # (case, method) -> [(error, wall and CPU seconds of the process, seconds computing, rtol)]
     with tempfile.TemporaryDirectory() as scratch:
         work = Path(scratch)
         cvode, why_not = build_cvode(work)
@@ -190,9 +199,10 @@ def main():
             scale = np.ptp(reference)
             dt_out = float(t[1] - t[0])
             print(f"\n{name}: {t.size} grid points to t = {t_end:g} s; error = max |x - x_ref| / range of x;"
-                  f" times in s, medians (whole: the process; compute: the integration alone)")
-            print(f"{'method':10s} {'rtol':>8s} {'error':>10s} {'whole':>10s} {'compute':>10s} {'steps':>8s}"
-                  f" {'Jacobians':>9s} {'CVODE/this':>10s} {'(compute)':>10s}")
+                  f" times in s, medians (wall and cpu: the whole process; compute: the integration alone);"
+                  f" CVODE/this: of wall, cpu, compute")
+            print(f"{'method':10s} {'rtol':>8s} {'error':>10s} {'wall':>8s} {'cpu':>8s} {'compute':>8s} {'steps':>8s}"
+                  f" {'Jacobians':>9s} {'CVODE/this':>22s}")
             rows = []
             for rtol in tolerances:
                 times = {"friction": [], "stepped": [], "CVODE": []}
@@ -210,29 +220,33 @@ def main():
                         times["CVODE"].append(seconds)
                         computes["CVODE"].append(counts["seconds"] if counts else float("nan"))
                         last["CVODE"] = (x, counts)
-                median = {method: statistics.median(v) for method, v in times.items() if v}
+                median = {method: statistics.median(w for w, _ in v) for method, v in times.items() if v}
+                cpu = {method: statistics.median(c for _, c in v) for method, v in times.items() if v}
                 busy = {method: statistics.median(v) for method, v in computes.items() if v}
                 for method in ("friction", "stepped"):
                     x, steps, jacobians = last[method]
                     if isinstance(x, str):
-                        rows.append(f"{method:10s} {rtol:8.0e} {'failed':>10s} {median[method]:10.4f}  {x}")
+                        rows.append(f"{method:10s} {rtol:8.0e} {'failed':>10s} {median[method]:8.4f}  {x}")
                         continue
                     error = np.max(np.abs(x - reference)) / scale
-                    points.setdefault((name, method), []).append((error, median[method], busy[method], rtol))
-                    ratio = (f"{median['CVODE'] / median[method]:10.2f} {busy['CVODE'] / busy[method]:10.2f}"
-                             if "CVODE" in median else "")
-                    rows.append(f"{method:10s} {rtol:8.0e} {error:10.2e} {median[method]:10.4f}"
-                                f" {busy[method]:10.4f} {steps:8d} {jacobians:9d} {ratio}")
+                    points.setdefault((name, method), []).append(
+                        (error, median[method], cpu[method], busy[method], rtol))
+                    ratio = (f" {median['CVODE'] / median[method]:6.2f} {cpu['CVODE'] / cpu[method]:6.2f}"
+                             f" {busy['CVODE'] / busy[method]:6.2f}" if "CVODE" in median else "")
+                    rows.append(f"{method:10s} {rtol:8.0e} {error:10.2e} {median[method]:8.4f} {cpu[method]:8.4f}"
+                                f" {busy[method]:8.4f} {steps:8d} {jacobians:9d} {ratio}")
                 if cvode:
                     x, counts = last["CVODE"]
                     if isinstance(x, str) or x.size != t.size:
-                        rows.append(f"{'CVODE':10s} {rtol:8.0e} {'failed':>10s} {median['CVODE']:10.4f}  "
+                        rows.append(f"{'CVODE':10s} {rtol:8.0e} {'failed':>10s} {median['CVODE']:8.4f}  "
                                     f"{x if isinstance(x, str) else ''}")
                     else:
                         error = np.max(np.abs(x - reference)) / scale
-                        points.setdefault((name, "CVODE"), []).append((error, median["CVODE"], busy["CVODE"], rtol))
-                        rows.append(f"{'CVODE':10s} {rtol:8.0e} {error:10.2e} {median['CVODE']:10.4f}"
-                                    f" {busy['CVODE']:10.4f} {counts['steps']:8d} {counts['jacobian_evaluations']:9d}")
+                        points.setdefault((name, "CVODE"), []).append(
+                            (error, median["CVODE"], cpu["CVODE"], busy["CVODE"], rtol))
+                        rows.append(f"{'CVODE':10s} {rtol:8.0e} {error:10.2e} {median['CVODE']:8.4f}"
+                                    f" {cpu['CVODE']:8.4f} {busy['CVODE']:8.4f} {counts['steps']:8d}"
+                                    f" {counts['jacobian_evaluations']:9d}")
             for key in ("friction", "stepped", "CVODE"):
                 for row in rows:
                     if row.startswith(key):
@@ -240,20 +254,22 @@ def main():
             for method in ("Radau", "LSODA"):
                 for rtol in tolerances:
                     runs = [scipy_run(work, name, method, rtol, dt_out, args.limit) for _ in range(args.scipy_repeats)]
-                    seconds = statistics.median(run[0] for run in runs)
+                    seconds = statistics.median(run[0][0] for run in runs)
+                    used = statistics.median(run[0][1] for run in runs)
                     alone = statistics.median(run[1] for run in runs)
                     x = runs[-1][2]
                     if isinstance(x, str) or x.size != t.size:
-                        print(f"{method:10s} {rtol:8.0e} {'failed':>10s} {seconds:10.4f} {alone:10.4f}  "
+                        print(f"{method:10s} {rtol:8.0e} {'failed':>10s} {seconds:8.4f} {used:8.4f} {alone:8.4f}  "
                               f"{x if isinstance(x, str) else ''}")
                         continue
                     error = np.max(np.abs(x - reference)) / scale
-                    points.setdefault((name, method), []).append((error, seconds, alone, rtol))
-                    print(f"{method:10s} {rtol:8.0e} {error:10.2e} {seconds:10.4f} {alone:10.4f}")
+                    points.setdefault((name, method), []).append((error, seconds, used, alone, rtol))
+                    print(f"{method:10s} {rtol:8.0e} {error:10.2e} {seconds:8.4f} {used:8.4f} {alone:8.4f}")
             print(f"\n{name} at equal or smaller error: each peer's point against the program's fastest run"
-                  f" (default settings) with an error at most the peer's; ratio = the peer's time / the program's")
-            print(f"{'peer':8s} {'rtol':>8s} {'error':>10s} {'whole':>10s} {'compute':>10s}   {'rtol':>8s} {'error':>10s}"
-                  f" {'whole':>10s} {'ratio':>8s}   {'rtol':>8s} {'compute':>10s} {'ratio':>8s}")
+                  f" (default settings, its rtol in brackets) with an error at most the peer's, by wall, cpu and"
+                  f" compute time; ratio = the peer's time / the program's")
+            print(f"{'peer':8s} {'rtol':>8s} {'error':>10s}" + "".join(
+                f"   {kind:>8s} {'friction':>8s} {'':7s} {'ratio':>7s}" for kind in ("wall", "cpu", "compute")))
             for row in equal_error(points, name):
                 print(row)
             sys.stdout.flush()
@@ -274,9 +290,9 @@ def chart(points, path):
                               ("CVODE", "D-.")):
             data = sorted(points.get((name, method), []))
             if data:
-                ax.loglog([p[0] for p in data], [p[1] for p in data], style, label=method)
+                ax.loglog([p[0] for p in data], [p[2] for p in data], style, label=method)
         ax.set_xlabel("error in x / range of x")
-        ax.set_ylabel("time of the whole process (s)")
+        ax.set_ylabel("CPU time of the whole process (s)")
         ax.set_title(title)
         ax.legend(fontsize=8)
     fig.tight_layout()
