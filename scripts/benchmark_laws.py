@@ -12,7 +12,7 @@ Not a test: the machine is shared and noisy, so each time is the median of
 
 Accuracy: the largest difference in x on the output grid from a reference,
 the program at rtol 1e-12 stepping onto every output time, relative to the
-range of x.  Three times for each run:
+range of x.  Four times for each run:
   wall     the whole process: for the program its start, input, integration
            and HDF5 file, "friction" as it runs by default (free steps, the
            grid from rodas4's continuous extension), "stepped" with &machine
@@ -25,17 +25,21 @@ range of x.  Three times for each run:
            Jacobian estimated by differences, its default)
   cpu      the same process's CPU time (user and system), which the load of
            a shared machine changes far less than its wall time
-  compute  the integration alone (wall time inside the process): the program's compute_time (its file
-           records it: the run's integration and output grid), CVODE's from
-           its state vector's creation to the last output point (its
-           process times it), solve_ivp's call (the interpreter already
-           running)
+  compute  the integration alone (wall time inside the process): the
+           program's compute_time (its file records it: the run's
+           integration and output grid), CVODE's from its state vector's
+           creation to the last output point (its process times it),
+           solve_ivp's call (the interpreter already running)
+  (cpu)    compute's CPU time: CVODE's and solve_ivp's over the same span
+           (the process's CPU clock); the program's, which its file does not
+           record, as its process's CPU time less that of the same run to
+           the first output point (start, input and file alike)
 The program's and CVODE's processes run interleaved (friction, stepped,
 CVODE, friction, ...), so that a change of the machine's load falls on all
 three alike; the ratio columns are CVODE's medians over the program's at
 the same rtol.  At the end, each peer's every point against the program's
 fastest run (default settings) with an error at most the peer's: the ratio
-of the peer's median to the program's, by wall, CPU and compute time.
+of the peer's median to the program's, by each of the four times.
 
     scripts/benchmark_laws [--repeats N] [--quick] [--limit S] [--chart FILE.png]
 
@@ -113,19 +117,20 @@ def rate_state_field():
 def scipy_run(work, name, method, rtol, dt_out, limit):
     """scripts/scipy_laws.py as a whole python3 process, given up after
     `limit` s (Radau took 310 s to fail on the rate-and-state case at rtol
-    1e-5): ((wall, CPU) seconds of the process, seconds of solve_ivp alone,
-    x or why it failed)."""
+    1e-5): ((wall, CPU) seconds of the process, (wall, CPU) seconds of
+    solve_ivp alone, x or why it failed)."""
     out = work / f"scipy_{name}.h5"
     command = [sys.executable, str(ROOT / "scripts" / "scipy_laws.py"), name, method, f"{rtol:.17g}",
                f"{dt_out:.17g}", str(out)]
     try:
         result, elapsed = timed(command, limit)
     except subprocess.TimeoutExpired:
-        return (limit, limit), limit, f"gave up after {limit:g} s"
+        return (limit, limit), (limit, limit), f"gave up after {limit:g} s"
     if result.returncode != 0:
-        return elapsed, float("nan"), (result.stderr.strip().splitlines() or ["failed"])[-1]
+        return elapsed, (float("nan"), float("nan")), (result.stderr.strip().splitlines() or ["failed"])[-1]
     with h5py.File(out) as f:
-        return elapsed, json.loads(result.stdout)["seconds"], f[f"{name}/x"][:]
+        alone = json.loads(result.stdout)
+        return elapsed, (alone["seconds"], alone["cpu_seconds"]), f[f"{name}/x"][:]
 
 
 SUNDIALS_LIBS = ["-lsundials_cvode", "-lsundials_nvecserial", "-lsundials_sunmatrixdense",
@@ -157,20 +162,21 @@ def cvode_run(exe, work, name, rtol, dt_out):
 
 def equal_error(points, name):
     """Each peer's point against the program's fastest run (default
-    settings) with an error at most the peer's, by wall time, CPU time and
-    compute time each: rows of text."""
+    settings) with an error at most the peer's, by each of the four times
+    (wall, CPU, compute, compute's CPU): rows of text."""
     ours = points.get((name, "friction"), [])
     rows = []
     for method in ("CVODE", "LSODA", "Radau"):
-        for error, wall, cpu, compute, rtol in sorted(points.get((name, method), []), key=lambda p: p[4]):
+        for point in sorted(points.get((name, method), []), key=lambda p: p[-1]):
+            error, rtol = point[0], point[-1]
             good = [p for p in ours if p[0] <= error]
             if not good:
                 rows.append(f"{method:8s} {rtol:8.0e} {error:10.2e}  the program reaches no error this small")
                 continue
             text = f"{method:8s} {rtol:8.0e} {error:10.2e}"
-            for k, value in ((1, wall), (2, cpu), (3, compute)):
+            for k in range(1, 5):
                 fast = min(good, key=lambda p: p[k])
-                text += f"   {value:8.4f} {fast[k]:8.4f} ({fast[4]:5.0e}) {value / fast[k]:7.2f}"
+                text += f"  {point[k]:7.4f} {fast[k]:7.4f} ({fast[-1]:5.0e}) {point[k] / fast[k]:6.2f}"
             rows.append(text)
     return rows
 
@@ -186,7 +192,7 @@ def main():
     parser.add_argument("--chart", help="draw the work-precision charts into this PNG")
     args = parser.parse_args()
     tolerances = [1e-5, 1e-7] if args.quick else [1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9]
-    points = {}   # (case, method) -> [(error, wall and CPU seconds of the process, seconds computing, rtol)]
+    points = {}   # (case, method) -> [(error, wall, cpu, compute, compute cpu, rtol)]
     with tempfile.TemporaryDirectory() as scratch:
         work = Path(scratch)
         cvode, why_not = build_cvode(work)
@@ -199,14 +205,17 @@ def main():
             scale = np.ptp(reference)
             dt_out = float(t[1] - t[0])
             print(f"\n{name}: {t.size} grid points to t = {t_end:g} s; error = max |x - x_ref| / range of x;"
-                  f" times in s, medians (wall and cpu: the whole process; compute: the integration alone);"
-                  f" CVODE/this: of wall, cpu, compute")
-            print(f"{'method':10s} {'rtol':>8s} {'error':>10s} {'wall':>8s} {'cpu':>8s} {'compute':>8s} {'steps':>8s}"
-                  f" {'Jacobians':>9s} {'CVODE/this':>22s}")
+                  f" times in s, medians: wall and cpu of the whole process, compute = the integration alone"
+                  f" (wall time, and cpu time: the program's the process's less that of the same run to the"
+                  f" first output point); CVODE/this: the ratios of the four")
+            header = f"{'method':10s} {'rtol':>8s} {'error':>10s} {'wall':>8s} {'cpu':>8s} {'compute':>8s} {'(cpu)':>8s}"
+            print(header + f" {'steps':>8s} {'Jacobians':>9s} {'CVODE/this':>27s}")
             rows = []
             for rtol in tolerances:
-                times = {"friction": [], "stepped": [], "CVODE": []}
-                computes = {"friction": [], "stepped": [], "CVODE": []}
+                times = {"friction": [], "stepped": [], "CVODE": []}     # (wall, cpu) of the processes
+                short = {"friction": [], "stepped": []}                  # cpu of the runs to dt_out
+                computes = {"friction": [], "stepped": [], "CVODE": []}  # wall of the integration
+                cvode_cpu = []
                 last = {}
                 for _ in range(args.repeats):
                     for method, settings in (("friction", sets), ("stepped", stepped)):
@@ -215,26 +224,34 @@ def main():
                         times[method].append(seconds)
                         computes[method].append(compute)
                         last[method] = (x, steps, jacobians)
+                        to_first = dict(settings, **{"machine.t_end": dt_out})
+                        short[method].append(program_run(args.binary, work, name, rtol, to_first)[0][1])
                     if cvode:
                         seconds, x, counts = cvode_run(cvode, work, name, rtol, dt_out)
                         times["CVODE"].append(seconds)
                         computes["CVODE"].append(counts["seconds"] if counts else float("nan"))
+                        cvode_cpu.append(counts["cpu_seconds"] if counts else float("nan"))
                         last["CVODE"] = (x, counts)
                 median = {method: statistics.median(w for w, _ in v) for method, v in times.items() if v}
                 cpu = {method: statistics.median(c for _, c in v) for method, v in times.items() if v}
                 busy = {method: statistics.median(v) for method, v in computes.items() if v}
+                busy_cpu = {method: cpu[method] - statistics.median(v) for method, v in short.items()}
+                if cvode_cpu:
+                    busy_cpu["CVODE"] = statistics.median(cvode_cpu)
                 for method in ("friction", "stepped"):
                     x, steps, jacobians = last[method]
                     if isinstance(x, str):
                         rows.append(f"{method:10s} {rtol:8.0e} {'failed':>10s} {median[method]:8.4f}  {x}")
                         continue
                     error = np.max(np.abs(x - reference)) / scale
-                    points.setdefault((name, method), []).append(
-                        (error, median[method], cpu[method], busy[method], rtol))
-                    ratio = (f" {median['CVODE'] / median[method]:6.2f} {cpu['CVODE'] / cpu[method]:6.2f}"
-                             f" {busy['CVODE'] / busy[method]:6.2f}" if "CVODE" in median else "")
-                    rows.append(f"{method:10s} {rtol:8.0e} {error:10.2e} {median[method]:8.4f} {cpu[method]:8.4f}"
-                                f" {busy[method]:8.4f} {steps:8d} {jacobians:9d} {ratio}")
+                    four = (median[method], cpu[method], busy[method], busy_cpu[method])
+                    points.setdefault((name, method), []).append((error, *four, rtol))
+                    ratio = ""
+                    if "CVODE" in median:
+                        theirs = (median["CVODE"], cpu["CVODE"], busy["CVODE"], busy_cpu["CVODE"])
+                        ratio = "".join(f" {c / o:6.2f}" for c, o in zip(theirs, four))
+                    rows.append(f"{method:10s} {rtol:8.0e} {error:10.2e}" + "".join(f" {v:8.4f}" for v in four)
+                                + f" {steps:8d} {jacobians:9d}{ratio}")
                 if cvode:
                     x, counts = last["CVODE"]
                     if isinstance(x, str) or x.size != t.size:
@@ -242,11 +259,10 @@ def main():
                                     f"{x if isinstance(x, str) else ''}")
                     else:
                         error = np.max(np.abs(x - reference)) / scale
-                        points.setdefault((name, "CVODE"), []).append(
-                            (error, median["CVODE"], cpu["CVODE"], busy["CVODE"], rtol))
-                        rows.append(f"{'CVODE':10s} {rtol:8.0e} {error:10.2e} {median['CVODE']:8.4f}"
-                                    f" {cpu['CVODE']:8.4f} {busy['CVODE']:8.4f} {counts['steps']:8d}"
-                                    f" {counts['jacobian_evaluations']:9d}")
+                        four = (median["CVODE"], cpu["CVODE"], busy["CVODE"], busy_cpu["CVODE"])
+                        points.setdefault((name, "CVODE"), []).append((error, *four, rtol))
+                        rows.append(f"{'CVODE':10s} {rtol:8.0e} {error:10.2e}" + "".join(f" {v:8.4f}" for v in four)
+                                    + f" {counts['steps']:8d} {counts['jacobian_evaluations']:9d}")
             for key in ("friction", "stepped", "CVODE"):
                 for row in rows:
                     if row.startswith(key):
@@ -254,22 +270,20 @@ def main():
             for method in ("Radau", "LSODA"):
                 for rtol in tolerances:
                     runs = [scipy_run(work, name, method, rtol, dt_out, args.limit) for _ in range(args.scipy_repeats)]
-                    seconds = statistics.median(run[0][0] for run in runs)
-                    used = statistics.median(run[0][1] for run in runs)
-                    alone = statistics.median(run[1] for run in runs)
+                    four = tuple(statistics.median(run[i][j] for run in runs) for i in (0, 1) for j in (0, 1))
                     x = runs[-1][2]
                     if isinstance(x, str) or x.size != t.size:
-                        print(f"{method:10s} {rtol:8.0e} {'failed':>10s} {seconds:8.4f} {used:8.4f} {alone:8.4f}  "
-                              f"{x if isinstance(x, str) else ''}")
+                        print(f"{method:10s} {rtol:8.0e} {'failed':>10s}" + "".join(f" {v:8.4f}" for v in four)
+                              + f"  {x if isinstance(x, str) else ''}")
                         continue
                     error = np.max(np.abs(x - reference)) / scale
-                    points.setdefault((name, method), []).append((error, seconds, used, alone, rtol))
-                    print(f"{method:10s} {rtol:8.0e} {error:10.2e} {seconds:8.4f} {used:8.4f} {alone:8.4f}")
+                    points.setdefault((name, method), []).append((error, *four, rtol))
+                    print(f"{method:10s} {rtol:8.0e} {error:10.2e}" + "".join(f" {v:8.4f}" for v in four))
             print(f"\n{name} at equal or smaller error: each peer's point against the program's fastest run"
-                  f" (default settings, its rtol in brackets) with an error at most the peer's, by wall, cpu and"
-                  f" compute time; ratio = the peer's time / the program's")
+                  f" (default settings, its rtol in brackets) with an error at most the peer's, by each of the four"
+                  f" times; ratio = the peer's time / the program's")
             print(f"{'peer':8s} {'rtol':>8s} {'error':>10s}" + "".join(
-                f"   {kind:>8s} {'friction':>8s} {'':7s} {'ratio':>7s}" for kind in ("wall", "cpu", "compute")))
+                f"  {kind:>7s} {'friction':>7s} {'':7s} {'ratio':>6s}" for kind in ("wall", "cpu", "compute", "(cpu)")))
             for row in equal_error(points, name):
                 print(row)
             sys.stdout.flush()
