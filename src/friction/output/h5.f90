@@ -389,7 +389,6 @@ contains
       class(h5_file), intent(inout) :: self
       character(len=*), intent(in) :: name, scales(:)
       type(error_printing) :: printing
-
       integer(hid_t) :: dset, scale
       integer :: stat, k
       character(len=:), allocatable :: path
