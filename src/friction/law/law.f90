@@ -37,6 +37,11 @@ module friction_law
       procedure :: state_scale
       !> The states of steady sliding at v.
       procedure :: steady_state
+      !> The slip rate down to which the force goes with its logarithm (rate
+      !> and state), 0 for a law whose force does not: the integrators then
+      !> hold the slip rate's error below a fixed fraction of the slip rate
+      !> itself down to this floor, whatever the absolute tolerance.
+      procedure :: log_slip_floor
       !> The partial derivatives of F and of the states' rates (the implicit
       !> steppers' Jacobian and the tangent equations); by default from
       !> central differences, which a law overrides with its exact ones.
@@ -118,6 +123,12 @@ contains
 
       z = 0.0_wp
    end subroutine steady_state
+
+   pure real(wp) function log_slip_floor(self)
+      class(sliding_law), intent(in) :: self
+
+      log_slip_floor = 0.0_wp
+   end function log_slip_floor
 
    !> ∂F/∂v, ∂F/∂z, ∂F/∂applied, ∂ż/∂v, ∂ż/∂z (dgdz(i, j) = ∂ż_i/∂z_j).
    !> Central differences with steps of 1e-6 of the variable's size (or of

@@ -33,6 +33,7 @@ module friction_law_rate_state
       procedure :: state_unit
       procedure :: state_scale
       procedure :: steady_state
+      procedure :: log_slip_floor
       procedure :: partials
       procedure :: coefficient
    end type rate_state_law
@@ -151,6 +152,16 @@ contains
       z(1) = self%p%dc / self%p%v0
       if (v /= 0.0_wp) z(1) = self%p%dc / abs(v)
    end subroutine steady_state
+
+   !> 2 v0 exp(-μ0/a): below it the asinh form turns linear in v (at the age
+   !> D_c/v0 of steady sliding at v0; an older contact's floor is lower
+   !> still), above it μ goes with a ln|v|, so an error δv of the slip rate
+   !> costs a N δv/|v| of force at any |v|.
+   pure real(wp) function log_slip_floor(self)
+      class(rate_state_law), intent(in) :: self
+
+      log_slip_floor = 2.0_wp * self%p%v0 * exp(min(-self%p%mu0 / self%p%a, 700.0_wp))
+   end function log_slip_floor
 
    pure subroutine partials(self, v, z, normal, applied, dfdv, dfdz, dfda, dgdv, dgdz)
       class(rate_state_law), intent(in) :: self

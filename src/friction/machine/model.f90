@@ -44,6 +44,7 @@ module friction_machine_model
       procedure :: dimension => smooth_dimension
       procedure :: rhs => smooth_rhs
       procedure :: jacobian => smooth_jacobian
+      procedure :: relative_component => smooth_relative_component
       procedure :: event_count => smooth_event_count
       procedure :: event_values => smooth_event_values
    end type machine_smooth
@@ -184,6 +185,18 @@ contains
          end do
       end do
    end subroutine smooth_jacobian
+
+   !> The slip rate v - belt (component 2) when the law's force goes with its
+   !> logarithm (rate and state).
+   pure subroutine smooth_relative_component(self, index, reference, floor)
+      class(machine_smooth), intent(in) :: self
+      integer, intent(out) :: index
+      real(wp), intent(out) :: reference, floor
+
+      floor = self%law%log_slip_floor()
+      reference = self%m%belt
+      index = merge(2, 0, floor > 0.0_wp)
+   end subroutine smooth_relative_component
 
    pure function smooth_event_count(self) result(n)
       class(machine_smooth), intent(in) :: self

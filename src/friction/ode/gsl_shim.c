@@ -20,6 +20,7 @@
  * one (its GSL_ERROR_NULL in an int function: set_hmin, reset_hstart,
  * driver_apply).  friction_gsl_error_reason gives GSL's own words for the
  * last such error of the calling thread. */
+#include <float.h>
 #include <math.h>
 #include <pthread.h>
 #include <stddef.h>
@@ -27,6 +28,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <gsl/gsl_errno.h>
+#include <gsl/gsl_math.h>
 #include <gsl/gsl_odeiv2.h>
 
 #include "rosenbrock.h"
@@ -193,6 +195,140 @@ const char *friction_gsl_error_reason(void)
     return recorded_reason != NULL ? recorded_reason : "";
 }
 
+/* ---- the error control with a relative component ---- */
+
+/* GSL's scaled control (a_y = 1, a_dydt = 0: the y_new control with an
+ * absolute scale per component), and on one component, the slip rate of a
+ * law that takes its logarithm, the further bound
+ *
+ *   D = min(eps_abs scale + eps_rel |y|, max(relative_fraction |y - reference|, floor)):
+ *
+ * an eps_abs above the slip rate would leave its error unmeasured, and a
+ * Rosenbrock step whose stages carry the slip rate across 0 (the force
+ * reverses) is then accepted (docs/speed.md, "Dense output").  The rest,
+ * the step's adjustment included, is GSL's standard control to the bit, so
+ * a run the bound never touches steps as before. */
+static const double relative_fraction = 0.1;
+
+struct relative_control {
+    double eps_abs, eps_rel, reference, floor;
+    size_t component, n;
+    double *scale;
+};
+
+static void *relative_control_alloc(void)
+{
+    return calloc(1, sizeof(struct relative_control));
+}
+
+static int relative_control_init(void *vstate, double eps_abs, double eps_rel, double a_y, double a_dydt)
+{
+    struct relative_control *s = vstate;
+
+    if (eps_abs < 0.0 || eps_rel < 0.0 || a_y != 1.0 || a_dydt != 0.0) return GSL_EINVAL;
+    s->eps_abs = eps_abs;
+    s->eps_rel = eps_rel;
+    return GSL_SUCCESS;
+}
+
+static double relative_control_level(const struct relative_control *s, double y, size_t i)
+{
+    double level = s->eps_rel * fabs(y) + s->eps_abs * s->scale[i];
+
+    if (i == s->component) {
+        double bound = relative_fraction * fabs(y - s->reference);
+        if (bound < s->floor) bound = s->floor;
+        if (bound < level) level = bound;
+    }
+    return level;
+}
+
+/* As GSL's std_control_hadjust (control/cstd.c of GSL 2). */
+static int relative_control_hadjust(void *vstate, size_t dim, unsigned int ord, const double y[],
+                                    const double yerr[], const double yp[], double *h)
+{
+    const struct relative_control *s = vstate;
+    const double safety = 0.9, h_old = *h;
+    double rmax = DBL_MIN;
+    size_t i;
+
+    (void)yp;
+    for (i = 0; i < dim && i < s->n; i++) {
+        const double r = fabs(yerr[i]) / fabs(relative_control_level(s, y[i], i));
+        rmax = GSL_MAX_DBL(r, rmax);
+    }
+    if (rmax > 1.1) {
+        double r = safety / pow(rmax, 1.0 / ord);
+        if (r < 0.2) r = 0.2;
+        *h = r * h_old;
+        return GSL_ODEIV_HADJ_DEC;
+    }
+    if (rmax < 0.5) {
+        double r = safety / pow(rmax, 1.0 / (ord + 1.0));
+        if (r > 5.0) r = 5.0;
+        if (r < 1.0) r = 1.0;
+        *h = r * h_old;
+        return GSL_ODEIV_HADJ_INC;
+    }
+    return GSL_ODEIV_HADJ_NIL;
+}
+
+static int relative_control_errlevel(void *vstate, const double y, const double dydt, const double h,
+                                     const size_t ind, double *errlev)
+{
+    const struct relative_control *s = vstate;
+
+    (void)dydt;
+    (void)h;
+    if (ind >= s->n) return GSL_EINVAL;
+    *errlev = relative_control_level(s, y, ind);
+    return GSL_SUCCESS;
+}
+
+static int relative_control_set_driver(void *vstate, const gsl_odeiv2_driver *d)
+{
+    (void)vstate;
+    (void)d;
+    return GSL_SUCCESS;
+}
+
+static void relative_control_free(void *vstate)
+{
+    struct relative_control *s = vstate;
+
+    if (s == NULL) return;
+    free(s->scale);
+    free(s);
+}
+
+static const gsl_odeiv2_control_type relative_control_type = {
+    "relative", relative_control_alloc, relative_control_init, relative_control_hadjust,
+    relative_control_errlevel, relative_control_set_driver, relative_control_free,
+};
+
+/* The control above for n components with these absolute scales (copied),
+ * or NULL. */
+static gsl_odeiv2_control *relative_control_new(double eps_abs, double eps_rel, const double scale[], size_t n,
+                                                size_t component, double reference, double floor)
+{
+    gsl_odeiv2_control *c = gsl_odeiv2_control_alloc(&relative_control_type);
+    struct relative_control *s;
+
+    if (c == NULL) return NULL;
+    s = c->state;
+    s->scale = malloc(n * sizeof *s->scale);
+    if (s->scale == NULL || gsl_odeiv2_control_init(c, eps_abs, eps_rel, 1.0, 0.0) != GSL_SUCCESS) {
+        gsl_odeiv2_control_free(c);
+        return NULL;
+    }
+    memcpy(s->scale, scale, n * sizeof *scale);
+    s->n = n;
+    s->component = component;
+    s->reference = reference;
+    s->floor = floor;
+    return c;
+}
+
 /* ---- the driver ---- */
 
 /* A driver for system sys with step type index (1-based), first step
@@ -200,28 +336,38 @@ const char *friction_gsl_error_reason(void)
  * components (all of them when controlled >= the dimension); *driver is
  * NULL unless GSL_SUCCESS is returned.  The others are given an absolute
  * scale so large that their error never limits the step: GSL's scaled
- * control with a_y = 1, a_dydt = 0 and scale 1 is the y_new control. */
+ * control with a_y = 1, a_dydt = 0 and scale 1 is the y_new control.
+ * relative (1-based, 0 for none) is a component whose error is further
+ * held within a tenth of |y - reference|, down to floor (the control
+ * above). */
 int friction_gsl_driver_new(gsl_odeiv2_driver **driver, const gsl_odeiv2_system *sys, int index,
-                            double hstart, double epsabs, double epsrel, int controlled)
+                            double hstart, double epsabs, double epsrel, int controlled, int relative,
+                            double reference, double floor)
 {
     gsl_odeiv2_driver *d;
     gsl_odeiv2_control *c = NULL;
     double *scale;
     size_t i, n = sys->dimension;
-    int status;
+    int status, own_control;
 
     *driver = NULL;
     if (index < 1 || index > step_type_count) return GSL_EINVAL;
     if (controlled < 1) return GSL_EINVAL;
+    if (relative < 0 || (size_t)relative > n || (relative > 0 && relative > controlled)) return GSL_EINVAL;
+    if (relative > 0 && !(floor > 0.0 && isfinite(reference))) return GSL_EINVAL;
     /* GSL's own check of hstart (non-zero) comes after its allocations and
      * leaks them. */
     if (!(hstart > 0.0 || hstart < 0.0)) return GSL_EINVAL;
+    own_control = (size_t)controlled < n || relative > 0;
     quiet_begin();
     d = gsl_odeiv2_driver_alloc_y_new(sys, *step_types[index - 1].type, hstart, epsabs, epsrel);
-    if (d != NULL && (size_t)controlled < n && (scale = malloc(n * sizeof *scale)) != NULL) {
+    if (d != NULL && own_control && (scale = malloc(n * sizeof *scale)) != NULL) {
         for (i = 0; i < n; i++) scale[i] = i < (size_t)controlled ? 1.0 : 1.0e200;
-        /* (GSL copies the scales.) */
-        c = gsl_odeiv2_control_scaled_new(epsabs, epsrel, 1.0, 0.0, scale, n);
+        /* (GSL copies the scales; so does relative_control_new.) */
+        if (relative > 0)
+            c = relative_control_new(epsabs, epsrel, scale, n, (size_t)relative - 1, reference, floor);
+        else
+            c = gsl_odeiv2_control_scaled_new(epsabs, epsrel, 1.0, 0.0, scale, n);
         free(scale);
         if (c != NULL) {
             gsl_odeiv2_control_free(d->c);
@@ -231,7 +377,7 @@ int friction_gsl_driver_new(gsl_odeiv2_driver **driver, const gsl_odeiv2_system 
     }
     status = quiet_end(GSL_SUCCESS);
     if (d == NULL) return status != GSL_SUCCESS ? status : GSL_ENOMEM;
-    if (status == GSL_SUCCESS && (size_t)controlled < n && c == NULL) status = GSL_ENOMEM;
+    if (status == GSL_SUCCESS && own_control && c == NULL) status = GSL_ENOMEM;
     if (status != GSL_SUCCESS) {
         quiet_begin();
         gsl_odeiv2_driver_free(d);

@@ -78,8 +78,8 @@ module friction_ode_solver
       real(wp) :: h_min = 0.0_wp
       character(len=16) :: method = ''
       !> what the driver was made for (init reuses a driver made for the same)
-      integer :: step_index = 0, controlled = 0
-      real(wp) :: atol = 0.0_wp, rtol = 0.0_wp
+      integer :: step_index = 0, controlled = 0, relative = 0
+      real(wp) :: atol = 0.0_wp, rtol = 0.0_wp, reference = 0.0_wp, floor = 0.0_wp
       !> how messages name the time and its unit (the brake runs in nondimensional τ)
       character(len=8) :: time_name = 't', time_unit = ' s'
       !> counters of the finished restarts
@@ -131,14 +131,15 @@ module friction_ode_solver
          integer(c_int) :: uses
       end function friction_gsl_step_type_uses_jacobian
 
-      function friction_gsl_driver_new(driver, sys, index, hstart, epsabs, epsrel, controlled) &
-         & result(status) bind(c, name='friction_gsl_driver_new')
+      function friction_gsl_driver_new(driver, sys, index, hstart, epsabs, epsrel, controlled, relative, &
+         & reference, floor) result(status) bind(c, name='friction_gsl_driver_new')
          import :: c_ptr, c_int, c_double
          type(c_ptr), intent(out) :: driver
          type(c_ptr), value :: sys
          integer(c_int), value :: index
          real(c_double), value :: hstart, epsabs, epsrel
-         integer(c_int), value :: controlled
+         integer(c_int), value :: controlled, relative
+         real(c_double), value :: reference, floor
          integer(c_int) :: status
       end function friction_gsl_driver_new
 
@@ -275,9 +276,11 @@ contains
       type(solver_settings), intent(in) :: settings
       real(wp), intent(in) :: h_start
       type(error_type), allocatable, intent(out) :: error
-      integer :: index
+      integer :: index, relative
       integer(c_int) :: status
+      real(wp) :: reference, floor
 
+      call model%relative_component(relative, reference, floor)
       ! A driver made for the same stepper, size and tolerances is reset
       ! instead of made again: integrations that start over and over (a
       ! Lyapunov exponent's perturbed run, a phase of the switched brake)
@@ -300,7 +303,8 @@ contains
       self%sys%params = c_loc(self%box)
       status = friction_gsl_driver_new(self%driver, c_loc(self%sys), int(index, c_int), &
          & real(h_start, c_double), real(settings%atol, c_double), real(settings%rtol, c_double), &
-         & int(model%controlled_dimension(), c_int))
+         & int(model%controlled_dimension(), c_int), int(relative, c_int), real(reference, c_double), &
+         & real(floor, c_double))
       if (status /= gsl_success) then
          if (status == gsl_enomem) then
             call fatal_error(error, 'GSL could not allocate a driver for '//trim(settings%method), &
@@ -317,6 +321,9 @@ contains
       self%method = settings%method
       self%step_index = index
       self%controlled = model%controlled_dimension()
+      self%relative = relative
+      self%reference = reference
+      self%floor = floor
       self%atol = settings%atol
       self%rtol = settings%rtol
       status = friction_gsl_driver_set_limits(self%driver, int(settings%max_steps, c_long), &
@@ -343,7 +350,8 @@ contains
          if (self%step_index /= step_type_index(settings%method) .or. self%box%n /= model%dimension() &
             & .or. self%controlled /= model%controlled_dimension() .or. self%atol /= settings%atol &
             & .or. self%rtol /= settings%rtol .or. self%h_min /= settings%h_min &
-            & .or. self%max_steps /= settings%max_steps) return
+            & .or. self%max_steps /= settings%max_steps .or. self%relative /= relative &
+            & .or. self%reference /= reference .or. self%floor /= floor) return
          if (friction_gsl_driver_reset(self%driver, real(h_start, c_double)) /= gsl_success) return
          self%box%model => model
          self%box%rhs_evaluations = 0

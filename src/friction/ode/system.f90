@@ -15,6 +15,7 @@ module friction_ode_system
       procedure(rhs_interface), deferred :: rhs
       procedure(jacobian_interface), deferred :: jacobian
       procedure :: controlled_dimension
+      procedure :: relative_component
    end type ode_system
 
    abstract interface
@@ -59,5 +60,19 @@ contains
 
       n = self%dimension()
    end function controlled_dimension
+
+   !> A component whose error the control also holds below a tenth of its
+   !> distance from `reference`, down to `floor` (index 0: none, the
+   !> default): a slip rate that a friction law takes the logarithm of, which
+   !> an absolute tolerance above the slip rate would leave unmeasured.
+   pure subroutine relative_component(self, index, reference, floor)
+      class(ode_system), intent(in) :: self
+      integer, intent(out) :: index
+      real(wp), intent(out) :: reference, floor
+
+      index = 0
+      reference = 0.0_wp
+      floor = 0.0_wp
+   end subroutine relative_component
 
 end module friction_ode_system
