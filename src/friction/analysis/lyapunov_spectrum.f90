@@ -31,6 +31,7 @@ module friction_analysis_lyapunov_spectrum
    contains
       procedure :: dimension => tangent_dimension
       procedure :: controlled_dimension => tangent_controlled_dimension
+      procedure :: relative_component => tangent_relative_component
       procedure :: rhs => tangent_rhs
       procedure :: jacobian => tangent_jacobian
       procedure :: event_count => tangent_event_count
@@ -80,6 +81,15 @@ contains
 
       n = self%base%dimension()
    end function tangent_controlled_dimension
+
+   !> The base's (its components come first).
+   pure subroutine tangent_relative_component(self, index, reference, floor)
+      class(tangent_system), intent(in) :: self
+      integer, intent(out) :: index
+      real(wp), intent(out) :: reference, floor
+
+      call self%base%relative_component(index, reference, floor)
+   end subroutine tangent_relative_component
 
    !> (f(y), J(y) Φ), Φ by columns.
    pure subroutine tangent_rhs(self, t, y, dydt)

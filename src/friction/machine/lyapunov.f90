@@ -57,6 +57,7 @@ module friction_machine_lyapunov
    contains
       procedure :: dimension => divergence_dimension
       procedure :: controlled_dimension => divergence_controlled_dimension
+      procedure :: relative_component => divergence_relative_component
       procedure :: rhs => divergence_rhs
       procedure :: jacobian => divergence_jacobian
    end type divergence_system
@@ -76,6 +77,15 @@ contains
 
       n = self%base%dimension()
    end function divergence_controlled_dimension
+
+   !> The base's (its components come first).
+   pure subroutine divergence_relative_component(self, index, reference, floor)
+      class(divergence_system), intent(in) :: self
+      integer, intent(out) :: index
+      real(wp), intent(out) :: reference, floor
+
+      call self%base%relative_component(index, reference, floor)
+   end subroutine divergence_relative_component
 
    pure subroutine divergence_rhs(self, t, y, dydt)
       class(divergence_system), intent(in) :: self

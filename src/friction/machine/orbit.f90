@@ -66,6 +66,7 @@ module friction_machine_orbit
       type(machine_smooth) :: base
    contains
       procedure :: dimension => frame_dimension
+      procedure :: relative_component => frame_relative_component
       procedure :: rhs => frame_rhs
       procedure :: jacobian => frame_jacobian
    end type load_frame
@@ -153,6 +154,15 @@ contains
 
       frame_dimension = self%base%dimension()
    end function frame_dimension
+
+   !> The base's (y(2) is v in this frame too).
+   pure subroutine frame_relative_component(self, index, reference, floor)
+      class(load_frame), intent(in) :: self
+      integer, intent(out) :: index
+      real(wp), intent(out) :: reference, floor
+
+      call self%base%relative_component(index, reference, floor)
+   end subroutine frame_relative_component
 
    pure subroutine frame_rhs(self, t, y, dydt)
       class(load_frame), intent(in) :: self
