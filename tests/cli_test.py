@@ -258,6 +258,13 @@ def leftovers(args):
 TIMING = ("compute_time", "peak_memory_per_rank", "wall_time")   # how long it took, not what it computed
 
 
+def identical(a, b):
+    """Two arrays the same bit for bit, NaN equal to NaN (a sweep point
+    without an orbit has NaN there)."""
+    a, b = np.asarray(a), np.asarray(b)
+    return np.array_equal(a, b, equal_nan=a.dtype.kind == "f" and b.dtype.kind == "f")
+
+
 def same_run(args, first, second, label):
     """fail() unless two output files hold the same datasets and attributes
     (bit for bit), timings and the created stamp aside."""
@@ -580,7 +587,7 @@ def case_graphite_ranks(args):
         if files[1].keys() != files[n].keys():
             fail(f"different objects on {n} ranks: {set(files[1]) ^ set(files[n])}")
         for key, value in files[1].items():
-            if not np.array_equal(np.asarray(value), np.asarray(files[n][key])):
+            if not identical(value, files[n][key]):
                 fail(f"{key} differs between 1 and {n} ranks")
 
 
@@ -687,7 +694,7 @@ def case_ranks(args):
         if files[a].keys() != files[b].keys():
             fail(f"{a} and {b} ranks wrote different objects: {set(files[a]) ^ set(files[b])}")
         for key, value in files[a].items():
-            if not np.array_equal(np.asarray(value), np.asarray(files[b][key])):
+            if not identical(value, files[b][key]):
                 fail(f"{key} differs between {a} and {b} ranks")
 
 
@@ -761,7 +768,7 @@ def case_thermal_zero(args):
     if a.keys() != b.keys():
         fail(f"T = 0 wrote other objects: {set(a) ^ set(b)}")
     for key, value in a.items():
-        if not np.array_equal(np.asarray(value), np.asarray(b[key])):
+        if not identical(value, b[key]):
             fail(f"{key} differs at temperature = 0")
     # A small temperature converges to it: at 1 mK the fluctuations are
     # sqrt(k k_B T) = 4e-4 nN, and what is left is the two integrators'
@@ -804,7 +811,7 @@ def case_thermal_ranks(args):
         if files[1].keys() != files[n].keys():
             fail(f"1 and {n} ranks wrote different objects: {set(files[1]) ^ set(files[n])}")
         for key, value in files[1].items():
-            if not np.array_equal(np.asarray(value), np.asarray(files[n][key])):
+            if not identical(value, files[n][key]):
                 fail(f"{key} differs between 1 and {n} ranks")
     path = os.path.join(args.workdir, "t_1.h5")
     with h5py.File(path, "r") as f:
@@ -870,7 +877,7 @@ def case_thermal_ranks(args):
     friction(args, "-o", "echo.h5", write(args, "echo.nml", echoed))
     again = comparable(os.path.join(args.workdir, "echo.h5"))
     for key, value in files[1].items():
-        if not np.array_equal(np.asarray(value), np.asarray(again[key])):
+        if not identical(value, again[key]):
             fail(f"{key} differs when run from the echoed input")
     other = write(args, "seed.nml", "&thermal seed = 8 /\n")
     friction(args, "-o", "seed8.h5", naf, small, other)
@@ -972,7 +979,7 @@ def case_thermal_lj(args):
         if files[1].keys() != files[ranks].keys():
             fail(f"1 and {ranks} ranks wrote different objects: {set(files[1]) ^ set(files[ranks])}")
         for key, value in files[1].items():
-            if not np.array_equal(np.asarray(value), np.asarray(files[ranks][key])):
+            if not identical(value, files[ranks][key]):
                 fail(f"{key} differs between 1 and {ranks} ranks")
     with h5py.File(os.path.join(args.workdir, "near_1.h5"), "r") as f:
         for trip in ("trace", "retrace"):
@@ -1101,7 +1108,7 @@ def case_thermal_kramers(args):
     if files[1].keys() != files[2].keys():
         fail(f"1 and 2 ranks wrote different objects: {set(files[1]) ^ set(files[2])}")
     for key, value in files[1].items():
-        if not np.array_equal(np.asarray(value), np.asarray(files[2][key])):
+        if not identical(value, files[2][key]):
             fail(f"{key} differs between 1 and 2 ranks")
 
 
@@ -1318,7 +1325,7 @@ def case_brake_ranks(args):
         for key, value in files[1].items():
             if key.endswith("compute_time"):
                 continue
-            if not np.array_equal(np.asarray(value), np.asarray(files[other][key])):
+            if not identical(value, files[other][key]):
                 fail(f"{key} differs between 1 and {other} ranks")
 
 
@@ -1400,7 +1407,7 @@ def case_brake_analysis(args):
     for key, value in files[1].items():
         if key.endswith("compute_time"):
             continue
-        if not np.array_equal(np.asarray(value), np.asarray(files[2][key])):
+        if not identical(value, files[2][key]):
             fail(f"{key} differs between 1 and 2 ranks")
     a = files[1]
     if abs(a["brake/spectrum@resolution"] - 1 / (3501 * 0.1)) > 1e-12:
@@ -1454,7 +1461,7 @@ def case_brake_analysis(args):
     for key, value in without.items():
         if key.endswith("compute_time") or key == "@input":
             continue
-        if not np.array_equal(np.asarray(value), np.asarray(a[key])):
+        if not identical(value, a[key]):
             fail(f"{key} differs with the spectrum off")
 
 
@@ -1768,7 +1775,7 @@ def case_sweep_ranks(args):
         fail("maxima offsets and counts do not index the flat maxima")
     for label in (2, 3, "2-static"):
         for key in SWEEP_PER_POINT:
-            if not np.array_equal(reference[key], runs[label][0][key]):
+            if not identical(reference[key], runs[label][0][key]):
                 fail(f"/sweep/{key} differs between 1 rank and {label}: {reference[key]} vs {runs[label][0][key]}")
     with h5py.File(os.path.join(args.workdir, "s1.h5"), "r") as handle:
         for key, unit in (("maxima", "m"), ("peak_frequency", "1/tau"), ("lyapunov", "1/tau")):
@@ -2060,7 +2067,7 @@ def case_sweep_resume(args):
     full, _ = sweep_results(os.path.join(args.workdir, "full.h5"))
     resumed, _ = sweep_results(os.path.join(args.workdir, "part.h5"))
     for key in SWEEP_PER_POINT:
-        if not np.array_equal(full[key], resumed[key]):
+        if not identical(full[key], resumed[key]):
             fail(f"/sweep/{key} differs after resume: {full[key]} vs {resumed[key]}")
     with h5py.File(os.path.join(args.workdir, "part.h5"), "r") as handle:
         computed = list(handle["sweep/computed_by_this_run"][()])
@@ -2124,7 +2131,7 @@ def same_sweep(args, first, second, label, ignore=()):
     if a.keys() != b.keys():
         fail(f"{label}: {first} and {second} hold different objects: {sorted(set(a) ^ set(b))}")
     for key, value in a.items():
-        if not np.array_equal(np.asarray(value), np.asarray(b[key])):
+        if not identical(value, b[key]):
             fail(f"{label}: {key} differs between {first} and {second}")
 
 
@@ -2298,7 +2305,7 @@ def case_serial_files(args):
             if key in RUN_DEPENDENT:
                 continue
             compared += 1
-            if not np.array_equal(np.asarray(a[key]), np.asarray(b[key])):
+            if not identical(a[key], b[key]):
                 fail(f"{label}: {key} differs between the serial run and mpirun -n 1")
         with h5py.File(os.path.join(args.workdir, serial), "r") as f:
             if f.attrs["nranks"] != 1:

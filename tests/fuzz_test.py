@@ -169,8 +169,8 @@ def stated_nonfinite(handle, name, data):
     of data: a standard error (*_sem) is NaN from one realization; a
     Lyapunov or Floquet exponent is -inf for the direction the stick
     collapses (a multiplier of 0); a continuation's period and largest
-    modulus are NaN where no orbit was found, as a machine sweep's orbit
-    results are at its points without one."""
+    modulus are NaN where no orbit was found, as a machine or brake sweep's
+    orbit results are at its points without one."""
     leaf = name.split("/")[-1]
     if leaf.endswith("_sem") and "afm" in handle and int(handle["afm"].attrs.get("realizations", 2)) == 1:
         return np.isnan(data)
@@ -180,7 +180,7 @@ def stated_nonfinite(handle, name, data):
         found = handle["brake/orbit/branch/found"][()].astype(bool)
         return np.isnan(data) & ~found
     if name.startswith("sweep/orbit_") and leaf != "orbit_found" and handle.attrs.get("sweep_scene") in (
-            b"machine", "machine"):
+            b"machine", "machine", b"brake", "brake"):
         found = handle["sweep/orbit_found"][()].astype(bool)
         return np.isnan(data) & ~found
     return np.zeros(data.shape, bool)

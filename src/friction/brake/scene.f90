@@ -6,6 +6,7 @@
 !> the number of ranks.
 module friction_brake_scene
    use mpi_f08
+   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
    use friction_kinds, only: wp, i8
    use friction_strings, only: fixed_text, etoa, itoa
    use friction_error, only: error_type, fatal_error, error_numerical, error_interrupted
@@ -244,9 +245,11 @@ contains
    end subroutine brake_point_series
 
    !> A sweep point: the run, its diagnostics, its periodic orbit (found,
-   !> period, the largest |μ| and the critical μ; 0 when none or off) and the
-   !> local maxima of x after the transient (the bifurcation diagram).  (A
-   !> brake point keeps nothing in `memory`: its set-up costs nothing.)
+   !> period, the largest |μ| and the critical μ; NaN where no orbit was
+   !> found or none was asked, as the machine's: 0 is the multiplier of an
+   !> orbit through stick) and the local maxima of x after the transient
+   !> (the bifurcation diagram).  (A brake point keeps nothing in `memory`:
+   !> its set-up costs nothing.)
    subroutine brake_run_point(self, sink, memory, error, reporter)
       class(brake_scene), intent(inout) :: self
       class(result_sink), intent(inout) :: sink
@@ -262,6 +265,7 @@ contains
       integer :: j
 
       results = 0.0_wp
+      results(6:9) = ieee_value(1.0_wp, ieee_quiet_nan)
       point = self%resolved()
       ! A sweep point reports no spectrum: skip its cost.
       point%analysis%lyapunov_spectrum = .false.
