@@ -9,7 +9,7 @@ module test_systems
    use friction_ode_events, only: event_system
    implicit none
    private
-   public :: lorenz, oscillator, decay, hopf, step_types_with_cases
+   public :: lorenz, oscillator, decay, hopf, logistic, step_types_with_cases
 
    !> The GSL step types that test_steppers.pf and test_events.pf have cases
    !> for, one each (and so one CTest test each).  Their guard cases require
@@ -61,7 +61,38 @@ module test_systems
       procedure :: jacobian => decay_jacobian
    end type decay
 
+   !> y' = y (1 - y): one variable whose Jacobian 1 - 2y depends on it.
+   type, extends(ode_system) :: logistic
+   contains
+      procedure :: dimension => logistic_dimension
+      procedure :: rhs => logistic_rhs
+      procedure :: jacobian => logistic_jacobian
+   end type logistic
+
 contains
+
+   pure integer function logistic_dimension(self) result(n)
+      class(logistic), intent(in) :: self
+      n = 1
+   end function logistic_dimension
+
+   pure subroutine logistic_rhs(self, t, y, dydt)
+      class(logistic), intent(in) :: self
+      real(wp), intent(in) :: t
+      real(wp), intent(in), contiguous :: y(:)
+      real(wp), intent(out), contiguous :: dydt(:)
+      dydt(1) = y(1) * (1.0_wp - y(1))
+   end subroutine logistic_rhs
+
+   pure subroutine logistic_jacobian(self, t, y, dfdy, dfdt)
+      class(logistic), intent(in) :: self
+      real(wp), intent(in) :: t
+      real(wp), intent(in) :: y(:)
+      real(wp), intent(out) :: dfdy(:, :)
+      real(wp), intent(out) :: dfdt(:)
+      dfdy(1, 1) = 1.0_wp - 2.0_wp * y(1)
+      dfdt(1) = 0.0_wp
+   end subroutine logistic_jacobian
 
    pure integer function lorenz_dimension(self) result(n)
       class(lorenz), intent(in) :: self

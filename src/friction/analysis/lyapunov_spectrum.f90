@@ -153,40 +153,72 @@ contains
 
    !> Jacobian of (f, J Φ) for the implicit steppers: J on the diagonal
    !> blocks, and ∂(J Φ)/∂y from central differences of the analytic J
-   !> (the orbit does not depend on Φ, so the upper right block is 0).
+   !> (the orbit does not depend on Φ, so the upper right block is 0).  No
+   !> room of its own (an implicit stepper asks for it every step, and an
+   !> allocation a call cost more than the small J's): J at y+h and y-h go
+   !> where the upper right block's zeros go, the perturbed y and the
+   !> unused ∂f/∂t where dfdt's zeros go, both zeroed at the end; n = 1,
+   !> whose blocks have no such room, in a few numbers on the stack.
    pure subroutine tangent_jacobian(self, t, y, dfdy, dfdt)
       class(tangent_system), intent(in) :: self
       real(wp), intent(in) :: t
       real(wp), intent(in) :: y(:)
       real(wp), intent(out) :: dfdy(:, :)
       real(wp), intent(out) :: dfdt(:)
-      real(wp), allocatable :: jac(:, :), jp(:, :), jm(:, :), phi(:, :), d0(:), yp(:)
-      real(wp) :: h
-      integer :: n, j, k
+      real(wp) :: one(1, 3), one_y(1), h, sum
+      integer :: n, i, j, k, l
 
       n = self%base%dimension()
-      allocate (jac(n, n), jp(n, n), jm(n, n), d0(n))
-      phi = reshape(y(n + 1:n + n * n), [n, n])
       dfdy = 0.0_wp
-      call self%base%jacobian(t, y(1:n), jac, d0)
       dfdt = 0.0_wp
-      dfdt(1:n) = d0
-      dfdy(1:n, 1:n) = jac
+      call self%base%jacobian(t, y(1:n), dfdy(1:n, 1:n), dfdt(1:n))
+      ! (Loops, here and below: sections of one array on both sides would be copied through a temporary.)
       do j = 1, n
-         dfdy(n + (j - 1) * n + 1:n + j * n, n + (j - 1) * n + 1:n + j * n) = jac
-      end do
-      do k = 1, n
-         h = 1.0e-6_wp * max(1.0_wp, abs(y(k)))
-         yp = y(1:n)
-         yp(k) = y(k) + h
-         call self%base%jacobian(t, yp, jp, d0)
-         yp(k) = y(k) - h
-         call self%base%jacobian(t, yp, jm, d0)
-         jp = (jp - jm) / (2.0_wp * h)
-         do j = 1, n
-            dfdy(n + (j - 1) * n + 1:n + j * n, k) = matmul(jp, phi(:, j))
+         do k = 1, n
+            do i = 1, n
+               dfdy(n + (j - 1) * n + i, n + (j - 1) * n + k) = dfdy(i, k)
+            end do
          end do
       end do
+      if (n == 1) then
+         h = 1.0e-6_wp * max(1.0_wp, abs(y(1)))
+         one_y = y(1) + h
+         call self%base%jacobian(t, one_y, one(:, 1:1), one(1, 3:3))
+         one_y = y(1) - h
+         call self%base%jacobian(t, one_y, one(:, 2:2), one(1, 3:3))
+         dfdy(2, 1) = (one(1, 1) - one(1, 2)) / (2.0_wp * h) * y(2)
+         return
+      end if
+      associate (jp => dfdy(1:n, n + 1:2 * n), jm => dfdy(1:n, 2 * n + 1:3 * n), yp => dfdt(n + 1:2 * n), &
+         & d0 => dfdt(2 * n + 1:3 * n))
+         do k = 1, n
+            h = 1.0e-6_wp * max(1.0_wp, abs(y(k)))
+            yp = y(1:n)
+            yp(k) = y(k) + h
+            call self%base%jacobian(t, yp, jp, d0)
+            yp(k) = y(k) - h
+            call self%base%jacobian(t, yp, jm, d0)
+            do l = 1, n
+               do i = 1, n
+                  jp(i, l) = (jp(i, l) - jm(i, l)) / (2.0_wp * h)
+               end do
+            end do
+            ! Column k of the lower left block: ∂J/∂y_k times each of Φ's columns (y holds Φ by columns).
+            do j = 1, n
+               do i = 1, n
+                  sum = 0.0_wp
+                  do l = 1, n
+                     sum = sum + jp(i, l) * y(n + (j - 1) * n + l)
+                  end do
+                  dfdy(n + (j - 1) * n + i, k) = sum
+               end do
+            end do
+         end do
+         jp = 0.0_wp
+         jm = 0.0_wp
+         yp = 0.0_wp
+         d0 = 0.0_wp
+      end associate
    end subroutine tangent_jacobian
 
    pure function tangent_event_count(self) result(m)
