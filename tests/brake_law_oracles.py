@@ -25,9 +25,10 @@ program and its file, against oracles that are not that model's output:
   lugre-stiff-steady   the same with the input's stiff bristles (σ0 = 1e5 N/m):
                        the five exponents, the bristles' -142 per τ among
                        them, against e^{J t}'s exact finite-time values,
-                       their sum against the trace
+                       their sum and spectrum_divergence against the trace
   lugre-stiff-sum      inputs/brake_lugre.nml in stick-slip: the exponents'
-                       sum against SciPy's Radau's time average of tr J
+                       sum and the file's spectrum_divergence against SciPy's
+                       Radau's time average of tr J, and against each other
   lugre-spectrum       &law lugre with soft bristles through stick and slip:
                        the spectrum against SciPy's Radau on the variational
                        equations written below, with the same QR steps
@@ -365,12 +366,14 @@ def lugre_stiff_steady(args):
                                      "analysis.lyapunov_spectrum_renormalise": every}, s2)
     with brake_spectrum_file(args, "lugre_stiff_steady", sets) as f:
         exponents = f["brake/lyapunov/exponents"][:]
+        divergence = float(f["brake/lyapunov"].attrs["spectrum_divergence"])
         drift = max(float(np.ptp(f["brake"][key][:])) for key in ("x", "y"))
     j, expected, bound = steady_jacobian(field, jacobian, state, duration)
     qr_exact = finite_time_spectrum(expm(j * every), generic_frame(5), int(round(duration / every))) / duration
     print(f"lugre-stiff-steady: residual of the start {residual:.1e}, drift {drift:.1e} m; exponents {exponents}; "
           f"J's eigenvalues' real parts {expected} (bound {bound:.2e}); exact finite-time {qr_exact}; off by "
-          f"{exponents - qr_exact}; sum {exponents.sum():.9f}, trace {np.trace(j):.9f}")
+          f"{exponents - qr_exact}; sum {exponents.sum():.9f}, trace {np.trace(j):.9f}, spectrum_divergence "
+          f"{divergence:.9f}")
     assert exponents.size == 5, exponents
     # The fastest: -142.37 per τ against the real part, within ln(cond V)/T = 4.8e-3.
     assert np.all(np.abs(exponents - expected) <= bound), (exponents, expected, bound)
@@ -380,6 +383,9 @@ def lugre_stiff_steady(args):
     assert np.all(np.abs(exponents - qr_exact) <= 1e-8), (exponents - qr_exact)
     # det e^{hJ} = e^{h tr J}: the sum is the trace but for rounding, measured 8e-15 of it; 1e-10 of it.
     assert abs(exponents.sum() - np.trace(j)) <= 1e-10 * abs(np.trace(j)), (exponents.sum(), np.trace(j))
+    # Simpson's rule for tr J on a state that stays put (drift above) is the trace but for rounding and
+    # the drift's effect on tr J: 1e-10 of it, as the sum (measured equal to 9 digits).
+    assert abs(divergence - np.trace(j)) <= 1e-10 * abs(np.trace(j)), (divergence, np.trace(j))
 
 
 def lugre_stiff_sum(args):
@@ -391,6 +397,7 @@ def lugre_stiff_sum(args):
             "analysis.lyapunov_spectrum": ".true.", "analysis.lyapunov_spectrum_transient": transient}
     with brake_spectrum_file(args, "lugre_stiff_sum", sets) as f:
         exponents = f["brake/lyapunov/exponents"][:]
+        written = float(f["brake/lyapunov"].attrs["spectrum_divergence"])
     field, jacobian, u = brake_lugre(1e5, np.sqrt(1e5), -0.002, 0.4)
     start = np.array([0.0, u["vdr"], 0.0, 0.0, 0.0])   # the input's start: v_rel = 0, z steady there (0)
     orbit = solve_ivp(field, (0.0, transient), start, method="Radau", rtol=1e-10, atol=1e-14,
@@ -410,11 +417,21 @@ def lugre_stiff_sum(args):
     assert span.status == 0, span.message
     divergence = span.y[5, -1] / (end - transient)
     print(f"lugre-stiff-sum: exponents {exponents}, sum {exponents.sum():.9f}; Radau's time average of tr J "
-          f"{divergence:.9f}; relative difference {abs(exponents.sum() / divergence - 1):.1e}")
+          f"{divergence:.9f}; relative difference {abs(exponents.sum() / divergence - 1):.1e}; spectrum_divergence "
+          f"{written:.9f}, {abs(written / divergence - 1):.1e} from Radau's, {abs(exponents.sum() / written - 1):.1e} "
+          f"from the sum")
     # The two orbits separate at the largest exponent (0.10 per τ: e^8 over the span) from the steppers'
     # errors (rtol 1e-9 and 1e-10), and tr J along them with it: measured 7.4e-7 of the average apart; 1e-4
     # is 130 times that and 1e-3 of what the stepper's own tangent missed.
     assert abs(exponents.sum() - divergence) <= 1e-4 * abs(divergence), (exponents.sum(), divergence)
+    # The file's spectrum_divergence, Simpson's rule for tr J on each of the program's steps: against
+    # Radau's on its own orbit, the same 1e-4 (the orbits' separation; measured 2.4e-7).  Against the
+    # exponents' sum along the same steps only the two quadratures differ (the exponentials' two Gauss
+    # points, Simpson's ends and midpoint, both fourth order on steps sized for the orbit at rtol 1e-9) and
+    # the QR's rounding: measured 9.8e-7 of it apart; 1e-5 is ten times that and 9000 times less than the
+    # stepper's own tangent missed (9 %).
+    assert abs(written - divergence) <= 1e-4 * abs(divergence), (written, divergence)
+    assert abs(exponents.sum() - written) <= 1e-5 * abs(written), (exponents.sum(), written)
 
 
 def force_state(force, s0, u):

@@ -25,7 +25,7 @@ module friction_analysis_tangent_magnus
    implicit none
    private
 
-   public :: magnus_tangent_step, orbit_step, tangent_over_step
+   public :: magnus_tangent_step, orbit_step, tangent_over_step, jacobian_trace, simpson_trace
 
    !> A part may shrink a column to e^-part_spread of another: the
    !> factorisation then loses at most e^18 ulp = 1.5e-8 of the small one,
@@ -413,6 +413,39 @@ contains
          x(k, :) = (x(k, :) - matmul(lu(k, k + 1:n), x(k + 1:n, :))) / lu(k, k)
       end do
    end function solve
+
+   !> tr J(t, y) of `system`.
+   pure real(wp) function jacobian_trace(system, t, y) result(trace)
+      class(ode_system), intent(in) :: system
+      real(wp), intent(in) :: t, y(:)
+      real(wp) :: jac(size(y), size(y)), dfdt(size(y))
+      integer :: i
+
+      call system%jacobian(t, y, jac, dfdt)
+      trace = 0.0_wp
+      do i = 1, size(y)
+         trace = trace + jac(i, i)
+      end do
+   end function jacobian_trace
+
+   !> ∫ tr J dt over the accepted step from (t_a, y_a) with the field f_a to
+   !> (t_b, y_b) with f_b by Simpson's rule: tr J at the step's ends (trace_a
+   !> given, trace_b returned for the next step) and at the midpoint of the
+   !> step's cubic Hermite interpolant.  The flow's divergence apart from the
+   !> exponentials' Gauss points, which the exponents' sum is the quadrature
+   !> on: the sum rule's check (docs/chaos.md, the brake with a law).
+   pure subroutine simpson_trace(system, t_a, y_a, f_a, t_b, y_b, f_b, trace_a, trace_b, integral)
+      class(ode_system), intent(in) :: system
+      real(wp), intent(in) :: t_a, t_b, trace_a
+      real(wp), intent(in) :: y_a(:), f_a(:), y_b(:), f_b(:)
+      real(wp), intent(out) :: trace_b, integral
+      real(wp) :: y(size(y_a)), h
+
+      h = t_b - t_a
+      call hermite(0.5_wp, h, y_a, f_a, y_b, f_b, y)
+      trace_b = jacobian_trace(system, t_b, y_b)
+      integral = h / 6.0_wp * (trace_a + 4.0_wp * jacobian_trace(system, t_a + 0.5_wp * h, y) + trace_b)
+   end subroutine simpson_trace
 
    !> The cubic Hermite interpolant of the step at θ = (t - t_a)/h.
    pure subroutine hermite(theta, h, y_a, f_a, y_b, f_b, y)

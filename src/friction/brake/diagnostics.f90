@@ -17,7 +17,7 @@ module friction_brake_diagnostics
    use friction_law_factory, only: make_law
    use friction_output_law_files, only: law_with_files
    use friction_ode_solver, only: ode_solver
-   use friction_analysis_tangent_magnus, only: orbit_step, tangent_over_step
+   use friction_analysis_tangent_magnus, only: orbit_step, tangent_over_step, jacobian_trace, simpson_trace
    use friction_analysis_settings, only: analysis_settings
    use friction_analysis_spectrum, only: spectrum_settings, spectrum_result, amplitude_spectrum
    use friction_analysis_poincare, only: stroboscopic_map, upward_section
@@ -47,6 +47,9 @@ module friction_brake_diagnostics
       type(spectrum_accumulator) :: qr                !! the whole spectrum (tangent equations, QR)
       real(wp), allocatable :: exponents(:)          !! largest first; -inf for directions lost in stick
       real(wp) :: kaplan_yorke = 0.0_wp
+      !> 1/τ: the time average of tr J over the spectrum's span, for a law
+      !> that is one ODE without a band (unallocated otherwise: law_flow_spectrum)
+      real(wp), allocatable :: divergence
       type(rosenstein_result) :: series
       real(wp) :: series_dt = 0.0_wp   !! sample spacing of the strided series
       type(brake_orbit) :: orbit       !! the periodic orbit through the section (Newton)
@@ -148,7 +151,8 @@ contains
             if (result%tangent%duration == 0.0_wp) &
                & result%tangent%duration = config%t_end - config%t_start - a%lyapunov_spectrum_transient
             result%tangent%renormalise = a%lyapunov_spectrum_renormalise
-            call brake_lyapunov_spectrum(config, result%tangent, result%qr, error, guard, reporter)
+            call brake_lyapunov_spectrum(config, result%tangent, result%qr, error, guard, reporter, &
+               & result%divergence)
             if (allocated(error)) return
             result%exponents = result%qr%exponents()
             result%kaplan_yorke = kaplan_yorke(result%exponents)
@@ -255,16 +259,20 @@ contains
    !> tangent matrix (the switched model applies the saltation matrices at
    !> its events and the stick flow, which forgets the block's velocity);
    !> after the transient, a QR step every renormalisation interval.  A
-   !> law that is one ODE without a band (&brake model = 'law'): law_flow_spectrum;
-   !> with Karnopp's band, the band's run (band.f90): its edges and the ends
-   !> of its hold located, a saltation at each jump, δv forgotten in a hold.
-   subroutine brake_lyapunov_spectrum(config, settings, result, error, guard, reporter)
+   !> law that is one ODE without a band (&brake model = 'law'): law_flow_spectrum,
+   !> which also gives `divergence` (1/τ, the time average of tr J; left
+   !> unallocated for the other models, whose exponents do not sum to it:
+   !> docs/chaos.md); with Karnopp's band, the band's run (band.f90): its
+   !> edges and the ends of its hold located, a saltation at each jump, δv
+   !> forgotten in a hold.
+   subroutine brake_lyapunov_spectrum(config, settings, result, error, guard, reporter, divergence)
       type(brake_config), intent(in) :: config
       type(tangent_settings), intent(in) :: settings
       type(spectrum_accumulator), intent(out) :: result
       type(error_type), allocatable, intent(out) :: error
       type(loop_guard), intent(in), optional :: guard   !! a stop request and max_wall_time, checked each interval
       class(job_reporter), intent(inout), optional :: reporter
+      real(wp), allocatable, intent(out), optional :: divergence
       class(brake_integrator), allocatable, target :: run
       class(sliding_law), allocatable :: law
       type(brake_event_table) :: events
@@ -284,7 +292,12 @@ contains
          if (allocated(error)) return
          call law%band(half_width, limit)
          if (.not. law%set_valued() .and. half_width == 0.0_wp) then
-            call law_flow_spectrum(config, settings, result, error, guard, reporter)
+            block
+               real(wp) :: average
+
+               call law_flow_spectrum(config, settings, result, average, error, guard, reporter)
+               if (present(divergence) .and. .not. allocated(error)) divergence = average
+            end block
             return
          end if
       end if
@@ -338,22 +351,26 @@ contains
    !> the step (analysis/tangent_magnus.f90, as the machine's), the logs
    !> summed over each renormalisation interval.  The flow's events (the
    !> creep band's edges) change neither the field nor the state: Φ needs no
-   !> saltation there, and the stepper does not stop at them.
-   subroutine law_flow_spectrum(config, settings, result, error, guard, reporter)
+   !> saltation there, and the stepper does not stop at them.  `divergence`:
+   !> ∫ tr J dt by Simpson's rule on each step (simpson_trace) over the
+   !> span's length, what the exponents sum to.
+   subroutine law_flow_spectrum(config, settings, result, divergence, error, guard, reporter)
       type(brake_config), intent(in) :: config
       type(tangent_settings), intent(in) :: settings
       type(spectrum_accumulator), intent(out) :: result
+      real(wp), intent(out) :: divergence
       type(error_type), allocatable, intent(out) :: error
       type(loop_guard), intent(in), optional :: guard
       class(job_reporter), intent(inout), optional :: reporter
       type(law_integrator), target :: run
       type(brake_event_table) :: events
       type(ode_solver) :: orbit
-      real(wp), allocatable :: z(:), y_a(:), f_a(:), phi(:, :), logs(:)
-      real(wp) :: t, t0, t_a, t_target
+      real(wp), allocatable :: z(:), y_a(:), f_a(:), f_b(:), phi(:, :), logs(:)
+      real(wp) :: t, t0, t_a, t_target, trace_a, trace_b, integral, total
       integer(i8) :: steps
       integer :: n, k, intervals, depth
 
+      divergence = 0.0_wp
       call run%start(config, config%t_start, initial_state(config), events, error)
       if (allocated(error)) return
       t0 = config%t_start + settings%transient
@@ -367,7 +384,7 @@ contains
          if (allocated(error)) return
       end do
       n = 4 + run%state_count()
-      allocate (z(n), y_a(n), f_a(n), logs(n))
+      allocate (z(n), y_a(n), f_a(n), f_b(n), logs(n))
       z(1:4) = run%y
       if (n > 4) call run%get_states(z(5:n))
       t = run%t
@@ -377,6 +394,8 @@ contains
       intervals = int(settings%duration / settings%renormalise + 1.0e-9_wp)
       call result%start(n, intervals)
       call run%flow%rhs(t, z, f_a)
+      trace_a = jacobian_trace(run%flow, t, z)
+      total = 0.0_wp
       depth = 0
       do k = 1, intervals
          t_target = t0 + k * settings%renormalise
@@ -392,8 +411,13 @@ contains
                   & //': the pad lifts off the belt, outside Eq. 10', error_numerical)
                exit
             end if
-            call tangent_over_step(run%flow, orbit, t_a, y_a, f_a, t, z, phi, logs, depth, error)
+            f_b = f_a
+            call tangent_over_step(run%flow, orbit, t_a, y_a, f_b, t, z, phi, logs, depth, error)
             if (allocated(error)) exit
+            call simpson_trace(run%flow, t_a, y_a, f_a, t, z, f_b, trace_a, trace_b, integral)
+            total = total + integral
+            trace_a = trace_b
+            f_a = f_b
             ! (The guard every 16 steps, and after every step whose exponentials took thousands of parts.)
             if (mod(steps, 16_i8) == 0 .or. depth >= 12) then
                call check_guard()
@@ -406,6 +430,7 @@ contains
          if (allocated(error)) exit
       end do
       call orbit%destroy()
+      if (result%elapsed > 0.0_wp) divergence = total / result%elapsed
       if (allocated(error)) error%message = error%message//" (&brake model = 'law', &law model = '" &
          & //trim(run%law%p%model)//"')"
 

@@ -277,6 +277,8 @@ contains
             call file%write_attribute_real('/brake/lyapunov', 'spectrum_transient', d%tangent%transient, 'tau')
             call file%write_attribute_real('/brake/lyapunov', 'spectrum_duration', d%tangent%duration, 'tau')
             call file%write_attribute_real('/brake/lyapunov', 'spectrum_renormalise', d%tangent%renormalise, 'tau')
+            if (allocated(d%divergence)) &
+               & call file%write_attribute_real('/brake/lyapunov', 'spectrum_divergence', d%divergence, '1/tau')
          end if
          if (a%lyapunov) then
             call file%write_attribute_real('/brake/lyapunov', 'benettin_exponent', d%flow%current(), '1/tau')
