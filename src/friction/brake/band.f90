@@ -27,6 +27,7 @@ module friction_brake_band
    use friction_error, only: error_type, fatal_error, error_numerical
    use friction_strings, only: rtoa, itoa
    use friction_ode_events, only: event_system, event_falling, event_rising, event_either
+   use friction_law, only: in_band, band_edge_velocity
    use friction_law_factory, only: make_law
    use friction_output_law_files, only: law_with_files
    use friction_analysis_lyapunov_spectrum, only: tangent_system
@@ -141,7 +142,7 @@ contains
       class(brake_band_flow), intent(in) :: self
       real(wp), intent(in) :: v
 
-      inside = abs((v - self%flow%params%v_dr) * self%flow%units%velocity) < self%half_width
+      inside = in_band(v, self%flow%params%v_dr, self%half_width, self%flow%units%velocity)
    end function inside
 
    !> The block's velocity closest to the edge of sign s on its inner side
@@ -151,16 +152,7 @@ contains
       real(wp), intent(in) :: s
       logical, intent(in) :: inner
 
-      v = self%flow%params%v_dr + s * self%half_width / self%flow%units%velocity
-      if (inner) then
-         do while (.not. self%inside(v))
-            v = nearest(v, -s)
-         end do
-      else
-         do while (self%inside(v))
-            v = nearest(v, s)
-         end do
-      end if
+      v = band_edge_velocity(self%flow%params%v_dr, self%half_width, self%flow%units%velocity, s, inner)
    end function edge_velocity
 
    ! ---- the integrator ----

@@ -16,6 +16,7 @@ module friction_law
    private
 
    public :: sliding_law, max_law_states, difference_partials, exact_stick_force
+   public :: in_band, band_edge_velocity
 
    !> The most internal states a law has (the ODE bridge's room): the
    !> Generalized Maxwell-Slip law's elements.
@@ -200,6 +201,36 @@ contains
       half_width = 0.0_wp
       limit = 0.0_wp
    end subroutine band
+
+   !> Whether a mechanism's velocity v is inside a band law's band about the
+   !> surface's velocity `centre`, as the law decides it: |(v - centre) scale|
+   !> < half_width, with `scale` the law's velocity unit per the mechanism's
+   !> (1 when both are SI).
+   pure logical function in_band(v, centre, half_width, scale)
+      real(wp), intent(in) :: v, centre, half_width, scale
+
+      in_band = abs((v - centre) * scale) < half_width
+   end function in_band
+
+   !> The mechanism's velocity closest to the band's edge of sign s, on its
+   !> inner side (in_band) or its outer side: where a block entering the band
+   !> is put, and where it leaves from at the end of a hold, the same to the
+   !> last bit on every pass (docs/chaos.md, "Karnopp's band").
+   pure real(wp) function band_edge_velocity(centre, half_width, scale, s, inner) result(v)
+      real(wp), intent(in) :: centre, half_width, scale, s
+      logical, intent(in) :: inner
+
+      v = centre + s * half_width / scale
+      if (inner) then
+         do while (.not. in_band(v, centre, half_width, scale))
+            v = nearest(v, -s)
+         end do
+      else
+         do while (in_band(v, centre, half_width, scale))
+            v = nearest(v, s)
+         end do
+      end if
+   end function band_edge_velocity
 
    pure real(wp) function slip_force(self, v, z, normal, s)
       class(sliding_law), intent(in) :: self

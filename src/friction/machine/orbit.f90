@@ -34,7 +34,7 @@ module friction_machine_orbit
    use friction_ode_events, only: event_system, event_locator, event_either, event_rising
    use friction_ode_watch, only: step_watch
    use friction_analysis_lyapunov_spectrum, only: tangent_system, pack_tangent, unpack_tangent
-   use friction_law, only: sliding_law, max_law_states
+   use friction_law, only: sliding_law, max_law_states, band_edge_velocity
    use friction_law_factory, only: make_law
    use friction_output_law_files, only: law_with_files
    use friction_analysis_periodic_orbit, only: section_map, orbit_settings, periodic_orbit, find_periodic_orbit, &
@@ -343,10 +343,10 @@ contains
                   near = y
                   if (abs(w) < width) then
                      ! Entering: just inside, deterministically.
-                     y(2) = edge_velocity(m%belt, edge, .true.)
-                     near(2) = edge_velocity(m%belt, edge, .false.)
+                     y(2) = band_edge_velocity(m%belt, width, 1.0_wp, sign(1.0_wp, edge), .true.)
+                     near(2) = band_edge_velocity(m%belt, width, 1.0_wp, sign(1.0_wp, edge), .false.)
                   else
-                     near(2) = edge_velocity(m%belt, edge, .true.)
+                     near(2) = band_edge_velocity(m%belt, width, 1.0_wp, sign(1.0_wp, edge), .true.)
                   end if
                   call b%rhs(t, near, f_minus)
                   call b%rhs(t, y, f_plus)
@@ -364,7 +364,7 @@ contains
                   sigma = merge(1.0_wp, -1.0_wp, which == 3)
                   a = m%applied(t, y(1) + m%load * t, y(2))
                   ! A hold at the edge the force pushes towards ends: out at once (else a kink, nothing to do).
-                  if (abs(w) < width .and. y(2) == edge_velocity(m%belt, sign(width, w), .true.) &
+                  if (abs(w) < width .and. y(2) == band_edge_velocity(m%belt, width, 1.0_wp, sign(1.0_wp, w), .true.) &
                      & .and. sigma * a >= limit .and. sigma * w > 0.0_wp) then
                      f_minus = 0.0_wp
                      f_minus(1) = y(2) - m%load   ! the hold's field: e' = v - load_velocity, v' = 0, the states'
@@ -372,7 +372,7 @@ contains
                         call b%rhs(t, y, f_plus)
                         f_minus(3:n) = f_plus(3:n)
                      end if
-                     y(2) = edge_velocity(m%belt, sign(width, w), .false.)
+                     y(2) = band_edge_velocity(m%belt, width, 1.0_wp, sign(1.0_wp, w), .false.)
                      call b%rhs(t, y, f_plus)
                      ! h = F_s - σ A(t, e + load t, v): ∇h = σ (k, c, 0...), ∂h/∂t at fixed e.
                      normal = 0.0_wp
@@ -645,24 +645,6 @@ contains
       end if
       if (present(watch)) map%watch => watch
    end subroutine section_of
-
-   !> The velocity closest to the band's edge belt + edge on its inner side
-   !> (|v - belt| < |edge| as computed) or its outer side (>=).
-   pure real(wp) function edge_velocity(belt, edge, inner) result(v)
-      real(wp), intent(in) :: belt, edge
-      logical, intent(in) :: inner
-
-      v = belt + edge
-      if (inner) then
-         do while (abs(v - belt) >= abs(edge))
-            v = nearest(v, -edge)
-         end do
-      else
-         do while (abs(v - belt) < abs(edge))
-            v = nearest(v, edge)
-         end do
-      end if
-   end function edge_velocity
 
    !> Whether the law has a band whose edges make its force jump.
    logical function has_band(frame)
