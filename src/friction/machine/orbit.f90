@@ -262,7 +262,10 @@ contains
    !> - a hold at an edge ends where |A| reaches F_s pushing outwards: the
    !>   block leaves at once (in the band's limit it drifts out in a time
    !>   that vanishes with its depth), a saltation from the hold's field into
-   !>   the outside one across h = F_s - σ A, ∂h/∂t included;
+   !>   the outside one across h = F_s - σ A, ∂h/∂t included.  The hold is
+   !>   known by the edge it was entered at, not by v: the step that reaches
+   !>   the force's event may move v by units of its last place, out past the
+   !>   edge, so that the edge's event may even come first;
    !> - without a moving support, Φ in a hold is projected along its
    !>   one-dimensional flow (as exact stick's: switching.f90).
    subroutine band_section_evaluate(self, s, image, jacobian, period, returned, reason, error)
@@ -275,7 +278,7 @@ contains
       type(event_locator) :: locator
       real(wp), allocatable :: y(:), phi(:, :), z(:), f_minus(:), f_plus(:), near(:), normal(:), row(:)
       integer, allocatable :: directions(:)
-      real(wp) :: t, t_end, h, w, edge, sigma, a, rate, rate_t
+      real(wp) :: t, t_end, h, w, edge, sigma, a, rate, rate_t, hold_edge
       integer :: n, i, which, events
       logical :: done
       !> Switches in one return beyond which the band's events are taken to chatter (no return).
@@ -315,6 +318,13 @@ contains
             call locator%restart(t, z, h)
             done = .false.
             events = 0
+            ! The sign of the edge the block holds at (0: none); a strobe point may be in a hold.
+            hold_edge = 0.0_wp
+            w = y(2) - m%belt
+            if (abs(w) < width .and. abs(m%applied(t, y(1) + m%load * t, y(2))) <= limit) then
+               if (y(2) == band_edge_velocity(m%belt, width, 1.0_wp, sign(1.0_wp, w), .true.)) &
+                  & hold_edge = sign(1.0_wp, w)
+            end if
             do while (t < t_end)
                if (events >= max_events) then
                   reason = 'more than 100000 switches at the band''s edges in one return'
@@ -331,6 +341,9 @@ contains
                which = locator%hits(locator%n_hits)%which
                call unpack_tangent(z, y, phi)
                w = y(2) - m%belt
+               ! Out past the edge of a hold before the force's event was located: that is the hold's end.
+               if ((which == 1 .or. which == 2) .and. hold_edge == merge(1.0_wp, -1.0_wp, which == 1) &
+                  & .and. .not. abs(w) < width) which = which + 2
                select case (which)
                case (5)
                   ! A function exactly 0 at the start crosses at once (ode/events.f90): that is the start itself.
@@ -358,21 +371,21 @@ contains
                      end do
                      phi(2, :) = row * (f_plus(2) / f_minus(2))
                   end if
+                  hold_edge = merge(sign(1.0_wp, edge), 0.0_wp, f_plus(2) == 0.0_wp .and. abs(w) < width)
                   ! A hold's flow is one-dimensional: without a support's motion what is left of Φ is a shift in time.
-                  if (.not. self%forced .and. f_plus(2) == 0.0_wp .and. abs(w) < width) phi = 0.0_wp
+                  if (.not. self%forced .and. hold_edge /= 0.0_wp) phi = 0.0_wp
                case (3, 4)
                   sigma = merge(1.0_wp, -1.0_wp, which == 3)
                   a = m%applied(t, y(1) + m%load * t, y(2))
                   ! A hold at the edge the force pushes towards ends: out at once (else a kink, nothing to do).
-                  if (abs(w) < width .and. y(2) == band_edge_velocity(m%belt, width, 1.0_wp, sign(1.0_wp, w), .true.) &
-                     & .and. sigma * a >= limit .and. sigma * w > 0.0_wp) then
+                  if (hold_edge == sigma .and. (sigma * a >= limit .or. .not. abs(w) < width)) then
                      f_minus = 0.0_wp
                      f_minus(1) = y(2) - m%load   ! the hold's field: e' = v - load_velocity, v' = 0, the states'
                      if (n > 2) then
                         call b%rhs(t, y, f_plus)
                         f_minus(3:n) = f_plus(3:n)
                      end if
-                     y(2) = band_edge_velocity(m%belt, width, 1.0_wp, sign(1.0_wp, w), .false.)
+                     y(2) = band_edge_velocity(m%belt, width, 1.0_wp, sigma, .false.)
                      call b%rhs(t, y, f_plus)
                      ! h = F_s - σ A(t, e + load t, v): ∇h = σ (k, c, 0...), ∂h/∂t at fixed e.
                      normal = 0.0_wp
@@ -387,6 +400,8 @@ contains
                         end do
                      end if
                   end if
+                  ! Ended, or pushed inwards into the band: no longer held at an edge.
+                  hold_edge = 0.0_wp
                end select
                z = pack_tangent(y, phi)
                call locator%restart(t, z, 0.0_wp)
