@@ -63,11 +63,15 @@ module friction_analysis_magnus_section
       real(wp), allocatable :: q(:, :), logs(:), upper(:, :), frame(:, :)
       real(wp) :: last_period = 0.0_wp
       logical :: evaluated = .false.
+      !> A start where the flow crosses y_k = c downwards (or not at all) is outside the map's domain and
+      !> refused, unless entering: then its image is the flow's next upward crossing (a guess moved onto it).
+      logical :: entering = .false.
    contains
       procedure :: setup => magnus_setup
       procedure :: dimension => magnus_dimension
       procedure :: evaluate => magnus_evaluate
       procedure :: log_multipliers => magnus_log_multipliers
+      procedure :: enter => magnus_enter
    end type magnus_map
 
 contains
@@ -191,6 +195,12 @@ contains
          call periodic(error)
          if (allocated(error)) return
       else
+         ! Off the upward side the next upward crossing is a short loop near the section's fold (where the flow
+         ! is tangent to it), not a return round the orbit: Newton would converge on the fold.
+         if (.not. (f_a(k) > 0.0_wp) .and. .not. self%entering) then
+            reason = 'the flow crosses the section downwards at this point (outside the section''s upward side)'
+            return
+         end if
          if (.not. (h > 0.0_wp)) h = 1.0e-3_wp
          t_end = self%t0 + self%max_return
          call returning(done, error)
@@ -298,6 +308,33 @@ contains
       end subroutine returning
 
    end subroutine magnus_evaluate
+
+   !> A guess s of the autonomous section moved onto its upward side: where
+   !> the flow crosses there downwards, to the flow's next upward crossing;
+   !> entered = .false. (with the reason) when it has none.
+   subroutine magnus_enter(self, s, entered, reason, error)
+      class(magnus_map), intent(inout) :: self
+      real(wp), intent(inout) :: s(:)
+      logical, intent(out) :: entered
+      character(len=:), allocatable, intent(out) :: reason
+      type(error_type), allocatable, intent(out) :: error
+      real(wp) :: image(size(s)), jacobian(size(s), size(s)), period, y(self%plane%base%dimension())
+      real(wp) :: f(self%plane%base%dimension())
+      integer :: i, k
+
+      entered = .true.
+      reason = ''
+      if (self%forced) return
+      k = self%plane%coordinate
+      y(pack([(i, i=1, size(y))], [(i, i=1, size(y))] /= k)) = s
+      y(k) = self%plane%level
+      call self%plane%rhs(self%t0, y, f)
+      if (f(k) > 0.0_wp) return
+      self%entering = .true.
+      call self%evaluate(s, image, jacobian, period, entered, reason, error)
+      self%entering = .false.
+      if (entered .and. .not. allocated(error)) s = image
+   end subroutine magnus_enter
 
    !> M = Q diag(exp(L)) U Gᵀ in doubles (what underflows is 0).
    function monodromy_double(self) result(m)

@@ -764,6 +764,9 @@ contains
       type(machine_section) :: map
       real(wp), allocatable :: scale(:), section_scale(:)
       complex(wp), allocatable :: logs(:)
+      real(wp) :: start(size(guess))
+      character(len=:), allocatable :: reason
+      logical :: entered
       integer :: n, i, j
 
       call frame_of(c, frame, scale, error)
@@ -772,7 +775,21 @@ contains
       result%forced = machine_orbit_forced(c)
       result%guess_time = t_guess
       call section_of(c, frame, t_guess, map, watch)
-      call find_periodic_orbit(map, guess, settings, result%orbit, error)
+      start = guess
+      select type (inner => map%inner)
+      type is (magnus_map)
+         ! The run's interpolated section point may lie where the flow crosses downwards (rate and state's
+         ! slow creep crosses v = load_velocity with v' ~ 1e-7 m/s^2): the flow's next upward crossing instead.
+         call inner%enter(start, entered, reason, error)
+         if (allocated(error)) return
+         if (.not. entered) then
+            result%orbit%point = guess
+            result%orbit%reason = reason
+            call equilibrium_of(c, result, error)
+            return
+         end if
+      end select
+      call find_periodic_orbit(map, start, settings, result%orbit, error)
       if (allocated(error)) return
       select type (inner => map%inner)
       type is (switching_section)
