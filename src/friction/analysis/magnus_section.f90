@@ -17,7 +17,7 @@
 !> eigenvalues by e^-36 of themselves at most), each cluster scaled into
 !> doubles for LAPACK.
 module friction_analysis_magnus_section
-   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_negative_inf
+   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_negative_inf, ieee_is_finite
    use friction_kinds, only: wp, i8
    use friction_error, only: error_type, fatal_error, error_numerical
    use friction_strings, only: rtoa
@@ -211,6 +211,12 @@ contains
          end if
       end if
       monodromy = monodromy_double(self)
+      if (.not. all(ieee_is_finite(monodromy))) then
+         ! A Jacobian past the largest double leaves Newton nothing to solve with; say why at once.
+         reason = 'the section map''s Jacobian overflows (a direction grows by e^'//rtoa(maxval(self%logs)) &
+            & //' over the return: the tangent through a switch of the law sharper than the orbit''s steps)'
+         return
+      end if
       if (self%forced) then
          image = y
          jacobian = monodromy

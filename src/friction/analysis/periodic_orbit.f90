@@ -207,6 +207,13 @@ contains
             orbit%reason = 'a multiplier equals 1: DP - I is singular'
             return
          end if
+         ! Coordinates off by more than the tolerance that the step cannot move (it is below their rounding): DP
+         ! is far larger than the map's slope there, and no halving helps; say so before evaluating more returns.
+         if (all(abs(image - s) <= settings%tolerance .or. abs(step) <= 4 * epsilon(1.0_wp) * abs(s))) then
+            orbit%reason = 'the Newton step is below the rounding of the point where it is off: the section ' &
+               & //'map''s Jacobian is far larger than its slope there'
+            return
+         end if
          orbit%iterations = orbit%iterations + 1
          scale = 1.0_wp
          do halving = 0, settings%max_halvings
