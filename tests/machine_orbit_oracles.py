@@ -75,6 +75,7 @@ from scipy.optimize import brentq
 
 from machine_cases import run_program, check_refusals, case_main
 
+
 def run(args, name, files, sets):
     with h5py.File(run_program(args, name, files, sets)) as f:
         g = f["machine/orbit"]
@@ -90,6 +91,7 @@ def run(args, name, files, sets):
     orbit["multipliers"] = orbit["floquet_multipliers"][:, 0] + 1j * orbit["floquet_multipliers"][:, 1]
     return orbit
 
+
 def jacobian_of(field, y, steps):
     """∂f/∂y by central differences (the divergence's oracle: no analytic partial of the program)."""
     n = len(y)
@@ -99,6 +101,7 @@ def jacobian_of(field, y, steps):
         d[j] = steps[j]
         jac[:, j] = (np.asarray(field(0.0, y + d)) - np.asarray(field(0.0, y - d))) / (2 * steps[j])
     return jac
+
 
 def forced_linear(args):
     # m x'' = -k (x - u) - F(x'), u = A sin ωt, F = (2/π) μ N arctan(ε x')/(1 + δ|x'|) with δ = 0 and
@@ -128,6 +131,7 @@ def forced_linear(args):
     assert mult_error < 1e-7, mult_error
     assert abs(got["period"] - 1 / freq) < 1e-12
 
+
 def lugre_field(m, k, c, vb, fc, fs, vs, s0, s1, s2, amp=0.0, freq=0.0):
     def g(w):
         return fc + (fs - fc) * np.exp(-(w / vs) ** 2)
@@ -141,6 +145,7 @@ def lugre_field(m, k, c, vb, fc, fs, vs, s0, s1, s2, amp=0.0, freq=0.0):
         return [v, (-k * (x - u) - c * (v - du) - (s0 * z + s1 * zdot + s2 * w)) / m, zdot]
     return field
 
+
 def central_differences(section_map, point, steps):
     """The Jacobian of `section_map` at `point` by central differences with `steps` per coordinate."""
     fd = np.zeros((len(point), len(point)))
@@ -149,6 +154,7 @@ def central_differences(section_map, point, steps):
         d[j] = steps[j]
         fd[:, j] = (section_map(point + d) - section_map(point - d)) / (2 * steps[j])
     return fd
+
 
 def check_fd_liouville(name, got, section_map, field, states_of, period, steps, tol_fd, tol_liouville):
     """DP against central differences of the map; ∏μ against exp(∮ div f dt) along the orbit."""
@@ -180,6 +186,7 @@ def check_fd_liouville(name, got, section_map, field, states_of, period, steps, 
     assert fd_error < tol_fd, (dp, fd)
     assert abs(log_product - integral) < tol_liouville * max(1.0, abs(integral))
 
+
 def forced_lugre(args):
     p = dict(m=1.0, k=2.0, c=0.0, vb=0.1, fc=1.0, fs=1.5, vs=1e-3, s0=20.0, s1=1.0, s2=0.4, amp=0.01, freq=0.25)
     got = run(args, "forced_lugre", ["machine_lugre.nml"], {
@@ -200,6 +207,7 @@ def forced_lugre(args):
     # Steps 1e-5 of x, v and z's sizes: truncation ~1e-10, Radau's noise 1e-15/1e-5 ~1e-10 (the map is
     # linear to that here); the program's DP from the variational equations at rtol 1e-9: 1e-6 is 1000 rtol.
     check_fd_liouville("forced-lugre", got, strobe, field, lambda s: s, period, [1e-5, 1e-5, 1e-7], 1e-6, 1e-6)
+
 
 def arctan_belt(args):
     m, k, vb, mu, normal, eps, delta = 1.0, 2.0, 0.1, 1.0, 1.0, 20.0, 10.0
@@ -231,6 +239,7 @@ def arctan_belt(args):
     # Liouville over the period with the trivial multiplier 1 included (ln 1 = 0).
     check_fd_liouville("arctan-belt", got, section_map, field, lambda s: [s[0], 0.0], got["period"], [1e-5],
                        1e-6, 1e-6)
+
 
 def hopf_belt(args):
     got = run(args, "hopf", ["machine_orbit.nml"], {})
@@ -266,6 +275,7 @@ def hopf_belt(args):
     # to 1e-12 of the step: 1e-9 relative is far outside both.
     assert abs(found - exact) / exact < 1e-9
     assert np.all(got["branch"]["found"] == 1)
+
 
 def coulomb_cycle(args):
     # Between sticks the block slips with the kinetic force s F_k (s the sign of w = v - belt): in the load
@@ -309,9 +319,11 @@ def coulomb_cycle(args):
         # Newton from the run's point: with DP = 0 one step lands on the fixed point.
         assert got["iterations"] <= 2
 
+
 def stribeck_slip_force(w, s, fc, fs, vs, exponent, sigma2):
     """The Stribeck law's slip force in the direction s (docs/laws.md), smooth through w = 0."""
     return s * (fc + (fs - fc) * np.exp(-np.abs(w / vs) ** exponent)) + sigma2 * w
+
 
 def switching_strobe(p, t0, period, state, rtol=1e-12, atol=1e-14):
     """The block's state at t0 + period from `state` at t0 with exact stick and slip, written here: slip with
@@ -364,10 +376,12 @@ def switching_strobe(p, t0, period, state, rtol=1e-12, atol=1e-14):
                     s = np.sign(a)
     return np.array([x, v])
 
+
 def forced_switching(args):
     forced_stribeck(args)
     forced_coulomb_stuck(args)
     forced_coulomb_reversals(args)
+
 
 def forced_coulomb_reversals(args):
     # Coulomb on a still surface (belt 0) driven hard (0.5 m at 0.3 Hz): the block never sticks, it reverses
@@ -393,6 +407,7 @@ def forced_coulomb_reversals(args):
     # As forced-stribeck: the orbit to 1e-8, DP and the multipliers to 1e-6 of the largest.
     assert got["stick_phases"] == 0 and closes < 1e-8, closes
     assert fd_error < 1e-6 and mu_error < 1e-6, (dp, fd)
+
 
 def forced_coulomb_stuck(args):
     # Coulomb (F_k = 0.5 N, F_s = 1 N) on the same support: a period-1 orbit whose strobe point sticks.  There
@@ -420,6 +435,7 @@ def forced_coulomb_stuck(args):
     assert abs(mu_got[0] - slope) < 1e-6 * abs(slope)
     assert np.all(dp[:, 1] == 0.0) and dp[1, 0] == 0.0, dp   # stuck at both ends: v's row and column are 0
     assert mu_got[1] == 0.0 and got["stick_phases"] == 1
+
 
 def forced_stribeck(args):
     p = dict(m=1.0, k=2.0, c=0.0, belt=0.1, load=0.0, fc=1.0, fs=1.5, vs=0.05, exponent=2.0, sigma2=0.4,
@@ -453,6 +469,7 @@ def forced_stribeck(args):
     # det to their noise), its exponent -inf.
     assert got["stick_phases"] == 1 and mu_got[1] == 0.0 and np.isneginf(got["floquet_exponents"][1])
     assert np.min(np.abs(expected)) < 1e-6
+
 
 def karnopp_flow(p, t0, duration, state, rtol=1e-12, atol=1e-14):
     """Karnopp's block from `state` at t0 for `duration`, written here in the band's limit of no depth:
@@ -509,6 +526,7 @@ def karnopp_flow(p, t0, duration, state, rtol=1e-12, atol=1e-14):
                 mode = "out"
     return np.array([x, v])
 
+
 def karnopp_band(args):
     # On the belt (inputs/machine_karnopp.nml): the orbit's section point (e, 0) comes back to itself after
     # the period under the flow integrated here, and its hold makes it superstable.
@@ -551,6 +569,7 @@ def karnopp_band(args):
     # The hold forgets δv: the second multiplier is 0 to the round-off of the closed form's determinant.
     assert abs(mu_got[1]) < 1e-12 * abs(mu_got[0])
 
+
 def karnopp_continued(args):
     # The moving support of karnopp-band, its orbit followed in support_amplitude from 0.2 to 0.3 m at the
     # program's default stepper and tolerances. Each point of the branch against the band's flow integrated
@@ -586,6 +605,7 @@ def karnopp_continued(args):
     assert worst_close < 1e-8, worst_close
     assert worst_mu < 1e-6, worst_mu
 
+
 def stribeck_hopf(args):
     fc, fs, vs, exponent, sigma2, m, k, c = 1.0, 1.5, 1e-3, 2.0, 0.4, 1.0, 2.0, 0.0
     got = run(args, "stribeck_hopf", ["machine_stribeck.nml"], {
@@ -616,6 +636,7 @@ def stribeck_hopf(args):
     # each orbit superstable: the trivial 1 and 0 exactly.
     assert np.all(branch["found"] == 1)
     assert np.all(mu[:, 0] == 1.0) and np.all(np.abs(mu[:, 1]) < 1e-15), mu   # h5py: (points, multipliers)
+
 
 def forced_gms(args):
     # The law's states z_i relax to their limits s w_i g / k_i at a rate k_i |w| / (w_i g ε) ~ 1e4 /s and, at
@@ -689,6 +710,7 @@ def forced_gms(args):
     # dgeev's backward error is ~1e-16 of the largest entry (1.5e9): ~1e-7 on the oscillator's 1.4; 1e-6 bounds it.
     assert eig_error < 1e-6, (eig, expected)
 
+
 def table_lugre(args):
     # The LuGre paper's belt oscillator at Table I's stiffness (inputs/machine_orbit.nml's first point): a
     # stick-slip orbit of 159 s whose stick damps the bristles' two fast directions by some e^-6800 and
@@ -752,6 +774,7 @@ def table_lugre(args):
     assert np.all(got["multipliers"][1:] == 0.0) and got["multipliers"][0] == 1.0
     assert np.max(np.abs(logs[1:] - adiabatic[1:])) < 2 * abs(adiabatic[0]) + 1.0, (logs, adiabatic)
 
+
 def rate_state_orbit(args):
     # inputs/machine_rate_state.nml run to its stick-slip cycle (growth 2.5e-3 /s: stick-slip from ~2500 s). The
     # cycle crosses v = V upwards in its slow creep (v' ~ 1.2e-7 m/s^2 there), so a point of the section 2.7e-10 m
@@ -808,6 +831,7 @@ def rate_state_orbit(args):
     # The loose tolerance (which took a 3.2e-7 s loop for the orbit) finds the same cycle.
     assert loose["found"] == 1 and abs(loose["period"] - period) < 1e-6 * period, loose["period"]
 
+
 def gms_table(args):
     # inputs/machine_gms.nml's stick-slip orbit is not found (docs/chaos.md: the map's slope in e is ~2.1, the
     # exponential tangent's 1e41 to 1e71). The oracle here is that slope: a Newton step from DP that large moves
@@ -819,6 +843,7 @@ def gms_table(args):
         residual = g.attrs["residual"]
     print(f"gms-table: found {found}, after {iterations} Newton steps, residual {residual:.3e}: {reason}")
     assert found == 0 and iterations == 0 and "Jacobian" in reason, reason
+
 
 def refusals(args):
     cases = [  # (the groups, the line named, what the message names, why)
@@ -834,17 +859,16 @@ def refusals(args):
     ]
     check_refusals(args, cases, "refusals")
 
+
 def main():
     return case_main(__doc__, {"forced-linear": forced_linear, "forced-lugre": forced_lugre,
                                "arctan-belt": arctan_belt, "hopf-belt": hopf_belt, "coulomb-cycle": coulomb_cycle,
                                "forced-switching": forced_switching,
                                "karnopp-band": karnopp_band, "karnopp-continued": karnopp_continued,
                                "stribeck-hopf": stribeck_hopf, "forced-gms": forced_gms,
-                               "table-lugre": table_lugre, "refusals": refusals})
-
-                               "karnopp-band": karnopp_band, "stribeck-hopf": stribeck_hopf, "forced-gms": forced_gms,
                                "table-lugre": table_lugre, "rate-state": rate_state_orbit, "gms-table": gms_table,
                                "refusals": refusals})
+
 
 if __name__ == "__main__":
     sys.exit(main())
