@@ -18,6 +18,7 @@ module friction_parameters
    public :: configurable, parameter_visitor, parameter_info, unit_hint, parameter_finding
    public :: list_parameters, set_parameter, set_parameter_number, get_parameter, parameters_text
    public :: implausible_values
+   public :: parameter_table
    public :: kind_text, value_has_kind, split_name, max_list_values
 
    integer, parameter :: mode_list = 1, mode_set = 2, mode_get = 3, mode_write = 4, mode_inspect = 5
@@ -46,6 +47,7 @@ module friction_parameters
    type :: parameter_visitor
       integer :: mode = mode_list
       character(len=32) :: group = ''          !! the group being visited
+      logical :: group_wanted = .false.        !! set, get: whether it is want_group (compared once a group)
       character(len=32) :: want_group = ''     !! set, get: the variable's group (or '' for all, write)
       character(len=32) :: want_name = ''      !! set, get: the variable's name
       integer :: first = 0                     !! set, get: the element given, name(first); 0 whole
@@ -77,6 +79,19 @@ module friction_parameters
       procedure, private :: wants, add_info, add_line, element_ok, inspect_reals
    end type parameter_visitor
 
+   !> The positions of (group, name) pairs in a list of variables, found by
+   !> hashing: reading an input looks each assignment up in the list of every
+   !> scene's variables, and building that list drops the pairs two scenes
+   !> share, both in time in proportion to the list instead of its square.
+   type :: parameter_table
+      character(len=32), allocatable :: groups(:), names(:)   !! the pairs, in the order added
+      integer, allocatable :: slots(:)   !! open addressing: 0 empty, else a position in groups/names
+      integer :: n = 0
+   contains
+      procedure :: find => table_find
+      procedure :: add => table_add
+   end type parameter_table
+
    !> A type whose variables can be visited.
    type, abstract :: configurable
    contains
@@ -94,6 +109,102 @@ module friction_parameters
 
 contains
 
+   ! ---- the table of names ----
+
+   !> The slot of group.name's hash (its first probe).  Names have no blanks
+   !> inside, so each is hashed up to its first blank: texts equal but for
+   !> trailing blanks hash alike.
+   pure integer function table_hash(group, name, n_slots) result(slot)
+      character(len=*), intent(in) :: group, name
+      integer, intent(in) :: n_slots
+      integer :: h, k, c
+
+      ! (Masked to 24 bits at every step, so no product overflows; the
+      ! characters as codes, which gfortran compares without a library call.)
+      h = 7
+      do k = 1, len(group)
+         c = ichar(group(k:k))
+         if (c == 32) exit
+         h = iand(h * 33 + c, 16777215)
+      end do
+      h = iand(h * 33 + 46, 16777215)
+      do k = 1, len(name)
+         c = ichar(name(k:k))
+         if (c == 32) exit
+         h = iand(h * 33 + c, 16777215)
+      end do
+      slot = iand(h, n_slots - 1) + 1
+   end function table_hash
+
+   !> The slot holding group.name, or the empty slot where it would go.
+   integer function table_slot(self, group, name) result(slot)
+      class(parameter_table), intent(in) :: self
+      character(len=*), intent(in) :: group, name
+      integer :: k
+
+      slot = table_hash(group, name, size(self%slots))
+      do
+         k = self%slots(slot)
+         if (k == 0) return
+         if (self%groups(k) == group .and. self%names(k) == name) return
+         slot = iand(slot, size(self%slots) - 1) + 1
+      end do
+   end function table_slot
+
+   !> The position of group.name in the table (0 if absent).
+   integer function table_find(self, group, name) result(found)
+      class(parameter_table), intent(in) :: self
+      character(len=*), intent(in) :: group, name
+
+      found = 0
+      if (self%n > 0) found = self%slots(table_slot(self, group, name))
+   end function table_find
+
+   !> Add group.name unless it is there; `position` is its position either
+   !> way and `added` whether it is new.
+   subroutine table_add(self, group, name, position, added)
+      class(parameter_table), intent(inout) :: self
+      character(len=*), intent(in) :: group, name
+      integer, intent(out) :: position
+      logical, intent(out) :: added
+      character(len=32), allocatable :: grown(:)
+      integer :: k, slot
+
+      if (.not. allocated(self%groups)) then
+         ! (Room for the some 300 variables of every scene without a rehash.)
+         allocate (self%groups(512), self%names(512), self%slots(1024))
+         self%slots = 0
+      end if
+      slot = table_slot(self, group, name)
+      position = self%slots(slot)
+      added = position == 0
+      if (.not. added) return
+      if (self%n == size(self%groups)) then
+         allocate (grown(2 * self%n))
+         grown(1:self%n) = self%groups(1:self%n)
+         call move_alloc(grown, self%groups)
+         allocate (grown(2 * self%n))
+         grown(1:self%n) = self%names(1:self%n)
+         call move_alloc(grown, self%names)
+      end if
+      self%n = self%n + 1
+      self%groups(self%n) = group
+      self%names(self%n) = name
+      position = self%n
+      ! At most half full (a power of two in size), so a probe ends soon at an empty slot.
+      if (2 * self%n > size(self%slots)) then
+         deallocate (self%slots)
+         allocate (self%slots(4 * size(self%groups)))
+         self%slots = 0
+         do k = 1, self%n
+            slot = table_slot(self, self%groups(k), self%names(k))
+            self%slots(slot) = k
+         end do
+      else
+         self%slots(slot) = position
+      end if
+   end subroutine table_add
+
    ! ---- visiting ----
 
    !> Start the variables of a namelist group.
@@ -103,6 +214,7 @@ contains
       logical :: shown
 
       self%group = name
+      self%group_wanted = (self%mode == mode_set .or. self%mode == mode_get) .and. self%group == self%want_group
       if (self%mode /= mode_write) return
       shown = .true.
       if (allocated(self%only)) shown = any(self%only == name)
@@ -116,6 +228,7 @@ contains
       if (self%mode == mode_write .and. self%in_group) self%text = self%text//'/'//new_line('a')
       self%in_group = .false.
       self%group = ''
+      self%group_wanted = .false.
    end subroutine end_group
 
    !> For a value refused as not of its variable's kind: which unit counts,
@@ -143,8 +256,7 @@ contains
       class(parameter_visitor), intent(in) :: self
       character(len=*), intent(in) :: name
 
-      wants = (self%mode == mode_set .or. self%mode == mode_get) .and. .not. self%found &
-         & .and. self%group == self%want_group .and. name == self%want_name
+      wants = self%group_wanted .and. .not. self%found .and. name == self%want_name
    end function wants
 
    !> Whether the element asked for (first, 0 for all) is one of the n; if

@@ -10,8 +10,7 @@ module friction_input_reader
    use friction_strings, only: itoa, join, one_line
    use friction_error, only: error_type, fatal_error, error_input
    use friction_parameters, only: configurable, parameter_info, set_parameter, list_parameters, kind_text, value_has_kind, &
-      & unit_hint, &
-      & split_name
+      & unit_hint, split_name, parameter_table
    use friction_checks, only: config_checker
    use friction_input_scan, only: mention, scan_namelist_file
    implicit none
@@ -151,19 +150,41 @@ contains
    !> Set `target` from the files, in order.  `universe` lists every variable
    !> of every group the files may name (groups of other scenes included,
    !> checked and ignored); only the groups `target` visits are set.  The
-   !> checker learns where each value came from.
-   subroutine apply_files(sources, universe, target, checker, error)
+   !> checker learns where each value came from.  `table`, if given, holds
+   !> universe's names, each at its position in universe (no name twice).
+   subroutine apply_files(sources, universe, target, checker, error, table)
       type(namelist_source), intent(in) :: sources(:)
       type(parameter_info), intent(in) :: universe(:)
       class(configurable), intent(inout) :: target
       type(config_checker), intent(inout) :: checker
       type(error_type), allocatable, intent(out) :: error
+      type(parameter_table), intent(in), optional :: table
       character(len=:), allocatable :: problem, base, where, shown
-      character(len=32), allocatable :: known(:)
+      character(len=32), allocatable :: known(:), own_groups(:)
       type(parameter_info), allocatable :: mine(:)
-      integer :: f, k, u, slash
+      type(parameter_table) :: names
+      integer, allocatable :: first_at(:)   !! a name's first position in universe, by its position in names
+      integer :: f, k, u, slash, position
+      logical :: added
 
       mine = list_parameters(target)
+      ! Each assignment is looked up by name, and each group once per
+      ! variable listed: a search of the whole list per assignment cost more
+      ! than setting the values.
+      if (.not. present(table)) then
+         allocate (first_at(size(universe)))
+         do k = 1, size(universe)
+            call names%add(universe(k)%group, universe(k)%name, position, added)
+            if (added) first_at(position) = k
+         end do
+      end if
+      allocate (own_groups(0))
+      do k = 1, size(mine)
+         if (k > 1) then
+            if (mine(k)%group == mine(k - 1)%group) cycle
+         end if
+         if (.not. any(own_groups == mine(k)%group)) own_groups = [character(len=32) :: own_groups, mine(k)%group]
+      end do
       do f = 1, size(sources)
          ! Relative file names in a file are relative to its directory, made
          ! absolute so that the echoed input reads back from anywhere.
@@ -178,15 +199,21 @@ contains
          ! with a bad assignment.
          do k = 1, size(sources(f)%mentions)
             associate (m => sources(f)%mentions(k))
-               where = source_place(sources(f), m%line)//': &'//trim(m%group)//': '
-               u = find(m%group, m%name)
+               if (present(table)) then
+                  u = table%find(m%group, m%name)
+               else
+                  u = names%find(m%group, m%name)
+                  if (u > 0) u = first_at(u)
+               end if
                if (u == 0) then
+                  where = source_place(sources(f), m%line)//': &'//trim(m%group)//': '
                   known = pack(universe%name, universe%group == m%group)
                   call fatal_error(error, where//"unknown variable '"//trim(m%name)//"' (known: " &
                      & //join(known)//')', error_input)
                   return
                end if
                if (.not. value_has_kind(m%value, universe(u)%kind)) then
+                  where = source_place(sources(f), m%line)//': &'//trim(m%group)//': '
                   call fatal_error(error, where//trim(m%name)//' = '//trim(one_line(m%value, 100))//': expected ' &
                      & //kind_text(universe(u)%kind)//unit_hint(universe(u)), error_input)
                   return
@@ -195,7 +222,7 @@ contains
          end do
          do k = 1, size(sources(f)%mentions)
             associate (m => sources(f)%mentions(k))
-               if (.not. any(mine%group == m%group)) cycle   ! another scene's group
+               if (.not. any(own_groups == m%group)) cycle   ! another scene's group
                where = source_place(sources(f), m%line)
                call set_parameter(target, trim(m%group), trim(m%name), m%value, m%first, base, problem)
                if (len(problem) > 0) then
@@ -209,17 +236,6 @@ contains
             end associate
          end do
       end do
-
-   contains
-
-      integer function find(group, name)
-         character(len=*), intent(in) :: group, name
-
-         do find = 1, size(universe)
-            if (universe(find)%group == group .and. universe(find)%name == name) return
-         end do
-         find = 0
-      end function find
 
    end subroutine apply_files
 

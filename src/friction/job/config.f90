@@ -6,7 +6,7 @@ module friction_job_config
    use friction_strings, only: itoa, rtoa, join, quoted, lower
    use friction_error, only: error_type, fatal_error, error_input
    use friction_parameters, only: configurable, parameter_visitor, parameter_info, list_parameters, &
-      & parameters_text, split_name, parameter_finding, implausible_values
+      & parameters_text, split_name, parameter_finding, implausible_values, parameter_table
    use friction_checks, only: config_checker
    use friction_plausibility, only: unit_plausibility
    use friction_input_reader, only: namelist_source, scan_files, apply_files, override_source, source_place, last_text
@@ -149,21 +149,30 @@ contains
       call self%sweep%visit(v)
    end subroutine job_visit
 
-   !> Every variable of every scene's job (the names a file may use).
-   function all_parameters() result(list)
+   !> Every variable of every scene's job (the names a file may use);
+   !> `table`, if given, holds their names at their positions in the list.
+   function all_parameters(table) result(list)
+      type(parameter_table), intent(out), optional, target :: table
       type(parameter_info), allocatable :: list(:), more(:), grown(:)
       type(job_config) :: probe
-      integer :: k, m, n
+      type(parameter_table), target :: own
+      type(parameter_table), pointer :: seen
+      integer :: k, m, n, position
+      logical :: added
 
       ! (Grown by doubling: appending one at a time copied the whole list each
-      ! time, a third of a short run's reading of its input.)
+      ! time, a third of a short run's reading of its input; the variables
+      ! scenes share are found by the table, not by a search of the list.)
+      seen => own
+      if (present(table)) seen => table
       allocate (list(256))
       n = 0
       do k = 1, size(scene_names)
          call new_scene(scene_names(k), probe%scene)
          more = list_parameters(probe)
          do m = 1, size(more)
-            if (any(list(1:n)%group == more(m)%group .and. list(1:n)%name == more(m)%name)) cycle
+            call seen%add(more(m)%group, more(m)%name, position, added)
+            if (.not. added) cycle
             if (n == size(list)) then
                allocate (grown(2 * n))
                grown(1:n) = list(1:n)
@@ -208,12 +217,13 @@ contains
       type(config_checker), intent(out), optional :: origins
       type(namelist_source), allocatable :: sources(:), files(:)
       type(parameter_info), allocatable :: universe(:)
+      type(parameter_table) :: names
       type(config_checker) :: checker
       character(len=32), allocatable :: groups(:)
       integer :: k, n_over
 
       if (present(notes)) allocate (notes(0))
-      universe = all_parameters()
+      universe = all_parameters(names)
       groups = parameter_groups(universe)
       call scan_files(paths, groups, files, error)
       if (allocated(error)) return
@@ -227,7 +237,7 @@ contains
       end do
       ! &job and &sweep first (every assignment of every file is checked here),
       ! then the scene they name.
-      call apply_files(sources, universe, config, checker, error)
+      call apply_files(sources, universe, config, checker, error, names)
       if (allocated(error)) return
       call new_scene(config%scene_name, config%scene)
       if (.not. allocated(config%scene)) then
@@ -238,7 +248,7 @@ contains
       end if
       call check_other_scenes(config, sources, len(last_text(sources, 'job', 'scene')) > 0, error, notes)
       if (allocated(error)) return
-      call apply_files(sources, universe, config, checker, error)
+      call apply_files(sources, universe, config, checker, error, names)
       if (allocated(error)) return
       call check_job(config, checker)
       if (checker%failed()) then
