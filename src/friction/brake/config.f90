@@ -38,12 +38,13 @@ module friction_brake_config
    character(len=*), parameter :: continuation_names(7) = [character(len=11) :: 'mu', 'mu_s', 'xi', 'kappa', &
       & 'g_prime', 'delta_prime', 'v_dr_prime']
    !> With model = 'law' the friction is &law's: the orbit follows the &brake
-   !> variables of the mechanism, or a parameter of &law's laws without
-   !> internal states (a name both groups have, mu or mu_s, is &law's: &brake's is unused then).
+   !> variables of the mechanism, or a real parameter of &law's laws (a name
+   !> both groups have, mu or mu_s, is &law's: &brake's is unused then).
    character(len=*), parameter :: brake_law_continuation_names(4) = [character(len=10) :: 'xi', 'kappa', &
       & 'g_prime', 'v_dr_prime']
-   character(len=*), parameter :: law_continuation_names(11) = [character(len=8) :: 'mu', 'mu_s', 'epsilon', &
-      & 'delta', 'fc', 'fs', 'vs', 'exponent', 'sigma2', 'scale', 'dv']
+   character(len=*), parameter :: law_continuation_names(21) = [character(len=10) :: 'mu', 'mu_s', 'epsilon', &
+      & 'delta', 'fc', 'fs', 'vs', 'exponent', 'sigma2', 'scale', 'dv', 'sigma0', 'sigma1', 'alpha', 'z_ba', &
+      & 'mu0', 'a', 'b', 'dc', 'v0', 'attraction']
 
    !> &integrator defaults for the brake when no file sets them: rk8pd, tight
    !> (the benchmark: the switched model reaches 1e-8 on x this way); times in τ.
@@ -292,7 +293,6 @@ contains
       type(brake_config), intent(in) :: self
       type(config_checker), intent(inout) :: c
       class(sliding_law), allocatable :: law
-      character(len=:), allocatable :: why
       integer :: k
 
       if (.not. self%uses_law()) then
@@ -314,13 +314,7 @@ contains
       end if
       call check_law(law_with_files(self%law), c)
       if (c%failed()) return
-      why = "is not computed for &brake model = 'law' with &law model = '"//trim(self%law%model)//"' (its " &
-         & //"internal states are not carried by the brake's section maps): use a law without states " &
-         & //'(coulomb, stribeck, table, arctan), or the switched model'
       call new_law(self%law, law)
-      associate (a => self%analysis)
-         if (a%orbit .and. law%state_count() > 0) call c%reject('analysis', 'orbit', '.true.', why)
-      end associate
       call check_band_edges(self, law, c)
       if (c%failed()) return
       ! Exact stick holds the closed-form stick phase, whose end needs a static limit affine in N'.

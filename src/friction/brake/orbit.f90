@@ -17,6 +17,11 @@
 !> Multipliers.  The orbit's four: the trivial 1 along the flow, the two of
 !> DP, and 0 exactly -- the stick forgets the block's velocity, the
 !> direction the Lyapunov spectrum reports with exponent -inf.
+!>
+!> A single-valued law (no exact stick) takes the creep band's exit
+!> instead, a hyperplane of its smooth flow (x, v, y, w, ẑ): the section's
+!> coordinates are x, y, w and the law's states ẑ in units of their scale,
+!> 3 + m of them; the multipliers the trivial 1 and the map's 3 + m.
 module friction_brake_orbit
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
    use friction_kinds, only: wp, pi
@@ -29,7 +34,7 @@ module friction_brake_orbit
    use friction_brake_law_model, only: law_integrator, brake_law_slip, brake_law_flow, law_units, law_static_line
    use friction_brake_integrator, only: brake_integrator
    use friction_brake_band, only: band_integrator
-   use friction_law, only: sliding_law
+   use friction_law, only: sliding_law, max_law_states
    use friction_law_factory, only: make_law, new_law
    use friction_output_law_files, only: law_with_files
    use friction_scene_report, only: job_reporter, loop_guard
@@ -41,7 +46,7 @@ module friction_brake_orbit
    private
 
    public :: brake_section_map, brake_orbit, brake_periodic_orbit, section_state, section_limit
-   public :: brake_band_map, exact_stick, band_law
+   public :: brake_band_map, exact_stick, band_law, orbit_states
    public :: orbit_branch, follow_branch, detect_bifurcations, bifurcation_names
    public :: bifurcation_period_doubling, bifurcation_fold, bifurcation_neimark_sacker, bifurcation_discontinuity
 
@@ -68,7 +73,7 @@ module friction_brake_orbit
       integer, allocatable :: source(:)              !! (n) 1: continued from the previous orbit, 2: from the attractor
       real(wp), allocatable :: period(:)             !! (n) τ; NaN where none
       real(wp), allocatable :: state(:, :)           !! (4, n) slip onset of the orbit
-      complex(wp), allocatable :: multipliers(:, :)  !! (4, n) as brake_orbit%multipliers
+      complex(wp), allocatable :: multipliers(:, :)  !! (4 + m, n) as brake_orbit%multipliers, m law states
       real(wp), allocatable :: max_modulus(:)        !! (n) largest |μ| of the section map
       integer, allocatable :: pattern(:, :)          !! (3, n) as brake_orbit%pattern
       integer, allocatable :: kind(:)                !! bifurcations: bifurcation_* ...
@@ -94,12 +99,13 @@ module friction_brake_orbit
       procedure :: evaluate => brake_map_evaluate
    end type brake_section_map
 
-   !> The return map of a single-valued law without states (&brake model =
-   !> 'law'): the exit from the creep band v_rel = s v_s (s = -σ, v_s the
-   !> brake's stick_velocity) crossed away from 0, the flow's own slip onset;
-   !> coordinates (x, y, w), the Jacobian from the variational equations
-   !> (analysis/periodic_orbit.f90's hyperplane map).  A trial point whose
-   !> integration fails returns nowhere.
+   !> The return map of a single-valued law (&brake model = 'law'): the exit
+   !> from the creep band v_rel = s v_s (s = -σ, v_s the brake's
+   !> stick_velocity) crossed away from 0, the flow's own slip onset;
+   !> coordinates (x, y, w, ẑ), ẑ the law's states in units of their scale
+   !> (none for arctan), the Jacobian from the variational equations with
+   !> the law's partial derivatives (analysis/periodic_orbit.f90's
+   !> hyperplane map).  A trial point whose integration fails returns nowhere.
    type, extends(section_map) :: brake_band_map
       type(hyperplane_map) :: plane
    contains
@@ -113,8 +119,13 @@ module friction_brake_orbit
       real(wp) :: limit = 1.0_wp              !! σ of the section
       real(wp) :: guess_time = 0.0_wp         !! τ of the run's slip onset Newton started from
       real(wp) :: state(4) = 0.0_wp           !! the orbit's slip onset (x, v, y, w)
-      complex(wp) :: multipliers(4) = (0.0_wp, 0.0_wp)  !! 1, those of DP (by modulus), 0
-      real(wp) :: exponents(4) = 0.0_wp       !! ln|μ|/T; -inf for the stick's 0
+      integer :: n_states = 0                 !! m, the law's states on the creep band's exit
+      real(wp) :: states(max_law_states) = 0.0_wp   !! (m) their values there, in units of their scale
+      real(wp) :: scale(max_law_states) = 1.0_wp    !! (m) the scales, in the law's units
+      character(len=16) :: state_names(max_law_states) = '', state_units(max_law_states) = ''
+      !> 1, those of DP (by modulus), 0 (exact stick); 1 and the 3 + m of DP (the creep band's exit)
+      complex(wp) :: multipliers(4 + max_law_states) = (0.0_wp, 0.0_wp)
+      real(wp) :: exponents(4 + max_law_states) = 0.0_wp   !! ln|μ|/T; -inf for the stick's 0
       !> Events of each kind over one period (stick-to-slip, slip-to-stick,
       !> slip reversal): the orbit's pattern, which a continuous branch keeps.
       integer :: pattern(size(event_kind_names)) = 0
@@ -319,7 +330,7 @@ contains
    pure integer function band_map_dimension(self)
       class(brake_band_map), intent(in) :: self
 
-      band_map_dimension = 3
+      band_map_dimension = self%plane%dimension()
    end function band_map_dimension
 
    subroutine band_map_evaluate(self, s, image, jacobian, period, returned, reason, error)
@@ -386,9 +397,43 @@ contains
       else
          ! The slip leaves the band in the direction s = -σ.
          result%limit = -sign(1.0_wp, events%state(2, j) - config%params%v_dr)
-         call continue_orbit(config, result%limit, events%state([1, 3, 4], j), settings, result, error)
+         block
+            real(wp), allocatable :: states(:)
+            call law_states_at(config, events%t(j), states, error)
+            if (allocated(error)) then
+               ! The run to the guess failed (it had not before): no guess, a result.
+               result%orbit%reason = 'the run to the slip onset failed: '//error%message
+               deallocate (error)
+               return
+            end if
+            call continue_orbit(config, result%limit, [events%state([1, 3, 4], j), states], settings, result, error)
+         end block
       end if
    end subroutine brake_periodic_orbit
+
+   !> The law's states (in units of their scale; none for a law without)
+   !> at time t of the configuration's run: the event table keeps (x, v, y,
+   !> w) alone, so the run is repeated up to t, the same stepper and
+   !> tolerances (its states there as close to the first run's as the
+   !> tolerances make them: a guess for Newton).
+   subroutine law_states_at(config, t, states, error)
+      type(brake_config), intent(in) :: config
+      real(wp), intent(in) :: t
+      real(wp), allocatable, intent(out) :: states(:)
+      type(error_type), allocatable, intent(out) :: error
+      type(law_integrator) :: run
+      type(brake_event_table) :: events
+
+      allocate (states(0))
+      call run%start(config, config%t_start, initial_state(config), events, error)
+      if (allocated(error)) return
+      if (run%state_count() == 0) return
+      call run%advance_to(t, events, error)
+      if (allocated(error)) return
+      deallocate (states)
+      allocate (states(run%state_count()))
+      call run%get_states(states)
+   end subroutine law_states_at
 
    !> Newton from the section point guess at the limit σ: (y, w) on the
    !> stick-to-slip section, (x, y, w) on the creep band's exit.
@@ -422,12 +467,12 @@ contains
       if (.not. result%orbit%found) return
       ! Newton's last evaluation was at the fixed point.
       result%pattern = map%counts
-      result%multipliers = floquet_multipliers(result%orbit, 1)
-      result%exponents = floquet_exponents(result%multipliers, result%orbit%period)
+      result%multipliers(1:4) = floquet_multipliers(result%orbit, 1)
+      result%exponents(1:4) = floquet_exponents(result%multipliers(1:4), result%orbit%period)
    end subroutine continue_orbit
 
-   !> Newton on the creep band's exit of a single-valued law without states;
-   !> the multipliers the trivial 1 and the three of the section map (no
+   !> Newton on the creep band's exit of a single-valued law, guess (x, y, w,
+   !> ẑ); the multipliers the trivial 1 and the 3 + m of the section map (no
    !> direction is forgotten: the creep only contracts).  The events of one
    !> period from a run of the orbit, over [T/2, 3T/2) (away from the
    !> section's own crossing at 0 and T).
@@ -443,17 +488,23 @@ contains
       type(brake_event_table) :: events
       type(error_type), allocatable :: run_error
       real(wp) :: level, period
-      integer :: i
+      integer :: i, ns
 
       result%section = 'creep_band_exit'
       result%limit = limit
       flow%params = config%params
       call make_law(law_with_files(config%law), flow%law, error)
       if (allocated(error)) return
-      if (flow%law%state_count() > 0) then
-         result%orbit%reason = "the brake's section maps do not carry the law's internal states"
-         return
-      end if
+      ! The flow with the law's states in units of their scale, as the run integrates them.
+      ns = flow%law%state_count()
+      result%n_states = ns
+      flow%n_states = ns
+      if (ns > 0) call flow%law%state_scale(flow%scale(1:ns))
+      result%scale(1:ns) = flow%scale(1:ns)
+      do i = 1, ns
+         result%state_names(i) = flow%law%state_name(i)
+         result%state_units(i) = flow%law%state_unit(i)
+      end do
       call config%law_units(flow%units%force, flow%units%velocity, flow%units%time)
       flow%stick_velocity = config%stick_velocity
       level = config%params%v_dr - limit * config%stick_velocity
@@ -462,11 +513,14 @@ contains
       call find_periodic_orbit(map, guess, settings, result%orbit, error)
       if (allocated(error)) return
       result%state = [result%orbit%point(1), level, result%orbit%point(2), result%orbit%point(3)]
+      result%states(1:ns) = result%orbit%point(4:3 + ns)
       if (.not. result%orbit%found) return
-      result%multipliers = floquet_multipliers(result%orbit, 0)
-      result%exponents = floquet_exponents(result%multipliers, result%orbit%period)
+      result%multipliers(1:4 + ns) = floquet_multipliers(result%orbit, 0)
+      result%exponents(1:4 + ns) = floquet_exponents(result%multipliers(1:4 + ns), result%orbit%period)
       period = result%orbit%period
       call run%start(config, 0.0_wp, result%state, events, run_error)
+      ! (start puts the states in steady sliding: the orbit's instead)
+      if (.not. allocated(run_error) .and. ns > 0) call run%set_states(result%orbit%point(4:3 + ns))
       if (.not. allocated(run_error)) call run%advance_to(1.5_wp * period, events, run_error)
       if (allocated(run_error)) return   ! (the orbit closed; its pattern stays unknown, 0)
       do i = 1, size(result%pattern)
@@ -544,7 +598,7 @@ contains
       branch%variable = config%analysis%continuation
       call continuation_variable(config, start, branch%unit)
       allocate (branch%parameter(n), branch%found(n), branch%source(n), branch%period(n), branch%state(4, n), &
-         & branch%multipliers(4, n), branch%max_modulus(n), branch%kind(0), branch%at(0), &
+         & branch%multipliers(4 + orbit_states(config), n), branch%max_modulus(n), branch%kind(0), branch%at(0), &
          & branch%pattern(size(event_kind_names), n), &
          & branch%section_parameter(0), branch%section_x(0))
       branch%parameter = branch_values(start, last, n)
@@ -586,7 +640,7 @@ contains
 
          branch%found(k) = o%orbit%found
          branch%state(:, k) = o%state
-         branch%multipliers(:, k) = o%multipliers
+         branch%multipliers(:, k) = o%multipliers(1:size(branch%multipliers, 1))
          branch%pattern(:, k) = o%pattern
          if (o%orbit%found) then
             branch%period(k) = o%orbit%period
@@ -598,6 +652,18 @@ contains
       end subroutine record
 
    end subroutine follow_branch
+
+   !> m, the law's states the orbit's section carries: those of a
+   !> single-valued law of &law (the creep band's exit), else none.
+   integer function orbit_states(config)
+      type(brake_config), intent(in) :: config
+      class(sliding_law), allocatable :: law
+
+      orbit_states = 0
+      if (exact_stick(config)) return
+      call new_law(config%law, law)
+      orbit_states = law%state_count()
+   end function orbit_states
 
    !> From the orbit `previous` at the value `from` to the value `to`.
    subroutine continue_along(config, from, to, previous, settings, result, error)

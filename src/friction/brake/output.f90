@@ -301,9 +301,9 @@ contains
       type(h5_file), intent(inout) :: file
       type(brake_diagnostics), intent(in) :: d
       character(len=*), parameter :: group = '/brake/orbit'
-      real(wp) :: parts(2, 4)
+      real(wp), allocatable :: parts(:, :)
 
-      associate (a => d%settings, o => d%orbit)
+      associate (a => d%settings, o => d%orbit, m => d%orbit%n_states)
          call file%create_group(group)
          call file%write_attribute_integer(group, 'found', merge(1_i8, 0_i8, o%orbit%found))
          if (.not. o%orbit%found) call file%write_attribute_text(group, 'reason', o%orbit%reason)
@@ -318,15 +318,23 @@ contains
          call file%write_vector(group//'/point', o%state, 'm')
          call file%write_attribute_text(group//'/point', 'names', 'x, v, y, w')
          call file%write_attribute_text(group//'/point', 'column_units_tau', state_units_tau)
+         if (m > 0) then
+            ! The law's states on the section (the Jacobian's coordinates 4 to 3 + m are them over their scale).
+            call file%write_vector(group//'/law_states', o%states(1:m) * o%scale(1:m), '')
+            call file%write_attribute_text(group//'/law_states', 'names', join(o%state_names(1:m)))
+            call file%write_attribute_text(group//'/law_states', 'units', join(o%state_units(1:m)))
+            call file%write_vector(group//'/law_state_scale', o%scale(1:m), '')
+         end if
          if (len_trim(a%continuation) > 0) call write_branch(file, d%branch)
          if (.not. o%orbit%found) return
          call file%write_attribute_real(group, 'period', o%orbit%period, 'tau')
          call file%write_matrix(group//'/section_jacobian', o%orbit%jacobian, '1')
-         parts(1, :) = real(o%multipliers)
-         parts(2, :) = aimag(o%multipliers)
+         allocate (parts(2, 4 + m))
+         parts(1, :) = real(o%multipliers(1:4 + m))
+         parts(2, :) = aimag(o%multipliers(1:4 + m))
          call file%write_matrix(group//'/floquet_multipliers', parts, '1')
          call file%write_attribute_text(group//'/floquet_multipliers', 'columns', 'real, imag')
-         call file%write_vector(group//'/floquet_exponents', o%exponents, '1/tau')
+         call file%write_vector(group//'/floquet_exponents', o%exponents(1:4 + m), '1/tau')
          call file%write_vector_integer(group//'/events_per_period', o%pattern, '1')
          call file%write_attribute_text(group//'/events_per_period', 'names', join(event_kind_names))
       end associate
