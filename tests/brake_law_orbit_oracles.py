@@ -22,13 +22,12 @@ against oracles that are not that model's output:
                      creep band's exit, coordinates (x, y, w, z/scale): the
                      section map's 4x4 Jacobian and multipliers against
                      central differences of the map integrated here (SciPy's
-                     Radau, events located), the orbit closing in SciPy's flow
-  rate-state-scipy   the same for rate-and-state friction (aging law, the
-                     contact's age θ the state)
+                     DOP853, events located), the orbit closing in SciPy's flow
+  elastoplastic-scipy the same for the elasto-plastic law (LuGre's bristle
+                     with an elastic range)
   lugre-continuation inputs/brake_lugre_orbit.nml's orbit followed in F_s:
                      the period doubling where the section map's real
-                     multiplier passes -1, the attractor's period doubled
-                     beyond it
+                     multiplier passes -1, the orbit stable beyond it
   refusals           what the orbit of this model does not do is refused with
                      file, line, group and variable, exit code 3, no file
 
@@ -332,62 +331,136 @@ def arctan_scipy(args):
 
 def law_band_map(force, rate, scale, stick_velocity, sigma, t_max=100.0):
     """The creep band's exit v_rel = s v_s (s = -σ) crossed away from 0 of Eq. 10 with a law with states
-    (force(u, z, N), rate(u, z, N), z in the law's units, the brake's units throughout), SciPy's Radau at
-    rtol 1e-12 with its events; coordinates (x, y, w, z/scale) as the program's."""
+    (force(u, z), rate(u, z), z in the law's units, the brake's units throughout), SciPy's DOP853 at rtol
+    1e-12 (σ0 = 1000 is not stiff for an explicit stepper) with its located events; coordinates (x, y, w,
+    z/scale) as the program's.  The laws' rates have a kink at v_rel = 0 (|v|, sgn v): located, and the
+    integration started again there, so that no step straddles it (the map's differences would carry
+    the stepper's first-order error there)."""
     s = -sigma
     level = V_DR + s * stick_velocity
     scale = np.asarray(scale, dtype=float)
 
     def rhs(t, q):
         x, v, y, w = q[:4]
-        u, n, z = v - V_DR, (1 - KAPPA) * y + G_PRIME, q[4:] * scale
-        return np.concatenate([[v, -(2 * x - y) - force(u, z, n), w, (x - KAPPA * y) / XI], rate(u, z, n) / scale])
+        u, z = v - V_DR, q[4:] * scale
+        return np.concatenate([[v, -(2 * x - y) - force(u, z), w, (x - KAPPA * y) / XI], rate(u, z) / scale])
 
     def crossing(t, q):
         return q[1] - level
     crossing.terminal, crossing.direction = True, s
 
+    def kink(t, q):
+        return q[1] - V_DR
+    kink.terminal = True
+
     def section_map(point):
         q = np.concatenate([[point[0], level], point[1:]])
         # Leave the start on the section before the crossing is looked for.
-        start = solve_ivp(rhs, (0, 1e-3), q, method="Radau", rtol=1e-12, atol=1e-15)
-        sol = solve_ivp(rhs, (start.t[-1], t_max), start.y[:, -1], method="Radau", rtol=1e-12, atol=1e-15,
-                        events=crossing)
-        q = sol.y_events[0][0]
-        return np.concatenate([[q[0]], q[2:]]), sol.t_events[0][0]
+        start = solve_ivp(rhs, (0, 1e-3), q, method="DOP853", rtol=1e-12, atol=1e-15)
+        t, q = start.t[-1], start.y[:, -1]
+        while t < t_max:
+            sol = solve_ivp(rhs, (t, t_max), q, method="DOP853", rtol=1e-12, atol=1e-15, events=[crossing, kink])
+            if sol.t_events[0].size:
+                q = sol.y_events[0][0]
+                return np.concatenate([[q[0]], q[2:]]), sol.t_events[0][0]
+            # On from the kink's far side: a step past it (SciPy's located root may sit on either side).
+            t, q = sol.t_events[1][0], sol.y_events[1][0]
+            q = q + 1e-13 * np.asarray(rhs(t, q))
+            t += 1e-13
+        raise RuntimeError("no return")
     return section_map
 
 
-def lugre_scipy(args):
-    # inputs/brake_lugre_orbit.nml: LuGre in the brake's units (F_c 0.0095 m, F_s 0.0105 m, v_s 2e-3 m/τ,
-    # σ0 = 1000, σ1 = √σ0, σ2 = 0), a creep band of 1e-5 m/τ.  The program at rtol 1e-12 (rk8pd: σ0 = 1000 is
-    # not stiff for it).
-    fc, fs, vs, s0, s1 = 0.0095, 0.0105, 2e-3, 1000.0, np.sqrt(1000.0)
-    sets = {"integrator.rtol": 1e-12, "integrator.atol": 1e-15, "brake.event_tolerance": 1e-12,
-            "analysis.orbit_tolerance": 1e-10}
-    orbit = orbit_of(args, "lugre", ["brake_lugre_orbit.nml"], sets)
+# inputs/brake_lugre_orbit.nml's law in the brake's units: F_c 0.0095 m, F_s 0.0100 m, v_s 2e-3 m/τ, δ = 2,
+# σ0 = 1000, σ1 = √σ0, σ2 = 0; a creep band of 1e-5 m/τ.
+FC, FS, VS, SIGMA0, SIGMA1, BAND = 0.0095, 0.0100, 2e-3, 1000.0, np.sqrt(1000.0), 1e-5
+
+
+def stribeck_g(u):
+    return FC + (FS - FC) * np.exp(-(u / VS) ** 2)
+
+
+def state_law_orbit(args, label, sets, force, rate):
+    """The program's orbit on the creep band's exit (rk8pd at rtol 1e-13: its Jacobian's largest row moves by
+    5e-4 from rtol 1e-12, measured) against the map integrated here.
+    The laws' rates have a kink at v_rel = 0 (|v|, sgn v), which the orbit crosses in its stick: both maps
+    locate it and start again there (stepped over, the program's section Jacobian was 1.7e-2 off at rtol
+    1e-12, converging to first order in rtol only)."""
+    sets = {"integrator.rtol": 1e-13, "integrator.atol": 1e-15, "brake.event_tolerance": 1e-12,
+            "analysis.orbit_tolerance": 1e-10, "analysis.continuation": "''", **sets}
+    orbit = orbit_of(args, label, ["brake_lugre_orbit.nml"], sets)
     assert orbit["section"] == "creep_band_exit"
+    # Four coordinates (x, y, w, z/scale): the multipliers the trivial 1 and the map's four (LAPACK's dgeev).
     assert orbit["section_jacobian"].shape == (4, 4) and orbit["multipliers"].size == 5
-
-    def g(u):
-        return fc + (fs - fc) * np.exp(-(u / vs) ** 2)
-
-    def rate(u, z, n):
-        return u - s0 * abs(u) * z / g(u)
-
-    def force(u, z, n):
-        return s0 * z[0] + s1 * rate(u, z, n)[0]
     scale = orbit["law_state_scale"]
-    assert abs(scale[0] - fs / s0) <= 1e-15 * scale[0]
     sigma = float(orbit["static_limit"])
     point = np.concatenate([orbit["point"][[0, 2, 3]], orbit["law_states"] / scale])
-    # SciPy's Radau at rtol 1e-12: the map closes to MEASURED; differences with steps 2e-7 and 1e-7
-    # (in m and in units of the bristles' scale 1e-5 m), extrapolated.
-    fine = check_map("lugre-scipy", orbit, law_band_map(force, rate, scale, 1e-5, sigma), point, 2e-7, 2.0, 1e-8,
-                     1e-9, 2e-6)
+    # SciPy's DOP853 at rtol 1e-12: the map closes to 1e-10 m (the orbit closes in SciPy's flow; measured
+    # 5e-11 and 3e-12).  Differences with steps 1e-6 and 5e-7 (m, and units of the state's scale): smaller
+    # steps meet the map's noise (1e-11 on z/scale over 1e-7: 1e-4 in the row of entries ~50); extrapolated,
+    # what is left is within a quarter of the two steps' spread (measured 4.4e-4 and 7.8e-4 against
+    # bounds 9e-4 and 1.0e-3, entries up to 59).
+    fine = check_map(label, orbit, law_band_map(force, rate, scale, BAND, sigma), point, 1e-6, 2.0, 1e-8, 1e-9,
+                     2e-6)
     assert orbit["multipliers"][0] == 1
+    # The multipliers of the differences' map, paired by modulus: measured 1.9e-6 (LuGre) and 1.8e-5
+    # (elasto-plastic, whose partials are the law's central differences); the differences' own Jacobian is
+    # uncertain to ~1e-3 in entries ~50 (2e-5 relative), which moves its eigenvalues as much: 5e-5.
     mu_fd = np.linalg.eigvals(fine)
-    assert np.max(np.abs(np.sort(np.abs(mu_fd)) - np.sort(np.abs(orbit["multipliers"][1:])))) <= 1e-5
+    assert np.max(np.abs(np.sort(np.abs(mu_fd)) - np.sort(np.abs(orbit["multipliers"][1:])))) <= 5e-5
+    return orbit
+
+
+def lugre_scipy(args):
+    def rate(u, z):
+        return u - SIGMA0 * np.abs(u) * z / stribeck_g(u)
+
+    def force(u, z):
+        return SIGMA0 * z[0] + SIGMA1 * rate(u, z)[0]
+    orbit = state_law_orbit(args, "lugre-scipy", {}, force, rate)
+    assert abs(orbit["law_state_scale"][0] - FS / SIGMA0) <= 1e-15 * FS / SIGMA0
+
+
+def elastoplastic_scipy(args):
+    # The elasto-plastic law on the same brake: LuGre's bristle elastic below z_ba = 5e-6 m (half of F_c/σ0).
+    z_ba = 5e-6
+
+    def share(u, z):
+        if u == 0 or z == 0 or np.sign(u) != np.sign(z) or abs(z) <= z_ba:
+            return 0.0
+        z_ss = stribeck_g(u) / SIGMA0
+        if abs(z) >= z_ss:
+            return 1.0
+        return 0.5 * np.sin(np.pi * (abs(z) - 0.5 * (z_ss + z_ba)) / (z_ss - z_ba)) + 0.5
+
+    def rate(u, z):
+        return np.array([u * (1 - share(u, z[0]) * SIGMA0 * abs(z[0]) / stribeck_g(u))])
+
+    def force(u, z):
+        return SIGMA0 * z[0] + SIGMA1 * rate(u, z)[0]
+    state_law_orbit(args, "elastoplastic-scipy", {"law.model": "'elastoplastic'", "law.z_ba": z_ba}, force, rate)
+
+
+def lugre_continuation(args):
+    # inputs/brake_lugre_orbit.nml as it is: the orbit followed in F_s from 0.0100 to 0.0102.  The section
+    # map's real multiplier rises through -1 (the unstable orbit of the input, -1.34, becomes stable): the
+    # bifurcation found is a period doubling, between the two points where that multiplier (the real
+    # negative one, looked for here in the written multipliers) is below and above -1, at the value where
+    # the linear interpolation of |μ| - 1 of the largest multiplier is 0.
+    with h5py.File(run_program(args, "lugre_continuation", ["brake_lugre_orbit.nml"], {})) as f:
+        b, bif = f["brake/orbit/branch"], f["brake/orbit/bifurcations"]
+        found, parameter = b["found"][()], b["parameter"][()]
+        mu = b["floquet_multipliers_real"][()] + 1j * b["floquet_multipliers_imag"][()]
+        kinds, at = bif["kind"][()], bif["parameter"][()]
+    assert found.all(), found
+    negative = np.array([min(m.real for m in row if abs(m.imag) == 0 and m.real < -0.5) for row in mu])
+    k = np.where((negative[:-1] < -1) & (negative[1:] > -1))[0]
+    print(f"lugre-continuation: F_s {np.round(parameter, 6)}; the real multiplier {np.round(negative, 4)}; "
+          f"bifurcations {list(kinds)} at {np.round(at, 7)}")
+    assert k.size == 1 and list(kinds) == [1], (k, kinds)
+    assert parameter[k[0]] <= at[0] <= parameter[k[0] + 1], (at, parameter[k])
+    # Beyond it the whole section map is inside the unit circle: the orbit is stable.
+    assert np.all(np.abs(mu[k[0] + 1:, 1:]) < 1), mu
 
 
 def refusals(args):
@@ -402,6 +475,10 @@ def refusals(args):
         ("&brake\n  model = 'law'\n/\n&law\n  model = 'coulomb'\n  mu = 0.3\n  mu_s = 0.4\n/\n&analysis\n"
          "  orbit = .true.\n  continuation = 'mu'\n  continuation_end = 0.5\n/\n", 16,
          "&analysis: continuation_end", "mu_s"),
+        # A law with states continues in its own parameters, up to where the law stops being one.
+        ("&brake\n  model = 'law'\n/\n&law\n  model = 'elastoplastic'\n  fc = 0.0095\n  fs = 0.01\n"
+         "  sigma0 = 1000.0\n  z_ba = 5e-6\n/\n&analysis\n  orbit = .true.\n  continuation = 'z_ba'\n"
+         "  continuation_end = 2e-5\n/\n", 18, "&analysis: continuation_end", "z_ba"),
     ]
     for i, (groups, line, names, why) in enumerate(cases):
         path = work / f"bad{i}.nml"
@@ -417,4 +494,5 @@ def refusals(args):
 if __name__ == "__main__":
     sys.exit(case_main(__doc__, {"coulomb-switched": coulomb_switched, "stribeck-scipy": stribeck_scipy,
                                  "table-stribeck": table_stribeck, "arctan-scipy": arctan_scipy, "lugre-scipy": lugre_scipy,
+                                 "elastoplastic-scipy": elastoplastic_scipy, "lugre-continuation": lugre_continuation,
                                  "refusals": refusals}))

@@ -22,7 +22,7 @@ module friction_analysis_periodic_orbit
    use friction_kinds, only: wp
    use friction_error, only: error_type, fatal_error, error_input
    use friction_ode_system, only: ode_system
-   use friction_ode_events, only: event_system, event_locator, event_rising, event_falling
+   use friction_ode_events, only: event_system, event_locator, event_rising, event_falling, event_either
    use friction_ode_solver, only: solver_settings, ode_solver
    use friction_ode_watch, only: step_watch
    use friction_analysis_lyapunov_spectrum, only: tangent_system, pack_tangent, unpack_tangent
@@ -115,11 +115,14 @@ module friction_analysis_periodic_orbit
       character(len=:), allocatable :: reason    !! why not found ('' when found)
    end type periodic_orbit
 
-   !> A smooth system with the hyperplane y_k = c as its (only) event.
+   !> A smooth system with the hyperplane y_k = c as its event, and the
+   !> hyperplanes y_j = c_j where its field has a kink (events 2, 3, ...).
    type, extends(event_system) :: hyperplane_system
       class(ode_system), allocatable :: base
       integer :: coordinate = 1
       real(wp) :: level = 0.0_wp
+      integer, allocatable :: kink_coordinate(:)
+      real(wp), allocatable :: kink_level(:)
    contains
       procedure :: dimension => hyperplane_dimension
       procedure :: rhs => hyperplane_rhs
@@ -153,6 +156,7 @@ module friction_analysis_periodic_orbit
       real(wp) :: max_return = 1000.0_wp
       real(wp) :: event_tolerance = 1.0e-12_wp
       logical :: falling = .false.   !! the section crossed downwards (y_k' < 0) instead
+      integer :: kinks = 0           !! kinks of the field located (events 2 to 1 + kinks)
       class(step_watch), pointer :: watch => null()   !! asked between steps when associated
    contains
       procedure :: setup => hyperplane_setup
@@ -622,6 +626,7 @@ contains
       integer :: m
 
       m = 1
+      if (allocated(self%kink_coordinate)) m = 1 + size(self%kink_coordinate)
    end function hyperplane_event_count
 
    pure subroutine hyperplane_event_values(self, t, y, g)
@@ -630,23 +635,40 @@ contains
       real(wp), intent(in) :: y(:)
       real(wp), intent(out) :: g(:)
 
+      integer :: i
+
       g(1) = y(self%coordinate) - self%level
+      do i = 2, size(g)
+         g(i) = y(self%kink_coordinate(i - 1)) - self%kink_level(i - 1)
+      end do
    end subroutine hyperplane_event_values
 
    !> The section y_k = c of an autonomous system, crossed upwards (or, with
-   !> falling = .true., downwards).
-   subroutine hyperplane_setup(self, system, solver, coordinate, level, max_return, event_tolerance, falling)
+   !> falling = .true., downwards).  Kinks y_j = c_j of the field (kink_coordinate,
+   !> kink_level): located and the integration restarted there, so that no
+   !> step straddles one (a step over a kink leaves the tangent equations an
+   !> error of first order in the tolerance).
+   subroutine hyperplane_setup(self, system, solver, coordinate, level, max_return, event_tolerance, falling, &
+      & kink_coordinate, kink_level)
       class(hyperplane_map), intent(inout) :: self
       class(ode_system), intent(in) :: system
       type(solver_settings), intent(in) :: solver
       integer, intent(in) :: coordinate
       real(wp), intent(in) :: level, max_return, event_tolerance
       logical, intent(in), optional :: falling
+      integer, intent(in), optional :: kink_coordinate(:)
+      real(wp), intent(in), optional :: kink_level(:)
       type(hyperplane_system) :: plane
 
       allocate (plane%base, source=system)
       plane%coordinate = coordinate
       plane%level = level
+      self%kinks = 0
+      if (present(kink_coordinate) .and. present(kink_level)) then
+         plane%kink_coordinate = kink_coordinate
+         plane%kink_level = kink_level
+         self%kinks = size(kink_coordinate)
+      end if
       if (allocated(self%extended)) deallocate (self%extended)
       allocate (self%extended)
       allocate (self%extended%base, source=plane)
@@ -679,8 +701,9 @@ contains
       real(wp) :: y(size(s) + 1), phi(size(s) + 1, size(s) + 1), f(size(s) + 1), z((size(s) + 1) * (size(s) + 2))
       real(wp) :: row(size(s) + 1)
       real(wp) :: t, h
-      integer :: n, i, k
+      integer :: n, i, k, m
       integer, allocatable :: others(:)
+      logical :: crossed
 
       n = size(s) + 1
       k = self%coordinate
@@ -698,12 +721,14 @@ contains
       reason = ''
       h = self%solver%h_start
       if (.not. (h > 0.0_wp)) h = 1.0e-3_wp
-      call locator%init(self%extended, self%solver, [merge(event_falling, event_rising, self%falling)], [.true.], &
-         & self%event_tolerance, h, error)
+      m = 1 + self%kinks
+      call locator%init(self%extended, self%solver, [merge(event_falling, event_rising, self%falling), &
+         & spread(event_either, 1, m - 1)], spread(.true., 1, m), self%event_tolerance, h, error)
       if (allocated(error)) return
       t = 0.0_wp
       z = pack_tangent(y, phi)
       call locator%restart(t, z, h)
+      crossed = .false.
       do while (t < self%max_return)
          if (associated(self%watch)) then
             call locator%advance(t, self%max_return, z, error, self%watch)
@@ -715,13 +740,15 @@ contains
             if (locator%hits(locator%n_hits)%terminal) then
                ! A function exactly 0 at a restart crosses at once (ode/events.f90):
                ! that first hit, within a few event tolerances, is the start itself.
-               if (t > 1.0e3_wp * self%event_tolerance) exit
+               ! A kink: on from its far side with a fresh step.
+               crossed = locator%hits(locator%n_hits)%which == 1 .and. t > 1.0e3_wp * self%event_tolerance
+               if (crossed) exit
                call locator%restart(t, z, 0.0_wp)
                locator%n_hits = 0
             end if
          end if
       end do
-      if (.not. (locator%n_hits > 0)) then
+      if (.not. crossed) then
          reason = 'no return to the section within the longest return time'
          return
       end if

@@ -508,8 +508,14 @@ contains
       call config%law_units(flow%units%force, flow%units%velocity, flow%units%time)
       flow%stick_velocity = config%stick_velocity
       level = config%params%v_dr - limit * config%stick_velocity
-      call map%plane%setup(flow, config%solver, 2, level, config%t_end - config%t_start, config%event_tolerance, &
-         & falling=limit > 0.0_wp)
+      if (ns > 0) then
+         ! The states' rates have a kink at v_rel = 0 (|v_rel|, sgn v_rel), which the stick crosses.
+         call map%plane%setup(flow, config%solver, 2, level, config%t_end - config%t_start, config%event_tolerance, &
+            & falling=limit > 0.0_wp, kink_coordinate=[2], kink_level=[config%params%v_dr])
+      else
+         call map%plane%setup(flow, config%solver, 2, level, config%t_end - config%t_start, config%event_tolerance, &
+            & falling=limit > 0.0_wp)
+      end if
       call find_periodic_orbit(map, guess, settings, result%orbit, error)
       if (allocated(error)) return
       result%state = [result%orbit%point(1), level, result%orbit%point(2), result%orbit%point(3)]
