@@ -115,14 +115,17 @@ module friction_analysis_periodic_orbit
       character(len=:), allocatable :: reason    !! why not found ('' when found)
    end type periodic_orbit
 
-   !> A smooth system with the hyperplane y_k = c as its event, and the
-   !> hyperplanes y_j = c_j where its field has a kink (events 2, 3, ...).
+   !> A smooth system with the hyperplane y_k = c as its event, the
+   !> hyperplanes y_j = c_j where its field has a kink (events 2, 3, ...) and
+   !> the section's rearming level (the last, when rearms).
    type, extends(event_system) :: hyperplane_system
       class(ode_system), allocatable :: base
       integer :: coordinate = 1
       real(wp) :: level = 0.0_wp
       integer, allocatable :: kink_coordinate(:)
       real(wp), allocatable :: kink_level(:)
+      logical :: rearms = .false.
+      real(wp) :: rearm_level = 0.0_wp
    contains
       procedure :: dimension => hyperplane_dimension
       procedure :: rhs => hyperplane_rhs
@@ -157,6 +160,10 @@ module friction_analysis_periodic_orbit
       real(wp) :: event_tolerance = 1.0e-12_wp
       logical :: falling = .false.   !! the section crossed downwards (y_k' < 0) instead
       integer :: kinks = 0           !! kinks of the field located (events 2 to 1 + kinks)
+      !> A crossing returns only after y_k has crossed rearm_level the other way
+      !> (the last event): a flow grazing the section is no return.
+      logical :: rearms = .false.
+      real(wp) :: rearm_level = 0.0_wp
       class(step_watch), pointer :: watch => null()   !! asked between steps when associated
    contains
       procedure :: setup => hyperplane_setup
@@ -627,6 +634,7 @@ contains
 
       m = 1
       if (allocated(self%kink_coordinate)) m = 1 + size(self%kink_coordinate)
+      if (self%rearms) m = m + 1
    end function hyperplane_event_count
 
    pure subroutine hyperplane_event_values(self, t, y, g)
@@ -638,18 +646,22 @@ contains
       integer :: i
 
       g(1) = y(self%coordinate) - self%level
-      do i = 2, size(g)
+      do i = 2, size(g) - merge(1, 0, self%rearms)
          g(i) = y(self%kink_coordinate(i - 1)) - self%kink_level(i - 1)
       end do
+      if (self%rearms) g(size(g)) = y(self%coordinate) - self%rearm_level
    end subroutine hyperplane_event_values
 
    !> The section y_k = c of an autonomous system, crossed upwards (or, with
    !> falling = .true., downwards).  Kinks y_j = c_j of the field (kink_coordinate,
    !> kink_level): located and the integration restarted there, so that no
    !> step straddles one (a step over a kink leaves the tangent equations an
-   !> error of first order in the tolerance).
+   !> error of first order in the tolerance).  With rearm_level, a crossing
+   !> counts only after y_k has crossed that level the other way since the
+   !> start or the last crossing: a trajectory that grazes the section (leaves
+   !> it and comes straight back) does not return there.
    subroutine hyperplane_setup(self, system, solver, coordinate, level, max_return, event_tolerance, falling, &
-      & kink_coordinate, kink_level)
+      & kink_coordinate, kink_level, rearm_level)
       class(hyperplane_map), intent(inout) :: self
       class(ode_system), intent(in) :: system
       type(solver_settings), intent(in) :: solver
@@ -658,6 +670,7 @@ contains
       logical, intent(in), optional :: falling
       integer, intent(in), optional :: kink_coordinate(:)
       real(wp), intent(in), optional :: kink_level(:)
+      real(wp), intent(in), optional :: rearm_level
       type(hyperplane_system) :: plane
 
       allocate (plane%base, source=system)
@@ -668,6 +681,12 @@ contains
          plane%kink_coordinate = kink_coordinate
          plane%kink_level = kink_level
          self%kinks = size(kink_coordinate)
+      end if
+      self%rearms = present(rearm_level)
+      plane%rearms = self%rearms
+      if (self%rearms) then
+         self%rearm_level = rearm_level
+         plane%rearm_level = rearm_level
       end if
       if (allocated(self%extended)) deallocate (self%extended)
       allocate (self%extended)
@@ -703,7 +722,7 @@ contains
       real(wp) :: t, h
       integer :: n, i, k, m
       integer, allocatable :: others(:)
-      logical :: crossed
+      logical :: crossed, armed
 
       n = size(s) + 1
       k = self%coordinate
@@ -722,13 +741,20 @@ contains
       h = self%solver%h_start
       if (.not. (h > 0.0_wp)) h = 1.0e-3_wp
       m = 1 + self%kinks
-      call locator%init(self%extended, self%solver, [merge(event_falling, event_rising, self%falling), &
-         & spread(event_either, 1, m - 1)], spread(.true., 1, m), self%event_tolerance, h, error)
+      if (self%rearms) then
+         call locator%init(self%extended, self%solver, [merge(event_falling, event_rising, self%falling), &
+            & spread(event_either, 1, m - 1), merge(event_rising, event_falling, self%falling)], &
+            & [spread(.true., 1, m), .false.], self%event_tolerance, h, error)
+      else
+         call locator%init(self%extended, self%solver, [merge(event_falling, event_rising, self%falling), &
+            & spread(event_either, 1, m - 1)], spread(.true., 1, m), self%event_tolerance, h, error)
+      end if
       if (allocated(error)) return
       t = 0.0_wp
       z = pack_tangent(y, phi)
       call locator%restart(t, z, h)
       crossed = .false.
+      armed = .not. self%rearms
       do while (t < self%max_return)
          if (associated(self%watch)) then
             call locator%advance(t, self%max_return, z, error, self%watch)
@@ -736,13 +762,20 @@ contains
             call locator%advance(t, self%max_return, z, error)
          end if
          if (allocated(error)) return
+         if (self%rearms .and. locator%n_hits > 0) then
+            if (any(locator%hits(1:locator%n_hits)%which == m + 1)) armed = .true.
+         end if
          if (locator%n_hits > 0) then
             if (locator%hits(locator%n_hits)%terminal) then
                ! A function exactly 0 at a restart crosses at once (ode/events.f90):
                ! that first hit, within a few event tolerances, is the start itself.
                ! A kink: on from its far side with a fresh step.
-               crossed = locator%hits(locator%n_hits)%which == 1 .and. t > 1.0e3_wp * self%event_tolerance
+               crossed = locator%hits(locator%n_hits)%which == 1 .and. t > 1.0e3_wp * self%event_tolerance &
+                  & .and. armed
                if (crossed) exit
+               ! (a crossing before the rearming level: the flow grazed the section)
+               if (locator%hits(locator%n_hits)%which == 1 .and. t > 1.0e3_wp * self%event_tolerance) &
+                  & armed = .not. self%rearms
                call locator%restart(t, z, 0.0_wp)
                locator%n_hits = 0
             end if

@@ -509,9 +509,12 @@ contains
       flow%stick_velocity = config%stick_velocity
       level = config%params%v_dr - limit * config%stick_velocity
       if (ns > 0) then
-         ! The states' rates have a kink at v_rel = 0 (|v_rel|, sgn v_rel), which the stick crosses.
+         ! The states' rates have a kink at v_rel = 0 (|v_rel|, sgn v_rel), which the stick crosses.  A
+         ! return must come back from half the band: the bristles' quick oscillation about the band's
+         ! edge (stiff σ0) grazes it and would make a fixed point of P with a return time near 0.
          call map%plane%setup(flow, config%solver, 2, level, config%t_end - config%t_start, config%event_tolerance, &
-            & falling=limit > 0.0_wp, kink_coordinate=[2], kink_level=[config%params%v_dr])
+            & falling=limit > 0.0_wp, kink_coordinate=[2], kink_level=[config%params%v_dr], &
+            & rearm_level=config%params%v_dr - limit * config%stick_velocity / 2)
       else
          call map%plane%setup(flow, config%solver, 2, level, config%t_end - config%t_start, config%event_tolerance, &
             & falling=limit > 0.0_wp)
