@@ -17,7 +17,7 @@ inputs/machine_orbit.nml's first point (LuGre at Table I's stiffness) with
 the orbit and without (Newton's cost), the whole continuation, and the GMS
 stick-slip orbit of inputs/machine_gms.nml (stopped after --limit seconds);
 --before PATH runs the same with a second program (an earlier build) in the
-same run, interleaved, for the ratio.
+same run, case by case, for the ratio.
 
 Medians over --repeats runs of each.
 
