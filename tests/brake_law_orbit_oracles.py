@@ -28,6 +28,10 @@ against oracles that are not that model's output:
   lugre-continuation inputs/brake_lugre_orbit.nml's orbit followed in F_s:
                      the period doubling where the section map's real
                      multiplier passes -1, the orbit stable beyond it
+  lugre-stiff        inputs/brake_lugre.nml's stiff bristles (σ0 = 1e5 N/m): Newton
+                     stops unconverged, and SciPy's Radau map at its last
+                     iterate gives the same residual and shows why: the map's
+                     derivative doubles within 1e-6 m of that point
   refusals           what the orbit of this model does not do is refused with
                      file, line, group and variable, exit code 3, no file
 
@@ -43,6 +47,7 @@ from scipy.integrate import solve_ivp
 from scipy.interpolate import PchipInterpolator
 
 from machine_cases import run_program, case_main
+from brake_law_oracles import brake_lugre
 
 QUIET = {"analysis.spectrum": ".false.", "analysis.poincare": ".false.", "analysis.lyapunov": ".false.",
          "analysis.lyapunov_spectrum": ".false.", "analysis.rosenstein": ".false.", "analysis.orbit": ".true.",
@@ -463,6 +468,79 @@ def lugre_continuation(args):
     assert np.all(np.abs(mu[k[0] + 1:, 1:]) < 1), mu
 
 
+def stiff_band_map(sigma, stick_velocity, rtol=1e-12, t_max=100.0):
+    """The creep band's exit of inputs/brake_lugre.nml (tests/brake_law_oracles.py's Eq. 10 with LuGre in SI,
+    σ0 = 1e5 N/m) by SciPy's Radau with the exact Jacobian, coordinates (x, y, w, z/scale) as the
+    program's: from the exit, a return counts once v_rel has come back to half the band (the program's
+    rearming), the kink at v_rel = 0 located and the integration started again there."""
+    field, jacobian, u = brake_lugre(1e5, np.sqrt(1e5), -0.002, 0.4)
+    s, vdr = -sigma, u["vdr"]
+    level, rearm = vdr + s * stick_velocity, vdr + s * stick_velocity / 2
+
+    def crossing(t, q):
+        return q[1] - level
+    crossing.terminal, crossing.direction = True, s
+
+    def back(t, q):
+        return q[1] - rearm
+    back.terminal, back.direction = True, -s
+
+    def kink(t, q):
+        return q[1] - vdr
+    kink.terminal = True
+
+    def run(t, q, event):
+        while t < t_max:
+            sol = solve_ivp(field, (t, t_max), q, method="Radau", jac=lambda _, y: jacobian(y), rtol=rtol,
+                            atol=1e-15, events=[event, kink])
+            assert sol.status == 1, sol.message
+            if sol.t_events[0].size:
+                return sol.t_events[0][0], sol.y_events[0][0]
+            t, q = sol.t_events[1][0], sol.y_events[1][0]
+            q = q + 1e-13 * field(t, q)
+            t += 1e-13
+        raise RuntimeError("no return")
+
+    def section_map(point):
+        t, q = run(0.0, np.array([point[0], level, point[1], point[2], point[3]]), back)
+        t, q = run(t, q, crossing)
+        return np.array([q[0], q[2], q[3], q[4]]), t
+    return section_map
+
+
+def lugre_stiff(args):
+    # inputs/brake_lugre.nml with its orbit on (rodas4 at rtol 1e-9, as the input has it): Newton does not
+    # converge from the attractor's slip onset.  Not the tangent's doing: the program's section Jacobian
+    # there matches forward differences of its own map at h = 1e-10 to 1e-4 of its entries (rk8pd at rtol
+    # 1e-12, measured; the differences at h = 1e-9 of Radau's map below and of the program's agree to 3e-6).
+    # The map itself bends within the residual.
+    with h5py.File(run_program(args, "lugre_stiff", ["brake_lugre.nml"], QUIET)) as f:
+        g = f["brake/orbit"]
+        found, residual = int(g.attrs["found"]), float(g.attrs["residual"])
+        sigma = float(g.attrs["static_limit"])
+        point = np.concatenate([g["point"][[0, 2, 3]], g["law_states"][()] / g["law_state_scale"][()]])
+    assert found == 0, "the stiff bristles' orbit converged: update docs/chaos.md"
+    section_map = stiff_band_map(sigma, 1e-6)
+    image, period = section_map(point)
+    # The same map through another stepper (Radau at rtol 1e-12 against rodas4 at 1e-9): the residual is the
+    # flow's.  Measured 3e-12 m apart; 1e-9 m is the input's tolerance on 1e-3 m coordinates.
+    radau_residual = np.max(np.abs(image - point))
+    print(f"lugre-stiff: program's residual {residual:.9e} m, Radau's map {radau_residual:.9e} m, return "
+          f"{period:.6f} tau")
+    assert abs(radau_residual - residual) <= 1e-9, (radau_residual, residual)
+    # ∂x'/∂y of the flow's map by forward differences 1e-8 and 1e-6 m from the point: measured -81.9 and
+    # -194.4.  A derivative that moves by more than half of itself over 1e-6 m, 1/160 of the residual,
+    # leaves Newton's linear model no use at the residual's distance (the differences' own error, Radau's
+    # 1e-12 over 1e-8, is 1e-4 of them).
+    slopes = []
+    for h in (1e-8, 1e-6):
+        moved, _ = section_map(point + np.array([0.0, h, 0.0, 0.0]))
+        slopes.append((moved[0] - image[0]) / h)
+    print(f"lugre-stiff: dx'/dy by forward differences 1e-8 m: {slopes[0]:.4f}, 1e-6 m: {slopes[1]:.4f}")
+    assert abs(slopes[1] - slopes[0]) > 0.5 * abs(slopes[0]), slopes
+    assert 1e-6 < 1e-2 * residual
+
+
 def refusals(args):
     work = Path(args.workdir)
     cases = [  # (groups, line, names, why)
@@ -495,4 +573,4 @@ if __name__ == "__main__":
     sys.exit(case_main(__doc__, {"coulomb-switched": coulomb_switched, "stribeck-scipy": stribeck_scipy,
                                  "table-stribeck": table_stribeck, "arctan-scipy": arctan_scipy, "lugre-scipy": lugre_scipy,
                                  "elastoplastic-scipy": elastoplastic_scipy, "lugre-continuation": lugre_continuation,
-                                 "refusals": refusals}))
+                                 "lugre-stiff": lugre_stiff, "refusals": refusals}))
