@@ -511,7 +511,7 @@ def stiff_band_map(sigma, stick_velocity, rtol=1e-12, t_max=100.0):
 def lugre_stiff(args):
     # inputs/brake_lugre.nml with its orbit on (rodas4 at rtol 1e-9, as the input has it): Newton does not
     # converge from the attractor's slip onset.  Not the tangent's doing: the program's section Jacobian
-    # there matches forward differences of its own map at h = 1e-10 to 1e-4 of its entries (rk8pd at rtol
+    # there matches forward differences of its own map at h = 1e-10 to 1.3e-4 of each entry (rk8pd at rtol
     # 1e-12, measured; the differences at h = 1e-9 of Radau's map below and of the program's agree to 3e-6).
     # The map itself bends within the residual.
     with h5py.File(run_program(args, "lugre_stiff", ["brake_lugre.nml"], QUIET)) as f:
