@@ -60,6 +60,7 @@ module friction_brake_law_model
       procedure :: dimension => flow_dimension
       procedure :: rhs => flow_rhs
       procedure :: jacobian => flow_jacobian
+      procedure :: relative_component => flow_relative_component
       procedure :: event_count => flow_event_count
       procedure :: event_values => flow_event_values
       procedure :: friction => flow_friction
@@ -197,6 +198,21 @@ contains
          end do
       end associate
    end subroutine flow_jacobian
+
+   !> The slip rate v_rel = v - v_dr (component 2) when the law's force goes
+   !> with its logarithm (rate and state), its floor in the brake's units but
+   !> no lower than 64 spacings of v_dr: v_rel is carried as v - v_dr, so a
+   !> finer bound is one the steps' rounding alone would break.
+   pure subroutine flow_relative_component(self, index, reference, floor)
+      class(brake_law_flow), intent(in) :: self
+      integer, intent(out) :: index
+      real(wp), intent(out) :: reference, floor
+
+      floor = self%law%log_slip_floor()
+      index = merge(2, 0, floor > 0.0_wp)
+      reference = self%params%v_dr
+      if (index > 0) floor = max(floor / self%units%velocity, 64.0_wp * spacing(abs(reference)))
+   end subroutine flow_relative_component
 
    pure function flow_event_count(self) result(n)
       class(brake_law_flow), intent(in) :: self
