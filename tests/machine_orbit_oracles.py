@@ -61,7 +61,8 @@ the program and its file, against oracles computed here:
   gms-table         GMS at Table I's stiffness: its tangent through the elements'
                     switch bands is not resolved, and the search says so after
                     one return instead of failing Newton step after step
-  refusals          what the orbit cannot do is refused with file, line, group
+  refusals          what the orbit cannot do, and a multistep stepper on
+                    Karnopp's band, is refused with file, line, group
                     and variable, exit code 3, no file written
 
     machine_orbit_oracles.py --binary build/friction --inputs inputs --workdir DIR CASE
@@ -856,6 +857,11 @@ def refusals(args):
         ("&machine\n  support_amplitude = 0.01\n  support_frequency = 0.2\n/\n&law\n  model = 'lugre'\n/\n"
          "&analysis\n  orbit = .true.\n  continuation = 'support_amplitude'\n  continuation_end = 0.0\n/\n", 15,
          "&analysis: continuation_end = ", "keep the support moving"),
+        # Both crawled for minutes on this orbit (the plain run alone ~200 times a one-step method's steps).
+        ("&law\n  model = 'karnopp'\n/\n&analysis\n  orbit = .true.\n/\n&integrator\n  method = 'msadams'\n"
+         "  rtol = 1e-6\n/\n", 12, "&integrator: method = ", "a multistep stepper on &law model = 'karnopp'"),
+        ("&law\n  model = 'karnopp'\n/\n&integrator\n  method = 'msbdf'\n/\n", 9,
+         "&integrator: method = ", "force jumps at the band's edges"),
     ]
     check_refusals(args, cases, "refusals")
 

@@ -317,6 +317,8 @@ contains
       call new_law(self%law, law)
       call check_band_edges(self, law, c)
       if (c%failed()) return
+      call check_band_stepper(self, law, c)
+      if (c%failed()) return
       ! Exact stick holds the closed-form stick phase, whose end needs a static limit affine in N'.
       if (law%set_valued()) then
          block
@@ -360,6 +362,24 @@ contains
       if (self%analysis%orbit) call c%reject('analysis', 'orbit', '.true.', why)
       if (self%analysis%lyapunov_spectrum) call c%reject('analysis', 'lyapunov_spectrum', '.true.', why)
    end subroutine check_band_edges
+
+   !> A band law with GSL's multistep steppers: a hold keeps the block within
+   !> the tolerance of an edge, where the force jumps, and they crawl there
+   !> (docs/speed.md, "Multistep steppers and Karnopp's band").
+   subroutine check_band_stepper(self, law, c)
+      type(brake_config), intent(in) :: self
+      class(sliding_law), intent(in) :: law
+      type(config_checker), intent(inout) :: c
+      real(wp) :: width, limit
+
+      if (self%solver%method /= 'msadams' .and. self%solver%method /= 'msbdf') return
+      call law%band(width, limit)
+      if (width > 0.0_wp) call c%reject('integrator', 'method', "'"//trim(self%solver%method)//"'", &
+         & "a multistep stepper on &law model = '"//trim(self%law%model)//"': the force jumps at the " &
+         & //'band''s edges, where a hold keeps the block, and every step across an edge is rejected with ' &
+         & //'the history spanning the jump (more than 500 times rk8pd''s steps at rtol 1e-6): use a one-step ' &
+         & //'method such as rk8pd')
+   end subroutine check_band_stepper
 
    !> The configuration with the continuation variable set to `value` (and no
    !> continuation of its own).

@@ -128,6 +128,8 @@ contains
          & rtoa(self%dt_out), 'gives more than 1e7 output points over [t_start, t_end]')
       call check_law(law_with_files(self%law), c)
       if (c%failed()) return
+      call check_band_stepper(self, c)
+      if (c%failed()) return
       call self%analysis%validate(c, self%t_start, self%t_end, ['x', 'v'])
       if (c%failed()) return
       ! Every diagnostic of &analysis runs on the machine; what a law cannot give is refused by name.
@@ -136,6 +138,26 @@ contains
          if (a%poincare) call check_sections(self, c)
       end associate
    end subroutine validate
+
+   !> A band law's force jumps at the band's edges, where a hold keeps the
+   !> block within the tolerance of the edge: GSL's multistep steppers reject
+   !> step after step there, their history spanning the jump, and crawl
+   !> (docs/speed.md, "Multistep steppers and Karnopp's band").
+   subroutine check_band_stepper(self, c)
+      class(machine_config), intent(in) :: self
+      type(config_checker), intent(inout) :: c
+      class(sliding_law), allocatable :: law
+      real(wp) :: width, limit
+
+      if (self%solver%method /= 'msadams' .and. self%solver%method /= 'msbdf') return
+      call new_law(self%law, law)
+      call law%band(width, limit)
+      if (width > 0.0_wp) call c%reject('integrator', 'method', "'"//trim(self%solver%method)//"'", &
+         & "a multistep stepper on &law model = '"//trim(self%law%model)//"': the force jumps at the " &
+         & //'band''s edges, where a hold keeps the block, and every step across an edge is rejected with ' &
+         & //'the history spanning the jump (some 200 times a one-step method''s steps at rtol 1e-6, more at ' &
+         & //'tighter tolerances): use a one-step method such as rodas4 or rk8pd')
+   end subroutine check_band_stepper
 
    !> What the machine's Poincaré maps need of the law: the located slip
    !> onsets exist for a set-valued law only.  (The Lyapunov spectrum needs
