@@ -23,14 +23,12 @@ edges |v_rel| = Δv and where the pull A = -(2x - y) reaches ±F_s):
 
     brake_karnopp_oracles.py --binary build/friction --inputs inputs --workdir DIR CASE
 """
-import subprocess
-from pathlib import Path
 
 import h5py
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from machine_cases import run_program, case_main
+from machine_cases import run_program, check_refusals, case_main
 from brake_law_orbit_oracles import QUIET, XI, KAPPA, V_DR, orbit_of, check_map
 
 # The law in the brake's units (units = 'nondimensional': forces over k1 in m, velocities in m per unit τ):
@@ -269,7 +267,6 @@ def stick_limit(args):
 
 
 def refusals(args):
-    work = Path(args.workdir)
     # σ2 = 1000 (m per m/τ): the force just outside the band, g(Δv) + σ2 Δv = 0.0105 + 0.01 (to 1e-8), is
     # above F_s = 0.0105.
     band = "&law\n  model = 'karnopp'\n  fc = 0.0085\n  fs = 0.0105\n  vs = 2e-4\n  sigma2 = 1000.0\n  dv = 1e-5\n/\n"
@@ -282,16 +279,7 @@ def refusals(args):
               "&analysis: lyapunov_spectrum", edge),
              (f"&brake\n  model = 'law'\n/\n{held}&integrator\n  method = 'msadams'\n/\n", 16,
               "&integrator: method", "a multistep stepper on &law model = 'karnopp'")]
-    for i, (groups, line, names, why) in enumerate(cases):
-        path = work / f"bad{i}.nml"
-        path.write_text("! a refused value\n&job\n  scene = 'brake'\n/\n" + groups)
-        out = work / f"bad{i}.h5"
-        result = subprocess.run([args.binary, "-o", str(out), str(path)], capture_output=True, text=True)
-        print(f"refusals: exit {result.returncode}: {result.stderr.strip()}")
-        assert result.returncode == 3, result
-        assert f"{path}:{line}: {names}" in result.stderr and why in result.stderr, \
-            result.stderr
-        assert not out.exists()
+    check_refusals(args, cases, "refusals", scene="brake")
 
 
 if __name__ == "__main__":

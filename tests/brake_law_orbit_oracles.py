@@ -37,7 +37,6 @@ against oracles that are not that model's output:
 
     brake_law_orbit_oracles.py --binary build/friction --inputs inputs --workdir DIR CASE
 """
-import subprocess
 import sys
 from pathlib import Path
 
@@ -46,7 +45,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.interpolate import PchipInterpolator
 
-from machine_cases import run_program, case_main
+from machine_cases import run_program, check_refusals, case_main
 from brake_law_oracles import brake_lugre
 
 QUIET = {"analysis.spectrum": ".false.", "analysis.poincare": ".false.", "analysis.lyapunov": ".false.",
@@ -542,7 +541,6 @@ def lugre_stiff(args):
 
 
 def refusals(args):
-    work = Path(args.workdir)
     cases = [  # (groups, line, names, why)
         ("&brake\n  model = 'law'\n/\n&law\n  model = 'coulomb'\n/\n&analysis\n  orbit = .true.\n"
          "  continuation = 'delta_prime'\n  continuation_end = 1.0\n/\n", 13, "&analysis: continuation",
@@ -558,15 +556,7 @@ def refusals(args):
          "  sigma0 = 1000.0\n  z_ba = 5e-6\n/\n&analysis\n  orbit = .true.\n  continuation = 'z_ba'\n"
          "  continuation_end = 2e-5\n/\n", 18, "&analysis: continuation_end", "z_ba"),
     ]
-    for i, (groups, line, names, why) in enumerate(cases):
-        path = work / f"bad{i}.nml"
-        path.write_text("! a refused value\n&job\n  scene = 'brake'\n/\n" + groups)
-        out = work / f"bad{i}.h5"
-        result = subprocess.run([args.binary, "-o", str(out), str(path)], capture_output=True, text=True)
-        print(f"refusals: exit {result.returncode}: {result.stderr.strip()}")
-        assert result.returncode == 3, result
-        assert f"{path}:{line}: {names}" in result.stderr and why in result.stderr, result.stderr
-        assert not out.exists()
+    check_refusals(args, cases, "refusals", scene="brake")
 
 
 if __name__ == "__main__":

@@ -21,14 +21,14 @@ def run_program(args, name, files, sets):
     return out
 
 
-def check_refusals(args, cases, label):
-    """For each (groups, line, names, why) of `cases`: a machine input of the
-    groups (after its &job) is refused with exit code 3, the message naming
+def check_refusals(args, cases, label, scene="machine"):
+    """For each (groups, line, names, why) of `cases`: an input of `scene` (the
+    machine's unless named) of the groups (after its &job) is refused with exit code 3, the message naming
     the file, the line and `names`, saying `why`, and no file is written."""
     work = Path(args.workdir)
     for i, (groups, line, names, why) in enumerate(cases):
         path = work / f"bad{i}.nml"
-        path.write_text("! a refused value\n&job\n  scene = 'machine'\n/\n" + groups)
+        path.write_text(f"! a refused value\n&job\n  scene = '{scene}'\n/\n" + groups)
         out = work / f"bad{i}.h5"
         result = subprocess.run([args.binary, "-o", str(out), str(path)], capture_output=True, text=True)
         print(f"{label}: exit {result.returncode}: {result.stderr.strip()}")
