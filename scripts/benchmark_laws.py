@@ -19,7 +19,12 @@ range of x.  Four times for each run:
            dense_output = .false. (a step ends at every output time); for
            CVODE its process (scripts/cvode_laws.c, compiled here: BDF, dense
            solver, the analytic Jacobian; Debian: libsundials-dev, without
-           which its rows are skipped); for SciPy a python3 process that
+           which its rows are skipped), which writes x alone as raw doubles,
+           and "CVODE+h5", the same program built with -DCVODE_LAWS_HDF5 by
+           HDF5's h5pcc (HDF5's static archives, as the program links them,
+           and --as-needed, as the program), which writes what a user keeps
+           of the run: t, x, v, z (theta) and the force with their units in an
+           HDF5 file (without h5pcc its rows are skipped); for SciPy a python3 process that
            imports SciPy, integrates with solve_ivp and writes its result
            with h5py, as a user's script would (scripts/scipy_laws.py: the
            Jacobian estimated by differences, its default)
@@ -35,9 +40,9 @@ range of x.  Four times for each run:
            record, as its process's CPU time less that of the same run to
            the first output point (start, input and file alike)
 The program's and CVODE's processes run interleaved (friction, stepped,
-CVODE, friction, ...), so that a change of the machine's load falls on all
-three alike; the ratio columns are CVODE's medians over the program's at
-the same rtol.  At the end, each peer's every point against the program's
+CVODE, CVODE+h5, friction, ...), so that a change of the machine's load
+falls on all four alike; the ratio columns are CVODE's and CVODE+h5's
+medians over the program's at the same rtol.  At the end, each peer's every point against the program's
 fastest run (default settings) with an error at most the peer's: the ratio
 of the peer's median to the program's, by each of the four times.
 
@@ -137,26 +142,33 @@ SUNDIALS_LIBS = ["-lsundials_cvode", "-lsundials_nvecserial", "-lsundials_sunmat
                  "-lsundials_sunlinsoldense", "-lm"]
 
 
-def build_cvode(work):
-    """Compile scripts/cvode_laws.c: (the program, None) or (None, why not)."""
-    cc = os.environ.get("CC", "cc")
+def build_cvode(work, hdf5=False):
+    """Compile scripts/cvode_laws.c: (the program, None) or (None, why not).
+    With hdf5, the variant that writes an HDF5 file, by HDF5's h5pcc (its
+    static archives) with --as-needed, as the program is linked."""
+    cc = "h5pcc" if hdf5 else os.environ.get("CC", "cc")
     if shutil.which(cc) is None:
         return None, f"no C compiler ({cc})"
-    exe = work / "cvode_laws"
-    result = subprocess.run([cc, "-O2", "-o", str(exe), str(ROOT / "scripts" / "cvode_laws.c"), *SUNDIALS_LIBS],
+    exe = work / ("cvode_laws_h5" if hdf5 else "cvode_laws")
+    flags = ["-DCVODE_LAWS_HDF5", "-Wl,--as-needed"] if hdf5 else []
+    result = subprocess.run([cc, "-O2", *flags, "-o", str(exe), str(ROOT / "scripts" / "cvode_laws.c"), *SUNDIALS_LIBS],
                             capture_output=True, text=True)
     if result.returncode != 0:
-        return None, "could not build the CVODE peer (Debian: apt-get install libsundials-dev)"
+        return None, (f"could not build the CVODE peer{' with HDF5' if hdf5 else ''}"
+                      " (Debian: apt-get install libsundials-dev libhdf5-openmpi-dev)")
     return exe, None
 
 
-def cvode_run(exe, work, name, rtol, dt_out):
+def cvode_run(exe, work, name, rtol, dt_out, hdf5=False):
     """((wall, CPU) seconds of the whole process, x on the grid, counts with
     the integration's "seconds") or (seconds, why it failed, None)."""
-    out = work / f"cvode_{name}.bin"
+    out = work / f"cvode_{name}.{'h5' if hdf5 else 'bin'}"
     result, elapsed = timed([str(exe), name, f"{rtol:.17g}", f"{rtol * 1e-3:.17g}", f"{dt_out:.17g}", str(out)])
     if result.returncode != 0:
         return elapsed, result.stderr.strip().splitlines()[-1], None
+    if hdf5:
+        with h5py.File(out) as f:
+            return elapsed, f["machine/x"][:], json.loads(result.stdout)
     return elapsed, np.fromfile(out), json.loads(result.stdout)
 
 
@@ -166,14 +178,14 @@ def equal_error(points, name):
     (wall, CPU, compute, compute's CPU): rows of text."""
     ours = points.get((name, "friction"), [])
     rows = []
-    for method in ("CVODE", "LSODA", "Radau"):
+    for method in ("CVODE", "CVODE+h5", "LSODA", "Radau"):
         for point in sorted(points.get((name, method), []), key=lambda p: p[-1]):
             error, rtol = point[0], point[-1]
             good = [p for p in ours if p[0] <= error]
             if not good:
-                rows.append(f"{method:8s} {rtol:8.0e} {error:10.2e}  the program reaches no error this small")
+                rows.append(f"{method:9s} {rtol:8.0e} {error:10.2e}  the program reaches no error this small")
                 continue
-            text = f"{method:8s} {rtol:8.0e} {error:10.2e}"
+            text = f"{method:9s} {rtol:8.0e} {error:10.2e}"
             for k in range(1, 5):
                 fast = min(good, key=lambda p: p[k])
                 text += f"  {point[k]:7.4f} {fast[k]:7.4f} ({fast[-1]:5.0e}) {point[k] / fast[k]:6.2f}"
@@ -183,7 +195,7 @@ def equal_error(points, name):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--repeats", type=int, default=3, help="runs of the program and CVODE per point")
+    parser.add_argument("--repeats", type=int, default=3, help="runs of the program and of each CVODE peer per point")
     parser.add_argument("--scipy-repeats", type=int, default=3, help="runs of SciPy per point")
     parser.add_argument("--quick", action="store_true", help="fewer tolerances")
     parser.add_argument("--binary", default=str(ROOT / "build" / "friction"))
@@ -198,6 +210,10 @@ def main():
         cvode, why_not = build_cvode(work)
         if why_not:
             print(f"CVODE rows skipped: {why_not}")
+        cvode_h5, why_not = build_cvode(work, hdf5=True) if cvode else (None, None)
+        if why_not:
+            print(f"CVODE+h5 rows skipped: {why_not}")
+        peers = [(label, exe) for label, exe in (("CVODE", cvode), ("CVODE+h5", cvode_h5)) if exe]
         for name, make in (("lugre", lugre_field), ("rate_state", rate_state_field)):
             t_end, sets = make()
             stepped = dict(sets, **{"machine.dense_output": ".false."})
@@ -207,15 +223,17 @@ def main():
             print(f"\n{name}: {t.size} grid points to t = {t_end:g} s; error = max |x - x_ref| / range of x;"
                   f" times in s, medians: wall and cpu of the whole process, compute = the integration alone"
                   f" (wall time, and cpu time: the program's the process's less that of the same run to the"
-                  f" first output point); CVODE/this: the ratios of the four")
+                  f" first output point); CVODE/this, CVODE+h5/this: the ratios of the four")
             header = f"{'method':10s} {'rtol':>8s} {'error':>10s} {'wall':>8s} {'cpu':>8s} {'compute':>8s} {'(cpu)':>8s}"
-            print(header + f" {'steps':>8s} {'Jacobians':>9s} {'CVODE/this':>27s}")
+            print(header + f" {'steps':>8s} {'Jacobians':>9s}"
+                  + "".join(f" {label + '/this':>27s}" for label, _ in peers))
             rows = []
             for rtol in tolerances:
-                times = {"friction": [], "stepped": [], "CVODE": []}     # (wall, cpu) of the processes
-                short = {"friction": [], "stepped": []}                  # cpu of the runs to dt_out
-                computes = {"friction": [], "stepped": [], "CVODE": []}  # wall of the integration
-                cvode_cpu = []
+                # (wall, cpu) of the processes, wall of the integration, cpu of the program's runs to dt_out
+                times = {method: [] for method in ("friction", "stepped", *(label for label, _ in peers))}
+                computes = {method: [] for method in times}
+                short = {"friction": [], "stepped": []}
+                peer_cpu = {label: [] for label, _ in peers}
                 last = {}
                 for _ in range(args.repeats):
                     for method, settings in (("friction", sets), ("stepped", stepped)):
@@ -226,18 +244,18 @@ def main():
                         last[method] = (x, steps, jacobians)
                         to_first = dict(settings, **{"machine.t_end": dt_out})
                         short[method].append(program_run(args.binary, work, name, rtol, to_first)[0][1])
-                    if cvode:
-                        seconds, x, counts = cvode_run(cvode, work, name, rtol, dt_out)
-                        times["CVODE"].append(seconds)
-                        computes["CVODE"].append(counts["seconds"] if counts else float("nan"))
-                        cvode_cpu.append(counts["cpu_seconds"] if counts else float("nan"))
-                        last["CVODE"] = (x, counts)
+                    for label, exe in peers:
+                        seconds, x, counts = cvode_run(exe, work, name, rtol, dt_out, hdf5=label == "CVODE+h5")
+                        times[label].append(seconds)
+                        computes[label].append(counts["seconds"] if counts else float("nan"))
+                        peer_cpu[label].append(counts["cpu_seconds"] if counts else float("nan"))
+                        last[label] = (x, counts)
                 median = {method: statistics.median(w for w, _ in v) for method, v in times.items() if v}
                 cpu = {method: statistics.median(c for _, c in v) for method, v in times.items() if v}
                 busy = {method: statistics.median(v) for method, v in computes.items() if v}
                 busy_cpu = {method: cpu[method] - statistics.median(v) for method, v in short.items()}
-                if cvode_cpu:
-                    busy_cpu["CVODE"] = statistics.median(cvode_cpu)
+                for label, values in peer_cpu.items():
+                    busy_cpu[label] = statistics.median(values)
                 for method in ("friction", "stepped"):
                     x, steps, jacobians = last[method]
                     if isinstance(x, str):
@@ -247,25 +265,25 @@ def main():
                     four = (median[method], cpu[method], busy[method], busy_cpu[method])
                     points.setdefault((name, method), []).append((error, *four, rtol))
                     ratio = ""
-                    if "CVODE" in median:
-                        theirs = (median["CVODE"], cpu["CVODE"], busy["CVODE"], busy_cpu["CVODE"])
-                        ratio = "".join(f" {c / o:6.2f}" for c, o in zip(theirs, four))
+                    for label, _ in peers:
+                        theirs = (median[label], cpu[label], busy[label], busy_cpu[label])
+                        ratio += "".join(f" {c / o:6.2f}" for c, o in zip(theirs, four))
                     rows.append(f"{method:10s} {rtol:8.0e} {error:10.2e}" + "".join(f" {v:8.4f}" for v in four)
                                 + f" {steps:8d} {jacobians:9d}{ratio}")
-                if cvode:
-                    x, counts = last["CVODE"]
+                for label, _ in peers:
+                    x, counts = last[label]
                     if isinstance(x, str) or x.size != t.size:
-                        rows.append(f"{'CVODE':10s} {rtol:8.0e} {'failed':>10s} {median['CVODE']:8.4f}  "
+                        rows.append(f"{label:10s} {rtol:8.0e} {'failed':>10s} {median[label]:8.4f}  "
                                     f"{x if isinstance(x, str) else ''}")
                     else:
                         error = np.max(np.abs(x - reference)) / scale
-                        four = (median["CVODE"], cpu["CVODE"], busy["CVODE"], busy_cpu["CVODE"])
-                        points.setdefault((name, "CVODE"), []).append((error, *four, rtol))
-                        rows.append(f"{'CVODE':10s} {rtol:8.0e} {error:10.2e}" + "".join(f" {v:8.4f}" for v in four)
+                        four = (median[label], cpu[label], busy[label], busy_cpu[label])
+                        points.setdefault((name, label), []).append((error, *four, rtol))
+                        rows.append(f"{label:10s} {rtol:8.0e} {error:10.2e}" + "".join(f" {v:8.4f}" for v in four)
                                     + f" {counts['steps']:8d} {counts['jacobian_evaluations']:9d}")
-            for key in ("friction", "stepped", "CVODE"):
+            for key in ("friction", "stepped", *(label for label, _ in peers)):
                 for row in rows:
-                    if row.startswith(key):
+                    if row.split()[0] == key:
                         print(row)
             for method in ("Radau", "LSODA"):
                 for rtol in tolerances:
@@ -282,7 +300,7 @@ def main():
             print(f"\n{name} at equal or smaller error: each peer's point against the program's fastest run"
                   f" (default settings, its rtol in brackets) with an error at most the peer's, by each of the four"
                   f" times; ratio = the peer's time / the program's")
-            print(f"{'peer':8s} {'rtol':>8s} {'error':>10s}" + "".join(
+            print(f"{'peer':9s} {'rtol':>8s} {'error':>10s}" + "".join(
                 f"  {kind:>7s} {'friction':>7s} {'':7s} {'ratio':>6s}" for kind in ("wall", "cpu", "compute", "(cpu)")))
             for row in equal_error(points, name):
                 print(row)
@@ -301,7 +319,7 @@ def chart(points, path):
     for ax, (name, title) in zip(axes, (("lugre", "LuGre stick-slip, 30 s"),
                                         ("rate_state", "rate and state spring-slider, 3000 s"))):
         for method, style in (("friction", "o-"), ("stepped", "o:"), ("Radau", "s--"), ("LSODA", "^:"),
-                              ("CVODE", "D-.")):
+                              ("CVODE", "D-."), ("CVODE+h5", "d-.")):
             data = sorted(points.get((name, method), []))
             if data:
                 ax.loglog([p[0] for p in data], [p[2] for p in data], style, label=method)

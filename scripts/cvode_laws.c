@@ -18,8 +18,13 @@
  * (atol = rtol x 1e-3, as the benchmark's other runs), CV_NORMAL output at
  * each grid point (CVODE interpolates there).
  *
- * Usage: cvode_laws CASE RTOL ATOL DT_OUT OUT.bin
- *   OUT.bin  x on the grid t = 0, DT_OUT, ..., t_end as raw doubles
+ * Usage: cvode_laws CASE RTOL ATOL DT_OUT OUT
+ *   OUT  x on the grid t = 0, DT_OUT, ..., t_end as raw doubles; built with
+ *        -DCVODE_LAWS_HDF5 (and HDF5's C library), an HDF5 file instead with
+ *        what the program's file holds of the run: group /machine with the
+ *        datasets t, x, v, the third state (z for LuGre, theta for rate and
+ *        state) and the friction force, each with its "units" attribute, as a
+ *        C user who keeps their result writes it
  * Prints one line of JSON: steps, rhs_evaluations, jacobian_evaluations,
  * seconds and cpu_seconds (the integration alone, wall and CPU time: from its
  * state vector's creation to the last output point).
@@ -35,6 +40,9 @@
 #include <sundials/sundials_context.h>
 #include <sunlinsol/sunlinsol_dense.h>
 #include <sunmatrix/sunmatrix_dense.h>
+#ifdef CVODE_LAWS_HDF5
+#include <hdf5.h>
+#endif
 
 typedef struct {
     int rate_state;
@@ -118,6 +126,69 @@ static int jacobian(double t, N_Vector yv, N_Vector fy, SUNMatrix jm, void *data
     return 0;
 }
 
+#ifdef CVODE_LAWS_HDF5
+/* The friction force on the block at state y (as rhs computes it): LuGre's
+ * sigma0 z + sigma1 dz/dt + sigma2 w, rate and state's N mu. */
+static double friction_force(const case_t *p, const double *y)
+{
+    if (!p->rate_state) {
+        double w = y[1] - p->belt;
+        double zdot = w - p->s0 * fabs(w) * y[2] / stribeck(p, w);
+        return p->s0 * y[2] + p->s1 * zdot + p->s2 * w;
+    }
+    double theta = y[2] > 1e-300 ? y[2] : 1e-300;
+    double speed = fabs(y[1]) > 1e-300 ? fabs(y[1]) : 1e-300;
+    double psi = p->mu0 + p->b * log(p->v0 * theta / p->dc);
+    double big = log(speed / (2.0 * p->v0)) + psi / p->a;
+    double sign = (y[1] > 0) - (y[1] < 0);
+    double mu = big > 18.0 ? sign * p->a * (big + log(2.0)) : p->a * asinh(sign * exp(big));
+    return p->normal * mu;
+}
+
+/* One dataset of n doubles with its units: 0 or -1. */
+static int write_series(hid_t group, const char *name, const double *values, long n, const char *units)
+{
+    hsize_t size = (hsize_t)n;
+    hid_t space = H5Screate_simple(1, &size, NULL);
+    hid_t set = H5Dcreate2(group, name, H5T_IEEE_F64LE, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    herr_t status = set < 0 ? -1 : H5Dwrite(set, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, values);
+    hid_t text = H5Tcopy(H5T_C_S1), scalar = H5Screate(H5S_SCALAR);
+    H5Tset_size(text, strlen(units));
+    H5Tset_cset(text, H5T_CSET_UTF8);
+    hid_t attribute = set < 0 ? -1 : H5Acreate2(set, "units", text, scalar, H5P_DEFAULT, H5P_DEFAULT);
+    if (attribute < 0 || H5Awrite(attribute, text, units) < 0) status = -1;
+    if (attribute >= 0) H5Aclose(attribute);
+    H5Sclose(scalar);
+    H5Tclose(text);
+    if (set >= 0) H5Dclose(set);
+    H5Sclose(space);
+    return status < 0 ? -1 : 0;
+}
+
+/* The run's file: /machine/{t, x, v, z or theta, force}; 0 or -1. */
+static int write_file(const char *path, const case_t *p, const double *t, const double *states, long n)
+{
+    double *column = malloc(sizeof(double) * (size_t)n);
+    hid_t file = H5Fcreate(path, H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+    hid_t group = file < 0 ? -1 : H5Gcreate2(file, "machine", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    int status = column == NULL || group < 0 ? -1 : write_series(group, "t", t, n, "s");
+    static const char *names[2][3] = {{"x", "v", "z"}, {"x", "v", "theta"}};
+    static const char *units[2][3] = {{"m", "m/s", "m"}, {"m", "m/s", "s"}};
+    for (int j = 0; j < 3 && status == 0; ++j) {
+        for (long i = 0; i < n; ++i) column[i] = states[3 * i + j];
+        status = write_series(group, names[p->rate_state][j], column, n, units[p->rate_state][j]);
+    }
+    if (status == 0) {
+        for (long i = 0; i < n; ++i) column[i] = friction_force(p, &states[3 * i]);
+        status = write_series(group, "force", column, n, "N");
+    }
+    if (group >= 0 && H5Gclose(group) < 0) status = -1;
+    if (file >= 0 && H5Fclose(file) < 0) status = -1;
+    free(column);
+    return file < 0 ? -1 : status;
+}
+#endif
+
 int main(int argc, char **argv)
 {
     if (argc != 6) {
@@ -153,6 +224,12 @@ int main(int argc, char **argv)
     }
     long n = lround(t_end / dt) + 1;
     double *x = malloc(sizeof(double) * (size_t)n);
+#ifdef CVODE_LAWS_HDF5
+    double *times = malloc(sizeof(double) * (size_t)n), *states = malloc(sizeof(double) * 3 * (size_t)n);
+    if (times == NULL || states == NULL) return 2;
+    times[0] = 0.0;
+    for (int j = 0; j < 3; ++j) states[j] = y0[j];
+#endif
     SUNContext context;
     if (x == NULL || SUNContext_Create(NULL, &context) != 0) return 2;
     struct timespec began, ended, cpu_began, cpu_ended;
@@ -174,6 +251,10 @@ int main(int argc, char **argv)
     for (long i = 1; i < n && status >= 0; ++i) {
         status = CVode(mem, (double)i * dt, y, &t, CV_NORMAL);
         x[i] = NV_Ith_S(y, 0);
+#ifdef CVODE_LAWS_HDF5
+        times[i] = (double)i * dt;
+        for (int j = 0; j < 3; ++j) states[3 * i + j] = NV_Ith_S(y, j);
+#endif
     }
     clock_gettime(CLOCK_MONOTONIC, &ended);
     clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &cpu_ended);
@@ -186,8 +267,12 @@ int main(int argc, char **argv)
     CVodeGetNumRhsEvals(mem, &rhs_evaluations);
     CVodeGetNumJacEvals(mem, &jacobians);
     CVodeGetNumLinRhsEvals(mem, &rhs_for_jacobian);
+#ifdef CVODE_LAWS_HDF5
+    if (write_file(argv[5], &p, times, states, n) != 0) {
+#else
     FILE *out = fopen(argv[5], "wb");
     if (out == NULL || fwrite(x, sizeof(double), (size_t)n, out) != (size_t)n || fclose(out) != 0) {
+#endif
         fprintf(stderr, "cvode_laws: cannot write %s\n", argv[5]);
         return 3;
     }
@@ -201,5 +286,9 @@ int main(int argc, char **argv)
     N_VDestroy(y);
     SUNContext_Free(&context);
     free(x);
+#ifdef CVODE_LAWS_HDF5
+    free(times);
+    free(states);
+#endif
     return 0;
 }
