@@ -151,8 +151,9 @@ def build_cvode(work, hdf5=False):
         return None, f"no C compiler ({cc})"
     exe = work / ("cvode_laws_h5" if hdf5 else "cvode_laws")
     flags = ["-DCVODE_LAWS_HDF5", "-Wl,--as-needed"] if hdf5 else []
+    # (in the scratch directory: h5pcc leaves its object file where it runs)
     result = subprocess.run([cc, "-O2", *flags, "-o", str(exe), str(ROOT / "scripts" / "cvode_laws.c"), *SUNDIALS_LIBS],
-                            capture_output=True, text=True)
+                            capture_output=True, text=True, cwd=work)
     if result.returncode != 0:
         return None, (f"could not build the CVODE peer{' with HDF5' if hdf5 else ''}"
                       " (Debian: apt-get install libsundials-dev libhdf5-openmpi-dev)")
