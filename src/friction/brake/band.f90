@@ -2,9 +2,10 @@
 !> band (Karnopp's: |v_rel| < Δv holds the springs' pull A = -(2x - y) up
 !> to F_s; docs/chaos.md, "Karnopp's band on the brake"), integrated with the
 !> band's edges and the ends of its hold as located events, and the tangent
-!> Φ carried through a saltation at each jump.  The periodic orbits
-!> (orbit.f90) and the Lyapunov spectrum (diagnostics.f90) of such a law run
-!> it; the brake's own run keeps the law's flow (law_model.f90).
+!> Φ carried through a saltation at each jump.  The brake's run of such a
+!> law (its trajectory, events, Poincaré maps and Benettin's two runs:
+!> simulate.f90's factory), its periodic orbits (orbit.f90) and its Lyapunov
+!> spectrum (diagnostics.f90) all run it.
 !>
 !> - an edge crossed: Φ ← (I + (f⁺ - f⁻) e_vᵀ / f⁻_v) Φ, f⁻ and f⁺ the fields
 !>   on the two sides at the crossing.  Entering, the block is put at the
@@ -27,8 +28,8 @@ module friction_brake_band
    use friction_error, only: error_type, fatal_error, error_numerical
    use friction_strings, only: rtoa, itoa
    use friction_ode_events, only: event_system, event_falling, event_rising, event_either
-   use friction_law, only: in_band, band_edge_velocity
-   use friction_law_factory, only: make_law
+   use friction_law, only: sliding_law, in_band, band_edge_velocity
+   use friction_law_factory, only: make_law, new_law
    use friction_output_law_files, only: law_with_files
    use friction_analysis_lyapunov_spectrum, only: tangent_system
    use friction_brake_config, only: brake_config
@@ -40,7 +41,7 @@ module friction_brake_band
    implicit none
    private
 
-   public :: brake_band_flow, band_integrator
+   public :: brake_band_flow, band_integrator, band_law
 
    !> Switches at the band's edges within one advance beyond which the edges are taken to chatter.
    integer, parameter :: max_switches = 1000000
@@ -78,6 +79,21 @@ module friction_brake_band
    end type band_integrator
 
 contains
+
+   !> Whether the brake's friction is a law of &law with a band whose force
+   !> jumps at its edges (Karnopp's): run through its switches
+   !> (the brake's run, its orbit and its spectrum).
+   logical function band_law(config)
+      type(brake_config), intent(in) :: config
+      class(sliding_law), allocatable :: law
+      real(wp) :: half_width, limit
+
+      band_law = config%uses_law()
+      if (.not. band_law) return
+      call new_law(config%law, law)
+      call law%band(half_width, limit)
+      band_law = half_width > 0.0_wp
+   end function band_law
 
    ! ---- the flow and its events ----
 

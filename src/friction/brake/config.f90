@@ -343,7 +343,8 @@ contains
    !> A band law (Karnopp's) whose force just outside the band exceeds its
    !> hold: an edge then attracts from both sides and the block would slide
    !> along it (a Filippov sliding mode), which the band's switches of the
-   !> orbit and the spectrum (band.f90) do not follow: refused by name.
+   !> run, the orbit and the spectrum (band.f90) do not follow: refused by
+   !> name (the orbit or the spectrum first, when asked).
    subroutine check_band_edges(self, law, c)
       type(brake_config), intent(in) :: self
       class(sliding_law), intent(in) :: law
@@ -361,6 +362,8 @@ contains
          & //'band''s edge, which the band''s switches do not follow: a smaller sigma2 or dv'
       if (self%analysis%orbit) call c%reject('analysis', 'orbit', '.true.', why)
       if (self%analysis%lyapunov_spectrum) call c%reject('analysis', 'lyapunov_spectrum', '.true.', why)
+      ! The run itself steps through the same switches (band.f90).
+      call c%reject(law_group, 'dv', rtoa(width), why)
    end subroutine check_band_edges
 
    !> A band law with GSL's multistep steppers: a hold keeps the block within

@@ -12,7 +12,6 @@ module friction_brake_diagnostics
    use friction_brake_simulate, only: initial_state, new_brake_integrator
    use friction_brake_integrator, only: brake_integrator
    use friction_brake_law_model, only: law_integrator
-   use friction_brake_band, only: band_integrator
    use friction_law, only: sliding_law
    use friction_law_factory, only: make_law
    use friction_output_law_files, only: law_with_files
@@ -301,11 +300,8 @@ contains
             return
          end if
       end if
-      if (half_width > 0.0_wp) then
-         allocate (band_integrator :: run)
-      else
-         call new_brake_integrator(config, run)
-      end if
+      ! (A band law's integrator is the band's run, band.f90.)
+      call new_brake_integrator(config, run)
       run%tangent = .true.
       call run%start(config, config%t_start, initial_state(config), events, error)
       if (allocated(error)) return

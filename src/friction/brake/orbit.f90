@@ -33,7 +33,7 @@ module friction_brake_orbit
    use friction_brake_switched, only: switched_integrator, brake_slip
    use friction_brake_law_model, only: law_integrator, brake_law_slip, brake_law_flow, law_units, law_static_line
    use friction_brake_integrator, only: brake_integrator
-   use friction_brake_band, only: band_integrator
+   use friction_brake_band, only: band_integrator, band_law
    use friction_law, only: sliding_law, max_law_states
    use friction_law_factory, only: make_law, new_law
    use friction_output_law_files, only: law_with_files
@@ -159,20 +159,6 @@ contains
          z = [(s(1) + limit * (slope * p%normal_force(s(1)) + level)) / 2, p%v_dr, s(1), s(2)]
       end if
    end function limit_state
-
-   !> Whether the brake's friction is a law of &law with a band whose force
-   !> jumps at its edges (Karnopp's): the section at the end of its hold.
-   logical function band_law(config)
-      type(brake_config), intent(in) :: config
-      class(sliding_law), allocatable :: law
-      real(wp) :: half_width, limit
-
-      band_law = config%uses_law()
-      if (.not. band_law) return
-      call new_law(config%law, law)
-      call law%band(half_width, limit)
-      band_law = half_width > 0.0_wp
-   end function band_law
 
    !> Whether the brake's friction sticks exactly (the switched model, or a
    !> set-valued law of &law): the stick-to-slip section; else the creep band's exit.

@@ -12,6 +12,7 @@ module friction_brake_simulate
    use friction_brake_switched, only: switched_integrator
    use friction_brake_regularized, only: regularized_integrator
    use friction_brake_law_model, only: law_integrator
+   use friction_brake_band, only: band_integrator, band_law
    implicit none
    private
 
@@ -127,13 +128,16 @@ contains
       time_reached = self%integrator%t
    end function time_reached
 
-   !> The integrator of the configuration's friction model.
+   !> The integrator of the configuration's friction model: a law with a
+   !> zero-velocity band (Karnopp's) runs through its band's switches (band.f90).
    subroutine new_brake_integrator(config, integrator)
       type(brake_config), intent(in) :: config
       class(brake_integrator), allocatable, intent(out) :: integrator
 
       if (config%switched()) then
          allocate (switched_integrator :: integrator)
+      else if (band_law(config)) then
+         allocate (band_integrator :: integrator)
       else if (config%uses_law()) then
          allocate (law_integrator :: integrator)
       else

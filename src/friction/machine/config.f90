@@ -137,7 +137,30 @@ contains
          if (a%orbit) call check_orbit(self, c)
          if (a%poincare) call check_sections(self, c)
       end associate
+      if (c%failed()) return
+      call check_band_edges(self, c)
    end subroutine validate
+
+   !> A band law whose force just outside the band exceeds its hold: the
+   !> edge attracts from both sides and the block would slide along it (a
+   !> Filippov sliding mode), which the run's switches at the band's edges
+   !> (band.f90) do not follow: refused by name (the orbit says so first, in
+   !> its own words).
+   subroutine check_band_edges(self, c)
+      class(machine_config), intent(in) :: self
+      type(config_checker), intent(inout) :: c
+      class(sliding_law), allocatable :: law
+      real(wp) :: width, limit, outside, none(0)
+
+      call new_law(self%law, law)
+      call law%band(width, limit)
+      if (.not. (width > 0.0_wp)) return
+      outside = law%force(width, none, self%normal, 0.0_wp)
+      if (outside > limit) call c%reject('law', 'dv', rtoa(width), "&law model = '"//trim(self%law%model) &
+         & //"': the force just outside the band, "//rtoa(outside)//' N at dv, exceeds the band''s hold fs = ' &
+         & //rtoa(limit)//' N, so the block would slide along the band''s edge, which the run''s switches at ' &
+         & //'the edges do not follow: a smaller sigma2 or dv')
+   end subroutine check_band_edges
 
    !> A band law's force jumps at the band's edges, where a hold keeps the
    !> block within the tolerance of the edge: GSL's multistep steppers reject
@@ -160,16 +183,20 @@ contains
    end subroutine check_band_stepper
 
    !> What the machine's Poincaré maps need of the law: the located slip
-   !> onsets exist for a set-valued law only.  (The Lyapunov spectrum needs
+   !> onsets exist for a set-valued law and a band law (the ends of its holds) only.  (The Lyapunov spectrum needs
    !> nothing: the tangent equations take any number of states.)
    subroutine check_sections(self, c)
       class(machine_config), intent(in) :: self
       type(config_checker), intent(inout) :: c
       class(sliding_law), allocatable :: law
 
+      real(wp) :: width, limit
+
       call new_law(self%law, law)
+      call law%band(width, limit)
       associate (a => self%analysis)
-         if (a%poincare .and. trim(a%section) == 'stick_to_slip' .and. .not. law%set_valued()) &
+         if (a%poincare .and. trim(a%section) == 'stick_to_slip' .and. .not. law%set_valued() .and. &
+            & .not. width > 0.0_wp) &
             & call c%reject('analysis', 'section', "'stick_to_slip'", "the located slip onsets are the events of " &
             & //"exact stick; &law model = '"//trim(self%law%model)//"' has none: use section = 'w_zero_up' " &
             & //"(the sliding velocity crossing 0 upwards) or 'none'")

@@ -29,21 +29,18 @@ module friction_machine_orbit
    use friction_kinds, only: wp
    use friction_error, only: error_type, error_interrupted
    use friction_parameters, only: configurable, set_parameter_number, get_parameter, list_parameters, parameter_info
-   use friction_ode_system, only: ode_system
    use friction_ode_solver, only: solver_settings
-   use friction_ode_events, only: event_system, event_locator, event_either, event_rising
    use friction_ode_watch, only: step_watch
-   use friction_analysis_lyapunov_spectrum, only: tangent_system, pack_tangent, unpack_tangent
-   use friction_law, only: sliding_law, max_law_states, band_edge_velocity
+   use friction_law, only: sliding_law, max_law_states
    use friction_law_factory, only: make_law
    use friction_output_law_files, only: law_with_files
    use friction_analysis_periodic_orbit, only: section_map, orbit_settings, periodic_orbit, find_periodic_orbit, &
       & floquet_multipliers, floquet_exponents, hyperplane_map, stroboscopic_map, section_multipliers, &
       & halving_walk, branch_values, modulus_crossing
    use friction_machine_config, only: machine_config
-   use friction_machine_model, only: machine_smooth
    use friction_machine_run, only: machine_run, run_machine
    use friction_machine_switching, only: switching_section
+   use friction_machine_band, only: load_frame, band_frame, machine_band, band_none, band_at_section
    use friction_analysis_magnus_section, only: magnus_map
    implicit none
    private
@@ -61,38 +58,11 @@ module friction_machine_orbit
    !> Most section points of the attractor kept per point of the line (the diagram).
    integer, parameter :: max_section_points = 400
 
-   !> The machine in the load point's frame: y = (e, v, ẑ), e = x - load t.
-   type, extends(ode_system) :: load_frame
-      type(machine_smooth) :: base
-   contains
-      procedure :: dimension => frame_dimension
-      procedure :: relative_component => frame_relative_component
-      procedure :: rhs => frame_rhs
-      procedure :: jacobian => frame_jacobian
-   end type load_frame
-
-   !> The load point's frame with the events of a law's band |w| < Δv
-   !> (Karnopp's): its edges w = ±Δv (1, 2), the applied force at ±F_s (3,
-   !> 4: where a hold in the band ends; located so that no step straddles the
-   !> kink of the clipped force) and, autonomous, the section v =
-   !> load_velocity (5).
-   type, extends(event_system) :: band_frame
-      type(load_frame) :: frame
-      real(wp) :: half_width = 0.0_wp, limit = 0.0_wp
-      logical :: sectioned = .false.
-   contains
-      procedure :: dimension => band_dimension
-      procedure :: rhs => band_rhs
-      procedure :: jacobian => band_jacobian
-      procedure :: event_count => band_event_count
-      procedure :: event_values => band_event_values
-   end type band_frame
-
    !> The return map of a law with a band (either section, as hyperplane_map
    !> and stroboscopic_map), with a saltation matrix at every edge and the
    !> hold in the band at an edge as a mode of its own.
    type, extends(section_map) :: band_section
-      type(tangent_system), allocatable :: extended   !! base: a band_frame
+      type(band_frame) :: band
       type(solver_settings) :: solver
       logical :: forced = .false.
       real(wp) :: t0 = 0.0_wp, period = 0.0_wp, max_return = 0.0_wp, event_tolerance = 1.0e-10_wp
@@ -147,127 +117,18 @@ module friction_machine_orbit
 
 contains
 
-   ! ---- the load point's frame ----
-
-   pure integer function frame_dimension(self)
-      class(load_frame), intent(in) :: self
-
-      frame_dimension = self%base%dimension()
-   end function frame_dimension
-
-   !> The base's (y(2) is v in this frame too).
-   pure subroutine frame_relative_component(self, index, reference, floor)
-      class(load_frame), intent(in) :: self
-      integer, intent(out) :: index
-      real(wp), intent(out) :: reference, floor
-
-      call self%base%relative_component(index, reference, floor)
-   end subroutine frame_relative_component
-
-   pure subroutine frame_rhs(self, t, y, dydt)
-      class(load_frame), intent(in) :: self
-      real(wp), intent(in) :: t
-      real(wp), intent(in), contiguous :: y(:)
-      real(wp), intent(out), contiguous :: dydt(:)
-      real(wp) :: moved(size(y))
-
-      moved = y
-      moved(1) = y(1) + self%base%m%load * t
-      call self%base%rhs(t, moved, dydt)
-      dydt(1) = y(2) - self%base%m%load
-   end subroutine frame_rhs
-
-   pure subroutine frame_jacobian(self, t, y, dfdy, dfdt)
-      class(load_frame), intent(in) :: self
-      real(wp), intent(in) :: t
-      real(wp), intent(in) :: y(:)
-      real(wp), intent(out) :: dfdy(:, :)
-      real(wp), intent(out) :: dfdt(:)
-      real(wp) :: moved(size(y))
-
-      moved = y
-      moved(1) = y(1) + self%base%m%load * t
-      call self%base%jacobian(t, moved, dfdy, dfdt)
-      ! d/dt at fixed e moves x with the load point.
-      dfdt = dfdt + dfdy(:, 1) * self%base%m%load
-      dfdt(1) = 0.0_wp
-   end subroutine frame_jacobian
-
-   ! ---- a law with a band: its events and its return map ----
-
-   pure integer function band_dimension(self)
-      class(band_frame), intent(in) :: self
-
-      band_dimension = self%frame%dimension()
-   end function band_dimension
-
-   pure subroutine band_rhs(self, t, y, dydt)
-      class(band_frame), intent(in) :: self
-      real(wp), intent(in) :: t
-      real(wp), intent(in), contiguous :: y(:)
-      real(wp), intent(out), contiguous :: dydt(:)
-
-      call self%frame%rhs(t, y, dydt)
-   end subroutine band_rhs
-
-   pure subroutine band_jacobian(self, t, y, dfdy, dfdt)
-      class(band_frame), intent(in) :: self
-      real(wp), intent(in) :: t
-      real(wp), intent(in) :: y(:)
-      real(wp), intent(out) :: dfdy(:, :)
-      real(wp), intent(out) :: dfdt(:)
-
-      call self%frame%jacobian(t, y, dfdy, dfdt)
-   end subroutine band_jacobian
-
-   pure integer function band_event_count(self)
-      class(band_frame), intent(in) :: self
-
-      band_event_count = merge(5, 4, self%sectioned)
-   end function band_event_count
-
-   pure subroutine band_event_values(self, t, y, g)
-      class(band_frame), intent(in) :: self
-      real(wp), intent(in) :: t
-      real(wp), intent(in) :: y(:)
-      real(wp), intent(out) :: g(:)
-      real(wp) :: w, a
-
-      associate (m => self%frame%base%m)
-         w = y(2) - m%belt
-         a = m%applied(t, y(1) + m%load * t, y(2))
-         g(1) = w - self%half_width
-         g(2) = w + self%half_width
-         g(3) = self%limit - a
-         g(4) = self%limit + a
-         if (self%sectioned) g(5) = y(2) - m%load
-      end associate
-   end subroutine band_event_values
+   ! ---- a law with a band: its return map ----
 
    pure integer function band_section_dimension(self)
       class(band_section), intent(in) :: self
 
-      band_section_dimension = self%extended%base%dimension() - merge(0, 1, self%forced)
+      band_section_dimension = self%band%dimension() - merge(0, 1, self%forced)
    end function band_section_dimension
 
    !> From the section point s with Φ = I to the return, as hyperplane_map
-   !> or stroboscopic_map, through the band's switches (docs/chaos.md):
-   !>
-   !> - an edge w = e crossed: a saltation across h = w - e (f⁻, f⁺ the fields
-   !>   on the two sides at the crossing).  Entering, the block is put just
-   !>   inside the edge, at the closest velocity: where the integration left it, a
-   !>   located time's distance inside, would set when a hold there ends, a
-   !>   noise of that size in the map;
-   !> - inside, v' = (A - clip(A, ±F_s))/m: 0 while |A| <= F_s (a hold);
-   !> - a hold at an edge ends where |A| reaches F_s pushing outwards: the
-   !>   block leaves at once (in the band's limit it drifts out in a time
-   !>   that vanishes with its depth), a saltation from the hold's field into
-   !>   the outside one across h = F_s - σ A, ∂h/∂t included.  The hold is
-   !>   known by the edge it was entered at, not by v: the step that reaches
-   !>   the force's event may move v by units of its last place, out past the
-   !>   edge, so that the edge's event may even come first;
-   !> - without a moving support, Φ in a hold is projected along its
-   !>   one-dimensional flow (as exact stick's: switching.f90).
+   !> or stroboscopic_map, through the band's switches (band.f90, the run's
+   !> own; docs/chaos.md); without a moving support, Φ in a hold is projected
+   !> along its one-dimensional flow (as exact stick's: switching.f90).
    subroutine band_section_evaluate(self, s, image, jacobian, period, returned, reason, error)
       class(band_section), intent(inout) :: self
       real(wp), intent(in) :: s(:)
@@ -275,16 +136,15 @@ contains
       logical, intent(out) :: returned
       character(len=:), allocatable, intent(out) :: reason
       type(error_type), allocatable, intent(out) :: error
-      type(event_locator) :: locator
-      real(wp), allocatable :: y(:), phi(:, :), z(:), f_minus(:), f_plus(:), near(:), normal(:), row(:)
-      integer, allocatable :: directions(:)
-      real(wp) :: t, t_end, h, w, edge, sigma, a, rate, rate_t, hold_edge
-      integer :: n, i, which, events
+      type(machine_band), target :: run
+      real(wp), allocatable :: y(:), f(:), row(:)
+      real(wp) :: t_end, h
+      integer :: n, i, outcome, events
       logical :: done
       !> Switches in one return beyond which the band's events are taken to chatter (no return).
       integer, parameter :: max_events = 100000
 
-      n = self%extended%base%dimension()
+      n = self%band%dimension()
       image = s
       jacobian = 0.0_wp
       period = 0.0_wp
@@ -294,141 +154,56 @@ contains
          y = s
          t_end = self%t0 + self%period
       else
-         y = [s(1), 0.0_wp, s(2:)]
+         y = [s(1), self%band%frame%base%m%load, s(2:)]
          t_end = self%t0 + self%max_return
       end if
-      allocate (phi(n, n), f_minus(n), f_plus(n), normal(n), row(n))
-      phi = 0.0_wp
-      do i = 1, n
-         phi(i, i) = 1.0_wp
+      h = self%solver%h_start
+      if (.not. (h > 0.0_wp)) h = 1.0e-6_wp
+      run%project_in_hold = .not. self%forced
+      call run%start(self%band, self%solver, self%event_tolerance, h, self%t0, y, .true., error)
+      if (allocated(error)) return
+      done = .false.
+      events = 0
+      do while (run%t < t_end)
+         if (events >= max_events) then
+            reason = 'more than 100000 switches at the band''s edges in one return'
+            return
+         end if
+         events = events + 1
+         if (associated(self%watch)) then
+            call run%advance(t_end, outcome, error, self%watch)
+         else
+            call run%advance(t_end, outcome, error)
+         end if
+         if (allocated(error)) return
+         if (outcome == band_none) exit
+         ! A function exactly 0 at the start crosses at once (ode/events.f90): that is the start itself.
+         if (outcome == band_at_section .and. run%t - self%t0 > 1.0e3_wp * self%event_tolerance) then
+            done = .true.
+            exit
+         end if
       end do
-      select type (b => self%extended%base)
-      type is (band_frame)
-         associate (m => b%frame%base%m, width => b%half_width, limit => b%limit)
-            if (.not. self%forced) y(2) = m%load
-            directions = [event_either, event_either, event_either, event_either]
-            if (.not. self%forced) directions = [directions, event_rising]
-            h = self%solver%h_start
-            if (.not. (h > 0.0_wp)) h = 1.0e-6_wp
-            call locator%init(self%extended, self%solver, directions, spread(.true., 1, size(directions)), &
-               & self%event_tolerance, h, error, 't', ' s')
-            if (allocated(error)) return
-            t = self%t0
-            z = pack_tangent(y, phi)
-            call locator%restart(t, z, h)
-            done = .false.
-            events = 0
-            ! The sign of the edge the block holds at (0: none); a strobe point may be in a hold.
-            hold_edge = 0.0_wp
-            w = y(2) - m%belt
-            if (abs(w) < width .and. abs(m%applied(t, y(1) + m%load * t, y(2))) <= limit) then
-               if (y(2) == band_edge_velocity(m%belt, width, 1.0_wp, sign(1.0_wp, w), .true.)) &
-                  & hold_edge = sign(1.0_wp, w)
-            end if
-            do while (t < t_end)
-               if (events >= max_events) then
-                  reason = 'more than 100000 switches at the band''s edges in one return'
-                  return
-               end if
-               events = events + 1
-               if (associated(self%watch)) then
-                  call locator%advance(t, t_end, z, error, self%watch)
-               else
-                  call locator%advance(t, t_end, z, error)
-               end if
-               if (allocated(error)) return
-               if (locator%n_hits == 0) exit
-               which = locator%hits(locator%n_hits)%which
-               call unpack_tangent(z, y, phi)
-               w = y(2) - m%belt
-               ! Out past the edge of a hold before the force's event was located: that is the hold's end.
-               if ((which == 1 .or. which == 2) .and. hold_edge == merge(1.0_wp, -1.0_wp, which == 1) &
-                  & .and. .not. abs(w) < width) which = which + 2
-               select case (which)
-               case (5)
-                  ! A function exactly 0 at the start crosses at once (ode/events.f90): that is the start itself.
-                  if (t - self%t0 > 1.0e3_wp * self%event_tolerance) then
-                     done = .true.
-                     exit
-                  end if
-               case (1, 2)
-                  edge = merge(width, -width, which == 1)
-                  near = y
-                  if (abs(w) < width) then
-                     ! Entering: just inside, deterministically.
-                     y(2) = band_edge_velocity(m%belt, width, 1.0_wp, sign(1.0_wp, edge), .true.)
-                     near(2) = band_edge_velocity(m%belt, width, 1.0_wp, sign(1.0_wp, edge), .false.)
-                  else
-                     near(2) = band_edge_velocity(m%belt, width, 1.0_wp, sign(1.0_wp, edge), .true.)
-                  end if
-                  call b%rhs(t, near, f_minus)
-                  call b%rhs(t, y, f_plus)
-                  if (f_minus(2) /= 0.0_wp) then
-                     ! Φ across h = w - edge (∇h = e_v): row v scales by f⁺_v/f⁻_v (0 exactly into a hold).
-                     row = phi(2, :)
-                     do i = 1, n
-                        if (i /= 2) phi(i, :) = phi(i, :) + (f_plus(i) - f_minus(i)) * row / f_minus(2)
-                     end do
-                     phi(2, :) = row * (f_plus(2) / f_minus(2))
-                  end if
-                  hold_edge = merge(sign(1.0_wp, edge), 0.0_wp, f_plus(2) == 0.0_wp .and. abs(w) < width)
-                  ! A hold's flow is one-dimensional: without a support's motion what is left of Φ is a shift in time.
-                  if (.not. self%forced .and. hold_edge /= 0.0_wp) phi = 0.0_wp
-               case (3, 4)
-                  sigma = merge(1.0_wp, -1.0_wp, which == 3)
-                  a = m%applied(t, y(1) + m%load * t, y(2))
-                  ! A hold at the edge the force pushes towards ends: out at once (else a kink, nothing to do).
-                  if (hold_edge == sigma .and. (sigma * a >= limit .or. .not. abs(w) < width)) then
-                     f_minus = 0.0_wp
-                     f_minus(1) = y(2) - m%load   ! the hold's field: e' = v - load_velocity, v' = 0, the states'
-                     if (n > 2) then
-                        call b%rhs(t, y, f_plus)
-                        f_minus(3:n) = f_plus(3:n)
-                     end if
-                     y(2) = band_edge_velocity(m%belt, width, 1.0_wp, sigma, .false.)
-                     call b%rhs(t, y, f_plus)
-                     ! h = F_s - σ A(t, e + load t, v): ∇h = σ (k, c, 0...), ∂h/∂t at fixed e.
-                     normal = 0.0_wp
-                     normal(1) = sigma * m%stiffness
-                     normal(2) = sigma * m%damping
-                     rate_t = -sigma * (m%applied_rate(t) - m%stiffness * m%load)
-                     rate = dot_product(normal, f_minus) + rate_t
-                     if (rate /= 0.0_wp) then
-                        row = matmul(normal, phi) / rate
-                        do i = 1, n
-                           phi(i, :) = phi(i, :) + (f_plus(i) - f_minus(i)) * row
-                        end do
-                     end if
-                  end if
-                  ! Ended, or pushed inwards into the band: no longer held at an edge.
-                  hold_edge = 0.0_wp
-               end select
-               z = pack_tangent(y, phi)
-               call locator%restart(t, z, 0.0_wp)
-            end do
-            if (self%forced) then
-               call unpack_tangent(z, y, phi)
-               image = y
-               jacobian = phi
-               period = self%period
-            else
-               if (.not. done) then
-                  reason = 'no return to the section v = load_velocity within t_end - t_start'
-                  return
-               end if
-               ! The projection along the flow onto the section (hyperplane_map's).
-               call b%rhs(t, y, f_plus)
-               row = phi(2, :)
-               do i = 1, n
-                  phi(i, :) = phi(i, :) - f_plus(i) * row / f_plus(2)
-               end do
-               image = [y(1), y(3:n)]
-               jacobian = phi([1, (i, i=3, n)], [1, (i, i=3, n)])
-               period = t - self%t0
-            end if
-            returned = .true.
-         end associate
-      end select
+      if (self%forced) then
+         image = run%y
+         jacobian = run%phi
+         period = self%period
+      else
+         if (.not. done) then
+            reason = 'no return to the section v = load_velocity within t_end - t_start'
+            return
+         end if
+         ! The projection along the flow onto the section (hyperplane_map's).
+         allocate (f(n))
+         call self%band%rhs(run%t, run%y, f)
+         row = run%phi(2, :)
+         do i = 1, n
+            run%phi(i, :) = run%phi(i, :) - f(i) * row / f(2)
+         end do
+         image = [run%y(1), run%y(3:n)]
+         jacobian = run%phi([1, (i, i=3, n)], [1, (i, i=3, n)])
+         period = run%t - self%t0
+      end if
+      returned = .true.
    end subroutine band_section_evaluate
 
    ! ---- the section, trial failures as no return ----
@@ -614,12 +389,9 @@ contains
          block
             ! A band with a jumping force at its edges (Karnopp's): the events and saltations of band_section.
             type(band_section) :: banded
-            type(band_frame) :: events
-            events%frame = frame
-            call frame%base%law%band(events%half_width, events%limit)
-            events%sectioned = .not. machine_orbit_forced(c)
-            allocate (banded%extended)
-            allocate (banded%extended%base, source=events)
+            banded%band%frame = frame
+            call frame%base%law%band(banded%band%half_width, banded%band%limit)
+            banded%band%sectioned = .not. machine_orbit_forced(c)
             banded%solver = c%solver
             banded%forced = machine_orbit_forced(c)
             banded%t0 = t0

@@ -2,11 +2,15 @@
 !> the output grid and the stick/slip events.  Set-valued laws switch
 !> exactly between stick and slip as the brake's switched model does
 !> (located events; in stick v = belt_velocity exactly; a slip that ends
-!> beyond the static limit reverses); the other laws are one ODE with the
-!> law's states, and the output counts |w| <= stick_velocity as stick.
+!> beyond the static limit reverses); a law with a zero-velocity band
+!> (Karnopp's) runs with the band's edges and the ends of its holds located
+!> (band.f90), and the output counts the band as stick; the other laws are
+!> one ODE with the law's states, and the output counts |w| <= stick_velocity
+!> as stick.
 module friction_machine_run
    use friction_kinds, only: wp, i8
    use friction_error, only: error_type, fatal_error, error_numerical
+   use friction_strings, only: rtoa, itoa
    use friction_ode_solver, only: ode_solver, integrator_statistics
    use friction_ode_watch, only: step_watch
    use friction_scene_report, only: job_reporter, new_job_watch
@@ -16,6 +20,8 @@ module friction_machine_run
    use friction_output_law_files, only: law_with_files
    use friction_machine_config, only: machine_config
    use friction_machine_model, only: mechanics, machine_smooth, machine_slip, machine_stick
+   use friction_machine_band, only: band_frame, machine_band, band_hold, band_cross, band_leave, band_exit, &
+      & band_hold_end, max_switches, band_frame_of, band_start_state
    implicit none
    private
 
@@ -124,9 +130,13 @@ contains
 
       subroutine integrate(watch)
          class(step_watch), intent(inout) :: watch
+         real(wp) :: width, limit
 
+         call law%band(width, limit)
          if (law%set_valued()) then
             call run_switched(c, law, m, run, watch, error)
+         else if (width > 0.0_wp) then
+            call run_band(c, law, m, run, watch, error)
          else
             call run_smooth(c, law, m, run, watch, error)
          end if
@@ -352,6 +362,91 @@ contains
          end if
       end subroutine record
    end subroutine run_switched
+
+   !> A law with a zero-velocity band (Karnopp's): the band's edges and the
+   !> ends of its holds located (band.f90, as the orbit's map runs them), the
+   !> events as the brake's band run records them: into a hold at an edge
+   !> slip_to_stick, into the band without a hold (crossing it) reversal, out
+   !> of a hold stick_to_slip.  The output counts the band as stick, and
+   !> stick_time is the time in it.
+   subroutine run_band(c, law, m, run, watch, error)
+      type(machine_config), intent(in) :: c
+      class(sliding_law), intent(in) :: law
+      type(mechanics), intent(in) :: m
+      type(machine_run), intent(inout) :: run
+      class(step_watch), intent(inout) :: watch
+      type(error_type), allocatable, intent(out) :: error
+      type(band_frame) :: band
+      type(machine_band), target :: stepper
+      real(wp) :: z(max_law_states), h, t_grid
+      integer :: i, k, ns, outcome, switches
+
+      call band_frame_of(c, law, band)
+      ns = band%frame%base%n_states
+      h = c%solver%h_start
+      if (.not. (h > 0.0_wp)) h = 1.0e-6_wp * c%dt_out
+      call stepper%start(band, c%solver, c%event_tolerance, h, c%t_start, band_start_state(c, band), .false., error)
+      if (allocated(error)) return
+      call record(1)
+      do i = 2, run%n
+         t_grid = c%grid_time(i)
+         switches = 0
+         do while (stepper%t < t_grid)
+            call stepper%advance(t_grid, outcome, error, watch)
+            if (allocated(error)) exit
+            select case (outcome)
+            case (band_hold)
+               call add(event_slip_to_stick)
+            case (band_cross)
+               call add(event_slip_reversal)
+            case (band_leave, band_hold_end)
+               call add(event_stick_to_slip)
+            end select
+            if (any(outcome == [band_hold, band_cross, band_leave, band_exit, band_hold_end])) switches = switches + 1
+            if (switches > max_switches) then
+               call fatal_error(error, 'more than '//itoa(max_switches)//' switches at the band''s edges ' &
+                  & //'before t = '//rtoa(stepper%t)//' s: the block slides along an edge', error_numerical)
+               exit
+            end if
+         end do
+         if (allocated(error)) then
+            call label(c, error)
+            return
+         end if
+         call watch%check(stepper%t, error)
+         if (allocated(error)) return
+         call record(i)
+      end do
+      run%stick_time = stepper%band_time
+      run%stats = stepper%statistics()
+
+   contains
+
+      subroutine add(kind)
+         integer, intent(in) :: kind
+
+         call run%add_event(stepper%t, kind, stepper%y(1) + m%load * stepper%t, stepper%y(2))
+      end subroutine add
+
+      !> Output point i at the state reached (its grid time).
+      subroutine record(i)
+         integer, intent(in) :: i
+         real(wp) :: x
+
+         associate (y => stepper%y)
+            z(1:ns) = y(3:2 + ns) * band%frame%base%scale(1:ns)
+            run%t(i) = c%grid_time(i)
+            x = y(1) + m%load * run%t(i)
+            run%x(i) = x
+            run%v(i) = y(2)
+            run%force(i) = law%force(y(2) - m%belt, z(1:ns), m%normal, m%applied(run%t(i), x, y(2)))
+            do k = 1, ns
+               run%states(k, i) = z(k)
+            end do
+            if (stepper%inside()) run%stick(i) = 1
+         end associate
+      end subroutine record
+   end subroutine run_band
 
    !> The law's name before an integrator's message (a watch's names it already).
    subroutine label(c, error)
