@@ -326,12 +326,20 @@ contains
 
    !> Advance towards t_target up to the first of the band's events, which is
    !> taken (module comment): `outcome` says which it was (band_none at t_target).
-   subroutine band_advance(self, t_target, outcome, error, watch)
+   !> With `single`, after one accepted step even without an event; with
+   !> `times` (increasing; not with the tangent), the states at the first
+   !> `filled` of them, those up to the time reached, into `states` from the
+   !> stepper's continuous extension (before the event is taken).
+   subroutine band_advance(self, t_target, outcome, error, watch, single, times, states, filled)
       class(machine_band), intent(inout) :: self
       real(wp), intent(in) :: t_target
       integer, intent(out) :: outcome
       type(error_type), allocatable, intent(out) :: error
       class(step_watch), intent(inout), optional :: watch
+      logical, intent(in), optional :: single
+      real(wp), intent(in), optional :: times(:)
+      real(wp), intent(inout), optional :: states(:, :)
+      integer, intent(out), optional :: filled
       real(wp), allocatable :: z(:), near(:), f_minus(:), f_plus(:), normal(:), row(:)
       real(wp) :: t_before, w, edge, sigma, a, rate, rate_t
       integer :: n, i, which, direction
@@ -343,14 +351,27 @@ contains
       was_inside = self%inside()
       if (self%tangent) then
          z = pack_tangent(self%y, self%phi)
-         call self%locator%advance(self%t, t_target, z, error, watch)
+         call self%locator%advance(self%t, t_target, z, error, watch, single)
          call unpack_tangent(z, self%y, self%phi)
       else
-         call self%locator%advance(self%t, t_target, self%y, error, watch)
+         call self%locator%advance(self%t, t_target, self%y, error, watch, single)
       end if
       ! (Between two of the band's events the block is inside it throughout or outside.)
       if (was_inside) self%band_time = self%band_time + (self%t - t_before)
       if (allocated(error)) return
+      if (present(filled)) then
+         filled = 0
+         do while (filled < size(times))
+            if (times(filled + 1) > self%t) exit
+            filled = filled + 1
+            if (times(filled) == self%t) then
+               states(:, filled) = self%y
+            else
+               call self%locator%dense_output(times(filled), states(:, filled), error)
+               if (allocated(error)) return
+            end if
+         end do
+      end if
       if (self%locator%n_hits == 0) return
       which = self%locator%hits(self%locator%n_hits)%which
       direction = self%locator%hits(self%locator%n_hits)%direction

@@ -387,40 +387,81 @@ contains
       if (.not. (h > 0.0_wp)) h = 1.0e-6_wp * c%dt_out
       call stepper%start(band, c%solver, c%event_tolerance, h, c%t_start, band_start_state(c, band), .false., error)
       if (allocated(error)) return
-      call record(1)
-      do i = 2, run%n
-         t_grid = c%grid_time(i)
-         switches = 0
-         do while (stepper%t < t_grid)
-            call stepper%advance(t_grid, outcome, error, watch)
-            if (allocated(error)) exit
-            select case (outcome)
-            case (band_hold)
-               call add(event_slip_to_stick)
-            case (band_cross)
-               call add(event_slip_reversal)
-            case (band_leave, band_hold_end)
-               call add(event_stick_to_slip)
-            end select
-            if (any(outcome == [band_hold, band_cross, band_leave, band_exit, band_hold_end])) switches = switches + 1
-            if (switches > max_switches) then
-               call fatal_error(error, 'more than '//itoa(max_switches)//' switches at the band''s edges ' &
-                  & //'before t = '//rtoa(stepper%t)//' s: the block slides along an edge', error_numerical)
-               exit
+      call record(1, stepper%y)
+      if (c%dense_output .and. stepper%locator%has_dense_output()) then
+         call free_steps()
+      else
+         do i = 2, run%n
+            t_grid = c%grid_time(i)
+            switches = 0
+            do while (stepper%t < t_grid)
+               call stepper%advance(t_grid, outcome, error, watch)
+               if (allocated(error)) exit
+               call take(outcome)
+               if (allocated(error)) exit
+            end do
+            if (allocated(error)) then
+               call label(c, error)
+               return
             end if
+            call watch%check(stepper%t, error)
+            if (allocated(error)) return
+            call record(i, stepper%y)
          end do
-         if (allocated(error)) then
-            call label(c, error)
-            return
-         end if
-         call watch%check(stepper%t, error)
-         if (allocated(error)) return
-         call record(i)
-      end do
+      end if
+      if (allocated(error)) return
       run%stick_time = stepper%band_time
       run%stats = stepper%statistics()
 
    contains
+
+      !> Steps of the error control's own size to the last output time, the
+      !> output points within each from its continuous extension (as
+      !> run_smooth's): the grid no longer pins the steps.
+      subroutine free_steps()
+         real(wp), allocatable :: times(:), states(:, :)
+         integer :: filled, j
+
+         times = [(c%grid_time(j), j = 2, run%n)]
+         allocate (states(size(stepper%y), size(times)))
+         i = 1
+         switches = 0
+         do while (i <= size(times))
+            call stepper%advance(times(size(times)), outcome, error, watch, .true., times(i:), states(:, i:), filled)
+            if (allocated(error)) then
+               call label(c, error)
+               return
+            end if
+            do j = i, i + filled - 1
+               call record(j + 1, states(:, j))
+            end do
+            if (filled > 0) switches = 0
+            i = i + filled
+            call take(outcome)
+            if (allocated(error)) return
+         end do
+         call watch%check(stepper%t, error)
+      end subroutine free_steps
+
+      !> The event of an advance into the table; the edges' switches counted.
+      subroutine take(outcome)
+         integer, intent(in) :: outcome
+
+         select case (outcome)
+         case (band_hold)
+            call add(event_slip_to_stick)
+         case (band_cross)
+            call add(event_slip_reversal)
+         case (band_leave, band_hold_end)
+            call add(event_stick_to_slip)
+         end select
+         if (any(outcome == [band_hold, band_cross, band_leave, band_exit, band_hold_end])) switches = switches + 1
+         if (switches > max_switches) then
+            call fatal_error(error, 'more than '//itoa(max_switches)//' switches at the band''s edges ' &
+               & //'before t = '//rtoa(stepper%t)//' s: the block slides along an edge', error_numerical)
+            call label(c, error)
+         end if
+      end subroutine take
 
       subroutine add(kind)
          integer, intent(in) :: kind
@@ -428,23 +469,22 @@ contains
          call run%add_event(stepper%t, kind, stepper%y(1) + m%load * stepper%t, stepper%y(2))
       end subroutine add
 
-      !> Output point i at the state reached (its grid time).
-      subroutine record(i)
+      !> Output point i from the state y at its grid time.
+      subroutine record(i, y)
          integer, intent(in) :: i
+         real(wp), intent(in) :: y(:)
          real(wp) :: x
 
-         associate (y => stepper%y)
-            z(1:ns) = y(3:2 + ns) * band%frame%base%scale(1:ns)
-            run%t(i) = c%grid_time(i)
-            x = y(1) + m%load * run%t(i)
-            run%x(i) = x
-            run%v(i) = y(2)
-            run%force(i) = law%force(y(2) - m%belt, z(1:ns), m%normal, m%applied(run%t(i), x, y(2)))
-            do k = 1, ns
-               run%states(k, i) = z(k)
-            end do
-            if (stepper%inside()) run%stick(i) = 1
-         end associate
+         z(1:ns) = y(3:2 + ns) * band%frame%base%scale(1:ns)
+         run%t(i) = c%grid_time(i)
+         x = y(1) + m%load * run%t(i)
+         run%x(i) = x
+         run%v(i) = y(2)
+         run%force(i) = law%force(y(2) - m%belt, z(1:ns), m%normal, m%applied(run%t(i), x, y(2)))
+         do k = 1, ns
+            run%states(k, i) = z(k)
+         end do
+         if (abs(y(2) - m%belt) < band%half_width) run%stick(i) = 1
       end subroutine record
    end subroutine run_band
 

@@ -136,10 +136,32 @@ module friction_ode_events
       procedure :: events_located
       procedure :: probes_taken
       procedure :: elapsed
+      procedure :: has_dense_output
+      procedure :: dense_output
       procedure, private :: locate
    end type event_locator
 
 contains
+
+   !> Whether the main stepper has a continuous extension (dense_output).
+   logical function has_dense_output(self)
+      class(event_locator), intent(in) :: self
+
+      has_dense_output = self%main%has_dense_output()
+   end function has_dense_output
+
+   !> The state at t within the main stepper's last step, from its
+   !> continuous extension: after an advance, any t since the start of that
+   !> step up to the time reached (a located event's too: the step that found
+   !> it spans it), until the next restart.
+   subroutine dense_output(self, t, y, error)
+      class(event_locator), intent(in) :: self
+      real(wp), intent(in) :: t
+      real(wp), intent(out) :: y(:)
+      type(error_type), allocatable, intent(out) :: error
+
+      call self%main%dense_output(t, y, error)
+   end subroutine dense_output
 
    !> Bind to a system.  direction(k) is event_rising, event_falling or
    !> event_either; terminal(k) stops the integration at event k.
