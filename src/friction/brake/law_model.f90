@@ -9,8 +9,9 @@
 !> own: a brake force is `force` N, a velocity `velocity` m/s and a unit τ
 !> `time` s (brake_config%law_units: SI with units = 'dimensional', else 1).
 !>
-!> - A single-valued law (arctan, Karnopp, Dahl, LuGre, elasto-plastic,
-!>   rate and state) is one ODE in (x, v, y, w, ẑ), the law's states in
+!> - A single-valued law (arctan, Dahl, LuGre, elasto-plastic, rate and
+!>   state; Karnopp's flow too, which band.f90 runs with its band's edges
+!>   located) is one ODE in (x, v, y, w, ẑ), the law's states in
 !>   units of their scale (the tangent's and Benettin's state too: the
 !>   integrator gives and takes them); events as the regularized model's: N' falling
 !>   through 0 (the pad lifts off: an error) and the edges of the creep

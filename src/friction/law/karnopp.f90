@@ -6,8 +6,9 @@
 !>   F = g(v) sgn v + σ2 v                            |v| >= Δv.
 !>
 !> In the band the body's acceleration is zero while the applied force stays
-!> within F_s, so the velocity it entered with is kept: stick without a
-!> switching of equations, at the price of a velocity error up to Δv.
+!> within F_s, so the velocity it entered with is kept, at the price of a
+!> velocity error up to Δv.  The force jumps at the edges: the mechanisms
+!> run them as located events (machine/band.f90, brake/band.f90).
 module friction_law_karnopp
    use friction_kinds, only: wp
    use friction_checks, only: config_checker

@@ -5,7 +5,7 @@
 !> set-valued law, two switching runs without Φ (the smooth laws' is the
 !> analysis layer's, diagnostics.f90).
 !>
-!> - A law that is one ODE (arctan, Karnopp, Dahl, LuGre, elasto-plastic,
+!> - A law that is one ODE (arctan, Dahl, LuGre, elasto-plastic,
 !>   rate and state): the variational equations Φ' = J Φ with J from the
 !>   law's analytic partial derivatives (model.f90's Jacobian), solved over
 !>   each of the orbit's steps by exponentials and factored within the step

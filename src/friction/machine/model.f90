@@ -4,7 +4,8 @@
 !> so that one absolute tolerance fits them all).
 !>
 !> - machine_smooth: a law that is single-valued (arctan, Karnopp, Dahl,
-!>   LuGre, elasto-plastic, rate and state), one ODE with the law's states.
+!>   LuGre, elasto-plastic, rate and state), one ODE with the law's states
+!>   (Karnopp's run with its band's edges located: band.f90).
 !> - machine_slip, machine_stick: a set-valued law (Coulomb, Stribeck, the
 !>   table) with exact stick.  In slip the law's slip force with the sign s
 !>   of the sliding velocity w = v - belt_velocity held fixed; the slip ends
