@@ -176,7 +176,7 @@ def machine(args):
 
 def brake_oracle(t_grid, z0):
     """KarnoppBrake's flow (brake_karnopp_oracles.py) from z0 on the grid, with its events recorded as the
-    program records them (the machine's kinds)."""
+    program records them (the machine's kinds), and the time it spends in the band."""
     band = KarnoppBrake()
     n = len(t_grid)
     out = np.full((4, n), np.nan)
@@ -193,11 +193,14 @@ def brake_oracle(t_grid, z0):
     else:
         mode, held = ("drift", np.sign(band.pull(z))), False
     t, end = t_grid[0], t_grid[-1]
+    band_time = 0.0
     while t < end:
         sol = solve_ivp(band.rhs(mode), (t, end), z, method="DOP853", events=band.events(mode), dense_output=True,
                         **band.tol)
         hits = [k for k, e in enumerate(sol.t_events) if e.size]
         t_to = min(sol.t_events[k][0] for k in hits) if hits else sol.t[-1]
+        if mode[0] != "out":
+            band_time += t_to - t
         inside = (t_grid > t) & (t_grid <= t_to)
         if inside.any():
             out[:, inside] = sol.sol(t_grid[inside])
@@ -225,7 +228,7 @@ def brake_oracle(t_grid, z0):
         else:
             held = True
         mode = new
-    return out, events
+    return out, events, band_time
 
 
 def brake(args):
@@ -238,8 +241,9 @@ def brake(args):
         ev = f["brake/events"]
         events = list(zip(ev["t"][()], ev["kind"][()]))
         event_v = ev["v"][()]
+        stick_time = f["brake"].attrs["stick_time"]
         x0, v0, y0, w0 = got[:, 0]
-    expected_traj, expected = brake_oracle(t, [x0, v0, y0, w0])
+    expected_traj, expected, band_time = brake_oracle(t, [x0, v0, y0, w0])
     worst_t = compare_events("brake", events, expected)
     diff = np.max(np.abs(got - expected_traj), axis=1)
     print(f"brake: events within {worst_t:.2e} tau of the oracle's; trajectory within |dx| {diff[0]:.2e}, "
@@ -254,6 +258,9 @@ def brake(args):
     # The belt moves at v_dr = -2e-4: a hold sits at v_dr + dv or v_dr - dv, inside the band to the last bit.
     assert np.all(np.min(np.abs(holds[:, None] - (V_DR + np.array([DV, -DV]))[None, :]), axis=1) < 1e-17), holds
     assert np.any(stick == 1)
+    # stick_time: the time in the band, between the located edges (event_tolerance 1e-10 tau each).
+    print(f"brake: stick_time {stick_time:.9f} tau, the oracle's time in the band {band_time:.9f} tau")
+    assert abs(stick_time - band_time) < 1e-8, (stick_time, band_time)
 
 
 def brake_benettin(args):
@@ -267,7 +274,7 @@ def brake_benettin(args):
         z0 = np.array([f["brake"][k][0] for k in ("x", "v", "y", "w")])
 
     def flow(t, z, span):
-        out, _ = brake_oracle(np.array([t, t + span]), z)
+        out, _, _ = brake_oracle(np.array([t, t + span]), z)
         return out[:, -1]
 
     reference = flow(0.0, z0, 60.0)

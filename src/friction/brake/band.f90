@@ -201,6 +201,8 @@ contains
       self%y = y0
       self%held = self%band%inside(y0(2))
       self%hold_edge = 0.0_wp
+      ! Exact: the time in the band, between its located edges.
+      self%stick_time = 0.0_wp
       call events%clear()
       directions = [event_falling, event_either, event_either, event_either, event_either]
       if (self%tangent) then
@@ -280,15 +282,19 @@ contains
       type(brake_event_table), intent(inout) :: events
       type(error_type), allocatable, intent(out) :: error
       logical, intent(out), optional :: hold_end
-      real(wp) :: near(4), f_minus(4), f_plus(4), row(4), s, sigma
+      real(wp) :: near(4), f_minus(4), f_plus(4), row(4), s, sigma, t_before
       integer :: which, direction, switches
-      logical :: entering, left
+      logical :: entering, left, was_inside
 
       if (present(hold_end)) hold_end = .false.
       switches = 0
       associate (b => self%band, y => self%y)
          do while (self%t < t_target)
+            t_before = self%t
+            was_inside = b%inside(y(2))
             call self%locator_advance(t_target, error)
+            ! (Between two of the band's events the block is inside it throughout or outside.)
+            if (was_inside) self%stick_time = self%stick_time + (self%t - t_before)
             if (allocated(error)) exit
             if (self%locator%n_hits == 0) cycle
             which = self%locator%hits(self%locator%n_hits)%which
