@@ -10,15 +10,17 @@ force reaches +-F_s):
                 trajectory on the output grid, and a hold sits exactly at the
                 edge's velocity (v' = 0 there, not a creep)
   brake         inputs/brake_karnopp.nml's brake (60 tau): the same for the
-                brake's run, /brake/events and /brake/trajectory
+                brake's run, /brake/events, the trajectory and stick_time
   brake-benettin  Benettin's two runs on the brake against the same two runs
                 of the oracle's flow
   stick-limit   the belt oscillator as dv -> 0 against the Stribeck law through
                 exact stick (another code path: machine/run.f90's switching):
                 the slip onsets converge to exact stick's, in proportion to dv
   machine-chaos the Poincare section of slip onsets of the belt oscillator (the
-                holds' ends the oracle finds) and Benettin's exponent against
-                the same two-run procedure on the oracle's flow
+                holds' ends the oracle finds), Benettin's exponent against
+                the same two-run procedure on the oracle's flow, and the
+                Lyapunov spectrum's first exponent against its exact value
+                along the cycle (the other lost in the holds)
 
     karnopp_run_oracles.py --binary build/friction --inputs inputs --workdir DIR CASE
 """
@@ -127,7 +129,6 @@ def read_machine(path):
         got = {key: g[key][()] for key in ("t", "x", "v", "stick")}
         got["events"] = list(zip(g["events/t"][()], g["events/kind"][()]))
         got["event_v"] = g["events/v"][()]
-        got["steps"] = int(f.attrs.get("steps", -1)) if "steps" in f.attrs else None
         got["stick_time"] = g.attrs["stick_time"]
     return got
 
