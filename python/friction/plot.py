@@ -1245,7 +1245,7 @@ def sweep_machine(data: DataLike) -> Figure:
     """A machine sweep's results against the parameter, a line per value of
     a second variable: the mean friction force and the stick fraction over
     the second half of each run; the stick/slip events when any point has
-    some (set-valued laws); Benettin's exponent when `lyapunov` was on (any
+    some (set-valued laws, Karnopp's); Benettin's exponent when `lyapunov` was on (any
     point nonzero); and with `&analysis orbit`, where any point found its
     periodic orbit, the orbit's period and the largest multiplier |μ| of its
     section map (the unit circle dashed: stable below).  Points without an
