@@ -178,6 +178,9 @@ def bad_input(args):
          "must be a finite number > 0"),
         ("&law\n  model = 'gms'\n  element_weight = 0.5, 0.2, 0.2, 0.2\n/\n", 7, "&law: element_weight = ",
          "add up to 1.1"),
+        # Found by the fuzzing suite's class laws: 'auto' passed the common check and the run then failed
+        # with "unknown step type 'auto'", naming no file, group or variable.
+        ("&integrator\n  method = 'auto'\n/\n", 6, "&integrator: method = 'auto'", "no automatic choice"),
     ]
     check_refusals(args, cases, "bad-input")
     # --netlist: the machine has no circuit form, refused naming where &job scene = 'machine' was set.

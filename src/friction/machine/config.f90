@@ -17,6 +17,7 @@ module friction_machine_config
    use friction_checks, only: config_checker
    use friction_ode_solver, only: solver_settings
    use friction_ode_settings, only: visit_integrator, check_integrator
+   use friction_ode_auto, only: auto_name
    use friction_law_settings, only: law_settings
    use friction_law_factory, only: check_law, new_law
    use friction_output_law_files, only: law_with_files
@@ -100,6 +101,10 @@ contains
       type(config_checker), intent(inout) :: c
 
       call check_integrator(self%solver, c)
+      ! 'auto' passes the common check (it is the AFM's and the brake's), but the machine has no choice table.
+      if (trim(self%solver%method) == auto_name) call c%reject('integrator', 'method', "'"//auto_name//"'", &
+         & "the machine scene has no automatic choice of stepper: leave method unset for its default 'rodas4' " &
+         & //'(every law runs with it), or name a stepper')
       call c%positive('machine', 'mass', self%mass, 'kg')
       call c%finite('machine', 'mass', self%mass)
       call c%nonnegative('machine', 'stiffness', self%stiffness, 'N/m')
