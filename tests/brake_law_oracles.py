@@ -498,6 +498,10 @@ def refusals(args):
     cases = [  # (file text, its line, what the message names)
         ("&law\n  model = 'lugre'\n  mu = 0.4\n/\n", 2, "&law: model = 'lugre': is read only with &brake model = 'law'"),
         ("&brake\n  model = 'law'\n/\n&law\n  model = 'lugre'\n  sigma0 = -1.0\n/\n", 6, "&law: sigma0 = -1"),
+        # Found by the fuzzing suite's class laws: a window of too few output points was refused after the
+        # whole run, as "&analysis: fewer than 16 output points", naming no file, line or variable.
+        ("&brake\n  model = 'law'\n  t_end = 50.0\n/\n&law\n  model = 'lugre'\n/\n&analysis\n  spectrum = .true.\n"
+         "  window_start = 5.0\n  window_end = 5.5\n/\n", 11, "&analysis: window_end = 5.5"),
     ]
     for i, (text, line, names) in enumerate(cases):
         path = work / f"bad{i}.nml"

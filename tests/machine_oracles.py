@@ -181,6 +181,12 @@ def bad_input(args):
         # Found by the fuzzing suite's class laws: 'auto' passed the common check and the run then failed
         # with "unknown step type 'auto'", naming no file, group or variable.
         ("&integrator\n  method = 'auto'\n/\n", 6, "&integrator: method = 'auto'", "no automatic choice"),
+        # Found by the fuzzing suite's class laws: a window of too few output points for the spectrum (or for
+        # the Poincare strobe's period from it) failed after the run, naming no file, line or variable.
+        ("&machine\n  t_end = 10.0\n/\n&analysis\n  spectrum = .true.\n  window_start = 5.0\n  window_end = 5.05\n/\n",
+         11, "&analysis: window_end = ", "leaves 6 output points"),
+        ("&machine\n  t_end = 10.0\n/\n&analysis\n  poincare = .true.\n  section = 'w_zero_up'\n  window_start = 2.0\n"
+         "  window_end = 2.1\n/\n", 12, "&analysis: window_end = ", "the spectrum of the strobe period needs 16"),
     ]
     check_refusals(args, cases, "bad-input")
     # --netlist: the machine has no circuit form, refused naming where &job scene = 'machine' was set.

@@ -143,13 +143,21 @@ contains
    !> The diagnostics' settings over a run from t_start to t_end sampled
    !> every `dt` (if given); `series` names the scene's variables that can
    !> be analysed.
-   subroutine validate(self, c, t_start, t_end, series, dt)
+   !> `strobe_known`: the scene has the strobe period without the spectrum
+   !> (the machine's moving support); `series_points`: the fewest output
+   !> points in the window the spectrum and Rosenstein's series take (16).
+   subroutine validate(self, c, t_start, t_end, series, dt, strobe_known, series_points)
       class(analysis_settings), intent(in) :: self
       type(config_checker), intent(inout) :: c
       real(wp), intent(in) :: t_start, t_end
       character(len=*), intent(in) :: series(:)
       real(wp), intent(in), optional :: dt
+      logical, intent(in), optional :: strobe_known
+      integer, intent(in), optional :: series_points
       real(wp) :: samples
+      integer :: need, points
+      logical :: strobe_given
+      character(len=:), allocatable :: what
 
       if (.not. any(series == self%series)) call c%reject('analysis', 'series', "'"//trim(self%series)//"'", &
          & 'unknown variable (known: '//quoted(series)//')')
@@ -164,12 +172,33 @@ contains
          & 'must be >= 1')
       ! K half-overlapping segments of the window's samples: each needs 8 (the
       ! spectrum's own check, which named no variable).
-      if (present(dt) .and. self%welch_segments > 1 .and. (self%spectrum .or. self%poincare)) then
+      strobe_given = .false.
+      if (present(strobe_known)) strobe_given = strobe_known
+      if (present(dt) .and. self%welch_segments > 1 .and. (self%spectrum .or. (self%poincare .and. &
+         & self%strobe_period == 0.0_wp .and. .not. strobe_given))) then
          samples = (min(self%window_end, t_end) - max(self%window_start, t_start)) / dt + 1.0_wp
          if (samples > 0.0_wp .and. 2.0_wp * samples / (self%welch_segments + 1.0_wp) < 8.0_wp) &
             & call c%reject('analysis', 'welch_segments', itoa(self%welch_segments), 'leaves fewer than 8 ' &
             & //'samples a segment of the window [window_start, window_end] ('//itoa(int(samples)) &
             & //' samples); at most '//itoa(max(1, int(samples) / 4 - 1)))
+      end if
+      ! The window's output points, which the diagnostics counted only after the
+      ! whole run, with a message that named no file (a run shorter than window_start).
+      if (present(dt) .and. .not. c%failed()) then
+         need = 0
+         if (self%spectrum .or. self%rosenstein) need = 16
+         if (present(series_points) .and. need > 0) need = series_points
+         if (self%poincare .and. self%strobe_period == 0.0_wp .and. .not. strobe_given) need = 16
+         points = window_points(self%window_start, self%window_end, t_start, t_end, dt)
+         if (need > 0 .and. points < need) then
+            what = 'the spectrum or Rosenstein''s series'
+            if (.not. (self%spectrum .or. self%rosenstein)) what = 'the spectrum of the strobe period'
+            if (self%window_end < t_end) then
+               call c%reject('analysis', 'window_end', rtoa(self%window_end), window_text())
+            else
+               call c%reject('analysis', 'window_start', rtoa(self%window_start), window_text())
+            end if
+         end if
       end if
       call c%nonnegative('analysis', 'strobe_period', self%strobe_period, 'τ; 0 for 1 / peak frequency')
       call c%finite('analysis', 'strobe_start', self%strobe_start)
@@ -262,6 +291,38 @@ contains
             & //rtoa(max_renormalisations)//' (each is an integration of its own): give a longer interval')
       end subroutine check_intervals
 
+      function window_text() result(text)
+         character(len=:), allocatable :: text
+
+         text = 'leaves '//itoa(points)//' output points in [window_start, window_end] = ['//rtoa(self%window_start) &
+            & //', '//rtoa(self%window_end)//'] within the run ['//rtoa(t_start)//', '//rtoa(t_end) &
+            & //'] every dt_out = '//rtoa(dt)//'; '//what//' needs '//itoa(need)
+      end function window_text
    end subroutine validate
+
+   !> The output points t_start + k dt (k = 0, 1, ...) up to t_end that lie in
+   !> [window_start, window_end] (a margin of 1e-9 of a step for the rounding of the grid).
+   pure integer function window_points(window_start, window_end, t_start, t_end, dt) result(points)
+      real(wp), intent(in) :: window_start, window_end, t_start, t_end, dt
+      real(wp) :: low, high
+
+      low = max(window_start, t_start)
+      high = min(window_end, t_end)
+      points = 0
+      if (.not. (high >= low .and. dt > 0.0_wp)) return
+      ! (In reals: the counts of a long run at a tiny step overflow an integer.)
+      points = int(min(down((high - t_start) / dt + 1.0e-9_wp) - up((low - t_start) / dt - 1.0e-9_wp) + 1.0_wp, &
+         & real(huge(points), wp)))
+      points = max(points, 0)
+   contains
+      pure real(wp) function down(x)
+         real(wp), intent(in) :: x
+         down = aint(x) - merge(1.0_wp, 0.0_wp, x < aint(x))
+      end function down
+      pure real(wp) function up(x)
+         real(wp), intent(in) :: x
+         up = aint(x) + merge(1.0_wp, 0.0_wp, x > aint(x))
+      end function up
+   end function window_points
 
 end module friction_analysis_settings

@@ -135,7 +135,8 @@ contains
       if (c%failed()) return
       call check_band_stepper(self, c)
       if (c%failed()) return
-      call self%analysis%validate(c, self%t_start, self%t_end, ['x', 'v'])
+      call self%analysis%validate(c, self%t_start, self%t_end, ['x', 'v'], self%dt_out, &
+         & strobe_known=self%support_amplitude > 0.0_wp .and. self%support_frequency > 0.0_wp, series_points=8)
       if (c%failed()) return
       ! Every diagnostic of &analysis runs on the machine; what a law cannot give is refused by name.
       associate (a => self%analysis)
