@@ -350,7 +350,7 @@ int friction_law_state_count(const friction_law *law, friction_error *err);
  * samples, so the velocity is constant on each interval).  force[i] (N) gets
  * the friction force (it resists the motion: the sign of v), and states (if
  * not NULL, states_len >= n * count) the internal states, states[i * count +
- * j].  normal is the normal load (N), used by the coefficient laws (coulomb,
+ * j].  normal is the normal load (N, finite, >= 0), used by the coefficient laws (coulomb,
  * arctan, rate_state).  The states start in steady sliding at the first
  * velocity.  The law is checked first; FRICTION_ERROR_NUMERICAL if the
  * integration fails. */

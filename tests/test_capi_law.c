@@ -65,6 +65,11 @@ int main(void) {
   expect_refusal(friction_law_history(dahl, 1.0, t, x, n, 1, force, states, n - 1, err), err, "states_len");
   expect_refusal(friction_law_history(dahl, 1.0, NULL, x, n, 1, force, NULL, 0, err), err, "null pointers");
   expect_refusal(friction_law_history(dahl, 1.0, t, x, n, 2, force, NULL, 0, err), err, "displacement = 2");
+  /* A negative normal load was taken (and coulomb's force came out pulling); found by the fuzzing suite's law-capi. */
+  double kept = force[0] = 12345.0;
+  expect_refusal(friction_law_history(dahl, -1.0, t, x, n, 1, force, NULL, 0, err), err, "normal = -1");
+  CHECK(force[0] == kept, "a refused history writes nothing");
+  expect_refusal(friction_law_history(dahl, NAN, t, x, n, 1, force, NULL, 0, err), err, "must be a finite number >= 0");
   expect_refusal(friction_law_check(NULL, err), err, "null pointer");
   CHECK(friction_law_new("bristles", err) == NULL, "unknown law");
   expect_refusal(friction_error_status(err), err, "unknown friction law 'bristles'");

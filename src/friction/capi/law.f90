@@ -308,8 +308,9 @@ contains
             & //'or 1 (a displacement history, m)')
          return
       end if
-      if (.not. (abs(normal) <= huge(normal))) then
-         status = refuse(err, 'normal = '//rtoa(real(normal, wp))//': must be a finite number (N)')
+      ! (>= 0 as &machine normal: a negative load turned the coefficient laws' force against the motion.)
+      if (.not. (normal >= 0.0_c_double .and. normal <= huge(normal))) then
+         status = refuse(err, 'normal = '//rtoa(real(normal, wp))//': must be a finite number >= 0 (N)')
          return
       end if
       call check_all(law, error)
