@@ -169,8 +169,9 @@ def stated_nonfinite(handle, name, data):
     of data: a standard error (*_sem) is NaN from one realization; a
     Lyapunov or Floquet exponent is -inf for the direction the stick
     collapses (a multiplier of 0); a continuation's period and largest
-    modulus are NaN where no orbit was found, as a machine or brake sweep's
-    orbit results are at its points without one."""
+    modulus are NaN where no orbit was found (the machine's multipliers
+    too), as a machine or brake sweep's orbit results are at its points
+    without one."""
     leaf = name.split("/")[-1]
     if leaf.endswith("_sem") and "afm" in handle and int(handle["afm"].attrs.get("realizations", 2)) == 1:
         return np.isnan(data)
@@ -179,6 +180,10 @@ def stated_nonfinite(handle, name, data):
     if name.startswith("brake/orbit/branch/") and leaf in ("period", "max_modulus"):
         found = handle["brake/orbit/branch/found"][()].astype(bool)
         return np.isnan(data) & ~found
+    if name.startswith("machine/orbit/branch/") and leaf in ("period", "max_modulus", "floquet_multipliers_real",
+                                                           "floquet_multipliers_imag"):
+        found = handle["machine/orbit/branch/found"][()].astype(bool)
+        return np.isnan(data) & ~found.reshape((-1,) + (1,) * (data.ndim - 1))
     if name.startswith("sweep/orbit_") and leaf != "orbit_found" and handle.attrs.get("sweep_scene") in (
             b"machine", "machine", b"brake", "brake"):
         found = handle["sweep/orbit_found"][()].astype(bool)
@@ -697,6 +702,423 @@ def newer_groups(contract, p):
         assert not left, f"checkpoints left after --resume: {left}"
 
 
+# ---- class 9: the friction laws (docs/laws.md): the machine and the brake with &law, every law and tool ----
+
+LAW_NAMES = ["coulomb", "arctan", "stribeck", "karnopp", "dahl", "lugre", "elastoplastic", "rate_state", "gms",
+             "table"]
+
+
+@st.composite
+def law_values(draw, model, force):
+    """A law's &law values over wide ranges (force: the scale of its force
+    levels, N on the machine, m on the nondimensional brake); mostly within
+    the law's checks, at times across them (a refusal is then the answer)."""
+    p = {"model": f"'{model}'"}
+    fc = force * draw(st.floats(0.0, 3.0))
+    fs = fc * draw(st.floats(1.0, 3.0)) + force * draw(st.sampled_from([0.0, 0.01]))
+    if model in ("coulomb", "arctan"):
+        p["mu"] = draw(st.floats(0.0, 2.0)) * force
+    if model == "coulomb":
+        p["mu_s"] = p["mu"] * draw(st.floats(1.0, 2.0))
+    if model == "arctan":
+        p["epsilon"], p["delta"] = draw(log_uniform(1.0, 1e9)), draw(st.floats(0.0, 10.0))
+    if model in ("stribeck", "karnopp", "lugre", "elastoplastic", "gms", "dahl"):
+        p["fc"] = fc
+    if model in ("stribeck", "karnopp", "lugre", "elastoplastic", "gms"):
+        p["fs"], p["vs"], p["exponent"] = fs, draw(log_uniform(1e-7, 1.0)), draw(st.floats(0.3, 4.0))
+    if model in ("coulomb", "stribeck", "karnopp", "lugre", "elastoplastic", "gms"):
+        p["sigma2"] = 0.0 if draw(st.booleans()) else draw(log_uniform(1e-4, 10.0))
+    if model == "karnopp":
+        p["dv"] = draw(log_uniform(1e-8, 1e-1))
+    if model in ("dahl", "lugre", "elastoplastic"):
+        p["sigma0"] = draw(log_uniform(1.0, 1e9)) * force
+    if model in ("lugre", "elastoplastic"):
+        p["sigma1"] = draw(log_uniform(1e-3, 1e5)) * force
+    if model == "dahl":
+        p["alpha"] = draw(st.floats(1.0, 4.0))
+    if model == "elastoplastic":
+        p["z_ba"] = draw(st.floats(0.0, 0.99)) * fc / p["sigma0"]
+    if model == "rate_state":
+        p["mu0"], p["a"], p["b"] = draw(st.floats(0.05, 1.0)), draw(log_uniform(1e-4, 0.1)), draw(log_uniform(1e-4, 0.1))
+        p["dc"], p["v0"] = draw(log_uniform(1e-8, 1e-2)), draw(log_uniform(1e-9, 1.0))
+        p["evolution"] = draw(st.sampled_from(["'aging'", "'slip'"]))
+    if model == "gms":
+        n = draw(st.integers(1, 8))
+        weights = [draw(st.floats(0.05, 1.0)) for _ in range(n)]
+        p["elements"] = str(n)
+        p["element_stiffness"] = ", ".join(number(draw(log_uniform(1.0, 1e8)) * force) for _ in range(n))
+        p["element_weight"] = ", ".join(number(w / sum(weights)) for w in weights)
+        p["attraction"] = draw(log_uniform(1e-2, 1e4))
+    if model == "table":
+        p["table_file"] = "'table.txt'"
+        p["scale"] = draw(log_uniform(1e-3, 1e3))
+        p["extrapolation"] = draw(st.sampled_from(["'constant'", "'logarithmic'"]))
+    return p
+
+
+def law_text(values):
+    return "&law " + ",\n  ".join(f"{name} = {value if isinstance(value, str) else number(value)}"
+                                   for name, value in values.items()) + " /\n"
+
+
+@st.composite
+def table_rows(draw, force):
+    """A valid table: strictly increasing positive velocities, forces >= 0."""
+    n = draw(st.integers(2, 12))
+    start = draw(st.floats(-9.0, 1.0))
+    steps = [draw(st.floats(0.01, 2.0)) for _ in range(n)]
+    rows, e = [], start
+    for step in steps:
+        rows.append((10.0 ** e, force * draw(st.floats(0.0, 3.0))))
+        e += step
+    return rows
+
+
+def rows_text(rows):
+    return "# v (m/s)  F (N)\n" + "".join(f"{v!r} {f!r}\n" for v, f in rows)
+
+
+# Tools of the machine's and the brake's &analysis; continuation variables of each.
+LAW_TOOLS = ["none", "spectrum", "poincare", "lyapunov", "lyapunov_spectrum", "orbit", "continuation", "sweep"]
+MACHINE_CONTINUATION = ["belt_velocity", "stiffness", "damping", "normal", "mass", "load_velocity",
+                        "support_amplitude", "support_frequency", "nonesuch"]
+BRAKE_CONTINUATION = ["xi", "kappa", "v_dr_prime", "mu", "fs", "fc", "vs", "sigma0", "sigma1", "dc", "a", "b",
+                      "dv", "attraction", "epsilon", "scale", "nonesuch"]
+# Values a law's check must refuse, by variable (the law that reads it).
+LAW_BAD = {
+    "sigma0": ("lugre", ["-1.0", "0.0", "nan", "inf", "-inf", "1e400"]),
+    "fs": ("stribeck", ["0.5", "-1.0", "nan"]),        # fc = 1: F_s < F_c
+    "vs": ("lugre", ["0.0", "-1e-3", "nan", "-inf"]),
+    "dc": ("rate_state", ["0.0", "-1e-5", "nan", "inf"]),
+    "a": ("rate_state", ["-0.01", "nan"]),
+    "mu_s": ("coulomb", ["0.1", "nan"]),               # mu = 0.3: mu_s < mu
+    "mu": ("arctan", ["-1.0", "nan", "inf"]),
+    "epsilon": ("arctan", ["0.0", "-1.0", "nan", "inf"]),
+    "dv": ("karnopp", ["0.0", "-1e-4", "nan"]),
+    "alpha": ("dahl", ["0.5", "-1.0", "nan"]),
+    "z_ba": ("elastoplastic", ["1e-3", "-1e-6", "nan"]),  # F_c/sigma0 = 1e-5
+    "sigma1": ("elastoplastic", ["-1.0", "nan", "inf"]),
+    "exponent": ("stribeck", ["0.0", "-2.0", "nan"]),
+    "sigma2": ("karnopp", ["-0.4", "nan", "inf"]),
+    "elements": ("gms", ["0", "9", "-1", "2147483647"]),
+    "element_stiffness": ("gms", ["-4.0e4", "0.0", "nan", "inf"]),
+    "element_weight": ("gms", ["0.0", "-0.1", "nan", "2.0"]),
+    "attraction": ("gms", ["0.0", "-20.0", "nan", "inf"]),
+    "scale": ("table", ["-1.0", "nan", "inf"]),
+    "extrapolation": ("table", ["'nonesuch'", "''"]),
+    "evolution": ("rate_state", ["'nonesuch'", "''"]),
+    "model": ("coulomb", ["'nonesuch'", "''", "' '", "1.0"]),
+    "table_file": ("table", ["''"]),
+}
+MACHINE_BAD = {"stiffness": ["-2.0", "nan", "inf", "1e400"], "mass": ["0.0", "-1.0", "nan"],
+               "normal": ["-1.0", "nan", "inf"], "damping": ["-0.1", "nan"], "dt_out": ["0.0", "-0.01", "nan", "1e-300"],
+               "t_end": ["-1.0", "nan", "inf"], "belt_velocity": ["nan", "inf", "1e400"],
+               "support_amplitude": ["-1.0", "nan"], "event_tolerance": ["0.0", "-1.0", "nan"],
+               "stick_velocity": ["0.0", "nan"]}
+LAW_MAYBE = ["1e300", "1e-300", "4.9e-324", "1.7976931348623157e308", "1e30", "1e-30", "0.0"]
+# Broken tables: each must be refused (exit 3), the message naming the table's file.
+TABLE_DEFECTS = ["decreasing", "repeated", "nan", "inf", "one-row", "empty", "missing", "one-column", "three-columns",
+                 "text", "negative-force", "zero-velocity", "directory", "h5-no-dataset", "h5-other-sweep",
+                 "h5-one-point", "h5-garbage"]
+
+
+@st.composite
+def law_cases(draw):
+    kind = draw(st.sampled_from(["machine", "machine", "brake", "broken-law", "broken-machine", "maybe",
+                                 "broken-table"]))
+    p = {"kind": kind}
+    if kind in ("machine", "brake"):
+        model = draw(st.sampled_from(LAW_NAMES))
+        force = 1.0 if kind == "machine" else 0.01
+        p["law"] = draw(law_values(model, force))
+        if model == "table":
+            p["rows"] = draw(table_rows(force))
+        p["tool"] = draw(st.sampled_from(LAW_TOOLS))
+        # ('auto' is the brake's choice; the machine refuses it, so rarely there.)
+        methods = ["auto", "auto", "rodas4", "rk8pd", "rkf45", "msbdf", "bsimp"] if kind == "brake" else \
+            ["rodas4", "rodas4", "rodas4", "rk8pd", "rkf45", "msbdf", "bsimp", "auto"]
+        p["method"] = draw(st.sampled_from(methods))
+        p["rtol"] = draw(log_uniform(1e-11, 1e-3))
+        p["end_factor"] = draw(st.floats(0.5, 2.0))
+        p["window"] = draw(st.floats(0.0, 0.9))
+        p["points"] = draw(st.sampled_from([2, 3, 2, 1, 0]))
+        p["count"] = draw(st.integers(1, 3))
+        if kind == "machine":
+            p["mechanism"] = draw(st.sampled_from(["belt", "slider", "support"]))
+            p["machine"] = {
+                "mass": draw(log_uniform(1e-3, 1e3)), "stiffness": draw(log_uniform(1e-2, 1e5)),
+                "damping": draw(st.sampled_from([0.0, 0.0, 0.1, 10.0])), "normal": draw(log_uniform(1e-2, 1e2)),
+                "belt_velocity": draw(st.sampled_from([-1.0, 1.0])) * draw(log_uniform(1e-7, 10.0)),
+                "v0": draw(st.floats(-1.0, 1.0)), "x0": draw(st.floats(-1e-2, 1e-2)),
+                "t_end": draw(st.floats(0.5, 60.0)), "dt_out": draw(log_uniform(1e-3, 1.0)),
+                "steady_start": draw(st.booleans())}
+            if p["mechanism"] == "slider":
+                p["machine"]["belt_velocity"] = 0.0
+                p["machine"]["load_velocity"] = draw(log_uniform(1e-7, 1.0))
+            elif p["mechanism"] == "support":
+                p["machine"]["support_amplitude"] = draw(log_uniform(1e-6, 1e-1))
+                p["machine"]["support_frequency"] = draw(log_uniform(1e-2, 1e2))
+            p["variable"] = draw(st.sampled_from(MACHINE_CONTINUATION))
+        else:
+            p["brake"] = {"v_dr_prime": -draw(log_uniform(1e-5, 1e-1)), "t_end": draw(st.floats(5.0, 400.0)),
+                          "dt_out": draw(st.sampled_from([0.05, 0.1, 1.0])), "units": "'nondimensional'"}
+            p["variable"] = draw(st.sampled_from(BRAKE_CONTINUATION))
+    elif kind == "broken-law":
+        p["variable"] = draw(st.sampled_from(sorted(LAW_BAD)))
+        p["value"] = draw(st.sampled_from(LAW_BAD[p["variable"]][1]))
+        p["scene"] = draw(st.sampled_from(["machine", "brake"]))
+    elif kind == "broken-machine":
+        p["variable"] = draw(st.sampled_from(sorted(MACHINE_BAD)))
+        p["value"] = draw(st.sampled_from(MACHINE_BAD[p["variable"]]))
+        p["model"] = draw(st.sampled_from(LAW_NAMES[:-1]))
+    elif kind == "maybe":
+        model = draw(st.sampled_from(LAW_NAMES[:-1]))
+        names = [name for name in draw(law_values(model, 1.0)) if name not in ("model", "evolution", "elements",
+                                                                                   "extrapolation", "table_file")]
+        p["model"], p["variable"] = model, draw(st.sampled_from(names))
+        p["value"] = draw(st.sampled_from(LAW_MAYBE + ["-" + v for v in LAW_MAYBE[:4]]))
+        p["scene"] = draw(st.sampled_from(["machine", "brake"]))
+    else:
+        p["defect"] = draw(st.sampled_from(TABLE_DEFECTS))
+        p["rows"] = draw(table_rows(1.0))
+        p["scene"] = draw(st.sampled_from(["machine", "brake"]))
+    return p
+
+
+def machine_law_text(p):
+    if p["kind"] == "machine":
+        head = "&job scene = 'machine' /\n&machine " + ", ".join(
+            f"{name} = {('.true.' if value else '.false.') if isinstance(value, bool) else number(value)}"
+            for name, value in p["machine"].items()) + " /\n"
+        variable, value = p["variable"], p["machine"].get(p["variable"], 1.0)
+        sweep = f"&sweep sweep_variable = 'machine.stiffness', sweep_spacing = 'linear'," \
+                f" sweep_from = {number(p['machine']['stiffness'])}," \
+                f" sweep_to = {number(p['machine']['stiffness'] * p['end_factor'])}, sweep_count = {p['count']} /\n"
+    else:
+        head = "&job scene = 'brake' /\n&brake model = 'law', " + ", ".join(
+            f"{name} = {value if isinstance(value, str) else number(value)}" for name, value in p["brake"].items()) \
+            + " /\n"
+        variable = p["variable"]
+        value = p["law"].get(variable, p["brake"].get(variable, 1.0))
+        value = value if isinstance(value, float) else 1.0
+        sweep = f"&sweep sweep_variable = 'brake.v_dr_prime', sweep_spacing = 'linear'," \
+                f" sweep_from = {number(p['brake']['v_dr_prime'])}," \
+                f" sweep_to = {number(p['brake']['v_dr_prime'] * p['end_factor'])}, sweep_count = {p['count']} /\n"
+    tool = p["tool"]
+    flags = {name: tool == name for name in ("spectrum", "poincare", "lyapunov", "lyapunov_spectrum")}
+    flags["orbit"] = tool in ("orbit", "continuation", "sweep")
+    analysis = "&analysis " + ", ".join(f"{name} = {'.true.' if on else '.false.'}" for name, on in flags.items())
+    analysis += ", rosenstein = .false., orbit_max_iterations = 8"
+    # The windows and transients within the run, so that the tools run (a window past t_end is refused).
+    span = p["machine"]["t_end"] if p["kind"] == "machine" else p["brake"]["t_end"]
+    start = p["window"] * span
+    analysis += (f",\n  window_start = {number(start)}, window_end = {number(span)},"
+                 f" lyapunov_transient = {number(start)}, lyapunov_spectrum_transient = {number(start)},"
+                 f" lyapunov_renormalise = {number(span / 20.0)}, lyapunov_spectrum_renormalise = {number(span / 20.0)},"
+                 f" orbit_transient = {number(start)}")
+    if tool == "continuation":
+        analysis += (f", continuation = '{variable}', continuation_end = {number(value * p['end_factor'])},"
+                     f" continuation_points = {p['points']}")
+    else:
+        analysis += ", continuation = ''"
+    text = head + law_text(p["law"]) + analysis + " /\n"
+    text += (f"&integrator method = '{p['method']}', rtol = {number(p['rtol'])}, max_wall_time = 3.0,"
+             " max_steps = 400000 /\n")
+    return text + (sweep if tool == "sweep" else "")
+
+
+def write_file(directory, name, text):
+    with open(os.path.join(directory, name), "w") as handle:
+        handle.write(text)
+
+
+def broken_table(directory, defect, rows):
+    """Writes the broken table; returns its file name."""
+    if defect.startswith("h5-"):
+        with h5py.File(os.path.join(directory, "table.h5"), "w") as handle:
+            if defect == "h5-no-dataset":
+                handle.create_group("sweep")
+            elif defect == "h5-garbage":
+                handle.create_dataset("something", data=np.arange(3.0))
+            else:
+                n = 1 if defect == "h5-one-point" else len(rows)
+                sweep = handle.create_group("sweep")
+                sweep.create_dataset("values", data=np.array([v for v, _ in rows[:n]]))
+                sweep.create_dataset("mean_friction", data=np.array([f for _, f in rows[:n]]))
+                sweep.create_dataset("status", data=np.ones(n, dtype=np.int32))
+                handle.attrs["sweep_variable"] = "scan.temperature" if defect == "h5-other-sweep" else "scan.velocity"
+        return "table.h5"
+    if defect == "missing":
+        return "nowhere.txt"
+    if defect == "directory":
+        os.mkdir(os.path.join(directory, "table.txt"))
+        return "table.txt"
+    rows = list(rows)
+    text = None
+    if defect == "decreasing":
+        rows[-1] = (rows[0][0] / 2.0, rows[-1][1])
+    elif defect == "repeated":
+        rows.append(rows[-1])
+    elif defect in ("nan", "inf"):
+        rows[len(rows) // 2] = (rows[len(rows) // 2][0], float(defect))
+    elif defect == "one-row":
+        rows = rows[:1]
+    elif defect == "empty":
+        text = "# no rows\n\n"
+    elif defect == "one-column":
+        text = rows_text(rows) + f"{rows[-1][0] * 10.0!r}\n"
+    elif defect == "three-columns":
+        text = "".join(f"{v!r} {f!r} 1.0\n" for v, f in rows)
+    elif defect == "text":
+        text = rows_text(rows) + "1.0e3 many\n"
+    elif defect == "negative-force":
+        rows[0] = (rows[0][0], -1.0)
+    elif defect == "zero-velocity":
+        rows[0] = (0.0, rows[0][1])
+    write_file(directory, "table.txt", text if text is not None else rows_text(rows))
+    return "table.txt"
+
+
+def refused_naming(result, *words):
+    """A refusal (exit 3) whose one message names each of words (one of a tuple)."""
+    stderr = result.stderr.decode("utf-8", "replace")
+    message = [line for line in stderr.splitlines() if line.startswith("friction: error:")][0]
+    for word in words:
+        options = word if isinstance(word, tuple) else (word,)
+        assert any(option in message for option in options), f"the message does not name {word}: {message}"
+
+
+def laws(contract, p):
+    directory = contract.fresh()
+    inputs = contract.args.inputs
+    kind = p["kind"]
+    if kind in ("machine", "brake"):
+        if p["law"]["model"] == "'table'":
+            write_file(directory, "table.txt", rows_text(p["rows"]))
+        write_file(directory, "run.nml", machine_law_text(p))
+        if p["tool"] == "sweep":
+            swept(contract, directory, ["run.nml"])
+        else:
+            result = contract.run(directory, ["-o", "out.h5", "run.nml"], output="out.h5", allowed={0, 3, 4},
+                                  timeout=90)
+            if result.returncode == 3:
+                # A value the file leaves at its default is refused as "(default): &group: ..." (docs/cli.md).
+                refused_naming(result, ("run.nml:", "(default): &"))
+        return
+    scene = p.get("scene", "machine")
+    base = os.path.join(inputs, "machine_lugre.nml" if scene == "machine" else "brake_lugre.nml")
+    if kind == "broken-table":
+        name = broken_table(directory, p["defect"], p["rows"])
+        write_file(directory, "bad.nml", f"&law model = 'table', table_file = '{name}' /\n" + BOUNDS)
+        result = contract.run(directory, ["-o", "out.h5", base, "bad.nml"], output="out.h5", allowed={3})
+        refused_naming(result, name)
+        return
+    if kind == "broken-machine":
+        law = f"&law model = '{p['model']}' /\n"
+        write_file(directory, "bad.nml", f"&machine {p['variable']} = {p['value']} /\n" + law + BOUNDS)
+        result = contract.run(directory, ["-o", "out.h5", os.path.join(inputs, "machine_lugre.nml"), "bad.nml"],
+                              output="out.h5", allowed={3})
+        refused_naming(result, "bad.nml:1", "&machine", p["variable"])
+        return
+    model = LAW_BAD[p["variable"]][0] if kind == "broken-law" else p["model"]
+    values = {"model": f"'{model}'"}
+    if model == "stribeck":
+        values["fc"] = "1.0"
+    if model == "table":
+        write_file(directory, "table.txt", rows_text([(1e-6, 1.5), (1e-3, 1.2), (1.0, 1.0)]))
+        if p["variable"] != "table_file":
+            values["table_file"] = "'table.txt'"
+    values[p["variable"]] = p["value"]
+    lines = [f"{name} = {value}" for name, value in values.items()]
+    write_file(directory, "bad.nml", "&law\n" + "\n".join(lines) + "\n/\n" + BOUNDS)
+    result = contract.run(directory, ["-o", "out.h5", base, "bad.nml"], output="out.h5",
+                          allowed={3} if kind == "broken-law" else {0, 3, 4}, timeout=90)
+    if result.returncode == 3:
+        line = 2 + list(values).index(p["variable"])
+        names = (p["variable"], "fc") if p["variable"] == "fs" else (p["variable"], "mu") \
+            if p["variable"] == "mu_s" else (p["variable"], "fc", "sigma0") if p["variable"] == "z_ba" else \
+            p["variable"]
+        if kind == "maybe":
+            # A doubtful value may break a check against another variable, set in the base file or left at
+            # its default: the message names where that one was set.
+            refused_naming(result, (".nml:", "(default): &"))
+            return
+        refused_naming(result, "bad.nml", "&law", names)
+        if p["variable"] not in ("fs", "mu_s", "z_ba"):
+            refused_naming(result, f"bad.nml:{line}")
+
+
+# ---- the law on its own through the C API: histories with wild values ----
+
+@st.composite
+def law_history_cases(draw):
+    model = draw(st.sampled_from(LAW_NAMES))
+    sets = {}
+    if draw(st.booleans()):
+        sets = {name: value for name, value in draw(law_values(model, 1.0)).items()
+                if name not in ("model", "table_file")}
+        sets = {name: value if isinstance(value, str) else float(value) for name, value in sets.items()}
+    if draw(st.integers(0, 3)) == 0:
+        variable = draw(st.sampled_from(sorted(LAW_BAD)))
+        sets[variable] = draw(st.sampled_from(LAW_BAD[variable][1] + [float("nan"), float("inf"), -1e300]))
+    n = draw(st.sampled_from([0, 1, 2, 3, 50, 400]))
+    t = draw(st.sampled_from(["increasing", "increasing", "decreasing", "repeated", "nan", "huge", "tiny"]))
+    u = draw(st.sampled_from(["sine", "sine", "ramp", "nan", "inf", "huge", "tiny", "zero", "step"]))
+    return {"model": model, "sets": sets, "n": n, "t": t, "u": u,
+            "amplitude": draw(log_uniform(1e-9, 1e3)),
+            "normal": draw(st.sampled_from([1.0, 0.0, 1e6, -1.0, float("nan"), float("inf"), 1e-300])),
+            "displacement": draw(st.sampled_from([0, 0, 1, 2, -1])),
+            "u_change": draw(st.sampled_from([0, 0, 0, -1, 5])),
+            "states_change": draw(st.sampled_from([0, 0, -1, 3, None])),
+            "table": draw(st.sampled_from(["table.txt", "table.txt", "nowhere.txt", "decreasing.txt"]))}
+
+
+def law_capi(contract, cases):
+    """1 to 4 histories in one host process (its start, the package's import, is most of a case's time)."""
+    directory = contract.fresh()
+    rows = [(1e-6, 1.5), (1e-3, 1.2), (1.0, 1.0)]
+    write_file(directory, "table.txt", rows_text(rows))
+    write_file(directory, "decreasing.txt", rows_text(rows[::-1]))
+    env = dict(os.environ, FRICTION_LIBRARY=contract.args.library)
+    here = os.path.dirname(os.path.abspath(__file__))
+    cmd = [sys.executable, os.path.join(here, "fuzz_law_host.py"), os.path.join(os.path.dirname(here), "python")]
+    job = json.dumps(cases, allow_nan=True)
+    start = time.monotonic()
+    try:
+        result = subprocess.run(cmd, input=job.encode(), capture_output=True, env=env, cwd=directory, timeout=120)
+    except subprocess.TimeoutExpired:
+        raise AssertionError(f"law histories {job}: no answer in 120 s (a hang)")
+    contract.seconds += time.monotonic() - start
+    stderr = result.stderr.decode("utf-8", "replace")
+    where = f"law histories {job}:\n{stderr}"
+    contract.codes[result.returncode] += 1
+    assert result.returncode >= 0, f"the host was killed by signal {-result.returncode}: {where}"
+    assert result.returncode == 0, f"the host ended with {result.returncode}: {where}"
+    for word in ABORTS:
+        assert word not in stderr, f"runtime abort ({word!r}): {where}"
+    for case, report in zip(cases, json.loads(result.stdout)):
+        where = f"law history {json.dumps(case, allow_nan=True)}:\n{stderr}"
+        for stage in ("new", "sets", "check", "history"):
+            for status, message in report[stage]:
+                assert status in CAPI_STATUSES, f"{stage}: status {status}: {where}"
+                if status != 0:
+                    assert message.strip(), f"{stage}: refused without a message: {where}"
+        if len(case["sets"]) == 1 and report["sets"] and report["sets"][0][0] == 0 and report["check"] \
+                and report["check"][0][0] != 0:
+            name = next(iter(case["sets"]))
+            assert name in report["check"][0][1], f"the check does not name {name}: {report['check'][0][1]}"
+        assert report["guard_intact"], f"friction_law_history wrote past its arrays: {where}"
+        if report["history"]:
+            status = report["history"][0][0]
+            if status == 1:
+                assert report["untouched"], f"a refused history wrote into the caller's arrays: {where}"
+            if status == 0:
+                assert report["finite"], f"a history holds non-finite values: {where}"
+                assert report["valid"], f"a history was computed from invalid arguments: {where}"
+            for status, message in report["history"][1:]:
+                assert status != 0, f"Law.history took arrays of different lengths: {where}"
+
+
 CLASSES = {
     "valid-afm": (VALID_AFM, valid_afm, 25),
     "valid-brake": (VALID_BRAKE, valid_brake, 15),
@@ -706,6 +1128,8 @@ CLASSES = {
     "output-faults": (OUTPUT_FAULTS, output_fault, 15),
     "capi-values": (capi_cases(), capi_values, 15),
     "newer-groups": (newer_cases(), newer_groups, 20),
+    "laws": (law_cases(), laws, 40),
+    "law-capi": (st.lists(law_history_cases(), min_size=1, max_size=4), law_capi, 5),
 }
 
 
@@ -753,6 +1177,18 @@ EXAMPLES = {
         {"kind": "orbit", "t_end": 200.0, "mu": 0.5, "variable": "mu", "end": 0.45, "points": 3, "iterations": 30,
          "spectrum": True, "renormalise": 1e-300},
         {"kind": "map-checkpoint", "nx": 8, "ny": 5, "stop_after": 1, "ranks": 2, "thermal": True}],
+    # The violations the class found first: 'auto' on the machine, a spectrum's window past a short run, a
+    # negative normal load in a law history.
+    "laws": [
+        {"kind": "machine", "law": {"model": "'coulomb'", "mu": 0.0, "mu_s": 0.0, "sigma2": 1.0}, "tool": tool,
+         "method": method, "rtol": 1e-3, "end_factor": 1.0, "window": window, "points": 2, "count": 1,
+         "mechanism": "belt", "variable": "belt_velocity",
+         "machine": {"mass": 1.0, "stiffness": 1.0, "damping": 0.0, "normal": 1.0, "belt_velocity": -1.0, "v0": 0.0,
+                     "x0": 0.0, "t_end": 1.0, "dt_out": 1.0, "steady_start": False}}
+        for tool, method, window in (("none", "auto", 0.0), ("spectrum", "rodas4", 0.5),
+                                     ("continuation", "rodas4", 0.0))],
+    "law-capi": [[{"model": "coulomb", "sets": {}, "n": 1, "t": "increasing", "u": "sine", "amplitude": 1.0,
+                   "normal": -1.0, "displacement": 0, "u_change": 0, "states_change": 0, "table": "table.txt"}]],
     "capi-values": [{"sets": [("tip.mass", "1e400", "bad")], "line_length_change": -1},
                     {"sets": [("surface.potential", "'\u00e9\udcff'", "bad")], "line_length_change": 0},
                     {"sets": [("tip.nonesuch", "1.0", "unknown")], "line_length_change": -7}],
@@ -795,9 +1231,9 @@ def main():
         args.stop_binary = os.path.abspath(args.stop_binary)
     args.inputs = os.path.abspath(args.inputs)
     args.workdir = os.path.abspath(args.workdir)
-    if "capi-values" in args.classes or "all" in args.classes:
+    if {"capi-values", "law-capi", "all"} & set(args.classes):
         if not args.library:
-            parser.error("the class capi-values needs --library")
+            parser.error("the classes capi-values and law-capi need --library")
         args.library = os.path.abspath(args.library)
     names = sorted(CLASSES) if "all" in args.classes else args.classes
     from_environment = os.environ.get("FRICTION_FUZZ_EXAMPLES")
