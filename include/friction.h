@@ -341,8 +341,10 @@ int friction_law_set(friction_law *law, const char *name, const char *value, fri
 int friction_law_set_real(friction_law *law, const char *name, double x, friction_error *err);
 int friction_law_get(const friction_law *law, const char *name, char *buf, size_t len, friction_error *err);
 int friction_law_check(const friction_law *law, friction_error *err);
-/* The number of the law's internal states (0, or 1: LuGre's and Dahl's
- * deflection z in m, rate and state's age theta in s); -1 on an error. */
+/* The number of the law's internal states (0 for a static law; 1 for LuGre's,
+ * Dahl's and the elasto-plastic law's deflection z in m and rate and state's
+ * age theta in s; the element count for GMS, each element's deflection in m);
+ * -1 on an error. */
 int friction_law_state_count(const friction_law *law, friction_error *err);
 /* The law along a prescribed history at the n times t[i] (s, increasing):
  * u[i] the sliding velocity (m/s; displacement = 0, linear between the
