@@ -23,6 +23,9 @@
 !> from both sides (a sliding mode this flow does not follow): refused on
 !> input (config.f90), and a run that switches at the edges more than
 !> max_switches times within one advance ends with an error.
+!>
+!> The state is the law's flow's, (x, v_rel, y, w): the band and its edges
+!> are in the slip rate v_rel itself, centred on 0.
 module friction_brake_band
    use friction_kinds, only: wp
    use friction_error, only: error_type, fatal_error, error_numerical
@@ -143,7 +146,7 @@ contains
 
       associate (p => self%flow%params, u => self%flow%units)
          ! The law's own arguments, so that each sign is the law's test of the band (|w| < Δv, clip at F_s).
-         w = (y(2) - p%v_dr) * u%velocity
+         w = y(2) * u%velocity
          a = -(2.0_wp * y(1) - y(3)) * u%force
          g(1) = (1.0_wp - p%kappa) * y(3) + p%g_prime
          g(2) = w - self%half_width
@@ -153,22 +156,22 @@ contains
       end associate
    end subroutine band_event_values
 
-   !> Whether the block's velocity v is inside the band, as the law decides.
-   pure logical function inside(self, v)
+   !> Whether the slip rate v_rel is inside the band, as the law decides.
+   pure logical function inside(self, v_rel)
       class(brake_band_flow), intent(in) :: self
-      real(wp), intent(in) :: v
+      real(wp), intent(in) :: v_rel
 
-      inside = in_band(v, self%flow%params%v_dr, self%half_width, self%flow%units%velocity)
+      inside = in_band(v_rel, 0.0_wp, self%half_width, self%flow%units%velocity)
    end function inside
 
-   !> The block's velocity closest to the edge of sign s on its inner side
-   !> (the law's band) or its outer side.
-   pure real(wp) function edge_velocity(self, s, inner) result(v)
+   !> The slip rate closest to the edge of sign s on its inner side (the
+   !> law's band) or its outer side.
+   pure real(wp) function edge_velocity(self, s, inner) result(v_rel)
       class(brake_band_flow), intent(in) :: self
       real(wp), intent(in) :: s
       logical, intent(in) :: inner
 
-      v = band_edge_velocity(self%flow%params%v_dr, self%half_width, self%flow%units%velocity, s, inner)
+      v_rel = band_edge_velocity(0.0_wp, self%half_width, self%flow%units%velocity, s, inner)
    end function edge_velocity
 
    ! ---- the integrator ----
@@ -198,8 +201,10 @@ contains
       self%h_start = config%solver%h_start
       if (.not. (self%h_start > 0.0_wp)) self%h_start = 1.0e-3_wp
       self%t = t0
-      self%y = y0
-      self%held = self%band%inside(y0(2))
+      ! The flow's coordinate is v_rel (law_model.f90); the input's state is x'.
+      self%v_origin = config%params%v_dr
+      self%y = [y0(1), y0(2) - config%params%v_dr, y0(3), y0(4)]
+      self%held = self%band%inside(self%y(2))
       self%hold_edge = 0.0_wp
       ! Exact: the time in the band, between its located edges.
       self%stick_time = 0.0_wp
@@ -221,7 +226,7 @@ contains
       call self%locator_restart(self%h_start)
    end subroutine band_start
 
-   !> Start at the instant a hold at the edge ends: y0's velocity replaced by
+   !> Start at the instant a hold at the edge ends: y0's slip rate replaced by
    !> the closest one outside the edge of sign s, the block leaving that way
    !> (a point of the section, brake/orbit.f90).
    subroutine start_leaving(self, config, t0, y0, s, events, error)
@@ -335,14 +340,14 @@ contains
                   if (entering .and. f_plus(2) == 0.0_wp) then
                      self%held = .true.
                      self%hold_edge = s
-                     call events%add(self%t, event_slip_to_stick, y)
+                     call events%add(self%t, event_slip_to_stick, self%state())
                   else if (entering) then
                      self%held = .false.
-                     call events%add(self%t, event_slip_reversal, y)
+                     call events%add(self%t, event_slip_reversal, self%state())
                   else if (self%held) then
                      ! A hold inside the band that drifted out.
                      self%held = .false.
-                     call events%add(self%t, event_stick_to_slip, y)
+                     call events%add(self%t, event_stick_to_slip, self%state())
                   end if
                end if
             case (4, 5)
@@ -381,7 +386,7 @@ contains
          real(wp), intent(in) :: sigma
 
          associate (p => self%band%flow%params, y => self%y)
-            f_minus = [y(2), 0.0_wp, y(4), (y(1) - p%kappa * y(3)) / p%xi]
+            f_minus = [y(2) + p%v_dr, 0.0_wp, y(4), (y(1) - p%kappa * y(3)) / p%xi]
             y(2) = self%band%edge_velocity(sigma, .false.)
             call self%band%rhs(self%t, y, f_plus)
             if (self%tangent) call saltation(self%phi, f_minus, f_plus, [2.0_wp * sigma, 0.0_wp, -sigma, 0.0_wp])
@@ -389,7 +394,7 @@ contains
          self%held = .false.
          self%hold_edge = 0.0_wp
          left = .true.
-         call events%add(self%t, event_stick_to_slip, self%y)
+         call events%add(self%t, event_stick_to_slip, self%state())
       end subroutine leave_hold
 
    end subroutine advance_band

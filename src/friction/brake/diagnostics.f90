@@ -248,7 +248,8 @@ contains
          real(wp), intent(out) :: y(:)
 
          call run%advance_to(t1, events, error)
-         y(1:4) = run%y
+         ! (x, x', y, y'): what start takes.
+         y(1:4) = run%state()
          if (size(y) > 4) call run%get_states(y(5:))
       end subroutine advance
 
@@ -381,6 +382,7 @@ contains
       end do
       n = 4 + run%state_count()
       allocate (z(n), y_a(n), f_a(n), f_b(n), logs(n))
+      ! The flow's own coordinates: (x, v_rel, y, w) (law_model.f90).
       z(1:4) = run%y
       if (n > 4) call run%get_states(z(5:n))
       t = run%t

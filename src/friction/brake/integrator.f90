@@ -17,7 +17,11 @@ module friction_brake_integrator
 
    type, abstract :: brake_integrator
       real(wp) :: t = 0.0_wp                !! time reached, τ
-      real(wp) :: y(4) = 0.0_wp             !! state there: x, x', y, y'
+      real(wp) :: y(4) = 0.0_wp             !! state there as integrated: x, x' - v_origin, y, y' (`state`: x')
+      !> What y(2) is measured from: 0 (the block's velocity x') for the brake's
+      !> own models and a set-valued law; v'_dr for a law's flow, whose y(2) is
+      !> the slip rate v_rel, which creeps far below the spacing of v'_dr's doubles.
+      real(wp) :: v_origin = 0.0_wp
       real(wp) :: stick_time = -1.0_wp      !! time spent in stick, when the model tracks it exactly; else < 0
       type(event_locator) :: locator
       !> Set before start: integrate the tangent matrix phi beside the state
@@ -37,6 +41,9 @@ module friction_brake_integrator
       !> Whether the block sticks to the belt now.
       procedure(sticking_interface), deferred :: is_sticking
       procedure :: statistics
+      !> The state (x, x', y, y') of y as integrated, and of any such vector (a located event's).
+      procedure :: state
+      procedure :: physical
       !> A friction law's internal states beyond (x, x', y, y'), as the model
       !> integrates them: how many, their values now, and setting them (after
       !> start, in place of the steady ones: Benettin's perturbed run).
@@ -83,6 +90,25 @@ contains
 
       stats = self%locator%statistics()
    end function statistics
+
+   !> The state now, (x, x', y, y').
+   pure function state(self) result(z)
+      class(brake_integrator), intent(in) :: self
+      real(wp) :: z(4)
+
+      z = self%physical(self%y)
+   end function state
+
+   !> (x, x', y, y') of a vector in the integrated coordinates: unchanged,
+   !> bit for bit, when v_origin = 0.
+   pure function physical(self, y) result(z)
+      class(brake_integrator), intent(in) :: self
+      real(wp), intent(in) :: y(4)
+      real(wp) :: z(4)
+
+      z = y
+      if (self%v_origin /= 0.0_wp) z(2) = y(2) + self%v_origin
+   end function physical
 
    !> No states: the brake's own models.
    pure integer function state_count(self)
@@ -184,7 +210,8 @@ contains
 
    !> The hits of the last locator advance of a model whose stick is the
    !> creep band |v_rel| < v_s (events N' = 0, v_rel - v_s, v_rel + v_s):
-   !> a lift-off is an error (`model` prefixes it), a band crossing an event.
+   !> a lift-off is an error (`model` prefixes it), a band crossing an event
+   !> (its state as x').
    subroutine record_band_hits(self, events, model, error)
       class(brake_integrator), intent(in) :: self
       type(brake_event_table), intent(inout) :: events
@@ -201,10 +228,10 @@ contains
                return
             case (2)   ! v_rel - v_s: falling enters the band from above
                call events%add(hit%t, merge(event_slip_to_stick, event_stick_to_slip, &
-                  & hit%direction == event_falling), hit%y(1:4))
+                  & hit%direction == event_falling), self%physical(hit%y(1:4)))
             case default   ! v_rel + v_s: rising enters the band from below
                call events%add(hit%t, merge(event_slip_to_stick, event_stick_to_slip, &
-                  & hit%direction == event_rising), hit%y(1:4))
+                  & hit%direction == event_rising), self%physical(hit%y(1:4)))
             end select
          end associate
       end do

@@ -11,7 +11,10 @@
 !>
 !> - A single-valued law (arctan, Dahl, LuGre, elasto-plastic, rate and
 !>   state; Karnopp's flow too, which band.f90 runs with its band's edges
-!>   located) is one ODE in (x, v, y, w, ẑ), the law's states in
+!>   located) is one ODE in (x, v_rel, y, w, ẑ), the slip rate
+!>   v_rel = v - v_dr in place of v (x' = v_rel + v_dr, v_rel' = v'): a
+!>   creep in stick far below the spacing of v_dr's doubles (rate and state)
+!>   is resolved, not rounded to v_dr; the law's states in
 !>   units of their scale (the tangent's and Benettin's state too: the
 !>   integrator gives and takes them); events as the regularized model's: N' falling
 !>   through 0 (the pad lifts off: an error) and the edges of the creep
@@ -49,7 +52,7 @@ module friction_brake_law_model
       real(wp) :: force = 1.0_wp, velocity = 1.0_wp, time = 1.0_wp
    end type law_units
 
-   !> Eq. 10 with a single-valued law and its states: (x, v, y, w, ẑ).
+   !> Eq. 10 with a single-valued law and its states: (x, v_rel, y, w, ẑ).
    type, extends(event_system) :: brake_law_flow
       type(brake_parameters) :: params
       class(sliding_law), allocatable :: law
@@ -127,7 +130,7 @@ contains
       n = self%n_states
       z(1:n) = y(5:4 + n) * self%scale(1:n)
       normal = (1.0_wp - self%params%kappa) * y(3) + self%params%g_prime
-      f = self%law%force((y(2) - self%params%v_dr) * self%units%velocity, z(1:n), normal * self%units%force, &
+      f = self%law%force(y(2) * self%units%velocity, z(1:n), normal * self%units%force, &
          & a * self%units%force) / self%units%force
    end function flow_friction
 
@@ -142,14 +145,14 @@ contains
       n = self%n_states
       associate (p => self%params, u => self%units)
          a = -(2.0_wp * y(1) - y(3))
-         dydt(1) = y(2)
+         dydt(1) = y(2) + p%v_dr
          dydt(2) = a - self%friction(y, a)
          dydt(3) = y(4)
          dydt(4) = (y(1) - p%kappa * y(3)) / p%xi
          if (n > 0) then
             z(1:n) = y(5:4 + n) * self%scale(1:n)
             normal = (1.0_wp - p%kappa) * y(3) + p%g_prime
-            call self%law%state_rate((y(2) - p%v_dr) * u%velocity, z(1:n), normal * u%force, rate(1:n))
+            call self%law%state_rate(y(2) * u%velocity, z(1:n), normal * u%force, rate(1:n))
             ! ż per second to per unit τ, in units of the scale.
             dydt(5:4 + n) = rate(1:n) * u%time / self%scale(1:n)
          end if
@@ -174,7 +177,7 @@ contains
          a = -(2.0_wp * y(1) - y(3))
          z(1:n) = y(5:4 + n) * self%scale(1:n)
          normal = (1.0_wp - p%kappa) * y(3) + p%g_prime
-         w = (y(2) - p%v_dr) * u%velocity
+         w = y(2) * u%velocity
          call self%law%partials(w, z(1:n), normal * u%force, a * u%force, dfdv, dfdz(1:n), dfda, dgdv(1:n), &
             & dgdz(1:n, 1:n))
          h = 1.0e-6_wp * max(abs(normal), 1.0e-6_wp)
@@ -200,19 +203,17 @@ contains
       end associate
    end subroutine flow_jacobian
 
-   !> The slip rate v_rel = v - v_dr (component 2) when the law's force goes
-   !> with its logarithm (rate and state), its floor in the brake's units but
-   !> no lower than 64 spacings of v_dr: v_rel is carried as v - v_dr, so a
-   !> finer bound is one the steps' rounding alone would break.
+   !> The slip rate v_rel (component 2, measured from 0) when the law's force
+   !> goes with its logarithm (rate and state), down to the law's floor in
+   !> the brake's units.
    pure subroutine flow_relative_component(self, index, reference, floor)
       class(brake_law_flow), intent(in) :: self
       integer, intent(out) :: index
       real(wp), intent(out) :: reference, floor
 
-      floor = self%law%log_slip_floor()
+      floor = self%law%log_slip_floor() / self%units%velocity
       index = merge(2, 0, floor > 0.0_wp)
-      reference = self%params%v_dr
-      if (index > 0) floor = max(floor / self%units%velocity, 64.0_wp * spacing(abs(reference)))
+      reference = 0.0_wp
    end subroutine flow_relative_component
 
    pure function flow_event_count(self) result(n)
@@ -231,8 +232,8 @@ contains
 
       associate (p => self%params)
          g(1) = (1.0_wp - p%kappa) * y(3) + p%g_prime
-         g(2) = y(2) - p%v_dr - self%stick_velocity
-         g(3) = y(2) - p%v_dr + self%stick_velocity
+         g(2) = y(2) - self%stick_velocity
+         g(3) = y(2) + self%stick_velocity
       end associate
    end subroutine flow_event_values
 
@@ -337,6 +338,8 @@ contains
       self%switching = self%law%set_valued()
       self%t = t0
       self%y = y0
+      ! A set-valued law keeps x' (its stick holds it at v_dr exactly; its slip is the switched model's).
+      self%v_origin = 0.0_wp
       call events%clear()
       if (self%switching) then
          self%stick_time = 0.0_wp
@@ -371,6 +374,9 @@ contains
          return
       end if
       self%stick_time = -1.0_wp
+      ! The flow's coordinate is v_rel (module comment); the input's state is x'.
+      self%v_origin = self%p%v_dr
+      self%y(2) = y0(2) - self%p%v_dr
       if (allocated(self%flow)) deallocate (self%flow)
       allocate (self%flow)
       self%flow%params = self%p
@@ -382,11 +388,11 @@ contains
       if (ns > 0) call self%law%state_scale(self%flow%scale(1:ns))
       normal = self%p%normal_force(y0(3))
       self%z = 0.0_wp
-      if (ns > 0) call self%law%steady_state((y0(2) - self%p%v_dr) * self%units%velocity, normal * self%units%force, &
+      if (ns > 0) call self%law%steady_state(self%y(2) * self%units%velocity, normal * self%units%force, &
          & self%z(1:ns))
       ! The first step: a tenth of the fastest time scale at the start (the
       ! velocity's under friction, the states' relaxation), at most 1e-3.
-      call self%law%partials((y0(2) - self%p%v_dr) * self%units%velocity, self%z(1:ns), normal * self%units%force, &
+      call self%law%partials(self%y(2) * self%units%velocity, self%z(1:ns), normal * self%units%force, &
          & -self%p%elastic_force(y0(1), y0(3)) * self%units%force, dfdv, dfdz(1:ns), dfda, dgdv(1:ns), &
          & dgdz(1:ns, 1:ns))
       fastest = max(1.0_wp, abs(dfdv) * self%units%velocity / self%units%force)
@@ -409,7 +415,7 @@ contains
       call self%locator%init(self%flow, config%solver, [event_falling, event_either, event_either], &
          & [.true., .false., .false.], config%event_tolerance, self%h_start, error, time_name='τ', time_unit='')
       if (allocated(error)) return
-      s(1:4) = y0
+      s(1:4) = self%y
       s(5:4 + ns) = self%z(1:ns) / self%flow%scale(1:ns)
       call self%locator%restart(t0, s(1:4 + ns), self%h_start)
    end subroutine law_start
@@ -475,7 +481,7 @@ contains
       if (self%switching) then
          law_sticking = self%sticking
       else
-         law_sticking = abs(self%y(2) - self%p%v_dr) <= self%flow%stick_velocity
+         law_sticking = abs(self%y(2)) <= self%flow%stick_velocity
       end if
    end function law_sticking
 

@@ -493,21 +493,22 @@ contains
       end do
       call config%law_units(flow%units%force, flow%units%velocity, flow%units%time)
       flow%stick_velocity = config%stick_velocity
-      level = config%params%v_dr - limit * config%stick_velocity
+      ! The flow's coordinate 2 is v_rel (law_model.f90): the band's exit at -σ v_s, the kink at 0.
+      level = -limit * config%stick_velocity
       if (ns > 0) then
          ! The states' rates have a kink at v_rel = 0 (|v_rel|, sgn v_rel), which the stick crosses.  A
          ! return must come back from half the band: the bristles' quick oscillation about the band's
          ! edge (stiff σ0) grazes it and would make a fixed point of P with a return time near 0.
          call map%plane%setup(flow, config%solver, 2, level, config%t_end - config%t_start, config%event_tolerance, &
-            & falling=limit > 0.0_wp, kink_coordinate=[2], kink_level=[config%params%v_dr], &
-            & rearm_level=config%params%v_dr - limit * config%stick_velocity / 2)
+            & falling=limit > 0.0_wp, kink_coordinate=[2], kink_level=[0.0_wp], &
+            & rearm_level=-limit * config%stick_velocity / 2)
       else
          call map%plane%setup(flow, config%solver, 2, level, config%t_end - config%t_start, config%event_tolerance, &
             & falling=limit > 0.0_wp)
       end if
       call find_periodic_orbit(map, guess, settings, result%orbit, error)
       if (allocated(error)) return
-      result%state = [result%orbit%point(1), level, result%orbit%point(2), result%orbit%point(3)]
+      result%state = [result%orbit%point(1), config%params%v_dr + level, result%orbit%point(2), result%orbit%point(3)]
       result%states(1:ns) = result%orbit%point(4:3 + ns)
       if (.not. result%orbit%found) return
       result%multipliers(1:4 + ns) = floquet_multipliers(result%orbit, 0)
@@ -562,7 +563,7 @@ contains
          call events%clear()
          if (found .and. run%t >= t_from) then
             times = [times, run%t]
-            states = reshape([states, run%y], [4, size(times)])
+            states = reshape([states, run%state()], [4, size(times)])
          end if
       end do
    end subroutine hold_ends

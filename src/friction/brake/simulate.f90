@@ -85,7 +85,7 @@ contains
       do i = self%done + 1, min(last, self%n)
          t = self%config%grid_time(i)
          call self%integrator%advance_to(t, self%events, error)
-         y = self%integrator%y
+         y = self%integrator%state()
          stick = self%integrator%is_sticking()
          if (allocated(error)) exit
          self%trajectory%t(i) = t
