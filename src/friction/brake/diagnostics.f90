@@ -222,9 +222,14 @@ contains
       intervals = int(settings%duration / settings%renormalise + 1.0e-9_wp)
       call result%start(settings%d0, intervals)
       do k = 1, intervals
-         call perturbed_run%start(config, t, perturbed(1:4), perturbed_events, error)
+         ! start takes (x, x', y, y'); the states' restart then sets the integrated coordinates exactly (a
+         ! law's creeping v_rel would lose its last digits to v_dr's spacing in x').
+         call perturbed_run%start(config, t, reference_run%physical(perturbed(1:4)), perturbed_events, error)
          if (allocated(error)) return
-         if (n > 4) call perturbed_run%set_states(perturbed(5:n))
+         if (n > 4) then
+            perturbed_run%y = perturbed(1:4)
+            call perturbed_run%set_states(perturbed(5:n))
+         end if
          t = config%t_start + settings%transient + k * settings%renormalise
          call advance(reference_run, reference_events, t, reference)
          if (allocated(error)) return
@@ -248,8 +253,8 @@ contains
          real(wp), intent(out) :: y(:)
 
          call run%advance_to(t1, events, error)
-         ! (x, x', y, y'): what start takes.
-         y(1:4) = run%state()
+         ! As integrated: (x, v_rel, y, w) for a law's flow (law_model.f90).
+         y(1:4) = run%y
          if (size(y) > 4) call run%get_states(y(5:))
       end subroutine advance
 

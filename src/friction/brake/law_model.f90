@@ -391,16 +391,17 @@ contains
       if (ns > 0) call self%law%steady_state(self%y(2) * self%units%velocity, normal * self%units%force, &
          & self%z(1:ns))
       ! The first step: a tenth of the fastest time scale at the start (the
-      ! velocity's under friction, the states' relaxation), at most 1e-3.
+      ! velocity's under friction, the states' relaxation), at most 1e-3, and
+      ! one that moves t (a creep's scale, at a restart late in a run, can lie below τ's spacing).
       call self%law%partials(self%y(2) * self%units%velocity, self%z(1:ns), normal * self%units%force, &
          & -self%p%elastic_force(y0(1), y0(3)) * self%units%force, dfdv, dfdz(1:ns), dfda, dgdv(1:ns), &
          & dgdz(1:ns, 1:ns))
       fastest = max(1.0_wp, abs(dfdv) * self%units%velocity / self%units%force)
       if (ns > 0) fastest = max(fastest, maxval(abs(dgdz(1:ns, 1:ns))) * self%units%time)
       self%h_start = config%solver%h_start
-      if (.not. (self%h_start > 0.0_wp)) self%h_start = min(1.0e-3_wp, 0.1_wp / fastest)
+      if (.not. (self%h_start > 0.0_wp)) self%h_start = max(min(1.0e-3_wp, 0.1_wp / fastest), 2.0_wp * spacing(abs(t0)))
       if (self%tangent) then
-         ! The tangent of (x, v, y, w, ẑ): the law's states (in units of their scale) are in it.
+         ! The tangent of (x, v_rel, y, w, ẑ): the law's states (in units of their scale) are in it.
          if (allocated(self%extended)) deallocate (self%extended)
          allocate (self%extended)
          allocate (self%extended%base, source=self%flow)
