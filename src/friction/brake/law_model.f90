@@ -399,7 +399,13 @@ contains
       fastest = max(1.0_wp, abs(dfdv) * self%units%velocity / self%units%force)
       if (ns > 0) fastest = max(fastest, maxval(abs(dgdz(1:ns, 1:ns))) * self%units%time)
       self%h_start = config%solver%h_start
-      if (.not. (self%h_start > 0.0_wp)) self%h_start = max(min(1.0e-3_wp, 0.1_wp / fastest), 2.0_wp * spacing(abs(t0)))
+      ! (A NaN partial makes the min NaN; the step then falls back to t's spacing and the run's own
+      ! checks report the NaN, not the event locator.)
+      if (.not. (self%h_start > 0.0_wp)) then
+         self%h_start = min(1.0e-3_wp, 0.1_wp / fastest)
+         if (.not. (self%h_start >= 0.0_wp)) self%h_start = 0.0_wp
+         self%h_start = max(self%h_start, 2.0_wp * spacing(abs(t0)), tiny(1.0_wp))
+      end if
       if (self%tangent) then
          ! The tangent of (x, v_rel, y, w, ẑ): the law's states (in units of their scale) are in it.
          if (allocated(self%extended)) deallocate (self%extended)
