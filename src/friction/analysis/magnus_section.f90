@@ -23,7 +23,7 @@ module friction_analysis_magnus_section
    use friction_strings, only: rtoa
    use friction_ode_system, only: ode_system
    use friction_ode_solver, only: solver_settings, ode_solver
-   use friction_ode_events, only: event_system, event_locator, event_rising
+   use friction_ode_events, only: event_system, event_locator, event_rising, event_either
    use friction_ode_watch, only: step_watch
    use friction_analysis_lyapunov_spectrum, only: generic_frame
    use friction_analysis_tangent_magnus, only: magnus_tangent_step
@@ -36,11 +36,15 @@ module friction_analysis_magnus_section
    !> Consecutive log-moduli further apart than this split the clusters (e^-36 < ε/2).
    real(wp), parameter :: cluster_gap = 36.0_wp
 
-   !> The flow with its section y_k = c as its only event.
+   !> The flow with its section y_k = c as event 1 (none when forced) and,
+   !> when the flow is an event system, its events after it: the kinks of its
+   !> Jacobian, where a step of the tangent must end.
    type, extends(event_system) :: plane_system
       class(ode_system), allocatable :: base
       integer :: coordinate = 1
       real(wp) :: level = 0.0_wp
+      logical :: forced = .false.
+      integer :: kinks = 0
    contains
       procedure :: dimension => plane_dimension
       procedure :: rhs => plane_rhs
@@ -104,7 +108,7 @@ contains
    pure integer function plane_event_count(self)
       class(plane_system), intent(in) :: self
 
-      plane_event_count = 1
+      plane_event_count = 1 + self%kinks
    end function plane_event_count
 
    pure subroutine plane_event_values(self, t, y, g)
@@ -113,11 +117,21 @@ contains
       real(wp), intent(in) :: y(:)
       real(wp), intent(out) :: g(:)
 
-      g(1) = y(self%coordinate) - self%level
+      g(1) = 1.0_wp
+      if (.not. self%forced) g(1) = y(self%coordinate) - self%level
+      if (self%kinks > 0) then
+         select type (base => self%base)
+         class is (event_system)
+            call base%event_values(t, y, g(2:))
+         end select
+      end if
    end subroutine plane_event_values
 
    !> The map of `system`: forced, from t0 over `period`; else the section
    !> y_coordinate = level crossed upwards, returns after max_return none.
+   !> A system with events has them located as kinks of its Jacobian: each
+   !> ends a step of the orbit, so that no exponential of the tangent reads J
+   !> across one (docs/chaos.md, "The tangent of a stiff law").
    subroutine magnus_setup(self, system, solver, forced, t0, period, coordinate, level, max_return, event_tolerance)
       class(magnus_map), intent(inout) :: self
       class(ode_system), intent(in) :: system
@@ -131,6 +145,12 @@ contains
       allocate (self%plane%base, source=system)
       self%plane%coordinate = coordinate
       self%plane%level = level
+      self%plane%forced = forced
+      self%plane%kinks = 0
+      select type (system)
+      class is (event_system)
+         self%plane%kinks = system%event_count()
+      end select
       self%solver = solver
       self%forced = forced
       self%t0 = t0
@@ -192,7 +212,11 @@ contains
       if (self%forced) then
          if (.not. (h > 0.0_wp)) h = 1.0e-6_wp * self%period
          t_end = self%t0 + self%period
-         call periodic(error)
+         if (self%plane%kinks > 0) then
+            call returning(done, error)
+         else
+            call periodic(error)
+         end if
          if (allocated(error)) return
       else
          ! Off the upward side the next upward crossing is a short loop near the section's fold (where the flow
@@ -245,7 +269,7 @@ contains
          call self%plane%rhs(t, y, f_b)
          if (t > t_a) then
             call magnus_tangent_step(self%plane%base, t_a, y_a, f_a, t, y, f_b, self%q, self%logs, depth, ok, &
-               & self%upper)
+               & self%upper, kinked=self%plane%kinks > 0)
             if (.not. ok) then
                call fatal_error(error, 'periodic orbit: the Jacobian is NaN or Inf, or too stiff for the step ' &
                   & //'of the section map ending near t = '//rtoa(t)//' s (an exponential of the ' &
@@ -280,13 +304,15 @@ contains
          call orbit%destroy()
       end subroutine periodic
 
+      !> To the section's return (or, forced, to t_end), every kink a stop.
       subroutine returning(done, error)
          logical, intent(out) :: done
          type(error_type), allocatable, intent(out) :: error
          type(event_locator) :: locator
 
          done = .false.
-         call locator%init(self%plane, self%solver, [event_rising], [.true.], self%event_tolerance, h, error)
+         call locator%init(self%plane, self%solver, [event_rising, spread(event_either, 1, self%plane%kinks)], &
+            & spread(.true., 1, 1 + self%plane%kinks), self%event_tolerance, h, error)
          if (allocated(error)) return
          call locator%restart(t, y, h)
          do while (t < t_end)
@@ -303,14 +329,24 @@ contains
             if (locator%n_hits > 0) then
                if (locator%hits(locator%n_hits)%terminal) then
                   ! A function exactly 0 at a restart crosses at once (ode/events.f90): that is the start itself.
-                  if (t - self%t0 > 1.0e3_wp * self%event_tolerance) then
+                  ! A kink: on from its far side with a fresh step.
+                  if (locator%hits(locator%n_hits)%which == 1 .and. &
+                     & t - self%t0 > 1.0e3_wp * self%event_tolerance) then
                      done = .true.
                      return
                   end if
-                  call locator%restart(t, y, 0.0_wp)
+                  if (locator%hits(locator%n_hits)%which > 1) then
+                     ! Past a kink with a step the size of the located time's error: a stepper that keeps its
+                     ! long step there damps the fast growth of a band it enters (an L-stable method damps
+                     ! h λ >> 1 either way) and sits on the band's edge, the tangent growing at every step.
+                     call locator%restart(t, y, self%event_tolerance)
+                  else
+                     call locator%restart(t, y, 0.0_wp)
+                  end if
                end if
             end if
          end do
+         done = self%forced
       end subroutine returning
 
    end subroutine magnus_evaluate

@@ -49,6 +49,8 @@ module friction_law_gms
       procedure :: state_scale
       procedure :: steady_state
       procedure :: partials
+      procedure :: kink_count
+      procedure :: kinks
    end type gms_law
 
 contains
@@ -201,6 +203,34 @@ contains
          end if
       end do
    end subroutine partials
+
+   !> The edges of each element's switch band, |u_i| = 1 - ε and 1 + ε
+   !> (|u_i|: continuous through v = 0), where ∂ż_i/∂z_i jumps between 0,
+   !> -|v|/(ε z_lim) and +|v|/(ε z_lim).  Not u_i = 1, where J is continuous
+   !> (the factor 1 - u_i kills the kink of the pull) and where steady
+   !> sliding sits to rounding: an event there would chatter.
+   pure integer function kink_count(self)
+      class(gms_law), intent(in) :: self
+
+      kink_count = 2 * self%p%elements
+   end function kink_count
+
+   pure subroutine kinks(self, v, z, normal, g)
+      class(gms_law), intent(in) :: self
+      real(wp), intent(in) :: v, normal
+      real(wp), intent(in) :: z(:)
+      real(wp), intent(out) :: g(:)
+      real(wp) :: limit, u
+      integer :: i, n
+
+      n = self%p%elements
+      limit = stribeck_curve(self%p, v)
+      do i = 1, n
+         u = abs(self%p%element_stiffness(i) * z(i)) / (self%p%element_weight(i) * limit)
+         g(i) = u - (1.0_wp - entry)
+         g(n + i) = u - (1.0_wp + entry)
+      end do
+   end subroutine kinks
 
    !> The factor a of the rate ż = sgn(v) (1 - u) a near and beyond the
    !> limit: |v|/ε from the entry to the limit (the rate falls linearly from

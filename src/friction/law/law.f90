@@ -58,6 +58,11 @@ module friction_law
       !> to `limit` and at whose edges the force jumps (Karnopp's); half_width
       !> 0 for a law without one.
       procedure :: band
+      !> Functions of (v, z) whose zeros are where the law's partial
+      !> derivatives jump (GMS's switch bands), none by default: a tangent
+      !> carried over a step must not straddle one.
+      procedure :: kink_count
+      procedure :: kinks
       !> What the law needs before it computes (a table read from its file).
       procedure :: prepare
    end type sliding_law
@@ -201,6 +206,19 @@ contains
       half_width = 0.0_wp
       limit = 0.0_wp
    end subroutine band
+
+   pure integer function kink_count(self)
+      class(sliding_law), intent(in) :: self
+
+      kink_count = 0
+   end function kink_count
+
+   pure subroutine kinks(self, v, z, normal, g)
+      class(sliding_law), intent(in) :: self
+      real(wp), intent(in) :: v, normal
+      real(wp), intent(in) :: z(:)
+      real(wp), intent(out) :: g(:)
+   end subroutine kinks
 
    !> Whether a mechanism's velocity v is inside a band law's band about the
    !> surface's velocity `centre`, as the law decides it: |(v - centre) scale|

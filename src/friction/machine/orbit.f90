@@ -29,7 +29,9 @@ module friction_machine_orbit
    use friction_kinds, only: wp
    use friction_error, only: error_type, error_interrupted
    use friction_parameters, only: configurable, set_parameter_number, get_parameter, list_parameters, parameter_info
+   use friction_ode_system, only: ode_system
    use friction_ode_solver, only: solver_settings
+   use friction_ode_events, only: event_system
    use friction_ode_watch, only: step_watch
    use friction_law, only: sliding_law, max_law_states
    use friction_law_factory, only: make_law
@@ -57,6 +59,19 @@ module friction_machine_orbit
 
    !> Most section points of the attractor kept per point of the line (the diagram).
    integer, parameter :: max_section_points = 400
+
+   !> The load point's frame with the kinks of the law's partial derivatives
+   !> as its events (GMS's switch bands), where the exponential tangent's
+   !> steps end.
+   type, extends(event_system) :: kink_frame
+      type(load_frame) :: frame
+   contains
+      procedure :: dimension => kink_dimension
+      procedure :: rhs => kink_rhs
+      procedure :: jacobian => kink_jacobian
+      procedure :: event_count => kink_event_count
+      procedure :: event_values => kink_event_values
+   end type kink_frame
 
    !> The return map of a law with a band (either section, as hyperplane_map
    !> and stroboscopic_map), with a saltation matrix at every edge and the
@@ -116,6 +131,51 @@ module friction_machine_orbit
    end type machine_branch
 
 contains
+
+   ! ---- the kinks of a law's partial derivatives as events ----
+
+   pure integer function kink_dimension(self)
+      class(kink_frame), intent(in) :: self
+
+      kink_dimension = self%frame%dimension()
+   end function kink_dimension
+
+   pure subroutine kink_rhs(self, t, y, dydt)
+      class(kink_frame), intent(in) :: self
+      real(wp), intent(in) :: t
+      real(wp), intent(in), contiguous :: y(:)
+      real(wp), intent(out), contiguous :: dydt(:)
+
+      call self%frame%rhs(t, y, dydt)
+   end subroutine kink_rhs
+
+   pure subroutine kink_jacobian(self, t, y, dfdy, dfdt)
+      class(kink_frame), intent(in) :: self
+      real(wp), intent(in) :: t
+      real(wp), intent(in) :: y(:)
+      real(wp), intent(out) :: dfdy(:, :)
+      real(wp), intent(out) :: dfdt(:)
+
+      call self%frame%jacobian(t, y, dfdy, dfdt)
+   end subroutine kink_jacobian
+
+   pure integer function kink_event_count(self)
+      class(kink_frame), intent(in) :: self
+
+      kink_event_count = self%frame%base%law%kink_count()
+   end function kink_event_count
+
+   pure subroutine kink_event_values(self, t, y, g)
+      class(kink_frame), intent(in) :: self
+      real(wp), intent(in) :: t
+      real(wp), intent(in) :: y(:)
+      real(wp), intent(out) :: g(:)
+      integer :: n
+
+      n = self%frame%base%n_states
+      call self%frame%base%law%kinks(y(2) - self%frame%base%m%belt, y(3:2 + n) * self%frame%base%scale(1:n), &
+         & self%frame%base%m%normal, g)
+   end subroutine kink_event_values
 
    ! ---- a law with a band: its return map ----
 
@@ -405,11 +465,17 @@ contains
          block
             ! A law with states (stiff bristles, GMS elements): the tangent by exponentials over the orbit's steps.
             type(magnus_map) :: exponential
+            class(ode_system), allocatable :: flow
+            if (frame%base%law%kink_count() > 0) then
+               allocate (flow, source=kink_frame(frame))
+            else
+               allocate (flow, source=frame)
+            end if
             if (machine_orbit_forced(c)) then
-               call exponential%setup(frame, c%solver, .true., t0, 1.0_wp / c%support_frequency, 2, 0.0_wp, &
+               call exponential%setup(flow, c%solver, .true., t0, 1.0_wp / c%support_frequency, 2, 0.0_wp, &
                   & 0.0_wp, c%event_tolerance)
             else
-               call exponential%setup(frame, c%solver, .false., 0.0_wp, 0.0_wp, 2, c%load_velocity, &
+               call exponential%setup(flow, c%solver, .false., 0.0_wp, 0.0_wp, 2, c%load_velocity, &
                   & c%t_end - c%t_start, c%event_tolerance)
             end if
             if (present(watch)) exponential%watch => watch
