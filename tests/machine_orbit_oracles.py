@@ -58,9 +58,11 @@ the program and its file, against oracles computed here:
                     Radau, the multiplier against central differences of the
                     return map integrated with Radau; at orbit_tolerance 1e-8
                     no short loop near the section's fold taken for the orbit
-  gms-table         GMS at Table I's stiffness: its tangent through the elements'
-                    switch bands is not resolved, and the search says so after
-                    one return instead of failing Newton step after step
+  gms-table         GMS at Table I's stiffness (inputs/machine_gms.nml): the
+                    stick-slip orbit closes under SciPy's LSODA at rtol 1e-12,
+                    its period, and its flip multiplier against central
+                    differences of that flow's section map; the elements'
+                    multipliers 0
   refusals          what the orbit cannot do, and a multistep stepper on
                     Karnopp's band, is refused with file, line, group
                     and variable, exit code 3, no file written
@@ -834,16 +836,79 @@ def rate_state_orbit(args):
 
 
 def gms_table(args):
-    # inputs/machine_gms.nml's stick-slip orbit is not found (docs/chaos.md: the map's slope in e is ~2.1, the
-    # exponential tangent's 1e41 to 1e71). The oracle here is that slope: a Newton step from DP that large moves
-    # e by < 1e-40 m, below its rounding, so one return is all the search may take, with that reason.
-    with h5py.File(run_program(args, "gms_table", ["machine_gms.nml"],
-                               {"analysis.orbit": ".true.", "analysis.orbit_transient": "20.0"})) as f:
-        g = f["machine/orbit"]
-        found, reason, iterations = g.attrs["found"], g.attrs["reason"].decode(), g.attrs["iterations"]
-        residual = g.attrs["residual"]
-    print(f"gms-table: found {found}, after {iterations} Newton steps, residual {residual:.3e}: {reason}")
-    assert found == 0 and iterations == 0 and "Jacobian" in reason, reason
+    # inputs/machine_gms.nml's stick-slip orbit (four elements at Table I's stiffness, their switch bands 1e-5 of
+    # their limits wide) against its flow integrated here: the law written from docs/laws.md, SciPy's LSODA at
+    # rtol 1e-12. The state's rate is continuous at the bands' edges (only J jumps there), so the flow needs no
+    # stop at them; the oracle's own error is bounded by its change from rtol 1e-11 to 1e-12 (period 1.5e-7 s,
+    # closure 1e-8 m, measured). The multiplier against central differences of the section map in e (the
+    # elements' columns of DP are ~1e-20: perturbed deflections are forgotten at ~1e9 1/s in the slip).
+    m, k, vb = 1.0, 2.0, 0.1
+    fc, fs, vs, s2, attraction, eps = 1.0, 1.5, 1e-3, 0.4, 20.0, 1e-5
+    ks, ws = (4e4, 3e4, 2e4, 1e4), (0.1, 0.2, 0.3, 0.4)
+
+    def field(_, y):
+        w = y[1] - vb
+        s = 1.0 if w >= 0 else -1.0
+        g = fc + (fs - fc) * np.exp(-(w / vs) ** 2)
+        out = [y[1], 0.0, 0.0, 0.0, 0.0, 0.0]
+        force = s2 * w
+        for i, (ki, wi) in enumerate(zip(ks, ws)):
+            z = y[2 + i]
+            force += ki * z
+            u = ki * z * s / (wi * g)   # the element's force over its limit, in the direction of motion
+            if w == 0 or u < 1 - eps:
+                out[2 + i] = w          # sticks
+            else:                       # the rate falls to 0 at the limit, the slip's (C/k)(1 - u) beyond 1 + eps
+                blend = min(1.0, max(0.0, (1 + eps - u) / eps))
+                out[2 + i] = s * (1 - u) * (attraction / ki + (abs(w) / eps - attraction / ki) * blend)
+        out[1] = (-k * y[0] - force) / m
+        return out
+
+    def crossing(_, y):
+        return y[1]
+    crossing.terminal, crossing.direction = True, 1
+
+    def section_map(p, rtol=1e-12):
+        atol = [1e-3 * rtol, 1e-3 * rtol] + [1e-6 * rtol] * 4
+        # Off the section first (the start lies on it), then to v = 0 crossed upwards.
+        off = solve_ivp(field, (0.0, 1.0), p, method="LSODA", rtol=rtol, atol=atol)
+        back = solve_ivp(field, (1.0, 20.0), off.y[:, -1], method="LSODA", rtol=rtol, atol=atol, events=crossing)
+        return back.t_events[0][0], back.y_events[0][0]
+
+    got = run(args, "gms_table", ["machine_gms.nml"], {"analysis.orbit": ".true.", "analysis.orbit_transient": 20.0})
+    p = got["point"]
+    period, image = section_map(p)
+    closure = image - p
+    print(f"gms-table: {got['iterations']} Newton steps, period {got['period']!r} s (SciPy {period!r}), section "
+          f"point {p}, closure {closure}")
+    # The period to the oracle's own error (1.5e-7 s) twice over; the program's at rtol 1e-9 is 4e-8 s from its
+    # own at rtol 1e-11.
+    assert abs(period - got["period"]) < 3e-7, (period, got["period"])
+    # e: Newton's tolerance (1e-9 m) over |1 - mu| ~ 2 and the oracle's 1e-8 m; the deflections at their limits.
+    assert abs(closure[0]) < 2e-8, closure
+    assert np.all(np.abs(closure[2:] / p[2:]) < 1e-6), closure
+    # dP_e/de by central differences at 2 and 1 um, extrapolated in the step (Richardson: P is far from linear at
+    # that scale, the two differ by 1e-2); the oracle's noise, ~1e-9 m per map, is ~1e-3 of a difference over
+    # 1 um, and the extrapolation from the pairs (3, 1) and (1, 0.3) um agreed to 3e-4 (-1.12346, -1.12343).
+    slopes = []
+    for d in (2e-6, 1e-6):
+        plus, minus = p.copy(), p.copy()
+        plus[0] += d
+        minus[0] -= d
+        slopes.append((section_map(plus)[1][0] - section_map(minus)[1][0]) / (2 * d))
+    slope = (4 * slopes[1] - slopes[0]) / 3
+    mu = got["multipliers"]
+    exponents = got["floquet_exponents"]
+    print(f"gms-table: multipliers {mu}, exponents {exponents}; central differences {slopes} -> {slope}")
+    # The trivial 1, the section map's one real multiplier, the four elements' lost (0, exponent -inf).
+    assert abs(mu[0] - 1) < 1e-12 and np.all(np.isneginf(exponents[2:])) and np.all(mu[2:] == 0), mu
+    # 5e-3: the program's tangent at its default rtol 1e-9 moves by 2.8e-3 to rtol 1e-10 (measured: -1.12123,
+    # -1.12406, -1.12387 at 1e-11), the differences' extrapolation by ~1e-3.
+    assert abs(mu[1].imag) < 1e-12 and abs(mu[1].real - slope) < 5e-3 * abs(slope), (mu[1], slope)
+    assert abs(got["section_jacobian"][0, 0] - slope) < 5e-3 * abs(slope), got["section_jacobian"]
+    # A flip multiplier beyond -1: the period-1 orbit is unstable (the run stays within 1e-5 m of it over the
+    # seven cycles to 56 s: 1.12^7 = 2.2).
+    assert slope < -1.05
 
 
 def refusals(args):
