@@ -28,7 +28,9 @@ module friction_machine_lyapunov
    use friction_output_h5, only: h5_file
    use friction_analysis_lyapunov_spectrum, only: tangent_settings, spectrum_accumulator, kaplan_yorke, &
       & generic_frame
-   use friction_analysis_tangent_magnus, only: orbit_step, tangent_over_step
+   use friction_analysis_tangent_magnus, only: orbit_step, tangent_over_step, magnus_tangent_step
+   use friction_ode_events, only: event_system, event_locator, event_either
+   use friction_strings, only: rtoa
    use friction_analysis_lyapunov_flow, only: benettin_settings, benettin_accumulator
    use friction_law, only: sliding_law, max_law_states
    use friction_law_factory, only: make_law
@@ -68,7 +70,144 @@ module friction_machine_lyapunov
       procedure :: jacobian => divergence_jacobian
    end type divergence_system
 
+   !> The machine with the kinks of its law's partial derivatives (GMS's
+   !> switch bands) as its events: where the spectrum's steps end.
+   type, extends(event_system) :: kink_machine
+      type(machine_smooth) :: base
+   contains
+      procedure :: dimension => kink_dimension
+      procedure :: relative_component => kink_relative_component
+      procedure :: rhs => kink_rhs
+      procedure :: jacobian => kink_jacobian
+      procedure :: event_count => kink_event_count
+      procedure :: event_values => kink_event_values
+   end type kink_machine
+
+   !> The orbit with D (its base a kink_machine) and the kinks as its events.
+   type, extends(event_system) :: kinked_divergence
+      type(divergence_system) :: flow
+   contains
+      procedure :: dimension => kinked_dimension
+      procedure :: controlled_dimension => kinked_controlled_dimension
+      procedure :: relative_component => kinked_relative_component
+      procedure :: rhs => kinked_rhs
+      procedure :: jacobian => kinked_jacobian
+      procedure :: event_count => kinked_event_count
+      procedure :: event_values => kinked_event_values
+   end type kinked_divergence
+
 contains
+
+   pure integer function kink_dimension(self)
+      class(kink_machine), intent(in) :: self
+
+      kink_dimension = self%base%dimension()
+   end function kink_dimension
+
+   pure subroutine kink_relative_component(self, index, reference, floor)
+      class(kink_machine), intent(in) :: self
+      integer, intent(out) :: index
+      real(wp), intent(out) :: reference, floor
+
+      call self%base%relative_component(index, reference, floor)
+   end subroutine kink_relative_component
+
+   pure subroutine kink_rhs(self, t, y, dydt)
+      class(kink_machine), intent(in) :: self
+      real(wp), intent(in) :: t
+      real(wp), intent(in), contiguous :: y(:)
+      real(wp), intent(out), contiguous :: dydt(:)
+
+      call self%base%rhs(t, y, dydt)
+   end subroutine kink_rhs
+
+   pure subroutine kink_jacobian(self, t, y, dfdy, dfdt)
+      class(kink_machine), intent(in) :: self
+      real(wp), intent(in) :: t
+      real(wp), intent(in) :: y(:)
+      real(wp), intent(out) :: dfdy(:, :)
+      real(wp), intent(out) :: dfdt(:)
+
+      call self%base%jacobian(t, y, dfdy, dfdt)
+   end subroutine kink_jacobian
+
+   pure integer function kink_event_count(self)
+      class(kink_machine), intent(in) :: self
+
+      kink_event_count = self%base%law%kink_count()
+   end function kink_event_count
+
+   pure subroutine kink_event_values(self, t, y, g)
+      class(kink_machine), intent(in) :: self
+      real(wp), intent(in) :: t
+      real(wp), intent(in) :: y(:)
+      real(wp), intent(out) :: g(:)
+      integer :: n
+
+      n = self%base%n_states
+      call self%base%law%kinks(y(2) - self%base%m%belt, y(3:2 + n) * self%base%scale(1:n), self%base%m%normal, g)
+   end subroutine kink_event_values
+
+   pure integer function kinked_dimension(self)
+      class(kinked_divergence), intent(in) :: self
+
+      kinked_dimension = self%flow%dimension()
+   end function kinked_dimension
+
+   pure integer function kinked_controlled_dimension(self)
+      class(kinked_divergence), intent(in) :: self
+
+      kinked_controlled_dimension = self%flow%controlled_dimension()
+   end function kinked_controlled_dimension
+
+   pure subroutine kinked_relative_component(self, index, reference, floor)
+      class(kinked_divergence), intent(in) :: self
+      integer, intent(out) :: index
+      real(wp), intent(out) :: reference, floor
+
+      call self%flow%relative_component(index, reference, floor)
+   end subroutine kinked_relative_component
+
+   pure subroutine kinked_rhs(self, t, y, dydt)
+      class(kinked_divergence), intent(in) :: self
+      real(wp), intent(in) :: t
+      real(wp), intent(in), contiguous :: y(:)
+      real(wp), intent(out), contiguous :: dydt(:)
+
+      call self%flow%rhs(t, y, dydt)
+   end subroutine kinked_rhs
+
+   pure subroutine kinked_jacobian(self, t, y, dfdy, dfdt)
+      class(kinked_divergence), intent(in) :: self
+      real(wp), intent(in) :: t
+      real(wp), intent(in) :: y(:)
+      real(wp), intent(out) :: dfdy(:, :)
+      real(wp), intent(out) :: dfdt(:)
+
+      call self%flow%jacobian(t, y, dfdy, dfdt)
+   end subroutine kinked_jacobian
+
+   pure integer function kinked_event_count(self)
+      class(kinked_divergence), intent(in) :: self
+
+      kinked_event_count = 0
+      select type (base => self%flow%base)
+      class is (event_system)
+         kinked_event_count = base%event_count()
+      end select
+   end function kinked_event_count
+
+   pure subroutine kinked_event_values(self, t, y, g)
+      class(kinked_divergence), intent(in) :: self
+      real(wp), intent(in) :: t
+      real(wp), intent(in) :: y(:)
+      real(wp), intent(out) :: g(:)
+
+      select type (base => self%flow%base)
+      class is (event_system)
+         call base%event_values(t, y(1:size(y) - 1), g)
+      end select
+   end subroutine kinked_event_values
 
    pure function divergence_dimension(self) result(n)
       class(divergence_system), intent(in) :: self
@@ -242,6 +381,10 @@ contains
          if (allocated(error)) return
       end if
       phi = generic_frame(n)
+      if (law%kink_count() > 0) then
+         call kinked_spectrum(error)
+         return
+      end if
       call orbit%init(extended, c%solver, h, error)
       if (allocated(error)) return
       intervals = int(s%duration / s%renormalise + 1.0e-9_wp)
@@ -274,6 +417,76 @@ contains
       end do
       call orbit%destroy()
       if (qr%elapsed > 0.0_wp) divergence = z(n + 1) / qr%elapsed
+
+   contains
+
+      !> The same with the law's kinks located (docs/chaos.md, "The tangent of a
+      !> stiff law"): each ends a step, the Gauss points stay on the step's side
+      !> of them, and past one the stepper restarts with a step of event_tolerance.
+      subroutine kinked_spectrum(error)
+         type(error_type), allocatable, intent(out) :: error
+         type(kinked_divergence), target :: kinked
+         type(kink_machine) :: machine
+         type(event_locator) :: locator
+         real(wp) :: f_b(n)
+         integer :: m
+         logical :: ok
+
+         machine%base = system
+         allocate (kinked%flow%base, source=machine)
+         m = machine%event_count()
+         call locator%init(kinked, c%solver, spread(event_either, 1, m), spread(.true., 1, m), c%event_tolerance, &
+            & h, error)
+         if (allocated(error)) return
+         intervals = int(s%duration / s%renormalise + 1.0e-9_wp)
+         call qr%start(n, intervals)
+         allocate (z(n + 1), y_a(n), f_a(n), logs(n))
+         z(1:n) = y
+         z(n + 1) = 0.0_wp
+         call locator%restart(t, z, h)
+         call system%rhs(t, y, f_a)
+         depth = 0
+         do k = 1, intervals
+            t_target = t0 + k * s%renormalise
+            logs = 0.0_wp
+            steps = 0
+            do while (t < t_target)
+               t_a = t
+               y_a = z(1:n)
+               call locator%advance(t, t_target, z, error, watch, single=.true.)
+               if (allocated(error)) return
+               steps = steps + 1
+               if (steps > c%solver%max_steps) then
+                  call fatal_error(error, trim(c%solver%method)//': more than max_steps steps in one ' &
+                     & //'renormalisation interval near t = '//rtoa(t)//' s', error_numerical)
+                  return
+               end if
+               call system%rhs(t, z(1:n), f_b)
+               if (t > t_a) then
+                  call magnus_tangent_step(machine, t_a, y_a, f_a, t, z(1:n), f_b, phi, logs, depth, ok, kinked=.true.)
+                  if (.not. ok) then
+                     call fatal_error(error, 'Lyapunov spectrum: the Jacobian is NaN or Inf, or too stiff for ' &
+                        & //'the step ending near t = '//rtoa(t)//' s (an exponential of the tangent in more ' &
+                        & //'than 2^24 parts)', error_numerical)
+                     return
+                  end if
+               end if
+               f_a = f_b
+               if (locator%n_hits > 0) then
+                  if (locator%hits(locator%n_hits)%terminal) call locator%restart(t, z, c%event_tolerance)
+               end if
+               if (mod(steps, 16_i8) == 0 .or. depth >= 12) then
+                  call watch%check(t, error)
+                  if (allocated(error)) return
+               end if
+            end do
+            call qr%add_logs(logs, s%renormalise, 0)
+            call watch%check(t, error)
+            if (allocated(error)) return
+         end do
+         if (qr%elapsed > 0.0_wp) divergence = z(n + 1) / qr%elapsed
+      end subroutine kinked_spectrum
+
    end subroutine smooth_spectrum
 
    !> A set-valued law's spectrum: the switching run with Φ; the transient in
