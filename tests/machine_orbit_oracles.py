@@ -906,8 +906,7 @@ def gms_table(args):
     # -1.12406, -1.12387 at 1e-11), the differences' extrapolation by ~1e-3.
     assert abs(mu[1].imag) < 1e-12 and abs(mu[1].real - slope) < 5e-3 * abs(slope), (mu[1], slope)
     assert abs(got["section_jacobian"][0, 0] - slope) < 5e-3 * abs(slope), got["section_jacobian"]
-    # A flip multiplier beyond -1: the period-1 orbit is unstable (the run stays within 1e-5 m of it over the
-    # seven cycles to 56 s: 1.12^7 = 2.2).
+    # A flip multiplier beyond -1: the period-1 orbit is unstable (the run settles on a period-2 cycle about it).
     assert slope < -1.05
 
 
