@@ -269,7 +269,7 @@ contains
          call self%plane%rhs(t, y, f_b)
          if (t > t_a) then
             call magnus_tangent_step(self%plane%base, t_a, y_a, f_a, t, y, f_b, self%q, self%logs, depth, ok, &
-               & self%upper, kinked=self%plane%kinks > 0)
+               & self%upper)
             if (.not. ok) then
                call fatal_error(error, 'periodic orbit: the Jacobian is NaN or Inf, or too stiff for the step ' &
                   & //'of the section map ending near t = '//rtoa(t)//' s (an exponential of the ' &

@@ -22,7 +22,6 @@ module friction_analysis_tangent_magnus
    use friction_error, only: error_type, fatal_error, error_numerical
    use friction_ode_system, only: ode_system
    use friction_ode_solver, only: ode_solver
-   use friction_ode_events, only: event_system
    implicit none
    private
 
@@ -120,11 +119,7 @@ contains
    !> triangular (rows scaled by R's diagonal: bounded while the columns keep
    !> the order of their growth, as they do from a generic frame), so that
    !> Φ(t) Φ(t_0)⁻¹ = Q R Φ(t_0)ᵀ with its smallest parts resolved.
-   !> `kinked` (a system whose events are the kinks of J, none inside the
-   !> step): a Gauss state on another side of a kink than the step's start
-   !> (the interpolant of a stiff relaxation overshoots: a band 3.7e-11 m wide
-   !> against a step's 1e-6 m) is taken on the chord instead, else at the start.
-   pure subroutine magnus_tangent_step(system, t_a, y_a, f_a, t_b, y_b, f_b, phi, logs, depth, ok, upper, kinked)
+   pure subroutine magnus_tangent_step(system, t_a, y_a, f_a, t_b, y_b, f_b, phi, logs, depth, ok, upper)
       class(ode_system), intent(in) :: system
       real(wp), intent(in) :: t_a, t_b
       real(wp), intent(in) :: y_a(:), f_a(:), y_b(:), f_b(:)
@@ -133,62 +128,19 @@ contains
       integer, intent(inout) :: depth
       logical, intent(out) :: ok
       real(wp), intent(inout), optional :: upper(:, :)
-      logical, intent(in), optional :: kinked
       real(wp), parameter :: offset = sqrt(3.0_wp) / 6.0_wp
       real(wp), parameter :: alpha = 0.25_wp + offset, beta = 0.25_wp - offset
       real(wp) :: a1(size(y_a), size(y_a)), a2(size(y_a), size(y_a)), y(size(y_a)), dfdt(size(y_a)), h
-      real(wp), allocatable :: g_a(:)
-      logical :: pieces
 
       h = t_b - t_a
-      pieces = .false.
-      if (present(kinked)) pieces = kinked
-      if (pieces) then
-         select type (system)
-         class is (event_system)
-            allocate (g_a(system%event_count()))
-            call system%event_values(t_a, y_a, g_a)
-         class default
-            pieces = .false.
-         end select
-      end if
       call hermite(0.5_wp - offset, h, y_a, f_a, y_b, f_b, y)
-      if (pieces) then
-         select type (system)
-         class is (event_system)
-            call keep_piece(system, t_a + (0.5_wp - offset) * h, 0.5_wp - offset, y_a, y_b, g_a, y)
-         end select
-      end if
       call system%jacobian(t_a + (0.5_wp - offset) * h, y, a1, dfdt)
       call hermite(0.5_wp + offset, h, y_a, f_a, y_b, f_b, y)
-      if (pieces) then
-         select type (system)
-         class is (event_system)
-            call keep_piece(system, t_a + (0.5_wp + offset) * h, 0.5_wp + offset, y_a, y_b, g_a, y)
-         end select
-      end if
       call system%jacobian(t_a + (0.5_wp + offset) * h, y, a2, dfdt)
       call apply_exponential(h * (alpha * a1 + beta * a2), phi, logs, depth, ok, upper)
       if (.not. ok) return
       call apply_exponential(h * (beta * a1 + alpha * a2), phi, logs, depth, ok, upper)
    end subroutine magnus_tangent_step
-
-   !> y (the interpolant's state at t_a + theta (t_b - t_a)) moved onto the
-   !> start's side of every kink, where g_a has the kinks' values: the
-   !> chord's point, or else the start.
-   pure subroutine keep_piece(system, t, theta, y_a, y_b, g_a, y)
-      class(event_system), intent(in) :: system
-      real(wp), intent(in) :: t, theta, y_a(:), y_b(:), g_a(:)
-      real(wp), intent(inout) :: y(:)
-      real(wp) :: g(size(g_a))
-
-      call system%event_values(t, y, g)
-      if (all(g * g_a >= 0.0_wp)) return
-      y = y_a + theta * (y_b - y_a)
-      call system%event_values(t, y, g)
-      if (all(g * g_a >= 0.0_wp)) return
-      y = y_a
-   end subroutine keep_piece
 
    !> Φ ← exp(X) Φ in parts exp(X / 2^j), Φ = Q R after each (Φ ← Q, logs +=
    !> log R_ii).  A part is taken whole when R's diagonal spans at most

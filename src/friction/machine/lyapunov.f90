@@ -421,8 +421,8 @@ contains
    contains
 
       !> The same with the law's kinks located (docs/chaos.md, "The tangent of a
-      !> stiff law"): each ends a step, the Gauss points stay on the step's side
-      !> of them, and past one the stepper restarts with a step of event_tolerance.
+      !> stiff law"): each ends a step, and past one the stepper restarts with a
+      !> step of event_tolerance.
       subroutine kinked_spectrum(error)
          type(error_type), allocatable, intent(out) :: error
          type(kinked_divergence), target :: kinked
@@ -463,7 +463,7 @@ contains
                end if
                call system%rhs(t, z(1:n), f_b)
                if (t > t_a) then
-                  call magnus_tangent_step(machine, t_a, y_a, f_a, t, z(1:n), f_b, phi, logs, depth, ok, kinked=.true.)
+                  call magnus_tangent_step(machine, t_a, y_a, f_a, t, z(1:n), f_b, phi, logs, depth, ok)
                   if (.not. ok) then
                      call fatal_error(error, 'Lyapunov spectrum: the Jacobian is NaN or Inf, or too stiff for ' &
                         & //'the step ending near t = '//rtoa(t)//' s (an exponential of the tangent in more ' &
