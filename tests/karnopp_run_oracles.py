@@ -57,6 +57,10 @@ def machine_oracle(p, grid, x0, v0):
         return np.sign(w) * (p["fc"] + (fs - p["fc"]) * np.exp(-np.abs(w / p["vs"]) ** p["exponent"])) \
             + p["sigma2"] * w
 
+    # The largest pull a hold at an edge keeps: F_s, or the force just outside when larger (Filippov's
+    # sliding mode: the pull between the two drives the block out, the slip force back, so it stays on the
+    # edge with v' = 0, entered from outside or driven onto the edge from inside).
+    hold_limit = max(fs, outside(dv))
     xs, vs, events = np.full(len(grid), np.nan), np.full(len(grid), np.nan), []
     t, x, v = grid[0], x0, v0
     xs[0], vs[0] = x, v
@@ -77,8 +81,9 @@ def machine_oracle(p, grid, x0, v0):
                           [x, v], method="DOP853", events=evs, dense_output=True, **TOL)
         elif mode == "hold":
             vh = v
-            evs = (terminal(lambda tt, y: fs - applied(y[0], vh), -1),
-                   terminal(lambda tt, y: fs + applied(y[0], vh), -1))
+            up, down = (hold_limit, fs) if edge > 0 else (fs, hold_limit)
+            evs = (terminal(lambda tt, y: up - applied(y[0], vh), -1),
+                   terminal(lambda tt, y: down + applied(y[0], vh), -1))
             r = solve_ivp(lambda tt, y: [vh, 0.0], (t, end), [x, vh], method="DOP853", events=evs,
                           dense_output=True, **TOL)
         else:
@@ -97,7 +102,7 @@ def machine_oracle(p, grid, x0, v0):
         if mode == "out":
             edge = dv if which == 0 else -dv
             v = belt + edge
-            if abs(applied(x, v)) <= fs:
+            if -fs <= np.sign(edge) * applied(x, v) <= hold_limit:
                 mode, held = "hold", True
                 events.append((t, SLIP_TO_STICK))
             else:
@@ -115,7 +120,15 @@ def machine_oracle(p, grid, x0, v0):
             if which == 2:
                 held = True   # |A| back within F_s inside: a hold where it is (v' = 0 in this mode)
                 continue
-            v = belt + (dv if which == 0 else -dv)
+            edge = dv if which == 0 else -dv
+            v = belt + edge
+            if np.sign(edge) * applied(x, v) < hold_limit:
+                # Onto the edge from inside, held there by the slip force outside: a hold (on, if held).
+                mode = "hold"
+                if not held:
+                    events.append((t, SLIP_TO_STICK))
+                held = True
+                continue
             mode = "out"
             if held:
                 events.append((t, STICK_TO_SLIP))
@@ -173,6 +186,46 @@ def machine(args):
         hold_time += got["t"][-1] - expected[-1][0]
     print(f"machine: stick_time {got['stick_time']:.9f} s, the oracle's holds {hold_time:.9f} s")
     assert abs(got["stick_time"] - hold_time) < 1e-6, (got["stick_time"], hold_time)
+
+
+def machine_slide(args):
+    # Bands whose force just outside, g(dv) + sigma2 dv, exceeds F_s: an edge attracts from both sides and
+    # the block slides along it (Filippov's sliding mode), held there until the pull reaches that force.
+    # Wide: vs = 0.05 m/s, dv = 1e-3 m/s (the force outside 1.5002 N, 2e-4 N above F_s: each hold's end
+    # 1e-3 s later at the spring's rate k v_edge = 0.2 N/s); narrow: the input's curve with dv = 1e-7 m/s,
+    # below the 8e-7 m/s where sigma2 = 0.4 N s/m makes every band slide (3.5e-8 N above F_s, 1.75e-7 s).
+    tight = {"integrator.rtol": 1e-12, "integrator.atol": 1e-15, "machine.event_tolerance": 1e-12}
+    for name, law in (("wide", {"law.vs": 0.05, "law.dv": 1e-3}), ("narrow", {"law.dv": 1e-7})):
+        p = dict(BELT, vs=law.get("law.vs", BELT["vs"]), dv=law["law.dv"])
+        path = run_program(args, f"machine_slide_{name}", ["machine_karnopp.nml"], dict(tight, **law))
+        got = read_machine(path)
+        xs, vs, expected = machine_oracle(p, got["t"], 0.0, 0.0)
+        outside = p["fc"] + (p["fs"] - p["fc"]) * np.exp(-(p["dv"] / p["vs"]) ** 2) + p["sigma2"] * p["dv"]
+        shift = (outside - p["fs"]) / (p["k"] * p["belt"])
+        worst_t = compare_events(f"machine-slide ({name})", got["events"], expected)
+        dx = np.max(np.abs(got["x"] - xs))
+        dvel = np.max(np.abs(got["v"] - vs))
+        # Each hold ends where the pull reaches the force just outside (the spring's A = -k x at the edge).
+        ends = [i for i, (_, k) in enumerate(got["events"]) if k == STICK_TO_SLIP]
+        with h5py.File(path) as f:
+            x_end = f["machine/events/x"][()][ends]
+        pull_gap = np.max(np.abs(np.abs(p["k"] * x_end) - outside))
+        print(f"machine-slide ({name}): the force outside {outside:.10f} N, F_s {p['fs']} N: each hold "
+              f"{shift:.2e} s longer than at F_s; events within {worst_t:.2e} s of the oracle's, |A| at the "
+              f"{len(ends)} ends of holds within {pull_gap:.1e} N of it; trajectory within |dx| {dx:.2e} m, "
+              f"|dv| {dvel:.2e} m/s")
+        assert len(ends) >= 3 and got["events"][0][1] == SLIP_TO_STICK, got["events"][:4]
+        # The program at rtol 1e-12 and events to 1e-12 s against the oracle's DOP853 at rtol 1e-12: a hold's
+        # start off by dx moves its end by k dx / 0.2 N/s = 10 dx, so 1e-9 s and 1e-9 m bound a few
+        # cycles' accumulation of ~1e-12 of the 0.3 m cycle, and stay below the sliding mode's own shift
+        # (1.75e-7 s at its narrowest): ending the holds at F_s instead fails this.
+        assert worst_t < 1e-9 < shift, (worst_t, shift)
+        assert dx < 1e-9 and dvel < 1e-9, (dx, dvel)
+        # The event's state is the located time's: k |dx| = 2 (1e-12 s of v_edge) and the stepper's 1e-12.
+        assert pull_gap < 1e-10, pull_gap
+        # A hold in the sliding mode is exactly at the edge's velocity (v' = 0, no creep).
+        held = got["stick"] == 1
+        assert held.any() and np.all(np.abs(np.abs(got["v"][held] - 0.1) - p["dv"]) < 1e-15), got["v"][held]
 
 
 def brake_oracle(t_grid, z0):
@@ -302,29 +355,30 @@ def brake_benettin(args):
 def stick_limit(args):
     # Karnopp's slip onsets as dv falls, against Stribeck's through exact stick (the same curve, the
     # static limit F_s): the hold's edge sits dv off the belt, which shifts the phase by O(dv).
-    # sigma2 = 0: with a viscous term the force just outside a narrow band, g(dv) + sigma2 dv, exceeds F_s
-    # once sigma2 dv > (F_s - F_c)(dv/vs)^2 (below 8e-7 m/s with the input's 0.4 N s/m), a band the run
-    # refuses (its edge would attract from both sides).
-    base = {"machine.t_end": 20.0, "integrator.rtol": 1e-11, "integrator.atol": 1e-14, "law.sigma2": 0.0}
-    stribeck = run_program(args, "stribeck", ["machine_karnopp.nml"], dict(base, **{"law.model": "'stribeck'"}))
-    with h5py.File(stribeck) as f:
-        kinds = f["machine/events/kind"][()]
-        onsets = f["machine/events/t"][()][kinds == STICK_TO_SLIP]
-    errors = []
-    widths = [1e-5, 1e-6, 1e-7]
-    for dv in widths:
-        got = read_machine(run_program(args, f"karnopp_{dv:g}", ["machine_karnopp.nml"], dict(base, **{"law.dv": dv})))
-        mine = np.array([t for t, k in got["events"] if k == STICK_TO_SLIP])
-        assert len(mine) == len(onsets), (len(mine), len(onsets))
-        errors.append(np.max(np.abs(mine - onsets)))
-        print(f"stick-limit: dv = {dv:g} m/s: slip onsets within {errors[-1]:.3e} s of exact stick's "
-              f"({len(onsets)} onsets in {base['machine.t_end']:g} s)")
-    # First order in dv: each factor of 10 in dv takes a factor of about 10 off (8 to 12 allowed: the
-    # curve's own change over the band, (dv/vs)^2 = 1e-4 of it at the widest, and the run's error, ~1e-9 s at
-    # rtol 1e-11, are far below the differences).
-    for a, b in zip(errors, errors[1:]):
-        assert 8 < a / b < 12, errors
-    assert errors[-1] < 1e-4, errors
+    # sigma2 = 0, and the input's 0.4 N s/m with bands below 8e-7 m/s, where the force just outside,
+    # g(dv) + sigma2 dv, exceeds F_s and the holds end in the sliding mode, at that force: F_s + O(dv) too.
+    for sigma2, widths in ((0.0, [1e-5, 1e-6, 1e-7]), (0.4, [4e-7, 4e-8, 4e-9])):
+        base = {"machine.t_end": 20.0, "integrator.rtol": 1e-11, "integrator.atol": 1e-14, "law.sigma2": sigma2}
+        stribeck = run_program(args, f"stribeck_{sigma2:g}", ["machine_karnopp.nml"],
+                               dict(base, **{"law.model": "'stribeck'"}))
+        with h5py.File(stribeck) as f:
+            kinds = f["machine/events/kind"][()]
+            onsets = f["machine/events/t"][()][kinds == STICK_TO_SLIP]
+        errors = []
+        for dv in widths:
+            got = read_machine(run_program(args, f"karnopp_{sigma2:g}_{dv:g}", ["machine_karnopp.nml"],
+                                           dict(base, **{"law.dv": dv})))
+            mine = np.array([t for t, k in got["events"] if k == STICK_TO_SLIP])
+            assert len(mine) == len(onsets), (len(mine), len(onsets))
+            errors.append(np.max(np.abs(mine - onsets)))
+            print(f"stick-limit: sigma2 = {sigma2:g} N s/m, dv = {dv:g} m/s: slip onsets within {errors[-1]:.3e} s "
+                  f"of exact stick's ({len(onsets)} onsets in {base['machine.t_end']:g} s)")
+        # First order in dv: each factor of 10 in dv takes a factor of about 10 off (8 to 12 allowed: the
+        # curve's own change over the band, (dv/vs)^2 = 1e-4 of it at the widest, and the run's error, ~1e-9
+        # s at rtol 1e-11, are far below the differences).
+        for a, b in zip(errors, errors[1:]):
+            assert 8 < a / b < 12, errors
+        assert errors[-1] < 1e-4, errors
 
 
 def oracle_benettin(p, t0, state, transient, duration, interval, d0):
@@ -411,7 +465,8 @@ def machine_chaos(args):
 
 
 def main():
-    return case_main(__doc__, {"machine": machine, "brake": brake, "brake-benettin": brake_benettin,
+    return case_main(__doc__, {"machine": machine, "machine-slide": machine_slide, "brake": brake,
+                               "brake-benettin": brake_benettin,
                                "stick-limit": stick_limit,
                                "machine-chaos": machine_chaos})
 

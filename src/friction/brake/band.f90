@@ -13,16 +13,20 @@
 !>   exact flow holds it on the edge; where the step left it would set when
 !>   it drifts out again).  Into a hold f⁺_v = 0: δv is forgotten, the
 !>   direction the spectrum reports as lost (-inf), as exact stick's;
-!> - a hold at the edge the pull pushes towards ends where σA reaches F_s:
+!> - a hold at the edge the pull pushes towards ends where σA reaches the
+!>   hold's limit F_h = max(F_s, F_e), F_e the force just outside the edge:
 !>   the block leaves at once, Φ through the saltation from the hold's field
-!>   into the outside one across h = F_s - σA (the brake's slip onset:
+!>   into the outside one across h = F_h - σA (the brake's slip onset:
 !>   event_stick_to_slip); pushing inwards, or from inside the band, it is a
-!>   kink of the clipped force, no jump.
+!>   kink of the clipped force, no jump.  With F_e > F_s a pull σA between
+!>   the two drives the block out of the band and the slip force back in:
+!>   it slides along the edge (Filippov's sliding mode), v' = 0 with the
+!>   friction equal to the pull, a hold entered from either side, ending
+!>   where σA = F_e with the force continuous (the saltation the identity
+!>   but for the velocity's last bit).
 !>
-!> Where the force just outside an edge exceeds the hold, the edge attracts
-!> from both sides (a sliding mode this flow does not follow): refused on
-!> input (config.f90), and a run that switches at the edges more than
-!> max_switches times within one advance ends with an error.
+!> A run that switches at the edges more than max_switches times within one
+!> advance ends with an error.
 !>
 !> The state is the law's flow's, (x, v_rel, y, w): the band and its edges
 !> are in the slip rate v_rel itself, centred on 0.
@@ -31,7 +35,7 @@ module friction_brake_band
    use friction_error, only: error_type, fatal_error, error_numerical
    use friction_strings, only: rtoa, itoa
    use friction_ode_events, only: event_system, event_falling, event_rising, event_either
-   use friction_law, only: sliding_law, in_band, band_edge_velocity
+   use friction_law, only: sliding_law, in_band, band_edge_velocity, band_hold_limit, sliding_at_edge
    use friction_law_factory, only: make_law, new_law
    use friction_output_law_files, only: law_with_files
    use friction_analysis_lyapunov_spectrum, only: tangent_system
@@ -56,6 +60,8 @@ module friction_brake_band
       type(brake_law_flow) :: flow
       real(wp) :: half_width = 0.0_wp   !! Δv in the law's units
       real(wp) :: limit = 0.0_wp        !! F_s in the law's units
+      real(wp) :: hold_limit = 0.0_wp   !! the largest pull a hold at an edge keeps (band_hold_limit), law's units
+      real(wp) :: held_at = 0.0_wp      !! the sign of the edge held at (0: none): v' = 0 in its sliding mode
    contains
       procedure :: dimension => band_dimension
       procedure :: rhs => band_rhs
@@ -64,6 +70,7 @@ module friction_brake_band
       procedure :: event_values => band_event_values
       procedure :: inside
       procedure :: edge_velocity
+      procedure :: sliding
    end type brake_band_flow
 
    type, extends(brake_integrator) :: band_integrator
@@ -118,7 +125,19 @@ contains
       if (self%inside(y(2))) then
          if (abs(-(2.0_wp * y(1) - y(3)) * self%flow%units%force) <= self%limit) dydt(2) = 0.0_wp
       end if
+      if (self%sliding(y)) dydt(2) = 0.0_wp
    end subroutine band_rhs
+
+   !> Whether the state is in the sliding mode of the hold at an edge (the
+   !> pull outwards beyond F_s): its field's v' is 0, not the law's.
+   pure logical function sliding(self, y)
+      class(brake_band_flow), intent(in) :: self
+      real(wp), intent(in) :: y(:)
+
+      sliding = .false.
+      if (self%held_at /= 0.0_wp) sliding = sliding_at_edge(self%held_at, &
+         & -(2.0_wp * y(1) - y(3)) * self%flow%units%force, self%limit)
+   end function sliding
 
    pure subroutine band_jacobian(self, t, y, dfdy, dfdt)
       class(brake_band_flow), intent(in) :: self
@@ -128,6 +147,10 @@ contains
       real(wp), intent(out) :: dfdt(:)
 
       call self%flow%jacobian(t, y, dfdy, dfdt)
+      if (self%sliding(y)) then
+         dfdy(2, :) = 0.0_wp
+         dfdt(2) = 0.0_wp
+      end if
    end subroutine band_jacobian
 
    pure function band_event_count(self) result(n)
@@ -151,8 +174,8 @@ contains
          g(1) = (1.0_wp - p%kappa) * y(3) + p%g_prime
          g(2) = w - self%half_width
          g(3) = w + self%half_width
-         g(4) = self%limit - a
-         g(5) = self%limit + a
+         g(4) = merge(self%hold_limit, self%limit, self%held_at == 1.0_wp) - a
+         g(5) = merge(self%hold_limit, self%limit, self%held_at == -1.0_wp) + a
       end associate
    end subroutine band_event_values
 
@@ -197,6 +220,8 @@ contains
             & self%band%flow%units%time)
          self%band%flow%n_states = 0
          call self%band%flow%law%band(self%band%half_width, self%band%limit)
+         ! (Karnopp's F_s and g(Δv) + σ2 Δv do not depend on the load.)
+         self%band%hold_limit = band_hold_limit(self%band%flow%law, 1.0_wp)
       end if
       self%h_start = config%solver%h_start
       if (.not. (self%h_start > 0.0_wp)) self%h_start = 1.0e-3_wp
@@ -206,6 +231,7 @@ contains
       self%y = [y0(1), y0(2) - config%params%v_dr, y0(3), y0(4)]
       self%held = self%band%inside(self%y(2))
       self%hold_edge = 0.0_wp
+      self%band%held_at = 0.0_wp
       ! Exact: the time in the band, between its located edges.
       self%stick_time = 0.0_wp
       call events%clear()
@@ -240,9 +266,24 @@ contains
       if (allocated(error)) return
       self%y(2) = self%band%edge_velocity(s, .false.)
       self%held = .false.
-      self%hold_edge = 0.0_wp
+      call set_hold(self, 0.0_wp)
       call self%locator_restart(self%h_start)
    end subroutine start_leaving
+
+   !> The edge the block holds at (0: none), in the run and in its flows.
+   subroutine set_hold(self, s)
+      type(band_integrator), intent(inout) :: self
+      real(wp), intent(in) :: s
+
+      self%hold_edge = s
+      self%band%held_at = s
+      if (allocated(self%extended)) then
+         select type (base => self%extended%base)
+         type is (brake_band_flow)
+            base%held_at = s
+         end select
+      end if
+   end subroutine set_hold
 
    logical function band_sticking(self)
       class(band_integrator), intent(in) :: self
@@ -287,9 +328,9 @@ contains
       type(brake_event_table), intent(inout) :: events
       type(error_type), allocatable, intent(out) :: error
       logical, intent(out), optional :: hold_end
-      real(wp) :: near(4), f_minus(4), f_plus(4), row(4), s, sigma, t_before
+      real(wp) :: near(4), f_minus(4), f_plus(4), row(4), s, sigma, t_before, pull
       integer :: which, direction, switches
-      logical :: entering, left, was_inside
+      logical :: entering, left, was_inside, onto
 
       if (present(hold_end)) hold_end = .false.
       switches = 0
@@ -328,6 +369,13 @@ contains
                   near(2) = b%edge_velocity(s, .not. entering)
                   if (entering) y(2) = b%edge_velocity(s, .true.)
                   call b%rhs(self%t, near, f_minus)
+                  ! Pulled outwards beyond F_s but within the hold's limit: held on the edge (the sliding
+                  ! mode), entering from outside or driven onto it from inside (then put just inside).
+                  pull = -(2.0_wp * y(1) - y(3)) * b%flow%units%force
+                  onto = .not. entering .and. sliding_at_edge(s, pull, b%limit) .and. s * pull < b%hold_limit
+                  if (onto) y(2) = near(2)
+                  if ((entering .or. onto) .and. sliding_at_edge(s, pull, b%limit) .and. s * pull <= b%hold_limit) &
+                     & call set_hold(self, s)
                   call b%rhs(self%t, y, f_plus)
                   if (self%tangent .and. f_minus(2) /= 0.0_wp) then
                      row = self%phi(2, :)
@@ -336,10 +384,13 @@ contains
                      self%phi(2, :) = row * (f_plus(2) / f_minus(2))
                      if (f_plus(2) == 0.0_wp) self%lost = 1
                   end if
-                  self%hold_edge = 0.0_wp
-                  if (entering .and. f_plus(2) == 0.0_wp) then
+                  call set_hold(self, 0.0_wp)
+                  if (onto .and. self%held) then
+                     ! A hold inside the band carried onto the edge: it goes on there, no event.
+                     call set_hold(self, s)
+                  else if ((entering .or. onto) .and. f_plus(2) == 0.0_wp) then
                      self%held = .true.
-                     self%hold_edge = s
+                     call set_hold(self, s)
                      call events%add(self%t, event_slip_to_stick, self%state())
                   else if (entering) then
                      self%held = .false.
@@ -364,7 +415,7 @@ contains
                   self%held = .true.
                else
                   ! Pushed inwards, or from inside: the block drifts into the band (a kink, no jump).
-                  self%hold_edge = 0.0_wp
+                  call set_hold(self, 0.0_wp)
                end if
             end select
             call self%locator_restart(0.0_wp)
@@ -387,12 +438,12 @@ contains
 
          associate (p => self%band%flow%params, y => self%y)
             f_minus = [y(2) + p%v_dr, 0.0_wp, y(4), (y(1) - p%kappa * y(3)) / p%xi]
+            call set_hold(self, 0.0_wp)
             y(2) = self%band%edge_velocity(sigma, .false.)
             call self%band%rhs(self%t, y, f_plus)
             if (self%tangent) call saltation(self%phi, f_minus, f_plus, [2.0_wp * sigma, 0.0_wp, -sigma, 0.0_wp])
          end associate
          self%held = .false.
-         self%hold_edge = 0.0_wp
          left = .true.
          call events%add(self%t, event_stick_to_slip, self%state())
       end subroutine leave_hold

@@ -315,8 +315,6 @@ contains
       call check_law(law_with_files(self%law), c)
       if (c%failed()) return
       call new_law(self%law, law)
-      call check_band_edges(self, law, c)
-      if (c%failed()) return
       call check_band_stepper(self, law, c)
       if (c%failed()) return
       ! Exact stick holds the closed-form stick phase, whose end needs a static limit affine in N'.
@@ -339,32 +337,6 @@ contains
          end block
       end if
    end subroutine check_law_choice
-
-   !> A band law (Karnopp's) whose force just outside the band exceeds its
-   !> hold: an edge then attracts from both sides and the block would slide
-   !> along it (a Filippov sliding mode), which the band's switches of the
-   !> run, the orbit and the spectrum (band.f90) do not follow: refused by
-   !> name (the orbit or the spectrum first, when asked).
-   subroutine check_band_edges(self, law, c)
-      type(brake_config), intent(in) :: self
-      class(sliding_law), intent(in) :: law
-      type(config_checker), intent(inout) :: c
-      real(wp) :: width, limit, outside, none(0)
-      character(len=:), allocatable :: why
-
-      call law%band(width, limit)
-      if (.not. (width > 0.0_wp)) return
-      ! (The band's hold and its edge's force do not depend on the load: Karnopp's F_s and g(Δv) + σ2 Δv.)
-      outside = law%force(width, none, 1.0_wp, 0.0_wp)
-      if (.not. (outside > limit)) return
-      why = "&law model = '"//trim(self%law%model)//"': the force just outside the band, "//rtoa(outside) &
-         & //' at dv, exceeds the band''s hold fs = '//rtoa(limit)//', so the block would slide along the ' &
-         & //'band''s edge, which the band''s switches do not follow: a smaller sigma2 or dv'
-      if (self%analysis%orbit) call c%reject('analysis', 'orbit', '.true.', why)
-      if (self%analysis%lyapunov_spectrum) call c%reject('analysis', 'lyapunov_spectrum', '.true.', why)
-      ! The run itself steps through the same switches (band.f90).
-      call c%reject(law_group, 'dv', rtoa(width), why)
-   end subroutine check_band_edges
 
    !> A band law with GSL's multistep steppers: a hold keeps the block within
    !> the tolerance of an edge, where the force jumps, and they crawl there

@@ -34,7 +34,7 @@ module friction_brake_orbit
    use friction_brake_law_model, only: law_integrator, brake_law_slip, brake_law_flow, law_units, law_static_line
    use friction_brake_integrator, only: brake_integrator
    use friction_brake_band, only: band_integrator, band_law
-   use friction_law, only: sliding_law, max_law_states
+   use friction_law, only: sliding_law, max_law_states, band_hold_limit
    use friction_law_factory, only: make_law, new_law
    use friction_output_law_files, only: law_with_files
    use friction_scene_report, only: job_reporter, loop_guard
@@ -266,7 +266,7 @@ contains
          ! h = slope N' + level - σ (2x - y) (switched.f90, stick_exit_saltation).
          normal = [-2.0_wp * sigma, 0.0_wp, slope * (1.0_wp - p%kappa) + sigma, 0.0_wp]
          if (self%band) then
-            ! The field outside the edge the block has just left by (slope 0: the hold's limit is F_s).
+            ! The field outside the edge the block has just left by (slope 0: a hold's limit is constant).
             f = with_band%field()
          else if (self%config%uses_law()) then
             law_slip%params = p
@@ -291,7 +291,7 @@ contains
    end subroutine brake_map_evaluate
 
    !> The static limit's slope and level of the map's set-valued law; of a
-   !> band law, the hold's limit F_s (slope 0).
+   !> band law, the hold's limit max(F_s, the force just outside the edge) (slope 0).
    subroutine prepare_limit(map, error)
       type(brake_section_map), intent(inout) :: map
       type(error_type), allocatable, intent(out) :: error
@@ -305,8 +305,9 @@ contains
       call law%band(half_width, limit)
       map%band = half_width > 0.0_wp
       if (map%band) then
+         ! The hold ends where the pull reaches its limit: F_s, or the force just outside the edge when larger.
          map%slope = 0.0_wp
-         map%level = limit / units%force
+         map%level = band_hold_limit(law, 1.0_wp) / units%force
       else
          call law_static_line(law, units, map%slope, map%level)
       end if

@@ -16,7 +16,7 @@ module friction_law
    private
 
    public :: sliding_law, max_law_states, difference_partials, exact_stick_force
-   public :: in_band, band_edge_velocity
+   public :: in_band, band_edge_velocity, band_hold_limit, sliding_at_edge
 
    !> The most internal states a law has (the ODE bridge's room): the
    !> Generalized Maxwell-Slip law's elements.
@@ -219,6 +219,32 @@ contains
       real(wp), intent(in) :: z(:)
       real(wp), intent(out) :: g(:)
    end subroutine kinks
+
+   !> The largest pull a hold at a band law's edge keeps: its own limit F_s,
+   !> or the force just outside the edge when that is larger.  The pull
+   !> between the two drives the block out of the band and the slip force
+   !> outside pushes it back: Filippov's convex combination of the two
+   !> fields keeps it on the edge with the friction equal to the pull, a
+   !> hold like any other (a sliding mode; docs/laws.md, Karnopp).  0 for a
+   !> law without a band.
+   pure real(wp) function band_hold_limit(law, normal) result(hold)
+      class(sliding_law), intent(in) :: law
+      real(wp), intent(in) :: normal
+      real(wp) :: half_width, limit, none(0)
+
+      call law%band(half_width, limit)
+      hold = 0.0_wp
+      if (half_width > 0.0_wp) hold = max(limit, abs(law%force(half_width, none, normal, 0.0_wp)))
+   end function band_hold_limit
+
+   !> Whether a pull held at the band's edge of sign s is the sliding mode's
+   !> (beyond the band's own limit, outwards): the friction is then the pull
+   !> by Filippov's rule, not the band's clip of it.
+   pure logical function sliding_at_edge(s, pull, limit)
+      real(wp), intent(in) :: s, pull, limit
+
+      sliding_at_edge = s * pull > limit
+   end function sliding_at_edge
 
    !> Whether a mechanism's velocity v is inside a band law's band about the
    !> surface's velocity `centre`, as the law decides it: |(v - centre) scale|

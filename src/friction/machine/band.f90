@@ -14,9 +14,16 @@
 !>   left it, a located time's distance inside, would set when a hold there
 !>   ends); with |A| <= F_s it holds there (v' = 0 exactly, f⁺_v = 0: δv
 !>   forgotten, the direction the spectrum reports as lost);
-!> - a hold at an edge ends where |A| reaches F_s pushing outwards: the block
-!>   leaves at once, through the saltation from the hold's field into the
-!>   outside one across h = F_s - σA (∂h/∂t of a moving support included).
+!> - a hold at an edge ends where |A| reaches the hold's limit pushing
+!>   outwards, F_h = max(F_s, F_e) with F_e the force just outside the edge:
+!>   the block leaves at once, through the saltation from the hold's field
+!>   into the outside one across h = F_h - σA (∂h/∂t of a moving support
+!>   included).  With F_e > F_s, a pull σA between the two drives the block
+!>   out of the band and the slip force back in: the block slides along the
+!>   edge (Filippov's sliding mode), v' = 0 with the friction equal to the
+!>   pull, a hold like the band's own, entered from either side; it ends
+!>   where σA = F_e, the force continuous there (the saltation the identity
+!>   but for the states' rounding).
 !>   The hold is known by the edge it was entered at, not by v: the step that
 !>   reaches the force's event may move v by units of its last place, out
 !>   past the edge, so that the edge's event may even come first.  Pushing
@@ -31,7 +38,7 @@ module friction_machine_band
    use friction_ode_events, only: event_system, event_locator, event_either, event_rising
    use friction_ode_watch, only: step_watch
    use friction_analysis_lyapunov_spectrum, only: tangent_system, pack_tangent, unpack_tangent
-   use friction_law, only: sliding_law, max_law_states, band_edge_velocity
+   use friction_law, only: sliding_law, max_law_states, band_edge_velocity, band_hold_limit, sliding_at_edge
    use friction_machine_config, only: machine_config
    use friction_machine_model, only: mechanics, machine_smooth
    implicit none
@@ -66,12 +73,16 @@ module friction_machine_band
    !> The load point's frame with the events of a law's band |w| < Δv
    !> (Karnopp's): its edges w = ±Δv (1, 2), the applied force at ±F_s (3,
    !> 4: where a hold in the band ends; located so that no step straddles the
-   !> kink of the clipped force) and, when sectioned, v = load_velocity (5).
+   !> kink of the clipped force), at ±hold_limit instead outwards from a hold
+   !> at an edge, and, when sectioned, v = load_velocity (5).
    type, extends(event_system) :: band_frame
       type(load_frame) :: frame
       real(wp) :: half_width = 0.0_wp, limit = 0.0_wp
+      real(wp) :: hold_limit = 0.0_wp   !! the largest pull a hold at an edge keeps (band_hold_limit)
+      real(wp) :: held_at = 0.0_wp      !! the sign of the edge held at (0: none): v' = 0 in its sliding mode
       logical :: sectioned = .false.
    contains
+      procedure :: set_limits => band_set_limits
       procedure :: dimension => band_dimension
       procedure :: rhs => band_rhs
       procedure :: jacobian => band_jacobian
@@ -160,6 +171,27 @@ contains
       band_dimension = self%frame%dimension()
    end function band_dimension
 
+   !> The band's half-width, its limit and a hold's limit, from the frame's law.
+   subroutine band_set_limits(self)
+      class(band_frame), intent(inout) :: self
+
+      call self%frame%base%law%band(self%half_width, self%limit)
+      self%hold_limit = band_hold_limit(self%frame%base%law, self%frame%base%m%normal)
+   end subroutine band_set_limits
+
+   !> Whether the state is in the sliding mode of the hold at an edge (the
+   !> pull outwards beyond F_s): its field's v' is 0, not the law's.
+   pure logical function sliding(self, t, y)
+      class(band_frame), intent(in) :: self
+      real(wp), intent(in) :: t, y(:)
+
+      sliding = .false.
+      if (self%held_at == 0.0_wp) return
+      associate (m => self%frame%base%m)
+         sliding = sliding_at_edge(self%held_at, m%applied(t, y(1) + m%load * t, y(2)), self%limit)
+      end associate
+   end function sliding
+
    pure subroutine band_rhs(self, t, y, dydt)
       class(band_frame), intent(in) :: self
       real(wp), intent(in) :: t
@@ -167,6 +199,7 @@ contains
       real(wp), intent(out), contiguous :: dydt(:)
 
       call self%frame%rhs(t, y, dydt)
+      if (sliding(self, t, y)) dydt(2) = 0.0_wp
    end subroutine band_rhs
 
    pure subroutine band_jacobian(self, t, y, dfdy, dfdt)
@@ -177,6 +210,10 @@ contains
       real(wp), intent(out) :: dfdt(:)
 
       call self%frame%jacobian(t, y, dfdy, dfdt)
+      if (sliding(self, t, y)) then
+         dfdy(2, :) = 0.0_wp
+         dfdt(2) = 0.0_wp
+      end if
    end subroutine band_jacobian
 
    pure integer function band_event_count(self)
@@ -197,8 +234,8 @@ contains
          a = m%applied(t, y(1) + m%load * t, y(2))
          g(1) = w - self%half_width
          g(2) = w + self%half_width
-         g(3) = self%limit - a
-         g(4) = self%limit + a
+         g(3) = merge(self%hold_limit, self%limit, self%held_at == 1.0_wp) - a
+         g(4) = merge(self%hold_limit, self%limit, self%held_at == -1.0_wp) + a
          if (self%sectioned) g(5) = y(2) - m%load
       end associate
    end subroutine band_event_values
@@ -217,7 +254,7 @@ contains
       allocate (band%frame%base%law, source=law)
       band%frame%base%n_states = ns
       if (ns > 0) call law%state_scale(band%frame%base%scale(1:ns))
-      call law%band(band%half_width, band%limit)
+      call band%set_limits()
    end subroutine band_frame_of
 
    !> The settings' initial state in the band's frame: e = x0 - load_velocity
@@ -249,7 +286,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       integer, allocatable :: directions(:)
       integer :: i, n
-      real(wp) :: w
+      real(wp) :: w, a
 
       if (allocated(self%band)) deallocate (self%band)
       allocate (self%band, source=band)
@@ -281,11 +318,17 @@ contains
       self%hold_edge = 0.0_wp
       associate (m => band%frame%base%m, width => band%half_width)
          w = y0(2) - m%belt
-         if (abs(w) < width .and. abs(m%applied(t0, y0(1) + m%load * t0, y0(2))) <= band%limit) then
+         a = m%applied(t0, y0(1) + m%load * t0, y0(2))
+         if (abs(w) < width .and. abs(a) <= band%limit) then
+            if (y0(2) == band_edge_velocity(m%belt, width, 1.0_wp, sign(1.0_wp, w), .true.)) &
+               & self%hold_edge = sign(1.0_wp, w)
+         else if (abs(w) < width .and. sign(1.0_wp, w) * a <= band%hold_limit) then
+            ! In the sliding mode at an edge.
             if (y0(2) == band_edge_velocity(m%belt, width, 1.0_wp, sign(1.0_wp, w), .true.)) &
                & self%hold_edge = sign(1.0_wp, w)
          end if
       end associate
+      call set_hold(self, self%hold_edge)
       self%held = self%inside()
       call restart(self, h)
    end subroutine band_start
@@ -312,6 +355,21 @@ contains
 
       stats = self%locator%statistics()
    end function band_statistics
+
+   !> The edge the block holds at (0: none), in the run and in its flows.
+   subroutine set_hold(self, s)
+      type(machine_band), intent(inout) :: self
+      real(wp), intent(in) :: s
+
+      self%hold_edge = s
+      self%band%held_at = s
+      if (allocated(self%extended)) then
+         select type (base => self%extended%base)
+         type is (band_frame)
+            base%held_at = s
+         end select
+      end if
+   end subroutine set_hold
 
    subroutine restart(self, h)
       type(machine_band), intent(inout) :: self
@@ -343,7 +401,7 @@ contains
       real(wp), allocatable :: z(:), near(:), f_minus(:), f_plus(:), normal(:), row(:)
       real(wp) :: t_before, w, edge, sigma, a, rate, rate_t
       integer :: n, i, which, direction
-      logical :: was_inside, entering
+      logical :: was_inside, entering, onto
 
       outcome = band_none
       n = size(self%y)
@@ -398,6 +456,14 @@ contains
                near(2) = band_edge_velocity(m%belt, width, 1.0_wp, sign(1.0_wp, edge), .true.)
             end if
             call b%rhs(self%t, near, f_minus)
+            ! Pulled outwards beyond F_s but within the hold's limit: held on the edge (the sliding mode),
+            ! entering from outside or driven onto it from inside (then put just inside, as entering).
+            a = m%applied(self%t, self%y(1) + m%load * self%t, self%y(2))
+            onto = .not. entering .and. sliding_at_edge(sign(1.0_wp, edge), a, limit) &
+               & .and. sign(1.0_wp, edge) * a < b%hold_limit
+            if (onto) self%y(2) = near(2)
+            if ((entering .or. onto) .and. sliding_at_edge(sign(1.0_wp, edge), a, limit) &
+               & .and. sign(1.0_wp, edge) * a <= b%hold_limit) call set_hold(self, sign(1.0_wp, edge))
             call b%rhs(self%t, self%y, f_plus)
             if (self%tangent .and. f_minus(2) /= 0.0_wp) then
                ! Φ across h = w - edge (∇h = e_v): row v scales by f⁺_v/f⁻_v (0 exactly into a hold).
@@ -408,10 +474,13 @@ contains
                self%phi(2, :) = row * (f_plus(2) / f_minus(2))
                if (f_plus(2) == 0.0_wp) self%lost = 1
             end if
-            self%hold_edge = merge(sign(1.0_wp, edge), 0.0_wp, f_plus(2) == 0.0_wp .and. entering)
+            call set_hold(self, merge(sign(1.0_wp, edge), 0.0_wp, f_plus(2) == 0.0_wp .and. (entering .or. onto)))
             ! A hold's flow is one-dimensional: without a support's motion what is left of Φ is a shift in time.
             if (self%tangent .and. self%project_in_hold .and. self%hold_edge /= 0.0_wp) self%phi = 0.0_wp
-            if (entering .and. f_plus(2) == 0.0_wp) then
+            if (onto .and. self%held) then
+               ! A hold inside the band carried onto the edge: it goes on there, no event.
+               outcome = band_pull
+            else if ((entering .or. onto) .and. f_plus(2) == 0.0_wp) then
                self%held = .true.
                outcome = band_hold
             else if (entering) then
@@ -429,13 +498,14 @@ contains
             a = m%applied(self%t, self%y(1) + m%load * self%t, self%y(2))
             outcome = band_pull
             ! A hold at the edge the force pushes towards ends: out at once (else a kink, nothing to do).
-            if (self%hold_edge == sigma .and. (sigma * a >= limit .or. .not. abs(w) < width)) then
+            if (self%hold_edge == sigma .and. (sigma * a >= b%hold_limit .or. .not. abs(w) < width)) then
                f_minus = 0.0_wp
                f_minus(1) = self%y(2) - m%load   ! the hold's field: e' = v - load_velocity, v' = 0, the states'
                if (n > 2) then
                   call b%rhs(self%t, self%y, f_plus)
                   f_minus(3:n) = f_plus(3:n)
                end if
+               call set_hold(self, 0.0_wp)
                self%y(2) = band_edge_velocity(m%belt, width, 1.0_wp, sigma, .false.)
                call b%rhs(self%t, self%y, f_plus)
                if (self%tangent) then
@@ -459,7 +529,7 @@ contains
                self%held = .true.
             end if
             ! Ended, or pushed inwards into the band: no longer held at an edge.
-            self%hold_edge = 0.0_wp
+            call set_hold(self, 0.0_wp)
          end select
       end associate
       call restart(self, 0.0_wp)

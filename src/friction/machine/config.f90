@@ -143,30 +143,7 @@ contains
          if (a%orbit) call check_orbit(self, c)
          if (a%poincare) call check_sections(self, c)
       end associate
-      if (c%failed()) return
-      call check_band_edges(self, c)
    end subroutine validate
-
-   !> A band law whose force just outside the band exceeds its hold: the
-   !> edge attracts from both sides and the block would slide along it (a
-   !> Filippov sliding mode), which the run's switches at the band's edges
-   !> (band.f90) do not follow: refused by name (the orbit says so first, in
-   !> its own words).
-   subroutine check_band_edges(self, c)
-      class(machine_config), intent(in) :: self
-      type(config_checker), intent(inout) :: c
-      class(sliding_law), allocatable :: law
-      real(wp) :: width, limit, outside, none(0)
-
-      call new_law(self%law, law)
-      call law%band(width, limit)
-      if (.not. (width > 0.0_wp)) return
-      outside = law%force(width, none, self%normal, 0.0_wp)
-      if (outside > limit) call c%reject('law', 'dv', rtoa(width), "&law model = '"//trim(self%law%model) &
-         & //"': the force just outside the band, "//rtoa(outside)//' N at dv, exceeds the band''s hold fs = ' &
-         & //rtoa(limit)//' N, so the block would slide along the band''s edge, which the run''s switches at ' &
-         & //'the edges do not follow: a smaller sigma2 or dv')
-   end subroutine check_band_edges
 
    !> A band law's force jumps at the band's edges, where a hold keeps the
    !> block within the tolerance of the edge: GSL's multistep steppers reject
@@ -219,20 +196,6 @@ contains
       logical :: forced
 
       call new_law(self%law, law)
-      block
-         real(wp) :: width, limit, none(0)
-         call law%band(width, limit)
-         ! Outside an edge the force may exceed the band's hold: the edge then attracts from both sides.
-         if (width > 0.0_wp) then
-            if (law%force(width, none, self%normal, 0.0_wp) > limit) then
-               call c%reject('analysis', 'orbit', '.true.', "&law model = '"//trim(self%law%model)//"': the " &
-                  & //'force just outside the band, '//rtoa(law%force(width, none, self%normal, 0.0_wp)) &
-                  & //' N at dv, exceeds the band''s hold fs = '//rtoa(limit)//' N, so the block would slide ' &
-                  & //'along the band''s edge, which the orbit''s map does not follow: a smaller sigma2 or dv')
-               return
-            end if
-         end if
-      end block
       forced = self%support_amplitude > 0.0_wp .and. self%support_frequency > 0.0_wp
       if (len_trim(self%analysis%continuation) == 0) return
       if (.not. any(orbit_variables == self%analysis%continuation)) then

@@ -450,7 +450,7 @@ contains
             ! A band with a jumping force at its edges (Karnopp's): the events and saltations of band_section.
             type(band_section) :: banded
             banded%band%frame = frame
-            call frame%base%law%band(banded%band%half_width, banded%band%limit)
+            call banded%band%set_limits()
             banded%band%sectioned = .not. machine_orbit_forced(c)
             banded%solver = c%solver
             banded%forced = machine_orbit_forced(c)
