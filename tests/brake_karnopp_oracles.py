@@ -37,15 +37,19 @@ TIGHT = {"brake.event_tolerance": 1e-12, "integrator.rtol": 1e-12, "integrator.a
 
 class KarnoppBrake:
     """Eq. 10 with Karnopp's force, its band taken exactly: outside, F = s g(|w|)
-    + σ2 w (w = v - v_dr, s its sign); a block that reaches an edge with |A| <=
-    F_s holds there (v' = 0, v the edge's); a hold ends where A reaches ±F_s,
-    out through that edge when the pull points that way, else the block
-    drifts into the band under v' = A ∓ F_s, which ends at an edge or where
-    |A| falls back to F_s (a hold inside).  Modes: ('out', s), ('hold', e) with
-    e the edge's sign (0 inside), ('drift', σ)."""
+    + σ2 w (w = v - v_dr, s its sign); a block that reaches an edge e with
+    -F_s <= eA <= F_h holds there (v' = 0, v the edge's); a hold ends where eA
+    reaches F_h, out through that edge, or -F_s, when the block drifts into
+    the band under v' = A ∓ F_s, which ends at an edge (held there if eA <
+    F_h, else out) or where |A| falls back to F_s (a hold inside).  F_h =
+    max(F_s, g(Δv) + σ2 Δv): a pull between F_s and the force just outside
+    keeps the block on the edge (Filippov's sliding mode).  Modes: ('out',
+    s), ('hold', e) with e the edge's sign (0 inside), ('drift', σ)."""
 
-    def __init__(self):
+    def __init__(self, sigma2=SIGMA2, dv=DV):
         self.tol = dict(rtol=1e-12, atol=1e-15)
+        self.sigma2, self.dv = sigma2, dv
+        self.hold_limit = max(FS, FC + (FS - FC) * np.exp(-abs(dv / VS) ** DELTA) + sigma2 * dv)
 
     @staticmethod
     def pull(z):
@@ -58,7 +62,7 @@ class KarnoppBrake:
             x, v, y, w = z
             if kind == "out":
                 u = v - V_DR
-                force = s * (FC + (FS - FC) * np.exp(-abs(u / VS) ** DELTA)) + SIGMA2 * u
+                force = s * (FC + (FS - FC) * np.exp(-abs(u / VS) ** DELTA)) + self.sigma2 * u
                 dv = self.pull(z) - force
             elif kind == "hold":
                 dv = 0.0
@@ -71,22 +75,25 @@ class KarnoppBrake:
         kind, s = mode
         if kind == "out":
             def enter(t, z):
-                return s * (z[1] - V_DR) - DV
+                return s * (z[1] - V_DR) - self.dv
             enter.terminal, enter.direction = True, -1
             return [enter]
         if kind == "hold":
+            up = self.hold_limit if s > 0 else FS
+            down = self.hold_limit if s < 0 else FS
+
             def upper(t, z):
-                return self.pull(z) - FS
+                return self.pull(z) - up
             def lower(t, z):
-                return self.pull(z) + FS
+                return self.pull(z) + down
             upper.terminal, upper.direction = True, 1
             lower.terminal, lower.direction = True, -1
             return [upper, lower]
 
         def top(t, z):
-            return z[1] - V_DR - DV
+            return z[1] - V_DR - self.dv
         def bottom(t, z):
-            return z[1] - V_DR + DV
+            return z[1] - V_DR + self.dv
         def back(t, z):
             return s * self.pull(z) - FS
         top.terminal, top.direction = True, 1
@@ -100,8 +107,8 @@ class KarnoppBrake:
         kind, s = mode
         a = self.pull(z)
         if kind == "out":
-            z[1] = V_DR + s * DV
-            if abs(a) <= FS:
+            z[1] = V_DR + s * self.dv
+            if -FS <= s * a <= self.hold_limit:
                 return ("hold", s), False
             assert np.sign(a) == -s, "the edge attracts from both sides"
             return ("drift", np.sign(a)), False
@@ -113,7 +120,9 @@ class KarnoppBrake:
         if which == 2:
             return ("hold", 0.0), False
         edge = 1.0 if which == 0 else -1.0
-        z[1] = V_DR + edge * DV
+        z[1] = V_DR + edge * self.dv
+        if edge * a < self.hold_limit:
+            return ("hold", edge), False
         return ("out", edge), False
 
     def run(self, t, z, mode, t_end, stop_at_section=False):
@@ -134,7 +143,7 @@ class KarnoppBrake:
     def section_map(self, sigma, point, t_max=400.0):
         """(y, w) where the hold at the edge -σ ends with 2x - y = σ F_s, to the next such end."""
         y, w = point
-        z = np.array([(y + sigma * FS) / 2, V_DR - sigma * DV, y, w])
+        z = np.array([(y + sigma * self.hold_limit) / 2, V_DR - sigma * self.dv, y, w])
         t, z, mode = self.run(0.0, z, ("out", -sigma), t_max, stop_at_section=True)
         assert t < t_max and np.sign(2 * z[0] - z[2]) == sigma, "no return to the section"
         return np.array([z[2], z[3]]), t

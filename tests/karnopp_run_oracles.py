@@ -228,10 +228,10 @@ def machine_slide(args):
         assert held.any() and np.all(np.abs(np.abs(got["v"][held] - 0.1) - p["dv"]) < 1e-15), got["v"][held]
 
 
-def brake_oracle(t_grid, z0):
-    """KarnoppBrake's flow (brake_karnopp_oracles.py) from z0 on the grid, with its events recorded as the
-    program records them (the machine's kinds), and the time it spends in the band."""
-    band = KarnoppBrake()
+def brake_oracle(t_grid, z0, band=None):
+    """KarnoppBrake's flow (brake_karnopp_oracles.py; `band`, else the input's) from z0 on the grid, with its
+    events recorded as the program records them (the machine's kinds), and the time it spends in the band."""
+    band = band or KarnoppBrake()
     n = len(t_grid)
     out = np.full((4, n), np.nan)
     out[:, 0] = z0
@@ -240,7 +240,7 @@ def brake_oracle(t_grid, z0):
     u = z[1] - V_DR
     # Inside the band with |A| <= F_s the block holds where it is (at rest on the belt to start), and
     # leaving the band after that is a slip onset, as after any hold.
-    if abs(u) >= DV:
+    if abs(u) >= band.dv:
         mode, held = ("out", np.sign(u)), False
     elif abs(band.pull(z)) <= FS:
         mode, held = ("hold", 0.0), True
@@ -279,6 +279,10 @@ def brake_oracle(t_grid, z0):
             if held:
                 events.append((t, STICK_TO_SLIP))
             held = False
+        elif new[1] != 0.0 and not held:
+            # Driven across the band onto an edge that holds it (the sliding mode): into a hold.
+            held = True
+            events.append((t, SLIP_TO_STICK))
         else:
             held = True
         mode = new
@@ -315,6 +319,46 @@ def brake(args):
     # stick_time: the time in the band, between the located edges (event_tolerance 1e-10 tau each).
     print(f"brake: stick_time {stick_time:.9f} tau, the oracle's time in the band {band_time:.9f} tau")
     assert abs(stick_time - band_time) < 1e-8, (stick_time, band_time)
+
+
+def brake_slide(args):
+    # inputs/brake_karnopp.nml with sigma2 = 0.1 (m per m/tau): the force just outside the band, g(dv) +
+    # sigma2 dv = F_s + 7.5e-6, exceeds F_s = 0.0105, so a hold at an edge goes on as the block slides along
+    # it until the pull reaches that force (each hold's end 7.5e-6 / |2x' - y'| ~ 1e-2 tau later than at F_s);
+    # 120 tau for three such ends.
+    band = KarnoppBrake(sigma2=0.1)
+    sets = dict(TIGHT_BRAKE, **{"brake.t_end": 120.0, "analysis.orbit": ".false.", "analysis.continuation": "''",
+                                "law.sigma2": 0.1})
+    with h5py.File(run_program(args, "brake_slide", ["brake_karnopp.nml"], sets)) as f:
+        tr = f["brake"]
+        t = tr["t"][()]
+        got = np.array([tr[k][()] for k in ("x", "v", "y", "w")])
+        ev = f["brake/events"]
+        events = list(zip(ev["t"][()], ev["kind"][()]))
+        states = np.array([ev[k][()] for k in ("x", "y")])
+        stick_time = f["brake"].attrs["stick_time"]
+    expected_traj, expected, band_time = brake_oracle(t, got[:, 0], band)
+    worst_t = compare_events("brake-slide", events, expected)
+    diff = np.max(np.abs(got - expected_traj), axis=1)
+    kinds = np.array([k for _, k in events])
+    # The ends of holds at an edge (after an entry into one; the first leaves the start's hold inside the
+    # band, the pull already past the limit when the block has drifted across to the edge).
+    ends = (kinds == STICK_TO_SLIP) & (np.roll(kinds, 1) == SLIP_TO_STICK)
+    ends[0] = False
+    pull_gap = np.max(np.abs(np.abs(2 * states[0, ends] - states[1, ends]) - band.hold_limit))
+    print(f"brake-slide: the hold's limit {band.hold_limit:.10f} against F_s {FS}; events within {worst_t:.2e} "
+          f"tau of the oracle's, |A| at the {ends.sum()} ends of holds within {pull_gap:.1e} of the limit; "
+          f"trajectory within {diff}; stick_time {stick_time:.9f} tau against {band_time:.9f}")
+    assert ends.sum() >= 3
+    # Both at rtol 1e-12 with events to 1e-12 tau: the pull's rate at a hold's end, ~1e-3 m/tau, turns a
+    # position error of ~1e-14 m into 1e-11 tau; the entries into a hold, where v reaches the edge at a small
+    # slope, are the least sharp (3.8e-10 tau measured).  1e-9 tau and 1e-11 m stay far below the sliding
+    # mode's own ~1e-2 tau.
+    assert worst_t < 1e-9, worst_t
+    assert np.all(diff < 1e-11), diff
+    # The located ends: 1e-12 tau at the pull's rate, and the positions' rounding.
+    assert pull_gap < 1e-13, pull_gap
+    assert abs(stick_time - band_time) < 1e-9, (stick_time, band_time)
 
 
 def brake_benettin(args):
@@ -466,6 +510,7 @@ def machine_chaos(args):
 
 def main():
     return case_main(__doc__, {"machine": machine, "machine-slide": machine_slide, "brake": brake,
+                               "brake-slide": brake_slide,
                                "brake-benettin": brake_benettin,
                                "stick-limit": stick_limit,
                                "machine-chaos": machine_chaos})
