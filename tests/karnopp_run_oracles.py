@@ -9,13 +9,18 @@ force reaches +-F_s):
                 event (into a hold, the end of a hold) in kind and time, the
                 trajectory on the output grid, and a hold sits exactly at the
                 edge's velocity (v' = 0 there, not a creep)
+  machine-slide bands whose force just outside exceeds F_s (the sliding mode:
+                the holds end where the pull reaches that force), a wide and
+                a narrow one: the events, the pull at the holds' ends, x, v
   brake         inputs/brake_karnopp.nml's brake (60 tau): the same for the
                 brake's run, /brake/events, the trajectory and stick_time
+  brake-slide   the brake with sigma2 = 0.1 (the sliding mode): the same
   brake-benettin  Benettin's two runs on the brake against the same two runs
                 of the oracle's flow
   stick-limit   the belt oscillator as dv -> 0 against the Stribeck law through
                 exact stick (another code path: machine/run.f90's switching):
-                the slip onsets converge to exact stick's, in proportion to dv
+                the slip onsets converge to exact stick's, in proportion to dv,
+                without a viscous term and with one (the sliding mode's bands)
   machine-chaos the Poincare section of slip onsets of the belt oscillator (the
                 holds' ends the oracle finds), Benettin's exponent against
                 the same two-run procedure on the oracle's flow, and the
