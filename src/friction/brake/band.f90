@@ -135,7 +135,8 @@ contains
       real(wp), intent(in) :: y(:)
 
       sliding = .false.
-      if (self%held_at /= 0.0_wp) sliding = sliding_at_edge(self%held_at, &
+      ! (A band without a sliding mode keeps the law's field: the steps past a hold's end at F_s, as before.)
+      if (self%held_at /= 0.0_wp .and. self%hold_limit > self%limit) sliding = sliding_at_edge(self%held_at, &
          & -(2.0_wp * y(1) - y(3)) * self%flow%units%force, self%limit)
    end function sliding
 

@@ -186,7 +186,8 @@ contains
       real(wp), intent(in) :: t, y(:)
 
       sliding = .false.
-      if (self%held_at == 0.0_wp) return
+      ! (A band without a sliding mode keeps the law's field: the steps past a hold's end at F_s, as before.)
+      if (self%held_at == 0.0_wp .or. .not. self%hold_limit > self%limit) return
       associate (m => self%frame%base%m)
          sliding = sliding_at_edge(self%held_at, m%applied(t, y(1) + m%load * t, y(2)), self%limit)
       end associate

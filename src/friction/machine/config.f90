@@ -186,16 +186,14 @@ contains
       end associate
    end subroutine check_sections
 
-   !> &analysis orbit (and continuation): a band law whose edge holds the
-   !> block (any number of states: the section's multipliers beyond 3 x 3 are
-   !> LAPACK's); the line's end a valid machine of the same kind (forced or not).
+   !> &analysis orbit (and continuation): any law, with any number of states
+   !> (the section's multipliers beyond 3 x 3 are LAPACK's); the line's end a
+   !> valid machine of the same kind (forced or not).
    subroutine check_orbit(self, c)
       type(machine_config), intent(in) :: self
       type(config_checker), intent(inout) :: c
-      class(sliding_law), allocatable :: law
       logical :: forced
 
-      call new_law(self%law, law)
       forced = self%support_amplitude > 0.0_wp .and. self%support_frequency > 0.0_wp
       if (len_trim(self%analysis%continuation) == 0) return
       if (.not. any(orbit_variables == self%analysis%continuation)) then
