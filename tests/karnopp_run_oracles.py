@@ -357,7 +357,7 @@ def brake_slide(args):
     assert ends.sum() >= 3
     # Both at rtol 1e-12 with events to 1e-12 tau: the pull's rate at a hold's end, ~1e-3 m/tau, turns a
     # position error of ~1e-14 m into 1e-11 tau; the entries into a hold, where v reaches the edge at a small
-    # slope, are the least sharp (3.8e-10 tau measured).  1e-9 tau and 1e-11 m stay far below the sliding
+    # slope, are the least sharp (4.0e-10 tau measured).  1e-9 tau and 1e-11 m stay far below the sliding
     # mode's own ~1e-2 tau.
     assert worst_t < 1e-9, worst_t
     assert np.all(diff < 1e-11), diff
