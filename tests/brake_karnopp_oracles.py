@@ -290,8 +290,8 @@ def stick_limit(args):
 
 
 def refusals(args):
-    # A multistep stepper on the band: msadams crawled on inputs/brake_karnopp.nml (5.7 million steps in a minute
-    # against rk8pd's 9769 for the whole run).
+    # A multistep stepper on the band: with the edges located, msadams on inputs/brake_karnopp.nml at rtol 1e-6
+    # takes 58 times rk8pd's steps and misses the events by 6e-2 tau (docs/speed.md).
     held = "&law\n  model = 'karnopp'\n  fc = 0.0095\n  fs = 0.0105\n  vs = 2e-3\n  dv = 1e-4\n/\n"
     cases = [(f"&brake\n  model = 'law'\n/\n{held}&integrator\n  method = 'msadams'\n/\n", 16,
               "&integrator: method", "a multistep stepper on &law model = 'karnopp'")]

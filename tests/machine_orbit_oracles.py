@@ -961,7 +961,7 @@ def refusals(args):
         ("&machine\n  support_amplitude = 0.01\n  support_frequency = 0.2\n/\n&law\n  model = 'lugre'\n/\n"
          "&analysis\n  orbit = .true.\n  continuation = 'support_amplitude'\n  continuation_end = 0.0\n/\n", 15,
          "&analysis: continuation_end = ", "keep the support moving"),
-        # Both crawled for minutes on this orbit (the plain run alone ~200 times a one-step method's steps).
+        # Both crawl into each hold: ~200 times rk8pd's steps at rtol 1e-6, its events 1e-2 s off (docs/speed.md).
         ("&law\n  model = 'karnopp'\n/\n&analysis\n  orbit = .true.\n/\n&integrator\n  method = 'msadams'\n"
          "  rtol = 1e-6\n/\n", 12, "&integrator: method = ", "a multistep stepper on &law model = 'karnopp'"),
         ("&law\n  model = 'karnopp'\n/\n&integrator\n  method = 'msbdf'\n/\n", 9,
