@@ -41,6 +41,7 @@ module friction_machine_band
    use friction_law, only: sliding_law, max_law_states, band_edge_velocity, band_hold_limit, sliding_at_edge
    use friction_machine_config, only: machine_config
    use friction_machine_model, only: mechanics, machine_smooth
+   use friction_machine_piecewise, only: piecewise_run
    implicit none
    private
 
@@ -92,7 +93,7 @@ module friction_machine_band
 
    !> A run through the band's switches (module comment), with Φ beside the
    !> state when `tangent`.  Declare it `target`: its locator points at its frame.
-   type :: machine_band
+   type, extends(piecewise_run) :: machine_band
       type(band_frame), allocatable :: band
       type(tangent_system), allocatable :: extended   !! the band's frame with its tangent (when tangent)
       type(event_locator) :: locator
@@ -100,18 +101,17 @@ module friction_machine_band
       !> In a hold at an edge Φ is set to 0: without a moving support what is left is a shift in time
       !> (an autonomous section map's choice).
       logical :: project_in_hold = .false.
-      real(wp) :: t = 0.0_wp
-      real(wp), allocatable :: y(:), phi(:, :)
       real(wp) :: hold_edge = 0.0_wp   !! the sign of the edge the block holds at (0: none)
       logical :: held = .false.        !! held in the band since it was entered: leaving it is a slip onset
-      integer :: lost = 0              !! directions a hold mapped to 0 since the last reset
       real(wp) :: band_time = 0.0_wp   !! s inside the band since the start
    contains
       procedure :: start => band_start
+      procedure :: start_from => band_start_from
       procedure :: advance => band_advance
       procedure :: advance_to => band_advance_to
       procedure :: reset => band_reset
       procedure :: inside => band_inside
+      procedure :: is_held => band_inside
       procedure :: statistics => band_statistics
    end type machine_band
 
@@ -334,12 +334,35 @@ contains
       call restart(self, h)
    end subroutine band_start
 
-   !> Φ from here on (the spectrum's renormalisation); the lost count cleared.
-   subroutine band_reset(self, phi)
-      class(machine_band), intent(inout) :: self
-      real(wp), intent(in) :: phi(:, :)
+   !> Start at t0 from y0, else from the settings' initial state (band_start_state), in the band's frame of
+   !> checked settings c and their band law, with their solver and a first step of h_start, else 1e-6 dt_out.
+   subroutine band_start_from(self, c, law, t0, tangent, error, y0)
+      class(machine_band), target, intent(inout) :: self
+      type(machine_config), intent(in) :: c
+      class(sliding_law), intent(in) :: law
+      real(wp), intent(in) :: t0
+      logical, intent(in) :: tangent
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), intent(in), optional :: y0(:)
+      type(band_frame) :: band
+      real(wp) :: h
 
-      self%phi = phi
+      call band_frame_of(c, law, band)
+      h = c%solver%h_start
+      if (.not. (h > 0.0_wp)) h = 1.0e-6_wp * c%dt_out
+      if (present(y0)) then
+         call self%start(band, c%solver, c%event_tolerance, h, t0, y0, tangent, error)
+      else
+         call self%start(band, c%solver, c%event_tolerance, h, t0, band_start_state(c, band), tangent, error)
+      end if
+   end subroutine band_start_from
+
+   !> Φ from here on (the spectrum's renormalisation); the lost count cleared.
+   subroutine band_reset(self, q)
+      class(machine_band), intent(inout) :: self
+      real(wp), intent(in) :: q(:, :)
+
+      self%phi = q
       self%lost = 0
       call restart(self, 0.0_wp)
    end subroutine band_reset

@@ -18,8 +18,8 @@ module friction_machine_diagnostics
    use friction_machine_model, only: machine_smooth
    use friction_machine_run, only: machine_run, machine_watch
    use friction_machine_section, only: machine_poincare, machine_sections
-   use friction_machine_lyapunov, only: machine_spectrum, machine_lyapunov_spectrum, smooth_start, switched_benettin, &
-      & band_benettin
+   use friction_machine_lyapunov, only: machine_spectrum, machine_lyapunov_spectrum, smooth_start, piecewise_benettin, &
+      & has_band
    use friction_analysis_periodic_orbit, only: orbit_settings
    use friction_machine_orbit, only: machine_orbit, machine_branch, machine_periodic_orbit, follow_machine_branch
    implicit none
@@ -127,36 +127,19 @@ contains
          if (b%duration == 0.0_wp) b%duration = c%t_end - c%t_start - b%transient
          b%renormalise = c%analysis%lyapunov_renormalise
          b%d0 = c%analysis%lyapunov_d0
-         if (law%set_valued()) then
-            ! Two runs through exact stick and slip (lyapunov.f90).
+         if (law%set_valued() .or. has_band(law)) then
+            ! Two runs through exact stick and slip, or through the band's switches (lyapunov.f90).
             if (present(watch)) then
-               call switched_benettin(c, law, b, d%flow, error, watch)
+               call piecewise_benettin(c, law, b, d%flow, error, watch)
             else
                block
                   class(step_watch), allocatable :: own
                   allocate (own, source=machine_watch(c, "&analysis: the Lyapunov exponent (Benettin)"))
-                  call switched_benettin(c, law, b, d%flow, error, own)
+                  call piecewise_benettin(c, law, b, d%flow, error, own)
                end block
             end if
             return
          end if
-         block
-            real(wp) :: width, limit
-            call law%band(width, limit)
-            if (width > 0.0_wp) then
-               ! Two runs through the band's switches (band.f90).
-               if (present(watch)) then
-                  call band_benettin(c, law, b, d%flow, error, watch)
-               else
-                  block
-                     class(step_watch), allocatable :: own
-                     allocate (own, source=machine_watch(c, "&analysis: the Lyapunov exponent (Benettin)"))
-                     call band_benettin(c, law, b, d%flow, error, own)
-                  end block
-               end if
-               return
-            end if
-         end block
          call smooth_start(c, law, system, y)
          if (present(watch)) then
             call benettin_exponent(system, c%solver, y, c%t_start, b, d%flow, error, watch)

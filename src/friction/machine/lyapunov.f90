@@ -38,12 +38,13 @@ module friction_machine_lyapunov
    use friction_machine_config, only: machine_config
    use friction_machine_model, only: machine_smooth
    use friction_machine_switching, only: machine_switching
-   use friction_machine_band, only: band_frame, machine_band, band_frame_of, band_start_state
+   use friction_machine_band, only: machine_band
+   use friction_machine_piecewise, only: piecewise_run
    implicit none
    private
 
-   public :: machine_spectrum, machine_lyapunov_spectrum, smooth_start, write_machine_spectrum, switched_benettin, &
-      & band_benettin
+   public :: machine_spectrum, machine_lyapunov_spectrum, smooth_start, write_machine_spectrum, piecewise_benettin, &
+      & has_band
 
    !> The spectrum and what it was computed over.
    type :: machine_spectrum
@@ -322,19 +323,8 @@ contains
       end associate
       call make_law(law_with_files(c%law), law, error)
       if (allocated(error)) return
-      block
-         real(wp) :: width, limit
-         call law%band(width, limit)
-         if (width > 0.0_wp .and. .not. law%set_valued()) then
-            call band_spectrum(c, law, result%settings, result%qr, error, watch)
-            if (allocated(error)) return
-            result%exponents = result%qr%exponents()
-            result%kaplan_yorke = kaplan_yorke(result%exponents)
-            return
-         end if
-      end block
-      if (law%set_valued()) then
-         call switched_spectrum(c, law, result%settings, result%qr, error, watch)
+      if (law%set_valued() .or. has_band(law)) then
+         call piecewise_spectrum(c, law, result%settings, result%qr, error, watch)
       else
          result%has_divergence = .true.
          call smooth_spectrum(c, law, result%settings, result%qr, result%divergence, error, watch)
@@ -489,102 +479,23 @@ contains
 
    end subroutine smooth_spectrum
 
-   !> A set-valued law's spectrum: the switching run with Φ; the transient in
-   !> renormalisation intervals too, so that Φ stays bounded.
-   subroutine switched_spectrum(c, law, s, qr, error, watch)
+   !> A set-valued law's or a band law's spectrum: its run through switches
+   !> with Φ (saltations at the switches, δv forgotten in stick or a hold); the
+   !> transient in renormalisation intervals too, so that Φ stays bounded.
+   subroutine piecewise_spectrum(c, law, s, qr, error, watch)
       type(machine_config), intent(in) :: c
       class(sliding_law), intent(in) :: law
       type(tangent_settings), intent(in) :: s
       type(spectrum_accumulator), intent(out) :: qr
       type(error_type), allocatable, intent(out) :: error
       class(step_watch), intent(inout) :: watch
-      type(machine_switching), target :: run
-      real(wp) :: t0, phi(2, 2)
-      integer :: k, intervals
-
-      call run%start(c, law, c%t_start, [c%x0, c%v0], .true., error)
-      if (allocated(error)) return
-      t0 = c%t_start + s%transient
-      do while (run%t < t0)
-         call run%advance_to(min(run%t + s%renormalise, t0), error, watch)
-         if (allocated(error)) return
-         call run%reset(generic_frame(2))
-         call watch%check(run%t, error)
-         if (allocated(error)) return
-      end do
-      intervals = int(s%duration / s%renormalise + 1.0e-9_wp)
-      call qr%start(2, intervals)
-      do k = 1, intervals
-         call run%advance_to(t0 + k * s%renormalise, error, watch)
-         if (allocated(error)) return
-         phi = run%phi
-         call qr%renormalise(phi, s%renormalise, run%lost)
-         call run%reset(phi)
-         call watch%check(run%t, error)
-         if (allocated(error)) return
-      end do
-   end subroutine switched_spectrum
-
-   !> Benettin's exponent of a set-valued law (as the brake's switched model
-   !> does it): a reference and a perturbed switching run in lockstep; after
-   !> each interval the perturbed one restarts from the reference plus the
-   !> separation scaled back to d0.  In stick the first perturbation is on x
-   !> alone, so that both runs start in the same phase.
-   subroutine switched_benettin(c, law, b, result, error, watch)
-      type(machine_config), intent(in) :: c
-      class(sliding_law), intent(in) :: law
-      type(benettin_settings), intent(in) :: b
-      type(benettin_accumulator), intent(out) :: result
-      type(error_type), allocatable, intent(out) :: error
-      class(step_watch), intent(inout) :: watch
-      type(machine_switching), target :: reference, perturbed
-      real(wp) :: direction(2), t, separated(2)
-      integer :: k, intervals
-
-      if (.not. benettin_valid(b, error)) return
-      call reference%start(c, law, c%t_start, [c%x0, c%v0], .false., error)
-      if (allocated(error)) return
-      t = c%t_start + b%transient
-      call reference%advance_to(t, error, watch)
-      if (allocated(error)) return
-      direction = [1.0_wp, 1.0_wp]
-      if (reference%in_stick) direction = [1.0_wp, 0.0_wp]
-      separated = reference%y + b%d0 * direction / norm2(direction)
-      intervals = int(b%duration / b%renormalise + 1.0e-9_wp)
-      call result%start(b%d0, intervals)
-      do k = 1, intervals
-         call perturbed%start(c, law, t, separated, .false., error)
-         if (allocated(error)) return
-         t = c%t_start + b%transient + k * b%renormalise
-         call reference%advance_to(t, error, watch)
-         if (allocated(error)) return
-         call perturbed%advance_to(t, error, watch)
-         if (allocated(error)) return
-         separated = perturbed%y
-         call result%renormalise(reference%y, separated, b%renormalise)
-         call watch%check(t, error)
-         if (allocated(error)) return
-      end do
-   end subroutine switched_benettin
-
-   !> A band law's spectrum: the band's run with Φ (saltations at its jumps,
-   !> δv forgotten in a hold); the transient in renormalisation intervals too.
-   subroutine band_spectrum(c, law, s, qr, error, watch)
-      type(machine_config), intent(in) :: c
-      class(sliding_law), intent(in) :: law
-      type(tangent_settings), intent(in) :: s
-      type(spectrum_accumulator), intent(out) :: qr
-      type(error_type), allocatable, intent(out) :: error
-      class(step_watch), intent(inout) :: watch
-      type(band_frame) :: band
-      type(machine_band), target :: run
+      class(piecewise_run), allocatable, target :: run
       real(wp), allocatable :: phi(:, :)
       real(wp) :: t0
       integer :: k, intervals, n
 
-      call band_frame_of(c, law, band)
-      call run%start(band, c%solver, c%event_tolerance, first_step(c), c%t_start, band_start_state(c, band), &
-         & .true., error)
+      call allocate_run(law, run)
+      call run%start_from(c, law, c%t_start, .true., error)
       if (allocated(error)) return
       n = size(run%y)
       t0 = c%t_start + s%transient
@@ -606,39 +517,41 @@ contains
          call watch%check(run%t, error)
          if (allocated(error)) return
       end do
-   end subroutine band_spectrum
+   end subroutine piecewise_spectrum
 
-   !> Benettin's exponent of a band law: a reference and a perturbed band run
-   !> in lockstep, as switched_benettin's; in the band the first perturbation
-   !> is on x alone, so that both runs start in the same hold.
-   subroutine band_benettin(c, law, b, result, error, watch)
+   !> Benettin's exponent of a set-valued law or a band law (as the brake's
+   !> switched model does it): a reference and a perturbed run through the
+   !> law's switches in lockstep; after each interval the perturbed one
+   !> restarts from the reference plus the separation scaled back to d0.
+   !> Held (in stick, or in the band) the first perturbation is off v, so
+   !> that both runs start in the same phase.
+   subroutine piecewise_benettin(c, law, b, result, error, watch)
       type(machine_config), intent(in) :: c
       class(sliding_law), intent(in) :: law
       type(benettin_settings), intent(in) :: b
       type(benettin_accumulator), intent(out) :: result
       type(error_type), allocatable, intent(out) :: error
       class(step_watch), intent(inout) :: watch
-      type(band_frame) :: band
-      type(machine_band), target :: reference, perturbed
+      class(piecewise_run), allocatable, target :: reference, perturbed
       real(wp), allocatable :: direction(:), separated(:)
       real(wp) :: t
       integer :: k, intervals
 
       if (.not. benettin_valid(b, error)) return
-      call band_frame_of(c, law, band)
-      call reference%start(band, c%solver, c%event_tolerance, first_step(c), c%t_start, band_start_state(c, band), &
-         & .false., error)
+      call allocate_run(law, reference)
+      call allocate_run(law, perturbed)
+      call reference%start_from(c, law, c%t_start, .false., error)
       if (allocated(error)) return
       t = c%t_start + b%transient
       call reference%advance_to(t, error, watch)
       if (allocated(error)) return
       allocate (direction(size(reference%y)), source=1.0_wp)
-      if (reference%inside()) direction(2) = 0.0_wp
+      if (reference%is_held()) direction(2) = 0.0_wp
       separated = reference%y + b%d0 * direction / norm2(direction)
       intervals = int(b%duration / b%renormalise + 1.0e-9_wp)
       call result%start(b%d0, intervals)
       do k = 1, intervals
-         call perturbed%start(band, c%solver, c%event_tolerance, first_step(c), t, separated, .false., error)
+         call perturbed%start_from(c, law, t, .false., error, separated)
          if (allocated(error)) return
          t = c%t_start + b%transient + k * b%renormalise
          call reference%advance_to(t, error, watch)
@@ -650,7 +563,28 @@ contains
          call watch%check(t, error)
          if (allocated(error)) return
       end do
-   end subroutine band_benettin
+   end subroutine piecewise_benettin
+
+   !> A run of the law's kind: exact stick and slip for a set-valued law, else the band's.
+   subroutine allocate_run(law, run)
+      class(sliding_law), intent(in) :: law
+      class(piecewise_run), allocatable, intent(out) :: run
+
+      if (law%set_valued()) then
+         allocate (machine_switching :: run)
+      else
+         allocate (machine_band :: run)
+      end if
+   end subroutine allocate_run
+
+   !> Whether the law has a zero-velocity band (Karnopp's).
+   logical function has_band(law)
+      class(sliding_law), intent(in) :: law
+      real(wp) :: width, limit
+
+      call law%band(width, limit)
+      has_band = width > 0.0_wp
+   end function has_band
 
    !> Whether Benettin's settings make sense, else the error.
    logical function benettin_valid(b, error)
@@ -662,14 +596,6 @@ contains
       if (.not. benettin_valid) call fatal_error(error, '&analysis: Benettin needs lyapunov_renormalise > 0, ' &
          & //'a duration of at least one interval after lyapunov_transient, lyapunov_d0 > 0', error_input)
    end function benettin_valid
-
-   !> The first step of the settings (h_start, else 1e-6 dt_out, as the run's).
-   pure real(wp) function first_step(c)
-      type(machine_config), intent(in) :: c
-
-      first_step = c%solver%h_start
-      if (.not. (first_step > 0.0_wp)) first_step = 1.0e-6_wp * c%dt_out
-   end function first_step
 
    !> /machine/lyapunov's spectrum (docs/output.md); the group exists.
    subroutine write_machine_spectrum(file, group, d)

@@ -15,6 +15,7 @@ module friction_machine_switching
    use friction_law, only: sliding_law
    use friction_machine_config, only: machine_config
    use friction_machine_model, only: mechanics, machine_slip, machine_stick
+   use friction_machine_piecewise, only: piecewise_run
    implicit none
    private
 
@@ -23,7 +24,7 @@ module friction_machine_switching
    !> A set-valued law's run with exact stick and slip, as run.f90's, with
    !> the tangent Φ beside the state when asked (the spectrum), or without
    !> it (Benettin's two runs).
-   type :: machine_switching
+   type, extends(piecewise_run) :: machine_switching
       type(mechanics) :: m
       real(wp) :: limit = 0.0_wp, h = 0.0_wp, direction = 1.0_wp
       type(machine_slip) :: slip                    !! the slip alone
@@ -31,8 +32,6 @@ module friction_machine_switching
       type(machine_stick) :: stick
       type(event_locator) :: slipping, sticking
       logical :: tangent = .false., in_stick = .false.
-      real(wp) :: t = 0.0_wp, y(2) = 0.0_wp, phi(2, 2) = 0.0_wp
-      integer :: lost = 0                           !! directions stick mapped to 0 since the last reset
       !> In stick Φ is projected along the flow in the load point's frame (an autonomous section map's choice).
       logical :: project_in_stick = .false.
       logical :: at_section = .false.               !! the last advance stopped where v rose through the section
@@ -40,8 +39,10 @@ module friction_machine_switching
       real(wp) :: stick_time = 0.0_wp               !! s in stick since the start
    contains
       procedure :: start => switching_start
+      procedure :: start_from => switching_start_from
       procedure :: advance_to => switching_advance
       procedure :: reset => switching_reset
+      procedure :: is_held => switching_held
       procedure :: slip_field => switching_slip_field
       procedure, private :: pin => switching_pin
       procedure, private :: set_direction => switching_set_direction
@@ -138,6 +139,29 @@ contains
          call self%restart_slip()
       end if
    end subroutine switching_start
+
+   !> Start at t0 from y0, else from the settings' (x0, v0).
+   subroutine switching_start_from(self, c, law, t0, tangent, error, y0)
+      class(machine_switching), target, intent(inout) :: self
+      type(machine_config), intent(in) :: c
+      class(sliding_law), intent(in) :: law
+      real(wp), intent(in) :: t0
+      logical, intent(in) :: tangent
+      type(error_type), allocatable, intent(out) :: error
+      real(wp), intent(in), optional :: y0(:)
+
+      if (present(y0)) then
+         call self%start(c, law, t0, y0, tangent, error)
+      else
+         call self%start(c, law, t0, [c%x0, c%v0], tangent, error)
+      end if
+   end subroutine switching_start_from
+
+   logical function switching_held(self)
+      class(machine_switching), intent(in) :: self
+
+      switching_held = self%in_stick
+   end function switching_held
 
    !> Through any number of stick and slip phases to t_target.  In slip Φ
    !> follows the slip's variational equations; in stick v is the belt's, so
@@ -283,7 +307,7 @@ contains
    !> Φ replaced (a QR step): the steppers' copies are stale.
    subroutine switching_reset(self, q)
       class(machine_switching), intent(inout) :: self
-      real(wp), intent(in) :: q(2, 2)
+      real(wp), intent(in) :: q(:, :)
 
       self%phi = q
       self%lost = 0
