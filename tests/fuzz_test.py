@@ -1002,7 +1002,8 @@ def laws(contract, p):
             result = contract.run(directory, ["-o", "out.h5", "run.nml"], output="out.h5", allowed={0, 3, 4},
                                   timeout=90)
             if result.returncode == 3:
-                # A value the file leaves at its default is refused as "(default): &group: ..." (docs/cli.md).
+                # A value the file leaves at its default is refused as "(default): &group: ...", or at the line of
+                # the variable it conflicts with when the file set that one (docs/input.md).
                 refused_naming(result, ("run.nml:", "(default): &"))
         return
     scene = p.get("scene", "machine")

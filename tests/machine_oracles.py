@@ -187,6 +187,18 @@ def bad_input(args):
          11, "&analysis: window_end = ", "leaves 6 output points"),
         ("&machine\n  t_end = 10.0\n/\n&analysis\n  poincare = .true.\n  section = 'w_zero_up'\n  window_start = 2.0\n"
          "  window_end = 2.1\n/\n", 12, "&analysis: window_end = ", "the spectrum of the strobe period needs 16"),
+        # A default refused against a value the file set leads with the set value's line (it named only
+        # "(default)", where the file has nothing to change): t_end = 50 ends the run before the default
+        # window_start = 100 and before the default Lyapunov transient of 100.
+        ("&machine\n  t_end = 50.0\n/\n&analysis\n  spectrum = .true.\n/\n", 6,
+         "&machine: t_end, with the default &analysis: window_start = 100.000: ", "leaves 0 output points"),
+        ("&machine\n  t_end = 50.0\n/\n&analysis\n  lyapunov = .true.\n/\n", 6,
+         "&machine: t_end, with the default &analysis: lyapunov_transient = 100.000: ",
+         "leaves less than one renormalisation interval before t_end"),
+        # Only the switch set: its line is where the check began.
+        ("&analysis\n  lyapunov = .true.\n  lyapunov_renormalise = 200.0\n/\n", 7,
+         "&analysis: lyapunov_renormalise, with the default &analysis: lyapunov_transient = ",
+         "leaves less than one renormalisation interval"),
     ]
     check_refusals(args, cases, "bad-input")
     # --netlist: the machine has no circuit form, refused naming where &job scene = 'machine' was set.

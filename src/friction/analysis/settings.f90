@@ -145,8 +145,10 @@ contains
    !> be analysed.
    !> `strobe_known`: the scene has the strobe period without the spectrum
    !> (the machine's moving support); `series_points`: the fewest output
-   !> points in the window the spectrum and Rosenstein's series take (16).
-   subroutine validate(self, c, t_start, t_end, series, dt, strobe_known, series_points)
+   !> points in the window the spectrum and Rosenstein's series take (16);
+   !> `run_group`: the group of t_start, t_end and dt_out, so that a default
+   !> refused against them names the line that set them.
+   subroutine validate(self, c, t_start, t_end, series, dt, strobe_known, series_points, run_group)
       class(analysis_settings), intent(in) :: self
       type(config_checker), intent(inout) :: c
       real(wp), intent(in) :: t_start, t_end
@@ -154,11 +156,17 @@ contains
       real(wp), intent(in), optional :: dt
       logical, intent(in), optional :: strobe_known
       integer, intent(in), optional :: series_points
+      character(len=*), intent(in), optional :: run_group
+      character(len=64) :: run(3)
       real(wp) :: samples
       integer :: need, points
       logical :: strobe_given
       character(len=:), allocatable :: what
 
+      ! (Without a group the names start with '.', which the checker skips.)
+      run = ''
+      if (present(run_group)) run = [character(len=64) :: run_group//'.t_end', run_group//'.t_start', &
+         & run_group//'.dt_out']
       if (.not. any(series == self%series)) call c%reject('analysis', 'series', "'"//trim(self%series)//"'", &
          & 'unknown variable (known: '//quoted(series)//')')
       if (self%window /= 'hann' .and. self%window /= 'none') call c%reject('analysis', 'window', &
@@ -167,7 +175,8 @@ contains
          & "'"//trim(self%section)//"'", 'unknown section (known: '//quoted(section_names)//')')
       call c%finite('analysis', 'window_start', self%window_start)
       if (.not. (self%window_end > self%window_start)) call c%reject('analysis', 'window_end', &
-         & rtoa(self%window_end), 'must be after window_start = '//rtoa(self%window_start))
+         & rtoa(self%window_end), 'must be after window_start = '//rtoa(self%window_start), &
+         & against=['analysis.window_start'])
       if (self%welch_segments < 1) call c%reject('analysis', 'welch_segments', itoa(self%welch_segments), &
          & 'must be >= 1')
       ! K half-overlapping segments of the window's samples: each needs 8 (the
@@ -180,7 +189,8 @@ contains
          if (samples > 0.0_wp .and. 2.0_wp * samples / (self%welch_segments + 1.0_wp) < 8.0_wp) &
             & call c%reject('analysis', 'welch_segments', itoa(self%welch_segments), 'leaves fewer than 8 ' &
             & //'samples a segment of the window [window_start, window_end] ('//itoa(int(samples)) &
-            & //' samples); at most '//itoa(max(1, int(samples) / 4 - 1)))
+            & //' samples); at most '//itoa(max(1, int(samples) / 4 - 1)), &
+            & against=[character(len=64) :: run, 'analysis.window_start', 'analysis.window_end'])
       end if
       ! The window's output points, which the diagnostics counted only after the
       ! whole run, with a message that named no file (a run shorter than window_start).
@@ -194,9 +204,11 @@ contains
             what = 'the spectrum or Rosenstein''s series'
             if (.not. (self%spectrum .or. self%rosenstein)) what = 'the spectrum of the strobe period'
             if (self%window_end < t_end) then
-               call c%reject('analysis', 'window_end', rtoa(self%window_end), window_text())
+               call c%reject('analysis', 'window_end', rtoa(self%window_end), window_text(), &
+                  & against=[character(len=64) :: run, 'analysis.window_start'])
             else
-               call c%reject('analysis', 'window_start', rtoa(self%window_start), window_text())
+               call c%reject('analysis', 'window_start', rtoa(self%window_start), window_text(), &
+                  & against=[character(len=64) :: run, 'analysis.window_end'])
             end if
          end if
       end if
@@ -215,7 +227,8 @@ contains
       if (self%lyapunov .and. self%lyapunov_duration == 0.0_wp .and. &
          & .not. (t_end - t_start - self%lyapunov_transient >= self%lyapunov_renormalise)) &
          & call c%reject('analysis', 'lyapunov_transient', rtoa(self%lyapunov_transient), &
-         & 'leaves less than one renormalisation interval before t_end')
+         & 'leaves less than one renormalisation interval before t_end', &
+         & against=[character(len=64) :: run, 'analysis.lyapunov_renormalise', 'analysis.lyapunov'])
       call c%nonnegative('analysis', 'lyapunov_spectrum_transient', self%lyapunov_spectrum_transient, 'τ')
       call c%nonnegative('analysis', 'lyapunov_spectrum_duration', self%lyapunov_spectrum_duration, &
          & 'τ; 0 for the rest of the run')
@@ -223,20 +236,21 @@ contains
       if (self%lyapunov_spectrum .and. self%lyapunov_spectrum_duration == 0.0_wp .and. &
          & .not. (t_end - t_start - self%lyapunov_spectrum_transient >= self%lyapunov_spectrum_renormalise)) &
          & call c%reject('analysis', 'lyapunov_spectrum_transient', rtoa(self%lyapunov_spectrum_transient), &
-         & 'leaves less than one renormalisation interval before t_end')
+         & 'leaves less than one renormalisation interval before t_end', against=[character(len=64) :: run, &
+         & 'analysis.lyapunov_spectrum_renormalise', 'analysis.lyapunov_spectrum'])
       if (self%lyapunov_spectrum .and. self%lyapunov_spectrum_duration > 0.0_wp .and. &
          & self%lyapunov_spectrum_duration < self%lyapunov_spectrum_renormalise) &
          & call c%reject('analysis', 'lyapunov_spectrum_duration', rtoa(self%lyapunov_spectrum_duration), &
          & 'shorter than one renormalisation interval, lyapunov_spectrum_renormalise = ' &
-         & //rtoa(self%lyapunov_spectrum_renormalise))
+         & //rtoa(self%lyapunov_spectrum_renormalise), against=['analysis.lyapunov_spectrum_renormalise'])
       ! Each renormalisation is an integration of its own: a tiny interval
       ! makes the loop endless in practice (1e-300 ran for hours, 1e-13 too).
       if (self%lyapunov) call check_intervals('lyapunov_renormalise', self%lyapunov_renormalise, &
-         & self%lyapunov_duration, self%lyapunov_transient, .false.)
+         & self%lyapunov_duration, self%lyapunov_transient, .false., 'lyapunov')
       ! (The spectrum's transient is integrated in renormalisation intervals too.)
       if (self%lyapunov_spectrum) call check_intervals('lyapunov_spectrum_renormalise', &
          & self%lyapunov_spectrum_renormalise, self%lyapunov_spectrum_duration, self%lyapunov_spectrum_transient, &
-         & .true.)
+         & .true., 'lyapunov_spectrum')
       call c%nonnegative('analysis', 'orbit_transient', self%orbit_transient, 'τ')
       call c%positive('analysis', 'orbit_tolerance', self%orbit_tolerance, 'm and m per unit time')
       if (self%orbit_max_iterations < 1) call c%reject('analysis', 'orbit_max_iterations', &
@@ -270,14 +284,15 @@ contains
          & itoa(self%rosenstein_fit_start), 'must be >= 0 (samples)')
       if (self%rosenstein_fit_end <= self%rosenstein_fit_start .or. &
          & self%rosenstein_fit_end > self%rosenstein_horizon) call c%reject('analysis', 'rosenstein_fit_end', &
-         & itoa(self%rosenstein_fit_end), 'must be in (rosenstein_fit_start, rosenstein_horizon]')
+         & itoa(self%rosenstein_fit_end), 'must be in (rosenstein_fit_start, rosenstein_horizon]', &
+         & against=[character(len=64) :: 'analysis.rosenstein_fit_start', 'analysis.rosenstein_horizon'])
    contains
 
       !> The renormalisation interval `name` over its span (duration, or the
       !> run after the transient; the transient too when `stepped`) gives at
       !> most max_renormalisations intervals.
-      subroutine check_intervals(name, interval, duration, transient, stepped)
-         character(len=*), intent(in) :: name
+      subroutine check_intervals(name, interval, duration, transient, stepped, tool)
+         character(len=*), intent(in) :: name, tool
          real(wp), intent(in) :: interval, duration, transient
          logical, intent(in) :: stepped
          real(wp) :: span
@@ -288,7 +303,9 @@ contains
          if (stepped) span = span + transient
          if (.not. (span / interval <= max_renormalisations)) call c%reject('analysis', name, rtoa(interval), &
             & 'gives '//rtoa(span / interval)//' renormalisation intervals over '//rtoa(span)//' τ; at most ' &
-            & //rtoa(max_renormalisations)//' (each is an integration of its own): give a longer interval')
+            & //rtoa(max_renormalisations)//' (each is an integration of its own): give a longer interval', &
+            & against=[character(len=64) :: 'analysis.'//tool//'_duration', 'analysis.'//tool//'_transient', run, &
+            & 'analysis.'//tool])
       end subroutine check_intervals
 
       function window_text() result(text)

@@ -230,7 +230,7 @@ contains
       call c%finite('brake', 't_start', self%t_start)
       call c%finite('brake', 't_end', self%t_end)
       if (.not. (self%t_end > self%t_start)) call c%reject('brake', 't_end', rtoa(self%t_end), &
-         & 'must be after t_start = '//rtoa(self%t_start))
+         & 'must be after t_start = '//rtoa(self%t_start), against=['brake.t_start'])
       call c%positive('brake', 'dt_out', self%dt_out, 'output grid step in τ')
       call c%positive('brake', 'event_tolerance', self%event_tolerance, 'τ')
       call c%positive('brake', 'stick_velocity', self%stick_velocity, 'm per unit τ')
@@ -238,7 +238,8 @@ contains
       if ((self%t_end - self%t_start) / self%dt_out > 1.0e7_wp) call c%reject('brake', 'dt_out', &
          & rtoa(self%dt_out), 'gives more than 1e7 output points over [t_start, t_end] (' &
          & //rtoa((self%t_end - self%t_start) / self%dt_out)//' points would need ' &
-         & //bytes_text(44.0_wp * (self%t_end - self%t_start) / self%dt_out)//' of memory for the trajectory alone)')
+         & //bytes_text(44.0_wp * (self%t_end - self%t_start) / self%dt_out)//' of memory for the trajectory alone)', &
+         & against=[character(len=16) :: 'brake.t_end', 'brake.t_start'])
       associate (p => resolved%params)
          normal = p%normal_force(self%y0)
          if (.not. (normal > 0.0_wp)) call c%reject('brake', 'y0', rtoa(self%y0), &
@@ -246,7 +247,7 @@ contains
             & //' must be > 0 (kappa = '//rtoa(p%kappa)//', g_prime = '//rtoa(p%g_prime)//')')
       end associate
       call check_verify(self%verify, c, 'm')
-      call self%analysis%validate(c, self%t_start, self%t_end, series_names, self%dt_out)
+      call self%analysis%validate(c, self%t_start, self%t_end, series_names, self%dt_out, run_group='brake')
       if (c%failed()) return
       call check_law_choice(self, c)
       if (c%failed() .or. len_trim(self%analysis%continuation) == 0) return

@@ -34,6 +34,7 @@ module friction_checks
       procedure :: is_set
       procedure :: failed
       procedure :: reject
+      procedure, private :: set_partner
       procedure :: warn
       procedure :: positive
       procedure :: nonnegative
@@ -102,19 +103,55 @@ contains
 
    !> A bad value: where it was set, group, variable (with its array index
    !> when given), value and reason.  Only the first is kept.
-   subroutine reject(self, group, name, value, reason, index)
+   !> `against` lists the variables ('group.name') the value was checked
+   !> against.  A value left at its default that conflicts with one of them
+   !> set in the input leads with that one's line, which is where the user
+   !> has something to change:
+   !> 'run.nml:3: &machine: t_end, with the default &analysis: window_start = 100: reason'.
+   subroutine reject(self, group, name, value, reason, index, against)
       class(config_checker), intent(inout) :: self
       character(len=*), intent(in) :: group, name, value, reason
       integer, intent(in), optional :: index
-      character(len=:), allocatable :: shown, where
+      character(len=*), intent(in), optional :: against(:)
+      character(len=:), allocatable :: shown, where, lead
 
       if (allocated(self%error)) return
       shown = name
       if (present(index)) shown = name//'('//itoa(index)//')'
       where = self%origin(group, name)
+      lead = ''
+      if (where == '(default)' .and. present(against)) lead = self%set_partner(against)
+      if (len(lead) > 0) then
+         call fatal_error(self%error, lead//', with the default &'//group//': '//shown//' = '//value//': ' &
+            & //reason, error_input)
+         return
+      end if
       if (len(where) > 0) where = where//': '
       call fatal_error(self%error, where//'&'//group//': '//shown//' = '//value//': '//reason, error_input)
    end subroutine reject
+
+   !> The first of `against` ('group.name') set in the input, as
+   !> 'where: &group: name' (no 'where: ' when set in memory); '' when none is.
+   function set_partner(self, against) result(text)
+      class(config_checker), intent(in) :: self
+      character(len=*), intent(in) :: against(:)
+      character(len=:), allocatable :: text
+      character(len=len(against)) :: group, name
+      integer :: k, dot
+
+      text = ''
+      do k = 1, size(against)
+         dot = index(against(k), '.')
+         if (dot < 2) cycle
+         group = against(k)(:dot - 1)
+         name = against(k)(dot + 1:)
+         if (.not. self%is_set(trim(group), trim(name))) cycle
+         text = self%origin(trim(group), trim(name))
+         if (len(text) > 0) text = text//': '
+         text = text//'&'//trim(group)//': '//trim(name)
+         return
+      end do
+   end function set_partner
 
    !> A value that is allowed but implausible: the same words as `reject`
    !> (where it was set, group, variable, value, reason), kept in `warnings`.

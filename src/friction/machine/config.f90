@@ -124,19 +124,21 @@ contains
       call c%finite('machine', 't_start', self%t_start)
       call c%finite('machine', 't_end', self%t_end)
       if (.not. (self%t_end > self%t_start)) call c%reject('machine', 't_end', rtoa(self%t_end), &
-         & 'must be after t_start = '//rtoa(self%t_start))
+         & 'must be after t_start = '//rtoa(self%t_start), against=['machine.t_start'])
       call c%positive('machine', 'dt_out', self%dt_out, 's')
       call c%positive('machine', 'event_tolerance', self%event_tolerance, 's')
       call c%positive('machine', 'stick_velocity', self%stick_velocity, 'm/s')
       if (c%failed()) return
       if ((self%t_end - self%t_start) / self%dt_out > 1.0e7_wp) call c%reject('machine', 'dt_out', &
-         & rtoa(self%dt_out), 'gives more than 1e7 output points over [t_start, t_end]')
+         & rtoa(self%dt_out), 'gives more than 1e7 output points over [t_start, t_end]', &
+         & against=[character(len=16) :: 'machine.t_end', 'machine.t_start'])
       call check_law(law_with_files(self%law), c)
       if (c%failed()) return
       call check_band_stepper(self, c)
       if (c%failed()) return
       call self%analysis%validate(c, self%t_start, self%t_end, ['x', 'v'], self%dt_out, &
-         & strobe_known=self%support_amplitude > 0.0_wp .and. self%support_frequency > 0.0_wp, series_points=8)
+         & strobe_known=self%support_amplitude > 0.0_wp .and. self%support_frequency > 0.0_wp, series_points=8, &
+         & run_group='machine')
       if (c%failed()) return
       ! Every diagnostic of &analysis runs on the machine; what a law cannot give is refused by name.
       associate (a => self%analysis)
