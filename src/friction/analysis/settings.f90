@@ -163,10 +163,13 @@ contains
       logical :: strobe_given
       character(len=:), allocatable :: what
 
-      ! (Without a group the names start with '.', which the checker skips.)
+      ! (Without a group the names are blank, which the checker skips.)
       run = ''
-      if (present(run_group)) run = [character(len=64) :: run_group//'.t_end', run_group//'.t_start', &
-         & run_group//'.dt_out']
+      if (present(run_group)) then
+         run(1) = run_group//'.t_end'
+         run(2) = run_group//'.t_start'
+         run(3) = run_group//'.dt_out'
+      end if
       if (.not. any(series == self%series)) call c%reject('analysis', 'series', "'"//trim(self%series)//"'", &
          & 'unknown variable (known: '//quoted(series)//')')
       if (self%window /= 'hann' .and. self%window /= 'none') call c%reject('analysis', 'window', &
@@ -176,7 +179,7 @@ contains
       call c%finite('analysis', 'window_start', self%window_start)
       if (.not. (self%window_end > self%window_start)) call c%reject('analysis', 'window_end', &
          & rtoa(self%window_end), 'must be after window_start = '//rtoa(self%window_start), &
-         & against=['analysis.window_start'])
+         & against=partners(run, 'analysis.window_start'))
       if (self%welch_segments < 1) call c%reject('analysis', 'welch_segments', itoa(self%welch_segments), &
          & 'must be >= 1')
       ! K half-overlapping segments of the window's samples: each needs 8 (the
@@ -190,7 +193,7 @@ contains
             & call c%reject('analysis', 'welch_segments', itoa(self%welch_segments), 'leaves fewer than 8 ' &
             & //'samples a segment of the window [window_start, window_end] ('//itoa(int(samples)) &
             & //' samples); at most '//itoa(max(1, int(samples) / 4 - 1)), &
-            & against=[character(len=64) :: run, 'analysis.window_start', 'analysis.window_end'])
+            & against=partners(run, 'run', 'analysis.window_start', 'analysis.window_end'))
       end if
       ! The window's output points, which the diagnostics counted only after the
       ! whole run, with a message that named no file (a run shorter than window_start).
@@ -205,10 +208,10 @@ contains
             if (.not. (self%spectrum .or. self%rosenstein)) what = 'the spectrum of the strobe period'
             if (self%window_end < t_end) then
                call c%reject('analysis', 'window_end', rtoa(self%window_end), window_text(), &
-                  & against=[character(len=64) :: run, 'analysis.window_start'])
+                  & against=partners(run, 'run', 'analysis.window_start'))
             else
                call c%reject('analysis', 'window_start', rtoa(self%window_start), window_text(), &
-                  & against=[character(len=64) :: run, 'analysis.window_end'])
+                  & against=partners(run, 'run', 'analysis.window_end'))
             end if
          end if
       end if
@@ -228,7 +231,7 @@ contains
          & .not. (t_end - t_start - self%lyapunov_transient >= self%lyapunov_renormalise)) &
          & call c%reject('analysis', 'lyapunov_transient', rtoa(self%lyapunov_transient), &
          & 'leaves less than one renormalisation interval before t_end', &
-         & against=[character(len=64) :: run, 'analysis.lyapunov_renormalise', 'analysis.lyapunov'])
+         & against=partners(run, 'run', 'analysis.lyapunov_renormalise', 'analysis.lyapunov'))
       call c%nonnegative('analysis', 'lyapunov_spectrum_transient', self%lyapunov_spectrum_transient, 'τ')
       call c%nonnegative('analysis', 'lyapunov_spectrum_duration', self%lyapunov_spectrum_duration, &
          & 'τ; 0 for the rest of the run')
@@ -236,13 +239,13 @@ contains
       if (self%lyapunov_spectrum .and. self%lyapunov_spectrum_duration == 0.0_wp .and. &
          & .not. (t_end - t_start - self%lyapunov_spectrum_transient >= self%lyapunov_spectrum_renormalise)) &
          & call c%reject('analysis', 'lyapunov_spectrum_transient', rtoa(self%lyapunov_spectrum_transient), &
-         & 'leaves less than one renormalisation interval before t_end', against=[character(len=64) :: run, &
-         & 'analysis.lyapunov_spectrum_renormalise', 'analysis.lyapunov_spectrum'])
+         & 'leaves less than one renormalisation interval before t_end', against=partners(run, 'run', &
+         & 'analysis.lyapunov_spectrum_renormalise', 'analysis.lyapunov_spectrum'))
       if (self%lyapunov_spectrum .and. self%lyapunov_spectrum_duration > 0.0_wp .and. &
          & self%lyapunov_spectrum_duration < self%lyapunov_spectrum_renormalise) &
          & call c%reject('analysis', 'lyapunov_spectrum_duration', rtoa(self%lyapunov_spectrum_duration), &
          & 'shorter than one renormalisation interval, lyapunov_spectrum_renormalise = ' &
-         & //rtoa(self%lyapunov_spectrum_renormalise), against=['analysis.lyapunov_spectrum_renormalise'])
+         & //rtoa(self%lyapunov_spectrum_renormalise), against=partners(run, 'analysis.lyapunov_spectrum_renormalise'))
       ! Each renormalisation is an integration of its own: a tiny interval
       ! makes the loop endless in practice (1e-300 ran for hours, 1e-13 too).
       if (self%lyapunov) call check_intervals('lyapunov_renormalise', self%lyapunov_renormalise, &
@@ -285,7 +288,7 @@ contains
       if (self%rosenstein_fit_end <= self%rosenstein_fit_start .or. &
          & self%rosenstein_fit_end > self%rosenstein_horizon) call c%reject('analysis', 'rosenstein_fit_end', &
          & itoa(self%rosenstein_fit_end), 'must be in (rosenstein_fit_start, rosenstein_horizon]', &
-         & against=[character(len=64) :: 'analysis.rosenstein_fit_start', 'analysis.rosenstein_horizon'])
+         & against=partners(run, 'analysis.rosenstein_fit_start', 'analysis.rosenstein_horizon'))
    contains
 
       !> The renormalisation interval `name` over its span (duration, or the
@@ -304,8 +307,8 @@ contains
          if (.not. (span / interval <= max_renormalisations)) call c%reject('analysis', name, rtoa(interval), &
             & 'gives '//rtoa(span / interval)//' renormalisation intervals over '//rtoa(span)//' τ; at most ' &
             & //rtoa(max_renormalisations)//' (each is an integration of its own): give a longer interval', &
-            & against=[character(len=64) :: 'analysis.'//tool//'_duration', 'analysis.'//tool//'_transient', run, &
-            & 'analysis.'//tool])
+            & against=partners(run, 'analysis.'//tool//'_duration', 'analysis.'//tool//'_transient', 'run', &
+            & 'analysis.'//tool))
       end subroutine check_intervals
 
       function window_text() result(text)
@@ -316,6 +319,36 @@ contains
             & //'] every dt_out = '//rtoa(dt)//'; '//what//' needs '//itoa(need)
       end function window_text
    end subroutine validate
+
+   !> The variables a check compares, 'group.name' ('run': the run's
+   !> t_end, t_start and dt_out), for the checker's `against`.  (Built
+   !> element by element: gfortran's typed array constructors of concatenated
+   !> strings here corrupted the heap.)
+   function partners(run, a, b, c, d) result(list)
+      character(len=*), intent(in) :: run(:), a
+      character(len=*), intent(in), optional :: b, c, d
+      character(len=64) :: list(6)
+      integer :: n
+
+      list = ''
+      n = 0
+      call add(a)
+      if (present(b)) call add(b)
+      if (present(c)) call add(c)
+      if (present(d)) call add(d)
+   contains
+      subroutine add(name)
+         character(len=*), intent(in) :: name
+
+         if (name == 'run') then
+            list(n + 1:n + 3) = run
+            n = n + 3
+         else
+            n = n + 1
+            list(n) = name
+         end if
+      end subroutine add
+   end function partners
 
    !> The output points t_start + k dt (k = 0, 1, ...) up to t_end that lie in
    !> [window_start, window_end] (a margin of 1e-9 of a step for the rounding of the grid).
