@@ -348,8 +348,7 @@ contains
       real(wp) :: h
 
       call band_frame_of(c, law, band)
-      h = c%solver%h_start
-      if (.not. (h > 0.0_wp)) h = 1.0e-6_wp * c%dt_out
+      h = c%first_step()
       if (present(y0)) then
          call self%start(band, c%solver, c%event_tolerance, h, t0, y0, tangent, error)
       else

@@ -60,6 +60,7 @@ module friction_machine_config
       procedure :: validate
       procedure :: grid_size
       procedure :: grid_time
+      procedure :: first_step
    end type machine_config
 
    !> The &machine variables a periodic orbit can be continued in (&analysis continuation).
@@ -237,5 +238,13 @@ contains
 
       grid_time = self%t_start + real(i - 1, wp) * self%dt_out
    end function grid_time
+
+   !> The integrators' first step: &integrator h_start, else 1e-6 dt_out.
+   pure real(wp) function first_step(self)
+      class(machine_config), intent(in) :: self
+
+      first_step = self%solver%h_start
+      if (.not. (first_step > 0.0_wp)) first_step = 1.0e-6_wp * self%dt_out
+   end function first_step
 
 end module friction_machine_config

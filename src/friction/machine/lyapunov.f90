@@ -359,8 +359,7 @@ contains
       call smooth_start(c, law, system, y)
       n = size(y)
       allocate (extended%base, source=system)
-      h = c%solver%h_start
-      if (.not. (h > 0.0_wp)) h = 1.0e-6_wp * c%dt_out
+      h = c%first_step()
       t = c%t_start
       t0 = c%t_start + s%transient
       if (s%transient > 0.0_wp) then

@@ -20,8 +20,8 @@ module friction_machine_run
    use friction_output_law_files, only: law_with_files
    use friction_machine_config, only: machine_config
    use friction_machine_model, only: mechanics, machine_smooth, machine_slip, machine_stick
-   use friction_machine_band, only: band_frame, machine_band, band_hold, band_cross, band_leave, band_exit, &
-      & band_hold_end, max_switches, band_frame_of, band_start_state
+   use friction_machine_band, only: machine_band, band_hold, band_cross, band_leave, band_exit, &
+      & band_hold_end, max_switches
    implicit none
    private
 
@@ -160,8 +160,7 @@ contains
       allocate (system%law, source=law)
       system%n_states = ns
       if (ns > 0) call law%state_scale(system%scale(1:ns))
-      h = c%solver%h_start
-      if (.not. (h > 0.0_wp)) h = 1.0e-6_wp * c%dt_out
+      h = c%first_step()
       call solver%init(system, c%solver, h, error)
       if (allocated(error)) return
       call solver%set_time_label('t', ' s')
@@ -275,8 +274,7 @@ contains
       allocate (slip%law, source=law)
       stick%m = m
       stick%limit = limit
-      h = c%solver%h_start
-      if (.not. (h > 0.0_wp)) h = 1.0e-6_wp * c%dt_out
+      h = c%first_step()
       call slipping%init(slip, c%solver, [event_falling], [.true.], c%event_tolerance, h, error, 't', ' s')
       if (allocated(error)) return
       call sticking%init(stick, c%solver, [event_falling, event_falling], [.true., .true.], c%event_tolerance, h, &
@@ -376,17 +374,13 @@ contains
       type(machine_run), intent(inout) :: run
       class(step_watch), intent(inout) :: watch
       type(error_type), allocatable, intent(out) :: error
-      type(band_frame) :: band
       type(machine_band), target :: stepper
-      real(wp) :: z(max_law_states), h, t_grid
+      real(wp) :: z(max_law_states), t_grid
       integer :: i, k, ns, outcome, switches
 
-      call band_frame_of(c, law, band)
-      ns = band%frame%base%n_states
-      h = c%solver%h_start
-      if (.not. (h > 0.0_wp)) h = 1.0e-6_wp * c%dt_out
-      call stepper%start(band, c%solver, c%event_tolerance, h, c%t_start, band_start_state(c, band), .false., error)
+      call stepper%start_from(c, law, c%t_start, .false., error)
       if (allocated(error)) return
+      ns = stepper%band%frame%base%n_states
       call record(1, stepper%y)
       if (c%dense_output .and. stepper%locator%has_dense_output()) then
          call free_steps()
@@ -475,7 +469,7 @@ contains
          real(wp), intent(in) :: y(:)
          real(wp) :: x
 
-         z(1:ns) = y(3:2 + ns) * band%frame%base%scale(1:ns)
+         z(1:ns) = y(3:2 + ns) * stepper%band%frame%base%scale(1:ns)
          run%t(i) = c%grid_time(i)
          x = y(1) + m%load * run%t(i)
          run%x(i) = x
@@ -484,7 +478,7 @@ contains
          do k = 1, ns
             run%states(k, i) = z(k)
          end do
-         if (abs(y(2) - m%belt) < band%half_width) run%stick(i) = 1
+         if (abs(y(2) - m%belt) < stepper%band%half_width) run%stick(i) = 1
       end subroutine record
    end subroutine run_band
 

@@ -107,8 +107,7 @@ contains
       self%slip = slip
       self%stick%m = self%m
       self%stick%limit = self%limit
-      self%h = c%solver%h_start
-      if (.not. (self%h > 0.0_wp)) self%h = 1.0e-6_wp * c%dt_out
+      self%h = c%first_step()
       if (tangent) then
          call self%slipping%init(self%slipping_system, c%solver, directions, spread(.true., 1, size(directions)), &
             & c%event_tolerance, self%h, error, 't', ' s')
