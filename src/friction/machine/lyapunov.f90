@@ -36,7 +36,7 @@ module friction_machine_lyapunov
    use friction_law_factory, only: make_law
    use friction_output_law_files, only: law_with_files
    use friction_machine_config, only: machine_config
-   use friction_machine_model, only: machine_smooth
+   use friction_machine_model, only: machine_smooth, kinked_system
    use friction_machine_switching, only: machine_switching
    use friction_machine_band, only: machine_band
    use friction_machine_piecewise, only: piecewise_run
@@ -71,144 +71,7 @@ module friction_machine_lyapunov
       procedure :: jacobian => divergence_jacobian
    end type divergence_system
 
-   !> The machine with the kinks of its law's partial derivatives (GMS's
-   !> switch bands) as its events: where the spectrum's steps end.
-   type, extends(event_system) :: kink_machine
-      type(machine_smooth) :: base
-   contains
-      procedure :: dimension => kink_dimension
-      procedure :: relative_component => kink_relative_component
-      procedure :: rhs => kink_rhs
-      procedure :: jacobian => kink_jacobian
-      procedure :: event_count => kink_event_count
-      procedure :: event_values => kink_event_values
-   end type kink_machine
-
-   !> The orbit with D (its base a kink_machine) and the kinks as its events.
-   type, extends(event_system) :: kinked_divergence
-      type(divergence_system) :: flow
-   contains
-      procedure :: dimension => kinked_dimension
-      procedure :: controlled_dimension => kinked_controlled_dimension
-      procedure :: relative_component => kinked_relative_component
-      procedure :: rhs => kinked_rhs
-      procedure :: jacobian => kinked_jacobian
-      procedure :: event_count => kinked_event_count
-      procedure :: event_values => kinked_event_values
-   end type kinked_divergence
-
 contains
-
-   pure integer function kink_dimension(self)
-      class(kink_machine), intent(in) :: self
-
-      kink_dimension = self%base%dimension()
-   end function kink_dimension
-
-   pure subroutine kink_relative_component(self, index, reference, floor)
-      class(kink_machine), intent(in) :: self
-      integer, intent(out) :: index
-      real(wp), intent(out) :: reference, floor
-
-      call self%base%relative_component(index, reference, floor)
-   end subroutine kink_relative_component
-
-   pure subroutine kink_rhs(self, t, y, dydt)
-      class(kink_machine), intent(in) :: self
-      real(wp), intent(in) :: t
-      real(wp), intent(in), contiguous :: y(:)
-      real(wp), intent(out), contiguous :: dydt(:)
-
-      call self%base%rhs(t, y, dydt)
-   end subroutine kink_rhs
-
-   pure subroutine kink_jacobian(self, t, y, dfdy, dfdt)
-      class(kink_machine), intent(in) :: self
-      real(wp), intent(in) :: t
-      real(wp), intent(in) :: y(:)
-      real(wp), intent(out) :: dfdy(:, :)
-      real(wp), intent(out) :: dfdt(:)
-
-      call self%base%jacobian(t, y, dfdy, dfdt)
-   end subroutine kink_jacobian
-
-   pure integer function kink_event_count(self)
-      class(kink_machine), intent(in) :: self
-
-      kink_event_count = self%base%law%kink_count()
-   end function kink_event_count
-
-   pure subroutine kink_event_values(self, t, y, g)
-      class(kink_machine), intent(in) :: self
-      real(wp), intent(in) :: t
-      real(wp), intent(in) :: y(:)
-      real(wp), intent(out) :: g(:)
-      integer :: n
-
-      n = self%base%n_states
-      call self%base%law%kinks(y(2) - self%base%m%belt, y(3:2 + n) * self%base%scale(1:n), self%base%m%normal, g)
-   end subroutine kink_event_values
-
-   pure integer function kinked_dimension(self)
-      class(kinked_divergence), intent(in) :: self
-
-      kinked_dimension = self%flow%dimension()
-   end function kinked_dimension
-
-   pure integer function kinked_controlled_dimension(self)
-      class(kinked_divergence), intent(in) :: self
-
-      kinked_controlled_dimension = self%flow%controlled_dimension()
-   end function kinked_controlled_dimension
-
-   pure subroutine kinked_relative_component(self, index, reference, floor)
-      class(kinked_divergence), intent(in) :: self
-      integer, intent(out) :: index
-      real(wp), intent(out) :: reference, floor
-
-      call self%flow%relative_component(index, reference, floor)
-   end subroutine kinked_relative_component
-
-   pure subroutine kinked_rhs(self, t, y, dydt)
-      class(kinked_divergence), intent(in) :: self
-      real(wp), intent(in) :: t
-      real(wp), intent(in), contiguous :: y(:)
-      real(wp), intent(out), contiguous :: dydt(:)
-
-      call self%flow%rhs(t, y, dydt)
-   end subroutine kinked_rhs
-
-   pure subroutine kinked_jacobian(self, t, y, dfdy, dfdt)
-      class(kinked_divergence), intent(in) :: self
-      real(wp), intent(in) :: t
-      real(wp), intent(in) :: y(:)
-      real(wp), intent(out) :: dfdy(:, :)
-      real(wp), intent(out) :: dfdt(:)
-
-      call self%flow%jacobian(t, y, dfdy, dfdt)
-   end subroutine kinked_jacobian
-
-   pure integer function kinked_event_count(self)
-      class(kinked_divergence), intent(in) :: self
-
-      kinked_event_count = 0
-      select type (base => self%flow%base)
-      class is (event_system)
-         kinked_event_count = base%event_count()
-      end select
-   end function kinked_event_count
-
-   pure subroutine kinked_event_values(self, t, y, g)
-      class(kinked_divergence), intent(in) :: self
-      real(wp), intent(in) :: t
-      real(wp), intent(in) :: y(:)
-      real(wp), intent(out) :: g(:)
-
-      select type (base => self%flow%base)
-      class is (event_system)
-         call base%event_values(t, y(1:size(y) - 1), g)
-      end select
-   end subroutine kinked_event_values
 
    pure function divergence_dimension(self) result(n)
       class(divergence_system), intent(in) :: self
@@ -414,16 +277,17 @@ contains
       !> step of event_tolerance.
       subroutine kinked_spectrum(error)
          type(error_type), allocatable, intent(out) :: error
-         type(kinked_divergence), target :: kinked
-         type(kink_machine) :: machine
+         type(kinked_system), target :: kinked
+         type(divergence_system) :: flow
          type(event_locator) :: locator
          real(wp) :: f_b(n)
          integer :: m
          logical :: ok
 
-         machine%base = system
-         allocate (kinked%flow%base, source=machine)
-         m = machine%event_count()
+         allocate (flow%base, source=system)
+         allocate (kinked%base, source=flow)
+         kinked%model = system
+         m = kinked%event_count()
          call locator%init(kinked, c%solver, spread(event_either, 1, m), spread(.true., 1, m), c%event_tolerance, &
             & h, error)
          if (allocated(error)) return
@@ -452,7 +316,7 @@ contains
                end if
                call system%rhs(t, z(1:n), f_b)
                if (t > t_a) then
-                  call magnus_tangent_step(machine, t_a, y_a, f_a, t, z(1:n), f_b, phi, logs, depth, ok)
+                  call magnus_tangent_step(system, t_a, y_a, f_a, t, z(1:n), f_b, phi, logs, depth, ok)
                   if (.not. ok) then
                      call fatal_error(error, 'Lyapunov spectrum: the Jacobian is NaN or Inf, or too stiff for ' &
                         & //'the step ending near t = '//rtoa(t)//' s (an exponential of the tangent in more ' &

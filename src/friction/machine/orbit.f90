@@ -42,6 +42,7 @@ module friction_machine_orbit
    use friction_machine_config, only: machine_config
    use friction_machine_run, only: machine_run, run_machine
    use friction_machine_switching, only: switching_section
+   use friction_machine_model, only: kinked_system
    use friction_machine_band, only: load_frame, band_frame, machine_band, band_none, band_at_section
    use friction_analysis_magnus_section, only: magnus_map
    implicit none
@@ -59,19 +60,6 @@ module friction_machine_orbit
 
    !> Most section points of the attractor kept per point of the line (the diagram).
    integer, parameter :: max_section_points = 400
-
-   !> The load point's frame with the kinks of the law's partial derivatives
-   !> as its events (GMS's switch bands), where the exponential tangent's
-   !> steps end.
-   type, extends(event_system) :: kink_frame
-      type(load_frame) :: frame
-   contains
-      procedure :: dimension => kink_dimension
-      procedure :: rhs => kink_rhs
-      procedure :: jacobian => kink_jacobian
-      procedure :: event_count => kink_event_count
-      procedure :: event_values => kink_event_values
-   end type kink_frame
 
    !> The return map of a law with a band (either section, as hyperplane_map
    !> and stroboscopic_map), with a saltation matrix at every edge and the
@@ -131,51 +119,6 @@ module friction_machine_orbit
    end type machine_branch
 
 contains
-
-   ! ---- the kinks of a law's partial derivatives as events ----
-
-   pure integer function kink_dimension(self)
-      class(kink_frame), intent(in) :: self
-
-      kink_dimension = self%frame%dimension()
-   end function kink_dimension
-
-   pure subroutine kink_rhs(self, t, y, dydt)
-      class(kink_frame), intent(in) :: self
-      real(wp), intent(in) :: t
-      real(wp), intent(in), contiguous :: y(:)
-      real(wp), intent(out), contiguous :: dydt(:)
-
-      call self%frame%rhs(t, y, dydt)
-   end subroutine kink_rhs
-
-   pure subroutine kink_jacobian(self, t, y, dfdy, dfdt)
-      class(kink_frame), intent(in) :: self
-      real(wp), intent(in) :: t
-      real(wp), intent(in) :: y(:)
-      real(wp), intent(out) :: dfdy(:, :)
-      real(wp), intent(out) :: dfdt(:)
-
-      call self%frame%jacobian(t, y, dfdy, dfdt)
-   end subroutine kink_jacobian
-
-   pure integer function kink_event_count(self)
-      class(kink_frame), intent(in) :: self
-
-      kink_event_count = self%frame%base%law%kink_count()
-   end function kink_event_count
-
-   pure subroutine kink_event_values(self, t, y, g)
-      class(kink_frame), intent(in) :: self
-      real(wp), intent(in) :: t
-      real(wp), intent(in) :: y(:)
-      real(wp), intent(out) :: g(:)
-      integer :: n
-
-      n = self%frame%base%n_states
-      call self%frame%base%law%kinks(y(2) - self%frame%base%m%belt, y(3:2 + n) * self%frame%base%scale(1:n), &
-         & self%frame%base%m%normal, g)
-   end subroutine kink_event_values
 
    ! ---- a law with a band: its return map ----
 
@@ -466,8 +409,11 @@ contains
             ! A law with states (stiff bristles, GMS elements): the tangent by exponentials over the orbit's steps.
             type(magnus_map) :: exponential
             class(ode_system), allocatable :: flow
+            type(kinked_system) :: kinked
             if (frame%base%law%kink_count() > 0) then
-               allocate (flow, source=kink_frame(frame))
+               allocate (kinked%base, source=frame)
+               kinked%model = frame%base
+               allocate (flow, source=kinked)
             else
                allocate (flow, source=frame)
             end if
