@@ -23,7 +23,7 @@ module friction_analysis_magnus_section
    use friction_strings, only: rtoa
    use friction_ode_system, only: ode_system
    use friction_ode_solver, only: solver_settings, ode_solver
-   use friction_ode_events, only: event_system, event_locator, event_rising, event_either
+   use friction_ode_events, only: event_system, event_locator, event_rising, event_falling, event_either
    use friction_ode_watch, only: step_watch
    use friction_analysis_lyapunov_spectrum, only: generic_frame
    use friction_analysis_tangent_magnus, only: magnus_tangent_step
@@ -38,13 +38,16 @@ module friction_analysis_magnus_section
 
    !> The flow with its section y_k = c as event 1 (none when forced) and,
    !> when the flow is an event system, its events after it: the kinks of its
-   !> Jacobian, where a step of the tangent must end.
+   !> Jacobian, where a step of the tangent must end; the section's rearming
+   !> level y_k = r the last, when it rearms.
    type, extends(event_system) :: plane_system
       class(ode_system), allocatable :: base
       integer :: coordinate = 1
       real(wp) :: level = 0.0_wp
       logical :: forced = .false.
       integer :: kinks = 0
+      logical :: rearms = .false.
+      real(wp) :: rearm_level = 0.0_wp
    contains
       procedure :: dimension => plane_dimension
       procedure :: rhs => plane_rhs
@@ -70,6 +73,8 @@ module friction_analysis_magnus_section
       !> A start where the flow crosses y_k = c downwards (or not at all) is outside the map's domain and
       !> refused, unless entering: then its image is the flow's next upward crossing (a guess moved onto it).
       logical :: entering = .false.
+      !> The section crossed downwards instead (y_k' < 0: every "upward" above reads "downward").
+      logical :: falling = .false.
    contains
       procedure :: setup => magnus_setup
       procedure :: dimension => magnus_dimension
@@ -108,7 +113,7 @@ contains
    pure integer function plane_event_count(self)
       class(plane_system), intent(in) :: self
 
-      plane_event_count = 1 + self%kinks
+      plane_event_count = 1 + self%kinks + merge(1, 0, self%rearms)
    end function plane_event_count
 
    pure subroutine plane_event_values(self, t, y, g)
@@ -122,23 +127,31 @@ contains
       if (self%kinks > 0) then
          select type (base => self%base)
          class is (event_system)
-            call base%event_values(t, y, g(2:))
+            call base%event_values(t, y, g(2:1 + self%kinks))
          end select
       end if
+      if (self%rearms) g(2 + self%kinks) = y(self%coordinate) - self%rearm_level
    end subroutine plane_event_values
 
    !> The map of `system`: forced, from t0 over `period`; else the section
    !> y_coordinate = level crossed upwards, returns after max_return none.
    !> A system with events has them located as kinks of its Jacobian: each
    !> ends a step of the orbit, so that no exponential of the tangent reads J
-   !> across one (docs/chaos.md, "The tangent of a stiff law").
-   subroutine magnus_setup(self, system, solver, forced, t0, period, coordinate, level, max_return, event_tolerance)
+   !> across one (docs/chaos.md, "The tangent of a stiff law").  With
+   !> `falling`, the section crossed downwards; with rearm_level, a crossing
+   !> counts only after y_k has crossed that level the other way since the
+   !> start or the last crossing (a flow grazing the section does not return
+   !> there), as hyperplane_map's.
+   subroutine magnus_setup(self, system, solver, forced, t0, period, coordinate, level, max_return, event_tolerance, &
+      & falling, rearm_level)
       class(magnus_map), intent(inout) :: self
       class(ode_system), intent(in) :: system
       type(solver_settings), intent(in) :: solver
       logical, intent(in) :: forced
       real(wp), intent(in) :: t0, period, level, max_return, event_tolerance
       integer, intent(in) :: coordinate
+      logical, intent(in), optional :: falling
+      real(wp), intent(in), optional :: rearm_level
 
       if (allocated(self%plane)) deallocate (self%plane)
       allocate (self%plane)
@@ -151,6 +164,10 @@ contains
       class is (event_system)
          self%plane%kinks = system%event_count()
       end select
+      self%falling = .false.
+      if (present(falling)) self%falling = falling
+      self%plane%rearms = present(rearm_level)
+      if (present(rearm_level)) self%plane%rearm_level = rearm_level
       self%solver = solver
       self%forced = forced
       self%t0 = t0
@@ -221,8 +238,10 @@ contains
       else
          ! Off the upward side the next upward crossing is a short loop near the section's fold (where the flow
          ! is tangent to it), not a return round the orbit: Newton would converge on the fold.
-         if (.not. (f_a(k) > 0.0_wp) .and. .not. self%entering) then
-            reason = 'the flow crosses the section downwards at this point (outside the section''s upward side)'
+         if (.not. (merge(-f_a(k), f_a(k), self%falling) > 0.0_wp) .and. .not. self%entering) then
+            reason = 'the flow crosses the section '//trim(merge('upwards  ', 'downwards', self%falling)) &
+               & //' at this point (outside the section''s '//trim(merge('downward', 'upward  ', self%falling)) &
+               & //' side)'
             return
          end if
          if (.not. (h > 0.0_wp)) h = 1.0e-3_wp
@@ -309,11 +328,20 @@ contains
          logical, intent(out) :: done
          type(error_type), allocatable, intent(out) :: error
          type(event_locator) :: locator
+         logical :: armed
 
          done = .false.
-         call locator%init(self%plane, self%solver, [event_rising, spread(event_either, 1, self%plane%kinks)], &
-            & spread(.true., 1, 1 + self%plane%kinks), self%event_tolerance, h, error)
+         if (self%plane%rearms) then
+            call locator%init(self%plane, self%solver, [merge(event_falling, event_rising, self%falling), &
+               & spread(event_either, 1, self%plane%kinks), merge(event_rising, event_falling, self%falling)], &
+               & [spread(.true., 1, 1 + self%plane%kinks), .false.], self%event_tolerance, h, error)
+         else
+            call locator%init(self%plane, self%solver, [merge(event_falling, event_rising, self%falling), &
+               & spread(event_either, 1, self%plane%kinks)], spread(.true., 1, 1 + self%plane%kinks), &
+               & self%event_tolerance, h, error)
+         end if
          if (allocated(error)) return
+         armed = .not. self%plane%rearms
          call locator%restart(t, y, h)
          do while (t < t_end)
             t_a = t
@@ -326,14 +354,19 @@ contains
             if (allocated(error)) return
             call carry(error)
             if (allocated(error)) return
+            if (self%plane%rearms .and. locator%n_hits > 0) then
+               if (any(locator%hits(1:locator%n_hits)%which == 2 + self%plane%kinks)) armed = .true.
+            end if
             if (locator%n_hits > 0) then
                if (locator%hits(locator%n_hits)%terminal) then
                   ! A function exactly 0 at a restart crosses at once (ode/events.f90): that is the start itself.
-                  ! A kink: on from its far side with a fresh step.
+                  ! A kink: on from its far side with a fresh step.  (A crossing before the rearming level:
+                  ! the flow grazed the section.)
                   if (locator%hits(locator%n_hits)%which == 1 .and. &
                      & t - self%t0 > 1.0e3_wp * self%event_tolerance) then
-                     done = .true.
-                     return
+                     done = armed
+                     if (done) return
+                     armed = .not. self%plane%rearms
                   end if
                   if (locator%hits(locator%n_hits)%which > 1) then
                      ! Past a kink with a step the size of the located time's error: a stepper that keeps its
@@ -371,7 +404,7 @@ contains
       y(pack([(i, i=1, size(y))], [(i, i=1, size(y))] /= k)) = s
       y(k) = self%plane%level
       call self%plane%rhs(self%t0, y, f)
-      if (f(k) > 0.0_wp) return
+      if (merge(-f(k), f(k), self%falling) > 0.0_wp) return
       self%entering = .true.
       call self%evaluate(s, image, jacobian, period, entered, reason, error)
       self%entering = .false.

@@ -16,6 +16,8 @@ module friction_brake_diagnostics
    use friction_law_factory, only: make_law
    use friction_output_law_files, only: law_with_files
    use friction_ode_solver, only: ode_solver
+   use friction_ode_events, only: event_locator, event_either
+   use friction_law_kinked, only: kinked_system
    use friction_analysis_tangent_magnus, only: orbit_step, tangent_over_step, jacobian_trace, simpson_trace
    use friction_analysis_settings, only: analysis_settings
    use friction_analysis_spectrum, only: spectrum_settings, spectrum_result, amplitude_spectrum
@@ -367,10 +369,13 @@ contains
       type(law_integrator), target :: run
       type(brake_event_table) :: events
       type(ode_solver) :: orbit
+      type(kinked_system), target :: kinked
+      type(event_locator) :: locator
       real(wp), allocatable :: z(:), y_a(:), f_a(:), f_b(:), phi(:, :), logs(:)
       real(wp) :: t, t0, t_a, t_target, trace_a, trace_b, integral, total
       integer(i8) :: steps
-      integer :: n, k, intervals, depth
+      integer :: n, k, intervals, depth, m
+      logical :: kinks
 
       divergence = 0.0_wp
       call run%start(config, config%t_start, initial_state(config), events, error)
@@ -392,8 +397,20 @@ contains
       if (n > 4) call run%get_states(z(5:n))
       t = run%t
       phi = generic_frame(n)
-      call orbit%init(run%flow, config%solver, run%h_start, error)
-      if (allocated(error)) return
+      kinks = run%law%kink_count() > 0
+      if (kinks) then
+         ! The law's kinks (GMS's switch bands) located: each ends a step (docs/chaos.md).
+         allocate (kinked%base, source=run%flow)
+         allocate (kinked%model, source=run%flow)
+         m = kinked%event_count()
+         call locator%init(kinked, config%solver, spread(event_either, 1, m), spread(.true., 1, m), &
+            & config%event_tolerance, run%h_start, error, time_name='τ', time_unit='')
+         if (allocated(error)) return
+         call locator%restart(t, z, run%h_start)
+      else
+         call orbit%init(run%flow, config%solver, run%h_start, error)
+         if (allocated(error)) return
+      end if
       intervals = int(settings%duration / settings%renormalise + 1.0e-9_wp)
       call result%start(n, intervals)
       call run%flow%rhs(t, z, f_a)
@@ -405,8 +422,12 @@ contains
          logs = 0.0_wp
          steps = 0
          do while (t < t_target)
-            call orbit_step(orbit, config%solver%method, config%solver%max_steps, t, t_target, z, t_a, y_a, &
-               & steps, error)
+            if (kinks) then
+               call kink_step(error)
+            else
+               call orbit_step(orbit, config%solver%method, config%solver%max_steps, t, t_target, z, t_a, y_a, &
+                  & steps, error)
+            end if
             if (allocated(error)) exit
             ! (At a step's end: a dip of N' below 0 within one step is the stepper's to resolve.)
             if (.not. (run%p%normal_force(z(3)) > 0.0_wp)) then
@@ -415,8 +436,11 @@ contains
                exit
             end if
             f_b = f_a
-            call tangent_over_step(run%flow, orbit, t_a, y_a, f_b, t, z, phi, logs, depth, error)
-            if (allocated(error)) exit
+            if (t > t_a) then
+               call tangent_over_step(run%flow, orbit, t_a, y_a, f_b, t, z, phi, logs, depth, error)
+               if (allocated(error)) exit
+            end if
+            if (kinks) call restart_past_kink()
             call simpson_trace(run%flow, t_a, y_a, f_a, t, z, f_b, trace_a, trace_b, integral)
             total = total + integral
             trace_a = trace_b
@@ -438,6 +462,26 @@ contains
          & //trim(run%law%p%model)//"')"
 
    contains
+
+      !> One accepted step of the kinked flow, ending at a kink if one comes first.
+      subroutine kink_step(error)
+         type(error_type), allocatable, intent(out) :: error
+
+         t_a = t
+         y_a = z
+         call locator%advance(t, t_target, z, error, single=.true.)
+         if (allocated(error)) return
+         steps = steps + 1
+         if (steps > config%solver%max_steps) call fatal_error(error, trim(config%solver%method) &
+            & //': more than max_steps steps in one renormalisation interval at τ = '//rtoa(t), error_numerical)
+      end subroutine kink_step
+
+      !> Past a kink, on with a step of event_tolerance: a stepper that keeps its long step damps the fast
+      !> growth of the band's upper half (an L-stable method damps h λ >> 1 either way) and sits on its edge.
+      subroutine restart_past_kink()
+         if (locator%n_hits == 0) return
+         if (locator%hits(locator%n_hits)%terminal) call locator%restart(t, z, config%event_tolerance)
+      end subroutine restart_past_kink
 
       subroutine check_guard()
          if (present(guard)) call guard%check(reporter, '&analysis: the Lyapunov spectrum', t, 'τ', error)

@@ -31,6 +31,7 @@ module friction_brake_law_model
    use friction_strings, only: rtoa
    use friction_ode_events, only: event_system, event_falling, event_either
    use friction_law, only: sliding_law, max_law_states
+   use friction_law_kinked, only: law_flow
    use friction_law_factory, only: make_law
    use friction_output_law_files, only: law_with_files
    use friction_brake_params, only: brake_parameters
@@ -52,13 +53,11 @@ module friction_brake_law_model
       real(wp) :: force = 1.0_wp, velocity = 1.0_wp, time = 1.0_wp
    end type law_units
 
-   !> Eq. 10 with a single-valued law and its states: (x, v_rel, y, w, ẑ).
-   type, extends(event_system) :: brake_law_flow
+   !> Eq. 10 with a single-valued law and its states: (x, v_rel, y, w, ẑ)
+   !> (the law, its states' count and scales: law_flow's).
+   type, extends(law_flow) :: brake_law_flow
       type(brake_parameters) :: params
-      class(sliding_law), allocatable :: law
       type(law_units) :: units
-      integer :: n_states = 0
-      real(wp) :: scale(max_law_states) = 1.0_wp   !! the states' scales, in the law's units
       real(wp) :: stick_velocity = 1.0e-6_wp
    contains
       procedure :: dimension => flow_dimension
@@ -68,6 +67,7 @@ module friction_brake_law_model
       procedure :: event_count => flow_event_count
       procedure :: event_values => flow_event_values
       procedure :: friction => flow_friction
+      procedure :: law_arguments => flow_law_arguments
    end type brake_law_flow
 
    !> Eq. 10 in one slip of a set-valued law, s the sign of v_rel: (x, v, y, w).
@@ -236,6 +236,17 @@ contains
          g(3) = y(2) + self%stick_velocity
       end associate
    end subroutine flow_event_values
+
+   !> The law's arguments at y in its units: the slip rate, the states, the normal load N'.
+   pure subroutine flow_law_arguments(self, y, v, z, normal)
+      class(brake_law_flow), intent(in) :: self
+      real(wp), intent(in) :: y(:)
+      real(wp), intent(out) :: v, z(:), normal
+
+      v = y(2) * self%units%velocity
+      z = y(5:4 + self%n_states) * self%scale(1:self%n_states)
+      normal = ((1.0_wp - self%params%kappa) * y(3) + self%params%g_prime) * self%units%force
+   end subroutine flow_law_arguments
 
    ! ---- a set-valued law in slip ----
 

@@ -42,6 +42,8 @@ module friction_brake_orbit
       & find_periodic_orbit, floquet_multipliers, floquet_exponents, bifurcation_period_doubling, &
       & bifurcation_fold, bifurcation_neimark_sacker, halving_walk, branch_values, &
       & modulus_crossing, hyperplane_map
+   use friction_analysis_magnus_section, only: magnus_map
+   use friction_law_kinked, only: kinked_system
    implicit none
    private
 
@@ -105,9 +107,11 @@ module friction_brake_orbit
    !> coordinates (x, y, w, ẑ), ẑ the law's states in units of their scale
    !> (none for arctan), the Jacobian from the variational equations with
    !> the law's partial derivatives (analysis/periodic_orbit.f90's
-   !> hyperplane map).  A trial point whose integration fails returns nowhere.
+   !> hyperplane map; a law with kinks, GMS, the exponential tangent's map of
+   !> analysis/magnus_section.f90 with them located).  A trial point whose
+   !> integration fails returns nowhere.
    type, extends(section_map) :: brake_band_map
-      type(hyperplane_map) :: plane
+      class(section_map), allocatable :: plane
    contains
       procedure :: dimension => band_map_dimension
       procedure :: evaluate => band_map_evaluate
@@ -471,6 +475,9 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(brake_law_flow) :: flow
       type(brake_band_map) :: map
+      type(hyperplane_map) :: plane
+      type(magnus_map) :: exponential
+      type(kinked_system) :: kinked
       type(law_integrator), target :: run
       type(brake_event_table) :: events
       type(error_type), allocatable :: run_error
@@ -496,16 +503,27 @@ contains
       flow%stick_velocity = config%stick_velocity
       ! The flow's coordinate 2 is v_rel (law_model.f90): the band's exit at -σ v_s, the kink at 0.
       level = -limit * config%stick_velocity
-      if (ns > 0) then
+      if (flow%law%kink_count() > 0) then
+         ! The kinks the law declares (GMS's switch bands, whose elements relax at up to ~1e8 1/s): the
+         ! tangent by exponentials over the orbit's steps, each kink a step's end, as the machine's map.
+         allocate (kinked%base, source=flow)
+         allocate (kinked%model, source=flow)
+         call exponential%setup(kinked, config%solver, .false., 0.0_wp, 0.0_wp, 2, level, &
+            & config%t_end - config%t_start, config%event_tolerance, falling=limit > 0.0_wp, &
+            & rearm_level=-limit * config%stick_velocity / 2)
+         allocate (map%plane, source=exponential)
+      else if (ns > 0) then
          ! The states' rates have a kink at v_rel = 0 (|v_rel|, sgn v_rel), which the stick crosses.  A
          ! return must come back from half the band: the bristles' quick oscillation about the band's
          ! edge (stiff σ0) grazes it and would make a fixed point of P with a return time near 0.
-         call map%plane%setup(flow, config%solver, 2, level, config%t_end - config%t_start, config%event_tolerance, &
+         call plane%setup(flow, config%solver, 2, level, config%t_end - config%t_start, config%event_tolerance, &
             & falling=limit > 0.0_wp, kink_coordinate=[2], kink_level=[0.0_wp], &
             & rearm_level=-limit * config%stick_velocity / 2)
+         allocate (map%plane, source=plane)
       else
-         call map%plane%setup(flow, config%solver, 2, level, config%t_end - config%t_start, config%event_tolerance, &
+         call plane%setup(flow, config%solver, 2, level, config%t_end - config%t_start, config%event_tolerance, &
             & falling=limit > 0.0_wp)
+         allocate (map%plane, source=plane)
       end if
       call find_periodic_orbit(map, guess, settings, result%orbit, error)
       if (allocated(error)) return

@@ -36,7 +36,8 @@ module friction_machine_lyapunov
    use friction_law_factory, only: make_law
    use friction_output_law_files, only: law_with_files
    use friction_machine_config, only: machine_config
-   use friction_machine_model, only: machine_smooth, kinked_system
+   use friction_machine_model, only: machine_smooth
+   use friction_law_kinked, only: kinked_system
    use friction_machine_switching, only: machine_switching
    use friction_machine_band, only: machine_band
    use friction_machine_piecewise, only: piecewise_run
@@ -286,7 +287,7 @@ contains
 
          allocate (flow%base, source=system)
          allocate (kinked%base, source=flow)
-         kinked%model = system
+         allocate (kinked%model, source=system)
          m = kinked%event_count()
          call locator%init(kinked, c%solver, spread(event_either, 1, m), spread(.true., 1, m), c%event_tolerance, &
             & h, error)

@@ -15,14 +15,14 @@
 !>   F_s - A (event 1) or F_s + A (event 2) falling through 0.
 module friction_machine_model
    use friction_kinds, only: wp, pi
-   use friction_ode_system, only: ode_system
    use friction_ode_events, only: event_system
    use friction_law, only: sliding_law, max_law_states
+   use friction_law_kinked, only: law_flow
    use friction_machine_config, only: machine_config
    implicit none
    private
 
-   public :: mechanics, machine_smooth, machine_slip, machine_stick, kinked_system
+   public :: mechanics, machine_smooth, machine_slip, machine_stick
 
    !> The mechanism's parameters and the support's motion.
    type :: mechanics
@@ -37,11 +37,9 @@ module friction_machine_model
       procedure :: applied_rate
    end type mechanics
 
-   type, extends(event_system) :: machine_smooth
+   !> (The law, its states' count and scales: law_flow's.)
+   type, extends(law_flow) :: machine_smooth
       type(mechanics) :: m
-      class(sliding_law), allocatable :: law
-      integer :: n_states = 0
-      real(wp) :: scale(max_law_states) = 1.0_wp
    contains
       procedure :: dimension => smooth_dimension
       procedure :: rhs => smooth_rhs
@@ -49,24 +47,8 @@ module friction_machine_model
       procedure :: relative_component => smooth_relative_component
       procedure :: event_count => smooth_event_count
       procedure :: event_values => smooth_event_values
+      procedure :: law_arguments => smooth_law_arguments
    end type machine_smooth
-
-   !> A flow of the machine (in the load point's frame, with the divergence
-   !> appended, ...: its components 2 to 2 + n_states those of `model`) with
-   !> the kinks of model's law's partial derivatives as its events (GMS's
-   !> switch bands), where the exponential tangent's steps end.
-   type, extends(event_system) :: kinked_system
-      class(ode_system), allocatable :: base
-      type(machine_smooth) :: model
-   contains
-      procedure :: dimension => kinked_dimension
-      procedure :: controlled_dimension => kinked_controlled_dimension
-      procedure :: relative_component => kinked_relative_component
-      procedure :: rhs => kinked_rhs
-      procedure :: jacobian => kinked_jacobian
-      procedure :: event_count => kinked_event_count
-      procedure :: event_values => kinked_event_values
-   end type kinked_system
 
    type, extends(event_system) :: machine_slip
       type(mechanics) :: m
@@ -231,64 +213,16 @@ contains
       real(wp), intent(out) :: g(:)
    end subroutine smooth_event_values
 
-   ! ---- a flow with the law's kinks as its events ----
-
-   pure integer function kinked_dimension(self)
-      class(kinked_system), intent(in) :: self
-
-      kinked_dimension = self%base%dimension()
-   end function kinked_dimension
-
-   pure integer function kinked_controlled_dimension(self)
-      class(kinked_system), intent(in) :: self
-
-      kinked_controlled_dimension = self%base%controlled_dimension()
-   end function kinked_controlled_dimension
-
-   pure subroutine kinked_relative_component(self, index, reference, floor)
-      class(kinked_system), intent(in) :: self
-      integer, intent(out) :: index
-      real(wp), intent(out) :: reference, floor
-
-      call self%base%relative_component(index, reference, floor)
-   end subroutine kinked_relative_component
-
-   pure subroutine kinked_rhs(self, t, y, dydt)
-      class(kinked_system), intent(in) :: self
-      real(wp), intent(in) :: t
-      real(wp), intent(in), contiguous :: y(:)
-      real(wp), intent(out), contiguous :: dydt(:)
-
-      call self%base%rhs(t, y, dydt)
-   end subroutine kinked_rhs
-
-   pure subroutine kinked_jacobian(self, t, y, dfdy, dfdt)
-      class(kinked_system), intent(in) :: self
-      real(wp), intent(in) :: t
+   !> The law's arguments at y: the slip rate v - belt, the states, the normal load.
+   pure subroutine smooth_law_arguments(self, y, v, z, normal)
+      class(machine_smooth), intent(in) :: self
       real(wp), intent(in) :: y(:)
-      real(wp), intent(out) :: dfdy(:, :)
-      real(wp), intent(out) :: dfdt(:)
+      real(wp), intent(out) :: v, z(:), normal
 
-      call self%base%jacobian(t, y, dfdy, dfdt)
-   end subroutine kinked_jacobian
-
-   pure integer function kinked_event_count(self)
-      class(kinked_system), intent(in) :: self
-
-      kinked_event_count = self%model%law%kink_count()
-   end function kinked_event_count
-
-   pure subroutine kinked_event_values(self, t, y, g)
-      class(kinked_system), intent(in) :: self
-      real(wp), intent(in) :: t
-      real(wp), intent(in) :: y(:)
-      real(wp), intent(out) :: g(:)
-      integer :: n
-
-      n = self%model%n_states
-      call self%model%law%kinks(y(2) - self%model%m%belt, y(3:2 + n) * self%model%scale(1:n), &
-         & self%model%m%normal, g)
-   end subroutine kinked_event_values
+      v = y(2) - self%m%belt
+      z = y(3:2 + self%n_states) * self%scale(1:self%n_states)
+      normal = self%m%normal
+   end subroutine smooth_law_arguments
 
    ! ---- set-valued laws: slip ----
 

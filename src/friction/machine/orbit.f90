@@ -42,7 +42,7 @@ module friction_machine_orbit
    use friction_machine_config, only: machine_config
    use friction_machine_run, only: machine_run, run_machine
    use friction_machine_switching, only: switching_section
-   use friction_machine_model, only: kinked_system
+   use friction_law_kinked, only: kinked_system
    use friction_machine_band, only: load_frame, band_frame, machine_band, band_none, band_at_section
    use friction_analysis_magnus_section, only: magnus_map
    implicit none
@@ -412,7 +412,7 @@ contains
             type(kinked_system) :: kinked
             if (frame%base%law%kink_count() > 0) then
                allocate (kinked%base, source=frame)
-               kinked%model = frame%base
+               allocate (kinked%model, source=frame%base)
                allocate (flow, source=kinked)
             else
                allocate (flow, source=frame)

@@ -1,0 +1,114 @@
+!> A mechanism's equations of motion with a law's force and states, and the
+!> same flow with the kinks of the law's partial derivatives as its events
+!> (docs/chaos.md, "The tangent of a stiff law"): where the exponential
+!> tangent's steps must end (GMS's switch bands), on the machine and the
+!> brake alike.
+module friction_law_kinked
+   use friction_kinds, only: wp
+   use friction_ode_system, only: ode_system
+   use friction_ode_events, only: event_system
+   use friction_law, only: sliding_law, max_law_states
+   implicit none
+   private
+
+   public :: law_flow, kinked_system
+
+   !> A mechanism's flow with a law: the law, how many states join the
+   !> equations and their scales (in the law's units; the flow integrates
+   !> them in units of their scale), and where in a state the law reads its
+   !> arguments (`law_arguments`, in the law's units).
+   type, abstract, extends(event_system) :: law_flow
+      class(sliding_law), allocatable :: law
+      integer :: n_states = 0
+      real(wp) :: scale(max_law_states) = 1.0_wp
+   contains
+      procedure(arguments_interface), deferred :: law_arguments
+   end type law_flow
+
+   abstract interface
+      !> The law's sliding velocity v, states z (n_states of them) and normal load at the flow's state y.
+      pure subroutine arguments_interface(self, y, v, z, normal)
+         import :: law_flow, wp
+         class(law_flow), intent(in) :: self
+         real(wp), intent(in) :: y(:)
+         real(wp), intent(out) :: v, z(:), normal
+      end subroutine arguments_interface
+   end interface
+
+   !> A flow of the mechanism (`model` itself, or in another frame, with the
+   !> divergence appended, ...: its leading components those of `model`) with
+   !> the kinks of model's law's partial derivatives as its events.
+   type, extends(event_system) :: kinked_system
+      class(ode_system), allocatable :: base
+      class(law_flow), allocatable :: model
+   contains
+      procedure :: dimension => kinked_dimension
+      procedure :: controlled_dimension => kinked_controlled_dimension
+      procedure :: relative_component => kinked_relative_component
+      procedure :: rhs => kinked_rhs
+      procedure :: jacobian => kinked_jacobian
+      procedure :: event_count => kinked_event_count
+      procedure :: event_values => kinked_event_values
+   end type kinked_system
+
+contains
+
+   pure integer function kinked_dimension(self)
+      class(kinked_system), intent(in) :: self
+
+      kinked_dimension = self%base%dimension()
+   end function kinked_dimension
+
+   pure integer function kinked_controlled_dimension(self)
+      class(kinked_system), intent(in) :: self
+
+      kinked_controlled_dimension = self%base%controlled_dimension()
+   end function kinked_controlled_dimension
+
+   pure subroutine kinked_relative_component(self, index, reference, floor)
+      class(kinked_system), intent(in) :: self
+      integer, intent(out) :: index
+      real(wp), intent(out) :: reference, floor
+
+      call self%base%relative_component(index, reference, floor)
+   end subroutine kinked_relative_component
+
+   pure subroutine kinked_rhs(self, t, y, dydt)
+      class(kinked_system), intent(in) :: self
+      real(wp), intent(in) :: t
+      real(wp), intent(in), contiguous :: y(:)
+      real(wp), intent(out), contiguous :: dydt(:)
+
+      call self%base%rhs(t, y, dydt)
+   end subroutine kinked_rhs
+
+   pure subroutine kinked_jacobian(self, t, y, dfdy, dfdt)
+      class(kinked_system), intent(in) :: self
+      real(wp), intent(in) :: t
+      real(wp), intent(in) :: y(:)
+      real(wp), intent(out) :: dfdy(:, :)
+      real(wp), intent(out) :: dfdt(:)
+
+      call self%base%jacobian(t, y, dfdy, dfdt)
+   end subroutine kinked_jacobian
+
+   pure integer function kinked_event_count(self)
+      class(kinked_system), intent(in) :: self
+
+      kinked_event_count = self%model%law%kink_count()
+   end function kinked_event_count
+
+   pure subroutine kinked_event_values(self, t, y, g)
+      class(kinked_system), intent(in) :: self
+      real(wp), intent(in) :: t
+      real(wp), intent(in) :: y(:)
+      real(wp), intent(out) :: g(:)
+      real(wp) :: v, z(max_law_states), normal
+      integer :: n
+
+      n = self%model%n_states
+      call self%model%law_arguments(y, v, z(1:n), normal)
+      call self%model%law%kinks(v, z(1:n), normal, g)
+   end subroutine kinked_event_values
+
+end module friction_law_kinked
