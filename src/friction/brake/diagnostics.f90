@@ -355,7 +355,8 @@ contains
    !> the step (analysis/tangent_magnus.f90, as the machine's), the logs
    !> summed over each renormalisation interval.  The flow's events (the
    !> creep band's edges) change neither the field nor the state: Φ needs no
-   !> saltation there, and the stepper does not stop at them.  `divergence`:
+   !> saltation there, and the stepper does not stop at them; the kinks a law
+   !> declares (GMS's switch bands) it does stop at, as the machine's (kinked_system).  `divergence`:
    !> ∫ tr J dt by Simpson's rule on each step (simpson_trace) over the
    !> span's length, what the exponents sum to.
    subroutine law_flow_spectrum(config, settings, result, divergence, error, guard, reporter)
