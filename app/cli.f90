@@ -11,11 +11,15 @@
 !> MPI is started only for a job launched by an MPI launcher (mpirun, srun,
 !> mpiexec: see launched()) or with FRICTION_MPI=1; any other run is serial,
 !> through the same job code, without MPI_Init and its start-up time.
-!> --help, --version, --netlist and usage errors never start MPI.
+!> --help, --version, --netlist and usage errors never start MPI.  The same
+!> code makes two programs (docs/layout.md, The two programs): friction,
+!> serial, which loads no MPI library and hands a launched job to the
+!> parallel program friction-mpi beside it (hand_over), and friction-mpi.
 module friction_app_cli
-   use, intrinsic :: iso_c_binding, only: c_int
+   use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char
    use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
-   use mpi_f08
+   use friction_parallel, only: communicator, serial_comm, world_comm, parallel_built, start_parallel, &
+      & finish_parallel, parallel_library
    use friction_error, only: error_type, error_input, error_io, error_interrupted, fatal_error
    use friction_version, only: version_string, revision_string, compiler_string, hdf5_version_string, &
       & gsl_version_string, fftw_version_string, cpu_target_string, table_kernels_string
@@ -35,9 +39,22 @@ module friction_app_cli
       end subroutine c_exit
       subroutine friction_ignore_write_signals() bind(c)
       end subroutine friction_ignore_write_signals
+      !> Run `name` from this program's directory in this process, with the
+      !> same arguments (app/hand_over.c); returns only if it could not, with
+      !> the path tried and why in `message` (NUL-terminated).
+      subroutine friction_hand_over(name, message, length) bind(c)
+         import :: c_int, c_char
+         character(kind=c_char), intent(in) :: name(*)
+         character(kind=c_char), intent(out) :: message(*)
+         integer(c_int), value :: length
+      end subroutine friction_hand_over
    end interface
 
-   integer, parameter :: exit_usage = 2, exit_input = 3, exit_numerical = 4, exit_io = 5, exit_interrupted = 6
+   integer, parameter :: exit_usage = 2, exit_input = 3, exit_numerical = 4, exit_io = 5, exit_interrupted = 6, &
+      & exit_no_parallel = 7
+
+   !> The program that runs launched jobs, installed beside this one.
+   character(len=*), parameter :: parallel_program = 'friction-mpi'
 
    type :: options
       character(len=:), allocatable :: output
@@ -66,7 +83,7 @@ contains
       integer :: rank, code, stat
       character(len=:), allocatable :: message
       logical :: mpi_started
-      type(MPI_Comm) :: comm
+      type(communicator) :: comm
 
       mpi_started = .false.
       reporter%t_start = wall_seconds()
@@ -79,7 +96,7 @@ contains
       code = parse_arguments(opts)
       if (code >= 0) call finish(code)
       reporter%quiet = opts%quiet
-      comm = MPI_COMM_NULL
+      comm = serial_comm()
       if (opts%print_input) then
          ! One process prints the resolved input, without MPI.
          if (rank /= 0) call finish(0)
@@ -99,10 +116,11 @@ contains
          opts%output = opts%netlist
       else
          if (launched() .or. forced_mpi()) then
-            call MPI_Init()
+            if (.not. parallel_built()) call hand_over()
+            call start_parallel(.false., stat)
             mpi_started = .true.
-            comm = MPI_COMM_WORLD
-            call MPI_Comm_rank(comm, rank)
+            comm = world_comm()
+            rank = comm%rank()
          end if
          call warn_lone_tasks(comm)
          if (.not. allocated(opts%output)) opts%output = default_output(opts%files(1))
@@ -127,6 +145,27 @@ contains
 
    contains
 
+      !> The serial program under a launcher (or FRICTION_MPI=1): the parallel
+      !> program beside it runs the job, in this process, with the same
+      !> arguments.  Without it, every rank stops with exit code 7 (rank 0 says why).
+      subroutine hand_over()
+         character(kind=c_char) :: buffer(4096)
+         character(len=:), allocatable :: why
+         integer :: k
+
+         call friction_hand_over(parallel_program//c_null_char, buffer, int(size(buffer), c_int))
+         why = ''
+         do k = 1, size(buffer)
+            if (buffer(k) == c_null_char) exit
+            why = why//buffer(k)
+         end do
+         if (rank == 0) call say(reporter, 'friction: error: this program is serial, and a launcher started it ' &
+            & //'(or FRICTION_MPI=1 asked for MPI); the parallel program that runs such jobs cannot be started: ' &
+            & //why//'; install '//parallel_program//' beside friction (it is built and installed with it), ' &
+            & //'or run without a launcher')
+         call finish(exit_no_parallel)
+      end subroutine hand_over
+
 
       !> Whether an MPI launcher started this process: Open MPI's mpirun
       !> (OMPI_COMM_WORLD_SIZE, OMPI_UNIVERSE_SIZE), any PMIx launcher (PMIX_RANK:
@@ -150,7 +189,7 @@ contains
       !> --mpi=pmix): each task would compute the whole job alone and write the
       !> same output.  Task 0 says so; the run goes on as asked.
       subroutine warn_lone_tasks(comm)
-         type(MPI_Comm), intent(in) :: comm
+         type(communicator), intent(in) :: comm
          character(len=32) :: text
          integer :: tasks, ranks, length, stat
 
@@ -158,8 +197,7 @@ contains
          if (stat /= 0 .or. length == 0) return
          read (text, *, iostat=stat) tasks
          if (stat /= 0 .or. tasks <= 1) return
-         ranks = 1
-         if (comm /= MPI_COMM_NULL) call MPI_Comm_size(comm, ranks)
+         ranks = comm%size()
          if (ranks > 1 .or. launcher_rank() /= 0) return
          write (error_unit, '(a,i0,a)') 'friction: warning: Slurm started ', tasks, ' tasks, but they are not one '// &
             & 'MPI job: each runs the whole job alone and writes the same output. Launch with srun --mpi=pmix '// &
@@ -393,30 +431,25 @@ contains
             & 'exit codes: 0 done, 2 usage, 3 bad input, 4 integration failed, 5 output failed', &
             & '            (a full disk, ulimit -f, or stderr or stdout closed: 2>&1 | head),', &
             & '            6 interrupted (a sweep''s file written with the points done, a map''s', &
-            & '            lines done checkpointed, --resume; a brake trajectory: nothing written)'
+            & '            lines done checkpointed, --resume; a brake trajectory: nothing written),', &
+            & '            7 launched, but the parallel program friction-mpi is missing beside friction'
          if (stat /= 0) reporter%lost = .true.
       end subroutine print_help
 
       !> The version's first line as before (scripts read it), then what the
       !> program was built with and what it chooses on this processor.  MPI's
-      !> is the library's own (MPI_Get_library_version may precede MPI_Init).
+      !> is the library's own (the serial program has none).
       subroutine print_version(stat)
          integer, intent(out) :: stat
-         character(len=MPI_MAX_LIBRARY_VERSION_STRING) :: mpi_text
          character(len=:), allocatable :: cpu
-         integer :: length, cut
 
-         call MPI_Get_library_version(mpi_text, length)
-         mpi_text = mpi_text(1:max(0, min(length, len(mpi_text))))
-         cut = scan(mpi_text, new_line('a')//achar(0))
-         if (cut > 0) mpi_text = mpi_text(1:cut - 1)
          cpu = cpu_target_string
          if (len(cpu) == 0) cpu = 'the compiler''s default'
          write (output_unit, '(a)', iostat=stat) 'friction '//version_string, &
             & '  revision     '//revision_string, &
             & '  compiler     '//compiler_string//' (processor level: '//cpu//')', &
-            & '  MPI          '//trim(mpi_text), &
-            & '  HDF5         '//hdf5_version_string//' (parallel)', &
+            & '  MPI          '//parallel_library(), &
+            & '  HDF5         '//hdf5_version_string//trim(merge(' (parallel)', ' (serial)  ', parallel_built())), &
             & '  GSL          '//gsl_version_string, &
             & '  FFTW         '//fftw_version_string, &
             & '  kernels      the surface table''s: '//table_kernels_string()
@@ -446,7 +479,7 @@ contains
 
          flush (error_unit, iostat=stat)
          flush (output_unit, iostat=stat)
-         if (mpi_started) call MPI_Finalize()
+         if (mpi_started) call finish_parallel()
          flush (error_unit, iostat=stat)
          flush (output_unit, iostat=stat)
          status = code

@@ -1,4 +1,5 @@
-# Finds GSL, FFTW3, LAPACK, parallel HDF5 with Fortran, and MPI with mpi_f08.  A
+# Finds GSL, FFTW3, LAPACK, parallel HDF5 with Fortran and the serial build of
+# the same HDF5 (for the serial program), and MPI with mpi_f08.  A
 # missing dependency stops configuration with the Debian package to install
 # (scripts/install-deps installs them all).
 
@@ -149,3 +150,65 @@ add_library(friction::hdf5_program INTERFACE IMPORTED)
 # met only by libraries that follow it.)
 target_link_libraries(friction::hdf5_program INTERFACE friction::hdf5_headers
   ${friction_hdf5_program_libraries} MPI::MPI_C)
+
+# The serial program's HDF5 (docs/layout.md, The two programs): Debian's
+# serial build of the same HDF5 (libhdf5-dev), whose libraries link no MPI,
+# in place of each of the parallel build's own libraries, archives or
+# shared as above.  The code is compiled once, against the parallel
+# build's Fortran modules: the two builds are of one HDF5 source, the
+# serial one without the MPI-IO driver, which only the MPI side of
+# src/friction/core/parallel.f90 calls; so the versions must be the same.
+# Without a serial HDF5 of that version (a cluster's modules, say) the
+# program friction is the parallel one, as friction-mpi is, and says so.
+find_path(FRICTION_SERIAL_HDF5_DIR NAMES libhdf5_fortran.so libhdf5_fortran.a
+  PATHS /usr/lib/${CMAKE_LIBRARY_ARCHITECTURE}/hdf5/serial NO_DEFAULT_PATH
+  DOC "The folder of the serial HDF5's libraries (libhdf5_fortran), for the serial program")
+set(FRICTION_SERIAL_PROGRAM OFF)
+set(friction_serial_why "no serial HDF5 (on Debian/Ubuntu: sudo apt-get install libhdf5-dev)")
+if(FRICTION_SERIAL_HDF5_DIR)
+  set(FRICTION_SERIAL_PROGRAM ON)
+  set(friction_hdf5_serial_program_libraries)
+  set(friction_parallel_hdf5_dir "")
+  foreach(library IN LISTS friction_hdf5_program_libraries)
+    get_filename_component(library_name "${library}" NAME)
+    if(library_name MATCHES "^libhdf5.*\\.(a|so)$")
+      get_filename_component(friction_parallel_hdf5_dir "${library}" DIRECTORY)
+      set(serial_library "${FRICTION_SERIAL_HDF5_DIR}/${library_name}")
+      if(NOT EXISTS "${serial_library}")
+        set(FRICTION_SERIAL_PROGRAM OFF)
+        set(friction_serial_why "the serial HDF5 in ${FRICTION_SERIAL_HDF5_DIR} has no ${library_name}")
+      endif()
+      list(APPEND friction_hdf5_serial_program_libraries "${serial_library}")
+    elseif(NOT library_name MATCHES "mpi")
+      list(APPEND friction_hdf5_serial_program_libraries "${library}")
+    endif()
+  endforeach()
+  # The same version: each build's libhdf5.settings says which.
+  foreach(build parallel serial)
+    if(build STREQUAL "parallel")
+      set(settings "${friction_parallel_hdf5_dir}/libhdf5.settings")
+    else()
+      set(settings "${FRICTION_SERIAL_HDF5_DIR}/libhdf5.settings")
+    endif()
+    set(friction_hdf5_${build}_version "unknown")
+    if(EXISTS "${settings}")
+      file(STRINGS "${settings}" version_line REGEX "HDF5 Version:")
+      string(REGEX REPLACE ".*HDF5 Version: *([^ ]+).*" "\\1" friction_hdf5_${build}_version "${version_line}")
+    endif()
+  endforeach()
+  if(NOT friction_hdf5_parallel_version STREQUAL friction_hdf5_serial_version
+     OR friction_hdf5_serial_version STREQUAL "unknown")
+    set(FRICTION_SERIAL_PROGRAM OFF)
+    set(friction_serial_why "the serial HDF5 (${FRICTION_SERIAL_HDF5_DIR}) is version "
+      "${friction_hdf5_serial_version}, the parallel one ${friction_hdf5_parallel_version}")
+  endif()
+endif()
+add_library(friction::hdf5_serial_program INTERFACE IMPORTED)
+if(FRICTION_SERIAL_PROGRAM)
+  message(STATUS "friction: the program friction is serial (loads no MPI), with the HDF5 in ${FRICTION_SERIAL_HDF5_DIR}")
+  target_link_libraries(friction::hdf5_serial_program INTERFACE friction::hdf5_headers
+    ${friction_hdf5_serial_program_libraries})
+else()
+  string(CONCAT friction_serial_why ${friction_serial_why})
+  message(STATUS "friction: the program friction is the parallel one, as friction-mpi: ${friction_serial_why}")
+endif()

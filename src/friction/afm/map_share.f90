@@ -4,7 +4,7 @@
 !> to checkpoints beside the output for --resume, and at a temperature
 !> their standard errors and slips.
 module friction_afm_map_share
-   use mpi_f08, only: MPI_Allgather, MPI_Allgatherv, MPI_INTEGER, MPI_DOUBLE_PRECISION
+   use friction_parallel, only: gather_all, gather_all_varying
    use friction_kinds, only: wp
    use friction_error, only: error_type, fatal_error, error_input
    use friction_files, only: available_memory, remove_file
@@ -271,14 +271,13 @@ contains
          call move_alloc(self%slips, slips)
          return
       end if
-      call MPI_Allgather(n, 1, MPI_INTEGER, counts, 1, MPI_INTEGER, job%comm)
+      call gather_all(job%comm, n, counts)
       displacements(1) = 0
       do r = 2, job%nranks
          displacements(r) = displacements(r - 1) + counts(r - 1)
       end do
       allocate (everything(n_slip_items, sum(counts)))
-      call MPI_Allgatherv(self%slips, n_slip_items * n, MPI_DOUBLE_PRECISION, everything, &
-         & n_slip_items * counts, n_slip_items * displacements, MPI_DOUBLE_PRECISION, job%comm)
+      call gather_all_varying(job%comm, self%slips, counts, displacements, everything)
       allocate (slips(n_slip_items, sum(counts)))
       cursor = displacements
       at = 0

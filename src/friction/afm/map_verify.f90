@@ -3,8 +3,7 @@
 !> each force component over every rank's samples of both trips; beyond
 !> check_limit the run fails (nothing written).
 module friction_afm_map_verify
-   use mpi_f08, only: MPI_Allreduce, MPI_IN_PLACE, MPI_INTEGER, MPI_INTEGER8, MPI_DOUBLE_PRECISION, MPI_MAX, &
-      & MPI_SUM
+   use friction_parallel, only: reduce_all, op_sum, op_max
    use friction_kinds, only: wp
    use friction_error, only: error_type, fatal_error, error_interrupted, error_numerical
    use friction_strings, only: etoa
@@ -76,7 +75,7 @@ contains
          if (allocated(error)) error%message = 'verify run: '//error%message
          call agree_on_error(job, error)
          if (allocated(error)) return
-         if (job%parallel()) call MPI_Allreduce(MPI_IN_PLACE, stopped, 1, MPI_INTEGER, MPI_MAX, job%comm)
+         call reduce_all(job%comm, stopped, op_max)
          if (stopped /= 0) then
             call map%save_lines(map%count, error)
             if (.not. allocated(error)) call fatal_error(error, 'map interrupted in its &verify run: no file ' &
@@ -89,8 +88,8 @@ contains
          check_stats = checker%statistics()
          record%rhs_evaluations = check_stats%rhs_evaluations
          if (job%parallel()) then
-            call MPI_Allreduce(MPI_IN_PLACE, record%max_difference, 3, MPI_DOUBLE_PRECISION, MPI_MAX, job%comm)
-            call MPI_Allreduce(MPI_IN_PLACE, record%rhs_evaluations, 1, MPI_INTEGER8, MPI_SUM, job%comm)
+            call reduce_all(job%comm, record%max_difference, op_max)
+            call reduce_all(job%comm, record%rhs_evaluations, op_sum)
          end if
          if (job%rank == 0) then
             call reporter%note('verify: '//trim(record%method)//' at rtol '//etoa(record%rtol, 2)//', atol ' &

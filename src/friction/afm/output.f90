@@ -1,7 +1,7 @@
 !> The friction-force-map file (docs/output.md).  Collective: all
 !> ranks call it; each passes the block of lines it computed.
 module friction_afm_output
-   use mpi_f08, only: MPI_Comm
+   use friction_parallel, only: communicator
    use friction_kinds, only: wp, i8
    use friction_error, only: error_type
    use friction_ode_solver, only: integrator_statistics
@@ -87,7 +87,7 @@ contains
    subroutine write_afm_file(path, comm, config, first, stride, trace, retrace, summary, error, surface, thermal, &
       & verify)
       character(len=*), intent(in) :: path
-      type(MPI_Comm), intent(in) :: comm
+      type(communicator), intent(in) :: comm
       type(afm_config), intent(in) :: config
       integer, intent(in) :: first, stride
       real(wp), intent(in) :: trace(:, :, :), retrace(:, :, :)

@@ -2,7 +2,7 @@
 !> by line (docs/physics.md).  Lines are dealt round-robin over the ranks;
 !> the file is written together, each rank its own lines.
 module friction_afm_scene
-   use mpi_f08
+   use friction_parallel, only: reduce_all, op_sum, op_max
    use friction_kinds, only: wp, i8
    use friction_error, only: error_type, fatal_error, error_input, error_interrupted, error_numerical
    use friction_strings, only: itoa, bytes_text
@@ -16,7 +16,7 @@ module friction_afm_scene
    use friction_scene, only: scene, point_result, point_memory, result_sink
    use friction_scene_report, only: job_reporter
    use friction_scene_context, only: job_context, agree_on_error, ranks_text, share_of, job_wall_time, &
-      & job_sharing, mpi_sharing
+      & job_sharing, rank_sharing
    use friction_afm_tip, only: model_overdamped, model_quasistatic
    use friction_afm_config, only: afm_config, auto_method, new_potential, species_count, scan_region, surface_fourier, &
       & with_attempt_damping
@@ -161,7 +161,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(afm_scanner), target :: scanner
       class(surface_potential), allocatable :: potential
-      type(mpi_sharing) :: share
+      type(rank_sharing) :: share
       type(line_record) :: line
       integer(i8) :: counts(4)
       integer :: j, flag
@@ -232,7 +232,7 @@ contains
          call agree_on_error(job, error)
          if (allocated(error)) return
          flag = merge(1, 0, interrupted)
-         if (job%parallel()) call MPI_Allreduce(MPI_IN_PLACE, flag, 1, MPI_INTEGER, MPI_MAX, job%comm)
+         call reduce_all(job%comm, flag, op_max)
          if (flag /= 0) then
             call fatal_error(error, 'map interrupted: no file written; the lines done are checkpointed beside ' &
                & //'the output ('//line_checkpoint_name(job%output, 0)//' ...): run again with --resume to ' &
@@ -252,7 +252,7 @@ contains
          ! The counts of every line, computed now or loaded: a resumed map
          ! records what an uninterrupted one does.
          counts = nint(sum(map%line_counts, dim=2), i8)
-         if (job%parallel()) call MPI_Allreduce(MPI_IN_PLACE, counts, 4, MPI_INTEGER8, MPI_SUM, job%comm)
+         call reduce_all(job%comm, counts, op_sum)
          ! (Component by component: gfortran's structure constructor mis-sizes a
          ! deferred-length component copied from another derived type's.)
          self%record%input_text = job%input_text
@@ -300,7 +300,7 @@ contains
          character(len=:), allocatable :: warning
 
          worst = following_bias(self%ran, scanner%tip, self%map%trace, self%map%retrace)
-         if (job%parallel()) call MPI_Allreduce(MPI_IN_PLACE, worst, 1, MPI_DOUBLE_PRECISION, MPI_MAX, job%comm)
+         call reduce_all(job%comm, worst, op_max)
          warning = following_bias_warning(self%ran, worst)
          if (job%rank == 0 .and. len(warning) > 0) call reporter%note('warning: '//warning)
       end subroutine check_following
@@ -314,7 +314,7 @@ contains
             sums = [sum(trace(:, :, q_f_along)), real(size(trace(:, :, q_f_along)), wp)]
             if (self%ran%retrace) sums(1) = 0.5_wp * (sums(1) - sum(retrace(:, :, q_f_along)))
          end associate
-         if (job%parallel()) call MPI_Allreduce(MPI_IN_PLACE, sums, 2, MPI_DOUBLE_PRECISION, MPI_SUM, job%comm)
+         call reduce_all(job%comm, sums, op_sum)
          warning = quasistatic_friction_warning(self%ran, sums(1) / max(1.0_wp, sums(2)))
          if (job%rank == 0 .and. len(warning) > 0) call reporter%note('warning: '//warning)
       end subroutine check_friction

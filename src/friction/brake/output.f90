@@ -2,7 +2,7 @@
 !> rank calls it with the same data (rank 0 computed it and broadcast it;
 !> the datasets are small), and rank 0 writes the values.
 module friction_brake_output
-   use mpi_f08, only: MPI_Comm
+   use friction_parallel, only: communicator
    use friction_kinds, only: wp, i8
    use friction_error, only: error_type
    use friction_strings, only: join
@@ -69,7 +69,7 @@ contains
 
    subroutine write_brake_file(path, comm, config, trajectory, events, summary, check, error, diagnostics)
       character(len=*), intent(in) :: path
-      type(MPI_Comm), intent(in) :: comm
+      type(communicator), intent(in) :: comm
       type(brake_config), intent(in) :: config
       type(brake_trajectory), intent(in) :: trajectory
       type(brake_event_table), intent(in) :: events

@@ -5,7 +5,7 @@
 !> the collective writes with the same data; the file does not depend on
 !> the number of ranks.
 module friction_brake_scene
-   use mpi_f08
+   use friction_parallel, only: broadcast
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
    use friction_kinds, only: wp, i8
    use friction_strings, only: fixed_text, etoa, itoa
@@ -433,17 +433,17 @@ contains
          run%n = n
          run%done = n
       end if
-      call MPI_Bcast(counts, 4, MPI_INTEGER8, root, job%comm)
-      call MPI_Bcast(times, 2, MPI_DOUBLE_PRECISION, root, job%comm)
-      call MPI_Bcast(n_events, 1, MPI_INTEGER, root, job%comm)
+      call broadcast(job%comm, counts, root)
+      call broadcast(job%comm, times, root)
+      call broadcast(job%comm, n_events, root)
       compute_time = times(1)
       stick_time = times(2)
-      call MPI_Bcast(run%trajectory%t, n, MPI_DOUBLE_PRECISION, root, job%comm)
-      call MPI_Bcast(run%trajectory%x, n, MPI_DOUBLE_PRECISION, root, job%comm)
-      call MPI_Bcast(run%trajectory%v, n, MPI_DOUBLE_PRECISION, root, job%comm)
-      call MPI_Bcast(run%trajectory%y, n, MPI_DOUBLE_PRECISION, root, job%comm)
-      call MPI_Bcast(run%trajectory%w, n, MPI_DOUBLE_PRECISION, root, job%comm)
-      call MPI_Bcast(run%trajectory%stick, n, MPI_INTEGER, root, job%comm)
+      call broadcast(job%comm, run%trajectory%t(1:n), root)
+      call broadcast(job%comm, run%trajectory%x(1:n), root)
+      call broadcast(job%comm, run%trajectory%v(1:n), root)
+      call broadcast(job%comm, run%trajectory%y(1:n), root)
+      call broadcast(job%comm, run%trajectory%w(1:n), root)
+      call broadcast(job%comm, run%trajectory%stick(1:n), root)
       if (job%rank /= root) then
          run%events%n = n_events
          if (allocated(run%events%t)) deallocate (run%events%t, run%events%kind, run%events%state)
@@ -451,9 +451,9 @@ contains
             & run%events%state(4, max(1, n_events)))
       end if
       if (n_events > 0) then
-         call MPI_Bcast(run%events%t, n_events, MPI_DOUBLE_PRECISION, root, job%comm)
-         call MPI_Bcast(run%events%kind, n_events, MPI_INTEGER, root, job%comm)
-         call MPI_Bcast(run%events%state, 4 * n_events, MPI_DOUBLE_PRECISION, root, job%comm)
+         call broadcast(job%comm, run%events%t(1:n_events), root)
+         call broadcast(job%comm, run%events%kind(1:n_events), root)
+         call broadcast(job%comm, run%events%state(:, 1:n_events), root)
       end if
    end subroutine share_brake_run
 

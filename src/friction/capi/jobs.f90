@@ -3,8 +3,8 @@
 !> one at a time in the process (job_lock.c), on MPI_COMM_WORLD or serially.
 module friction_capi_jobs
    use, intrinsic :: iso_c_binding, only: c_ptr, c_int, c_associated, c_f_pointer, c_funptr, c_f_procpointer
-   use mpi_f08, only: MPI_Comm, MPI_Initialized, MPI_Finalized, MPI_Init_thread, MPI_THREAD_FUNNELED, &
-      & MPI_COMM_WORLD, MPI_COMM_NULL
+   use friction_parallel, only: communicator, serial_comm, world_comm, start_parallel, parallel_started, &
+      & parallel_finished
    use friction_error, only: error_type, fatal_error, error_input
    use friction_strings, only: itoa
    use friction_job, only: run_job, run_job_config
@@ -37,38 +37,35 @@ contains
 
    !> The flags' checks and the job's communicator: MPI_COMM_WORLD when the
    !> caller initialised MPI, or when it passes FRICTION_JOB_INIT_MPI (MPI is
-   !> initialised here); otherwise MPI_COMM_NULL, a serial job on this process
+   !> initialised here); otherwise one not attached, a serial job on this process
    !> that makes no MPI call.
    subroutine prepare_job(flags, comm, error)
       integer(c_int), intent(in) :: flags
-      type(MPI_Comm), intent(out) :: comm
+      type(communicator), intent(out) :: comm
       type(error_type), allocatable, intent(inout) :: error
-      logical :: ready, finished
-      integer :: provided, ierror
+      integer :: ierror
 
-      comm = MPI_COMM_NULL
+      comm = serial_comm()
       if (allocated(error)) return
       if (iand(flags, not(job_force + job_resume + job_init_mpi)) /= 0) then
          call fatal_error(error, 'flags = '//itoa(int(flags))//': unknown bits (known: FRICTION_JOB_FORCE, ' &
             & //'FRICTION_JOB_RESUME, FRICTION_JOB_INIT_MPI)', error_input)
          return
       end if
-      call MPI_Finalized(finished)
-      if (finished) then
+      if (parallel_finished()) then
          call fatal_error(error, 'MPI has been finalized: a job needs MPI (call it before MPI_Finalize)', &
             & error_input)
          return
       end if
-      call MPI_Initialized(ready)
-      if (.not. ready) then
+      if (.not. parallel_started()) then
          if (iand(flags, job_init_mpi) == 0) return   ! serial, without MPI
-         call MPI_Init_thread(MPI_THREAD_FUNNELED, provided, ierror)
+         call start_parallel(.true., ierror)
          if (ierror /= 0) then
             call fatal_error(error, 'MPI_Init_thread failed (error '//itoa(ierror)//')', error_input)
             return
          end if
       end if
-      comm = MPI_COMM_WORLD
+      comm = world_comm()
    end subroutine prepare_job
 
    !> int friction_run_job(const char *const *files, int nfiles, const char *output, int flags,
@@ -83,7 +80,7 @@ contains
       character(len=4096), allocatable :: paths(:)
       character(len=:), allocatable :: summary, path
       type(callback_reporter) :: reporter
-      type(MPI_Comm) :: comm
+      type(communicator) :: comm
       integer :: k
 
       allocate (paths(0))
@@ -138,7 +135,7 @@ contains
       type(error_type), allocatable :: error
       character(len=:), allocatable :: summary
       type(callback_reporter) :: reporter
-      type(MPI_Comm) :: comm
+      type(communicator) :: comm
 
       if (config_of(cfg, config, error)) then
          if (.not. c_associated(output)) call fatal_error(error, 'output is a null pointer', error_input)

@@ -4,7 +4,7 @@
 !> every rank returns the same error or none.  Progress and notes go to the
 !> caller's reporter (rank 0 only); nothing is printed.
 module friction_job
-   use mpi_f08
+   use friction_parallel, only: communicator, broadcast, reduce_all, op_max
    use friction_kinds, only: wp
    use friction_clock, only: wall_seconds
    use friction_error, only: error_type, fatal_error, error_input
@@ -35,7 +35,7 @@ contains
       character(len=*), intent(in) :: output
       logical, intent(in) :: force, resume
       character(len=*), intent(in), optional :: overrides(:)
-      type(MPI_Comm), intent(in) :: comm
+      type(communicator), intent(in) :: comm
       class(job_reporter), intent(inout) :: reporter
       character(len=:), allocatable, intent(out) :: summary
       type(error_type), allocatable, intent(out) :: error
@@ -73,7 +73,7 @@ contains
       type(job_config), intent(in) :: config
       character(len=*), intent(in) :: output
       logical, intent(in) :: force, resume
-      type(MPI_Comm), intent(in) :: comm
+      type(communicator), intent(in) :: comm
       class(job_reporter), intent(inout) :: reporter
       character(len=:), allocatable, intent(out) :: summary
       type(error_type), allocatable, intent(out) :: error
@@ -113,7 +113,7 @@ contains
    !> Collective over `comm`; warnings go to the reporter.
    subroutine resolve_input(files, comm, reporter, text, error, overrides)
       character(len=*), intent(in) :: files(:)
-      type(MPI_Comm), intent(in) :: comm
+      type(communicator), intent(in) :: comm
       class(job_reporter), intent(inout) :: reporter
       character(len=:), allocatable, intent(out) :: text
       type(error_type), allocatable, intent(out) :: error
@@ -155,7 +155,7 @@ contains
 
    !> A job's context on `comm`, its clock started.
    subroutine start_job(comm, output, resume, job)
-      type(MPI_Comm), intent(in) :: comm
+      type(communicator), intent(in) :: comm
       character(len=*), intent(in) :: output
       logical, intent(in) :: resume
       type(job_context), intent(out) :: job
@@ -166,17 +166,17 @@ contains
       job%resume = resume
    end subroutine start_job
 
-   !> The job's communicator, rank and size; MPI_COMM_NULL: serial, MPI not started.
+   !> The job's communicator, rank and size; one not attached: serial, MPI not started.
    subroutine set_comm(comm, job)
-      type(MPI_Comm), intent(in) :: comm
+      type(communicator), intent(in) :: comm
       type(job_context), intent(inout) :: job
 
       job%comm = comm
       job%rank = 0
       job%nranks = 1
       if (.not. job%parallel()) return
-      call MPI_Comm_rank(comm, job%rank)
-      call MPI_Comm_size(comm, job%nranks)
+      job%rank = comm%rank()
+      job%nranks = comm%size()
    end subroutine set_comm
 
    !> The common body of run_job and run_job_config: a checked
@@ -227,7 +227,7 @@ contains
 
       if (.not. job%parallel()) return
       rank0_failed = merge(1, 0, allocated(error))
-      call MPI_Bcast(rank0_failed, 1, MPI_INTEGER, 0, job%comm)
+      call broadcast(job%comm, rank0_failed, 0)
       if (job%rank == 0 .or. rank0_failed /= 0 .or. .not. allocated(error)) return
       do k = 1, size(files)
          if (path_kind(trim(files(k)), follow=.true.) /= kind_regular) then
@@ -250,9 +250,9 @@ contains
 
       if (.not. job%parallel()) return
       hash = text_hash(job%input_text)
-      call MPI_Bcast(hash, 16, MPI_CHARACTER, 0, job%comm)
+      call broadcast(job%comm, hash, 0)
       differs = merge(1, 0, hash /= text_hash(job%input_text))
-      call MPI_Allreduce(MPI_IN_PLACE, differs, 1, MPI_INTEGER, MPI_MAX, job%comm)
+      call reduce_all(job%comm, differs, op_max)
       if (differs == 0) return
       culprit = 0
       do k = 1, size(job%files)
@@ -321,7 +321,7 @@ contains
       character(len=*), intent(in), optional :: overrides(:)
       character(len=*), intent(in) :: path
       logical, intent(in) :: force
-      type(MPI_Comm), intent(in) :: comm
+      type(communicator), intent(in) :: comm
       class(job_reporter), intent(inout) :: reporter
       character(len=:), allocatable, intent(out) :: summary
       type(error_type), allocatable, intent(out) :: error

@@ -13,7 +13,7 @@
 !> the end (sweep_output.f90).  Memory per rank does not grow with the
 !> number of points: no rank holds an array over all points.
 module friction_job_sweep
-   use mpi_f08
+   use friction_parallel, only: broadcast, reduce_all, gather_to_root, op_sum, op_max, op_min
    use friction_kinds, only: wp
    use friction_error, only: error_type, fatal_error, error_interrupted, error_input, error_numerical
    use friction_strings, only: itoa, text_hash, bytes_text
@@ -81,8 +81,8 @@ contains
       call agree_on_error(job, error)
       if (allocated(error)) return
       if (job%parallel()) then
-         call MPI_Bcast(n_work, 1, MPI_INTEGER, 0, job%comm)
-         call MPI_Bcast(use_todo, 1, MPI_LOGICAL, 0, job%comm)
+         call broadcast(job%comm, n_work, 0)
+         call broadcast(job%comm, use_todo, 0)
       end if
       if (use_todo) then
          call scheduler%start(job, config%sweep%schedule == 'dynamic', n_work, todo_path, error)
@@ -140,13 +140,13 @@ contains
       end if
       call scheduler%finish()
       flag = merge(1, 0, interrupted)
-      if (job%parallel()) call MPI_Allreduce(MPI_IN_PLACE, flag, 1, MPI_INTEGER, MPI_MAX, job%comm)
+      call reduce_all(job%comm, flag, op_max)
       interrupted = flag /= 0
       ! One warning for the whole sweep, not one a point: how many points
       ! the scene warned about, and the first one's words.
       if (job%parallel()) then
-         call MPI_Allreduce(MPI_IN_PLACE, warned, 1, MPI_INTEGER, MPI_SUM, job%comm)
-         call MPI_Allreduce(MPI_IN_PLACE, first_warned, 1, MPI_INTEGER, MPI_MIN, job%comm)
+         call reduce_all(job%comm, warned, op_sum)
+         call reduce_all(job%comm, first_warned, op_min)
       end if
       if (job%rank == 0 .and. warned > 0) then
          warning = point_warning(config, first_warned)
@@ -157,11 +157,7 @@ contains
       ! Peak resident memory of every rank, for the benchmark (docs/sweeps.md).
       allocate (writer%memory(job%nranks))
       wall = job_wall_time(job)
-      if (job%parallel()) then
-         call MPI_Gather(peak_memory_kb(), 1, MPI_INTEGER, writer%memory, 1, MPI_INTEGER, 0, job%comm)
-      else
-         writer%memory(1) = peak_memory_kb()
-      end if
+      call gather_to_root(job%comm, peak_memory_kb(), writer%memory)
       ! (Component by component: gfortran's structure constructor mis-sizes a
       ! deferred-length component copied from another derived type's.)
       writer%record%input_text = job%input_text
@@ -179,7 +175,7 @@ contains
          call writer%write(temporary, ckpt, error)
          counts = writer%counts
       end if
-      if (job%parallel()) call MPI_Bcast(counts, 3, MPI_INTEGER, 0, job%comm)
+      call broadcast(job%comm, counts, 0)
       ! A stop request after the last point stopped nothing: the sweep is complete.
       interrupted = interrupted .and. counts(1) + counts(2) < n
       call publish(job, temporary, error)

@@ -3,7 +3,7 @@
 !> every column in point order, a piece of copy_points points at a time, so
 !> that the copy holds no array over all points.
 module friction_job_sweep_output
-   use mpi_f08, only: MPI_COMM_SELF, MPI_COMM_NULL
+   use friction_parallel, only: self_comm, serial_comm
    use friction_kinds, only: wp, i8
    use friction_error, only: error_type
    use friction_strings, only: itoa
@@ -34,7 +34,7 @@ module friction_job_sweep_output
       type(run_summary) :: record
       integer, allocatable :: memory(:)   !! peak resident memory of each rank, kB
       logical :: interrupted = .false.
-      logical :: parallel = .false.   !! on MPI (rank 0 writes through MPI_COMM_SELF), else serial
+      logical :: parallel = .false.   !! on MPI (rank 0 writes on MPI_COMM_SELF), else serial
       integer :: counts(3) = 0   !! after `write`: points done, failed, computed in this run
       character(len=:), allocatable :: first_reason   !! after `write`: point 1's reason
    contains
@@ -108,7 +108,7 @@ contains
       self%first_reason = ''
       ! The run's attributes and the small datasets, through the program's
       ! one file type; then the columns, streamed.
-      call file%create(path, merge(MPI_COMM_SELF, MPI_COMM_NULL, self%parallel), error)
+      call file%create(path, merge(self_comm(), serial_comm(), self%parallel), error)
       if (allocated(error)) return
       call write_run_attributes(file, 'sweep', self%method, self%record)
       call file%write_attribute_text('/', 'sweep_scene', self%scene_name)

@@ -1,7 +1,7 @@
 !> Which rank computes which sweep point (docs/sweeps.md).
 !>
 !> With sweep_schedule = 'dynamic' every rank takes the next point from a
-!> counter on rank 0 with MPI_Fetch_and_op (passive target): no master
+!> counter on rank 0 (friction_parallel's shared_counter, one-sided): no master
 !> serving requests between its own points (no polling, rank 0 computes
 !> like the others), and points handed out on demand, so a chaotic, long
 !> point does not hold up a whole static share.  'static' is the naive
@@ -9,8 +9,7 @@
 !> points still to do come from a list in a file every rank reads, so that
 !> no rank holds a list over all points.
 module friction_job_sweep_schedule
-   use, intrinsic :: iso_c_binding, only: c_ptr, c_f_pointer
-   use mpi_f08
+   use friction_parallel, only: shared_counter
    use friction_kinds, only: i8
    use friction_error, only: error_type, fatal_error, error_io
    use friction_scene_context, only: job_context, agree_on_error
@@ -22,7 +21,7 @@ module friction_job_sweep_schedule
    type :: sweep_scheduler
       private
       logical :: dynamic = .false.
-      type(MPI_Win) :: window
+      type(shared_counter) :: counter
       integer :: n_work = 0          !! points to hand out (all, or those the list holds)
       integer :: block_first = 0, block_last = 0   !! static: this rank's block, [first, last)
       integer :: taken = 0           !! static: points this rank has taken
@@ -46,9 +45,6 @@ contains
       integer, intent(in) :: n_work
       character(len=*), intent(in) :: todo_path
       type(error_type), allocatable, intent(out) :: error
-      integer(kind=MPI_ADDRESS_KIND) :: window_size
-      type(c_ptr) :: counter_base
-      integer, pointer :: counter_value
       integer :: stat
 
       self%n_work = n_work
@@ -64,23 +60,9 @@ contains
             return
          end if
       end if
-      ! (One rank needs no counter; Open MPI may have no one-sided component for it.)
+      ! (One rank takes its points in order: a block of all of them.)
       self%dynamic = dynamic .and. job%nranks > 1
-      ! MPI_Win_allocate (not MPI_Win_create on a Fortran variable) lets Open MPI
-      ! pick its shared-memory one-sided component on a node: the fetch is an
-      ! atomic in memory and needs no progress from rank 0, which is busy
-      ! computing (with MPI_Win_create a fetch waits for rank 0's point).
-      if (self%dynamic) then
-         window_size = merge(4, 0, job%rank == 0)
-         call MPI_Win_allocate(window_size, 4, MPI_INFO_NULL, job%comm, counter_base, self%window)
-         if (job%rank == 0) then
-            call MPI_Win_lock(MPI_LOCK_EXCLUSIVE, 0, 0, self%window)
-            call c_f_pointer(counter_base, counter_value)
-            counter_value = 0
-            call MPI_Win_unlock(0, self%window)
-         end if
-         call MPI_Barrier(job%comm)
-      end if
+      if (self%dynamic) call self%counter%create(job%comm)
       self%block_first = int(int(n_work, i8) * job%rank / job%nranks)
       self%block_last = int(int(n_work, i8) * (job%rank + 1) / job%nranks)
       self%taken = 0
@@ -91,18 +73,14 @@ contains
    subroutine scheduler_next(self, point)
       class(sweep_scheduler), intent(inout) :: self
       integer, intent(out) :: point
-      integer :: one(1), fetched(1), next, w
+      integer :: next, w
 
       if (.not. self%dynamic) then
          ! Contiguous blocks: a run of expensive neighbours lands on one rank.
          next = self%block_first + self%taken
          if (next >= self%block_last) next = self%n_work
       else
-         one = 1
-         call MPI_Win_lock(MPI_LOCK_EXCLUSIVE, 0, 0, self%window)
-         call MPI_Fetch_and_op(one, fetched, MPI_INTEGER, 0, 0_MPI_ADDRESS_KIND, MPI_SUM, self%window)
-         call MPI_Win_unlock(0, self%window)
-         next = fetched(1)
+         call self%counter%take(next)
       end if
       w = next + 1
       point = 0
@@ -120,7 +98,7 @@ contains
 
       if (self%listed) close (self%todo_unit)
       self%listed = .false.
-      if (self%dynamic) call MPI_Win_free(self%window)
+      if (self%dynamic) call self%counter%free()
       self%dynamic = .false.
    end subroutine scheduler_finish
 

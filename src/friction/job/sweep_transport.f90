@@ -5,7 +5,7 @@
 !> them between its own points, and at the end until every rank has said
 !> it finished.
 module friction_job_sweep_transport
-   use mpi_f08
+   use friction_parallel, only: send_request, send_async, wait_sends, probe_any, receive
    use friction_kinds, only: wp
    use friction_scene_context, only: job_context
    use friction_job_sweep_point, only: finished_point
@@ -22,7 +22,7 @@ module friction_job_sweep_transport
 
    !> A point on its way, kept until rank 0 has matched its sends.
    type, extends(finished_point) :: outbox_slot
-      type(MPI_Request) :: requests(3)
+      type(send_request) :: requests(3)
       logical :: busy = .false.
    end type outbox_slot
 
@@ -50,19 +50,16 @@ contains
       if (.not. allocated(self%outbox)) allocate (self%outbox(in_flight))
       self%slot = mod(self%slot, size(self%outbox)) + 1
       associate (box => self%outbox(self%slot))
-         if (box%busy) call MPI_Waitall(3, box%requests, MPI_STATUSES_IGNORE)
+         if (box%busy) call wait_sends(box%requests)
          box%header = point%header
          box%numbers = point%numbers
          box%reason = point%reason
-         box%requests = MPI_REQUEST_NULL
          ! Synchronous sends: done only when rank 0 has taken them, so a rank
          ! has at most size(outbox) points on their way.
-         call MPI_Issend(box%header, 5, MPI_INTEGER, 0, tag_header, job%comm, box%requests(1))
+         call send_async(job%comm, box%header, 0, tag_header, box%requests(1))
          if (box%header(1) > 0) then
-            call MPI_Issend(box%numbers, size(box%numbers), MPI_DOUBLE_PRECISION, 0, tag_numbers, job%comm, &
-               & box%requests(2))
-            if (len(box%reason) > 0) call MPI_Issend(box%reason, len(box%reason), MPI_CHARACTER, 0, tag_reason, &
-               & job%comm, box%requests(3))
+            call send_async(job%comm, box%numbers, 0, tag_numbers, box%requests(2))
+            if (len(box%reason) > 0) call send_async(job%comm, box%reason, 0, tag_reason, box%requests(3))
          end if
          box%busy = .true.
       end associate
@@ -82,7 +79,7 @@ contains
       last%reason = ''
       call self%send(job, last)
       do k = 1, size(self%outbox)
-         if (self%outbox(k)%busy) call MPI_Waitall(3, self%outbox(k)%requests, MPI_STATUSES_IGNORE)
+         if (self%outbox(k)%busy) call wait_sends(self%outbox(k)%requests)
       end do
    end subroutine transport_finish
 
@@ -95,7 +92,6 @@ contains
       logical, intent(in) :: wait
       type(finished_point), intent(inout) :: point
       logical, intent(out) :: arrived
-      type(MPI_Status) :: status
       integer :: source
 
       arrived = .false.
@@ -103,13 +99,10 @@ contains
       do
          if (wait) then
             if (self%finished == job%nranks - 1) return
-            call MPI_Probe(MPI_ANY_SOURCE, tag_header, job%comm, status)
-         else
-            call MPI_Iprobe(MPI_ANY_SOURCE, tag_header, job%comm, arrived, status)
-            if (.not. arrived) return
          end if
-         source = status%MPI_SOURCE
-         call MPI_Recv(point%header, 5, MPI_INTEGER, source, tag_header, job%comm, MPI_STATUS_IGNORE)
+         call probe_any(job%comm, tag_header, wait, arrived, source)
+         if (.not. arrived) return
+         call receive(job%comm, point%header, source, tag_header)
          if (point%header(1) == 0) then
             self%finished = self%finished + 1
             arrived = .false.
@@ -117,12 +110,10 @@ contains
          end if
          if (allocated(point%numbers)) deallocate (point%numbers)
          allocate (point%numbers(point%header(3) + 1 + point%header(4)))
-         call MPI_Recv(point%numbers, size(point%numbers), MPI_DOUBLE_PRECISION, source, tag_numbers, job%comm, &
-            & MPI_STATUS_IGNORE)
+         call receive(job%comm, point%numbers, source, tag_numbers)
          if (allocated(point%reason)) deallocate (point%reason)
          allocate (character(len=point%header(5)) :: point%reason)
-         if (point%header(5) > 0) call MPI_Recv(point%reason, point%header(5), MPI_CHARACTER, source, tag_reason, &
-            & job%comm, MPI_STATUS_IGNORE)
+         if (point%header(5) > 0) call receive(job%comm, point%reason, source, tag_reason)
          arrived = .true.
          return
       end do

@@ -2,7 +2,7 @@
 !> every rank calls it with the same run (each computed it: a run is
 !> deterministic), and rank 0 writes the values.
 module friction_machine_output
-   use mpi_f08, only: MPI_Comm
+   use friction_parallel, only: communicator
    use friction_kinds, only: wp
    use friction_error, only: error_type
    use friction_strings, only: join
@@ -29,7 +29,7 @@ contains
 
    subroutine write_machine_file(path, comm, config, run, summary, diagnostics, error)
       character(len=*), intent(in) :: path
-      type(MPI_Comm), intent(in) :: comm
+      type(communicator), intent(in) :: comm
       type(machine_config), intent(in) :: config
       type(machine_run), intent(in) :: run
       type(machine_summary), intent(in) :: summary

@@ -15,8 +15,8 @@ module friction_output_h5
    use, intrinsic :: iso_fortran_env, only: int64
    use, intrinsic :: iso_c_binding, only: c_ptr, c_loc, c_funptr, c_int, c_int64_t, c_null_ptr, c_null_funptr, &
       & c_size_t, c_double, c_char, c_null_char
-   use mpi_f08, only: MPI_Comm, MPI_INFO_NULL, MPI_Comm_rank, MPI_Allreduce, MPI_Barrier, MPI_IN_PLACE, &
-      & MPI_INTEGER, MPI_MAX, MPI_Bcast, MPI_DOUBLE_PRECISION, MPI_COMM_NULL, operator(==)
+   use friction_parallel, only: communicator, broadcast, reduce_all, barrier, op_max, set_parallel_file_access, &
+      & set_collective_transfer
    use hdf5
    use friction_kinds, only: wp, i8
    use friction_error, only: error_type, fatal_error, error_io
@@ -120,7 +120,7 @@ module friction_output_h5
       integer(hid_t) :: id = -1
       character(len=:), allocatable :: path
       integer :: rank = 0         !! this process in the communicator
-      type(MPI_Comm) :: comm      !! the file's communicator
+      type(communicator) :: comm  !! the file's communicator
       logical :: parallel = .true. !! written through MPI-IO (.false.: serial, MPI not started; sec2 driver)
       !> The objects last written or opened, kept open for what comes next
       !> (a group's attributes one after another, a dataset's coordinates
@@ -171,12 +171,12 @@ contains
    end subroutine open_hdf5
 
    !> Create (truncate) a file for parallel writing on communicator comm;
-   !> comm = MPI_COMM_NULL: a serial run without MPI, written by this process
+   !> comm not attached to MPI: a serial run, written by this process
    !> alone with HDF5's default (sec2) driver (the mpio driver needs MPI_Init).
    subroutine create(self, path, comm, error)
       class(h5_file), intent(inout) :: self
       character(len=*), intent(in) :: path
-      type(MPI_Comm), intent(in) :: comm
+      type(communicator), intent(in) :: comm
       type(error_type), allocatable, intent(out) :: error
       integer(hid_t) :: fapl
       integer :: stat
@@ -186,14 +186,13 @@ contains
       self%path = path
       self%status = 0
       self%comm = comm
-      self%parallel = .not. (comm == MPI_COMM_NULL)
-      self%rank = 0
-      if (self%parallel) call MPI_Comm_rank(comm, self%rank)
+      self%parallel = comm%parallel()
+      self%rank = comm%rank()
       ! Not on a (nearly) full disk: room to spare is what lets a failed
       ! file be closed (give_back_space).
       free = -1.0_c_double
       if (self%rank == 0) free = free_bytes(path)
-      if (self%parallel) call MPI_Bcast(free, 1, MPI_DOUBLE_PRECISION, 0, comm)
+      if (self%parallel) call broadcast(comm, free, 0)
       if (free >= 0.0_c_double .and. free < min_free_bytes) then
          call fatal_error(error, path//': '//full_text(path, free)//'; writing ' &
             & //'the output needs at least '//bytes_text(real(min_free_bytes, wp))//' to spare)', error_io)
@@ -206,7 +205,7 @@ contains
       call h5pcreate_f(H5P_FILE_ACCESS_F, fapl, stat)
       call self%check(stat, 'creating the file access list')
       if (self%parallel) then
-         call h5pset_fapl_mpio_f(fapl, comm%MPI_VAL, MPI_INFO_NULL%MPI_VAL, stat)
+         call set_parallel_file_access(fapl, comm, stat)
          call self%check(stat, 'selecting the MPI-IO driver')
       end if
       call h5fcreate_f(path, H5F_ACC_TRUNC_F, self%id, stat, access_prp=fapl)
@@ -352,7 +351,7 @@ contains
          call h5sselect_none_f(memspace, stat)
       end if
       call h5pcreate_f(H5P_DATASET_XFER_F, xfer, stat)
-      if (self%parallel) call h5pset_dxpl_mpio_f(xfer, H5FD_MPIO_COLLECTIVE_F, stat)
+      if (self%parallel) call set_collective_transfer(xfer, stat)
       call h5dwrite_f(dset, type, buffer, stat, mem_space_id=memspace, file_space_id=filespace, &
          & xfer_prp=xfer)
       call self%agree(stat)
@@ -481,7 +480,7 @@ contains
          call h5sselect_none_f(memspace, stat)
       end if
       call h5pcreate_f(H5P_DATASET_XFER_F, xfer, stat)
-      if (self%parallel) call h5pset_dxpl_mpio_f(xfer, H5FD_MPIO_COLLECTIVE_F, stat)
+      if (self%parallel) call set_collective_transfer(xfer, stat)
       call h5dwrite_f(dset, H5T_NATIVE_INTEGER, values, dims, stat, &
          & mem_space_id=memspace, file_space_id=filespace, xfer_prp=xfer)
       call self%agree(stat)
@@ -520,7 +519,7 @@ contains
                call h5sselect_none_f(memspace, stat)
             end if
             call h5pcreate_f(H5P_DATASET_XFER_F, xfer, stat)
-            if (self%parallel) call h5pset_dxpl_mpio_f(xfer, H5FD_MPIO_COLLECTIVE_F, stat)
+            if (self%parallel) call set_collective_transfer(xfer, stat)
             call h5dwrite_f(dset, type, texts, dims, stat, mem_space_id=memspace, file_space_id=filespace, &
                & xfer_prp=xfer)
             call self%agree(stat)
@@ -814,12 +813,12 @@ contains
          if (len(problem) > 0) call self%check(1, problem)
       end if
       failed = merge(1, 0, self%status /= 0)
-      if (self%parallel) call MPI_Allreduce(MPI_IN_PLACE, failed, 1, MPI_INTEGER, MPI_MAX, self%comm)
+      if (self%parallel) call reduce_all(self%comm, failed, op_max)
       if (failed == 0) return
       call self%check(1, 'writing the file on another rank')
-      if (self%parallel) call MPI_Barrier(self%comm)
+      call barrier(self%comm)
       if (self%rank == 0) call truncate_file(self%path)
-      if (self%parallel) call MPI_Barrier(self%comm)
+      call barrier(self%comm)
    end subroutine give_back_space
 
    !> Whether the disk has room for the metadata HDF5 holds in its cache for
@@ -861,7 +860,7 @@ contains
       ! crashed: the dataset must fit, with min_free_bytes for the metadata.
       room = -1.0_c_double
       if (self%rank == 0) room = size_limit_room(self%path)
-      if (self%parallel) call MPI_Bcast(room, 1, MPI_DOUBLE_PRECISION, 0, self%comm)
+      if (self%parallel) call broadcast(self%comm, room, 0)
       if (room >= 0.0_c_double) then
          call h5sget_simple_extent_npoints_f(filespace, points, stat)
          call h5tget_size_f(type, bytes, stat)
@@ -891,7 +890,7 @@ contains
       integer :: failed
 
       failed = merge(1, 0, stat /= 0)
-      if (self%parallel) call MPI_Allreduce(MPI_IN_PLACE, failed, 1, MPI_INTEGER, MPI_MAX, self%comm)
+      if (self%parallel) call reduce_all(self%comm, failed, op_max)
       if (failed /= 0 .and. stat == 0) stat = -1
    end subroutine agree
 

@@ -1,10 +1,12 @@
 !> What every job shares: its communicator and clock, the output's
 !> temporary name and publication, and one error agreed on by all ranks.
-!> A job whose communicator is MPI_COMM_NULL is serial: one process, MPI
-!> not started (a run without a launcher); every helper here then does on
-!> its own what the MPI one does on one rank, so the job code is the same.
+!> A job whose communicator is not attached to MPI (serial_comm()) is
+!> serial: one process, MPI not started (a run without a launcher, or the
+!> serial program); every helper here then does on its own what the MPI
+!> one does on one rank, so the job code is the same.
 module friction_scene_context
-   use mpi_f08
+   use friction_parallel, only: communicator, broadcast, reduce_all, reduce_to_root, &
+      & op_sum, op_max, op_min, op_and
    use friction_kinds, only: wp
    use friction_clock, only: wall_seconds
    use friction_error, only: error_type, fatal_error, error_io
@@ -15,14 +17,14 @@ module friction_scene_context
    private
 
    public :: job_context, agree_on_error, temporary_name, publish, check_writable, default_output, &
-      & ranks_text, sum_to_root_real, sum_to_root_integer, share_of, job_wall_time, job_sharing, mpi_sharing
+      & ranks_text, sum_to_root_real, sum_to_root_integer, share_of, job_wall_time, job_sharing, rank_sharing
 
    !> One job's run: where it runs, since when, what it read and writes.
    type :: job_context
-      type(MPI_Comm) :: comm = MPI_COMM_NULL  !! MPI_COMM_NULL: serial, without MPI
+      type(communicator) :: comm              !! not attached (the default): serial, without MPI
       integer :: rank = 0
       integer :: nranks = 1
-      real(wp) :: t_start = 0.0_wp            !! MPI_Wtime at the start of the job
+      real(wp) :: t_start = 0.0_wp            !! wall_seconds() at the start of the job
       character(len=:), allocatable :: output
       character(len=:), allocatable :: input_text
       character(len=4096), allocatable :: files(:)
@@ -34,56 +36,56 @@ module friction_scene_context
 
    !> The job's ranks as friction_sharing's work_sharing: the layers below
    !> the scenes share work (a surface table's build) through it.
-   type, extends(work_sharing) :: mpi_sharing
-      type(MPI_Comm) :: comm = MPI_COMM_NULL
+   type, extends(work_sharing) :: rank_sharing
+      type(communicator) :: comm
    contains
-      procedure :: sum_reals => mpi_sum_reals
-      procedure :: max_real => mpi_max_real
-      procedure :: every => mpi_every
-   end type mpi_sharing
+      procedure :: sum_reals => ranks_sum_reals
+      procedure :: max_real => ranks_max_real
+      procedure :: every => ranks_every
+   end type rank_sharing
 
 contains
 
    !> The job's ranks, for work_sharing (serial: one process alone).
    function job_sharing(job) result(share)
       type(job_context), intent(in) :: job
-      type(mpi_sharing) :: share
+      type(rank_sharing) :: share
 
       share%comm = job%comm
       share%rank = job%rank
       share%ranks = merge(job%nranks, 1, job%parallel())
    end function job_sharing
 
-   subroutine mpi_sum_reals(self, values, n)
-      class(mpi_sharing), intent(inout) :: self
+   subroutine ranks_sum_reals(self, values, n)
+      class(rank_sharing), intent(inout) :: self
       integer, intent(in) :: n
       real(wp), intent(inout) :: values(*)
 
-      if (self%comm == MPI_COMM_NULL .or. self%ranks < 2) return
-      call MPI_Allreduce(MPI_IN_PLACE, values, n, MPI_DOUBLE_PRECISION, MPI_SUM, self%comm)
-   end subroutine mpi_sum_reals
+      if (.not. self%comm%parallel() .or. self%ranks < 2) return
+      call reduce_all(self%comm, values(1:n), op_sum)
+   end subroutine ranks_sum_reals
 
-   subroutine mpi_max_real(self, x)
-      class(mpi_sharing), intent(inout) :: self
+   subroutine ranks_max_real(self, x)
+      class(rank_sharing), intent(inout) :: self
       real(wp), intent(inout) :: x
 
-      if (self%comm == MPI_COMM_NULL .or. self%ranks < 2) return
-      call MPI_Allreduce(MPI_IN_PLACE, x, 1, MPI_DOUBLE_PRECISION, MPI_MAX, self%comm)
-   end subroutine mpi_max_real
+      if (.not. self%comm%parallel() .or. self%ranks < 2) return
+      call reduce_all(self%comm, x, op_max)
+   end subroutine ranks_max_real
 
-   subroutine mpi_every(self, flag)
-      class(mpi_sharing), intent(inout) :: self
+   subroutine ranks_every(self, flag)
+      class(rank_sharing), intent(inout) :: self
       logical, intent(inout) :: flag
 
-      if (self%comm == MPI_COMM_NULL .or. self%ranks < 2) return
-      call MPI_Allreduce(MPI_IN_PLACE, flag, 1, MPI_LOGICAL, MPI_LAND, self%comm)
-   end subroutine mpi_every
+      if (.not. self%comm%parallel() .or. self%ranks < 2) return
+      call reduce_all(self%comm, flag, op_and)
+   end subroutine ranks_every
 
    !> Whether the job runs on MPI (false: serial, no MPI call may be made).
    logical function parallel(self)
       class(job_context), intent(in) :: self
 
-      parallel = .not. (self%comm == MPI_COMM_NULL)
+      parallel = self%comm%parallel()
    end function parallel
 
    !> Seconds since the job started (job%t_start), the longest of any rank:
@@ -93,7 +95,7 @@ contains
       real(wp) :: wall
 
       wall = wall_seconds() - job%t_start
-      if (job%parallel()) call MPI_Allreduce(MPI_IN_PLACE, wall, 1, MPI_DOUBLE_PRECISION, MPI_MAX, job%comm)
+      call reduce_all(job%comm, wall, op_max)
    end function job_wall_time
 
    !> A rank's share of n items, dealt round-robin: items first, first +
@@ -120,15 +122,15 @@ contains
 
       if (.not. job%parallel()) return
       failed = merge(job%rank, job%nranks, allocated(error))
-      call MPI_Allreduce(MPI_IN_PLACE, failed, 1, MPI_INTEGER, MPI_MIN, job%comm)
+      call reduce_all(job%comm, failed, op_min)
       if (failed == job%nranks) return
       if (job%rank == failed) then
          header = [error%stat, len(error%message)]
          message = error%message
       end if
-      call MPI_Bcast(header, 2, MPI_INTEGER, failed, job%comm)
+      call broadcast(job%comm, header, failed)
       if (job%rank /= failed) allocate (character(len=header(2)) :: message)
-      call MPI_Bcast(message, header(2), MPI_CHARACTER, failed, job%comm)
+      call broadcast(job%comm, message, failed)
       if (allocated(error)) deallocate (error)
       call fatal_error(error, message, header(1))
    end subroutine agree_on_error
@@ -141,7 +143,7 @@ contains
       integer :: pid
 
       pid = process_id()
-      if (job%parallel()) call MPI_Bcast(pid, 1, MPI_INTEGER, 0, job%comm)
+      call broadcast(job%comm, pid, 0)
       name = job%output//'.tmp-'//itoa(pid)
    end function temporary_name
 
@@ -159,7 +161,7 @@ contains
       logical :: keep
 
       failed = merge(1, 0, allocated(error))
-      if (job%parallel()) call MPI_Allreduce(MPI_IN_PLACE, failed, 1, MPI_INTEGER, MPI_MAX, job%comm)
+      call reduce_all(job%comm, failed, op_max)
       if (job%rank == 0) then
          keep = .false.
          if (failed == 0) then
@@ -246,12 +248,7 @@ contains
       type(job_context), intent(in) :: job
       real(wp), intent(inout) :: values(:)
 
-      if (.not. job%parallel()) return
-      if (job%rank == 0) then
-         call MPI_Reduce(MPI_IN_PLACE, values, size(values), MPI_DOUBLE_PRECISION, MPI_SUM, 0, job%comm)
-      else
-         call MPI_Reduce(values, values, size(values), MPI_DOUBLE_PRECISION, MPI_SUM, 0, job%comm)
-      end if
+      call reduce_to_root(job%comm, values, op_sum)
    end subroutine sum_to_root_real
 
    !> Sum an integer array of `count` entries onto rank 0.
@@ -260,12 +257,7 @@ contains
       integer, intent(inout) :: values(*)
       integer, intent(in) :: count
 
-      if (.not. job%parallel()) return
-      if (job%rank == 0) then
-         call MPI_Reduce(MPI_IN_PLACE, values, count, MPI_INTEGER, MPI_SUM, 0, job%comm)
-      else
-         call MPI_Reduce(values, values, count, MPI_INTEGER, MPI_SUM, 0, job%comm)
-      end if
+      call reduce_to_root(job%comm, values(1:count), op_sum)
    end subroutine sum_to_root_integer
 
 end module friction_scene_context
