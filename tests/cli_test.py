@@ -11,7 +11,9 @@ brake-run, brake-ranks, brake-dimensional, brake-verify, brake-failure, brake-an
 brake-creep-band and
 bad-brake-<name> for each bad input in BAD_BRAKE_INPUTS; for sweeps sweep-ranks,
 sweep-failure, sweep-resume, sweep-signal, sweep-grid-ranks, sweep-large-resume, sweep-method and bad-sweep-<name> for each bad input in BAD_SWEEP_INPUTS;
-serial-files and serial-no-mpi for runs without a launcher (no MPI).  Each asserts on exit codes,
+serial-files and serial-no-mpi for runs without a launcher (no MPI); serial-loads-no-mpi,
+serial-hand-over and serial-missing-parallel for the serial program and its hand-over to the
+parallel one under a launcher.  Each asserts on exit codes,
 messages and file contents (read with h5py); none asserts on timings.
 """
 import argparse
@@ -2313,6 +2315,109 @@ def case_serial_files(args):
         print(f"ok: {label}: {compared} datasets and attributes identical")
 
 
+def parallel_program(args):
+    """The parallel program the serial one hands launched runs to: beside it."""
+    return os.path.join(os.path.dirname(os.path.abspath(args.binary)), "friction-mpi")
+
+
+def initialised_libraries(result):
+    """The shared libraries the dynamic loader initialised in a run under
+    LD_DEBUG=libs (its "calling init: PATH" lines on stderr)."""
+    return [line.split("calling init:", 1)[1].strip() for line in result.stderr.splitlines()
+            if "calling init:" in line]
+
+
+def case_serial_loads_no_mpi(args):
+    """The program users type is serial: neither its dynamic section nor
+    what that needs in turn names an MPI library (readelf, ldd), and a run of
+    it maps none (the loader's own account, LD_DEBUG=libs).  The control: the
+    parallel program beside it, run the same way, is seen to load libmpi."""
+    mpi = re.compile(r"lib(mpi|open-pal|open-rte|pmix|hwloc|ucp|fabric)")
+    needed = run(args, ["readelf", "-d", args.binary]).stdout
+    names = re.findall(r"\(NEEDED\)\s+Shared library: \[([^\]]+)\]", needed)
+    if not any(name.startswith("libc.so") for name in names):
+        fail(f"readelf -d {args.binary}: no NEEDED entries read (the check could not see them):\n{needed}")
+    if any(mpi.search(name) for name in names):
+        fail(f"the serial program needs an MPI library: {names}")
+    loaded = run(args, ["ldd", args.binary]).stdout
+    if "libc.so" not in loaded or mpi.search(loaded) or "libhdf5" in loaded:
+        fail(f"ldd {args.binary}: an MPI library or HDF5's shared one among what it loads:\n{loaded}")
+    short = write(args, "short.nml", BRAKE_SHORT)
+    traced = dict(serial_env(), LD_DEBUG="libs")
+    result = helpers.run([args.binary, "--quiet", "-o", "serial.h5", os.path.join(args.inputs, "brake.nml"), short],
+                         cwd=args.workdir, env=traced)
+    libraries = initialised_libraries(result)
+    if not any("libc.so" in path for path in libraries):
+        fail(f"LD_DEBUG=libs showed no library initialised (the check could not see them):\n{result.stderr[:2000]}")
+    if any(mpi.search(path) for path in libraries):
+        fail(f"a serial run mapped an MPI library: {libraries}")
+    with h5py.File(os.path.join(args.workdir, "serial.h5"), "r") as f:
+        if f.attrs["nranks"] != 1 or f["brake/x"].size != 1001:
+            fail(f"serial.h5: nranks {f.attrs['nranks']}, {f['brake/x'].size} samples (expected 1 and 1001)")
+    control = helpers.run([parallel_program(args), "--version"], cwd=args.workdir, env=traced)
+    if not any("libmpi" in path for path in initialised_libraries(control)):
+        fail("LD_DEBUG=libs does not show the parallel program loading libmpi: the check would miss it")
+    print(f"ok: {len(names)} libraries needed, {len(libraries)} initialised in a run, none of MPI")
+
+
+def case_serial_hand_over(args):
+    """Under mpirun the serial program hands the run to the parallel one
+    (the same process, the same arguments): `mpirun -n 2 friction` writes
+    the file `mpirun -n 2 friction-mpi` writes, on 2 ranks, and the one a
+    serial run writes (timings and the number of ranks aside), for a map
+    whose lines the ranks share and a sweep whose points they share."""
+    naf = os.path.join(args.inputs, "naf.nml")
+    brake = os.path.join(args.inputs, "brake.nml")
+    cases = {"afm": [naf, write(args, "small.nml", SMALL)],
+             "sweep": [brake, write(args, "sweep.nml", SWEEP_SMALL)]}
+    for label, files in cases.items():
+        handed, direct, serial = f"{label}_handed.h5", f"{label}_direct.h5", f"{label}_serial.h5"
+        friction(args, "-o", handed, *files, ranks=2)
+        run(args, [args.mpiexec, "-n", "2", parallel_program(args), "--quiet", "-o", direct, *files])
+        helpers.run([args.binary, "--quiet", "-o", serial, *files], cwd=args.workdir, env=serial_env())
+        with h5py.File(os.path.join(args.workdir, handed), "r") as f:
+            if f.attrs["nranks"] != 2:
+                fail(f"{handed}: nranks = {f.attrs['nranks']}: mpirun -n 2 friction did not run on 2 ranks")
+        same_run(args, handed, direct, f"{label}: mpirun -n 2 friction and friction-mpi")
+        a, b = (comparable(os.path.join(args.workdir, name)) for name in (handed, serial))
+        keys = [key for key in a if key not in RUN_DEPENDENT]
+        if a.keys() != b.keys() or any(not identical(a[key], b[key]) for key in keys):
+            fail(f"{label}: mpirun -n 2 friction and a serial run wrote different files")
+        print(f"ok: {label}: handed over on 2 ranks, {len(keys)} datasets and attributes as friction-mpi's and "
+              "the serial run's")
+
+
+def case_serial_missing_parallel(args):
+    """The serial program without the parallel one beside it, launched (or
+    with FRICTION_MPI=1): exit code 7, a message naming friction-mpi and
+    where it was looked for, nothing written.  A serial program installed
+    under the parallel one's name is refused, not handed to for ever."""
+    lone = os.path.join(args.workdir, "lone")
+    os.makedirs(lone)
+    binary = os.path.join(lone, "friction")
+    shutil.copy2(args.binary, binary)
+    short = write(args, "short.nml", BRAKE_SHORT)
+    files = [os.path.join(args.inputs, "brake.nml"), short]
+    forced = helpers.run([binary, "--quiet", "-o", "forced.h5", *files], cwd=args.workdir, expect=7,
+                         env=dict(serial_env(), FRICTION_MPI="1"))
+    where = os.path.join(lone, "friction-mpi")
+    if where not in forced.stderr or "No such file" not in forced.stderr:
+        fail(f"FRICTION_MPI=1 without friction-mpi: the message does not say where it was looked for:\n"
+             f"{forced.stderr}")
+    launched = run(args, [args.mpiexec, "-n", "2", binary, "--quiet", "-o", "launched.h5", *files], expect=7)
+    if launched.stderr.count(where) != 1:
+        fail(f"mpirun -n 2 without friction-mpi: not one message from rank 0:\n{launched.stderr}")
+    shutil.copy2(args.binary, where)
+    looped = helpers.run([binary, "--quiet", "-o", "looped.h5", *files], cwd=args.workdir, expect=7,
+                         env=dict(serial_env(), FRICTION_MPI="1"))
+    if "itself a serial program" not in looped.stderr:
+        fail(f"a serial friction-mpi: no message saying so:\n{looped.stderr}")
+    left = [name for name in leftovers(args) if name != "lone"]
+    if left:
+        fail(f"files written without the parallel program: {left}")
+    print("ok: exit code 7 with the path looked for, from rank 0 alone; a serial friction-mpi refused")
+
+
 def case_serial_no_mpi(args):
     """--version, --help, usage errors, --netlist, bad input and a serial run
     never call MPI_Init: with Open MPI told to use a point-to-point layer that
@@ -2405,7 +2510,9 @@ def main():
           "thermal-ranks": case_thermal_ranks, "thermal-equipartition": case_thermal_equipartition,
           "thermal-kramers": case_thermal_kramers, "thermal-kramers-law": case_thermal_kramers_law,
           "thermal-lj": case_thermal_lj,
-          "serial-files": case_serial_files, "serial-no-mpi": case_serial_no_mpi}[args.case](args)
+          "serial-files": case_serial_files, "serial-no-mpi": case_serial_no_mpi,
+          "serial-loads-no-mpi": case_serial_loads_no_mpi, "serial-hand-over": case_serial_hand_over,
+          "serial-missing-parallel": case_serial_missing_parallel}[args.case](args)
     print("1 passed, 0 failed")
 
 

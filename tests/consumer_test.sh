@@ -12,6 +12,8 @@ case "$1" in
     cmake --install "$2" --prefix "$3" > /dev/null
     # The installed program finds the installed shared library.
     "$3/bin/friction" --version
+    # The parallel program the serial one hands launched runs to, beside it.
+    "$3/bin/friction-mpi" --version | grep -q 'HDF5 .*(parallel)'
     ;;
   cmake)
     rm -rf "$4"
