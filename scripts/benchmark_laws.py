@@ -46,7 +46,7 @@ medians over the program's at the same rtol.  At the end, each peer's every poin
 fastest run (default settings) with an error at most the peer's: the ratio
 of the peer's median to the program's, by each of the four times.
 
-    scripts/benchmark_laws [--repeats N] [--quick] [--limit S] [--chart FILE.png]
+    scripts/benchmark_laws [--repeats N] [--quick] [--no-scipy] [--limit S] [--chart FILE.png]
 
 --chart draws the work-precision chart of each case (CPU time against error,
 one line per method) into FILE.png.
@@ -199,6 +199,8 @@ def main():
     parser.add_argument("--repeats", type=int, default=3, help="runs of the program and of each CVODE peer per point")
     parser.add_argument("--scipy-repeats", type=int, default=3, help="runs of SciPy per point")
     parser.add_argument("--quick", action="store_true", help="fewer tolerances")
+    parser.add_argument("--no-scipy", action="store_true",
+                        help="the program and CVODE alone (the whole processes interleaved), without SciPy's rows")
     parser.add_argument("--binary", default=str(ROOT / "build" / "friction"))
     parser.add_argument("--limit", type=float, default=60.0,
                         help="seconds before a SciPy run or the program's integration is given up")
@@ -286,7 +288,7 @@ def main():
                 for row in rows:
                     if row.split()[0] == key:
                         print(row)
-            for method in ("Radau", "LSODA"):
+            for method in () if args.no_scipy else ("Radau", "LSODA"):
                 for rtol in tolerances:
                     runs = [scipy_run(work, name, method, rtol, dt_out, args.limit) for _ in range(args.scipy_repeats)]
                     four = tuple(statistics.median(run[i][j] for run in runs) for i in (0, 1) for j in (0, 1))
