@@ -426,13 +426,18 @@ class Benchmark:
 
 
 def snapshot_program(binary: Path, workdir: Path) -> Path:
-    """A private copy of the program and of its shared library (libfriction.so,
+    """A private copy of the program, of the parallel program beside it
+    (friction-mpi, which it runs under mpirun) and of its shared library (libfriction.so,
     found first through LD_LIBRARY_PATH), so that a rebuild during a
     benchmark neither breaks it nor mixes two builds in one table.  (The
     program alone is not enough: it loads the library from the build tree
     through its run path.)"""
     snapshot = workdir / "friction"
     shutil.copy2(binary, snapshot)
+    # The parallel program the serial one hands a launched run to, beside it.
+    parallel = Path(binary).resolve().parent / "friction-mpi"
+    if parallel.exists():
+        shutil.copy2(parallel, workdir / "friction-mpi")
     libraries = sorted(Path(binary).resolve().parent.glob("libfriction.so*"))
     if libraries:
         (workdir / "lib").mkdir(exist_ok=True)
