@@ -196,8 +196,8 @@ if(FRICTION_SERIAL_HDF5_DIR)
       string(REGEX REPLACE ".*HDF5 Version: *([^ ]+).*" "\\1" friction_hdf5_${build}_version "${version_line}")
     endif()
   endforeach()
-  if(NOT friction_hdf5_parallel_version STREQUAL friction_hdf5_serial_version
-     OR friction_hdf5_serial_version STREQUAL "unknown")
+  if(FRICTION_SERIAL_PROGRAM AND (NOT friction_hdf5_parallel_version STREQUAL friction_hdf5_serial_version
+     OR friction_hdf5_serial_version STREQUAL "unknown"))
     set(FRICTION_SERIAL_PROGRAM OFF)
     set(friction_serial_why "the serial HDF5 (${FRICTION_SERIAL_HDF5_DIR}) is version "
       "${friction_hdf5_serial_version}, the parallel one ${friction_hdf5_parallel_version}")
