@@ -47,7 +47,17 @@ fastest run (default settings) with an error at most the peer's: the ratio
 of the peer's median to the program's, by each of the four times.
 
     scripts/benchmark_laws [--repeats N] [--quick] [--no-scipy] [--limit S] [--chart FILE.png]
+    scripts/benchmark_laws --horizons [M1,M2,...] [--repeats N] [--quick]
 
+--horizons runs the program (default settings) and the two CVODE peers alone
+over M1, M2, ... times each case's span (default 1,10,100), the grid's
+spacing kept, the error against a reference over the same span: how the
+ratios change with the run's length, as the program's fixed cost (start,
+input, the HDF5 file's creation) weighs less.  For each span it prints the
+tables above and then, by span, each peer's CPU ratio at equal or smaller
+error (the median over its points and their range), and the span at which
+the program's whole process is as fast as the peer's (the ratio interpolated
+linearly in the span's logarithm).
 --chart draws the work-precision chart of each case (CPU time against error,
 one line per method) into FILE.png.
 """
@@ -160,11 +170,12 @@ def build_cvode(work, hdf5=False):
     return exe, None
 
 
-def cvode_run(exe, work, name, rtol, dt_out, hdf5=False):
+def cvode_run(exe, work, name, rtol, dt_out, t_end, hdf5=False):
     """((wall, CPU) seconds of the whole process, x on the grid, counts with
     the integration's "seconds") or (seconds, why it failed, None)."""
     out = work / f"cvode_{name}.{'h5' if hdf5 else 'bin'}"
-    result, elapsed = timed([str(exe), name, f"{rtol:.17g}", f"{rtol * 1e-3:.17g}", f"{dt_out:.17g}", str(out)])
+    result, elapsed = timed([str(exe), name, f"{rtol:.17g}", f"{rtol * 1e-3:.17g}", f"{dt_out:.17g}", str(out),
+                             f"{t_end:.17g}"])
     if result.returncode != 0:
         return elapsed, result.stderr.strip().splitlines()[-1], None
     if hdf5:
@@ -194,6 +205,152 @@ def equal_error(points, name):
     return rows
 
 
+def measure(args, work, peers, name, t_end, sets, tolerances, points, key, horizon=1.0):
+    """The program's and the peers' processes at each rtol over `sets`'
+    span, interleaved (the program by default and, at horizon 1, stepped),
+    their four times' medians and errors against the program at rtol 1e-12
+    stepping onto every output time: the table's rows, and each point in
+    points[(key, method)].  Returns the reference's grid t, x and x's range."""
+    stepped = dict(sets, **{"machine.dense_output": ".false."})
+    _, t, reference, _, _, _ = program_run(args.binary, work, name, 1e-12, stepped)
+    scale = np.ptp(reference)
+    dt_out = float(t[1] - t[0])
+    variants = (("friction", sets), ("stepped", stepped)) if horizon == 1.0 else (("friction", sets),)
+    # (the give-up limit grows with the span: it is there for runs that crawl)
+    limit = min(args.limit * horizon, PROGRAM_LIMIT * horizon)
+    rows = []
+    for rtol in tolerances:
+        # (wall, cpu) of the processes, wall of the integration, cpu of the program's runs to dt_out
+        times = {method: [] for method in (*(v for v, _ in variants), *(label for label, _ in peers))}
+        computes = {method: [] for method in times}
+        short = {v: [] for v, _ in variants}
+        peer_cpu = {label: [] for label, _ in peers}
+        last = {}
+        for _ in range(args.repeats):
+            for method, settings in variants:
+                seconds, _, x, steps, jacobians, compute = program_run(
+                    args.binary, work, name, rtol, settings, limit)
+                times[method].append(seconds)
+                computes[method].append(compute)
+                last[method] = (x, steps, jacobians)
+                to_first = dict(settings, **{"machine.t_end": dt_out})
+                short[method].append(program_run(args.binary, work, name, rtol, to_first)[0][1])
+            for label, exe in peers:
+                seconds, x, counts = cvode_run(exe, work, name, rtol, dt_out, t_end, hdf5=label == "CVODE+h5")
+                times[label].append(seconds)
+                computes[label].append(counts["seconds"] if counts else float("nan"))
+                peer_cpu[label].append(counts["cpu_seconds"] if counts else float("nan"))
+                last[label] = (x, counts)
+        median = {method: statistics.median(w for w, _ in v) for method, v in times.items() if v}
+        cpu = {method: statistics.median(c for _, c in v) for method, v in times.items() if v}
+        busy = {method: statistics.median(v) for method, v in computes.items() if v}
+        busy_cpu = {method: cpu[method] - statistics.median(v) for method, v in short.items()}
+        for label, values in peer_cpu.items():
+            busy_cpu[label] = statistics.median(values)
+        for method, _ in variants:
+            x, steps, jacobians = last[method]
+            if isinstance(x, str):
+                rows.append(f"{method:10s} {rtol:8.0e} {'failed':>10s} {median[method]:8.4f}  {x}")
+                continue
+            error = np.max(np.abs(x - reference)) / scale
+            four = (median[method], cpu[method], busy[method], busy_cpu[method])
+            points.setdefault((key, method), []).append((error, *four, rtol))
+            ratio = ""
+            for label, _ in peers:
+                theirs = (median[label], cpu[label], busy[label], busy_cpu[label])
+                ratio += "".join(f" {c / o:6.2f}" for c, o in zip(theirs, four))
+            rows.append(f"{method:10s} {rtol:8.0e} {error:10.2e}" + "".join(f" {v:8.4f}" for v in four)
+                        + f" {steps:8d} {jacobians:9d}{ratio}")
+        for label, _ in peers:
+            x, counts = last[label]
+            if isinstance(x, str) or x.size != t.size:
+                rows.append(f"{label:10s} {rtol:8.0e} {'failed':>10s} {median[label]:8.4f}  "
+                            f"{x if isinstance(x, str) else ''}")
+            else:
+                error = np.max(np.abs(x - reference)) / scale
+                four = (median[label], cpu[label], busy[label], busy_cpu[label])
+                points.setdefault((key, label), []).append((error, *four, rtol))
+                rows.append(f"{label:10s} {rtol:8.0e} {error:10.2e}" + "".join(f" {v:8.4f}" for v in four)
+                            + f" {counts['steps']:8d} {counts['jacobian_evaluations']:9d}")
+    print(f"\n{key}: {t.size} grid points to t = {t_end:g} s; error = max |x - x_ref| / range of x;"
+          f" times in s, medians: wall and cpu of the whole process, compute = the integration alone"
+          f" (wall time, and cpu time: the program's the process's less that of the same run to the"
+          f" first output point); CVODE/this, CVODE+h5/this: the ratios of the four")
+    header = f"{'method':10s} {'rtol':>8s} {'error':>10s} {'wall':>8s} {'cpu':>8s} {'compute':>8s} {'(cpu)':>8s}"
+    print(header + f" {'steps':>8s} {'Jacobians':>9s}" + "".join(f" {label + '/this':>27s}" for label, _ in peers))
+    for method in (*(v for v, _ in variants), *(label for label, _ in peers)):
+        for row in rows:
+            if row.split()[0] == method:
+                print(row)
+    return t, reference, scale
+
+
+def print_equal_error(points, key):
+    """The table of each peer's points at equal or smaller error."""
+    print(f"\n{key} at equal or smaller error: each peer's point against the program's fastest run"
+          f" (default settings, its rtol in brackets) with an error at most the peer's, by each of the four"
+          f" times; ratio = the peer's time / the program's")
+    print(f"{'peer':9s} {'rtol':>8s} {'error':>10s}" + "".join(
+        f"  {kind:>7s} {'friction':>7s} {'':7s} {'ratio':>6s}" for kind in ("wall", "cpu", "compute", "(cpu)")))
+    for row in equal_error(points, key):
+        print(row)
+    sys.stdout.flush()
+
+
+def cpu_ratios(points, key, peer):
+    """The peer's CPU time of the whole process over the program's fastest
+    run with an error at most the peer's, at each of the peer's points."""
+    ours = points.get((key, "friction"), [])
+    ratios = []
+    for point in points.get((key, peer), []):
+        good = [p for p in ours if p[0] <= point[0]]
+        if good:
+            ratios.append(point[2] / min(p[2] for p in good))
+    return ratios
+
+
+def crossover(spans, ratios):
+    """The span at which the ratio reaches 1, interpolated linearly in the
+    span's logarithm between the spans that bracket it: a text."""
+    pairs = [(s, r) for s, r in zip(spans, ratios) if r == r]
+    if pairs and pairs[0][1] >= 1.0:
+        return f"at or below {pairs[0][0]:g} s"
+    for (s0, r0), (s1, r1) in zip(pairs, pairs[1:]):
+        if r0 < 1.0 <= r1:
+            return f"{s0 * (s1 / s0) ** ((1.0 - r0) / (r1 - r0)):.3g} s"
+    return f"beyond {pairs[-1][0]:g} s" if pairs else "not measured"
+
+
+def horizons(args, work, peers, tolerances, points):
+    """Each case over args.horizons times its span, the grid's spacing kept:
+    the equal-error tables and, by span, the CPU ratios of each peer's
+    points (their median and range) and the span at which the median, and
+    the smallest, reaches 1: the program's whole process as fast as the
+    peer's at its typical point, and at every point."""
+    multiples = [float(m) for m in args.horizons.split(",")]
+    for name, make in (("lugre", lugre_field), ("rate_state", rate_state_field)):
+        t_end, sets = make()
+        spans = [t_end * multiple for multiple in multiples]
+        for multiple, span in zip(multiples, spans):
+            key = f"{name} x{multiple:g}"
+            measure(args, work, peers, name, span, dict(sets, **{"machine.t_end": span}), tolerances, points, key,
+                    multiple)
+            print_equal_error(points, key)
+        print(f"\n{name}: the whole process's CPU at equal or smaller error by span (the peer's / the program's:"
+              f" the median over the peer's points, and their range)")
+        for label, _ in peers:
+            medians, lows = [], []
+            for multiple, span in zip(multiples, spans):
+                ratios = cpu_ratios(points, f"{name} x{multiple:g}", label)
+                medians.append(statistics.median(ratios) if ratios else float("nan"))
+                lows.append(min(ratios) if ratios else float("nan"))
+                text = f"{min(ratios):.2f} to {max(ratios):.2f}" if ratios else "no point"
+                print(f"  {label:9s} {span:10g} s  median {medians[-1]:5.2f}  ({text})")
+            print(f"  {label:9s} the program as fast as {label}: at the median {crossover(spans, medians)},"
+                  f" at every point {crossover(spans, lows)}")
+        sys.stdout.flush()
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--repeats", type=int, default=3, help="runs of the program and of each CVODE peer per point")
@@ -201,6 +358,9 @@ def main():
     parser.add_argument("--quick", action="store_true", help="fewer tolerances")
     parser.add_argument("--no-scipy", action="store_true",
                         help="the program and CVODE alone (the whole processes interleaved), without SciPy's rows")
+    parser.add_argument("--horizons", nargs="?", const="1,10,100",
+                        help="the program and CVODE alone over these multiples of each case's span (default"
+                             " 1,10,100), the grid's spacing kept: how the ratios change with the run's length")
     parser.add_argument("--binary", default=str(ROOT / "build" / "friction"))
     parser.add_argument("--limit", type=float, default=60.0,
                         help="seconds before a SciPy run or the program's integration is given up")
@@ -217,77 +377,13 @@ def main():
         if why_not:
             print(f"CVODE+h5 rows skipped: {why_not}")
         peers = [(label, exe) for label, exe in (("CVODE", cvode), ("CVODE+h5", cvode_h5)) if exe]
+        if args.horizons:
+            horizons(args, work, peers, tolerances, points)
+            return 0
         for name, make in (("lugre", lugre_field), ("rate_state", rate_state_field)):
             t_end, sets = make()
-            stepped = dict(sets, **{"machine.dense_output": ".false."})
-            _, t, reference, _, _, _ = program_run(args.binary, work, name, 1e-12, stepped)
-            scale = np.ptp(reference)
+            t, reference, scale = measure(args, work, peers, name, t_end, sets, tolerances, points, name)
             dt_out = float(t[1] - t[0])
-            print(f"\n{name}: {t.size} grid points to t = {t_end:g} s; error = max |x - x_ref| / range of x;"
-                  f" times in s, medians: wall and cpu of the whole process, compute = the integration alone"
-                  f" (wall time, and cpu time: the program's the process's less that of the same run to the"
-                  f" first output point); CVODE/this, CVODE+h5/this: the ratios of the four")
-            header = f"{'method':10s} {'rtol':>8s} {'error':>10s} {'wall':>8s} {'cpu':>8s} {'compute':>8s} {'(cpu)':>8s}"
-            print(header + f" {'steps':>8s} {'Jacobians':>9s}"
-                  + "".join(f" {label + '/this':>27s}" for label, _ in peers))
-            rows = []
-            for rtol in tolerances:
-                # (wall, cpu) of the processes, wall of the integration, cpu of the program's runs to dt_out
-                times = {method: [] for method in ("friction", "stepped", *(label for label, _ in peers))}
-                computes = {method: [] for method in times}
-                short = {"friction": [], "stepped": []}
-                peer_cpu = {label: [] for label, _ in peers}
-                last = {}
-                for _ in range(args.repeats):
-                    for method, settings in (("friction", sets), ("stepped", stepped)):
-                        seconds, _, x, steps, jacobians, compute = program_run(
-                            args.binary, work, name, rtol, settings, min(args.limit, PROGRAM_LIMIT))
-                        times[method].append(seconds)
-                        computes[method].append(compute)
-                        last[method] = (x, steps, jacobians)
-                        to_first = dict(settings, **{"machine.t_end": dt_out})
-                        short[method].append(program_run(args.binary, work, name, rtol, to_first)[0][1])
-                    for label, exe in peers:
-                        seconds, x, counts = cvode_run(exe, work, name, rtol, dt_out, hdf5=label == "CVODE+h5")
-                        times[label].append(seconds)
-                        computes[label].append(counts["seconds"] if counts else float("nan"))
-                        peer_cpu[label].append(counts["cpu_seconds"] if counts else float("nan"))
-                        last[label] = (x, counts)
-                median = {method: statistics.median(w for w, _ in v) for method, v in times.items() if v}
-                cpu = {method: statistics.median(c for _, c in v) for method, v in times.items() if v}
-                busy = {method: statistics.median(v) for method, v in computes.items() if v}
-                busy_cpu = {method: cpu[method] - statistics.median(v) for method, v in short.items()}
-                for label, values in peer_cpu.items():
-                    busy_cpu[label] = statistics.median(values)
-                for method in ("friction", "stepped"):
-                    x, steps, jacobians = last[method]
-                    if isinstance(x, str):
-                        rows.append(f"{method:10s} {rtol:8.0e} {'failed':>10s} {median[method]:8.4f}  {x}")
-                        continue
-                    error = np.max(np.abs(x - reference)) / scale
-                    four = (median[method], cpu[method], busy[method], busy_cpu[method])
-                    points.setdefault((name, method), []).append((error, *four, rtol))
-                    ratio = ""
-                    for label, _ in peers:
-                        theirs = (median[label], cpu[label], busy[label], busy_cpu[label])
-                        ratio += "".join(f" {c / o:6.2f}" for c, o in zip(theirs, four))
-                    rows.append(f"{method:10s} {rtol:8.0e} {error:10.2e}" + "".join(f" {v:8.4f}" for v in four)
-                                + f" {steps:8d} {jacobians:9d}{ratio}")
-                for label, _ in peers:
-                    x, counts = last[label]
-                    if isinstance(x, str) or x.size != t.size:
-                        rows.append(f"{label:10s} {rtol:8.0e} {'failed':>10s} {median[label]:8.4f}  "
-                                    f"{x if isinstance(x, str) else ''}")
-                    else:
-                        error = np.max(np.abs(x - reference)) / scale
-                        four = (median[label], cpu[label], busy[label], busy_cpu[label])
-                        points.setdefault((name, label), []).append((error, *four, rtol))
-                        rows.append(f"{label:10s} {rtol:8.0e} {error:10.2e}" + "".join(f" {v:8.4f}" for v in four)
-                                    + f" {counts['steps']:8d} {counts['jacobian_evaluations']:9d}")
-            for key in ("friction", "stepped", *(label for label, _ in peers)):
-                for row in rows:
-                    if row.split()[0] == key:
-                        print(row)
             for method in () if args.no_scipy else ("Radau", "LSODA"):
                 for rtol in tolerances:
                     runs = [scipy_run(work, name, method, rtol, dt_out, args.limit) for _ in range(args.scipy_repeats)]
@@ -300,14 +396,7 @@ def main():
                     error = np.max(np.abs(x - reference)) / scale
                     points.setdefault((name, method), []).append((error, *four, rtol))
                     print(f"{method:10s} {rtol:8.0e} {error:10.2e}" + "".join(f" {v:8.4f}" for v in four))
-            print(f"\n{name} at equal or smaller error: each peer's point against the program's fastest run"
-                  f" (default settings, its rtol in brackets) with an error at most the peer's, by each of the four"
-                  f" times; ratio = the peer's time / the program's")
-            print(f"{'peer':9s} {'rtol':>8s} {'error':>10s}" + "".join(
-                f"  {kind:>7s} {'friction':>7s} {'':7s} {'ratio':>6s}" for kind in ("wall", "cpu", "compute", "(cpu)")))
-            for row in equal_error(points, name):
-                print(row)
-            sys.stdout.flush()
+            print_equal_error(points, name)
     if args.chart:
         chart(points, args.chart)
     return 0

@@ -18,7 +18,8 @@
  * (atol = rtol x 1e-3, as the benchmark's other runs), CV_NORMAL output at
  * each grid point (CVODE interpolates there).
  *
- * Usage: cvode_laws CASE RTOL ATOL DT_OUT OUT
+ * Usage: cvode_laws CASE RTOL ATOL DT_OUT OUT [T_END]
+ *   T_END  the span's end in s (default the case's: 30 s, 3000 s)
  *   OUT  x on the grid t = 0, DT_OUT, ..., t_end as raw doubles; built with
  *        -DCVODE_LAWS_HDF5 (and HDF5's C library), an HDF5 file instead with
  *        what the program's file holds of the run: group /machine with the
@@ -191,8 +192,8 @@ static int write_file(const char *path, const case_t *p, const double *t, const 
 
 int main(int argc, char **argv)
 {
-    if (argc != 6) {
-        fprintf(stderr, "usage: cvode_laws lugre|rate_state RTOL ATOL DT_OUT OUT.bin\n");
+    if (argc != 6 && argc != 7) {
+        fprintf(stderr, "usage: cvode_laws lugre|rate_state RTOL ATOL DT_OUT OUT.bin [T_END]\n");
         return 1;
     }
     case_t p = {0};
@@ -218,8 +219,9 @@ int main(int argc, char **argv)
     }
     char *end;
     double rtol = strtod(argv[2], &end), atol = strtod(argv[3], &end), dt = strtod(argv[4], &end);
-    if (!(rtol > 0) || !(atol > 0) || !(dt > 0)) {
-        fprintf(stderr, "cvode_laws: RTOL, ATOL and DT_OUT must be positive\n");
+    if (argc == 7) t_end = strtod(argv[6], &end);
+    if (!(rtol > 0) || !(atol > 0) || !(dt > 0) || !(t_end > 0)) {
+        fprintf(stderr, "cvode_laws: RTOL, ATOL, DT_OUT and T_END must be positive\n");
         return 1;
     }
     long n = lround(t_end / dt) + 1;
