@@ -50,7 +50,7 @@ of the peer's median to the program's, by each of the four times.
     scripts/benchmark_laws --horizons [M1,M2,...] [--repeats N] [--quick]
 
 --horizons runs the program (default settings) and the two CVODE peers alone
-over M1, M2, ... times each case's span (default 1,10,100), the grid's
+over M1, M2, ... times each case's span (default 1,2,4,10,100), the grid's
 spacing kept, the error against a reference over the same span: how the
 ratios change with the run's length, as the program's fixed cost (start,
 input, the HDF5 file's creation) weighs less.  For each span it prints the
@@ -362,9 +362,9 @@ def main():
     parser.add_argument("--quick", action="store_true", help="fewer tolerances")
     parser.add_argument("--no-scipy", action="store_true",
                         help="the program and CVODE alone (the whole processes interleaved), without SciPy's rows")
-    parser.add_argument("--horizons", nargs="?", const="1,10,100",
+    parser.add_argument("--horizons", nargs="?", const="1,2,4,10,100",
                         help="the program and CVODE alone over these multiples of each case's span (default"
-                             " 1,10,100), the grid's spacing kept: how the ratios change with the run's length")
+                             " 1,2,4,10,100), the grid's spacing kept: how the ratios change with the run's length")
     parser.add_argument("--binary", default=str(ROOT / "build" / "friction"))
     parser.add_argument("--limit", type=float, default=60.0,
                         help="seconds before a SciPy run or the program's integration is given up")
