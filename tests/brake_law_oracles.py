@@ -42,6 +42,10 @@ program and its file, against oracles that are not that model's output:
                        and the slip, at rtol 1e-9 and 1e-6: x, v and the
                        creep band's crossings against SciPy's Radau at rtol
                        1e-10 on the equations in v_rel written below
+  rate-state-spectrum  the same case's Lyapunov spectrum over [190, 290] tau
+                       (the creep after the stick relaxes at 1e8 per tau):
+                       the exponents' sum against SciPy's Radau's time
+                       average of tr J, the four slow ones at two rtols
 
     brake_law_oracles.py --binary build/friction --inputs inputs --workdir DIR CASE
 """
@@ -630,12 +634,10 @@ CREEP_NML = """&job
 """
 
 
-def rate_state_creep(args):
-    # Before the brake carried v_rel as its coordinate (docs/speed.md, "Dense output") this run kept v at v_dr
-    # to the end, x moving with the belt past the break-away: no event, x off by 0.37 of its range.
-    t_end, stick_velocity = 200.0, 1e-6           # the creep, the break-away (177.7), the slip, stick (185.5)
-    path = Path(args.workdir) / "brake_rate_state_defaults.nml"
-    path.write_text(CREEP_NML)
+def creep_equations():
+    """Eq. 10 with &law rate_state at the law's defaults on the 2 mm/s belt in the brake's units, in the state
+    (x, u, y, w, z): u = v - v_dr the slip rate in m/tau, z = theta/scale.  The field, its Jacobian and the
+    belt's velocity vdr in m/tau."""
     m, mc, k1, k3, grav, v_dr = 0.174, 0.215, 214.62, 107.31, 9.81, -0.002
     mu0, a, b, dc, v0 = (RATE_STATE_DEFAULTS[k] for k in ("mu0", "a", "b", "dc", "v0"))
     T = math.sqrt(m / k1)                         # seconds per unit tau
@@ -662,6 +664,16 @@ def rate_state_creep(args):
         return [[0.0, 1.0, 0.0, 0.0, 0.0], [-2.0, -normal * dmu_du, 1.0 - mu * (1.0 - kappa), 0.0, -normal * dmu_dz],
                 [0.0, 0.0, 0.0, 1.0, 0.0], [1.0 / xi, 0.0, -kappa / xi, 0.0, 0.0],
                 [0.0, -math.copysign(z / dc, u), 0.0, 0.0, -abs(u) / dc]]
+    return field, jacobian, vdr
+
+
+def rate_state_creep(args):
+    # Before the brake carried v_rel as its coordinate (docs/speed.md, "Dense output") this run kept v at v_dr
+    # to the end, x moving with the belt past the break-away: no event, x off by 0.37 of its range.
+    t_end, stick_velocity = 200.0, 1e-6           # the creep, the break-away (177.7), the slip, stick (185.5)
+    path = Path(args.workdir) / "brake_rate_state_defaults.nml"
+    path.write_text(CREEP_NML)
+    field, jacobian, vdr = creep_equations()
 
     def band_edge(sign):
         event = lambda _, s: s[1] - sign * stick_velocity
@@ -707,12 +719,68 @@ def rate_state_creep(args):
                                                                             & (t < crossings[1] - 0.05)] == 0)
 
 
+def rate_state_spectrum(args):
+    # The creep band's stick (185.5) relaxes v_rel at N' a / v_rel, 2.7e8 per tau at 190 and more before: the
+    # tangent's exponentials take that direction's log from the trace (analysis/tangent_magnus.f90's closed
+    # exponential), where 2^24 parts a step did not reach (the spectrum stopped at the transient's end).
+    transient, end = 190.0, 290.0                 # creep from the stick, break-aways and slips after it
+    path = Path(args.workdir) / "brake_rate_state_defaults.nml"
+    path.write_text(CREEP_NML)
+    got = {}
+    for rtol in (1e-10, 1e-9):
+        out = Path(args.workdir) / f"spectrum{rtol:g}.h5"
+        command = [args.binary, "--quiet", "--force", "-o", str(out), str(path)]
+        for key, value in {**QUIET, "brake.t_end": end, "analysis.lyapunov_spectrum": ".true.",
+                           "analysis.lyapunov_spectrum_transient": transient, "integrator.rtol": rtol,
+                           "integrator.atol": rtol * 1e-2, "integrator.max_wall_time": 30.0}.items():
+            command += ["--set", f"{key}={value}"]
+        subprocess.run(command, check=True)
+        with h5py.File(out) as f:
+            got[rtol] = (f["brake/lyapunov/exponents"][:], float(f["brake/lyapunov"].attrs["spectrum_divergence"]))
+    # Liouville: ln det Φ = ∫ tr J dt, tr J integrated by SciPy's Radau beside the equations written above, on
+    # its own orbit.  Radau's own error: 3.6e-11 of the average against rtol 1e-10 (measured).
+    field, jacobian, _ = creep_equations()
+    atol = [1e-14, 1e-60, 1e-14, 1e-14, 1e-12]
+    orbit = solve_ivp(field, (0.0, transient), [0.0, 0.0, 0.0, 0.0, 1.0], method="Radau", rtol=1e-9, atol=atol,
+                      jac=jacobian)
+    assert orbit.status == 0, orbit.message
+
+    def extended(t, s):
+        return np.append(field(t, s[:5]), np.trace(jacobian(t, s[:5])))
+
+    def extended_jacobian(t, s):
+        j = np.zeros((6, 6))
+        j[:5, :5] = jacobian(t, s[:5])
+        return j
+
+    span = solve_ivp(extended, (transient, end), np.append(orbit.y[:, -1], 0.0), method="Radau", rtol=1e-9,
+                     atol=atol + [1e-3], jac=extended_jacobian)
+    assert span.status == 0, span.message
+    divergence = span.y[5, -1] / (end - transient)
+    exponents, written = got[1e-10]
+    print(f"rate-state-spectrum: exponents {exponents}, sum {exponents.sum():.6f}; Radau's time average of tr J "
+          f"{divergence:.6f}, {abs(exponents.sum() / divergence - 1):.1e} apart; spectrum_divergence {written:.6f}, "
+          f"{abs(written / divergence - 1):.1e}; at rtol 1e-9: exponents {got[1e-9][0]}")
+    # The sum is the exponentials' Gauss rule for ∫ tr J on the program's steps (exactly: the stiff direction's
+    # log is the trace less the others'), the divergence Simpson's; both converge to Radau's at first order in
+    # rtol (measured 2.9e-6 and 3.4e-6 at rtol 1e-9, 2.9e-7 and 3.5e-7 at 1e-10, 3.2e-9 and 3.8e-9 at 1e-12:
+    # the creeping v_rel's own error, on which tr J ~ 1/v_rel hangs).  3e-6 is ten times the worst at 1e-10.
+    assert abs(exponents.sum() - divergence) <= 3e-6 * abs(divergence), (exponents.sum(), divergence)
+    assert abs(written - divergence) <= 3e-6 * abs(divergence), (written, divergence)
+    # The slow four against their own at rtol 1e-9: measured 8.1e-6 apart at most, 4.8e-6 the largest exponent
+    # (0.0878 per tau; 6e-7 from rtol 1e-12's).  With the fourth-order Magnus weights (one of them negative)
+    # the largest was 1.8e5 per tau at rtol 1e-8; 1e-4 is twelve times the measured spread.
+    assert np.max(np.abs(exponents[:4] - got[1e-9][0][:4])) <= 1e-4, (exponents, got[1e-9][0])
+    assert exponents[0] > 0.05 and np.all(np.diff(exponents) < 0), exponents
+
+
 def main():
     return case_main(__doc__, {"coulomb-switched": coulomb_switched, "arctan-regularized": arctan_regularized,
                                "lugre-radau": lugre_radau, "refusals": refusals, "benettin": benettin,
                                "spectrum": spectrum, "lugre-steady": lugre_steady, "lugre-spectrum": lugre_spectrum,
                                "lugre-stiff-steady": lugre_stiff_steady, "lugre-stiff-sum": lugre_stiff_sum,
-                               "rate-state-loose": rate_state_loose, "rate-state-creep": rate_state_creep})
+                               "rate-state-loose": rate_state_loose, "rate-state-creep": rate_state_creep,
+                               "rate-state-spectrum": rate_state_spectrum})
 
 
 if __name__ == "__main__":

@@ -164,6 +164,10 @@ module friction_analysis_periodic_orbit
       !> (the last event): a flow grazing the section is no return.
       logical :: rearms = .false.
       real(wp) :: rearm_level = 0.0_wp
+      !> The first step of an evaluation when solver%h_start is unset: the
+      !> scene's rule, which its map may set before each evaluation (the
+      !> brake's at the section point, brake/orbit.f90).
+      real(wp) :: first_step = 1.0e-3_wp
       class(step_watch), pointer :: watch => null()   !! asked between steps when associated
    contains
       procedure :: setup => hyperplane_setup
@@ -739,7 +743,7 @@ contains
       returned = .false.
       reason = ''
       h = self%solver%h_start
-      if (.not. (h > 0.0_wp)) h = 1.0e-3_wp
+      if (.not. (h > 0.0_wp)) h = self%first_step
       m = 1 + self%kinks
       if (self%rearms) then
          call locator%init(self%extended, self%solver, [merge(event_falling, event_rising, self%falling), &

@@ -17,6 +17,14 @@
 !> Φ is factored Φ = Q R after every part: Φ stays orthonormal between
 !> steps, and the logs of R's diagonal are summed into the caller's `logs`.
 !> The parts follow the stiffness met: about (λ_max - λ_min) h / 18 of them.
+!>
+!> With `closed` the last column is left out of that count: its log is
+!> tr X less the others' (det exp(X) = e^tr X, Φ orthonormal before each
+!> part) and its direction the complement of the others, so a single
+!> direction contracting faster than any number of parts resolves (a creep
+!> slip rate relaxing at 1e8 per τ over a step of τ) costs the parts the
+!> other directions need.  X is then scaled into the Padé's range however
+!> large (at most 2^max_closed_scaling).
 module friction_analysis_tangent_magnus
    use friction_kinds, only: wp, i8
    use friction_error, only: error_type, fatal_error, error_numerical
@@ -25,7 +33,7 @@ module friction_analysis_tangent_magnus
    implicit none
    private
 
-   public :: magnus_tangent_step, orbit_step, tangent_over_step, jacobian_trace, simpson_trace
+   public :: magnus_tangent_step, orbit_step, tangent_over_step, jacobian_trace, simpson_trace, step_state
 
    !> A part may shrink a column to e^-part_spread of another: the
    !> factorisation then loses at most e^18 ulp = 1.5e-8 of the small one,
@@ -33,6 +41,8 @@ module friction_analysis_tangent_magnus
    real(wp), parameter :: part_spread = 18.0_wp
    !> ||X||_1 at most 2^max_parts / 2 (beyond, J is not a number worth trusting).
    integer, parameter :: max_parts = 60
+   !> ||X||_1 at most 2^max_closed_scaling / 2 when the last column is closed by the trace.
+   integer, parameter :: max_closed_scaling = 1000
    !> At most 2^max_level parts to an exponential (seconds of work): a step
    !> that needs more ends the spectrum with an error instead of stalling.
    integer, parameter :: max_level = 24
@@ -41,6 +51,8 @@ module friction_analysis_tangent_magnus
    !> within one of them (faster than e^(-18 · 1024) over one exponential, the
    !> GMS elements held at their limits) is lost, its multiplier 0 exactly.
    integer, parameter :: lost_level = 10
+   !> The Gauss points of a step at 1/2 ∓ gauss_offset of it.
+   real(wp), parameter :: gauss_offset = sqrt(3.0_wp) / 6.0_wp
    !> The log of a lost direction's R factor.
    real(wp), parameter :: lost_log = -huge(1.0_wp)
 
@@ -83,7 +95,7 @@ contains
    !> Φ over the step orbit_step just took, from (t_a, y_a) with the field
    !> f_a to (t, y): the field there into f_a for the next step, an error
    !> naming the step where magnus_tangent_step cannot go on.
-   subroutine tangent_over_step(system, orbit, t_a, y_a, f_a, t, y, phi, logs, depth, error)
+   subroutine tangent_over_step(system, orbit, t_a, y_a, f_a, t, y, phi, logs, depth, error, closed)
       class(ode_system), intent(in) :: system
       type(ode_solver), intent(in) :: orbit
       real(wp), intent(in) :: t_a, t
@@ -93,11 +105,21 @@ contains
       real(wp), intent(inout) :: logs(:)
       integer, intent(inout) :: depth
       type(error_type), allocatable, intent(out) :: error
-      real(wp) :: f_b(size(y))
-      logical :: ok
+      logical, intent(in), optional :: closed   !! closed_tangent_step's, the last column closed by the trace
+      real(wp) :: f_b(size(y)), y_1(size(y)), y_2(size(y)), h
+      logical :: ok, by_trace
 
       call system%rhs(t, y, f_b)
-      call magnus_tangent_step(system, t_a, y_a, f_a, t, y, f_b, phi, logs, depth, ok)
+      by_trace = .false.
+      if (present(closed)) by_trace = closed
+      if (by_trace) then
+         h = t - t_a
+         call step_state(orbit, 0.5_wp - gauss_offset, t_a, h, y_a, f_a, y, f_b, y_1)
+         call step_state(orbit, 0.5_wp + gauss_offset, t_a, h, y_a, f_a, y, f_b, y_2)
+         call closed_tangent_step(system, t_a, y_1, y_2, t, phi, logs, depth, ok)
+      else
+         call magnus_tangent_step(system, t_a, y_a, f_a, t, y, f_b, phi, logs, depth, ok)
+      end if
       if (.not. ok) then
          call fatal_error(error, 'Lyapunov spectrum: the Jacobian is NaN or Inf, or too stiff for ' &
             & //'the step ending at '//orbit%time_at(t)//' (an exponential of the tangent in more ' &
@@ -106,6 +128,51 @@ contains
       end if
       f_a = f_b
    end subroutine tangent_over_step
+
+   !> The state at t_a + θh within the orbit's last step: its stepper's
+   !> continuous extension where it has one (rodas4's, of order 3), else the
+   !> cubic Hermite interpolant of the step's ends.  (A creeping slip rate's
+   !> field is the difference of two nearly equal forces, its rounding far
+   !> above the rate itself: the Hermite interpolant, which takes the field
+   !> at the ends, puts the rate off by orders of magnitude within the step;
+   !> the stepper's stages are solved through the Jacobian and do not.)
+   subroutine step_state(orbit, theta, t_a, h, y_a, f_a, y_b, f_b, y)
+      type(ode_solver), intent(in) :: orbit
+      real(wp), intent(in) :: theta, t_a, h, y_a(:), f_a(:), y_b(:), f_b(:)
+      real(wp), intent(out) :: y(:)
+      type(error_type), allocatable :: error
+
+      if (orbit%has_dense_output()) then
+         call orbit%dense_output(t_a + theta * h, y, error)
+         if (.not. allocated(error)) return
+      end if
+      call hermite(theta, h, y_a, f_a, y_b, f_b, y)
+   end subroutine step_state
+
+   !> Φ over the step from t_a to t_b with the last column closed by the
+   !> trace (closed_exponential), the Jacobians A_i at the Gauss points from
+   !> the states y_1, y_2 there: Φ ← exp(h A2 / 2) exp(h A1 / 2) Φ, second
+   !> order in the commutator [A1, A2] (the fourth-order method's weights
+   !> include a negative one, -0.039: where a creeping slip rate's stiffness,
+   !> which goes with its inverse, changes by more than 14 times within a
+   !> step, its exponential grows that direction at 1e9 per τ), each factor
+   !> contracting wherever J does, and the trace's sum h (tr A1 + tr A2)/2
+   !> still the Gauss rule's, of fourth order.
+   pure subroutine closed_tangent_step(system, t_a, y_1, y_2, t_b, phi, logs, depth, ok)
+      class(ode_system), intent(in) :: system
+      real(wp), intent(in) :: t_a, t_b, y_1(:), y_2(:)
+      real(wp), intent(inout) :: phi(:, :), logs(:)
+      integer, intent(inout) :: depth
+      logical, intent(out) :: ok
+      real(wp) :: a1(size(y_1), size(y_1)), a2(size(y_1), size(y_1)), dfdt(size(y_1)), h
+
+      h = t_b - t_a
+      call system%jacobian(t_a + (0.5_wp - gauss_offset) * h, y_1, a1, dfdt)
+      call system%jacobian(t_a + (0.5_wp + gauss_offset) * h, y_2, a2, dfdt)
+      call closed_exponential(0.5_wp * h * a1, phi, logs, depth, ok)
+      if (.not. ok) return
+      call closed_exponential(0.5_wp * h * a2, phi, logs, depth, ok)
+   end subroutine closed_tangent_step
 
    !> Φ (orthonormal) over the accepted step from (t_a, y_a), with the field
    !> f_a there, to (t_b, y_b) with f_b: Φ orthonormal again, the logs of the
@@ -234,6 +301,99 @@ contains
          call apply_part(levels, level + 1, last, phi, logs, product, finest, widest, upper)
       end if
    end subroutine apply_part
+
+   !> apply_exponential with the last column closed by the trace: the parts
+   !> judged by the other columns' span alone, the last column's log
+   !> tr X less the others' logs, its direction their complement.
+   pure subroutine closed_exponential(x, phi, logs, depth, ok)
+      real(wp), intent(in) :: x(:, :)
+      real(wp), intent(inout) :: phi(:, :)
+      real(wp), intent(inout) :: logs(:)
+      integer, intent(inout) :: depth
+      logical, intent(out) :: ok
+      real(wp), allocatable :: levels(:, :, :)
+      real(wp) :: norm, product(size(logs)), widest, before(size(logs)), trace
+      integer :: scaling, j, first, k, finest, n
+
+      n = size(x, 1)
+      norm = maxval(sum(abs(x), dim=1))
+      ok = all(abs(x) <= huge(x)) .and. norm <= pade_norm * 2.0_wp**max_closed_scaling
+      if (.not. ok) return
+      scaling = 0
+      if (norm > pade_norm) scaling = ceiling(log(norm / pade_norm) / log(2.0_wp))
+      allocate (levels(n, n, 0:scaling))
+      levels(:, :, scaling) = pade_exponential(x / 2.0_wp**scaling)
+      do j = scaling - 1, 0, -1
+         levels(:, :, j) = matmul(levels(:, :, j + 1), levels(:, :, j + 1))
+      end do
+      trace = 0.0_wp
+      do j = 1, n
+         trace = trace + x(j, j)
+      end do
+      before = logs
+      first = min(max(depth, 0), scaling)
+      finest = first
+      widest = 1.0_wp
+      product = 1.0_wp
+      do k = 1, 2**first
+         call closed_part(levels, first, scaling, phi, logs, product, finest, widest)
+         ok = finest <= max_level
+         if (.not. ok) return
+      end do
+      logs = logs + log(product)
+      logs(n) = before(n) + trace - sum(logs(1:n - 1) - before(1:n - 1))
+      depth = finest
+      if (finest == first .and. widest <= exp(0.5_wp * part_spread)) depth = max(first - 1, 0)
+   end subroutine closed_exponential
+
+   !> apply_part's with the last column closed: a part is taken whole when
+   !> the first n - 1 diagonal entries of R span at most e^part_spread; the
+   !> last column becomes the others' complement, its R left out (1).
+   pure recursive subroutine closed_part(levels, level, last, phi, logs, product, finest, widest)
+      real(wp), intent(in) :: levels(:, :, 0:)
+      integer, intent(in) :: level, last
+      real(wp), intent(inout) :: phi(:, :)
+      real(wp), intent(inout) :: logs(:), product(:), widest
+      integer, intent(inout) :: finest
+      real(wp) :: trial(size(phi, 1), size(phi, 2)), r(size(phi, 2))
+      integer :: n, m, i, j, k
+      logical :: fits
+
+      if (finest > max_level) return
+      n = size(phi, 1)
+      m = n - 1
+      do j = 1, n
+         do i = 1, n
+            trial(i, j) = 0.0_wp
+         end do
+         do k = 1, n
+            do i = 1, n
+               trial(i, j) = trial(i, j) + levels(i, k, level) * phi(k, j)
+            end do
+         end do
+      end do
+      call factor(trial, r)
+      fits = all(r(1:m) > 0.0_wp .and. r(1:m) <= huge(r))
+      if (fits .and. m > 0) fits = minval(r(1:m)) >= exp(-part_spread) * maxval(r(1:m))
+      if (level == last .or. fits) then
+         call complete(trial, n)
+         phi = trial
+         finest = max(finest, level)
+         if (m > 0 .and. fits) widest = max(widest, maxval(r(1:m)) / minval(r(1:m)))
+         r(n) = 1.0_wp
+         if (any(product < 1.0e-100_wp .or. product > 1.0e100_wp .or. r < 1.0e-100_wp .or. r > 1.0e100_wp)) then
+            logs = logs + log(product) + log(r)
+            product = 1.0_wp
+         else
+            product = product * r
+         end if
+      else if (level == max_level) then
+         finest = max_level + 1
+      else
+         call closed_part(levels, level + 1, last, phi, logs, product, finest, widest)
+         call closed_part(levels, level + 1, last, phi, logs, product, finest, widest)
+      end if
+   end subroutine closed_part
 
    !> apply_part's for a monodromy matrix: `trial` = the part applied to Φ,
    !> factored with all of R kept in `upper` and `logs`; the lost directions
@@ -434,15 +594,22 @@ contains
    !> step's cubic Hermite interpolant.  The flow's divergence apart from the
    !> exponentials' Gauss points, which the exponents' sum is the quadrature
    !> on: the sum rule's check (docs/chaos.md, the brake with a law).
-   pure subroutine simpson_trace(system, t_a, y_a, f_a, t_b, y_b, f_b, trace_a, trace_b, integral)
+   !> `middle`: the state at the midpoint given (step_state's), in place of
+   !> the interpolant's.
+   pure subroutine simpson_trace(system, t_a, y_a, f_a, t_b, y_b, f_b, trace_a, trace_b, integral, middle)
       class(ode_system), intent(in) :: system
       real(wp), intent(in) :: t_a, t_b, trace_a
       real(wp), intent(in) :: y_a(:), f_a(:), y_b(:), f_b(:)
       real(wp), intent(out) :: trace_b, integral
+      real(wp), intent(in), optional :: middle(:)
       real(wp) :: y(size(y_a)), h
 
       h = t_b - t_a
-      call hermite(0.5_wp, h, y_a, f_a, y_b, f_b, y)
+      if (present(middle)) then
+         y = middle
+      else
+         call hermite(0.5_wp, h, y_a, f_a, y_b, f_b, y)
+      end if
       trace_b = jacobian_trace(system, t_b, y_b)
       integral = h / 6.0_wp * (trace_a + 4.0_wp * jacobian_trace(system, t_a + 0.5_wp * h, y) + trace_b)
    end subroutine simpson_trace

@@ -18,7 +18,8 @@ module friction_brake_diagnostics
    use friction_ode_solver, only: ode_solver
    use friction_ode_events, only: event_locator, event_either
    use friction_law_kinked, only: kinked_system
-   use friction_analysis_tangent_magnus, only: orbit_step, tangent_over_step, jacobian_trace, simpson_trace
+   use friction_analysis_tangent_magnus, only: orbit_step, tangent_over_step, jacobian_trace, simpson_trace, &
+      & step_state
    use friction_analysis_settings, only: analysis_settings
    use friction_analysis_spectrum, only: spectrum_settings, spectrum_result, amplitude_spectrum
    use friction_analysis_poincare, only: stroboscopic_map, upward_section
@@ -358,7 +359,11 @@ contains
    !> saltation there, and the stepper does not stop at them; the kinks a law
    !> declares (GMS's switch bands) it does stop at, as the machine's (kinked_system).  `divergence`:
    !> ∫ tr J dt by Simpson's rule on each step (simpson_trace) over the
-   !> span's length, what the exponents sum to.
+   !> span's length, what the exponents sum to.  A law whose force goes with
+   !> the slip rate's logarithm (rate and state) relaxes a creeping v_rel
+   !> at up to N' a / v_rel, without bound as v_rel falls: the last column of
+   !> Φ is closed by the trace there (tangent_magnus.f90's `closed`), the one
+   !> direction the exponentials' parts cannot follow.
    subroutine law_flow_spectrum(config, settings, result, divergence, error, guard, reporter)
       type(brake_config), intent(in) :: config
       type(tangent_settings), intent(in) :: settings
@@ -372,11 +377,11 @@ contains
       type(ode_solver) :: orbit
       type(kinked_system), target :: kinked
       type(event_locator) :: locator
-      real(wp), allocatable :: z(:), y_a(:), f_a(:), f_b(:), phi(:, :), logs(:)
-      real(wp) :: t, t0, t_a, t_target, trace_a, trace_b, integral, total
+      real(wp), allocatable :: z(:), y_a(:), f_a(:), f_b(:), phi(:, :), logs(:), middle(:)
+      real(wp) :: t, t0, t_a, t_target, trace_a, trace_b, integral, total, reference, floor, h
       integer(i8) :: steps
-      integer :: n, k, intervals, depth, m
-      logical :: kinks
+      integer :: n, k, intervals, depth, m, relative
+      logical :: kinks, closed
 
       divergence = 0.0_wp
       call run%start(config, config%t_start, initial_state(config), events, error)
@@ -392,12 +397,19 @@ contains
          if (allocated(error)) return
       end do
       n = 4 + run%state_count()
-      allocate (z(n), y_a(n), f_a(n), f_b(n), logs(n))
+      allocate (z(n), y_a(n), f_a(n), f_b(n), logs(n), middle(n))
       ! The flow's own coordinates: (x, v_rel, y, w) (law_model.f90).
       z(1:4) = run%y
       if (n > 4) call run%get_states(z(5:n))
       t = run%t
       phi = generic_frame(n)
+      call run%flow%relative_component(relative, reference, floor)
+      closed = relative > 0
+      ! The run's first step, unless it cannot move t here (a creep's relaxation at τ = 0 is 1e-31 τ for
+      ! rate and state, below the spacing of a τ of 190): then the run's first-step rule at this state.
+      h = run%h_start
+      if (.not. (t + h > t)) h = run%flow%first_step(config%solver%h_start, t, z(1:4), &
+         & z(5:n) * run%flow%scale(1:n - 4))
       kinks = run%law%kink_count() > 0
       if (kinks) then
          ! The law's kinks (GMS's switch bands) located: each ends a step (docs/chaos.md).
@@ -405,11 +417,11 @@ contains
          allocate (kinked%model, source=run%flow)
          m = kinked%event_count()
          call locator%init(kinked, config%solver, spread(event_either, 1, m), spread(.true., 1, m), &
-            & config%event_tolerance, run%h_start, error, time_name='τ', time_unit='')
+            & config%event_tolerance, h, error, time_name='τ', time_unit='')
          if (allocated(error)) return
-         call locator%restart(t, z, run%h_start)
+         call locator%restart(t, z, h)
       else
-         call orbit%init(run%flow, config%solver, run%h_start, error)
+         call orbit%init(run%flow, config%solver, h, error)
          if (allocated(error)) return
       end if
       intervals = int(settings%duration / settings%renormalise + 1.0e-9_wp)
@@ -438,11 +450,17 @@ contains
             end if
             f_b = f_a
             if (t > t_a) then
-               call tangent_over_step(run%flow, orbit, t_a, y_a, f_b, t, z, phi, logs, depth, error)
+               call tangent_over_step(run%flow, orbit, t_a, y_a, f_b, t, z, phi, logs, depth, error, closed)
                if (allocated(error)) exit
             end if
             if (kinks) call restart_past_kink()
-            call simpson_trace(run%flow, t_a, y_a, f_a, t, z, f_b, trace_a, trace_b, integral)
+            if (closed) then
+               ! (The same states as the exponentials': the stepper's own between its ends.)
+               call step_state(orbit, 0.5_wp, t_a, t - t_a, y_a, f_a, z, f_b, middle)
+               call simpson_trace(run%flow, t_a, y_a, f_a, t, z, f_b, trace_a, trace_b, integral, middle)
+            else
+               call simpson_trace(run%flow, t_a, y_a, f_a, t, z, f_b, trace_a, trace_b, integral)
+            end if
             total = total + integral
             trace_a = trace_b
             f_a = f_b

@@ -68,6 +68,7 @@ module friction_brake_law_model
       procedure :: event_values => flow_event_values
       procedure :: friction => flow_friction
       procedure :: law_arguments => flow_law_arguments
+      procedure :: first_step => flow_first_step
    end type brake_law_flow
 
    !> Eq. 10 in one slip of a set-valued law, s the sign of v_rel: (x, v, y, w).
@@ -248,6 +249,35 @@ contains
       normal = ((1.0_wp - self%params%kappa) * y(3) + self%params%g_prime) * self%units%force
    end subroutine flow_law_arguments
 
+   !> The first step from (t0, y) with the law's states z (in its units):
+   !> h_start when set, else a tenth of the fastest time scale there (the
+   !> velocity's under friction, the states' relaxation), at most 1e-3, and
+   !> one that moves t (a creep's scale, at a restart late in a run, can lie
+   !> below τ's spacing).  The run's start and the orbit's section map alike.
+   pure real(wp) function flow_first_step(self, h_start, t0, y, z) result(h)
+      class(brake_law_flow), intent(in) :: self
+      real(wp), intent(in) :: h_start, t0, y(4), z(:)
+      real(wp) :: normal, fastest, dfdv, dfdz(max_law_states), dfda, dgdv(max_law_states), &
+         & dgdz(max_law_states, max_law_states)
+      integer :: ns
+
+      h = h_start
+      if (h > 0.0_wp) return
+      ns = self%n_states
+      associate (p => self%params, u => self%units)
+         normal = p%normal_force(y(3))
+         call self%law%partials(y(2) * u%velocity, z(1:ns), normal * u%force, -p%elastic_force(y(1), y(3)) &
+            & * u%force, dfdv, dfdz(1:ns), dfda, dgdv(1:ns), dgdz(1:ns, 1:ns))
+         fastest = max(1.0_wp, abs(dfdv) * u%velocity / u%force)
+         if (ns > 0) fastest = max(fastest, maxval(abs(dgdz(1:ns, 1:ns))) * u%time)
+      end associate
+      ! (A NaN partial makes the min NaN; the step then falls back to t's spacing and the run's own
+      ! checks report the NaN, not the event locator.)
+      h = min(1.0e-3_wp, 0.1_wp / fastest)
+      if (.not. (h >= 0.0_wp)) h = 0.0_wp
+      h = max(h, 2.0_wp * spacing(abs(t0)), tiny(1.0_wp))
+   end function flow_first_step
+
    ! ---- a set-valued law in slip ----
 
    pure function slip_dimension(self) result(n)
@@ -334,8 +364,7 @@ contains
       real(wp), intent(in) :: t0, y0(4)
       type(brake_event_table), intent(inout) :: events
       type(error_type), allocatable, intent(out) :: error
-      real(wp) :: normal, s(4 + max_law_states), dfdv, dfdz(max_law_states), dfda, dgdv(max_law_states), &
-         & dgdz(max_law_states, max_law_states), fastest
+      real(wp) :: normal, s(4 + max_law_states)
       integer :: ns
 
       ! An integrator runs one configuration (new_brake_integrator's) and Benettin restarts it every
@@ -401,22 +430,7 @@ contains
       self%z = 0.0_wp
       if (ns > 0) call self%law%steady_state(self%y(2) * self%units%velocity, normal * self%units%force, &
          & self%z(1:ns))
-      ! The first step: a tenth of the fastest time scale at the start (the
-      ! velocity's under friction, the states' relaxation), at most 1e-3, and
-      ! one that moves t (a creep's scale, at a restart late in a run, can lie below τ's spacing).
-      call self%law%partials(self%y(2) * self%units%velocity, self%z(1:ns), normal * self%units%force, &
-         & -self%p%elastic_force(y0(1), y0(3)) * self%units%force, dfdv, dfdz(1:ns), dfda, dgdv(1:ns), &
-         & dgdz(1:ns, 1:ns))
-      fastest = max(1.0_wp, abs(dfdv) * self%units%velocity / self%units%force)
-      if (ns > 0) fastest = max(fastest, maxval(abs(dgdz(1:ns, 1:ns))) * self%units%time)
-      self%h_start = config%solver%h_start
-      ! (A NaN partial makes the min NaN; the step then falls back to t's spacing and the run's own
-      ! checks report the NaN, not the event locator.)
-      if (.not. (self%h_start > 0.0_wp)) then
-         self%h_start = min(1.0e-3_wp, 0.1_wp / fastest)
-         if (.not. (self%h_start >= 0.0_wp)) self%h_start = 0.0_wp
-         self%h_start = max(self%h_start, 2.0_wp * spacing(abs(t0)), tiny(1.0_wp))
-      end if
+      self%h_start = self%flow%first_step(config%solver%h_start, t0, self%y, self%z(1:ns))
       if (self%tangent) then
          ! The tangent of (x, v_rel, y, w, ẑ): the law's states (in units of their scale) are in it.
          if (allocated(self%extended)) deallocate (self%extended)

@@ -112,6 +112,7 @@ module friction_brake_orbit
    !> integration fails returns nowhere.
    type, extends(section_map) :: brake_band_map
       class(section_map), allocatable :: plane
+      type(brake_law_flow) :: flow   !! the flow the plane steps: its first-step rule at each start
    contains
       procedure :: dimension => band_map_dimension
       procedure :: evaluate => band_map_evaluate
@@ -331,7 +332,17 @@ contains
       logical, intent(out) :: returned
       character(len=:), allocatable, intent(out) :: reason
       type(error_type), allocatable, intent(out) :: error
+      integer :: ns
 
+      ! The run's first step at the section point (law_model.f90's rule), not a fixed one: from the
+      ! creep band's edge a rate-and-state slip rate relaxes far faster than 1e-3 τ.
+      ! (The exponential tangent's map of a law with kinks keeps its own.)
+      ns = self%flow%n_states
+      select type (plane => self%plane)
+      type is (hyperplane_map)
+         plane%first_step = self%flow%first_step(plane%solver%h_start, 0.0_wp, [s(1), plane%level, s(2), s(3)], &
+            & s(4:3 + ns) * self%flow%scale(1:ns))
+      end select
       call self%plane%evaluate(s, image, jacobian, period, returned, reason, error)
       if (allocated(error)) then
          ! A trial point whose integration fails (the stepper gives up) returns nowhere.
@@ -525,6 +536,7 @@ contains
             & falling=limit > 0.0_wp)
          allocate (map%plane, source=plane)
       end if
+      map%flow = flow
       call find_periodic_orbit(map, guess, settings, result%orbit, error)
       if (allocated(error)) return
       result%state = [result%orbit%point(1), config%params%v_dr + level, result%orbit%point(2), result%orbit%point(3)]
