@@ -165,10 +165,11 @@ contains
       real(wp), intent(in) :: y(:)
       real(wp), intent(out) :: dfdy(:, :)
       real(wp), intent(out) :: dfdt(:)
-      real(wp) :: one(1, 3), one_y(1), h, sum
-      integer :: n, i, j, k, l
+      real(wp) :: one(1, 3), one_y(1), h, sum, reference, floor
+      integer :: n, i, j, k, l, relative
 
       n = self%base%dimension()
+      call self%base%relative_component(relative, reference, floor)
       dfdy = 0.0_wp
       dfdt = 0.0_wp
       call self%base%jacobian(t, y(1:n), dfdy(1:n, 1:n), dfdt(1:n))
@@ -193,6 +194,9 @@ contains
          & d0 => dfdt(2 * n + 1:3 * n))
          do k = 1, n
             h = 1.0e-6_wp * max(1.0_wp, abs(y(k)))
+            ! A slip rate the law takes the logarithm of is stepped relative to itself: 1e-6 across a creep of
+            ! 1e-13 put J's 1/v_rel at v_rel ~ 0 into this block, and Φ's stages overflowed at any step above 1e-7.
+            if (k == relative) h = 1.0e-6_wp * max(abs(y(k) - reference), floor)
             yp = y(1:n)
             yp(k) = y(k) + h
             call self%base%jacobian(t, yp, jp, d0)
