@@ -150,7 +150,7 @@ contains
    end subroutine step_state
 
    !> Φ over the step from t_a to t_b with the last column closed by the
-   !> trace (closed_exponential), the Jacobians A_i at the Gauss points from
+   !> trace (apply_exponential, closed), the Jacobians A_i at the Gauss points from
    !> the states y_1, y_2 there: Φ ← exp(h A2 / 2) exp(h A1 / 2) Φ, second
    !> order in the commutator [A1, A2] (the fourth-order method's weights
    !> include a negative one, -0.039: where a creeping slip rate's stiffness,
@@ -169,9 +169,9 @@ contains
       h = t_b - t_a
       call system%jacobian(t_a + (0.5_wp - gauss_offset) * h, y_1, a1, dfdt)
       call system%jacobian(t_a + (0.5_wp + gauss_offset) * h, y_2, a2, dfdt)
-      call closed_exponential(0.5_wp * h * a1, phi, logs, depth, ok)
+      call apply_exponential(0.5_wp * h * a1, phi, logs, depth, ok, closed=.true.)
       if (.not. ok) return
-      call closed_exponential(0.5_wp * h * a2, phi, logs, depth, ok)
+      call apply_exponential(0.5_wp * h * a2, phi, logs, depth, ok, closed=.true.)
    end subroutine closed_tangent_step
 
    !> Φ (orthonormal) over the accepted step from (t_a, y_a), with the field
@@ -214,37 +214,52 @@ contains
    !> e^part_spread, else as two parts of half the size (at ||X / 2^j||_1 <= 1/2
    !> it spans at most e).  The first parts are tried at level `depth`, which
    !> becomes the finest level taken, or one coarser when every part spanned
-   !> less than e^(part_spread / 2).
-   pure subroutine apply_exponential(x, phi, logs, depth, ok, upper)
+   !> less than e^(part_spread / 2).  `closed`: the last column is closed by
+   !> the trace, the parts judged by the other columns' span alone, the last
+   !> column's log tr X less the others' logs, its direction their complement.
+   pure subroutine apply_exponential(x, phi, logs, depth, ok, upper, closed)
       real(wp), intent(in) :: x(:, :)
       real(wp), intent(inout) :: phi(:, :)
       real(wp), intent(inout) :: logs(:)
       integer, intent(inout) :: depth
       logical, intent(out) :: ok
       real(wp), intent(inout), optional :: upper(:, :)
-      real(wp) :: levels(size(x, 1), size(x, 1), 0:max_parts), norm, product(size(logs)), widest
-      integer :: scaling, j, first, k, finest
+      logical, intent(in), optional :: closed
+      real(wp), allocatable :: levels(:, :, :)
+      real(wp) :: norm, product(size(logs)), widest, before(size(logs)), trace
+      integer :: scaling, j, first, k, finest, n
+      logical :: closing
 
+      closing = .false.
+      if (present(closed)) closing = closed
+      n = size(x, 1)
       norm = maxval(sum(abs(x), dim=1))
-      ok = all(abs(x) <= huge(x)) .and. norm <= pade_norm * 2.0_wp**max_parts
+      ok = all(abs(x) <= huge(x)) .and. norm <= pade_norm * 2.0_wp**merge(max_closed_scaling, max_parts, closing)
       if (.not. ok) return
       scaling = 0
       if (norm > pade_norm) scaling = ceiling(log(norm / pade_norm) / log(2.0_wp))
       ! levels(:, :, j) = exp(X / 2^j), from the Padé at the finest level up by squaring.
+      allocate (levels(n, n, 0:scaling))
       levels(:, :, scaling) = pade_exponential(x / 2.0_wp**scaling)
       do j = scaling - 1, 0, -1
          levels(:, :, j) = matmul(levels(:, :, j + 1), levels(:, :, j + 1))
       end do
+      trace = 0.0_wp
+      do j = 1, n
+         trace = trace + x(j, j)
+      end do
+      before = logs
       first = min(max(depth, 0), scaling)
       finest = first
       widest = 1.0_wp
       product = 1.0_wp
       do k = 1, 2**first
-         call apply_part(levels(:, :, 0:scaling), first, scaling, phi, logs, product, finest, widest, upper)
+         call apply_part(levels, first, scaling, closing, phi, logs, product, finest, widest, upper)
          ok = finest <= max_level
          if (.not. ok) return
       end do
       logs = logs + log(product)
+      if (closing) logs(n) = before(n) + trace - sum(logs(1:n - 1) - before(1:n - 1))
       depth = finest
       if (finest == first .and. widest <= exp(0.5_wp * part_spread)) depth = max(first - 1, 0)
    end subroutine apply_exponential
@@ -254,16 +269,20 @@ contains
    !> would be a third of the part's cost), which goes into logs before it
    !> leaves [1e-100, 1e100]; `finest` and `widest` record the finest level
    !> taken and the largest span of R's diagonal (finest > max_level: a part
-   !> beyond max_level was needed, and nothing more is done).
-   pure recursive subroutine apply_part(levels, level, last, phi, logs, product, finest, widest, upper)
+   !> beyond max_level was needed, and nothing more is done).  `closed`: a
+   !> part is judged by the first n - 1 entries of R's diagonal; the last
+   !> column becomes the others' complement, its R left out (1).
+   pure recursive subroutine apply_part(levels, level, last, closed, phi, logs, product, finest, widest, upper)
       real(wp), intent(in) :: levels(:, :, 0:)
       integer, intent(in) :: level, last
+      logical, intent(in) :: closed
       real(wp), intent(inout) :: phi(:, :)
       real(wp), intent(inout) :: logs(:), product(:), widest
       integer, intent(inout) :: finest
       real(wp), intent(inout), optional :: upper(:, :)
       real(wp) :: trial(size(phi, 1), size(phi, 2)), r(size(phi, 2))
-      integer :: n, i, j, k
+      integer :: n, m, i, j, k
+      logical :: fits
 
       if (finest > max_level) return
       n = size(phi, 1)
@@ -282,105 +301,16 @@ contains
          return
       end if
       call factor(trial, r)
+      m = merge(n - 1, n, closed)
       ! (A part that underflowed or overflowed a column is never taken whole.)
-      if (level == last .or. (all(r > 0.0_wp .and. r <= huge(r)) &
-         & .and. minval(r) >= exp(-part_spread) * maxval(r))) then
-         phi = trial
-         finest = max(finest, level)
-         widest = max(widest, maxval(r) / minval(r))
-         if (any(product < 1.0e-100_wp .or. product > 1.0e100_wp .or. r < 1.0e-100_wp .or. r > 1.0e100_wp)) then
-            logs = logs + log(product) + log(r)
-            product = 1.0_wp
-         else
-            product = product * r
-         end if
-      else if (level == max_level) then
-         finest = max_level + 1
-      else
-         call apply_part(levels, level + 1, last, phi, logs, product, finest, widest, upper)
-         call apply_part(levels, level + 1, last, phi, logs, product, finest, widest, upper)
-      end if
-   end subroutine apply_part
-
-   !> apply_exponential with the last column closed by the trace: the parts
-   !> judged by the other columns' span alone, the last column's log
-   !> tr X less the others' logs, its direction their complement.
-   pure subroutine closed_exponential(x, phi, logs, depth, ok)
-      real(wp), intent(in) :: x(:, :)
-      real(wp), intent(inout) :: phi(:, :)
-      real(wp), intent(inout) :: logs(:)
-      integer, intent(inout) :: depth
-      logical, intent(out) :: ok
-      real(wp), allocatable :: levels(:, :, :)
-      real(wp) :: norm, product(size(logs)), widest, before(size(logs)), trace
-      integer :: scaling, j, first, k, finest, n
-
-      n = size(x, 1)
-      norm = maxval(sum(abs(x), dim=1))
-      ok = all(abs(x) <= huge(x)) .and. norm <= pade_norm * 2.0_wp**max_closed_scaling
-      if (.not. ok) return
-      scaling = 0
-      if (norm > pade_norm) scaling = ceiling(log(norm / pade_norm) / log(2.0_wp))
-      allocate (levels(n, n, 0:scaling))
-      levels(:, :, scaling) = pade_exponential(x / 2.0_wp**scaling)
-      do j = scaling - 1, 0, -1
-         levels(:, :, j) = matmul(levels(:, :, j + 1), levels(:, :, j + 1))
-      end do
-      trace = 0.0_wp
-      do j = 1, n
-         trace = trace + x(j, j)
-      end do
-      before = logs
-      first = min(max(depth, 0), scaling)
-      finest = first
-      widest = 1.0_wp
-      product = 1.0_wp
-      do k = 1, 2**first
-         call closed_part(levels, first, scaling, phi, logs, product, finest, widest)
-         ok = finest <= max_level
-         if (.not. ok) return
-      end do
-      logs = logs + log(product)
-      logs(n) = before(n) + trace - sum(logs(1:n - 1) - before(1:n - 1))
-      depth = finest
-      if (finest == first .and. widest <= exp(0.5_wp * part_spread)) depth = max(first - 1, 0)
-   end subroutine closed_exponential
-
-   !> apply_part's with the last column closed: a part is taken whole when
-   !> the first n - 1 diagonal entries of R span at most e^part_spread; the
-   !> last column becomes the others' complement, its R left out (1).
-   pure recursive subroutine closed_part(levels, level, last, phi, logs, product, finest, widest)
-      real(wp), intent(in) :: levels(:, :, 0:)
-      integer, intent(in) :: level, last
-      real(wp), intent(inout) :: phi(:, :)
-      real(wp), intent(inout) :: logs(:), product(:), widest
-      integer, intent(inout) :: finest
-      real(wp) :: trial(size(phi, 1), size(phi, 2)), r(size(phi, 2))
-      integer :: n, m, i, j, k
-      logical :: fits
-
-      if (finest > max_level) return
-      n = size(phi, 1)
-      m = n - 1
-      do j = 1, n
-         do i = 1, n
-            trial(i, j) = 0.0_wp
-         end do
-         do k = 1, n
-            do i = 1, n
-               trial(i, j) = trial(i, j) + levels(i, k, level) * phi(k, j)
-            end do
-         end do
-      end do
-      call factor(trial, r)
       fits = all(r(1:m) > 0.0_wp .and. r(1:m) <= huge(r))
       if (fits .and. m > 0) fits = minval(r(1:m)) >= exp(-part_spread) * maxval(r(1:m))
       if (level == last .or. fits) then
-         call complete(trial, n)
+         if (closed) call complete(trial, n)
          phi = trial
          finest = max(finest, level)
-         if (m > 0 .and. fits) widest = max(widest, maxval(r(1:m)) / minval(r(1:m)))
-         r(n) = 1.0_wp
+         if (.not. closed .or. (m > 0 .and. fits)) widest = max(widest, maxval(r(1:m)) / minval(r(1:m)))
+         if (closed) r(n) = 1.0_wp
          if (any(product < 1.0e-100_wp .or. product > 1.0e100_wp .or. r < 1.0e-100_wp .or. r > 1.0e100_wp)) then
             logs = logs + log(product) + log(r)
             product = 1.0_wp
@@ -390,10 +320,10 @@ contains
       else if (level == max_level) then
          finest = max_level + 1
       else
-         call closed_part(levels, level + 1, last, phi, logs, product, finest, widest)
-         call closed_part(levels, level + 1, last, phi, logs, product, finest, widest)
+         call apply_part(levels, level + 1, last, closed, phi, logs, product, finest, widest, upper)
+         call apply_part(levels, level + 1, last, closed, phi, logs, product, finest, widest, upper)
       end if
-   end subroutine closed_part
+   end subroutine apply_part
 
    !> apply_part's for a monodromy matrix: `trial` = the part applied to Φ,
    !> factored with all of R kept in `upper` and `logs`; the lost directions
