@@ -1741,7 +1741,9 @@ BAD_SWEEP_INPUTS = {
                  ["bad.nml:2", "&sweep", "sweep_from", "must not be 0"]),
     "count": ("&sweep sweep_variable = 'brake.mu', sweep_spacing = 'linear', sweep_count = 0 /\n",
               ["bad.nml:1", "&sweep", "sweep_count"]),
-    "no-values": ("&sweep sweep_variable = 'brake.mu' /\n", ["&sweep", "sweep_values", "at least one"]),
+    # sweep_values left at its default: named at the line of sweep_variable (docs/input.md, Checks).
+    "no-values": ("&sweep sweep_variable = 'brake.mu' /\n",
+                  ["bad.nml:1: &sweep: sweep_variable, with the default &sweep: sweep_values", "at least one"]),
     "schedule": ("&sweep sweep_variable = 'brake.mu', sweep_values = 0.5, sweep_schedule = 'greedy' /\n",
                  ["bad.nml:1", "&sweep", "sweep_schedule", "'dynamic'"]),
     # A sweep runs no &verify: asking for it, or sweeping its settings, would be ignored.

@@ -58,7 +58,7 @@ contains
       if (int(self%nx, i8) * int(max(self%ny, 1), i8) > int(huge(1), i8)) call c%reject('scan', 'nx', &
          & itoa(self%nx), 'with ny = '//itoa(self%ny)//' the map has '//itoa(int(self%nx, i8) * self%ny) &
          & //' samples, more than 2147483647 per dataset (and '//bytes_text(8.0_wp * n_quantities &
-         & * real(self%nx, wp) * self%ny)//' of memory for the trace alone)')
+         & * real(self%nx, wp) * self%ny)//' of memory for the trace alone)', against=['scan.ny'])
       call check_integrator(self%solver, c)
       call check_verify(self%verify, c, 'nN')
       call self%thermal%validate(c)
@@ -143,12 +143,15 @@ contains
          eff = with_attempt_damping(self)
          ! Fluctuation-dissipation: the bath that heats an axis is its damper.
          if (.not. (self%cx > 0.0_wp)) call c%reject('tip', 'cx', rtoa(self%cx), 'must be > 0 (N s/m)'//at// &
-            & ': the heat bath acts through the damper (fluctuation-dissipation), an undamped axis has none')
+            & ': the heat bath acts through the damper (fluctuation-dissipation), an undamped axis has none', &
+            & against=['thermal.temperature'])
          if (.not. (self%cy > 0.0_wp)) call c%reject('tip', 'cy', rtoa(self%cy), 'must be > 0 (N s/m)'//at// &
-            & ': the heat bath acts through the damper (fluctuation-dissipation), an undamped axis has none')
+            & ': the heat bath acts through the damper (fluctuation-dissipation), an undamped axis has none', &
+            & against=['thermal.temperature'])
+         ! (cz's default 0 is refused only here and for the overdamped tip: with potential = 'lj'.)
          if (self%potential == 'lj' .and. .not. (self%cz > 0.0_wp)) call c%reject('tip', 'cz', rtoa(self%cz), &
             & 'must be > 0 (N s/m)'//at//': the heat bath acts through the damper (fluctuation-dissipation), ' &
-            & //'an undamped axis has none')
+            & //'an undamped axis has none', against=[character(len=19) :: 'thermal.temperature', 'surface.potential'])
          if (.not. c%failed() .and. self%thermal%model == 'kramers') call check_kramers()
          if (c%failed() .or. self%thermal%time_step == 0.0_wp) return
          ! (Here, where the message can name the variable, not in the scan at run time.)
@@ -191,6 +194,9 @@ contains
       !> direction the jumps go (a stiff spring across it, which keeps the
       !> tip on a row, does not take part in them).
       subroutine check_kramers()
+         ! What sets omega and the damping's floor, then the switch.
+         character(len=*), parameter :: kramers_partners(5) = [character(len=13) :: 'tip.mass', 'tip.kx', &
+            & 'tip.ky', 'scan.angle', 'thermal.model']
          real(wp) :: omega, least, theta
          character(len=:), allocatable :: why
 
@@ -210,11 +216,11 @@ contains
          if (self%cx / self%mass < least) call c%reject('tip', 'cx', rtoa(self%cx), 'is too weak '//why &
             & //rtoa(self%cx / self%mass)//' /s below omega = '//rtoa(least)//" /s, with the spring along " &
             & //"the scan: escape is then limited by energy diffusion, where Kramers' rate does not hold); " &
-            & //"use model = 'langevin'")
+            & //"use model = 'langevin'", against=kramers_partners)
          if (self%cy / self%mass < least) call c%reject('tip', 'cy', rtoa(self%cy), 'is too weak '//why &
             & //rtoa(self%cy / self%mass)//' /s below omega = '//rtoa(least)//" /s, with the spring along " &
             & //"the scan: escape is then limited by energy diffusion, where Kramers' rate does not hold); " &
-            & //"use model = 'langevin'")
+            & //"use model = 'langevin'", against=kramers_partners)
       end subroutine check_kramers
 
       !> &fourier: finite coefficients, not all zero, and only for potential = 'fourier'.
@@ -232,7 +238,7 @@ contains
          if (self%potential == 'fourier') then
             if (all(self%cosine == 0.0_wp) .and. all(self%sine == 0.0_wp)) call c%reject('fourier', 'cosine', &
                & '0.0', "every coefficient of &fourier is 0 (a flat surface): give at least cosine(1), the " &
-               & //"amplitude V0 of -V0 cos(2 pi x/ax)")
+               & //"amplitude V0 of -V0 cos(2 pi x/ax)", against=['surface.potential'])
          else if (self%cosine(n) /= 0.0_wp) then
             call c%reject('fourier', 'cosine', rtoa(self%cosine(n)), "is used only with &surface potential = " &
                & //"'fourier' (here '"//trim(self%potential)//"')", n)
@@ -249,7 +255,8 @@ contains
 
          if (.not. (value > 0.0_wp)) call c%reject('tip', name, rtoa(value), "must be > 0 (N s/m) for " &
             & //"model = 'overdamped': c dr/dt = -k (r - r_M) - grad V has no motion without damping " &
-            & //"(use 'inertial', or 'quasistatic' for the slow limit)")
+            & //"(use 'inertial', or 'quasistatic' for the slow limit)", &
+            & against=[character(len=17) :: 'tip.model', 'surface.potential'])
       end subroutine require_damped
 
       !> The Lennard-Jones sum and its crystal net (Eq. 3).
@@ -263,7 +270,7 @@ contains
          if (ns == 0) call c%reject('surface', 'species', "''", 'name at least one species')
          do k = 1, ns
             if (.not. (self%sigma(k) > 0.0_wp)) call c%reject('surface', 'sigma', rtoa(self%sigma(k)), &
-               & 'must be > 0 (Å) for species '//trim(self%species(k)), k)
+               & 'must be > 0 (Å) for species '//trim(self%species(k)), k, against=['surface.species'])
             if (.not. (self%epsilon(k) >= 0.0_wp)) call c%reject('surface', 'epsilon', rtoa(self%epsilon(k)), &
                & 'must be >= 0 (eV) for species '//trim(self%species(k)), k)
          end do
@@ -283,7 +290,8 @@ contains
             if (self%side < 1) call c%reject('surface', 'side', itoa(self%side), 'must be >= 1')
          case ('file')
             if (len_trim(self%net_file) == 0) then
-               call c%reject('surface', 'net_file', "''", "name an XYZ file for net = 'file'")
+               call c%reject('surface', 'net_file', "''", "name an XYZ file for net = 'file'", &
+                  & against=['surface.net'])
             else if (.not. file_exists(trim(self%net_file))) then
                call c%reject('surface', 'net_file', "'"//trim(self%net_file)//"'", 'no such file')
             end if
@@ -300,7 +308,8 @@ contains
          end do
          if (any(self%substitutions > 0) .and. .not. any(self%species(1:max(ns, 1)) == self%substitution_species)) &
             & call c%reject('surface', 'substitution_species', "'"//trim(self%substitution_species)//"'", &
-            & 'not in the species table (known: '//quoted(self%species(1:max(ns, 1)))//')')
+            & 'not in the species table (known: '//quoted(self%species(1:max(ns, 1)))//')', &
+            & against=[character(len=21) :: 'surface.substitutions', 'surface.species'])
       end subroutine check_net
 
    end procedure validate

@@ -190,7 +190,8 @@ contains
          call c%nonnegative('brake', 'mu_s', p%mu_s, 'static friction coefficient')
          if (self%model == model_switched .and. p%mu > p%mu_s) call c%reject('brake', 'mu', rtoa(p%mu), &
             & 'the switched model needs mu <= mu_s = '//rtoa(p%mu_s)//' (a kinetic coefficient above the ' &
-            & //'static one makes every slip stop at once: use the regularized model)')
+            & //'static one makes every slip stop at once: use the regularized model)', &
+            & against=[character(len=16) :: 'brake.mu_s', 'brake.model'])
          if (dimensional) then
             call c%positive('brake_dimensional', 'arm_length', d%arm_length, 'm')
             call c%nonnegative('brake_dimensional', 'drum_radius', d%drum_radius, 'm')
@@ -205,7 +206,8 @@ contains
             call c%nonnegative('brake_dimensional', 'delta_si', d%delta, 's/m')
             call c%finite('brake_dimensional', 'v_dr_si', d%v_dr)
             if (abs(d%k2 - d%k1) > 1.0e-9_wp * d%k1) call c%reject('brake_dimensional', 'k2', rtoa(d%k2), &
-               & 'must equal k1 = '//rtoa(d%k1)//': Eq. 10 assumes k2 = k1 (paper §4.1)')
+               & 'must equal k1 = '//rtoa(d%k1)//': Eq. 10 assumes k2 = k1 (paper §4.1)', &
+               & against=['brake_dimensional.k1'])
          else
             call c%positive('brake', 'xi', p%xi, 'J/(m L²)')
             call c%positive('brake', 'kappa', p%kappa, '(k1 + k3)/k1')
@@ -242,9 +244,13 @@ contains
          & against=[character(len=16) :: 'brake.t_end', 'brake.t_start'])
       associate (p => resolved%params)
          normal = p%normal_force(self%y0)
+         ! A default y0 = 0 gives N' = g_prime: refused against g_prime, or the data it is derived from.
          if (.not. (normal > 0.0_wp)) call c%reject('brake', 'y0', rtoa(self%y0), &
             & "the initial normal force N' = (1 - kappa) y0 + g_prime = "//rtoa(normal) &
-            & //' must be > 0 (kappa = '//rtoa(p%kappa)//', g_prime = '//rtoa(p%g_prime)//')')
+            & //' must be > 0 (kappa = '//rtoa(p%kappa)//', g_prime = '//rtoa(p%g_prime)//')', &
+            & against=merge([character(len=29) :: 'brake_dimensional.gravity', 'brake_dimensional.block_mass', &
+            & 'brake_dimensional.crank_mass', 'brake_dimensional.k1'], [character(len=29) :: 'brake.g_prime', '', &
+            & '', ''], dimensional))
       end associate
       call check_verify(self%verify, c, 'm')
       call self%analysis%validate(c, self%t_start, self%t_end, series_names, self%dt_out, run_group='brake')
@@ -281,7 +287,8 @@ contains
             ! The inner checker knows no file: drop its '(default): ' origin.
             associate (message => inner%error%message, origin => index(inner%error%message, '(default): '))
                call c%reject('analysis', 'continuation_end', rtoa(self%analysis%continuation_end), &
-                  & 'the end of the line is not a valid brake: '//message(merge(origin + 11, 1, origin == 1):))
+                  & 'the end of the line is not a valid brake: '//message(merge(origin + 11, 1, origin == 1):), &
+                  & against=['analysis.continuation'])
             end associate
          end if
       end block

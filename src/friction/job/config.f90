@@ -501,8 +501,14 @@ contains
          real(wp) :: x, previous
          integer :: k, found
          logical :: whole
+         character(len=32) :: partners(3)
 
          n = 0
+         ! A value of this axis left at its default is refused against the axis's spacing and variable
+         ! (2:3), sweep_to also against sweep_from.  (Element by element: see analysis_settings' partners.)
+         partners(1) = 'sweep.sweep_from'//suffix
+         partners(2) = 'sweep.sweep_spacing'//suffix
+         partners(3) = 'sweep.sweep_variable'//suffix
          associate (s => config%sweep)
             shown = "'"//trim(s%variables(a))//"'"
             call split_name(s%variables(a), group, name)
@@ -560,7 +566,7 @@ contains
                   & 'not given (a null value or a gap), but a later element is: give every value up to the last', &
                   & index=n + 1)
                if (n == 0) call c%reject('sweep', 'sweep_values'//suffix, '(none)', "give at least one value for " &
-                  & //"sweep_spacing"//suffix//" = 'list'")
+                  & //"sweep_spacing"//suffix//" = 'list'", against=partners(2:3))
                if (a == 1) then
                   s%listed1 = listed(1:n)
                else
@@ -568,7 +574,8 @@ contains
                end if
             case ('linear', 'log')
                if (s%count(a) < 1) then
-                  call c%reject('sweep', 'sweep_count'//suffix, itoa(s%count(a)), 'must be at least 1')
+                  call c%reject('sweep', 'sweep_count'//suffix, itoa(s%count(a)), 'must be at least 1', &
+                     & against=partners(2:3))
                   return
                end if
                call c%finite('sweep', 'sweep_from'//suffix, s%from(a))
@@ -578,10 +585,11 @@ contains
                if (s%spacings(a) == 'log' .and. .not. c%failed()) then
                   if (s%from(a) == 0.0_wp) then
                      call c%reject('sweep', 'sweep_from'//suffix, rtoa(s%from(a)), &
-                        & "must not be 0 for sweep_spacing"//suffix//" = 'log'")
+                        & "must not be 0 for sweep_spacing"//suffix//" = 'log'", against=partners(2:3))
                   else if (.not. (s%to(a) * sign(1.0_wp, s%from(a)) > 0.0_wp)) then
                      call c%reject('sweep', 'sweep_to'//suffix, rtoa(s%to(a)), "must be nonzero and of the sign " &
-                        & //"of sweep_from"//suffix//" = "//rtoa(s%from(a))//" for sweep_spacing"//suffix//" = 'log'")
+                        & //"of sweep_from"//suffix//" = "//rtoa(s%from(a))//" for sweep_spacing"//suffix//" = 'log'", &
+                        & against=partners)
                   end if
                end if
                if (c%failed()) return

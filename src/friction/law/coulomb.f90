@@ -36,7 +36,8 @@ contains
       call c%finite(law_group, 'mu', self%p%mu)
       call c%finite(law_group, 'mu_s', self%p%mu_s)
       if (.not. (self%p%mu_s >= self%p%mu)) call c%reject(law_group, 'mu_s', rtoa(self%p%mu_s), &
-         & 'must be >= mu = '//rtoa(self%p%mu)//' (exact stick needs a static coefficient not below the kinetic one)')
+         & 'must be >= mu = '//rtoa(self%p%mu)//' (exact stick needs a static coefficient not below the kinetic one)', &
+         & against=[law_group//'.mu'])
       call c%nonnegative(law_group, 'sigma2', self%p%sigma2, 'N s/m')
       call c%finite(law_group, 'sigma2', self%p%sigma2)
    end subroutine check

@@ -40,7 +40,8 @@ contains
       if (c%failed()) return
       if (.not. (self%p%z_ba >= 0.0_wp .and. self%p%z_ba < self%p%fc / self%p%sigma0)) &
          & call c%reject(law_group, 'z_ba', rtoa(self%p%z_ba), 'must be >= 0 and below fc/sigma0 = ' &
-         & //rtoa(self%p%fc / self%p%sigma0)//' m (the break-away deflection below the least steady one)')
+         & //rtoa(self%p%fc / self%p%sigma0)//' m (the break-away deflection below the least steady one)', &
+         & against=[character(len=16) :: law_group//'.fc', law_group//'.sigma0'])
    end subroutine check
 
    !> α(z, v): the share of the motion that is plastic.

@@ -72,10 +72,11 @@ contains
       do i = 1, n
          if (.not. (self%p%element_stiffness(i) > 0.0_wp .and. self%p%element_stiffness(i) <= huge(1.0_wp))) &
             & call c%reject(law_group, 'element_stiffness', rtoa(self%p%element_stiffness(i)), &
-            & 'must be a finite number > 0 (N/m) for each of the '//itoa(n)//' elements', i)
+            & 'must be a finite number > 0 (N/m) for each of the '//itoa(n)//' elements', i, &
+            & against=[law_group//'.elements'])
          if (.not. (self%p%element_weight(i) > 0.0_wp .and. self%p%element_weight(i) <= 1.0_wp)) &
             & call c%reject(law_group, 'element_weight', rtoa(self%p%element_weight(i)), &
-            & 'must be > 0 and <= 1 for each of the '//itoa(n)//' elements', i)
+            & 'must be > 0 and <= 1 for each of the '//itoa(n)//' elements', i, against=[law_group//'.elements'])
       end do
       if (c%failed()) return
       ! The weights share out the Stribeck curve: the steady force is g(v) only if they add up to 1.
@@ -85,7 +86,8 @@ contains
             shown = shown//', '//rtoa(self%p%element_weight(i))
          end do
          call c%reject(law_group, 'element_weight', shown, 'the '//itoa(n)//' weights add up to ' &
-            & //rtoa(sum(self%p%element_weight(1:n)))//', not 1 (they share out the Stribeck curve)')
+            & //rtoa(sum(self%p%element_weight(1:n)))//', not 1 (they share out the Stribeck curve)', &
+            & against=[law_group//'.elements'])
       end if
       call c%positive(law_group, 'attraction', self%p%attraction, 'N/s')
       call c%finite(law_group, 'attraction', self%p%attraction)

@@ -59,7 +59,8 @@ contains
 
       call c%nonnegative(law_group, 'fc', p%fc, 'N')
       if (.not. (p%fs >= p%fc)) call c%reject(law_group, 'fs', rtoa(p%fs), &
-         & 'must be >= fc = '//rtoa(p%fc)//' (the static level is not below the Coulomb level)')
+         & 'must be >= fc = '//rtoa(p%fc)//' (the static level is not below the Coulomb level)', &
+         & against=[law_group//'.fc'])
       call c%positive(law_group, 'vs', p%vs, 'm/s')
       call c%positive(law_group, 'exponent', p%exponent, '1')
       call c%finite(law_group, 'exponent', p%exponent)

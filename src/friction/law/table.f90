@@ -161,7 +161,8 @@ contains
          & "unknown extrapolation (known: 'constant', 'logarithmic')")
       if (c%failed()) return
       if (len_trim(self%p%table_file) == 0) then
-         call c%reject(law_group, 'table_file', "''", 'the tabulated law needs a file of v (m/s), F (N) rows')
+         call c%reject(law_group, 'table_file', "''", 'the tabulated law needs a file of v (m/s), F (N) rows', &
+            & against=[law_group//'.model'])
          return
       end if
       if (associated(self%p%reader)) then

@@ -216,12 +216,13 @@ contains
          if (inner%failed()) then
             associate (message => inner%error%message, origin => index(inner%error%message, '(default): '))
                call c%reject('analysis', 'continuation_end', rtoa(self%analysis%continuation_end), &
-                  & 'the end of the line is not a valid machine: '//message(merge(origin + 11, 1, origin == 1):))
+                  & 'the end of the line is not a valid machine: '//message(merge(origin + 11, 1, origin == 1):), &
+                  & against=['analysis.continuation'])
             end associate
          else if ((end_point%support_amplitude > 0.0_wp .and. end_point%support_frequency > 0.0_wp) .neqv. forced) then
             call c%reject('analysis', 'continuation_end', rtoa(self%analysis%continuation_end), 'the line must ' &
                & //'keep the support moving (support_amplitude and support_frequency > 0) or keep it still at ' &
-               & //'both ends: the section changes between them')
+               & //'both ends: the section changes between them', against=['analysis.continuation'])
          end if
       end block
    end subroutine check_orbit
