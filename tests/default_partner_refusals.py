@@ -46,6 +46,9 @@ def machine(args):
          "  continuation = 'mass'\n/\n", 11,
          "&analysis: continuation, with the default &analysis: continuation_end = 0.00000: ",
          "not a valid machine"),
+        # The default section, the slip onsets, with a law that has none.
+        ("&law\n  model = 'lugre'\n/\n&analysis\n  poincare = .true.\n/\n", 6,
+         "&law: model, with the default &analysis: section = 'stick_to_slip': ", "has none"),
         # A value that was itself set keeps its own line, the partner default or not.
         ("&law\n  model = 'stribeck'\n  fs = 0.5\n/\n", 7, "&law: fs = 0.500000: ", "must be >= fc = 1.00000"),
     ]

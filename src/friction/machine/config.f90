@@ -185,7 +185,8 @@ contains
             & .not. width > 0.0_wp) &
             & call c%reject('analysis', 'section', "'stick_to_slip'", "the located slip onsets are the events of " &
             & //"exact stick; &law model = '"//trim(self%law%model)//"' has none: use section = 'w_zero_up' " &
-            & //"(the sliding velocity crossing 0 upwards) or 'none'")
+            & //"(the sliding velocity crossing 0 upwards) or 'none'", &
+            & against=[character(len=17) :: 'law.model', 'analysis.poincare'])
       end associate
    end subroutine check_sections
 

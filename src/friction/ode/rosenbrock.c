@@ -35,8 +35,11 @@
  * Failures: a singular matrix (a zero or non-finite pivot) or a
  * non-finite result returns GSL_ESING or GSL_FAILURE with y unchanged;
  * GSL's evolve then halves the step and tries again, and gives up (with
- * that status) once the step no longer changes t.  A failing right-hand
- * side or Jacobian returns its own status (GSL_EBADFUNC: evolve stops).
+ * that status) once the step no longer changes t.  So does a right-hand
+ * side that is not finite at a stage's trial state or at the step's end
+ * (a step too long for a stiffness the Jacobian at its start did not
+ * see).  A failing right-hand side at the step's start, or a failing
+ * Jacobian, returns its own status (GSL_EBADFUNC: evolve stops).
  *
  * The right-hand side at the start of a step is the previous step's
  * dydt_out when the step starts where that one ended (same system, same t
@@ -334,6 +337,10 @@ static inline __attribute__((always_inline)) int step_sized(struct rosenbrock_st
                 s->ytmp[i] = sum;
             }
             status = GSL_ODEIV_FN_EVAL(sys, t + m->alpha[stage] * h, s->ytmp, s->f);
+            /* A stage's state is a trial, not the solution: where f is not finite there, the step
+             * is too long for the stiffness the Jacobian at (t, y) did not see (Dahl's sigma0 |v| / F_c
+             * at v = 0): rejected, evolve halves it. */
+            if (status == GSL_EBADFUNC) return GSL_FAILURE;
             if (status != GSL_SUCCESS) return status;
         }
         for (i = 0; i < n; i++) {
@@ -358,6 +365,8 @@ static inline __attribute__((always_inline)) int step_sized(struct rosenbrock_st
 
     if (dydt_out != NULL) {
         status = GSL_ODEIV_FN_EVAL(sys, t + h, s->ytmp, dydt_out);
+        /* (The same at the step's end, whose error the control has not yet judged.) */
+        if (status == GSL_EBADFUNC) return GSL_FAILURE;
         if (status != GSL_SUCCESS) return status;
         kept_set(&s->end, sys, t + h, s->ytmp, dydt_out, n);
     }
