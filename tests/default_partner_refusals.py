@@ -47,8 +47,12 @@ def machine(args):
          "&analysis: continuation, with the default &analysis: continuation_end = 0.00000: ",
          "not a valid machine"),
         # The default section, the slip onsets, with a law that has none.
-        ("&law\n  model = 'lugre'\n/\n&analysis\n  poincare = .true.\n/\n", 6,
+        ("&machine\n  t_end = 2000.0\n/\n&law\n  model = 'lugre'\n/\n&analysis\n  poincare = .true.\n/\n", 9,
          "&law: model, with the default &analysis: section = 'stick_to_slip': ", "has none"),
+        # The default window [100, 1000] s beyond the default run [0, 100] s: the switch that needs it.
+        ("&law\n  model = 'lugre'\n/\n&analysis\n  poincare = .true.\n  section = 'w_zero_up'\n/\n", 9,
+         "&analysis: poincare, with the default &analysis: window_start = 100.000: ",
+         "the spectrum of the strobe period needs 16"),
         # A value that was itself set keeps its own line, the partner default or not.
         ("&law\n  model = 'stribeck'\n  fs = 0.5\n/\n", 7, "&law: fs = 0.500000: ", "must be >= fc = 1.00000"),
     ]

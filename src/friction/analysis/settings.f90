@@ -157,7 +157,7 @@ contains
       logical, intent(in), optional :: strobe_known
       integer, intent(in), optional :: series_points
       character(len=*), intent(in), optional :: run_group
-      character(len=64) :: run(3)
+      character(len=64) :: run(3), tools(2)
       real(wp) :: samples
       integer :: need, points
       logical :: strobe_given
@@ -206,12 +206,18 @@ contains
          if (need > 0 .and. points < need) then
             what = 'the spectrum or Rosenstein''s series'
             if (.not. (self%spectrum .or. self%rosenstein)) what = 'the spectrum of the strobe period'
+            ! The switches that need the window, last: with the whole window at its defaults, the line
+            ! that asked for it.
+            tools = ''
+            if (self%spectrum) tools(1) = 'analysis.spectrum'
+            if (self%rosenstein) tools(2) = 'analysis.rosenstein'
+            if (.not. (self%spectrum .or. self%rosenstein)) tools(1) = 'analysis.poincare'
             if (self%window_end < t_end) then
                call c%reject('analysis', 'window_end', rtoa(self%window_end), window_text(), &
-                  & against=partners(run, 'run', 'analysis.window_start'))
+                  & against=partners(run, 'run', 'analysis.window_start', tools(1), tools(2)))
             else
                call c%reject('analysis', 'window_start', rtoa(self%window_start), window_text(), &
-                  & against=partners(run, 'run', 'analysis.window_end'))
+                  & against=partners(run, 'run', 'analysis.window_end', tools(1), tools(2)))
             end if
          end if
       end if
