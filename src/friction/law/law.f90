@@ -263,15 +263,30 @@ contains
    pure real(wp) function band_edge_velocity(centre, half_width, scale, s, inner) result(v)
       real(wp), intent(in) :: centre, half_width, scale, s
       logical, intent(in) :: inner
+      integer :: k
 
       v = centre + s * half_width / scale
+      ! By units of v's last place, which reach the edge in a step or two unless v is far below the
+      ! centre's size: an edge at v = 0 (a belt at ±half_width) has subnormal units, and 2^60 steps of
+      ! them moved v - centre by less than its own unit (a hang).  After 64, units of the larger.
+      k = 0
       if (inner) then
          do while (.not. in_band(v, centre, half_width, scale))
-            v = nearest(v, -s)
+            k = k + 1
+            if (k <= 64) then
+               v = nearest(v, -s)
+            else
+               v = v - s * spacing(max(abs(v), abs(centre)))
+            end if
          end do
       else
          do while (in_band(v, centre, half_width, scale))
-            v = nearest(v, s)
+            k = k + 1
+            if (k <= 64) then
+               v = nearest(v, s)
+            else
+               v = v + s * spacing(max(abs(v), abs(centre)))
+            end if
          end do
       end if
    end function band_edge_velocity
