@@ -569,6 +569,8 @@ contains
          if (.not. entered) then
             result%orbit%point = guess
             result%orbit%reason = reason
+            ! (The state too, which the file and a branch's point read: unset, its size was garbage.)
+            result%state = state_at(guess)
             call equilibrium_of(c, result, error)
             return
          end if
@@ -587,13 +589,9 @@ contains
       end select
       call equilibrium_of(c, result, error)
       if (allocated(error)) return
-      if (result%forced) then
-         section_scale = scale
-         result%state = result%orbit%point * scale
-      else
-         section_scale = [scale(1), scale(3:n)]
-         result%state = [result%orbit%point(1), c%load_velocity, result%orbit%point(2:) * scale(3:n)]
-      end if
+      section_scale = scale
+      if (.not. result%forced) section_scale = [scale(1), scale(3:n)]
+      result%state = state_at(result%orbit%point)
       if (.not. result%orbit%found) return
       if (result%has_equilibrium) then
          ! Newton may close on the equilibrium itself, which lies on the section: no orbit.
@@ -631,6 +629,20 @@ contains
             result%exponents = [0.0_wp, real(logs) / result%orbit%period]
          end if
       end select
+
+   contains
+
+      !> A section point (scaled section coordinates) as the state in SI: e, v, the law's states.
+      function state_at(point) result(state)
+         real(wp), intent(in) :: point(:)
+         real(wp), allocatable :: state(:)
+
+         if (result%forced) then
+            state = point * scale
+         else
+            state = [point(1), c%load_velocity, point(2:) * scale(3:n)]
+         end if
+      end function state_at
    end subroutine orbit_from
 
    ! ---- continuation ----
