@@ -170,8 +170,8 @@ def stated_nonfinite(handle, name, data):
     Lyapunov or Floquet exponent is -inf for the direction the stick
     collapses (a multiplier of 0); a continuation's period and largest
     modulus are NaN where no orbit was found (the machine's multipliers
-    too), as a machine or brake sweep's orbit results are at its points
-    without one."""
+    too), and the machine's equilibrium's growth where it has none, as a
+    machine or brake sweep's orbit results are at its points without one."""
     leaf = name.split("/")[-1]
     if leaf.endswith("_sem") and "afm" in handle and int(handle["afm"].attrs.get("realizations", 2)) == 1:
         return np.isnan(data)
@@ -184,6 +184,9 @@ def stated_nonfinite(handle, name, data):
                                                            "floquet_multipliers_imag"):
         found = handle["machine/orbit/branch/found"][()].astype(bool)
         return np.isnan(data) & ~found.reshape((-1,) + (1,) * (data.ndim - 1))
+    if name == "machine/orbit/branch/growth" and "machine/orbit/equilibrium" not in handle:
+        # A machine on a moving support has no equilibrium: its growth is NaN at every point.
+        return np.isnan(data)
     if name.startswith("sweep/orbit_") and leaf != "orbit_found" and handle.attrs.get("sweep_scene") in (
             b"machine", "machine", b"brake", "brake"):
         found = handle["sweep/orbit_found"][()].astype(bool)
