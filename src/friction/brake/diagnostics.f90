@@ -29,7 +29,7 @@ module friction_brake_diagnostics
    use friction_analysis_lyapunov_series, only: rosenstein_result
    use friction_analysis_periodic_orbit, only: orbit_settings
    use friction_brake_orbit, only: brake_orbit, brake_periodic_orbit, orbit_branch, follow_branch
-   use friction_scene_report, only: job_reporter, loop_guard
+   use friction_scene_report, only: job_reporter, loop_guard, job_watch, new_job_watch
    use friction_clock, only: wall_seconds
    implicit none
    private
@@ -75,6 +75,7 @@ contains
       integer :: first, last, k, column
       real(wp) :: t_end
       type(loop_guard) :: guard
+      type(job_watch), target :: watch
 
       guard = loop_guard(started=wall_seconds(), limit=config%solver%max_wall_time)
 
@@ -162,15 +163,19 @@ contains
          if (a%orbit .and. .not. (config%switched() .or. config%uses_law())) then
             result%orbit%orbit%reason = "the section is the switched model's located slip onsets: model = 'switched'"
          else if (a%orbit) then
-            ! Not finding one is a result (orbit%found), not an error.
+            ! Not finding one is a result (orbit%found), not an error.  A Newton step's trial points can
+            ! take long (rate and state on the slow belt): the watch is asked after each and inside the map.
+            watch = new_job_watch('&analysis: the periodic orbit''s search', 'the return''s τ', &
+               & config%solver%max_wall_time, reporter)
+            watch%guard = guard
             call brake_periodic_orbit(config, events, a%orbit_transient, &
                & orbit_settings(tolerance=a%orbit_tolerance, max_iterations=a%orbit_max_iterations), &
-               & result%orbit, error)
+               & result%orbit, error, watch)
             if (allocated(error)) return
             if (len_trim(a%continuation) > 0) then
                call follow_branch(config, result%orbit, a%continuation_end, a%continuation_points, &
                   & a%orbit_transient, orbit_settings(tolerance=a%orbit_tolerance, &
-                  & max_iterations=a%orbit_max_iterations), result%branch, error, guard, reporter)
+                  & max_iterations=a%orbit_max_iterations), result%branch, error, guard, reporter, watch)
                if (allocated(error)) return
             end if
          end if

@@ -25,7 +25,8 @@
 module friction_brake_orbit
    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
    use friction_kinds, only: wp, pi
-   use friction_error, only: error_type
+   use friction_error, only: error_type, error_interrupted
+   use friction_ode_watch, only: step_watch
    use friction_brake_config, only: brake_config, continuation_config, continuation_variable
    use friction_brake_simulate, only: brake_run, simulate_brake, initial_state
    use friction_brake_params, only: brake_parameters
@@ -93,6 +94,7 @@ module friction_brake_orbit
       real(wp) :: max_return = 1.0e4_wp   !! τ; no slip onset by then: no return
       logical :: tangent = .true.         !! .false.: P alone (jacobian = 0)
       integer :: counts(size(event_kind_names)) = 0   !! events by kind over the last return
+      class(step_watch), pointer :: watch => null()   !! asked after every return when associated
       logical, private :: prepared = .false.          !! slope and level known (model = 'law')
       logical, private :: band = .false.              !! a band law: the end of a hold at the edge (band.f90)
       real(wp), private :: slope = 0.0_wp, level = 0.0_wp
@@ -113,6 +115,7 @@ module friction_brake_orbit
    type, extends(section_map) :: brake_band_map
       class(section_map), allocatable :: plane
       type(brake_law_flow) :: flow   !! the flow the plane steps: its first-step rule at each start
+      class(step_watch), pointer :: watch => null()   !! the plane's too: asked inside its integration
    contains
       procedure :: dimension => band_map_dimension
       procedure :: evaluate => band_map_evaluate
@@ -207,6 +210,7 @@ contains
       type(brake_law_slip) :: law_slip
       real(wp) :: normal(4), f(4), b(4, 2), projected(4, 2), slope
       integer :: i
+      logical :: ends
 
       image = s
       jacobian = 0.0_wp
@@ -244,6 +248,9 @@ contains
             call switched%advance_to_slip_onset(self%max_return, events, returned, error)
             run => switched
          end if
+         ! (The switched and law integrators take no watch: it is asked after each return.)
+         call search_end(self%watch, run%t, error, ends)
+         if (ends) return
          if (allocated(error)) then
             ! A trial point of Newton's whose orbit leaves Eq. 10 (the pad lifts
             ! off) or defeats the stepper returns nowhere: a result of the search.
@@ -333,6 +340,7 @@ contains
       character(len=:), allocatable, intent(out) :: reason
       type(error_type), allocatable, intent(out) :: error
       integer :: ns
+      logical :: ends
 
       ! The run's first step at the section point (law_model.f90's rule), not a fixed one: from the
       ! creep band's edge a rate-and-state slip rate relaxes far faster than 1e-3 τ.
@@ -344,6 +352,8 @@ contains
             & s(4:3 + ns) * self%flow%scale(1:ns))
       end select
       call self%plane%evaluate(s, image, jacobian, period, returned, reason, error)
+      call search_end(self%watch, period, error, ends)
+      if (ends) return
       if (allocated(error)) then
          ! A trial point whose integration fails (the stepper gives up) returns nowhere.
          returned = .false.
@@ -352,17 +362,43 @@ contains
       end if
    end subroutine band_map_evaluate
 
+   !> Whether a trial point's return ends the search: stopped on request
+   !> inside its integration (the watch polls the reporter at intervals, so
+   !> asking it again might not say so), or the watch says so now (a stop
+   !> request, max_wall_time: an integration that failed keeps its error,
+   !> the watch's own where it fired inside, with the time it reached).
+   !> Otherwise a failed integration is the trial's result, no return.
+   subroutine search_end(watch, t, error, ends)
+      class(step_watch), pointer, intent(in) :: watch
+      real(wp), intent(in) :: t
+      type(error_type), allocatable, intent(inout) :: error
+      logical, intent(out) :: ends
+      type(error_type), allocatable :: stop
+
+      ends = .false.
+      if (.not. associated(watch)) return
+      if (allocated(error)) then
+         ends = error%stat == error_interrupted
+         if (ends) return
+      end if
+      call watch%check(t, stop)
+      ends = allocated(stop)
+      if (ends .and. .not. allocated(error)) call move_alloc(stop, error)
+   end subroutine search_end
+
    !> The periodic orbit through the run's first slip onset at or after
    !> t_start + transient (the guess), Newton on its section.  No slip onset
    !> there, or no convergence: found = .false. with the reason.  A
    !> single-valued law's slip onsets are the exits from the creep band.
-   subroutine brake_periodic_orbit(config, events, transient, settings, result, error)
+   !> `watch` (a stop request, max_wall_time) ends the search with its error.
+   subroutine brake_periodic_orbit(config, events, transient, settings, result, error, watch)
       type(brake_config), intent(in) :: config
       type(brake_event_table), intent(in) :: events
       real(wp), intent(in) :: transient
       type(orbit_settings), intent(in) :: settings
       type(brake_orbit), intent(out) :: result
       type(error_type), allocatable, intent(out) :: error
+      class(step_watch), intent(inout), optional, target :: watch   !! asked in the search (search_end)
       integer :: j
       real(wp), allocatable :: times(:), states(:, :)
       type(error_type), allocatable :: run_error
@@ -381,7 +417,7 @@ contains
          end if
          result%guess_time = times(1)
          result%limit = section_limit(config%params, states(:, 1))
-         call continue_orbit(config, result%limit, states(3:4, 1), settings, result, error)
+         call continue_orbit(config, result%limit, states(3:4, 1), settings, result, error, watch)
          return
       end if
       if (.not. exact_stick(config)) result%section = 'creep_band_exit'
@@ -395,7 +431,7 @@ contains
       result%guess_time = events%t(j)
       if (exact_stick(config)) then
          result%limit = section_limit(config%params, events%state(:, j))
-         call continue_orbit(config, result%limit, events%state(3:4, j), settings, result, error)
+         call continue_orbit(config, result%limit, events%state(3:4, j), settings, result, error, watch)
       else
          ! The slip leaves the band in the direction s = -σ.
          result%limit = -sign(1.0_wp, events%state(2, j) - config%params%v_dr)
@@ -408,7 +444,13 @@ contains
                deallocate (error)
                return
             end if
-            call continue_orbit(config, result%limit, [events%state([1, 3, 4], j), states], settings, result, error)
+            if (present(watch)) then
+               ! (The run to the guess takes no watch: asked once it is done.)
+               call watch%check(events%t(j), error)
+               if (allocated(error)) return
+            end if
+            call continue_orbit(config, result%limit, [events%state([1, 3, 4], j), states], settings, result, &
+               & error, watch)
          end block
       end if
    end subroutine brake_periodic_orbit
@@ -439,24 +481,26 @@ contains
 
    !> Newton from the section point guess at the limit σ: (y, w) on the
    !> stick-to-slip section, (x, y, w) on the creep band's exit.
-   subroutine continue_orbit(config, limit, guess, settings, result, error)
+   subroutine continue_orbit(config, limit, guess, settings, result, error, watch)
       type(brake_config), intent(in) :: config
       real(wp), intent(in) :: limit, guess(:)
       type(orbit_settings), intent(in) :: settings
       type(brake_orbit), intent(inout) :: result
       type(error_type), allocatable, intent(out) :: error
+      class(step_watch), intent(inout), optional, target :: watch   !! asked in the search (search_end)
       type(brake_section_map) :: map
       logical :: band
 
       band = band_law(config)
       if (.not. (exact_stick(config) .or. band)) then
-         call band_orbit(config, limit, guess, settings, result, error)
+         call band_orbit(config, limit, guess, settings, result, error, watch)
          return
       end if
       if (band) result%section = 'band_hold_end'
       map%config = config
       map%limit = limit
       map%max_return = config%t_end - config%t_start
+      if (present(watch)) map%watch => watch
       result%limit = limit
       call find_periodic_orbit(map, guess, settings, result%orbit, error)
       if (allocated(error)) return
@@ -478,12 +522,13 @@ contains
    !> direction is forgotten: the creep only contracts).  The events of one
    !> period from a run of the orbit, over [T/2, 3T/2) (away from the
    !> section's own crossing at 0 and T).
-   subroutine band_orbit(config, limit, guess, settings, result, error)
+   subroutine band_orbit(config, limit, guess, settings, result, error, watch)
       type(brake_config), intent(in) :: config
       real(wp), intent(in) :: limit, guess(:)
       type(orbit_settings), intent(in) :: settings
       type(brake_orbit), intent(inout) :: result
       type(error_type), allocatable, intent(out) :: error
+      class(step_watch), intent(inout), optional, target :: watch   !! asked in the search (search_end)
       type(brake_law_flow) :: flow
       type(brake_band_map) :: map
       type(hyperplane_map) :: plane
@@ -514,6 +559,11 @@ contains
       flow%stick_velocity = config%stick_velocity
       ! The flow's coordinate 2 is v_rel (law_model.f90): the band's exit at -σ v_s, the kink at 0.
       level = -limit * config%stick_velocity
+      if (present(watch)) then
+         map%watch => watch
+         exponential%watch => watch
+         plane%watch => watch
+      end if
       if (flow%law%kink_count() > 0) then
          ! The kinks the law declares (GMS's switch bands, whose elements relax at up to ~1e8 1/s): the
          ! tangent by exponentials over the orbit's steps, each kink a step's end, as the machine's map.
@@ -606,7 +656,7 @@ contains
    !> that fails, from the first slip onset after `transient` of a run at
    !> the point.  Every point's run also gives the attractor's slip onsets.
    !> Sequential: the result does not depend on ranks.
-   subroutine follow_branch(config, first, last, n, transient, settings, branch, error, guard, reporter)
+   subroutine follow_branch(config, first, last, n, transient, settings, branch, error, guard, reporter, watch)
       type(brake_config), intent(in) :: config
       type(brake_orbit), intent(in) :: first
       real(wp), intent(in) :: last, transient
@@ -616,6 +666,7 @@ contains
       type(error_type), allocatable, intent(out) :: error
       type(loop_guard), intent(in), optional :: guard   !! a stop request and max_wall_time, checked each point
       class(job_reporter), intent(inout), optional :: reporter
+      class(step_watch), intent(inout), optional, target :: watch   !! asked in each point's orbit search
       type(brake_orbit) :: previous, current
       type(brake_config) :: point
       real(wp) :: start
@@ -640,11 +691,12 @@ contains
             current = brake_orbit()
             if (previous%orbit%found) then
                call continue_along(config, branch%parameter(k - 1), branch%parameter(k), previous, settings, &
-                  & current, error)
+                  & current, error, watch)
                if (allocated(error)) return
             end if
             branch%source(k) = merge(1, 2, current%orbit%found)
-            call attractor_onsets(point, transient, onsets, current, .not. current%orbit%found, error, settings)
+            call attractor_onsets(point, transient, onsets, current, .not. current%orbit%found, error, settings, &
+               & watch)
          end if
          if (allocated(error)) return
          branch%section_parameter = [branch%section_parameter, spread(branch%parameter(k), 1, size(onsets))]
@@ -693,13 +745,14 @@ contains
    end function orbit_states
 
    !> From the orbit `previous` at the value `from` to the value `to`.
-   subroutine continue_along(config, from, to, previous, settings, result, error)
+   subroutine continue_along(config, from, to, previous, settings, result, error, watch)
       type(brake_config), intent(in) :: config
       real(wp), intent(in) :: from, to
       type(brake_orbit), intent(in) :: previous
       type(orbit_settings), intent(in) :: settings
       type(brake_orbit), intent(out) :: result
       type(error_type), allocatable, intent(out) :: error
+      class(step_watch), intent(inout), optional, target :: watch
       type(brake_orbit) :: reached
       type(halving_walk) :: walk
 
@@ -708,7 +761,7 @@ contains
       do while (.not. walk%done)
          result = brake_orbit()
          call continue_orbit(continuation_config(config, walk%trial), reached%limit, reached%orbit%point, settings, &
-            & result, error)
+            & result, error, watch)
          if (allocated(error)) return
          if (result%orbit%found) reached = result
          call walk%record(result%orbit%found)
@@ -718,7 +771,7 @@ contains
    !> A run at the point: x at its slip onsets after `transient` (at most
    !> max_section_points, the last ones) and, with `fresh`, the orbit through
    !> the first of them.  A run that fails (the pad lifts off) gives none.
-   subroutine attractor_onsets(point, transient, onsets, orbit, fresh, error, settings)
+   subroutine attractor_onsets(point, transient, onsets, orbit, fresh, error, settings, watch)
       type(brake_config), intent(in) :: point
       real(wp), intent(in) :: transient
       real(wp), allocatable, intent(out) :: onsets(:)
@@ -726,6 +779,7 @@ contains
       logical, intent(in) :: fresh
       type(error_type), allocatable, intent(out) :: error
       type(orbit_settings), intent(in), optional :: settings
+      class(step_watch), intent(inout), optional, target :: watch
       type(brake_run), target :: run
       type(error_type), allocatable :: run_error
       logical, allocatable :: keep(:)
@@ -740,7 +794,7 @@ contains
             return
          end if
          onsets = states(1, max(1, size(times) - max_section_points + 1):)
-         if (fresh) call brake_periodic_orbit(point, run%events, transient, settings, orbit, error)
+         if (fresh) call brake_periodic_orbit(point, run%events, transient, settings, orbit, error, watch)
          return
       end if
       call simulate_brake(point, run, run_error)
@@ -753,7 +807,7 @@ contains
          onsets = pack(e%state(1, 1:e%n), keep)
          if (size(onsets) > max_section_points) onsets = onsets(size(onsets) - max_section_points + 1:)
       end associate
-      if (fresh) call brake_periodic_orbit(point, run%events, transient, settings, orbit, error)
+      if (fresh) call brake_periodic_orbit(point, run%events, transient, settings, orbit, error, watch)
    end subroutine attractor_onsets
 
    !> Between consecutive points with an orbit: a discontinuity (recorded at
