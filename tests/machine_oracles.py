@@ -23,6 +23,10 @@ oracles computed here:
                        against the program stepping onto every output time at a
                        1000 times tighter tolerance; with the same first step, a
                        grid of half the spacing holds the same values bit for bit
+  analysis-defaults    every diagnostic of &analysis on the machine with its
+                       window and transients left at their defaults runs (the
+                       brake's 100 tau and beyond were refused against the
+                       machine's 100 s run), over the second half of the run
   rate-state-loose     the spring-slider at 0.2 k_c, 3000 s, its slip rate over ten
                        decades, with free steps at rtol 1e-4 ... 1e-9 (atol 1e-3
                        rtol, above the creep's 4e-13 m/s): every run ends in a few
@@ -188,12 +192,12 @@ def bad_input(args):
         ("&machine\n  t_end = 10.0\n/\n&analysis\n  poincare = .true.\n  section = 'w_zero_up'\n  window_start = 2.0\n"
          "  window_end = 2.1\n/\n", 12, "&analysis: window_end = ", "the spectrum of the strobe period needs 16"),
         # A default refused against a value the file set leads with the set value's line (it named only
-        # "(default)", where the file has nothing to change): t_end = 50 ends the run before the default
-        # window_start = 100 and before the default Lyapunov transient of 100.
-        ("&machine\n  t_end = 50.0\n/\n&analysis\n  spectrum = .true.\n/\n", 6,
-         "&machine: t_end, with the default &analysis: window_start = 100.000: ", "leaves 0 output points"),
-        ("&machine\n  t_end = 50.0\n/\n&analysis\n  lyapunov = .true.\n/\n", 6,
-         "&machine: t_end, with the default &analysis: lyapunov_transient = 100.000: ",
+        # "(default)", where the file has nothing to change): t_end = 20 ends the run before the default
+        # window_start = 50 and before the default Lyapunov transient of 50.
+        ("&machine\n  t_end = 20.0\n/\n&analysis\n  spectrum = .true.\n/\n", 6,
+         "&machine: t_end, with the default &analysis: window_start = 50.0000: ", "leaves 0 output points"),
+        ("&machine\n  t_end = 20.0\n/\n&analysis\n  lyapunov = .true.\n/\n", 6,
+         "&machine: t_end, with the default &analysis: lyapunov_transient = 50.0000: ",
          "leaves less than one renormalisation interval before t_end"),
         # Only the switch set: its line is where the check began.
         ("&analysis\n  lyapunov = .true.\n  lyapunov_renormalise = 200.0\n/\n", 7,
@@ -318,10 +322,34 @@ def rate_state_loose(args):
             assert error < 1.5e4 * rtol, error
 
 
+def analysis_defaults(args):
+    # Only the switches set: each diagnostic exits 0 and records the machine's own defaults,
+    # the second half of its default run [0, 100] s (every one but the orbit was refused before).
+    work = Path(args.workdir)
+    for switch, group, names in [("spectrum", "spectrum", ["window_start", "window_end"]),
+                                 ("rosenstein", "lyapunov", ["rosenstein_exponent"]), ("poincare", "poincare", []),
+                                 ("lyapunov", "lyapunov", []),
+                                 ("lyapunov_spectrum", "lyapunov", ["spectrum_transient"]),
+                                 ("orbit", "orbit", ["transient"])]:
+        path = work / f"{switch}.nml"
+        path.write_text(f"&job\n  scene = 'machine'\n/\n&analysis\n  {switch} = .true.\n/\n")
+        with h5py.File(run_program(args, switch, [path.resolve()], {})) as f:
+            assert group in f["machine"], (switch, list(f["machine"]))
+            attrs = dict(f["machine"][group].attrs)
+            print(f"analysis-defaults: {switch}: /machine/{group}, " + ", ".join(f"{n} = {attrs[n]}" for n in names))
+            expected = {"window_start": 50.0, "window_end": 100.0, "spectrum_transient": 50.0, "transient": 50.0}
+            for n in names:
+                if n in expected:
+                    assert float(attrs[n]) == expected[n], (switch, n, attrs[n])
+                else:
+                    assert np.isfinite(attrs[n]), (switch, n, attrs[n])
+
+
 def main():
     return case_main(__doc__, {"lugre-radau": lugre_radau, "rate-state-critical": rate_state_critical,
                                "table-onset": table_onset, "bad-input": bad_input, "gms-saturated": gms_saturated,
-                               "dense-output": dense_output, "rate-state-loose": rate_state_loose})
+                               "dense-output": dense_output, "rate-state-loose": rate_state_loose,
+                               "analysis-defaults": analysis_defaults})
 
 
 if __name__ == "__main__":

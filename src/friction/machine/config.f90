@@ -33,6 +33,12 @@ module friction_machine_config
    type(solver_settings), parameter :: machine_solver_defaults = solver_settings(method='rodas4', &
       & rtol=1.0e-9_wp, atol=1.0e-12_wp, h_start=0.0_wp, h_min=0.0_wp, max_steps=100000000_i8, max_wall_time=0.0_wp)
 
+   !> The analysis in the machine's own run: its default run is 100 s (the brake's
+   !> window and transients, 100 τ and beyond, would leave it nothing), so the window
+   !> and the transients default to its second half.
+   type(analysis_settings), parameter :: machine_analysis_defaults = analysis_settings(window_start=50.0_wp, &
+      & window_end=100.0_wp, lyapunov_transient=50.0_wp, lyapunov_spectrum_transient=50.0_wp, orbit_transient=50.0_wp)
+
    type, extends(configurable) :: machine_config
       real(wp) :: mass = 1.0_wp              !! m, kg
       real(wp) :: stiffness = 2.0_wp         !! k, N/m
@@ -54,7 +60,7 @@ module friction_machine_config
       logical :: dense_output = .true.
       type(law_settings) :: law
       type(solver_settings) :: solver = machine_solver_defaults
-      type(analysis_settings) :: analysis   !! &analysis: the spectrum and the Lyapunov exponent
+      type(analysis_settings) :: analysis = machine_analysis_defaults  !! &analysis: the spectrum and the Lyapunov exponent
    contains
       procedure :: visit
       procedure :: validate
