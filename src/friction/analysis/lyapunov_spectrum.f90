@@ -18,6 +18,7 @@ module friction_analysis_lyapunov_spectrum
    use friction_error, only: error_type, fatal_error, error_input
    use friction_ode_system, only: ode_system
    use friction_ode_events, only: event_system
+   use friction_ode_forwarding, only: forwarding_system
    use friction_ode_solver, only: ode_solver, solver_settings
    implicit none
    private
@@ -25,13 +26,12 @@ module friction_analysis_lyapunov_spectrum
    public :: tangent_system, tangent_settings, spectrum_accumulator, tangent_spectrum, kaplan_yorke
    public :: orthonormalise, pack_tangent, unpack_tangent, generic_frame, tangent_field
 
-   !> The orbit and its tangent matrix as one system (events: those of the base).
-   type, extends(event_system) :: tangent_system
-      class(ode_system), allocatable :: base
+   !> The orbit and its tangent matrix as one system (events: those of the
+   !> base; its relative component the base's, whose components come first).
+   type, extends(forwarding_system) :: tangent_system
    contains
       procedure :: dimension => tangent_dimension
       procedure :: controlled_dimension => tangent_controlled_dimension
-      procedure :: relative_component => tangent_relative_component
       procedure :: rhs => tangent_rhs
       procedure :: jacobian => tangent_jacobian
       procedure :: event_count => tangent_event_count
@@ -81,15 +81,6 @@ contains
 
       n = self%base%dimension()
    end function tangent_controlled_dimension
-
-   !> The base's (its components come first).
-   pure subroutine tangent_relative_component(self, index, reference, floor)
-      class(tangent_system), intent(in) :: self
-      integer, intent(out) :: index
-      real(wp), intent(out) :: reference, floor
-
-      call self%base%relative_component(index, reference, floor)
-   end subroutine tangent_relative_component
 
    !> (f(y), J(y) Φ), Φ by columns.
    pure subroutine tangent_rhs(self, t, y, dydt)

@@ -24,6 +24,7 @@ module friction_analysis_magnus_section
    use friction_ode_system, only: ode_system
    use friction_ode_solver, only: solver_settings, ode_solver
    use friction_ode_events, only: event_system, event_locator, event_rising, event_falling, event_either
+   use friction_ode_forwarding, only: forwarding_system
    use friction_ode_watch, only: step_watch
    use friction_analysis_lyapunov_spectrum, only: generic_frame
    use friction_analysis_tangent_magnus, only: magnus_tangent_step
@@ -39,9 +40,10 @@ module friction_analysis_magnus_section
    !> The flow with its section y_k = c as event 1 (none when forced) and,
    !> when the flow is an event system, its events after it: the kinks of its
    !> Jacobian, where a step of the tangent must end; the section's rearming
-   !> level y_k = r the last, when it rearms.
-   type, extends(event_system) :: plane_system
-      class(ode_system), allocatable :: base
+   !> level y_k = r the last, when it rearms.  The locator steps it with no
+   !> relative component, as it always has (the base's, which the hyperplane
+   !> map keeps, would change this map's steps: not measured here).
+   type, extends(forwarding_system) :: plane_system
       integer :: coordinate = 1
       real(wp) :: level = 0.0_wp
       logical :: forced = .false.
@@ -49,9 +51,7 @@ module friction_analysis_magnus_section
       logical :: rearms = .false.
       real(wp) :: rearm_level = 0.0_wp
    contains
-      procedure :: dimension => plane_dimension
-      procedure :: rhs => plane_rhs
-      procedure :: jacobian => plane_jacobian
+      procedure :: relative_component => plane_relative_component
       procedure :: event_count => plane_event_count
       procedure :: event_values => plane_event_values
    end type plane_system
@@ -85,30 +85,15 @@ module friction_analysis_magnus_section
 
 contains
 
-   pure integer function plane_dimension(self)
+   pure subroutine plane_relative_component(self, index, reference, floor)
       class(plane_system), intent(in) :: self
+      integer, intent(out) :: index
+      real(wp), intent(out) :: reference, floor
 
-      plane_dimension = self%base%dimension()
-   end function plane_dimension
-
-   pure subroutine plane_rhs(self, t, y, dydt)
-      class(plane_system), intent(in) :: self
-      real(wp), intent(in) :: t
-      real(wp), intent(in), contiguous :: y(:)
-      real(wp), intent(out), contiguous :: dydt(:)
-
-      call self%base%rhs(t, y, dydt)
-   end subroutine plane_rhs
-
-   pure subroutine plane_jacobian(self, t, y, dfdy, dfdt)
-      class(plane_system), intent(in) :: self
-      real(wp), intent(in) :: t
-      real(wp), intent(in) :: y(:)
-      real(wp), intent(out) :: dfdy(:, :)
-      real(wp), intent(out) :: dfdt(:)
-
-      call self%base%jacobian(t, y, dfdy, dfdt)
-   end subroutine plane_jacobian
+      index = 0
+      reference = 0.0_wp
+      floor = 0.0_wp
+   end subroutine plane_relative_component
 
    pure integer function plane_event_count(self)
       class(plane_system), intent(in) :: self

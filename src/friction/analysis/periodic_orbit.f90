@@ -22,7 +22,8 @@ module friction_analysis_periodic_orbit
    use friction_kinds, only: wp
    use friction_error, only: error_type, fatal_error, error_input
    use friction_ode_system, only: ode_system
-   use friction_ode_events, only: event_system, event_locator, event_rising, event_falling, event_either
+   use friction_ode_events, only: event_locator, event_rising, event_falling, event_either
+   use friction_ode_forwarding, only: forwarding_system
    use friction_ode_solver, only: solver_settings, ode_solver
    use friction_ode_watch, only: step_watch
    use friction_analysis_lyapunov_spectrum, only: tangent_system, pack_tangent, unpack_tangent
@@ -117,9 +118,12 @@ module friction_analysis_periodic_orbit
 
    !> A smooth system with the hyperplane y_k = c as its event, the
    !> hyperplanes y_j = c_j where its field has a kink (events 2, 3, ...) and
-   !> the section's rearming level (the last, when rearms).
-   type, extends(event_system) :: hyperplane_system
-      class(ode_system), allocatable :: base
+   !> the section's rearming level (the last, when rearms).  Otherwise the
+   !> base, its relative component included: a creeping slip rate's error is
+   !> held relative to itself in the map as in the run (without it rodas4
+   !> crawled through the rate-and-state creep in millions of steps, its
+   !> stages carrying v_rel across 0 within an atol above it).
+   type, extends(forwarding_system) :: hyperplane_system
       integer :: coordinate = 1
       real(wp) :: level = 0.0_wp
       integer, allocatable :: kink_coordinate(:)
@@ -127,10 +131,6 @@ module friction_analysis_periodic_orbit
       logical :: rearms = .false.
       real(wp) :: rearm_level = 0.0_wp
    contains
-      procedure :: dimension => hyperplane_dimension
-      procedure :: rhs => hyperplane_rhs
-      procedure :: jacobian => hyperplane_jacobian
-      procedure :: relative_component => hyperplane_relative_component
       procedure :: event_count => hyperplane_event_count
       procedure :: event_values => hyperplane_event_values
    end type hyperplane_system
@@ -606,43 +606,6 @@ contains
          end if
       end do
    end function floquet_exponents
-
-   pure function hyperplane_dimension(self) result(n)
-      class(hyperplane_system), intent(in) :: self
-      integer :: n
-
-      n = self%base%dimension()
-   end function hyperplane_dimension
-
-   pure subroutine hyperplane_rhs(self, t, y, dydt)
-      class(hyperplane_system), intent(in) :: self
-      real(wp), intent(in) :: t
-      real(wp), intent(in), contiguous :: y(:)
-      real(wp), intent(out), contiguous :: dydt(:)
-
-      call self%base%rhs(t, y, dydt)
-   end subroutine hyperplane_rhs
-
-   pure subroutine hyperplane_jacobian(self, t, y, dfdy, dfdt)
-      class(hyperplane_system), intent(in) :: self
-      real(wp), intent(in) :: t
-      real(wp), intent(in) :: y(:)
-      real(wp), intent(out) :: dfdy(:, :)
-      real(wp), intent(out) :: dfdt(:)
-
-      call self%base%jacobian(t, y, dfdy, dfdt)
-   end subroutine hyperplane_jacobian
-
-   !> The base's: a creeping slip rate's error held relative to itself in the
-   !> map as in the run (without it rodas4 crawled through the rate-and-state
-   !> creep in millions of steps, its stages carrying v_rel across 0 within an atol above it).
-   pure subroutine hyperplane_relative_component(self, index, reference, floor)
-      class(hyperplane_system), intent(in) :: self
-      integer, intent(out) :: index
-      real(wp), intent(out) :: reference, floor
-
-      call self%base%relative_component(index, reference, floor)
-   end subroutine hyperplane_relative_component
 
    pure function hyperplane_event_count(self) result(m)
       class(hyperplane_system), intent(in) :: self

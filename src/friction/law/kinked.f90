@@ -5,8 +5,8 @@
 !> brake alike.
 module friction_law_kinked
    use friction_kinds, only: wp
-   use friction_ode_system, only: ode_system
    use friction_ode_events, only: event_system
+   use friction_ode_forwarding, only: forwarding_system
    use friction_law, only: sliding_law, max_law_states
    implicit none
    private
@@ -38,59 +38,14 @@ module friction_law_kinked
    !> A flow of the mechanism (`model` itself, or in another frame, with the
    !> divergence appended, ...: its leading components those of `model`) with
    !> the kinks of model's law's partial derivatives as its events.
-   type, extends(event_system) :: kinked_system
-      class(ode_system), allocatable :: base
+   type, extends(forwarding_system) :: kinked_system
       class(law_flow), allocatable :: model
    contains
-      procedure :: dimension => kinked_dimension
-      procedure :: controlled_dimension => kinked_controlled_dimension
-      procedure :: relative_component => kinked_relative_component
-      procedure :: rhs => kinked_rhs
-      procedure :: jacobian => kinked_jacobian
       procedure :: event_count => kinked_event_count
       procedure :: event_values => kinked_event_values
    end type kinked_system
 
 contains
-
-   pure integer function kinked_dimension(self)
-      class(kinked_system), intent(in) :: self
-
-      kinked_dimension = self%base%dimension()
-   end function kinked_dimension
-
-   pure integer function kinked_controlled_dimension(self)
-      class(kinked_system), intent(in) :: self
-
-      kinked_controlled_dimension = self%base%controlled_dimension()
-   end function kinked_controlled_dimension
-
-   pure subroutine kinked_relative_component(self, index, reference, floor)
-      class(kinked_system), intent(in) :: self
-      integer, intent(out) :: index
-      real(wp), intent(out) :: reference, floor
-
-      call self%base%relative_component(index, reference, floor)
-   end subroutine kinked_relative_component
-
-   pure subroutine kinked_rhs(self, t, y, dydt)
-      class(kinked_system), intent(in) :: self
-      real(wp), intent(in) :: t
-      real(wp), intent(in), contiguous :: y(:)
-      real(wp), intent(out), contiguous :: dydt(:)
-
-      call self%base%rhs(t, y, dydt)
-   end subroutine kinked_rhs
-
-   pure subroutine kinked_jacobian(self, t, y, dfdy, dfdt)
-      class(kinked_system), intent(in) :: self
-      real(wp), intent(in) :: t
-      real(wp), intent(in) :: y(:)
-      real(wp), intent(out) :: dfdy(:, :)
-      real(wp), intent(out) :: dfdt(:)
-
-      call self%base%jacobian(t, y, dfdy, dfdt)
-   end subroutine kinked_jacobian
 
    pure integer function kinked_event_count(self)
       class(kinked_system), intent(in) :: self
