@@ -622,7 +622,8 @@ contains
          hint = ' (max_steps reached; raise max_steps, loosen the tolerance or try an implicit method)'
       case (-1) ! GSL_FAILURE: the stepper failed at every step size GSL tried, down to t's spacing
          hint = ' (the stepper failed at every step size down to the spacing of t; for rodas3 and rodas4' &
-            & //' that means a result that is not finite: the equations overflow or divide by zero there)'
+            & //' that means a right-hand side or a result that is NaN or Inf at every step: the equations' &
+            & //' overflow or divide by zero there)'
       case (27) ! GSL_ENOPROG
          hint = ' (step size fell below h_min; the problem may be stiff: try an implicit method)'
       case default
