@@ -21,24 +21,11 @@ from pathlib import Path
 from machine_cases import case_main
 from machine_guard import MARGIN, catches_sigterm, finished
 
-SLOW_NML = """&job
-  scene = 'brake'
-/
-&brake
-  model = 'law'
-  units = 'dimensional'
-  dt_out = 0.05
-  stick_velocity = 1.0e-6
+from brake_law_oracles import CREEP_NML
+
+# The creep case's input, run to 300 tau, with only the orbit's search on (an override file).
+SLOW_NML = """&brake
   t_end = 300.0
-/
-&brake_dimensional
-  v_dr_si = -0.002
-/
-&law
-  model = 'rate_state'
-/
-&integrator
-  method = 'rodas4'
 /
 &analysis
   spectrum = .false.
@@ -54,9 +41,11 @@ SLOW_NML = """&job
 
 
 def command(args, out, extra):
+    creep = Path(args.workdir) / "creep.nml"
+    creep.write_text(CREEP_NML)
     path = Path(args.workdir) / "slow_orbit.nml"
     path.write_text(SLOW_NML)
-    return [args.binary, "-o", str(out), str(path)] + extra
+    return [args.binary, "-o", str(out), str(creep), str(path)] + extra
 
 
 def run_alone(args):
